@@ -1,0 +1,77 @@
+// A thin RAII layer over the HDF5 C API: just what the superelement file needs. Matrices are
+// stored in C (row-major) order with shape (rows, cols), so h5py and h5dump show them as written.
+#pragma once
+
+#include <hdf5.h>
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+namespace femb::h5 {
+
+/// An open HDF5 object handle (file or group), closed on destruction.
+class Handle {
+ public:
+  Handle() = default;
+  Handle(hid_t id, herr_t (*closer)(hid_t)) : id_(id), closer_(closer) {}
+  Handle(const Handle&) = delete;
+  Handle& operator=(const Handle&) = delete;
+  Handle(Handle&& o) noexcept : id_(o.id_), closer_(o.closer_) { o.id_ = -1; }
+  Handle& operator=(Handle&& o) noexcept;
+  ~Handle();
+  hid_t id() const { return id_; }
+
+ private:
+  hid_t id_ = -1;
+  herr_t (*closer_)(hid_t) = nullptr;
+};
+
+/// Writes datasets and attributes below one location of a file being created at `path`.
+/// Every failure throws femb::InputError naming the file and the object.
+class Writer {
+ public:
+  /// Creates (truncates) the file `path`.
+  explicit Writer(const std::string& path);
+  void CreateGroup(const std::string& group);
+  void Matrix(const std::string& name, const Eigen::MatrixXd& value);
+  void Vector(const std::string& name, const Eigen::VectorXd& value);
+  void IntMatrix(const std::string& name, const Eigen::MatrixXi& value);
+  void Scalar(const std::string& name, double value);
+  void Strings(const std::string& name, const std::vector<std::string>& value);
+  /// Attributes on an existing object ("/" for the root).
+  void Attribute(const std::string& object, const std::string& name, const std::string& value);
+  void Attribute(const std::string& object, const std::string& name, long value);
+  void Close();
+
+ private:
+  void WriteDoubles(const std::string& name, const std::vector<hsize_t>& shape, const double* data);
+  std::string path_;
+  Handle file_;
+};
+
+/// Reads datasets and attributes of an existing file. Every failure (no file, not HDF5,
+/// truncated, missing object, wrong shape) throws femb::InputError naming the file and object.
+class Reader {
+ public:
+  explicit Reader(const std::string& path);
+  bool Exists(const std::string& name) const;
+  Eigen::MatrixXd Matrix(const std::string& name) const;
+  Eigen::VectorXd Vector(const std::string& name) const;
+  Eigen::MatrixXi IntMatrix(const std::string& name) const;
+  double Scalar(const std::string& name) const;
+  std::vector<std::string> Strings(const std::string& name) const;
+  std::string StringAttribute(const std::string& object, const std::string& name) const;
+  long IntAttribute(const std::string& object, const std::string& name) const;
+  /// Shape of a dataset (empty for a scalar).
+  std::vector<hsize_t> Shape(const std::string& name) const;
+  const std::string& path() const { return path_; }
+
+ private:
+  std::vector<double> ReadDoubles(const std::string& name, std::vector<hsize_t>* shape) const;
+  [[noreturn]] void Fail(const std::string& what) const;
+  std::string path_;
+  Handle file_;
+};
+
+}  // namespace femb::h5

@@ -1,0 +1,219 @@
+#include "formats/part_file.h"
+
+#include <cstdio>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+#include "formats/input_error.h"
+#include "formats/yaml_reader.h"
+
+namespace femb {
+namespace {
+
+std::string Fnv1a64(const std::string& text) {
+  unsigned long long h = 1469598103934665603ull;
+  for (unsigned char c : text) {
+    h ^= c;
+    h *= 1099511628211ull;
+  }
+  char buffer[17];
+  std::snprintf(buffer, sizeof buffer, "%016llx", h);
+  return buffer;
+}
+
+MaterialSpec ParseMaterial(const YamlValue& value) {
+  YamlMap m = value.Map();
+  MaterialSpec material;
+  material.E = m.Required("E").PositiveNumber();
+  YamlValue nu = m.Required("nu");
+  material.nu = nu.Number();
+  if (!(material.nu > -1.0 && material.nu < 0.5)) {
+    nu.Fail("Poisson's ratio must be in (-1, 0.5), got " + std::to_string(material.nu));
+  }
+  material.rho = m.Required("rho").PositiveNumber();
+  m.CheckNoUnknownKeys();
+  return material;
+}
+
+BeamSectionSpec ParseSection(const YamlValue& value) {
+  YamlMap m = value.Map();
+  BeamSectionSpec s;
+  s.where = value.Where();
+  YamlValue shape = m.Required("shape");
+  s.shape = shape.String();
+  if (s.shape == "circle") {
+    s.diameter = m.Required("diameter").PositiveNumber();
+  } else if (s.shape == "tube") {
+    s.outer_radius = m.Required("outer_radius").PositiveNumber();
+    YamlValue wall = m.Required("wall");
+    s.wall = wall.PositiveNumber();
+    if (s.wall > s.outer_radius) {
+      wall.Fail("tube wall " + std::to_string(s.wall) + " is thicker than the outer radius " +
+                std::to_string(s.outer_radius));
+    }
+  } else if (s.shape == "rectangle") {
+    s.width = m.Required("width").PositiveNumber();
+    s.height = m.Required("height").PositiveNumber();
+  } else if (s.shape == "general") {
+    s.A = m.Required("A").PositiveNumber();
+    s.Iy = m.Required("Iy").PositiveNumber();
+    s.Iz = m.Required("Iz").PositiveNumber();
+    s.J = m.Required("J").PositiveNumber();
+    if (auto v = m.Optional("Ip")) s.Ip = v->PositiveNumber();
+  } else {
+    shape.Fail("unknown section shape '" + s.shape + "' (known: circle, tube, rectangle, general)");
+  }
+  // Shear factors override the shape's own (Cowper) values; a general section without them
+  // is rigid in shear.
+  if (auto v = m.Optional("ky")) s.ky = v->PositiveNumber();
+  if (auto v = m.Optional("kz")) s.kz = v->PositiveNumber();
+  m.CheckNoUnknownKeys();
+  return s;
+}
+
+void ParseBeam(const YamlValue& value, PartSpec& part) {
+  YamlMap m = value.Map();
+  BeamSpec& beam = part.beam;
+  std::map<std::string, int> index;
+  YamlValue points = m.Required("points");
+  for (const auto& [name, coords] : points.Map().Entries()) {
+    index[name] = int(beam.points.size());
+    beam.point_names.push_back(name);
+    beam.points.push_back(coords.Vector3());
+  }
+  if (beam.points.size() < 2) points.Fail("a beam needs at least 2 points");
+  YamlValue segments = m.Required("segments");
+  for (const YamlValue& item : segments.List()) {
+    YamlMap s = item.Map();
+    BeamSegmentSpec seg;
+    seg.where = item.Where();
+    for (auto [key, target] : {std::pair{"from", &seg.from}, std::pair{"to", &seg.to}}) {
+      YamlValue v = s.Required(key);
+      auto it = index.find(v.String());
+      if (it == index.end()) v.Fail("point '" + v.String() + "' is not defined in beam.points");
+      *target = it->second;
+    }
+    YamlValue elements = s.Required("elements");
+    seg.elements = int(elements.Integer());
+    if (seg.elements < 1) elements.Fail("a segment needs at least 1 element, got " + std::to_string(seg.elements));
+    if ((beam.points[seg.to] - beam.points[seg.from]).norm() == 0.0) {
+      item.Fail("zero-length element: points '" + beam.point_names[seg.from] + "' and '" +
+                beam.point_names[seg.to] + "' coincide");
+    }
+    if (auto sec = s.Optional("section")) seg.section = ParseSection(*sec);
+    s.CheckNoUnknownKeys();
+    beam.segments.push_back(seg);
+  }
+  if (beam.segments.empty()) segments.Fail("a beam needs at least one segment");
+  if (auto v = m.Optional("orientation")) {
+    Eigen::Vector3d o = v->Vector3();
+    if (o.norm() == 0.0) v->Fail("orientation vector must not be zero");
+    beam.orientation = o;
+  }
+  if (auto v = m.Optional("theory")) {
+    std::string theory = v->String();
+    if (theory == "timoshenko") beam.shear_deformation = true;
+    else if (theory == "euler_bernoulli") beam.shear_deformation = false;
+    else v->Fail("unknown beam theory '" + theory + "' (known: timoshenko, euler_bernoulli)");
+  }
+  m.CheckNoUnknownKeys();
+}
+
+}  // namespace
+
+Units UnitSystem(const std::string& name, const std::string& where) {
+  Units u;
+  u.system = name;
+  if (name == "SI") return u;
+  if (name == "mm-t-s") {
+    u.length = "mm"; u.mass = "t"; u.time = "s"; u.force = "N"; u.stress = "MPa";
+    return u;
+  }
+  if (name == "mm-kg-ms") {
+    u.length = "mm"; u.mass = "kg"; u.time = "ms"; u.force = "kN"; u.stress = "GPa";
+    return u;
+  }
+  throw InputError(where + ": unknown unit system '" + name + "' (known: SI, mm-t-s, mm-kg-ms)");
+}
+
+PartSpec ParsePart(const std::string& text, const std::string& name,
+                   const std::vector<std::string>& overrides) {
+  YamlDocument doc = YamlDocument::LoadString(text, name);
+  std::string effective = text;
+  for (const auto& o : overrides) {
+    doc.Set(o);
+    effective += "\n#--set " + o;
+  }
+  YamlMap root = doc.Root();
+  PartSpec part;
+  part.file = name;
+  part.text_hash = Fnv1a64(effective);
+  part.name = root.Required("name").String();
+  YamlValue type = root.Required("type");
+  part.type = type.String();
+  if (part.type != "beam") type.Fail("unknown part type '" + part.type + "' (known: beam)");
+  if (auto u = root.Optional("units")) part.units = UnitSystem(u->String(), u->Where());
+  part.material = ParseMaterial(root.Required("material"));
+  part.beam.section = ParseSection(root.Required("section"));
+  ParseBeam(root.Required("beam"), part);
+
+  auto interfaces = root.Optional("interfaces");
+  if (!interfaces || interfaces->List().empty()) {
+    throw InputError(name + ": no interface defined: list at least one under 'interfaces' "
+                     "(a superelement couples to the world only through interface nodes)");
+  }
+  for (const YamlValue& item : interfaces->List()) {
+    YamlMap m = item.Map();
+    InterfaceSpec spec;
+    spec.where = item.Where();
+    spec.name = m.Required("name").String();
+    YamlValue point = m.Optional("point").value_or(m.Required("name"));
+    const std::string point_name = point.String();
+    for (size_t i = 0; i < part.beam.point_names.size(); ++i) {
+      if (part.beam.point_names[i] == point_name) spec.point = int(i);
+    }
+    if (spec.point < 0) point.Fail("interface point '" + point_name + "' not found in beam.points");
+    for (const auto& other : part.interfaces) {
+      if (other.name == spec.name) item.Fail("interface name '" + spec.name + "' used twice");
+      if (other.point == spec.point) item.Fail("point '" + point_name + "' is already interface '" + other.name + "'");
+    }
+    m.CheckNoUnknownKeys();
+    part.interfaces.push_back(spec);
+  }
+
+  if (auto r = root.Optional("reduction")) {
+    YamlMap m = r->Map();
+    if (auto v = m.Optional("internal_modes")) part.reduction.internal_modes = int(v->NonNegativeInteger());
+    if (auto v = m.Optional("floating_frame")) {
+      part.reduction.floating_frame = v->String();
+      part.reduction.where_floating_frame = v->Where();
+      const std::string& f = part.reduction.floating_frame;
+      if (f.rfind("interface:", 0) == 0) {
+        const std::string iname = f.substr(10);
+        bool found = false;
+        for (const auto& i : part.interfaces) found |= (i.name == iname);
+        if (!found) v->Fail("floating frame interface '" + iname + "' is not one of the part's interfaces");
+      } else if (f != "center_of_mass" && f != "mean_axes" && f != "cardona") {
+        v->Fail("unknown floating frame '" + f +
+                "' (known: center_of_mass, mean_axes, interface:<name>, cardona)");
+      }
+    }
+    if (auto v = m.Optional("keep_mesh")) part.reduction.keep_mesh = v->Bool();
+    if (auto v = m.Optional("full_modes")) part.reduction.full_modes = int(v->NonNegativeInteger());
+    m.CheckNoUnknownKeys();
+  }
+  if (part.reduction.where_floating_frame.empty()) part.reduction.where_floating_frame = name;
+  root.CheckNoUnknownKeys();
+  return part;
+}
+
+PartSpec ReadPartFile(const std::string& path, const std::vector<std::string>& overrides) {
+  std::ifstream in(path);
+  if (!in) throw InputError(path + ": cannot open part file (does it exist and is it readable?)");
+  std::stringstream text;
+  text << in.rdbuf();
+  return ParsePart(text.str(), path, overrides);
+}
+
+}  // namespace femb

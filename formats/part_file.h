@@ -1,0 +1,86 @@
+// The part file (YAML): what femb-reduce reads. Parsing checks every value it can check without
+// numerics (ranges, names, geometry of points) and names FILE:LINE: key on failure.
+// The format is documented in formats/PART_FORMAT.md.
+#pragma once
+
+#include <Eigen/Core>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "formats/superelement.h"
+
+namespace femb {
+
+/// Isotropic linear elastic material. E, rho > 0; -1 < nu < 0.5.
+struct MaterialSpec {
+  double E = 0.0;    ///< Young's modulus [stress]
+  double nu = 0.0;   ///< Poisson's ratio [-]
+  double rho = 0.0;  ///< density [mass / length^3]
+};
+
+/// A beam cross-section: a named shape with its dimensions, or explicit properties.
+struct BeamSectionSpec {
+  std::string shape;  ///< "circle", "tube", "rectangle" or "general"
+  // circle: diameter; tube: outer_radius + wall; rectangle: width (local y) + height (local z).
+  double diameter = 0.0, outer_radius = 0.0, wall = 0.0, width = 0.0, height = 0.0;
+  // general: A, Iy = int z^2 dA, Iz = int y^2 dA, J (torsion constant); shear factors ky, kz
+  // (shear area = k A; 0 = rigid in shear); Ip polar moment for rotary inertia (default Iy + Iz).
+  double A = 0.0, Iy = 0.0, Iz = 0.0, J = 0.0, ky = 0.0, kz = 0.0, Ip = 0.0;
+  std::string where;  ///< location for error messages
+};
+
+struct BeamSegmentSpec {
+  int from = 0, to = 0;  ///< indices into BeamSpec::points
+  int elements = 1;
+  std::optional<BeamSectionSpec> section;  ///< overrides the part's section
+  std::string where;
+};
+
+struct BeamSpec {
+  std::vector<std::string> point_names;
+  std::vector<Eigen::Vector3d> points;
+  std::vector<BeamSegmentSpec> segments;
+  std::optional<Eigen::Vector3d> orientation;  ///< a vector in the local x-y plane
+  bool shear_deformation = true;                ///< false: Euler-Bernoulli
+  BeamSectionSpec section;
+};
+
+struct InterfaceSpec {
+  std::string name;
+  int point = -1;  ///< index into BeamSpec::points (beam parts)
+  std::string where;
+};
+
+struct ReductionSpec {
+  int internal_modes = 10;
+  std::string floating_frame = "center_of_mass";
+  bool keep_mesh = true;  ///< store the mesh and mode shapes (visualization group)
+  int full_modes = 0;     ///< K lowest nonzero free-free frequencies of the full model
+  std::string where_floating_frame;
+};
+
+struct PartSpec {
+  std::string file;
+  std::string text_hash;  ///< FNV-1a 64-bit of the file text (after --set), hex
+  std::string name;
+  std::string type;       ///< "beam"
+  Units units;
+  MaterialSpec material;
+  BeamSpec beam;
+  std::vector<InterfaceSpec> interfaces;
+  ReductionSpec reduction;
+};
+
+/// Reads and checks a part file; `overrides` are "key.path=value" strings applied first.
+/// Throws InputError naming FILE:LINE and the key for any problem.
+PartSpec ReadPartFile(const std::string& path, const std::vector<std::string>& overrides = {});
+
+/// Same, from text (`name` is used in messages).
+PartSpec ParsePart(const std::string& text, const std::string& name,
+                   const std::vector<std::string>& overrides = {});
+
+/// The named consistent unit systems: "SI", "mm-t-s", "mm-kg-ms". Throws InputError otherwise.
+Units UnitSystem(const std::string& name, const std::string& where);
+
+}  // namespace femb

@@ -1,0 +1,68 @@
+#include "formats/superelement.h"
+
+#include <cstdio>
+
+namespace femb {
+
+std::string ReducedCoordinateLabel(const Superelement& se, int i) {
+  static const char* kComponents[6] = {"u_x", "u_y", "u_z", "theta_x", "theta_y", "theta_z"};
+  if (i < se.n_interface_dofs()) {
+    return se.interfaces[i / 6].name + "." + kComponents[i % 6];
+  }
+  int mode = i - se.n_interface_dofs();
+  char buffer[64];
+  std::snprintf(buffer, sizeof buffer, "mode %d (%.6g Hz)", mode + 1,
+                se.internal_frequencies_hz[mode]);
+  return buffer;
+}
+
+Eigen::MatrixXd RigidBodyModes(const Superelement& se, const Eigen::Vector3d& origin) {
+  Eigen::MatrixXd Phi_rig0 = Eigen::MatrixXd::Zero(se.n_reduced_dofs(), 6);
+  for (int k = 0; k < se.n_interface_nodes(); ++k) {
+    // thesis (3.12): [1, -x~; 0, 1] with x the node position relative to the frame origin.
+    const Eigen::Vector3d x = se.interfaces[k].position - origin;
+    auto block = Phi_rig0.block(6 * k, 0, 6, 6);
+    block.setIdentity();
+    block(0, 4) = x.z();
+    block(0, 5) = -x.y();
+    block(1, 3) = -x.z();
+    block(1, 5) = x.x();
+    block(2, 3) = x.y();
+    block(2, 4) = -x.x();
+  }
+  return Phi_rig0;
+}
+
+}  // namespace femb
+
+namespace femb {
+
+Eigen::Matrix<double, 6, 6> RigidBodyMassMatrix(const Superelement& se, const Eigen::Vector3d& origin) {
+  const Eigen::MatrixXd Phi_rig0 = RigidBodyModes(se, origin);
+  Eigen::Matrix<double, 6, 6> M_rig = Phi_rig0.transpose() * se.M * Phi_rig0;
+  return 0.5 * (M_rig + M_rig.transpose());
+}
+
+MassProperties ComputeMassProperties(const Superelement& se) {
+  const Eigen::Matrix<double, 6, 6> M0 = RigidBodyMassMatrix(se, Eigen::Vector3d::Zero());
+  MassProperties p;
+  p.mass = M0.block<3, 3>(0, 0).trace() / 3.0;
+  // Lower-left block is m c~ (skew): read c from its antisymmetric part.
+  const Eigen::Matrix3d mc = M0.block<3, 3>(3, 0);
+  const Eigen::Vector3d c = Eigen::Vector3d(mc(2, 1) - mc(1, 2), mc(0, 2) - mc(2, 0), mc(1, 0) - mc(0, 1)) /
+                            (2.0 * p.mass);
+  p.center_of_mass = c;
+  // Parallel axis theorem: J_0 = J_c + m (|c|^2 1 - c c^T).
+  p.inertia_com = M0.block<3, 3>(3, 3) -
+                  p.mass * (c.squaredNorm() * Eigen::Matrix3d::Identity() - c * c.transpose());
+  return p;
+}
+
+}  // namespace femb
+
+#include <cmath>
+namespace femb {
+double FrequencyHz(double lambda) {
+  return std::copysign(std::sqrt(std::abs(lambda)), lambda) / (2.0 * M_PI);
+}
+}  // namespace femb

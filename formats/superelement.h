@@ -1,0 +1,119 @@
+// The superelement: the only contract between femb-reduce and femb-solve (and femb-inspect).
+// Written and read by superelement_file.h; the on-disk schema is in SUPERELEMENT_FORMAT.md.
+#pragma once
+
+#include <Eigen/Core>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace femb {
+
+/// Unit system of every number in a part and its superelement. Consistent systems only:
+/// force = mass * length / time^2, stress = force / length^2.
+struct Units {
+  std::string system = "SI";  ///< "SI" (m, kg, s), "mm-t-s" (mm, t, s) or "mm-kg-ms" (mm, kg, ms)
+  std::string length = "m";
+  std::string mass = "kg";
+  std::string time = "s";
+  std::string force = "N";
+  std::string stress = "Pa";
+  std::string angle = "rad";
+};
+
+/// One 6-DOF interface node: position in part axes [length]; orientation maps node axes to part
+/// axes. Its reduced coordinates are (u_x, u_y, u_z, theta_x, theta_y, theta_z) in part axes.
+struct InterfaceNode {
+  std::string name;
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d orientation = Eigen::Matrix3d::Identity();
+};
+
+/// The floating frame: the point whose elastic deformation is zero, thesis (3.7):
+/// Phi_CB * q = 0, with Phi_CB (6 x n_reduced) and Phi_CB * Phi_rig0 = 1, Phi_rig0 built from
+/// the interface positions relative to `origin` (thesis 3.20).
+struct FloatingFrame {
+  std::string type;  ///< center_of_mass | mean_axes | interface:<name> | cardona
+  Eigen::Vector3d origin = Eigen::Vector3d::Zero();            ///< undeformed, part axes [length]
+  Eigen::Matrix3d orientation = Eigen::Matrix3d::Identity();   ///< frame axes in part axes
+  Eigen::MatrixXd Phi_CB;                                      ///< 6 x n_reduced
+  Eigen::VectorXd cardona_weights;                             ///< alpha_k (cardona only)
+};
+
+/// Rigid-body mass properties of the undeformed part (from the full FE mass matrix).
+struct MassProperties {
+  double mass = 0.0;                                           ///< [mass]
+  Eigen::Vector3d center_of_mass = Eigen::Vector3d::Zero();    ///< part axes [length]
+  Eigen::Matrix3d inertia_com = Eigen::Matrix3d::Zero();       ///< about the CoM, part axes [mass length^2]
+};
+
+/// Optional: the full mesh and each reduced coordinate's full displacement field, for
+/// visualization and stress recovery.
+struct Visualization {
+  Eigen::MatrixXd nodes;        ///< n_nodes x 3, part axes [length]
+  Eigen::MatrixXi cells;        ///< n_cells x nodes_per_cell, 0-based node indices
+  std::string cell_type;        ///< "line2", "tet4", "tet10", "hex8", "hex20"
+  int dofs_per_node = 6;        ///< 6 (u, theta) for beams, 3 (u) for solids
+  Eigen::MatrixXd shapes;       ///< (n_nodes * dofs_per_node) x n_reduced, node-major
+};
+
+/// Where the file came from and what it cost.
+struct Provenance {
+  std::string femb_version;
+  std::string input_file;
+  std::string input_hash;       ///< FNV-1a 64-bit of the part file text, hex
+  std::string element_type;
+  long n_nodes = 0;
+  long n_elements = 0;
+  std::vector<std::pair<std::string, double>> stage_seconds;
+};
+
+struct Superelement {
+  std::string name;
+  Units units;
+  std::vector<InterfaceNode> interfaces;
+  /// Reduced stiffness and mass, n_reduced x n_reduced, ordered
+  /// [node 1 (u, theta), ..., node N (u, theta), internal mode 1, ..., internal mode m].
+  Eigen::MatrixXd K;
+  Eigen::MatrixXd M;
+  Eigen::VectorXd internal_frequencies_hz;   ///< fixed-interface frequencies of the internal modes
+  FloatingFrame floating_frame;
+  MassProperties mass_properties;
+  long n_full_dofs = 0;
+  Eigen::VectorXd full_free_free_frequencies_hz;  ///< optional (empty when not computed)
+  long n_modal_derivatives = 0;
+  std::optional<Visualization> visualization;
+  Provenance provenance;
+
+  int n_interface_nodes() const { return int(interfaces.size()); }
+  int n_interface_dofs() const { return 6 * n_interface_nodes(); }
+  int n_internal_modes() const { return int(internal_frequencies_hz.size()); }
+  int n_reduced_dofs() const { return int(K.rows()); }
+};
+
+/// Label of reduced coordinate i, e.g. "A.u_x", "B.theta_z", "mode 3 (512.4 Hz)".
+std::string ReducedCoordinateLabel(const Superelement& se, int i);
+
+/// Rigid-body modes of the interface coordinates about `origin` (thesis 3.20):
+/// Phi_rig0 (n_reduced x 6), rows of the internal modes zero.
+Eigen::MatrixXd RigidBodyModes(const Superelement& se, const Eigen::Vector3d& origin);
+
+}  // namespace femb
+
+namespace femb {
+
+/// 6 x 6 rigid-body mass matrix about `origin` in part axes, thesis (3.21):
+/// M_rig = Phi_rig0^T M Phi_rig0 = [m 1, -m c~; m c~, J_origin], c the CoM relative to origin.
+Eigen::Matrix<double, 6, 6> RigidBodyMassMatrix(const Superelement& se, const Eigen::Vector3d& origin);
+
+/// Mass, centre of mass and inertia about the centre of mass from the reduced mass matrix
+/// (exact: the static modes reproduce rigid motions of the full model).
+MassProperties ComputeMassProperties(const Superelement& se);
+
+}  // namespace femb
+
+namespace femb {
+/// Signed frequency in Hz from an eigenvalue omega^2: sign(lambda) sqrt(|lambda|) / (2 pi).
+double FrequencyHz(double lambda);
+}  // namespace femb

@@ -1,0 +1,240 @@
+#include "formats/superelement_file.h"
+
+#include <unistd.h>
+
+#include <cstdio>
+#include <filesystem>
+
+#include "formats/hdf5_file.h"
+#include "formats/input_error.h"
+
+namespace femb {
+namespace {
+
+void WriteContent(const Superelement& se, h5::Writer& w) {
+  w.Attribute("/", "format", kSuperelementFormatTag);
+  w.Attribute("/", "format_version",
+              std::to_string(kSuperelementFormatMajor) + "." + std::to_string(kSuperelementFormatMinor));
+  w.Attribute("/", "format_version_major", kSuperelementFormatMajor);
+  w.Attribute("/", "format_version_minor", kSuperelementFormatMinor);
+  w.Attribute("/", "name", se.name);
+
+  w.CreateGroup("/units");
+  w.Attribute("/units", "system", se.units.system);
+  w.Attribute("/units", "length", se.units.length);
+  w.Attribute("/units", "mass", se.units.mass);
+  w.Attribute("/units", "time", se.units.time);
+  w.Attribute("/units", "force", se.units.force);
+  w.Attribute("/units", "stress", se.units.stress);
+  w.Attribute("/units", "angle", se.units.angle);
+
+  const int N = se.n_interface_nodes();
+  w.CreateGroup("/interfaces");
+  std::vector<std::string> names;
+  Eigen::MatrixXd positions(N, 3), orientations(N, 9);
+  for (int k = 0; k < N; ++k) {
+    names.push_back(se.interfaces[k].name);
+    positions.row(k) = se.interfaces[k].position.transpose();
+    Eigen::Matrix<double, 3, 3, Eigen::RowMajor> R = se.interfaces[k].orientation;
+    orientations.row(k) = Eigen::Map<const Eigen::Matrix<double, 1, 9>>(R.data());
+  }
+  w.Strings("/interfaces/names", names);
+  w.Matrix("/interfaces/positions", positions);
+  w.Matrix("/interfaces/orientations", orientations);
+
+  w.CreateGroup("/reduced");
+  w.Matrix("/reduced/K", se.K);
+  w.Matrix("/reduced/M", se.M);
+  std::vector<std::string> labels;
+  for (int i = 0; i < se.n_reduced_dofs(); ++i) labels.push_back(ReducedCoordinateLabel(se, i));
+  w.Strings("/reduced/labels", labels);
+  w.Attribute("/reduced", "n_interface_dofs", long(se.n_interface_dofs()));
+  w.Attribute("/reduced", "n_internal_modes", long(se.n_internal_modes()));
+  w.Attribute("/reduced", "n_modal_derivatives", se.n_modal_derivatives);
+  w.Vector("/reduced/internal_frequencies_hz", se.internal_frequencies_hz);
+
+  w.CreateGroup("/floating_frame");
+  w.Attribute("/floating_frame", "type", se.floating_frame.type);
+  w.Vector("/floating_frame/origin", se.floating_frame.origin);
+  w.Matrix("/floating_frame/orientation", se.floating_frame.orientation);
+  w.Matrix("/floating_frame/Phi_CB", se.floating_frame.Phi_CB);
+  if (se.floating_frame.cardona_weights.size() > 0) {
+    w.Vector("/floating_frame/cardona_weights", se.floating_frame.cardona_weights);
+  }
+
+  w.CreateGroup("/mass_properties");
+  w.Scalar("/mass_properties/mass", se.mass_properties.mass);
+  w.Vector("/mass_properties/center_of_mass", se.mass_properties.center_of_mass);
+  w.Matrix("/mass_properties/inertia_com", se.mass_properties.inertia_com);
+
+  w.CreateGroup("/full_model");
+  w.Attribute("/full_model", "n_dofs", se.n_full_dofs);
+  if (se.full_free_free_frequencies_hz.size() > 0) {
+    w.Vector("/full_model/free_free_frequencies_hz", se.full_free_free_frequencies_hz);
+  }
+
+  if (se.visualization) {
+    const Visualization& v = *se.visualization;
+    w.CreateGroup("/visualization");
+    w.Attribute("/visualization", "cell_type", v.cell_type);
+    w.Attribute("/visualization", "dofs_per_node", long(v.dofs_per_node));
+    w.Matrix("/visualization/nodes", v.nodes);
+    w.IntMatrix("/visualization/cells", v.cells);
+    w.Matrix("/visualization/shapes", v.shapes);
+  }
+
+  const Provenance& p = se.provenance;
+  w.CreateGroup("/provenance");
+  w.Attribute("/provenance", "femb_version", p.femb_version);
+  w.Attribute("/provenance", "input_file", p.input_file);
+  w.Attribute("/provenance", "input_hash", p.input_hash);
+  w.Attribute("/provenance", "element_type", p.element_type);
+  w.Attribute("/provenance", "n_nodes", p.n_nodes);
+  w.Attribute("/provenance", "n_elements", p.n_elements);
+  std::vector<std::string> stages;
+  Eigen::VectorXd seconds(p.stage_seconds.size());
+  for (size_t i = 0; i < p.stage_seconds.size(); ++i) {
+    stages.push_back(p.stage_seconds[i].first);
+    seconds[i] = p.stage_seconds[i].second;
+  }
+  w.Strings("/provenance/stages", stages);
+  w.Vector("/provenance/stage_seconds", seconds);
+}
+
+void RequireShape(const h5::Reader& r, const std::string& name, long rows, long cols) {
+  Eigen::MatrixXd dummy;
+  auto shape = r.Shape(name);
+  bool ok = (cols < 0) ? (shape.size() == 1 && long(shape[0]) == rows)
+                       : (shape.size() == 2 && long(shape[0]) == rows && long(shape[1]) == cols);
+  if (!ok) {
+    std::string got;
+    for (auto d : shape) got += (got.empty() ? "" : " x ") + std::to_string(d);
+    std::string want = std::to_string(rows) + (cols < 0 ? "" : " x " + std::to_string(cols));
+    throw InputError(r.path() + ": dataset " + name + " has shape (" + got + "), expected (" +
+                     want + ")");
+  }
+}
+
+}  // namespace
+
+void WriteSuperelementFile(const Superelement& se, const std::string& path) {
+  const std::string temporary = path + ".tmp." + std::to_string(::getpid());
+  try {
+    h5::Writer writer(temporary);
+    WriteContent(se, writer);
+    writer.Close();
+  } catch (...) {
+    std::remove(temporary.c_str());
+    throw;
+  }
+  std::error_code ec;
+  std::filesystem::rename(temporary, path, ec);
+  if (ec) {
+    std::remove(temporary.c_str());
+    throw InputError(path + ": cannot rename the temporary file into place (" + ec.message() + ")");
+  }
+}
+
+Superelement ReadSuperelementFile(const std::string& path, const SuperelementReadOptions& options) {
+  h5::Reader r(path);
+  Superelement se;
+  // Version first: nothing else is meaningful in a file of another major version.
+  std::string tag;
+  try {
+    tag = r.StringAttribute("/", "format");
+  } catch (const InputError&) {
+    throw InputError(path + ": not a femb superelement file (no root attribute 'format')");
+  }
+  if (tag != kSuperelementFormatTag) {
+    throw InputError(path + ": not a femb superelement file (format is '" + tag + "')");
+  }
+  long major = r.IntAttribute("/", "format_version_major");
+  if (major != kSuperelementFormatMajor) {
+    throw InputError(path + ": superelement format version " + r.StringAttribute("/", "format_version") +
+                     " is not supported by this femb (reads major version " +
+                     std::to_string(kSuperelementFormatMajor) + "); re-run femb-reduce on the part");
+  }
+  se.name = r.StringAttribute("/", "name");
+  se.units.system = r.StringAttribute("/units", "system");
+  se.units.length = r.StringAttribute("/units", "length");
+  se.units.mass = r.StringAttribute("/units", "mass");
+  se.units.time = r.StringAttribute("/units", "time");
+  se.units.force = r.StringAttribute("/units", "force");
+  se.units.stress = r.StringAttribute("/units", "stress");
+  se.units.angle = r.StringAttribute("/units", "angle");
+
+  std::vector<std::string> names = r.Strings("/interfaces/names");
+  const long N = long(names.size());
+  RequireShape(r, "/interfaces/positions", N, 3);
+  RequireShape(r, "/interfaces/orientations", N, 9);
+  Eigen::MatrixXd positions = r.Matrix("/interfaces/positions");
+  Eigen::MatrixXd orientations = r.Matrix("/interfaces/orientations");
+  for (long k = 0; k < N; ++k) {
+    InterfaceNode node;
+    node.name = names[k];
+    node.position = positions.row(k).transpose();
+    Eigen::Matrix<double, 1, 9> row = orientations.row(k);
+    node.orientation = Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(row.data());
+    se.interfaces.push_back(node);
+  }
+
+  se.internal_frequencies_hz = r.Vector("/reduced/internal_frequencies_hz");
+  se.n_modal_derivatives = r.IntAttribute("/reduced", "n_modal_derivatives");
+  const long n = 6 * N + se.internal_frequencies_hz.size() + se.n_modal_derivatives;
+  RequireShape(r, "/reduced/K", n, n);
+  RequireShape(r, "/reduced/M", n, n);
+  se.K = r.Matrix("/reduced/K");
+  se.M = r.Matrix("/reduced/M");
+
+  se.floating_frame.type = r.StringAttribute("/floating_frame", "type");
+  RequireShape(r, "/floating_frame/origin", 3, -1);
+  RequireShape(r, "/floating_frame/orientation", 3, 3);
+  RequireShape(r, "/floating_frame/Phi_CB", 6, n);
+  se.floating_frame.origin = r.Vector("/floating_frame/origin");
+  se.floating_frame.orientation = r.Matrix("/floating_frame/orientation");
+  se.floating_frame.Phi_CB = r.Matrix("/floating_frame/Phi_CB");
+  if (r.Exists("/floating_frame/cardona_weights")) {
+    RequireShape(r, "/floating_frame/cardona_weights", N, -1);
+    se.floating_frame.cardona_weights = r.Vector("/floating_frame/cardona_weights");
+  }
+
+  se.mass_properties.mass = r.Scalar("/mass_properties/mass");
+  RequireShape(r, "/mass_properties/center_of_mass", 3, -1);
+  RequireShape(r, "/mass_properties/inertia_com", 3, 3);
+  se.mass_properties.center_of_mass = r.Vector("/mass_properties/center_of_mass");
+  se.mass_properties.inertia_com = r.Matrix("/mass_properties/inertia_com");
+
+  se.n_full_dofs = r.IntAttribute("/full_model", "n_dofs");
+  if (r.Exists("/full_model/free_free_frequencies_hz")) {
+    se.full_free_free_frequencies_hz = r.Vector("/full_model/free_free_frequencies_hz");
+  }
+
+  if (options.visualization && r.Exists("/visualization")) {
+    Visualization v;
+    v.cell_type = r.StringAttribute("/visualization", "cell_type");
+    v.dofs_per_node = int(r.IntAttribute("/visualization", "dofs_per_node"));
+    v.nodes = r.Matrix("/visualization/nodes");
+    v.cells = r.IntMatrix("/visualization/cells");
+    RequireShape(r, "/visualization/shapes", v.nodes.rows() * v.dofs_per_node, n);
+    v.shapes = r.Matrix("/visualization/shapes");
+    se.visualization = std::move(v);
+  }
+
+  if (r.Exists("/provenance")) {
+    Provenance& p = se.provenance;
+    p.femb_version = r.StringAttribute("/provenance", "femb_version");
+    p.input_file = r.StringAttribute("/provenance", "input_file");
+    p.input_hash = r.StringAttribute("/provenance", "input_hash");
+    p.element_type = r.StringAttribute("/provenance", "element_type");
+    p.n_nodes = r.IntAttribute("/provenance", "n_nodes");
+    p.n_elements = r.IntAttribute("/provenance", "n_elements");
+    std::vector<std::string> stages = r.Strings("/provenance/stages");
+    Eigen::VectorXd seconds = r.Vector("/provenance/stage_seconds");
+    for (size_t i = 0; i < stages.size() && long(i) < seconds.size(); ++i) {
+      p.stage_seconds.emplace_back(stages[i], seconds[i]);
+    }
+  }
+  return se;
+}
+
+}  // namespace femb

@@ -1,0 +1,44 @@
+// A linear finite element model of one part, ready for reduction: sparse K and M over all DOFs,
+// the mesh (for visualization) and the interface nodes.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace femb {
+
+using SparseMatrix = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
+
+/// A full-model DOF number, distinct from interface and reduced coordinate numbers.
+struct FullDof {
+  int value;
+};
+
+struct FeModel {
+  int dofs_per_node = 6;             ///< 6 for beams (u, theta); 3 for solids
+  Eigen::MatrixXd nodes;             ///< n_nodes x 3, part axes
+  Eigen::MatrixXi cells;             ///< n_cells x nodes_per_cell
+  std::string cell_type;             ///< "line2", ...
+  std::string element_type;          ///< e.g. "timoshenko_beam"
+  SparseMatrix K, M;                 ///< n_dofs x n_dofs, full (both triangles stored)
+
+  /// Boundary coordinates: 6 per interface, ordered (u_x, u_y, u_z, th_x, th_y, th_z) in part
+  /// axes. For beams these are DOFs of interface nodes directly.
+  std::vector<std::string> interface_names;
+  std::vector<Eigen::Vector3d> interface_positions;
+  std::vector<std::vector<FullDof>> interface_dofs;  ///< 6 full DOFs per interface
+
+  /// (u, theta) of the material point at `x` as a 6 x n_dofs matrix acting on full DOF vectors;
+  /// nullopt when `x` lies outside the material.
+  std::function<std::optional<SparseMatrix>(const Eigen::Vector3d& x)> interpolate_at;
+
+  long n_dofs() const { return long(K.rows()); }
+  long n_nodes() const { return long(nodes.rows()); }
+  long n_elements() const { return long(cells.rows()); }
+};
+
+}  // namespace femb

@@ -1,0 +1,108 @@
+// femb-reduce: a part file in, a Craig-Bampton superelement file out.
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include "formats/input_error.h"
+#include "formats/part_file.h"
+#include "formats/superelement_file.h"
+#include "reducer/reduce_part.h"
+
+namespace {
+
+constexpr const char* kUsage = R"(usage: femb-reduce PART.yaml [-o OUT.h5] [--full-modes K] [--set key=value]... [--quiet]
+
+Reduces a part (beam polyline; see formats/PART_FORMAT.md) to a Craig-Bampton superelement file
+(HDF5; see formats/SUPERELEMENT_FORMAT.md).
+
+options:
+  -o, --output OUT.h5   output file (default: <part name>.h5 in the current folder). Written to a
+                        temporary name and renamed, so it is never half-written.
+  --full-modes K        also compute the K lowest nonzero free-free frequencies of the unreduced
+                        model (plus the 6 rigid-body ones) and store them for comparison
+                        (same as --set reduction.full_modes=K)
+  --set key=value       override a part-file key, e.g. --set reduction.internal_modes=8
+                        --set reduction.floating_frame=mean_axes (repeatable)
+  -q, --quiet           no progress lines
+  -h, --help            this text
+
+exit codes: 0 success, 2 bad input (one line names the file, line and key), 3 numerical failure.
+)";
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string part_path, output;
+  std::vector<std::string> overrides;
+  bool quiet = false;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    auto value = [&](const char* flag) -> std::string {
+      if (i + 1 >= argc) {
+        std::fprintf(stderr, "femb-reduce: %s needs a value (see --help)\n", flag);
+        std::exit(2);
+      }
+      return argv[++i];
+    };
+    if (a == "-h" || a == "--help") {
+      std::fputs(kUsage, stdout);
+      return 0;
+    } else if (a == "-o" || a == "--output") {
+      output = value("-o");
+    } else if (a == "--full-modes") {
+      overrides.push_back("reduction.full_modes=" + value("--full-modes"));
+    } else if (a == "--set") {
+      overrides.push_back(value("--set"));
+    } else if (a == "-q" || a == "--quiet") {
+      quiet = true;
+    } else if (!a.empty() && a[0] == '-') {
+      std::fprintf(stderr, "femb-reduce: unknown option '%s' (see --help)\n", a.c_str());
+      return 2;
+    } else if (part_path.empty()) {
+      part_path = a;
+    } else {
+      std::fprintf(stderr, "femb-reduce: more than one part file given ('%s', '%s')\n",
+                   part_path.c_str(), a.c_str());
+      return 2;
+    }
+  }
+  if (part_path.empty()) {
+    std::fprintf(stderr, "femb-reduce: no part file given\n%s", kUsage);
+    return 2;
+  }
+  try {
+    femb::Stopwatch total;
+    const femb::PartSpec part = femb::ReadPartFile(part_path, overrides);
+    if (output.empty()) output = part.name + ".h5";
+    auto progress = [&](const std::string& stage, double seconds, const std::string& detail) {
+      if (quiet) return;
+      std::printf("femb-reduce: [%8.3f s] %-16s %8.3f s  %s\n", total.Seconds(), stage.c_str(),
+                  seconds, detail.c_str());
+      std::fflush(stdout);
+    };
+    femb::ReduceResult result = femb::ReducePart(part, progress);
+    if (!result.ok) {
+      std::fprintf(stderr, "femb-reduce: %s: numerical failure: %s (no output written)\n",
+                   part_path.c_str(), result.message.c_str());
+      return 3;
+    }
+    femb::Stopwatch write_clock;
+    femb::WriteSuperelementFile(result.superelement, output);
+    progress("write", write_clock.Seconds(), output);
+    if (!quiet) {
+      std::printf("femb-reduce: wrote %s (%d reduced DOFs from %ld) in %.3f s\n", output.c_str(),
+                  result.superelement.n_reduced_dofs(), result.superelement.n_full_dofs,
+                  total.Seconds());
+    }
+    return 0;
+  } catch (const femb::InputError& e) {
+    std::fprintf(stderr, "femb-reduce: %s\n", e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "femb-reduce: internal error: %s\n", e.what());
+    return 1;
+  }
+}

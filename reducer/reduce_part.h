@@ -1,0 +1,21 @@
+// The femb-reduce pipeline: part spec -> FE model -> Craig-Bampton -> superelement.
+#pragma once
+
+#include <string>
+
+#include "formats/part_file.h"
+#include "formats/superelement.h"
+#include "reducer/progress.h"
+
+namespace femb {
+
+struct ReduceResult {
+  bool ok = false;
+  std::string message;  ///< numerical failure, when !ok
+  Superelement superelement;
+};
+
+/// Input errors throw InputError; numerical failures return ok = false with a message.
+ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress);
+
+}  // namespace femb

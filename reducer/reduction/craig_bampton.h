@@ -1,0 +1,38 @@
+// Craig-Bampton reduction (thesis 3.1, 8.1). Boundary coordinates b are the 6N interface DOFs,
+// interior i the rest. With ONE sparse Cholesky factor of K_ii:
+//   static constraint modes   Psi_c = -K_ii^-1 K_ib                      (n_i x 6N)
+//   fixed-interface modes     K_ii Phi_i = M_ii Phi_i Lambda, Phi_i^T M_ii Phi_i = 1 (n_i x m)
+//   basis                     Phi = [1 0; Psi_c Phi_i]
+//   reduced                   K_r = Phi^T K Phi = [K_bb + K_bi Psi_c, 0; 0, Lambda]
+//                             M_r = Phi^T M Phi
+// ordered [interface 1 (u, theta), ..., interface N, internal modes].
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+
+#include "reducer/fe/fe_model.h"
+#include "reducer/linalg/sparse_cholesky.h"
+#include "reducer/progress.h"
+
+namespace femb {
+
+struct CraigBamptonResult {
+  bool ok = false;
+  std::string message;        ///< why it failed (numerical), when !ok
+  Eigen::MatrixXd K, M;       ///< reduced, n_r x n_r
+  Eigen::VectorXd lambda;     ///< internal eigenvalues omega^2, ascending
+  Eigen::MatrixXd shapes;     ///< n_full x n_r: full DOF field of each reduced coordinate
+  FactorizationInfo factorization;
+  long eigen_linear_solves = 0;
+  bool dense_eigen = false;
+};
+
+/// `internal_modes` fixed-interface modes are kept. Reports stages through `progress`.
+CraigBamptonResult CraigBamptonReduce(const FeModel& model, int internal_modes,
+                                      const ProgressFn& progress, long dense_limit = 200);
+
+/// The interior DOFs (all DOFs not used by an interface), ascending.
+std::vector<int> InteriorDofs(const FeModel& model);
+
+}  // namespace femb

@@ -1,0 +1,61 @@
+#include "reducer/reduction/floating_frame.h"
+
+#include <Eigen/Dense>
+#include <cstdio>
+
+#include "formats/input_error.h"
+
+namespace femb {
+
+FloatingFrame ComputeFloatingFrame(const std::string& type, const std::string& where,
+                                   const Superelement& se, const FeModel& model,
+                                   const Eigen::MatrixXd& shapes) {
+  FloatingFrame frame;
+  frame.type = type;
+  const int n_r = se.n_reduced_dofs(), N = se.n_interface_nodes();
+  const Eigen::Vector3d c = se.mass_properties.center_of_mass;
+  frame.Phi_CB = Eigen::MatrixXd::Zero(6, n_r);
+
+  if (type == "center_of_mass") {
+    auto interpolation = model.interpolate_at ? model.interpolate_at(c) : std::nullopt;
+    if (!interpolation) {
+      char buffer[160];
+      std::snprintf(buffer, sizeof buffer, "(%.6g, %.6g, %.6g)", c.x(), c.y(), c.z());
+      throw InputError(where + ": floating_frame center_of_mass: the centre of mass " + buffer +
+                       " lies outside the material; use floating_frame: mean_axes");
+    }
+    frame.origin = c;
+    frame.Phi_CB = (*interpolation) * shapes;
+  } else if (type == "mean_axes") {
+    frame.origin = c;
+    const Eigen::MatrixXd Phi_rig0 = RigidBodyModes(se, c);
+    const Eigen::Matrix<double, 6, 6> M_rig = RigidBodyMassMatrix(se, c);
+    frame.Phi_CB = M_rig.ldlt().solve(Phi_rig0.transpose() * se.M);
+  } else if (type.rfind("interface:", 0) == 0) {
+    const std::string name = type.substr(10);
+    int k = -1;
+    for (int i = 0; i < N; ++i) {
+      if (se.interfaces[i].name == name) k = i;
+    }
+    if (k < 0) throw InputError(where + ": floating frame interface '" + name + "' not found");
+    frame.origin = se.interfaces[k].position;
+    frame.Phi_CB.block(0, 6 * k, 6, 6).setIdentity();
+  } else if (type == "cardona") {
+    Eigen::MatrixXd X(3, N);
+    for (int k = 0; k < N; ++k) X.col(k) = se.interfaces[k].position - c;
+    Eigen::MatrixXd A(N + 1, N);
+    A.topRows(N) = X.transpose() * X;
+    A.row(N).setOnes();
+    Eigen::VectorXd v = Eigen::VectorXd::Zero(N + 1);
+    v[N] = 1.0;
+    const Eigen::VectorXd alpha = A.completeOrthogonalDecomposition().solve(v);
+    frame.cardona_weights = alpha;
+    frame.origin = c + X * alpha;
+    for (int k = 0; k < N; ++k) frame.Phi_CB.block(0, 6 * k, 6, 6) = alpha[k] * Eigen::Matrix<double, 6, 6>::Identity();
+  } else {
+    throw InputError(where + ": unknown floating frame '" + type + "'");
+  }
+  return frame;
+}
+
+}  // namespace femb
