@@ -2,6 +2,7 @@
 
 #include <cstdio>
 
+#include "formats/input_error.h"
 #include "reducer/fe/beam_model.h"
 #include "reducer/reduction/craig_bampton.h"
 #include "reducer/reduction/floating_frame.h"
@@ -28,6 +29,12 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
                 model.n_elements(), model.element_type.c_str(), model.n_dofs());
   report("mesh+assembly", clock.Seconds(), detail);
 
+  const long n_interior = long(InteriorDofs(model).size());
+  if (part.reduction.internal_modes > n_interior) {
+    throw InputError(part.file + ": reduction.internal_modes = " +
+                     std::to_string(part.reduction.internal_modes) + " exceeds the " +
+                     std::to_string(n_interior) + " interior DOFs of the mesh (refine it or keep fewer modes)");
+  }
   const CraigBamptonResult cb = CraigBamptonReduce(model, part.reduction.internal_modes, report);
   if (!cb.ok) {
     result.message = cb.message;

@@ -1,0 +1,113 @@
+// Part file parsing: every bad input gives one line naming the file, line and key.
+#include "formats/part_file.h"
+
+#include <gtest/gtest.h>
+
+#include "test_util.h"
+
+namespace femb {
+namespace {
+
+const std::string kGood =
+    "name: rod\n"                                        // 1
+    "type: beam\n"                                       // 2
+    "material: {E: 2.0e11, nu: 0.3, rho: 7870}\n"        // 3
+    "section: {shape: circle, diameter: 0.006}\n"        // 4
+    "beam:\n"                                            // 5
+    "  points:\n"                                        // 6
+    "    A: [0, 0, 0]\n"                                 // 7
+    "    B: [0.3, 0, 0]\n"                               // 8
+    "  segments:\n"                                      // 9
+    "    - {from: A, to: B, elements: 10}\n"             // 10
+    "interfaces:\n"                                      // 11
+    "  - {name: A}\n"                                    // 12
+    "  - {name: B}\n"                                    // 13
+    "reduction:\n"                                       // 14
+    "  internal_modes: 4\n";                             // 15
+
+std::string Replace(std::string text, const std::string& from, const std::string& to) {
+  const size_t at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  return text.replace(at, from.size(), to);
+}
+
+std::string Error(const std::string& text, const std::vector<std::string>& overrides = {}) {
+  return test::ThrownMessage([&] { ParsePart(text, "part.yaml", overrides); });
+}
+
+TEST(PartFile, GoodFileParses) {
+  const PartSpec p = ParsePart(kGood, "part.yaml");
+  EXPECT_EQ(p.name, "rod");
+  EXPECT_EQ(p.units.system, "SI");
+  EXPECT_EQ(p.beam.points.size(), 2u);
+  EXPECT_EQ(p.beam.segments[0].elements, 10);
+  EXPECT_EQ(p.interfaces.size(), 2u);
+  EXPECT_EQ(p.interfaces[1].point, 1);
+  EXPECT_EQ(p.reduction.internal_modes, 4);
+  EXPECT_EQ(p.reduction.floating_frame, "center_of_mass");
+}
+
+TEST(PartFile, SetOverridesKeys) {
+  const PartSpec p = ParsePart(kGood, "part.yaml",
+                               {"reduction.internal_modes=7", "reduction.floating_frame=mean_axes", "units=mm-t-s"});
+  EXPECT_EQ(p.reduction.internal_modes, 7);
+  EXPECT_EQ(p.reduction.floating_frame, "mean_axes");
+  EXPECT_EQ(p.units.length, "mm");
+  EXPECT_EQ(p.units.stress, "MPa");
+  EXPECT_NE(ParsePart(kGood, "part.yaml").text_hash, p.text_hash);
+}
+
+TEST(PartFile, BadInputNamesFileLineAndKey) {
+  struct Case {
+    std::string text, expected;
+  };
+  const std::vector<Case> cases = {
+      {Replace(kGood, "  internal_modes: 4\n", "  internal_modes: 4\n  inernal_modes: 5\n"),
+       "part.yaml:16: reduction.inernal_modes: unknown key 'inernal_modes' in 'reduction'"},
+      {Replace(kGood, "E: 2.0e11", "E: -5"), "part.yaml:3: material.E: must be positive, got -5"},
+      {Replace(kGood, "E: 2.0e11", "E: 0"), "part.yaml:3: material.E: must be positive"},
+      {Replace(kGood, "rho: 7870", "rho: 0"), "part.yaml:3: material.rho: must be positive"},
+      {Replace(kGood, "nu: 0.3", "nu: 0.5"), "part.yaml:3: material.nu: Poisson's ratio must be in (-1, 0.5), got 0.5"},
+      {Replace(kGood, "nu: 0.3", "nu: -1.2"), "material.nu: Poisson's ratio must be in (-1, 0.5)"},
+      {Replace(kGood, "B: [0.3, 0, 0]", "B: [0, 0, 0]"), "part.yaml:10: beam.segments[0]: zero-length element"},
+      {Replace(kGood, "  - {name: B}\n", "  - {name: B, point: C}\n"),
+       "part.yaml:13: interfaces[1].point: interface point 'C' not found in beam.points"},
+      {Replace(kGood, "interfaces:\n  - {name: A}\n  - {name: B}\n", ""), "part.yaml: no interface defined"},
+      {Replace(kGood, "interfaces:\n  - {name: A}\n  - {name: B}\n", "interfaces: []\n"), "part.yaml: no interface defined"},
+      {Replace(kGood, "name: rod\n", "name: rod\nbogus: 1\n"), "part.yaml:2: bogus: unknown key 'bogus'"},
+      {Replace(kGood, "{from: A, to: B", "{from: A, to: X"), "part.yaml:10: beam.segments[0].to: point 'X' is not defined"},
+      {Replace(kGood, "shape: circle", "shape: hexagon"), "part.yaml:4: section.shape: unknown section shape 'hexagon'"},
+      {Replace(kGood, "type: beam", "type: shell"), "part.yaml:2: type: unknown part type 'shell'"},
+      {Replace(kGood, "section: {shape: circle, diameter: 0.006}\n", ""), "part.yaml:1: missing required key 'section'"},
+      {Replace(kGood, "elements: 10", "elements: 0"), "part.yaml:10: beam.segments[0].elements: a segment needs at least 1 element"},
+      {Replace(kGood, "  internal_modes: 4\n", "  floating_frame: interface:Q\n"),
+       "part.yaml:15: reduction.floating_frame: floating frame interface 'Q' is not one of the part's interfaces"},
+  };
+  for (const Case& c : cases) {
+    const std::string message = Error(c.text);
+    EXPECT_NE(message.find(c.expected), std::string::npos) << "expected: " << c.expected << "\n     got: " << message;
+    EXPECT_EQ(message.find('\n'), std::string::npos) << "one line: " << message;
+  }
+}
+
+TEST(PartFile, YamlSyntaxErrorNamesTheLine) {
+  const std::string message = Error(Replace(kGood, "    B: [0.3, 0, 0]\n", "    B: [0.3, 0, 0\n"));
+  EXPECT_NE(message.find("part.yaml:"), std::string::npos) << message;
+  EXPECT_NE(message.find("YAML syntax error"), std::string::npos) << message;
+}
+
+TEST(PartFile, BadOverridesAreNamed) {
+  EXPECT_NE(Error(kGood, {"reduction.internal_modes=-3"}).find("--set reduction.internal_modes: must be zero or positive"),
+            std::string::npos) << Error(kGood, {"reduction.internal_modes=-3"});
+  EXPECT_NE(Error(kGood, {"reduction.modes=3"}).find("--set reduction.modes: unknown key 'modes'"), std::string::npos)
+      << Error(kGood, {"reduction.modes=3"});
+  EXPECT_NE(Error(kGood, {"novalue"}).find("expected key.path=value"), std::string::npos);
+}
+
+TEST(PartFile, MissingFileIsNamed) {
+  const std::string message = test::ThrownMessage([] { ReadPartFile("/nonexistent/part.yaml"); });
+  EXPECT_NE(message.find("/nonexistent/part.yaml: cannot open part file"), std::string::npos) << message;
+}
+
+}  // namespace
+}  // namespace femb

@@ -1,0 +1,36 @@
+// Helpers shared by the tests: parts built from text, reduced in memory.
+#pragma once
+
+#include <string>
+
+#include "formats/part_file.h"
+#include "formats/superelement.h"
+
+namespace femb::test {
+
+/// A straight beam part along x from 0 to L with interfaces at the named ends ("A" at x = 0,
+/// "B" at x = L), `extra` appended to the YAML (e.g. a reduction block).
+std::string StraightBeamYaml(double L, int elements, const std::string& section,
+                             const std::string& material, const std::string& interfaces,
+                             const std::string& extra = "");
+
+/// Parses and reduces; fails the calling test on error.
+Superelement Reduce(const std::string& yaml, const std::vector<std::string>& overrides = {});
+
+/// Expects `fn` to throw femb::InputError whose message contains every one of `parts`.
+template <typename Fn>
+std::string ThrownMessage(Fn fn);
+
+}  // namespace femb::test
+
+#include "formats/input_error.h"
+
+template <typename Fn>
+std::string femb::test::ThrownMessage(Fn fn) {
+  try {
+    fn();
+  } catch (const femb::InputError& e) {
+    return e.what();
+  }
+  return "(no InputError thrown)";
+}

@@ -1,0 +1,101 @@
+#!/usr/bin/env bash
+# Command-line behaviour of femb-reduce and femb-inspect: outputs, exit codes, one-line errors,
+# and no output file on bad input. Usage: cli_test.sh BIN_DIR SOURCE_DIR
+set -u
+bin=$1
+src=$2
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+passed=0
+failed=0
+ok() { passed=$((passed + 1)); }
+fail() { failed=$((failed + 1)); echo "FAIL: $*"; }
+py=/usr/bin/python3
+
+# --help on every program.
+for p in femb-reduce femb-inspect; do
+  "$bin/$p" --help | grep -q "usage: $p" && ok || fail "$p --help"
+done
+
+# Examples reduce with one command and pass the checks.
+for ex in beam_rod tube_cantilever; do
+  if "$bin/femb-reduce" "$src/examples/$ex/part.yaml" -o "$work/$ex.h5" --full-modes 10 > "$work/$ex.log"; then ok; else fail "reduce $ex"; fi
+  grep -q "factorize K_ii" "$work/$ex.log" && ok || fail "$ex: no progress line with timing"
+  "$bin/femb-inspect" "$work/$ex.h5" --check > "$work/$ex.txt" && ok || fail "inspect --check $ex"
+  grep -q "rel. error" "$work/$ex.txt" && ok || fail "$ex: summary has no full vs reduced table"
+  "$bin/femb-inspect" "$work/$ex.h5" --json > "$work/$ex.json" || fail "inspect --json $ex"
+  $py - "$work/$ex.json" <<'PY' && ok || fail "$ex: JSON keys"
+import json, sys
+j = json.load(open(sys.argv[1]))
+keys = ["format_version", "name", "units", "n_interface_nodes", "interface_names", "n_internal_modes",
+        "n_modal_derivatives", "n_reduced_dofs", "n_full_dofs", "mass", "center_of_mass", "inertia_com",
+        "floating_frame", "internal_frequencies_hz", "free_free_frequencies_hz",
+        "full_free_free_frequencies_hz", "checks"]
+missing = [k for k in keys if k not in j]
+assert not missing, missing
+for c in ["K_symmetric", "M_symmetric", "M_positive_definite", "rigid_body_modes"]:
+    assert j["checks"][c]["ok"], c
+assert len(j["inertia_com"]) == 3 and len(j["inertia_com"][0]) == 3
+assert len(j["free_free_frequencies_hz"]) == j["n_reduced_dofs"] == 16
+ff = j["free_free_frequencies_hz"]; assert ff == sorted(ff)
+full = j["full_free_free_frequencies_hz"]; assert len(full) == 16
+# reduced frequencies are Rayleigh-Ritz upper bounds of the full ones
+for r, f in zip(ff[6:10], full[6:10]):
+    assert r >= f * (1 - 1e-9) and r < 1.01 * f, (r, f)
+PY
+done
+
+# --dump: K as CSV is 16 x 16; PhiCB as Matrix Market 6 x 16.
+rows=$("$bin/femb-inspect" "$work/beam_rod.h5" --dump K --format csv | wc -l)
+[ "$rows" = 16 ] && ok || fail "--dump K csv rows $rows"
+"$bin/femb-inspect" "$work/beam_rod.h5" --dump PhiCB | sed -n 3p | grep -qx "6 16" && ok || fail "--dump PhiCB mtx"
+# --set works under the documented names.
+"$bin/femb-reduce" -q "$src/examples/beam_rod/part.yaml" -o "$work/m8.h5" --set reduction.internal_modes=8 \
+  --set reduction.floating_frame=mean_axes || fail "--set"
+"$bin/femb-inspect" "$work/m8.h5" --json | $py -c "
+import json,sys; j=json.load(sys.stdin); assert j['n_internal_modes']==8 and j['floating_frame']['type']=='mean_axes'" \
+  && ok || fail "--set values not in file"
+# The file is readable by h5py (an independent HDF5 reader) with the documented layout.
+$py - "$work/beam_rod.h5" <<'PY' && ok || fail "h5py layout"
+import sys, h5py
+f = h5py.File(sys.argv[1], "r")
+assert f.attrs["format"] in (b"femb-superelement", "femb-superelement")
+assert f["reduced/K"].shape == (16, 16) and f["floating_frame/Phi_CB"].shape == (6, 16)
+assert abs(f["mass_properties/mass"][()] - 7870 * 3.141592653589793 * 0.003**2 * 0.3) < 1e-12
+PY
+
+# Bad input: exit code 2, one line on stderr naming the file, no output file.
+good="$src/examples/beam_rod/part.yaml"
+expect_input_error() {  # name, expected text, femb-reduce arguments...
+  local name=$1 text=$2
+  shift 2
+  rm -f "$work/bad.h5"
+  "$bin/femb-reduce" -q "$@" -o "$work/bad.h5" 2> "$work/err.txt" > /dev/null
+  local code=$?
+  [ $code = 2 ] || { fail "$name: exit code $code, want 2"; return; }
+  [ "$(wc -l < "$work/err.txt")" = 1 ] || { fail "$name: stderr not one line: $(cat "$work/err.txt")"; return; }
+  grep -qF -- "$text" "$work/err.txt" || { fail "$name: stderr '$(cat "$work/err.txt")' lacks '$text'"; return; }
+  [ ! -e "$work/bad.h5" ] || { fail "$name: output file written"; return; }
+  ls "$work" | grep -q "bad.h5.tmp" && { fail "$name: temporary left behind"; return; }
+  ok
+}
+variant() { sed "$1" "$good" > "$work/$2.yaml"; echo "$work/$2.yaml"; }
+expect_input_error "missing file" "nope.yaml: cannot open part file" "$work/nope.yaml"
+expect_input_error "yaml syntax" "YAML syntax error" "$(variant 's/B: \[0.3, 0.0, 0.0\]/B: [0.3, 0.0, 0.0/' syntax)"
+expect_input_error "unknown key" "unknown key 'internal_mode'" "$(variant 's/^  internal_modes: 4/  internal_mode: 4/' unknown)"
+expect_input_error "E <= 0" "e0.yaml:7: material.E: must be positive" "$(variant 's/E: 2.0e11/E: 0/' e0)"
+expect_input_error "rho <= 0" "material.rho: must be positive" "$(variant 's/rho: 7870/rho: -1/' rho)"
+expect_input_error "nu range" "Poisson's ratio must be in (-1, 0.5), got 0.7" "$(variant 's/nu: 0.3/nu: 0.7/' nu)"
+expect_input_error "zero length" "zero-length element" "$(variant 's/B: \[0.3, 0.0, 0.0\]/B: [0.0, 0.0, 0.0]/' zero)"
+expect_input_error "interface not found" "interface point 'Q' not found" "$(variant 's/{name: B}/{name: B, point: Q}/' iface)"
+expect_input_error "no interface" "no interface defined" "$(variant '/^interfaces:/,/name: B}/d' none)"
+expect_input_error "too many modes" "exceeds the 54 interior DOFs" "$good" --set reduction.internal_modes=500
+expect_input_error "bad --set" "--set reduction.floating_frame: unknown floating frame 'centroid'" "$good" --set reduction.floating_frame=centroid
+
+# femb-inspect on bad files: exit 2, one line.
+"$bin/femb-inspect" "$work/none.h5" 2> "$work/err.txt"; [ $? = 2 ] && grep -q "cannot open file" "$work/err.txt" && ok || fail "inspect missing"
+head -c 2000 "$work/beam_rod.h5" > "$work/trunc.h5"
+"$bin/femb-inspect" "$work/trunc.h5" 2> "$work/err.txt"; [ $? = 2 ] && [ "$(wc -l < "$work/err.txt")" = 1 ] && ok || fail "inspect truncated: $(cat "$work/err.txt")"
+
+echo "cli: $passed passed, $failed failed"
+[ $failed = 0 ]
