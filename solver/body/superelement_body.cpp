@@ -1,0 +1,179 @@
+#include "solver/body/superelement_body.h"
+
+#include <Eigen/Dense>
+
+#include "formats/input_error.h"
+#include "solver/rotation.h"
+
+namespace femb {
+namespace {
+// Local (elastic) rotations are small in this theory; beyond 2 rad a frame is rejected.
+constexpr double kMaxLocalRotation = 2.0;
+}  // namespace
+
+struct SuperelementBody::Kinematics {
+  Eigen::MatrixXd Phi_rig;  // n x 6
+  Eigen::MatrixXd D;        // n x n (block diagonal)
+  Eigen::Matrix<double, 6, 6> S;
+  Eigen::MatrixXd Z;        // 6 x n
+  Eigen::MatrixXd T;        // n x n
+  Eigen::MatrixXd B;        // n x n
+};
+
+SuperelementBody::SuperelementBody(const Superelement& se, const SuperelementOptions& options,
+                                   const Eigen::Matrix3d& placement_R, const Eigen::Vector3d& placement_x)
+    : n_nodes_(se.n_interface_nodes()),
+      n_modes_(se.n_reduced_dofs() - se.n_interface_dofs()),
+      options_(options),
+      K_(se.K),
+      M_(se.M),
+      Phi_CB_(se.floating_frame.Phi_CB),
+      placement_R_(placement_R),
+      placement_x_(placement_x),
+      origin_part_(se.floating_frame.origin) {
+  if (!se.floating_frame.orientation.isIdentity(1e-12)) {
+    throw InputError(se.name + ": floating frame orientation other than the part axes is not supported");
+  }
+  for (const InterfaceNode& node : se.interfaces) {
+    X_.push_back(node.position - se.floating_frame.origin);
+    R0_.push_back(node.orientation);
+  }
+  const Eigen::MatrixXd Phi_rig0 = RigidBodyModes(se, se.floating_frame.origin);
+  T0_ = Eigen::MatrixXd::Identity(n_coordinates(), n_coordinates()) - Phi_rig0 * Phi_CB_;
+  initial_frame_.x = placement_x_ + placement_R_ * origin_part_;
+  initial_frame_.R = placement_R_;
+  initial_frame_.ok = true;
+}
+
+BodyConfiguration SuperelementBody::InitialConfiguration() const {
+  BodyConfiguration c;
+  for (int k = 0; k < n_nodes_; ++k) {
+    c.x.push_back(placement_x_ + placement_R_ * (origin_part_ + X_[k]));
+    c.R.push_back(placement_R_ * R0_[k]);
+  }
+  c.eta = Eigen::VectorXd::Zero(n_modes_);
+  return c;
+}
+
+Eigen::VectorXd SuperelementBody::LocalCoordinates(const BodyConfiguration& c, const FrameSolution& frame) const {
+  Eigen::VectorXd q(n_coordinates());
+  const Eigen::Matrix3d Rt = frame.R.transpose();
+  for (int k = 0; k < n_nodes_; ++k) {
+    q.segment<3>(6 * k) = Rt * (c.x[k] - frame.x) - X_[k];
+    q.segment<3>(6 * k + 3) = LogSO3(Rt * c.R[k] * R0_[k].transpose());
+  }
+  q.tail(n_modes_) = c.eta;
+  return q;
+}
+
+SuperelementBody::Kinematics SuperelementBody::ComputeKinematics(const Eigen::VectorXd& q) const {
+  const int n = n_coordinates();
+  Kinematics k;
+  k.Phi_rig = Eigen::MatrixXd::Zero(n, 6);
+  k.D = Eigen::MatrixXd::Identity(n, n);
+  for (int a = 0; a < n_nodes_; ++a) {
+    const Eigen::Vector3d r = X_[a] + q.segment<3>(6 * a);
+    auto block = k.Phi_rig.block<6, 6>(6 * a, 0);
+    block.setIdentity();
+    block.block<3, 3>(0, 3) = -Skew<double>(r);
+    k.D.block<3, 3>(6 * a + 3, 6 * a + 3) = LeftJacobianInverse<double>(Eigen::Vector3d(q.segment<3>(6 * a + 3)));
+  }
+  const Eigen::MatrixXd W = Phi_CB_ * k.D;
+  k.S = W * k.Phi_rig;
+  k.Z = k.S.lu().solve(W);
+  k.T = Eigen::MatrixXd::Identity(n, n) - k.Phi_rig * k.Z;
+  k.B = k.D * k.T;
+  return k;
+}
+
+FrameSolution SuperelementBody::GuessFrame(const BodyConfiguration& c) const {
+  FrameSolution frame;
+  frame.R = c.R[0] * R0_[0].transpose();
+  frame.x = c.x[0] - frame.R * X_[0];
+  return frame;
+}
+
+FrameSolution SuperelementBody::SolveFrame(const BodyConfiguration& c, const FrameSolution& guess) const {
+  FrameSolution frame = guess;
+  frame.ok = false;
+  double scale = 1.0;
+  for (int k = 0; k < n_nodes_; ++k) scale = std::max(scale, X_[k].norm());
+  for (int it = 0; it < 30; ++it) {
+    const Eigen::VectorXd q = LocalCoordinates(c, frame);
+    Eigen::Matrix<double, 6, 1> g = Phi_CB_ * q;
+    frame.iterations = it;
+    // Translations relative to the body size, rotations as they are.
+    if (g.head<3>().norm() <= 1e-13 * scale && g.tail<3>().norm() <= 1e-13) {
+      // A root with local rotations beyond kMaxLocalRotation is a spurious branch of the log
+      // map (far start), not an elastic state: report failure.
+      frame.ok = true;
+      for (int k = 0; k < n_nodes_; ++k) frame.ok &= q.segment<3>(6 * k + 3).norm() < kMaxLocalRotation;
+      return frame;
+    }
+    // d q_loc = -D Phi_rig zeta for a frame variation zeta (frame axes): zeta = S^-1 g.
+    const Kinematics kin = ComputeKinematics(q);
+    const Eigen::Matrix<double, 6, 1> zeta = kin.S.lu().solve(g);
+    frame.x += frame.R * zeta.head<3>();
+    frame.R = frame.R * ExpSO3(zeta.tail<3>());
+  }
+  return frame;
+}
+
+double SuperelementBody::ElasticEnergy(const BodyConfiguration& c, const FrameSolution& frame) const {
+  const Eigen::VectorXd q = LocalCoordinates(c, frame);
+  return 0.5 * q.dot(K_ * q);
+}
+
+void SuperelementBody::ElasticForce(const BodyConfiguration& c, const FrameSolution& frame, Eigen::VectorXd* f,
+                                    Eigen::MatrixXd* tangent) const {
+  const int n = n_coordinates();
+  const Eigen::VectorXd q = LocalCoordinates(c, frame);
+  const Kinematics kin = ComputeKinematics(q);
+  const Eigen::VectorXd Q = K_ * q;
+  const Eigen::VectorXd Qhat = options_.approximated ? Eigen::VectorXd(T0_.transpose() * Q)
+                                                     : Eigen::VectorXd(kin.B.transpose() * Q);
+  // Rbar: R_j on every node's force and moment, identity on modal rows.
+  auto rotate = [&](const Eigen::VectorXd& local) {
+    Eigen::VectorXd global = local;
+    for (int a = 0; a < 2 * n_nodes_; ++a) global.segment<3>(3 * a) = frame.R * local.segment<3>(3 * a);
+    return global;
+  };
+  if (f) *f = rotate(Qhat);
+  if (!tangent) return;
+
+  Eigen::MatrixXd Kt;
+  if (options_.approximated) {
+    Kt = T0_.transpose() * K_ * kin.B;
+  } else {
+    Kt = kin.B.transpose() * K_ * kin.B;  // K1
+  }
+  if (options_.full_tangent) {
+    // Fhat, Mhat (n x 6) from Qhat: node rows [0, F~; 0, 0] and [0, 0; 0, M~].
+    Eigen::MatrixXd Fhat = Eigen::MatrixXd::Zero(n, 6), FMhat = Eigen::MatrixXd::Zero(n, 6);
+    for (int a = 0; a < n_nodes_; ++a) {
+      const Eigen::Matrix3d F = Skew<double>(Eigen::Vector3d(Qhat.segment<3>(6 * a)));
+      Fhat.block<3, 3>(6 * a, 3) = F;
+      FMhat.block<3, 3>(6 * a, 3) = F;
+      FMhat.block<3, 3>(6 * a + 3, 3) = Skew<double>(Eigen::Vector3d(Qhat.segment<3>(6 * a + 3)));
+    }
+    Kt -= FMhat * kin.Z;  // K3: rotation of the frame
+    if (!options_.approximated) {
+      Kt -= kin.Z.transpose() * Fhat.transpose() * kin.B;  // K2: variation of Phi_rig in T
+      // K4: variation of D (exact rotation kinematics), v = P^T Q, P = 1 - D Phi_rig S^-1 Phi_CB.
+      const Eigen::VectorXd v =
+          Q - Phi_CB_.transpose() * kin.S.transpose().lu().solve(kin.Phi_rig.transpose() * (kin.D.transpose() * Q));
+      Eigen::MatrixXd G = Eigen::MatrixXd::Zero(n, n);
+      for (int a = 0; a < n_nodes_; ++a) {
+        G.block<3, 3>(6 * a + 3, 6 * a + 3) = LeftJacobianInverseTransposeDerivative(
+            Eigen::Vector3d(q.segment<3>(6 * a + 3)), Eigen::Vector3d(v.segment<3>(6 * a + 3)));
+      }
+      Kt += kin.T.transpose() * G * kin.B;
+    }
+  }
+  // Rbar Kt Rbar^T.
+  Eigen::MatrixXd Rbar = Eigen::MatrixXd::Identity(n, n);
+  for (int a = 0; a < 2 * n_nodes_; ++a) Rbar.block<3, 3>(3 * a, 3 * a) = frame.R;
+  *tangent = Rbar * Kt * Rbar.transpose();
+}
+
+}  // namespace femb

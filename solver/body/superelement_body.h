@@ -1,0 +1,107 @@
+// A superelement in absolute interface coordinates (thesis ch. 3-4, 8.1; tangent stiffness paper).
+//
+// System coordinates of one body: for each interface node k its position x_k and rotation R_k
+// (variations dx_k, spatial dpi_k), then the internal modal coordinates eta. The floating frame
+// (x_j, R_j) is not a coordinate: it solves Phi_CB q_loc = 0 (thesis 3.7, 4.2) by Newton.
+//
+// Local coordinates (thesis 3.1): u_k = R_j^T (x_k - x_j) - X_k,
+//   theta_k = log(R_j^T R_k R0_k^T), eta.
+// Their variation, exact to first order:  d q_loc = B Rbar^T d q,  B = D T  with
+//   D = blockdiag(1, J_l^-1(theta_k), 1)         (exact rotation kinematics; the thesis uses D = 1)
+//   Phi_rig rows [1, -r~_k; 0, 1], r_k = X_k + u_k (thesis 3.14)
+//   S = Phi_CB D Phi_rig, Z = S^-1 Phi_CB D       (thesis 3.17 with D)
+//   T = 1 - Phi_rig Z                              (thesis 3.18)
+// Elastic force, the gradient of V = q_loc^T K q_loc / 2:  f = Rbar B^T K q_loc  (thesis 4.12).
+// Tangent (exact derivative, checked against finite differences), local part of
+// K_t = Rbar (K1 + K2 + K3 + K4) Rbar^T:
+//   K1 = B^T K B                                   (thesis 4.25)
+//   K2 = -Z^T Fhat^T B,  Fhat from Qhat = B^T K q   (thesis 4.32)
+//   K3 = -(Fhat + Mhat) Z                           (thesis 4.37)
+//   K4 = T^T G B, G = blockdiag(d/dtheta [J_l^-T(theta_k) v_k]), v = P^T K q,
+//        P = 1 - D Phi_rig S^-1 Phi_CB              (from D; zero when D = 1)
+// Option `approximated` (thesis 3.23, 5.3): the force uses the constant T0 = 1 - Phi_rig0 Phi_CB,
+// f = Rbar T0^T K q_loc; its tangent is the exact derivative of that force.
+#pragma once
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "formats/superelement.h"
+
+namespace femb {
+
+struct SuperelementOptions {
+  bool approximated = false;  ///< Phi_rig0 / constant T0 (thesis 5.3) instead of the deformed Phi_rig
+  bool full_tangent = true;   ///< false: K1 only (the paper shows Newton then fails at high load)
+};
+
+/// Configuration of one body's system coordinates.
+struct BodyConfiguration {
+  std::vector<Eigen::Vector3d> x;  ///< interface node positions (global)
+  std::vector<Eigen::Matrix3d> R;  ///< interface node rotations (global)
+  Eigen::VectorXd eta;             ///< internal modal coordinates
+};
+
+/// The floating frame of a configuration.
+struct FrameSolution {
+  Eigen::Vector3d x = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
+  int iterations = 0;
+  bool ok = false;
+};
+
+/// Immutable model of one superelement (from its file) plus its placement in the scene.
+class SuperelementBody {
+ public:
+  /// `placement_R`, `placement_x` map part coordinates to global ones (x = p + R_p X).
+  SuperelementBody(const Superelement& se, const SuperelementOptions& options,
+                   const Eigen::Matrix3d& placement_R = Eigen::Matrix3d::Identity(),
+                   const Eigen::Vector3d& placement_x = Eigen::Vector3d::Zero());
+
+  int n_nodes() const { return n_nodes_; }
+  int n_modes() const { return n_modes_; }
+  int n_coordinates() const { return 6 * n_nodes_ + n_modes_; }
+  const Eigen::MatrixXd& K() const { return K_; }
+  const Eigen::MatrixXd& M() const { return M_; }
+  const SuperelementOptions& options() const { return options_; }
+
+  /// Undeformed configuration at the placement, and its floating frame.
+  BodyConfiguration InitialConfiguration() const;
+  FrameSolution InitialFrame() const { return initial_frame_; }
+
+  /// A starting guess for SolveFrame with no previous frame: the frame carried rigidly by
+  /// interface node 0.
+  FrameSolution GuessFrame(const BodyConfiguration& c) const;
+
+  /// Newton on Phi_CB q_loc(x_j, R_j) = 0 from `guess` (thesis 4.2). ok = false when the
+  /// residual does not fall below 1e-12 (relative) in 30 iterations.
+  FrameSolution SolveFrame(const BodyConfiguration& c, const FrameSolution& guess) const;
+
+  /// Local coordinates q_loc (6N + m).
+  Eigen::VectorXd LocalCoordinates(const BodyConfiguration& c, const FrameSolution& frame) const;
+
+  /// Elastic force f (6N + m; per node force then moment, global axes; then modal forces) and,
+  /// if `tangent` is not null, its derivative with respect to (dx_k, dpi_k, d eta).
+  void ElasticForce(const BodyConfiguration& c, const FrameSolution& frame, Eigen::VectorXd* f,
+                    Eigen::MatrixXd* tangent) const;
+
+  /// Strain energy q_loc^T K q_loc / 2.
+  double ElasticEnergy(const BodyConfiguration& c, const FrameSolution& frame) const;
+
+ private:
+  struct Kinematics;  // Phi_rig, D, S, Z, T, B at a configuration
+  Kinematics ComputeKinematics(const Eigen::VectorXd& q_loc) const;
+
+  int n_nodes_ = 0, n_modes_ = 0;
+  SuperelementOptions options_;
+  Eigen::MatrixXd K_, M_, Phi_CB_;
+  std::vector<Eigen::Vector3d> X_;    ///< node positions relative to the frame origin, frame axes
+  std::vector<Eigen::Matrix3d> R0_;   ///< node orientations relative to the frame
+  Eigen::MatrixXd T0_;                ///< 1 - Phi_rig0 Phi_CB (approximated option)
+  Eigen::Matrix3d placement_R_;
+  Eigen::Vector3d placement_x_;
+  Eigen::Vector3d origin_part_;
+  FrameSolution initial_frame_;
+};
+
+}  // namespace femb

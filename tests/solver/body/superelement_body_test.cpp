@@ -1,0 +1,194 @@
+// Superelement body in absolute interface coordinates: the elastic force is the gradient of the
+// strain energy, and the tangent K1+K2+K3(+K4) is its derivative — both checked by central
+// finite differences — and both are invariant under rigid motions.
+#include "solver/body/superelement_body.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <random>
+
+#include "solver/rotation.h"
+#include "test_util.h"
+
+namespace femb {
+namespace {
+
+Superelement Rod(const std::string& frame, int modes = 3) {
+  return test::Reduce(test::StraightBeamYaml(0.5, 8, "{shape: rectangle, width: 0.02, height: 0.01}",
+                                             "{E: 7.0e10, nu: 0.3, rho: 2700}", "[{name: A}, {name: B}]",
+                                             "reduction: {internal_modes: " + std::to_string(modes) + "}\n"),
+                      {"reduction.floating_frame=" + frame});
+}
+
+// A three-interface part (T-shape) to exercise N > 2.
+Superelement Tee() {
+  return test::Reduce(
+      "name: tee\ntype: beam\nmaterial: {E: 7.0e10, nu: 0.3, rho: 2700}\n"
+      "section: {shape: circle, diameter: 0.01}\n"
+      "beam:\n  points: {A: [0, 0, 0], C: [0.2, 0, 0], B: [0.4, 0, 0], D: [0.2, 0.3, 0]}\n"
+      "  segments: [{from: A, to: C, elements: 3}, {from: C, to: B, elements: 3}, {from: C, to: D, elements: 3}]\n"
+      "interfaces: [{name: A}, {name: B}, {name: D}]\n"
+      "reduction: {internal_modes: 2, floating_frame: mean_axes}\n");
+}
+
+// A deformed configuration: large rigid rotation and translation, plus node perturbations of
+// the given size (displacements relative to the body size, rotations in rad).
+BodyConfiguration Deformed(const SuperelementBody& body, double size, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  BodyConfiguration c = body.InitialConfiguration();
+  const Eigen::Matrix3d Rr = ExpSO3(Eigen::Vector3d(0.7, -1.1, 0.4));
+  const Eigen::Vector3d tr(0.3, -0.2, 1.5);
+  for (int k = 0; k < body.n_nodes(); ++k) {
+    c.x[k] = Rr * c.x[k] + tr + 0.05 * size * Eigen::Vector3d(u(rng), u(rng), u(rng));
+    c.R[k] = ExpSO3(size * Eigen::Vector3d(u(rng), u(rng), u(rng))) * Rr * c.R[k];
+  }
+  for (int m = 0; m < c.eta.size(); ++m) c.eta[m] = 1e-3 * size * u(rng);
+  return c;
+}
+
+// Applies eps * e (per node dx, dpi spatial; then d eta).
+BodyConfiguration Perturb(const BodyConfiguration& c, const Eigen::VectorXd& e, double eps) {
+  BodyConfiguration p = c;
+  for (size_t k = 0; k < c.x.size(); ++k) {
+    p.x[k] += eps * e.segment<3>(6 * k);
+    p.R[k] = ExpSO3(eps * Eigen::Vector3d(e.segment<3>(6 * k + 3))) * c.R[k];
+  }
+  p.eta += eps * e.tail(c.eta.size());
+  return p;
+}
+
+struct Evaluation {
+  Eigen::VectorXd f;
+  double energy;
+};
+
+Evaluation Evaluate(const SuperelementBody& body, const BodyConfiguration& c, FrameSolution guess) {
+  const FrameSolution frame = body.SolveFrame(c, guess);
+  EXPECT_TRUE(frame.ok);
+  Evaluation e;
+  body.ElasticForce(c, frame, &e.f, nullptr);
+  e.energy = body.ElasticEnergy(c, frame);
+  return e;
+}
+
+void CheckAgainstFiniteDifferences(const Superelement& se, const SuperelementOptions& options, double size) {
+  const SuperelementBody body(se, options);
+  const BodyConfiguration c = Deformed(body, size, 42);
+  const FrameSolution frame = body.SolveFrame(c, body.GuessFrame(c));
+  ASSERT_TRUE(frame.ok);
+  Eigen::VectorXd f;
+  Eigen::MatrixXd K;
+  body.ElasticForce(c, frame, &f, &K);
+  const int n = body.n_coordinates();
+  Eigen::MatrixXd K_fd(n, n);
+  Eigen::VectorXd f_fd(n);
+  for (int i = 0; i < n; ++i) {
+    const Eigen::VectorXd e = Eigen::VectorXd::Unit(n, i);
+    const double h = 1e-6;
+    const Evaluation plus = Evaluate(body, Perturb(c, e, h), frame);
+    const Evaluation minus = Evaluate(body, Perturb(c, e, -h), frame);
+    K_fd.col(i) = (plus.f - minus.f) / (2 * h);
+    f_fd[i] = (plus.energy - minus.energy) / (2 * h);
+  }
+  // Central differences: truncation O(h^2), round-off O(eps |f| / h): 1e-6 relative is ample.
+  EXPECT_LT((K - K_fd).norm(), 1e-6 * K.norm()) << "tangent, approximated=" << options.approximated
+                                                  << "\nK - K_fd (max) " << (K - K_fd).cwiseAbs().maxCoeff();
+  if (!options.approximated) {
+    // The force is the gradient of the strain energy.
+    EXPECT_LT((f - f_fd).norm(), 1e-6 * f.norm()) << "force vs energy gradient";
+  }
+  EXPECT_GT(f.norm(), 0.0);
+}
+
+TEST(SuperelementBody, ExactTangentMatchesFiniteDifferences) {
+  for (const std::string frame : {"center_of_mass", "mean_axes", "interface:A", "cardona"}) {
+    SCOPED_TRACE(frame);
+    CheckAgainstFiniteDifferences(Rod(frame), {false, true}, 0.3);
+  }
+  CheckAgainstFiniteDifferences(Tee(), {false, true}, 0.3);
+}
+
+TEST(SuperelementBody, ApproximatedTransformationTangentMatchesFiniteDifferences) {
+  CheckAgainstFiniteDifferences(Rod("center_of_mass"), {true, true}, 0.3);
+  CheckAgainstFiniteDifferences(Tee(), {true, true}, 0.3);
+}
+
+TEST(SuperelementBody, TangentIsSymmetricAtEquilibriumFreeConfiguration) {
+  // The exact force is a gradient, so its derivative (a Hessian) is symmetric everywhere.
+  const SuperelementBody body(Rod("center_of_mass"), {false, true});
+  const BodyConfiguration c = Deformed(body, 0.2, 7);
+  const FrameSolution frame = body.SolveFrame(c, body.GuessFrame(c));
+  Eigen::VectorXd f;
+  Eigen::MatrixXd K;
+  body.ElasticForce(c, frame, &f, &K);
+  // A Hessian on SO(3) with spatial variations is symmetric up to the term (f_moment x) — the
+  // asymmetric part is bounded by the moments: check it is small relative to K.
+  EXPECT_LT((K - K.transpose()).norm(), 1e-3 * K.norm());
+}
+
+TEST(SuperelementBody, RigidMotionsAreForceFreeAndForcesRotateWithTheBody) {
+  const Superelement se = Rod("center_of_mass");
+  const SuperelementBody body(se, {false, true});
+  BodyConfiguration c0 = body.InitialConfiguration();
+  Eigen::VectorXd f;
+  body.ElasticForce(c0, body.SolveFrame(c0, body.InitialFrame()), &f, nullptr);
+  EXPECT_LT(f.norm(), 1e-12);
+  // Rigid motion of the undeformed body: still no force; frame follows.
+  const Eigen::Matrix3d Rr = ExpSO3(Eigen::Vector3d(2.0, -0.5, 1.0));
+  const Eigen::Vector3d t(1, 2, 3);
+  BodyConfiguration moved = c0;
+  for (int k = 0; k < body.n_nodes(); ++k) {
+    moved.x[k] = Rr * c0.x[k] + t;
+    moved.R[k] = Rr * c0.R[k];
+  }
+  const FrameSolution frame = body.SolveFrame(moved, body.GuessFrame(moved));
+  ASSERT_TRUE(frame.ok);
+  body.ElasticForce(moved, frame, &f, nullptr);
+  EXPECT_LT(f.norm(), 1e-14 * se.K.cwiseAbs().maxCoeff());  // round-off of positions ~3 m
+  EXPECT_LT((frame.R - Rr).norm(), 1e-12);
+  EXPECT_LT((frame.x - (Rr * body.InitialFrame().x + t)).norm(), 1e-12);
+  // A deformed configuration moved rigidly: same energy, forces rotated.
+  const BodyConfiguration d = Deformed(body, 0.2, 3);
+  BodyConfiguration dm = d;
+  for (int k = 0; k < body.n_nodes(); ++k) {
+    dm.x[k] = Rr * d.x[k] + t;
+    dm.R[k] = Rr * d.R[k];
+  }
+  Eigen::VectorXd fd, fdm;
+  const FrameSolution a = body.SolveFrame(d, body.GuessFrame(d)), b = body.SolveFrame(dm, body.GuessFrame(dm));
+  body.ElasticForce(d, a, &fd, nullptr);
+  body.ElasticForce(dm, b, &fdm, nullptr);
+  EXPECT_NEAR(body.ElasticEnergy(d, a), body.ElasticEnergy(dm, b), 1e-10 * body.ElasticEnergy(d, a));
+  for (int k = 0; k < 2 * body.n_nodes(); ++k) {
+    EXPECT_LT((Rr * fd.segment<3>(3 * k) - fdm.segment<3>(3 * k)).norm(), 1e-9 * fd.norm());
+  }
+  // Total force and moment about the origin of the elastic forces vanish (internal forces).
+  Eigen::Vector3d F = Eigen::Vector3d::Zero(), Mo = Eigen::Vector3d::Zero();
+  for (int k = 0; k < body.n_nodes(); ++k) {
+    F += fd.segment<3>(6 * k);
+    Mo += fd.segment<3>(6 * k + 3) + d.x[k].cross(fd.segment<3>(6 * k));
+  }
+  EXPECT_LT(F.norm(), 1e-9 * fd.norm());
+  EXPECT_LT(Mo.norm(), 1e-9 * fd.norm());
+}
+
+TEST(SuperelementBody, SmallDeformationsReproduceTheReducedStiffness) {
+  // About the undeformed placement the tangent is Rbar K Rbar^T for deformation directions
+  // (K1 = T^T K T with T removing rigid motions, thesis 3.25, and K2 = K3 = 0 with no load).
+  const Superelement se = Rod("center_of_mass");
+  const Eigen::Matrix3d Rp = ExpSO3(Eigen::Vector3d(0.3, 0.2, -0.4));
+  const SuperelementBody body(se, {false, true}, Rp, Eigen::Vector3d(1, 0, 0));
+  const BodyConfiguration c = body.InitialConfiguration();
+  Eigen::MatrixXd Kt;
+  Eigen::VectorXd f;
+  body.ElasticForce(c, body.SolveFrame(c, body.InitialFrame()), &f, &Kt);
+  const int n = body.n_coordinates();
+  Eigen::MatrixXd Rbar = Eigen::MatrixXd::Identity(n, n);
+  for (int a = 0; a < 2 * body.n_nodes(); ++a) Rbar.block<3, 3>(3 * a, 3 * a) = Rp;
+  EXPECT_LT((Kt - Rbar * se.K * Rbar.transpose()).norm(), 1e-9 * se.K.norm());
+}
+
+}  // namespace
+}  // namespace femb
