@@ -1,0 +1,73 @@
+#include "solver/analysis/static_analysis.h"
+
+#include <Eigen/Dense>
+#include <cmath>
+#include <cstdio>
+
+namespace femb {
+namespace {
+
+double ExternalScale(const SystemModel& model) {
+  double s = 0.0;
+  for (const NodeLoad& l : model.loads) s += l.force.norm() + l.moment.norm();
+  return std::max(s, 1e-300);
+}
+
+}  // namespace
+
+StaticResult SolveStatic(const SystemModel& model, SystemState& state, const StaticOptions& options,
+                         const std::function<void(const StaticStepReport&, const SystemState&)>& on_step) {
+  StaticResult result;
+  const DofMap dofs(model);
+  const double f_scale = ExternalScale(model);
+  double lambda = 0.0, step = 1.0 / options.steps;
+  int cuts = 0;
+  while (lambda < 1.0 - 1e-12) {
+    const double target = std::min(1.0, lambda + step);
+    SystemState trial = state;
+    bool converged = false;
+    int it = 0;
+    double r_norm = 0.0, energy = 0.0;
+    for (; it < options.max_iterations; ++it) {
+      const SystemForces f = AssembleStatic(model, dofs, trial, target, true);
+      if (!f.ok) break;
+      r_norm = f.residual.norm();
+      energy = f.elastic_energy;
+      if (!std::isfinite(r_norm)) break;
+      if (r_norm <= options.tolerance * std::max(target * f_scale, 1.0) && it > 0) {
+        converged = true;
+        break;
+      }
+      const Eigen::VectorXd delta = f.tangent.partialPivLu().solve(f.residual);
+      if (!delta.allFinite()) break;
+      ApplyIncrement(model, dofs, delta, trial);
+    }
+    if (!converged) {
+      if (cuts >= options.max_cuts) {
+        char buffer[200];
+        std::snprintf(buffer, sizeof buffer,
+                      "Newton did not converge at load factor %.6g after %d step cuts (last residual %.3g)",
+                      target, cuts, r_norm);
+        result.message = buffer;
+        return result;
+      }
+      step *= 0.5;
+      ++cuts;
+      continue;
+    }
+    state = trial;
+    lambda = target;
+    StaticStepReport report{lambda, it, r_norm, energy};
+    result.steps.push_back(report);
+    if (on_step) on_step(report, state);
+    // Grow back towards the nominal step after easy steps.
+    if (it <= 4 && cuts > 0) {
+      step = std::min(1.0 / options.steps, 2.0 * step);
+      --cuts;
+    }
+  }
+  result.ok = true;
+  return result;
+}
+
+}  // namespace femb

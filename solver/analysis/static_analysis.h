@@ -1,0 +1,38 @@
+// Static analysis: load stepping on the load factor lambda in [0, 1] (or a given list), Newton
+// with the full tangent at each step, step cutting on divergence (thesis 4.2).
+#pragma once
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "solver/assembly/system.h"
+
+namespace femb {
+
+struct StaticOptions {
+  int steps = 10;             ///< equal load steps to lambda = 1
+  int max_iterations = 25;    ///< Newton iterations per step
+  int max_cuts = 6;           ///< halvings of a step before giving up
+  double tolerance = 1e-8;    ///< ||residual|| <= tol * max(||lambda f_ext||, 1) and ||dq|| small
+};
+
+struct StaticStepReport {
+  double lambda = 0.0;
+  int iterations = 0;
+  double residual = 0.0;
+  double elastic_energy = 0.0;
+};
+
+struct StaticResult {
+  bool ok = false;
+  std::string message;                  ///< why it stopped early
+  std::vector<StaticStepReport> steps;  ///< converged steps
+};
+
+/// Runs the load stepping from `state` (updated to the last converged step). `on_step` is
+/// called after each converged step (output writing, progress).
+StaticResult SolveStatic(const SystemModel& model, SystemState& state, const StaticOptions& options,
+                         const std::function<void(const StaticStepReport&, const SystemState&)>& on_step = nullptr);
+
+}  // namespace femb

@@ -1,0 +1,87 @@
+// A multibody system of superelements on shared 6-DOF nodes, without Lagrange multipliers.
+// Nodes shared by bodies are rigid connections; grounded nodes are removed from the unknowns.
+// Unknowns: (dx, dpi) of every free node (spatial increments), then the modal coordinates of
+// every body. Model (immutable) and State are separate: f(const Model&, State&).
+#pragma once
+
+#include <Eigen/Core>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "solver/body/superelement_body.h"
+
+namespace femb {
+
+/// A force and moment on a node, scaled by the load factor. `follower`: given in the node's
+/// frame and turning with it; else fixed in space.
+struct NodeLoad {
+  int node = -1;
+  Eigen::Vector3d force = Eigen::Vector3d::Zero();
+  Eigen::Vector3d moment = Eigen::Vector3d::Zero();
+  bool follower = false;
+};
+
+struct SystemModel {
+  std::vector<std::string> node_names;
+  std::vector<Eigen::Vector3d> node_x0;   ///< initial positions
+  std::vector<Eigen::Matrix3d> node_R0;   ///< initial rotations
+  std::vector<bool> grounded;
+  std::vector<SuperelementBody> bodies;
+  std::vector<std::vector<int>> body_nodes;  ///< system node of each interface of each body
+  std::vector<NodeLoad> loads;
+
+  int n_nodes() const { return int(node_names.size()); }
+};
+
+struct SystemState {
+  std::vector<Eigen::Vector3d> x;
+  std::vector<Eigen::Matrix3d> R;
+  std::vector<Eigen::VectorXd> eta;         ///< per body
+  std::vector<FrameSolution> frames;        ///< per body, the last solved floating frame
+};
+
+/// Numbering of the unknowns.
+class DofMap {
+ public:
+  explicit DofMap(const SystemModel& model);
+  int n_dofs() const { return n_dofs_; }
+  /// First unknown of node k (6 of them), or -1 when grounded.
+  int node_dof(int k) const { return node_dof_[k]; }
+  /// First unknown of body b's modal coordinates.
+  int mode_dof(int b) const { return mode_dof_[b]; }
+
+ private:
+  std::vector<int> node_dof_, mode_dof_;
+  int n_dofs_ = 0;
+};
+
+/// Adds an interface node to `model` at a position and returns its index.
+int AddNode(SystemModel& model, const std::string& name, const Eigen::Vector3d& x,
+            const Eigen::Matrix3d& R = Eigen::Matrix3d::Identity());
+
+/// The initial state: nodes at their initial placement, modes at rest, frames at the bodies'
+/// undeformed frames.
+SystemState InitialState(const SystemModel& model);
+
+/// Result of an evaluation of internal and external forces.
+struct SystemForces {
+  bool ok = true;
+  std::string message;            ///< what failed (a floating frame did not converge, ...)
+  Eigen::VectorXd residual;       ///< lambda f_ext - f_int over the unknowns
+  Eigen::MatrixXd tangent;        ///< d(f_int - lambda f_ext)/d(unknowns)
+  double elastic_energy = 0.0;
+};
+
+/// Solves every body's floating frame (updating state.frames) and assembles the static
+/// residual and tangent at load factor `lambda`.
+SystemForces AssembleStatic(const SystemModel& model, const DofMap& dofs, SystemState& state, double lambda,
+                            bool with_tangent);
+
+/// Applies an increment of the unknowns: x += dx, R <- exp(dpi~) R, eta += d eta.
+void ApplyIncrement(const SystemModel& model, const DofMap& dofs, const Eigen::VectorXd& delta, SystemState& state);
+
+/// The body's configuration taken from the system state.
+BodyConfiguration BodyConfigurationOf(const SystemModel& model, const SystemState& state, int body);
+
+}  // namespace femb
