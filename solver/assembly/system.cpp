@@ -65,13 +65,7 @@ SystemForces AssembleStatic(const SystemModel& model, const DofMap& dofs, System
     Eigen::MatrixXd K;
     body.ElasticForce(c, frame, &f, with_tangent ? &K : nullptr);
     out.elastic_energy += body.ElasticEnergy(c, frame);
-    // Scatter: local coordinate index -> system unknown (-1 grounded).
-    std::vector<int> map(body.n_coordinates(), -1);
-    for (int a = 0; a < body.n_nodes(); ++a) {
-      const int first = dofs.node_dof(model.body_nodes[b][a]);
-      for (int i = 0; i < 6 && first >= 0; ++i) map[6 * a + i] = first + i;
-    }
-    for (int m = 0; m < body.n_modes(); ++m) map[6 * body.n_nodes() + m] = dofs.mode_dof(int(b)) + m;
+    const std::vector<int> map = BodyDofMap(model, dofs, int(b));
     for (int i = 0; i < body.n_coordinates(); ++i) {
       if (map[i] < 0) continue;
       out.residual[map[i]] -= f[i];
@@ -81,21 +75,47 @@ SystemForces AssembleStatic(const SystemModel& model, const DofMap& dofs, System
       }
     }
   }
+  AddNodeLoads(model, dofs, state, lambda, out.residual, with_tangent ? &out.tangent : nullptr);
+  return out;
+}
+
+void AddNodeLoads(const SystemModel& model, const DofMap& dofs, const SystemState& state, double t,
+                  Eigen::VectorXd& residual, Eigen::MatrixXd* tangent) {
   for (const NodeLoad& load : model.loads) {
     const int first = dofs.node_dof(load.node);
     if (first < 0) continue;
+    const double s = load.Scale(t);
     const Eigen::Matrix3d& R = state.R[load.node];
-    const Eigen::Vector3d F = lambda * (load.follower ? Eigen::Vector3d(R * load.force) : load.force);
-    const Eigen::Vector3d Mo = lambda * (load.follower ? Eigen::Vector3d(R * load.moment) : load.moment);
-    out.residual.segment<3>(first) += F;
-    out.residual.segment<3>(first + 3) += Mo;
-    if (with_tangent && load.follower) {
+    const Eigen::Vector3d F = s * (load.follower ? Eigen::Vector3d(R * load.force) : load.force);
+    const Eigen::Vector3d Mo = s * (load.follower ? Eigen::Vector3d(R * load.moment) : load.moment);
+    residual.segment<3>(first) += F;
+    residual.segment<3>(first + 3) += Mo;
+    if (tangent && load.follower) {
       // d(R F_loc)/d pi = -(R F_loc)~: enters the tangent of f_int - f_ext with a plus sign.
-      out.tangent.block<3, 3>(first, first + 3) += Skew<double>(F);
-      out.tangent.block<3, 3>(first + 3, first + 3) += Skew<double>(Mo);
+      tangent->block<3, 3>(first, first + 3) += Skew<double>(F);
+      tangent->block<3, 3>(first + 3, first + 3) += Skew<double>(Mo);
     }
   }
-  return out;
+}
+
+std::vector<int> BodyDofMap(const SystemModel& model, const DofMap& dofs, int b) {
+  const SuperelementBody& body = model.bodies[b];
+  std::vector<int> map(body.n_coordinates(), -1);
+  for (int a = 0; a < body.n_nodes(); ++a) {
+    const int first = dofs.node_dof(model.body_nodes[b][a]);
+    for (int i = 0; i < 6 && first >= 0; ++i) map[6 * a + i] = first + i;
+  }
+  for (int m = 0; m < body.n_modes(); ++m) map[6 * body.n_nodes() + m] = dofs.mode_dof(b) + m;
+  return map;
+}
+
+Eigen::VectorXd GatherBody(const SystemModel& model, const DofMap& dofs, int b, const Eigen::VectorXd& W) {
+  const std::vector<int> map = BodyDofMap(model, dofs, b);
+  Eigen::VectorXd w = Eigen::VectorXd::Zero(map.size());
+  for (size_t i = 0; i < map.size(); ++i) {
+    if (map[i] >= 0) w[i] = W[map[i]];
+  }
+  return w;
 }
 
 void ApplyIncrement(const SystemModel& model, const DofMap& dofs, const Eigen::VectorXd& delta, SystemState& state) {

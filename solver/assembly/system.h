@@ -20,6 +20,9 @@ struct NodeLoad {
   Eigen::Vector3d force = Eigen::Vector3d::Zero();
   Eigen::Vector3d moment = Eigen::Vector3d::Zero();
   bool follower = false;
+  /// Time function scaling the load (static: pseudo-time = load factor). Empty: identity.
+  std::function<double(double)> scale;
+  double Scale(double t) const { return scale ? scale(t) : t; }
 };
 
 struct SystemModel {
@@ -30,6 +33,7 @@ struct SystemModel {
   std::vector<SuperelementBody> bodies;
   std::vector<std::vector<int>> body_nodes;  ///< system node of each interface of each body
   std::vector<NodeLoad> loads;
+  Eigen::Vector3d gravity = Eigen::Vector3d::Zero();  ///< uniform acceleration field (dynamic analyses)
 
   int n_nodes() const { return int(node_names.size()); }
 };
@@ -77,6 +81,18 @@ struct SystemForces {
 /// residual and tangent at load factor `lambda`.
 SystemForces AssembleStatic(const SystemModel& model, const DofMap& dofs, SystemState& state, double lambda,
                             bool with_tangent);
+
+/// External nodal loads at time t (or load factor) and their stiffness d(-f_ext)/dq added to
+/// `tangent` when not null (follower loads).
+void AddNodeLoads(const SystemModel& model, const DofMap& dofs, const SystemState& state, double t,
+                  Eigen::VectorXd& residual, Eigen::MatrixXd* tangent);
+
+/// Gathers body b's velocities (xdot, omega per interface node, then etadot) from system
+/// velocities W over the unknowns (grounded nodes: zero).
+Eigen::VectorXd GatherBody(const SystemModel& model, const DofMap& dofs, int b, const Eigen::VectorXd& W);
+
+/// For each local coordinate of body b the system unknown, or -1 (grounded).
+std::vector<int> BodyDofMap(const SystemModel& model, const DofMap& dofs, int b);
 
 /// Applies an increment of the unknowns: x += dx, R <- exp(dpi~) R, eta += d eta.
 void ApplyIncrement(const SystemModel& model, const DofMap& dofs, const Eigen::VectorXd& delta, SystemState& state);

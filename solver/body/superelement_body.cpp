@@ -38,8 +38,8 @@ SuperelementBody::SuperelementBody(const Superelement& se, const SuperelementOpt
     X_.push_back(node.position - se.floating_frame.origin);
     R0_.push_back(node.orientation);
   }
-  const Eigen::MatrixXd Phi_rig0 = RigidBodyModes(se, se.floating_frame.origin);
-  T0_ = Eigen::MatrixXd::Identity(n_coordinates(), n_coordinates()) - Phi_rig0 * Phi_CB_;
+  Phi_rig0_ = RigidBodyModes(se, se.floating_frame.origin);
+  T0_ = Eigen::MatrixXd::Identity(n_coordinates(), n_coordinates()) - Phi_rig0_ * Phi_CB_;
   initial_frame_.x = placement_x_ + placement_R_ * origin_part_;
   initial_frame_.R = placement_R_;
   initial_frame_.ok = true;
@@ -174,6 +174,106 @@ void SuperelementBody::ElasticForce(const BodyConfiguration& c, const FrameSolut
   Eigen::MatrixXd Rbar = Eigen::MatrixXd::Identity(n, n);
   for (int a = 0; a < 2 * n_nodes_; ++a) Rbar.block<3, 3>(3 * a, 3 * a) = frame.R;
   *tangent = Rbar * Kt * Rbar.transpose();
+}
+
+void SuperelementBody::VelocityMaps(const BodyConfiguration& c, const FrameSolution& frame, Eigen::MatrixXd* P,
+                                    Eigen::MatrixXd* U) const {
+  const int n = n_coordinates();
+  const Eigen::VectorXd q = LocalCoordinates(c, frame);
+  const Kinematics kin = ComputeKinematics(q);
+  Eigen::MatrixXd Rbar_t = Eigen::MatrixXd::Identity(n, n);
+  *P = Eigen::MatrixXd::Identity(n, n);
+  for (int a = 0; a < n_nodes_; ++a) {
+    Rbar_t.block<3, 3>(6 * a, 6 * a) = frame.R.transpose();
+    Rbar_t.block<3, 3>(6 * a + 3, 6 * a + 3) = frame.R.transpose();
+    P->block<3, 3>(6 * a, 6 * a) = frame.R.transpose();
+    P->block<3, 3>(6 * a + 3, 6 * a + 3) = options_.cardona_option_b ? c.R[a].transpose() : frame.R.transpose();
+  }
+  // Spatial variation of the frame rotation: d pi_j = R_j (Z Rbar^T dq)_rot (thesis 3.17).
+  *U = frame.R * (kin.Z * Rbar_t).bottomRows(3);
+}
+
+Eigen::VectorXd SuperelementBody::QuadraticInertia(const BodyConfiguration& c, const Eigen::MatrixXd& P,
+                                                   const Eigen::MatrixXd& U, const Eigen::MatrixXd& Mg,
+                                                   const BodyVelocity& w) const {
+  const int n = n_coordinates();
+  const Eigen::Vector3d omega_j = U * w;
+  Eigen::MatrixXd G = Eigen::MatrixXd::Zero(n, n);
+  Eigen::VectorXd out = Eigen::VectorXd::Zero(n);
+  const Eigen::VectorXd p = Mg * w;
+  for (int a = 0; a < n_nodes_; ++a) {
+    const Eigen::Vector3d xdot = w.segment<3>(6 * a), omega = w.segment<3>(6 * a + 3);
+    G.middleRows<3>(6 * a) = Skew<double>(xdot) * U;
+    if (options_.cardona_option_b) {
+      G.block<3, 3>(6 * a + 3, 6 * a + 3) = Skew<double>(omega);
+    } else {
+      G.middleRows<3>(6 * a + 3) = Skew<double>(omega) * U;
+    }
+    // (Omega_P - Omega_hat) p: translation rows omega_j~, rotation rows omega_j~ - omega_a~ (A), 0 (B).
+    out.segment<3>(6 * a) += omega_j.cross(Eigen::Vector3d(p.segment<3>(6 * a)));
+    if (!options_.cardona_option_b) {
+      out.segment<3>(6 * a + 3) += (omega_j - omega).cross(Eigen::Vector3d(p.segment<3>(6 * a + 3)));
+    }
+  }
+  (void)c;
+  (void)P;
+  out += Mg * (G * w) - G.transpose() * p;
+  return out;
+}
+
+void SuperelementBody::InertiaForce(const BodyConfiguration& c, const FrameSolution& frame, const BodyVelocity& w,
+                                    const BodyVelocity& wdot, Eigen::VectorXd* f_in, Eigen::MatrixXd* mass,
+                                    Eigen::MatrixXd* gyroscopic) const {
+  const int n = n_coordinates();
+  Eigen::MatrixXd P, U;
+  VelocityMaps(c, frame, &P, &U);
+  const Eigen::MatrixXd Mg = P.transpose() * M_ * P;
+  if (f_in) {
+    *f_in = Mg * wdot;
+    if (options_.quadratic_velocity_terms) *f_in += QuadraticInertia(c, P, U, Mg, w);
+  }
+  if (mass) *mass = Mg;
+  if (gyroscopic) {
+    gyroscopic->setZero(n, n);
+    if (!options_.quadratic_velocity_terms) return;
+    // g(w) is quadratic: Dg(w) e = [g(w + s e) - g(w) - g(s e)] / s exactly, for any s > 0.
+    const double s = std::max(w.norm(), 1.0);
+    const Eigen::VectorXd g0 = QuadraticInertia(c, P, U, Mg, w);
+    for (int i = 0; i < n; ++i) {
+      const Eigen::VectorXd e = s * Eigen::VectorXd::Unit(n, i);
+      gyroscopic->col(i) = (QuadraticInertia(c, P, U, Mg, w + e) - g0 - QuadraticInertia(c, P, U, Mg, e)) / s;
+    }
+  }
+}
+
+double SuperelementBody::KineticEnergy(const BodyConfiguration& c, const FrameSolution& frame,
+                                       const BodyVelocity& w) const {
+  Eigen::MatrixXd P, U;
+  VelocityMaps(c, frame, &P, &U);
+  const Eigen::VectorXd v = P * w;
+  return 0.5 * v.dot(M_ * v);
+}
+
+void SuperelementBody::Momentum(const BodyConfiguration& c, const FrameSolution& frame, const BodyVelocity& w,
+                                Eigen::Vector3d* linear, Eigen::Vector3d* angular) const {
+  Eigen::MatrixXd P, U;
+  VelocityMaps(c, frame, &P, &U);
+  const Eigen::VectorXd p = P.transpose() * (M_ * (P * w));
+  linear->setZero();
+  angular->setZero();
+  for (int a = 0; a < n_nodes_; ++a) {
+    *linear += p.segment<3>(6 * a);
+    *angular += p.segment<3>(6 * a + 3) + c.x[a].cross(Eigen::Vector3d(p.segment<3>(6 * a)));
+  }
+}
+
+Eigen::VectorXd SuperelementBody::GravityForce(const BodyConfiguration& c, const FrameSolution& frame,
+                                               const Eigen::Vector3d& g) const {
+  Eigen::MatrixXd P, U;
+  VelocityMaps(c, frame, &P, &U);
+  Eigen::Matrix<double, 6, 1> rigid;
+  rigid << frame.R.transpose() * g, Eigen::Vector3d::Zero();
+  return P.transpose() * (M_ * (Phi_rig0_ * rigid));
 }
 
 }  // namespace femb

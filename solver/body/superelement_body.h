@@ -33,7 +33,12 @@ namespace femb {
 struct SuperelementOptions {
   bool approximated = false;  ///< Phi_rig0 / constant T0 (thesis 5.3) instead of the deformed Phi_rig
   bool full_tangent = true;   ///< false: K1 only (the paper shows Newton then fails at high load)
+  bool quadratic_velocity_terms = true;  ///< false: inertia force M_g wdot only (thesis 4.11 remark)
+  bool cardona_option_b = false;  ///< angular velocities in node frames R_k^T (Cardona's option B)
 };
+
+/// Velocities of one body's system coordinates: per node xdot_k, omega_k (spatial), then etadot.
+using BodyVelocity = Eigen::VectorXd;
 
 /// Configuration of one body's system coordinates.
 struct BodyConfiguration {
@@ -88,9 +93,36 @@ class SuperelementBody {
   /// Strain energy q_loc^T K q_loc / 2.
   double ElasticEnergy(const BodyConfiguration& c, const FrameSolution& frame) const;
 
+  /// Inertia force from the corotational kinetic energy T = v^T M v / 2, v = P w (thesis 3.22,
+  /// 4.9; DESIGN.md "Inertia"), P = blockdiag(R_j^T ... , 1) (option A) or with R_k^T on the
+  /// angular rows (option B). With G defined by d(P w) = P G dq and Omega_P, Omega_hat the
+  /// block-diagonal skew matrices of Pdot^T = Omega_P P^T and of the node angular velocities:
+  ///   f_in = M_g wdot + M_g G w + (Omega_P - Omega_hat) p - G^T p,  M_g = P^T M P, p = M_g w.
+  /// `mass` receives M_g, `gyroscopic` d f_in / d w (exact: f_in is quadratic in w).
+  void InertiaForce(const BodyConfiguration& c, const FrameSolution& frame, const BodyVelocity& w,
+                    const BodyVelocity& wdot, Eigen::VectorXd* f_in, Eigen::MatrixXd* mass,
+                    Eigen::MatrixXd* gyroscopic) const;
+
+  /// Kinetic energy v^T M v / 2.
+  double KineticEnergy(const BodyConfiguration& c, const FrameSolution& frame, const BodyVelocity& w) const;
+
+  /// Linear momentum and angular momentum about the global origin (Noether: sums of the
+  /// generalized momenta p = M_g w of the nodes).
+  void Momentum(const BodyConfiguration& c, const FrameSolution& frame, const BodyVelocity& w,
+                Eigen::Vector3d* linear, Eigen::Vector3d* angular) const;
+
+  /// Generalized force of a uniform acceleration field g (gravity): P^T M Phi_rig0 [R_j^T g; 0].
+  Eigen::VectorXd GravityForce(const BodyConfiguration& c, const FrameSolution& frame, const Eigen::Vector3d& g) const;
+
  private:
   struct Kinematics;  // Phi_rig, D, S, Z, T, B at a configuration
   Kinematics ComputeKinematics(const Eigen::VectorXd& q_loc) const;
+  // P (system velocities -> local velocities) and the frame's angular velocity map U (3 x n).
+  void VelocityMaps(const BodyConfiguration& c, const FrameSolution& frame, Eigen::MatrixXd* P, Eigen::MatrixXd* U) const;
+  // The quadratic part of f_in: M_g G w + (Omega_P - Omega_hat) p - G^T p.
+  Eigen::VectorXd QuadraticInertia(const BodyConfiguration& c, const Eigen::MatrixXd& P, const Eigen::MatrixXd& U,
+                                   const Eigen::MatrixXd& Mg, const BodyVelocity& w) const;
+  Eigen::MatrixXd Phi_rig0_;
 
   int n_nodes_ = 0, n_modes_ = 0;
   SuperelementOptions options_;

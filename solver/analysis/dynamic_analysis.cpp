@@ -1,0 +1,181 @@
+#include "solver/analysis/dynamic_analysis.h"
+
+#include <Eigen/Dense>
+#include <cmath>
+#include <cstdio>
+
+namespace femb {
+namespace {
+
+struct Assembly {
+  bool ok = true;
+  std::string message;
+  Eigen::VectorXd residual;  // f_ext + f_grav - f_int - f_in
+  Eigen::VectorXd f_ext;     // nodal loads and gravity, for the work
+  Eigen::MatrixXd K, C, M;
+  double scale = 0.0;
+};
+
+Assembly AssembleDynamic(const SystemModel& model, const DofMap& dofs, DynamicState& s, double t, bool matrices) {
+  Assembly out;
+  const int n = dofs.n_dofs();
+  out.residual = Eigen::VectorXd::Zero(n);
+  out.f_ext = Eigen::VectorXd::Zero(n);
+  if (matrices) {
+    out.K = Eigen::MatrixXd::Zero(n, n);
+    out.C = Eigen::MatrixXd::Zero(n, n);
+    out.M = Eigen::MatrixXd::Zero(n, n);
+  }
+  for (size_t b = 0; b < model.bodies.size(); ++b) {
+    const SuperelementBody& body = model.bodies[b];
+    const BodyConfiguration c = BodyConfigurationOf(model, s.config, int(b));
+    FrameSolution frame = body.SolveFrame(c, s.config.frames[b]);
+    if (!frame.ok) frame = body.SolveFrame(c, body.GuessFrame(c));
+    if (!frame.ok) {
+      out.ok = false;
+      out.message = "floating frame of body " + std::to_string(b) + " did not converge";
+      return out;
+    }
+    s.config.frames[b] = frame;
+    const Eigen::VectorXd w = GatherBody(model, dofs, int(b), s.W), wdot = GatherBody(model, dofs, int(b), s.Wdot);
+    Eigen::VectorXd f_int, f_in;
+    Eigen::MatrixXd Kb, Mb, Cb;
+    body.ElasticForce(c, frame, &f_int, matrices ? &Kb : nullptr);
+    body.InertiaForce(c, frame, w, wdot, &f_in, matrices ? &Mb : nullptr, matrices ? &Cb : nullptr);
+    Eigen::VectorXd f_grav = Eigen::VectorXd::Zero(body.n_coordinates());
+    if (model.gravity.squaredNorm() > 0) f_grav = body.GravityForce(c, frame, model.gravity);
+    out.scale = std::max({out.scale, f_int.norm(), f_in.norm(), f_grav.norm()});
+    const std::vector<int> map = BodyDofMap(model, dofs, int(b));
+    for (int i = 0; i < body.n_coordinates(); ++i) {
+      if (map[i] < 0) continue;
+      out.residual[map[i]] += f_grav[i] - f_int[i] - f_in[i];
+      out.f_ext[map[i]] += f_grav[i];
+      if (!matrices) continue;
+      for (int j = 0; j < body.n_coordinates(); ++j) {
+        if (map[j] < 0) continue;
+        out.K(map[i], map[j]) += Kb(i, j);
+        out.C(map[i], map[j]) += Cb(i, j);
+        out.M(map[i], map[j]) += Mb(i, j);
+      }
+    }
+  }
+  Eigen::VectorXd loads = Eigen::VectorXd::Zero(n);
+  AddNodeLoads(model, dofs, s.config, t, loads, matrices ? &out.K : nullptr);
+  out.residual += loads;
+  out.f_ext += loads;
+  out.scale = std::max({out.scale, loads.norm(), 1e-300});
+  return out;
+}
+
+}  // namespace
+
+DynamicState InitialDynamicState(const SystemModel& model, const SystemState& config, const Eigen::VectorXd& W,
+                                 double t0) {
+  const DofMap dofs(model);
+  DynamicState s;
+  s.config = config;
+  s.W = W;
+  s.Wdot = Eigen::VectorXd::Zero(dofs.n_dofs());
+  s.t = t0;
+  const Assembly a = AssembleDynamic(model, dofs, s, t0, true);
+  s.Wdot = a.M.ldlt().solve(a.residual);
+  s.a = s.Wdot;
+  s.f_ext = a.f_ext;
+  return s;
+}
+
+DynamicStepReport Measure(const SystemModel& model, DynamicState& s) {
+  const DofMap dofs(model);
+  DynamicStepReport r;
+  r.t = s.t;
+  r.external_work = s.external_work;
+  for (size_t b = 0; b < model.bodies.size(); ++b) {
+    const SuperelementBody& body = model.bodies[b];
+    const BodyConfiguration c = BodyConfigurationOf(model, s.config, int(b));
+    const FrameSolution& frame = s.config.frames[b];
+    const Eigen::VectorXd w = GatherBody(model, dofs, int(b), s.W);
+    r.kinetic_energy += body.KineticEnergy(c, frame, w);
+    r.elastic_energy += body.ElasticEnergy(c, frame);
+    Eigen::Vector3d L, H;
+    body.Momentum(c, frame, w, &L, &H);
+    r.linear_momentum += L;
+    r.angular_momentum += H;
+  }
+  return r;
+}
+
+DynamicResult SolveDynamic(const SystemModel& model, DynamicState& state, const DynamicOptions& options,
+                           const std::function<void(const DynamicStepReport&, const DynamicState&)>& on_step) {
+  DynamicResult result;
+  const DofMap dofs(model);
+  const double rho = std::clamp(options.rho_inf, 0.0, 1.0);
+  const double alpha_m = (2 * rho - 1) / (rho + 1), alpha_f = rho / (rho + 1);
+  const double gamma = 0.5 + alpha_f - alpha_m, beta = 0.25 * (gamma + 0.5) * (gamma + 0.5);
+  double h = options.step;
+  int cuts = 0;
+  while (state.t < options.end_time - 1e-12 * options.end_time) {
+    h = std::min(h, options.end_time - state.t);
+    DynamicState next = state;
+    const Eigen::VectorXd a_pred = (alpha_f * state.Wdot - alpha_m * state.a) / (1 - alpha_m);
+    next.a = a_pred;
+    next.Wdot.setZero();
+    next.W = state.W + h * (1 - gamma) * state.a + h * gamma * a_pred;
+    const Eigen::VectorXd dq = state.W + h * (0.5 - beta) * state.a + h * beta * a_pred;
+    ApplyIncrement(model, dofs, h * dq, next.config);
+    const double gamma_p = gamma / (beta * h), beta_p = (1 - alpha_m) / (beta * h * h * (1 - alpha_f));
+    const double t_new = state.t + h;
+    bool converged = false;
+    int it = 0;
+    Eigen::VectorXd f_ext_new;
+    for (; it < options.max_iterations; ++it) {
+      const Assembly a = AssembleDynamic(model, dofs, next, t_new, true);
+      if (!a.ok || !a.residual.allFinite()) break;
+      if (a.residual.norm() <= options.tolerance * a.scale && it > 0) {
+        converged = true;
+        f_ext_new = a.f_ext;
+        break;
+      }
+      const Eigen::MatrixXd S = a.K + gamma_p * a.C + beta_p * a.M;
+      const Eigen::VectorXd delta = S.partialPivLu().solve(a.residual);
+      if (!delta.allFinite()) break;
+      ApplyIncrement(model, dofs, delta, next.config);
+      next.W += gamma_p * delta;
+      next.Wdot += beta_p * delta;
+    }
+    if (!converged) {
+      if (cuts >= options.max_cuts) {
+        char buffer[200];
+        std::snprintf(buffer, sizeof buffer, "Newton diverged at t = %.6g after %d step cuts (step %.3g)",
+                      state.t, cuts, h);
+        result.message = buffer;
+        return result;
+      }
+      h *= 0.5;
+      ++cuts;
+      continue;
+    }
+    next.a += (1 - alpha_f) / (1 - alpha_m) * next.Wdot;
+    next.t = t_new;
+    // External work by the trapezoidal rule on the increment h dq (nodal loads and gravity).
+    const Eigen::VectorXd increment = h * (0.5 * (state.W + next.W));
+    next.external_work += 0.5 * (state.f_ext + f_ext_new).dot(increment);
+    next.f_ext = f_ext_new;
+    state = next;
+    result.steps += 1;
+    result.newton_iterations += it;
+    if (on_step) {
+      DynamicStepReport r = Measure(model, state);
+      r.h = h;
+      r.iterations = it;
+      on_step(r, state);
+    }
+    if (cuts > 0 && it <= 4) {
+      h = std::min(options.step, 2 * h);
+      --cuts;
+    }
+  }
+  result.ok = true;
+  return result;
+}
+
+}  // namespace femb

@@ -1,0 +1,63 @@
+// Dynamic analysis: Lie-group generalized-alpha (Arnold & Bruls 2007, Bruls & Cardona 2010) on
+// the nodes' SE(3)-like coordinates (x_k, R_k) with spatial velocities, rotations updated by
+// R <- exp(h dq~) R; Newton with the full iteration matrix S = K_t + gamma' C_t + beta' M_g
+// (the configuration dependence of the inertia forces is left out of S: it costs iterations,
+// not accuracy); step cutting when Newton diverges.
+#pragma once
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "solver/assembly/system.h"
+
+namespace femb {
+
+struct DynamicOptions {
+  double step = 1e-3;         ///< time step h [time]
+  double end_time = 1.0;
+  double rho_inf = 0.9;       ///< spectral radius at infinity in [0, 1]; 1: no numerical damping
+  int max_iterations = 20;
+  double tolerance = 1e-9;    ///< ||residual|| <= tol * (force scale of the step)
+  int max_cuts = 8;           ///< halvings of the step before giving up
+};
+
+struct DynamicState {
+  SystemState config;
+  Eigen::VectorXd W;     ///< velocities over the unknowns
+  Eigen::VectorXd Wdot;  ///< accelerations
+  Eigen::VectorXd a;     ///< generalized-alpha acceleration-like variable
+  double t = 0.0;
+  double external_work = 0.0;
+  Eigen::VectorXd f_ext;  ///< external forces (nodal loads, gravity) at t, for the work
+};
+
+struct DynamicStepReport {
+  double t = 0.0;
+  double h = 0.0;
+  int iterations = 0;
+  double kinetic_energy = 0.0, elastic_energy = 0.0, external_work = 0.0;
+  Eigen::Vector3d linear_momentum = Eigen::Vector3d::Zero();
+  Eigen::Vector3d angular_momentum = Eigen::Vector3d::Zero();
+};
+
+struct DynamicResult {
+  bool ok = false;
+  std::string message;
+  long steps = 0;
+  long newton_iterations = 0;
+};
+
+/// Initial state: configuration and velocities given; accelerations from M_g wdot = f_ext -
+/// f_int - f_gyro at t0.
+DynamicState InitialDynamicState(const SystemModel& model, const SystemState& config, const Eigen::VectorXd& W,
+                                 double t0 = 0.0);
+
+/// Energies and momenta of a state.
+DynamicStepReport Measure(const SystemModel& model, DynamicState& state);
+
+/// Integrates from state.t to options.end_time; `on_step` after every converged step.
+DynamicResult SolveDynamic(const SystemModel& model, DynamicState& state, const DynamicOptions& options,
+                           const std::function<void(const DynamicStepReport&, const DynamicState&)>& on_step = nullptr);
+
+}  // namespace femb
