@@ -44,7 +44,13 @@ Assembly AssembleDynamic(const SystemModel& model, const DofMap& dofs, DynamicSt
     body.InertiaForce(c, frame, w, wdot, &f_in, matrices ? &Mb : nullptr, matrices ? &Cb : nullptr);
     Eigen::VectorXd f_grav = Eigen::VectorXd::Zero(body.n_coordinates());
     if (model.gravity.squaredNorm() > 0) f_grav = body.GravityForce(c, frame, model.gravity);
+    // Scale of the forces in balance, each term on its own (for a torque-free body M_g wdot and
+    // the gyroscopic terms cancel: their sum is no scale).
     out.scale = std::max({out.scale, f_int.norm(), f_in.norm(), f_grav.norm()});
+    if (matrices) {
+      const Eigen::VectorXd f_acc = Mb * wdot;
+      out.scale = std::max({out.scale, f_acc.norm(), (f_in - f_acc).norm()});
+    }
     const std::vector<int> map = BodyDofMap(model, dofs, int(b));
     for (int i = 0; i < body.n_coordinates(); ++i) {
       if (map[i] < 0) continue;

@@ -6,8 +6,7 @@ namespace femb {
 
 DofMap::DofMap(const SystemModel& model) {
   for (int k = 0; k < model.n_nodes(); ++k) {
-    node_dof_.push_back(model.grounded[k] ? -1 : n_dofs_);
-    if (!model.grounded[k]) n_dofs_ += 6;
+    for (int i = 0; i < 6; ++i) node_dof_.push_back(model.fixed[k][i] ? -1 : n_dofs_++);
   }
   for (const SuperelementBody& body : model.bodies) {
     mode_dof_.push_back(n_dofs_);
@@ -19,7 +18,7 @@ int AddNode(SystemModel& model, const std::string& name, const Eigen::Vector3d& 
   model.node_names.push_back(name);
   model.node_x0.push_back(x);
   model.node_R0.push_back(R);
-  model.grounded.push_back(false);
+  model.fixed.push_back({false, false, false, false, false, false});
   return model.n_nodes() - 1;
 }
 
@@ -82,18 +81,23 @@ SystemForces AssembleStatic(const SystemModel& model, const DofMap& dofs, System
 void AddNodeLoads(const SystemModel& model, const DofMap& dofs, const SystemState& state, double t,
                   Eigen::VectorXd& residual, Eigen::MatrixXd* tangent) {
   for (const NodeLoad& load : model.loads) {
-    const int first = dofs.node_dof(load.node);
-    if (first < 0) continue;
     const double s = load.Scale(t);
     const Eigen::Matrix3d& R = state.R[load.node];
     const Eigen::Vector3d F = s * (load.follower ? Eigen::Vector3d(R * load.force) : load.force);
     const Eigen::Vector3d Mo = s * (load.follower ? Eigen::Vector3d(R * load.moment) : load.moment);
-    residual.segment<3>(first) += F;
-    residual.segment<3>(first + 3) += Mo;
-    if (tangent && load.follower) {
-      // d(R F_loc)/d pi = -(R F_loc)~: enters the tangent of f_int - f_ext with a plus sign.
-      tangent->block<3, 3>(first, first + 3) += Skew<double>(F);
-      tangent->block<3, 3>(first + 3, first + 3) += Skew<double>(Mo);
+    Eigen::Matrix<double, 6, 1> f;
+    f << F, Mo;
+    Eigen::Matrix<double, 6, 3> stiffness = Eigen::Matrix<double, 6, 3>::Zero();  // d(-f_ext)/d pi
+    if (load.follower) stiffness << Skew<double>(F), Skew<double>(Mo);
+    for (int i = 0; i < 6; ++i) {
+      const int row = dofs.node_dof(load.node, i);
+      if (row < 0) continue;  // reaction: taken by the support
+      residual[row] += f[i];
+      if (!tangent || !load.follower) continue;
+      for (int j = 0; j < 3; ++j) {
+        const int col = dofs.node_dof(load.node, 3 + j);
+        if (col >= 0) (*tangent)(row, col) += stiffness(i, j);
+      }
     }
   }
 }
@@ -102,8 +106,7 @@ std::vector<int> BodyDofMap(const SystemModel& model, const DofMap& dofs, int b)
   const SuperelementBody& body = model.bodies[b];
   std::vector<int> map(body.n_coordinates(), -1);
   for (int a = 0; a < body.n_nodes(); ++a) {
-    const int first = dofs.node_dof(model.body_nodes[b][a]);
-    for (int i = 0; i < 6 && first >= 0; ++i) map[6 * a + i] = first + i;
+    for (int i = 0; i < 6; ++i) map[6 * a + i] = dofs.node_dof(model.body_nodes[b][a], i);
   }
   for (int m = 0; m < body.n_modes(); ++m) map[6 * body.n_nodes() + m] = dofs.mode_dof(b) + m;
   return map;
@@ -120,10 +123,12 @@ Eigen::VectorXd GatherBody(const SystemModel& model, const DofMap& dofs, int b, 
 
 void ApplyIncrement(const SystemModel& model, const DofMap& dofs, const Eigen::VectorXd& delta, SystemState& state) {
   for (int k = 0; k < model.n_nodes(); ++k) {
-    const int first = dofs.node_dof(k);
-    if (first < 0) continue;
-    state.x[k] += delta.segment<3>(first);
-    state.R[k] = ExpSO3(Eigen::Vector3d(delta.segment<3>(first + 3))) * state.R[k];
+    Eigen::Matrix<double, 6, 1> d = Eigen::Matrix<double, 6, 1>::Zero();
+    for (int i = 0; i < 6; ++i) {
+      if (dofs.node_dof(k, i) >= 0) d[i] = delta[dofs.node_dof(k, i)];
+    }
+    state.x[k] += d.head<3>();
+    if (d.tail<3>().squaredNorm() > 0) state.R[k] = ExpSO3(Eigen::Vector3d(d.tail<3>())) * state.R[k];
   }
   for (size_t b = 0; b < model.bodies.size(); ++b) {
     state.eta[b] += delta.segment(dofs.mode_dof(int(b)), model.bodies[b].n_modes());

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <array>
 #include <functional>
 #include <string>
 #include <vector>
@@ -29,7 +30,9 @@ struct SystemModel {
   std::vector<std::string> node_names;
   std::vector<Eigen::Vector3d> node_x0;   ///< initial positions
   std::vector<Eigen::Matrix3d> node_R0;   ///< initial rotations
-  std::vector<bool> grounded;
+  /// Per node: which of its 6 components (x, y, z, rx, ry, rz; spatial) are held fixed. All six:
+  /// clamped to ground; the first three: spherical joint to ground.
+  std::vector<std::array<bool, 6>> fixed;
   std::vector<SuperelementBody> bodies;
   std::vector<std::vector<int>> body_nodes;  ///< system node of each interface of each body
   std::vector<NodeLoad> loads;
@@ -50,8 +53,8 @@ class DofMap {
  public:
   explicit DofMap(const SystemModel& model);
   int n_dofs() const { return n_dofs_; }
-  /// First unknown of node k (6 of them), or -1 when grounded.
-  int node_dof(int k) const { return node_dof_[k]; }
+  /// Unknown of component i (0-5) of node k, or -1 when that component is fixed.
+  int node_dof(int k, int i) const { return node_dof_[6 * k + i]; }
   /// First unknown of body b's modal coordinates.
   int mode_dof(int b) const { return mode_dof_[b]; }
 
@@ -59,6 +62,11 @@ class DofMap {
   std::vector<int> node_dof_, mode_dof_;
   int n_dofs_ = 0;
 };
+
+/// Holds all 6 components of node k fixed (clamp to ground).
+inline void Clamp(SystemModel& model, int k) { model.fixed[k].fill(true); }
+/// Holds node k's position fixed, rotation free (spherical joint to ground).
+inline void Pin(SystemModel& model, int k) { model.fixed[k] = {true, true, true, false, false, false}; }
 
 /// Adds an interface node to `model` at a position and returns its index.
 int AddNode(SystemModel& model, const std::string& name, const Eigen::Vector3d& x,

@@ -64,7 +64,7 @@ SystemModel TubeChain(int n_bodies, const SuperelementOptions& options, double P
   const Superelement se = test::Reduce(part);
   SystemModel model;
   for (int i = 0; i <= n_bodies; ++i) AddNode(model, "n" + std::to_string(i), Eigen::Vector3d(i * Lb, 0, 0));
-  model.grounded[0] = true;
+  Clamp(model, 0);
   for (int i = 0; i < n_bodies; ++i) {
     model.bodies.emplace_back(se, options, Eigen::Matrix3d::Identity(), Eigen::Vector3d(i * Lb, 0, 0));
     model.body_nodes.push_back({i, i + 1});
