@@ -42,6 +42,7 @@ Assembly AssembleDynamic(const SystemModel& model, const DofMap& dofs, DynamicSt
     Eigen::MatrixXd Kb, Mb, Cb;
     body.ElasticForce(c, frame, &f_int, matrices ? &Kb : nullptr);
     body.InertiaForce(c, frame, w, wdot, &f_in, matrices ? &Mb : nullptr, matrices ? &Cb : nullptr);
+    body.AddModalDamping(w, f_in, matrices ? &Cb : nullptr);
     Eigen::VectorXd f_grav = Eigen::VectorXd::Zero(body.n_coordinates());
     if (model.gravity.squaredNorm() > 0) f_grav = body.GravityForce(c, frame, model.gravity);
     // Scale of the forces in balance, each term on its own (for a torque-free body M_g wdot and

@@ -5,25 +5,15 @@
 #include <cstdio>
 
 namespace femb {
-namespace {
-
-double ExternalScale(const SystemModel& model) {
-  double s = 0.0;
-  for (const NodeLoad& l : model.loads) s += l.force.norm() + l.moment.norm();
-  return std::max(s, 1e-300);
-}
-
-}  // namespace
-
 StaticResult SolveStatic(const SystemModel& model, SystemState& state, const StaticOptions& options,
                          const std::function<void(const StaticStepReport&, const SystemState&)>& on_step) {
   StaticResult result;
   const DofMap dofs(model);
-  const double f_scale = ExternalScale(model);
-  double lambda = 0.0, step = 1.0 / options.steps;
+  const double end = options.end_time, nominal = options.end_time / options.steps;
+  double lambda = 0.0, step = nominal;
   int cuts = 0;
-  while (lambda < 1.0 - 1e-12) {
-    const double target = std::min(1.0, lambda + step);
+  while (lambda < end * (1 - 1e-12)) {
+    const double target = std::min(end, lambda + step);
     SystemState trial = state;
     bool converged = false;
     int it = 0;
@@ -34,7 +24,7 @@ StaticResult SolveStatic(const SystemModel& model, SystemState& state, const Sta
       r_norm = f.residual.norm();
       energy = f.elastic_energy;
       if (!std::isfinite(r_norm)) break;
-      if (r_norm <= options.tolerance * std::max(target * f_scale, 1.0) && it > 0) {
+      if (r_norm <= options.tolerance * std::max(f.force_scale, 1e-300) && it > 0) {
         converged = true;
         break;
       }
@@ -46,7 +36,7 @@ StaticResult SolveStatic(const SystemModel& model, SystemState& state, const Sta
       if (cuts >= options.max_cuts) {
         char buffer[200];
         std::snprintf(buffer, sizeof buffer,
-                      "Newton did not converge at load factor %.6g after %d step cuts (last residual %.3g)",
+                      "Newton did not converge at pseudo-time %.6g after %d step cuts (last residual %.3g)",
                       target, cuts, r_norm);
         result.message = buffer;
         return result;
@@ -62,7 +52,7 @@ StaticResult SolveStatic(const SystemModel& model, SystemState& state, const Sta
     if (on_step) on_step(report, state);
     // Grow back towards the nominal step after easy steps.
     if (it <= 4 && cuts > 0) {
-      step = std::min(1.0 / options.steps, 2.0 * step);
+      step = std::min(nominal, 2.0 * step);
       --cuts;
     }
   }

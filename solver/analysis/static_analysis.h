@@ -11,14 +11,15 @@
 namespace femb {
 
 struct StaticOptions {
-  int steps = 10;             ///< equal load steps to lambda = 1
+  double end_time = 1.0;      ///< pseudo-time at the end; loads are scaled by their functions of it
+  int steps = 10;             ///< equal pseudo-time steps to end_time
   int max_iterations = 25;    ///< Newton iterations per step
   int max_cuts = 6;           ///< halvings of a step before giving up
-  double tolerance = 1e-8;    ///< ||residual|| <= tol * max(||lambda f_ext||, 1) and ||dq|| small
+  double tolerance = 1e-8;    ///< ||residual|| <= tol * (largest force term of the step)
 };
 
 struct StaticStepReport {
-  double lambda = 0.0;
+  double lambda = 0.0;        ///< pseudo-time
   int iterations = 0;
   double residual = 0.0;
   double elastic_energy = 0.0;

@@ -64,6 +64,7 @@ SystemForces AssembleStatic(const SystemModel& model, const DofMap& dofs, System
     Eigen::MatrixXd K;
     body.ElasticForce(c, frame, &f, with_tangent ? &K : nullptr);
     out.elastic_energy += body.ElasticEnergy(c, frame);
+    out.force_scale = std::max(out.force_scale, f.norm());
     const std::vector<int> map = BodyDofMap(model, dofs, int(b));
     for (int i = 0; i < body.n_coordinates(); ++i) {
       if (map[i] < 0) continue;
@@ -74,7 +75,10 @@ SystemForces AssembleStatic(const SystemModel& model, const DofMap& dofs, System
       }
     }
   }
-  AddNodeLoads(model, dofs, state, lambda, out.residual, with_tangent ? &out.tangent : nullptr);
+  Eigen::VectorXd loads = Eigen::VectorXd::Zero(n);
+  AddNodeLoads(model, dofs, state, lambda, loads, with_tangent ? &out.tangent : nullptr);
+  out.residual += loads;
+  out.force_scale = std::max(out.force_scale, loads.norm());
   return out;
 }
 

@@ -83,6 +83,7 @@ struct SystemForces {
   Eigen::VectorXd residual;       ///< lambda f_ext - f_int over the unknowns
   Eigen::MatrixXd tangent;        ///< d(f_int - lambda f_ext)/d(unknowns)
   double elastic_energy = 0.0;
+  double force_scale = 0.0;       ///< largest norm of the internal or external force terms
 };
 
 /// Solves every body's floating frame (updating state.frames) and assembles the static

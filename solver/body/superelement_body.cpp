@@ -246,6 +246,17 @@ void SuperelementBody::InertiaForce(const BodyConfiguration& c, const FrameSolut
   }
 }
 
+void SuperelementBody::AddModalDamping(const BodyVelocity& w, Eigen::VectorXd& f, Eigen::MatrixXd* C) const {
+  if (options_.modal_damping <= 0.0) return;
+  for (int m = 0; m < n_modes_; ++m) {
+    const int i = 6 * n_nodes_ + m;
+    // Internal modes are mass-normalized: K_ii = omega_i^2.
+    const double c = 2.0 * options_.modal_damping * std::sqrt(std::max(K_(i, i), 0.0));
+    f[i] += c * w[i];
+    if (C) (*C)(i, i) += c;
+  }
+}
+
 double SuperelementBody::KineticEnergy(const BodyConfiguration& c, const FrameSolution& frame,
                                        const BodyVelocity& w) const {
   Eigen::MatrixXd P, U;

@@ -35,6 +35,7 @@ struct SuperelementOptions {
   bool full_tangent = true;   ///< false: K1 only (the paper shows Newton then fails at high load)
   bool quadratic_velocity_terms = true;  ///< false: inertia force M_g wdot only (thesis 4.11 remark)
   bool cardona_option_b = false;  ///< angular velocities in node frames R_k^T (Cardona's option B)
+  double modal_damping = 0.0;     ///< damping ratio zeta of the internal modes: f = 2 zeta omega etadot
 };
 
 /// Velocities of one body's system coordinates: per node xdot_k, omega_k (spatial), then etadot.
@@ -102,6 +103,10 @@ class SuperelementBody {
   void InertiaForce(const BodyConfiguration& c, const FrameSolution& frame, const BodyVelocity& w,
                     const BodyVelocity& wdot, Eigen::VectorXd* f_in, Eigen::MatrixXd* mass,
                     Eigen::MatrixXd* gyroscopic) const;
+
+  /// Modal damping force 2 zeta omega_i etadot_i on the internal-mode rows and its derivative
+  /// with respect to w (added to `f` and `C`).
+  void AddModalDamping(const BodyVelocity& w, Eigen::VectorXd& f, Eigen::MatrixXd* C) const;
 
   /// Kinetic energy v^T M v / 2.
   double KineticEnergy(const BodyConfiguration& c, const FrameSolution& frame, const BodyVelocity& w) const;

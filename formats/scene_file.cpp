@@ -1,0 +1,262 @@
+#include "formats/scene_file.h"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include "formats/input_error.h"
+#include "formats/yaml_reader.h"
+
+namespace femb {
+
+double TimeFunctionSpec::Evaluate(double t) const {
+  if (type == "linear") return t;
+  if (type == "constant") return value;
+  if (type == "ramp") {
+    if (t <= t_start) return 0.0;
+    if (t >= t_end) return value;
+    return value * (t - t_start) / (t_end - t_start);
+  }
+  if (type == "step") return t >= t_start ? value : 0.0;
+  if (type == "pulse") return (t >= t_start && t < t_end) ? value : 0.0;
+  if (type == "sine") return offset + amplitude * std::sin(2 * M_PI * frequency * t + phase);
+  // table
+  if (t <= table.front().first) return table.front().second;
+  if (t >= table.back().first) return table.back().second;
+  auto it = std::upper_bound(table.begin(), table.end(), t, [](double v, const auto& p) { return v < p.first; });
+  const auto& b = *it;
+  const auto& a = *(it - 1);
+  return a.second + (b.second - a.second) * (t - a.first) / (b.first - a.first);
+}
+
+namespace {
+
+TimeFunctionSpec ParseFunction(const YamlValue& value) {
+  YamlMap m = value.Map();
+  TimeFunctionSpec f;
+  YamlValue type = m.Required("type");
+  f.type = type.String();
+  if (f.type == "constant") {
+    f.value = m.Required("value").Number();
+  } else if (f.type == "ramp" || f.type == "pulse") {
+    f.value = m.Required("value").Number();
+    f.t_start = m.Required("t_start").Number();
+    YamlValue t_end = m.Required("t_end");
+    f.t_end = t_end.Number();
+    if (!(f.t_end > f.t_start)) t_end.Fail("t_end must be after t_start");
+  } else if (f.type == "step") {
+    f.value = m.Required("value").Number();
+    f.t_start = m.Required("t_start").Number();
+  } else if (f.type == "sine") {
+    f.amplitude = m.Required("amplitude").Number();
+    f.frequency = m.Required("frequency").Number();
+    if (auto v = m.Optional("phase")) f.phase = v->Number();
+    if (auto v = m.Optional("offset")) f.offset = v->Number();
+  } else if (f.type == "table") {
+    YamlValue points = m.Required("points");
+    for (const YamlValue& p : points.List()) {
+      auto pair = p.List();
+      if (pair.size() != 2) p.Fail("expected [t, value]");
+      f.table.emplace_back(pair[0].Number(), pair[1].Number());
+      if (f.table.size() > 1 && !(f.table.back().first > f.table[f.table.size() - 2].first)) {
+        p.Fail("table times must increase");
+      }
+    }
+    if (f.table.empty()) points.Fail("a table needs at least one point");
+  } else if (f.type != "linear") {
+    type.Fail("unknown time function type '" + f.type + "' (known: linear, constant, ramp, step, pulse, sine, table)");
+  }
+  m.CheckNoUnknownKeys();
+  return f;
+}
+
+}  // namespace
+
+SceneSpec ParseScene(const std::string& text, const std::string& name, const std::vector<std::string>& overrides) {
+  YamlDocument doc = YamlDocument::LoadString(text, name);
+  for (const auto& o : overrides) doc.Set(o);
+  YamlMap root = doc.Root();
+  SceneSpec scene;
+  scene.file = name;
+  scene.name = root.Required("name").String();
+  if (auto u = root.Optional("units")) scene.units = u->String();
+
+  if (auto functions = root.Optional("functions")) {
+    for (const auto& [fname, value] : functions->Map().Entries()) scene.functions[fname] = ParseFunction(value);
+  }
+
+  std::set<std::string> nodes;
+  YamlValue bodies = root.Required("bodies");
+  for (const YamlValue& item : bodies.List()) {
+    YamlMap m = item.Map();
+    SceneBodySpec b;
+    b.where = item.Where();
+    b.name = m.Required("name").String();
+    for (const auto& other : scene.bodies) {
+      if (other.name == b.name) item.Fail("body name '" + b.name + "' used twice");
+    }
+    if (auto t = m.Optional("type")) {
+      if (t->String() != "superelement") t->Fail("unknown body type '" + t->String() + "' (known: superelement)");
+    }
+    b.superelement = m.Required("superelement").String();
+    if (auto p = m.Optional("placement")) {
+      YamlMap pm = p->Map();
+      if (auto v = pm.Optional("position")) b.position = v->Vector3();
+      if (auto v = pm.Optional("rotation")) b.rotation = v->Vector3();
+      pm.CheckNoUnknownKeys();
+    }
+    YamlValue node_map = m.Required("nodes");
+    for (const auto& [iname, scene_node] : node_map.Map().Entries()) {
+      b.nodes[iname] = scene_node.String();
+      nodes.insert(scene_node.String());
+    }
+    if (auto o = m.Optional("options")) {
+      YamlMap om = o->Map();
+      if (auto v = om.Optional("transformations")) {
+        const std::string t = v->String();
+        if (t != "exact" && t != "approximated") v->Fail("expected exact or approximated, got '" + t + "'");
+        b.approximated = t == "approximated";
+      }
+      if (auto v = om.Optional("tangent")) {
+        const std::string t = v->String();
+        if (t != "full" && t != "K1") v->Fail("expected full or K1, got '" + t + "'");
+        b.full_tangent = t == "full";
+      }
+      if (auto v = om.Optional("quadratic_velocity_terms")) b.quadratic_velocity_terms = v->Bool();
+      if (auto v = om.Optional("inertia_option")) {
+        const std::string t = v->String();
+        if (t != "A" && t != "B") v->Fail("expected A or B (Cardona's options), got '" + t + "'");
+        b.option_b = t == "B";
+      }
+      if (auto v = om.Optional("modal_damping")) {
+        b.modal_damping = v->Number();
+        if (b.modal_damping < 0) v->Fail("damping ratio must be >= 0");
+      }
+      om.CheckNoUnknownKeys();
+    }
+    m.CheckNoUnknownKeys();
+    scene.bodies.push_back(b);
+  }
+  if (scene.bodies.empty()) bodies.Fail("a scene needs at least one body");
+
+  auto check_node = [&](const YamlValue& v) {
+    const std::string n = v.String();
+    if (!nodes.count(n)) v.Fail("node '" + n + "' is not a node of any body");
+    return n;
+  };
+
+  if (auto joints = root.Optional("joints")) {
+    for (const YamlValue& item : joints->List()) {
+      YamlMap m = item.Map();
+      SceneJointSpec j;
+      j.where = item.Where();
+      YamlValue type = m.Required("type");
+      j.type = type.String();
+      if (j.type != "clamp" && j.type != "spherical") {
+        type.Fail("unknown joint type '" + j.type + "' (known here: clamp, spherical; to ground)");
+      }
+      j.node = check_node(m.Required("node"));
+      m.CheckNoUnknownKeys();
+      scene.joints.push_back(j);
+    }
+  }
+
+  if (auto loads = root.Optional("loads")) {
+    for (const YamlValue& item : loads->List()) {
+      YamlMap m = item.Map();
+      SceneLoadSpec l;
+      l.where = item.Where();
+      YamlValue type = m.Required("type");
+      l.type = type.String();
+      if (l.type == "force") {
+        l.node = check_node(m.Required("node"));
+        if (auto v = m.Optional("force")) l.force = v->Vector3();
+        if (auto v = m.Optional("moment")) l.moment = v->Vector3();
+        if (auto v = m.Optional("follower")) l.follower = v->Bool();
+        if (auto v = m.Optional("function")) {
+          l.function = v->String();
+          if (!scene.functions.count(l.function)) v->Fail("time function '" + l.function + "' is not defined under 'functions'");
+        }
+      } else if (l.type == "gravity") {
+        l.g = m.Required("g").Vector3();
+      } else {
+        type.Fail("unknown load type '" + l.type + "' (known: force, gravity)");
+      }
+      m.CheckNoUnknownKeys();
+      scene.loads.push_back(l);
+    }
+  }
+
+  if (auto initial = root.Optional("initial_velocity")) {
+    for (const auto& [node, value] : initial->Map().Entries()) {
+      YamlMap m = value.Map();
+      std::pair<Eigen::Vector3d, Eigen::Vector3d> v{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
+      if (auto x = m.Optional("linear")) v.first = x->Vector3();
+      if (auto x = m.Optional("angular")) v.second = x->Vector3();
+      m.CheckNoUnknownKeys();
+      if (!nodes.count(node)) value.Fail("node '" + node + "' is not a node of any body");
+      scene.initial_velocities[node] = v;
+    }
+  }
+
+  YamlValue analysis = root.Required("analysis");
+  {
+    YamlMap m = analysis.Map();
+    SceneAnalysisSpec& a = scene.analysis;
+    YamlValue type = m.Required("type");
+    a.type = type.String();
+    if (a.type != "static" && a.type != "dynamic") type.Fail("unknown analysis type '" + a.type + "' (known: static, dynamic)");
+    if (auto v = m.Optional("end_time")) a.end_time = v->PositiveNumber();
+    if (auto v = m.Optional("steps")) {
+      a.steps = int(v->Integer());
+      if (a.steps < 1) v->Fail("needs at least 1 step");
+    }
+    if (auto v = m.Optional("step")) a.step = v->PositiveNumber();
+    if (auto v = m.Optional("rho_inf")) {
+      a.rho_inf = v->Number();
+      if (a.rho_inf < 0 || a.rho_inf > 1) v->Fail("rho_inf must be in [0, 1]");
+    }
+    if (auto v = m.Optional("tolerance")) a.tolerance = v->PositiveNumber();
+    if (auto v = m.Optional("max_iterations")) a.max_iterations = int(v->NonNegativeInteger());
+    if (auto v = m.Optional("output_every")) a.output_every = std::max(1, int(v->NonNegativeInteger()));
+    m.CheckNoUnknownKeys();
+  }
+
+  if (auto outputs = root.Optional("outputs")) {
+    YamlMap m = outputs.value().Map();
+    if (auto probes = m.Optional("probes")) {
+      for (const YamlValue& item : probes->List()) {
+        YamlMap pm = item.Map();
+        SceneProbeSpec p;
+        p.where = item.Where();
+        p.name = pm.Required("name").String();
+        p.node = check_node(pm.Required("node"));
+        YamlValue q = pm.Required("quantities");
+        for (const YamlValue& qi : q.List()) {
+          const std::string s = qi.String();
+          if (s != "position" && s != "rotation" && s != "velocity" && s != "angular_velocity") {
+            qi.Fail("unknown probe quantity '" + s + "' (known: position, rotation, velocity, angular_velocity)");
+          }
+          p.quantities.push_back(s);
+        }
+        pm.CheckNoUnknownKeys();
+        scene.probes.push_back(p);
+      }
+    }
+    m.CheckNoUnknownKeys();
+  }
+  root.CheckNoUnknownKeys();
+  return scene;
+}
+
+SceneSpec ReadSceneFile(const std::string& path, const std::vector<std::string>& overrides) {
+  std::ifstream in(path);
+  if (!in) throw InputError(path + ": cannot open scene file (does it exist and is it readable?)");
+  std::stringstream text;
+  text << in.rdbuf();
+  return ParseScene(text.str(), path, overrides);
+}
+
+}  // namespace femb

@@ -1,0 +1,87 @@
+// The scene file (YAML): what femb-solve reads. Parsing checks names and ranges and names
+// FILE:LINE: key on failure; the format is documented in formats/SCENE_FORMAT.md.
+#pragma once
+
+#include <Eigen/Core>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace femb {
+
+/// A scalar function of time (or of the pseudo-time of a static analysis).
+struct TimeFunctionSpec {
+  std::string type = "linear";  ///< linear (f = t), constant, ramp, step, sine, table
+  double value = 1.0;           ///< constant value; final value of ramp and step
+  double t_start = 0.0, t_end = 1.0;  ///< ramp from 0 at t_start to value at t_end; step at t_start
+  double amplitude = 0.0, frequency = 0.0, phase = 0.0, offset = 0.0;  ///< sine [Hz]
+  std::vector<std::pair<double, double>> table;  ///< (t, f) pairs, linear in between
+  double Evaluate(double t) const;
+};
+
+struct SceneBodySpec {
+  std::string name;
+  std::string superelement;      ///< file path (relative paths are relative to the scene file)
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();
+  Eigen::Vector3d rotation = Eigen::Vector3d::Zero();  ///< rotation vector [rad]
+  std::map<std::string, std::string> nodes;  ///< interface name -> scene node name
+  bool approximated = false, full_tangent = true, quadratic_velocity_terms = true, option_b = false;
+  double modal_damping = 0.0;    ///< damping ratio of the internal modes
+  std::string where;
+};
+
+struct SceneJointSpec {
+  std::string type;  ///< clamp (ground), spherical (to ground)
+  std::string node;
+  std::string where;
+};
+
+struct SceneLoadSpec {
+  std::string type;  ///< force (force and/or moment on a node), gravity
+  std::string node;
+  Eigen::Vector3d force = Eigen::Vector3d::Zero(), moment = Eigen::Vector3d::Zero();
+  bool follower = false;
+  std::string function;  ///< name of a time function ("" = linear for static, constant 1 for dynamic)
+  Eigen::Vector3d g = Eigen::Vector3d::Zero();
+  std::string where;
+};
+
+struct SceneProbeSpec {
+  std::string name;
+  std::string node;
+  std::vector<std::string> quantities;  ///< position, rotation, velocity, angular_velocity
+  std::string where;
+};
+
+struct SceneAnalysisSpec {
+  std::string type = "static";  ///< static, dynamic
+  double end_time = 1.0;
+  int steps = 10;               ///< static: load steps over [0, end_time]
+  double step = 1e-3;           ///< dynamic: time step
+  double rho_inf = 0.9;
+  double tolerance = 1e-8;
+  int max_iterations = 25;
+  int output_every = 1;
+};
+
+struct SceneSpec {
+  std::string file;
+  std::string name;
+  std::string units = "SI";
+  std::vector<SceneBodySpec> bodies;
+  std::vector<SceneJointSpec> joints;
+  std::vector<SceneLoadSpec> loads;
+  std::map<std::string, TimeFunctionSpec> functions;
+  SceneAnalysisSpec analysis;
+  std::vector<SceneProbeSpec> probes;
+  /// Initial velocity (spatial) of named nodes: (linear, angular).
+  std::map<std::string, std::pair<Eigen::Vector3d, Eigen::Vector3d>> initial_velocities;
+};
+
+/// Reads a scene file with "key.path=value" overrides applied first. Throws InputError naming
+/// FILE:LINE and the key.
+SceneSpec ReadSceneFile(const std::string& path, const std::vector<std::string>& overrides = {});
+SceneSpec ParseScene(const std::string& text, const std::string& name, const std::vector<std::string>& overrides = {});
+
+}  // namespace femb

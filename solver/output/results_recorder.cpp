@@ -1,0 +1,155 @@
+#include "solver/output/results_recorder.h"
+
+#include <unistd.h>
+
+#include <Eigen/Geometry>
+#include <cstdio>
+#include <filesystem>
+
+#include "formats/hdf5_file.h"
+#include "formats/input_error.h"
+
+namespace femb {
+namespace {
+
+Eigen::Vector4d Quaternion(const Eigen::Matrix3d& R) {
+  Eigen::Quaterniond q(R);
+  if (q.w() < 0) q.coeffs() *= -1;  // w >= 0: a continuous, unique representative
+  return Eigen::Vector4d(q.w(), q.x(), q.y(), q.z());
+}
+
+std::string Num(double v) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%.10g", v);
+  return buffer;
+}
+
+Eigen::MatrixXd Stack(const std::vector<Eigen::VectorXd>& rows, int cols) {
+  Eigen::MatrixXd m(rows.size(), cols);
+  for (size_t i = 0; i < rows.size(); ++i) m.row(long(i)) = rows[i].transpose();
+  return m;
+}
+
+}  // namespace
+
+ResultsRecorder::ResultsRecorder(const Scene& scene, const std::string& directory)
+    : scene_(scene), directory_(directory) {
+  std::error_code ec;
+  std::filesystem::create_directories(directory, ec);
+  if (ec) throw InputError(directory + ": cannot create output folder (" + ec.message() + ")");
+  csv_path_ = (std::filesystem::path(directory) / "probes.csv").string();
+  h5_path_ = (std::filesystem::path(directory) / "results.h5").string();
+  csv_tmp_ = csv_path_ + ".tmp." + std::to_string(::getpid());
+  csv_.open(csv_tmp_);
+  if (!csv_) throw InputError(csv_tmp_ + ": cannot write");
+  csv_ << "time";
+  static const char* xyz[3] = {"x", "y", "z"};
+  static const char* wxyz[4] = {"w", "x", "y", "z"};
+  for (const SceneProbeSpec& p : scene.spec.probes) {
+    for (const std::string& q : p.quantities) {
+      if (q == "rotation") {
+        for (const char* c : wxyz) csv_ << "," << p.name << "." << q << "." << c;
+      } else {
+        for (const char* c : xyz) csv_ << "," << p.name << "." << q << "." << c;
+      }
+    }
+  }
+  csv_ << ",kinetic_energy,elastic_energy,external_work\n";
+}
+
+void ResultsRecorder::Record(double t, const SystemState& state, const Eigen::VectorXd& W, double kinetic,
+                             double elastic, double external_work) {
+  const SystemModel& model = scene_.model;
+  const DofMap dofs(model);
+  const int n = model.n_nodes();
+  Eigen::VectorXd pos(3 * n), quat(4 * n), vel(3 * n), ang(3 * n);
+  for (int k = 0; k < n; ++k) {
+    pos.segment<3>(3 * k) = state.x[k];
+    quat.segment<4>(4 * k) = Quaternion(state.R[k]);
+    for (int i = 0; i < 3; ++i) {
+      const int dv = dofs.node_dof(k, i), dw = dofs.node_dof(k, 3 + i);
+      vel[3 * k + i] = (dv >= 0 && W.size()) ? W[dv] : 0.0;
+      ang[3 * k + i] = (dw >= 0 && W.size()) ? W[dw] : 0.0;
+    }
+  }
+  time_.push_back(t);
+  kinetic_.push_back(kinetic);
+  elastic_.push_back(elastic);
+  work_.push_back(external_work);
+  positions_.push_back(pos);
+  quaternions_.push_back(quat);
+  velocities_.push_back(vel);
+  angular_velocities_.push_back(ang);
+  std::vector<Eigen::VectorXd> modal, frames;
+  for (size_t b = 0; b < model.bodies.size(); ++b) {
+    modal.push_back(state.eta[b]);
+    Eigen::VectorXd f(7);
+    f << state.frames[b].x, Quaternion(state.frames[b].R);
+    frames.push_back(f);
+  }
+  modal_.push_back(modal);
+  frames_.push_back(frames);
+
+  csv_ << Num(t);
+  for (const SceneProbeSpec& p : scene_.spec.probes) {
+    const int k = scene_.node_index.at(p.node);
+    for (const std::string& q : p.quantities) {
+      if (q == "position") for (int i = 0; i < 3; ++i) csv_ << "," << Num(pos[3 * k + i]);
+      if (q == "rotation") for (int i = 0; i < 4; ++i) csv_ << "," << Num(quat[4 * k + i]);
+      if (q == "velocity") for (int i = 0; i < 3; ++i) csv_ << "," << Num(vel[3 * k + i]);
+      if (q == "angular_velocity") for (int i = 0; i < 3; ++i) csv_ << "," << Num(ang[3 * k + i]);
+    }
+  }
+  csv_ << "," << Num(kinetic) << "," << Num(elastic) << "," << Num(external_work) << "\n";
+}
+
+void ResultsRecorder::Finish(const std::string& status) {
+  csv_.close();
+  std::error_code ec;
+  std::filesystem::rename(csv_tmp_, csv_path_, ec);
+  if (ec) throw InputError(csv_path_ + ": cannot rename into place (" + ec.message() + ")");
+
+  const std::string tmp = h5_path_ + ".tmp." + std::to_string(::getpid());
+  {
+    const SystemModel& model = scene_.model;
+    const int n = model.n_nodes();
+    h5::Writer w(tmp);
+    w.Attribute("/", "format", "femb-results");
+    w.Attribute("/", "format_version", "1.0");
+    w.Attribute("/", "scene", scene_.spec.file);
+    w.Attribute("/", "analysis", scene_.spec.analysis.type);
+    w.Attribute("/", "status", status);
+    w.Attribute("/", "units", scene_.spec.units);
+    w.Vector("/time", Eigen::Map<const Eigen::VectorXd>(time_.data(), long(time_.size())));
+    w.CreateGroup("/nodes");
+    w.Strings("/nodes/names", model.node_names);
+    w.Matrix("/nodes/position", Stack(positions_, 3 * n));
+    w.Matrix("/nodes/quaternion", Stack(quaternions_, 4 * n));
+    w.Matrix("/nodes/velocity", Stack(velocities_, 3 * n));
+    w.Matrix("/nodes/angular_velocity", Stack(angular_velocities_, 3 * n));
+    w.CreateGroup("/energy");
+    w.Vector("/energy/kinetic", Eigen::Map<const Eigen::VectorXd>(kinetic_.data(), long(kinetic_.size())));
+    w.Vector("/energy/elastic", Eigen::Map<const Eigen::VectorXd>(elastic_.data(), long(elastic_.size())));
+    w.Vector("/energy/external_work", Eigen::Map<const Eigen::VectorXd>(work_.data(), long(work_.size())));
+    w.CreateGroup("/bodies");
+    for (size_t b = 0; b < model.bodies.size(); ++b) {
+      const std::string g = "/bodies/" + scene_.body_names[b];
+      w.CreateGroup(g);
+      std::vector<Eigen::VectorXd> modal, frames;
+      for (size_t s = 0; s < time_.size(); ++s) {
+        modal.push_back(modal_[s][b]);
+        frames.push_back(frames_[s][b]);
+      }
+      w.Matrix(g + "/modal_coordinates", Stack(modal, model.bodies[b].n_modes()));
+      w.Matrix(g + "/floating_frame", Stack(frames, 7));
+      std::vector<std::string> nodes;
+      for (int k : model.body_nodes[b]) nodes.push_back(model.node_names[k]);
+      w.Strings(g + "/nodes", nodes);
+    }
+    w.Close();
+  }
+  std::filesystem::rename(tmp, h5_path_, ec);
+  if (ec) throw InputError(h5_path_ + ": cannot rename into place (" + ec.message() + ")");
+}
+
+}  // namespace femb

@@ -1,0 +1,40 @@
+// Results of a simulation: an HDF5 file with every node's motion, the modal coordinates and
+// floating frames of every body and the energies per output step, and a CSV of the requested
+// probes that always ends with kinetic_energy,elastic_energy,external_work. Both are written
+// to temporary names and renamed by Finish(), which is also called after a numerical failure
+// so the results up to it are kept. Layout: formats/RESULTS_FORMAT.md.
+#pragma once
+
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "solver/scene/scene_builder.h"
+
+namespace femb {
+
+class ResultsRecorder {
+ public:
+  /// Creates `directory` if needed; opens results.h5 (at Finish) and probes.csv (streamed).
+  ResultsRecorder(const Scene& scene, const std::string& directory);
+  /// Records one output step. W: velocities over the unknowns (zero for static analyses).
+  void Record(double t, const SystemState& state, const Eigen::VectorXd& W, double kinetic, double elastic,
+              double external_work);
+  /// Writes results.h5 and renames both files into place. `status` is stored ("completed" or the
+  /// failure message).
+  void Finish(const std::string& status);
+  const std::string& csv_path() const { return csv_path_; }
+  const std::string& h5_path() const { return h5_path_; }
+  long steps() const { return long(time_.size()); }
+
+ private:
+  const Scene& scene_;
+  std::string directory_, csv_path_, h5_path_, csv_tmp_;
+  std::ofstream csv_;
+  std::vector<double> time_, kinetic_, elastic_, work_;
+  std::vector<Eigen::VectorXd> positions_, quaternions_, velocities_, angular_velocities_;
+  std::vector<std::vector<Eigen::VectorXd>> modal_;     // per step, per body
+  std::vector<std::vector<Eigen::VectorXd>> frames_;    // per step, per body: x (3), quaternion (4)
+};
+
+}  // namespace femb

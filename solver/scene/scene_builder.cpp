@@ -1,0 +1,117 @@
+#include "solver/scene/scene_builder.h"
+
+#include <cstdio>
+#include <filesystem>
+
+#include "formats/input_error.h"
+#include "formats/superelement_file.h"
+#include "solver/rotation.h"
+
+namespace femb {
+
+Scene BuildScene(const SceneSpec& spec) {
+  Scene scene;
+  scene.spec = spec;
+  SystemModel& model = scene.model;
+  const std::filesystem::path base = std::filesystem::path(spec.file).parent_path();
+  std::map<std::string, std::pair<Eigen::Vector3d, std::string>> placed;  // node -> position, by body
+  for (const SceneBodySpec& b : spec.bodies) {
+    std::filesystem::path file(b.superelement);
+    if (file.is_relative()) file = base / file;
+    Superelement se;
+    try {
+      SuperelementReadOptions options;
+      options.visualization = false;
+      se = ReadSuperelementFile(file.string(), options);
+    } catch (const InputError& e) {
+      throw InputError(b.where + ": body '" + b.name + "': " + e.what());
+    }
+    if (se.units.system != spec.units) {
+      throw InputError(b.where + ": body '" + b.name + "': superelement units " + se.units.system +
+                       " differ from the scene's " + spec.units);
+    }
+    const Eigen::Matrix3d R = ExpSO3(b.rotation);
+    SuperelementOptions options;
+    options.approximated = b.approximated;
+    options.full_tangent = b.full_tangent;
+    options.quadratic_velocity_terms = b.quadratic_velocity_terms;
+    options.cardona_option_b = b.option_b;
+    options.modal_damping = b.modal_damping;
+    std::vector<int> nodes;
+    for (const auto& [iname, _] : b.nodes) {
+      bool found = false;
+      for (const auto& i : se.interfaces) found |= i.name == iname;
+      if (!found) {
+        std::string known;
+        for (const auto& i : se.interfaces) known += (known.empty() ? "" : ", ") + i.name;
+        throw InputError(b.where + ": body '" + b.name + "': " + file.string() + " has no interface '" + iname +
+                         "' (it has: " + known + ")");
+      }
+    }
+    for (const InterfaceNode& interface : se.interfaces) {
+      auto it = b.nodes.find(interface.name);
+      if (it == b.nodes.end()) {
+        throw InputError(b.where + ": body '" + b.name + "': interface '" + interface.name +
+                         "' is not mapped to a scene node under 'nodes'");
+      }
+      const std::string& node = it->second;
+      const Eigen::Vector3d x = b.position + R * interface.position;
+      auto found = scene.node_index.find(node);
+      if (found == scene.node_index.end()) {
+        scene.node_index[node] = AddNode(model, node, x, R * interface.orientation);
+        placed[node] = {x, b.name};
+      } else {
+        const auto& [x_other, other] = placed[node];
+        if ((x - x_other).norm() > 1e-9 * std::max(1.0, x.norm())) {
+          char buffer[300];
+          std::snprintf(buffer, sizeof buffer, "node '%s' is placed at (%.6g, %.6g, %.6g) by body '%s' but at (%.6g, %.6g, %.6g) by body '%s'",
+                        node.c_str(), x.x(), x.y(), x.z(), b.name.c_str(), x_other.x(), x_other.y(), x_other.z(), other.c_str());
+          throw InputError(b.where + ": " + buffer);
+        }
+      }
+      nodes.push_back(scene.node_index[node]);
+    }
+    model.bodies.emplace_back(se, options, R, b.position);
+    model.body_nodes.push_back(nodes);
+    scene.body_names.push_back(b.name);
+  }
+  for (const SceneJointSpec& j : spec.joints) {
+    const int k = scene.node_index.at(j.node);
+    if (j.type == "clamp") Clamp(model, k);
+    if (j.type == "spherical") Pin(model, k);
+  }
+  for (const SceneLoadSpec& l : spec.loads) {
+    if (l.type == "gravity") {
+      model.gravity += l.g;
+      continue;
+    }
+    const int k = scene.node_index.at(l.node);
+    bool all_fixed = true;
+    for (bool f : model.fixed[k]) all_fixed &= f;
+    if (all_fixed) throw InputError(l.where + ": load on node '" + l.node + "', which is clamped to the ground");
+    NodeLoad load;
+    load.node = k;
+    load.force = l.force;
+    load.moment = l.moment;
+    load.follower = l.follower;
+    if (!l.function.empty()) {
+      const TimeFunctionSpec f = spec.functions.at(l.function);
+      load.scale = [f](double t) { return f.Evaluate(t); };
+    } else if (spec.analysis.type == "dynamic") {
+      load.scale = [](double) { return 1.0; };
+    }
+    model.loads.push_back(load);
+  }
+  const DofMap dofs(model);
+  scene.initial_velocity = Eigen::VectorXd::Zero(dofs.n_dofs());
+  for (const auto& [node, v] : spec.initial_velocities) {
+    const int k = scene.node_index.at(node);
+    for (int i = 0; i < 6; ++i) {
+      const int d = dofs.node_dof(k, i);
+      if (d >= 0) scene.initial_velocity[d] = i < 3 ? v.first[i] : v.second[i - 3];
+    }
+  }
+  return scene;
+}
+
+}  // namespace femb

@@ -1,0 +1,27 @@
+// From a scene file to a system model: loads the superelement files, maps interface nodes to
+// scene nodes (shared names are rigid connections), applies joints to ground and loads, and
+// checks consistency (one clear error per problem, naming FILE:LINE).
+#pragma once
+
+#include <map>
+#include <string>
+
+#include "formats/scene_file.h"
+#include "solver/assembly/system.h"
+
+namespace femb {
+
+struct Scene {
+  SceneSpec spec;
+  SystemModel model;
+  std::map<std::string, int> node_index;
+  std::vector<std::string> body_names;
+  Eigen::VectorXd initial_velocity;  ///< over the unknowns
+};
+
+/// Throws InputError for: a missing or wrong-version superelement file, an interface name the
+/// file does not have, an interface left unmapped, a node placed at different points by two
+/// bodies, a load or probe on an unknown node, a load on a clamped node.
+Scene BuildScene(const SceneSpec& spec);
+
+}  // namespace femb

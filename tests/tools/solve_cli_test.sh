@@ -1,0 +1,72 @@
+#!/usr/bin/env bash
+# femb-solve from the command line: the static cantilever example end to end, outputs, and one
+# clear line with exit code 2 (input) or 3 (numerical failure, results kept) for bad cases.
+# Usage: solve_cli_test.sh BIN_DIR SOURCE_DIR
+set -u
+bin=$1
+src=$2
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+passed=0
+failed=0
+ok() { passed=$((passed + 1)); }
+fail() { failed=$((failed + 1)); echo "FAIL: $*"; }
+py=/usr/bin/python3
+
+"$bin/femb-solve" --help | grep -q "usage: femb-solve" && ok || fail "--help"
+cp "$src/examples/cantilever_static/segment.yaml" "$src/examples/cantilever_static/scene.yaml" "$work/"
+"$bin/femb-reduce" -q "$work/segment.yaml" -o "$work/segment.h5" || fail "reduce segment"
+"$bin/femb-solve" "$work/scene.yaml" -o "$work/out" > "$work/log.txt" && ok || fail "solve: $(cat "$work/log.txt")"
+grep -q "Newton iterations" "$work/log.txt" && ok || fail "no progress line"
+head -1 "$work/out/probes.csv" | grep -qx "time,tip.position.x,tip.position.y,tip.position.z,tip.rotation.w,tip.rotation.x,tip.rotation.y,tip.rotation.z,kinetic_energy,elastic_energy,external_work" \
+  && ok || fail "CSV header: $(head -1 "$work/out/probes.csv")"
+$py - "$work/out" <<'PY' && ok || fail "results content"
+import csv, sys, h5py
+rows = list(csv.DictReader(open(sys.argv[1] + "/probes.csv")))
+assert len(rows) == 101, len(rows)
+assert float(rows[-1]["time"]) == 100.0
+# 10 kN tip force: the elastica gives (du, w) = (0.8055, 0.9195) m; femb within 1%.
+du = 1 - float(rows[-1]["tip.position.x"]); w = -float(rows[-1]["tip.position.y"])
+err = ((du - 0.80554) ** 2 + (w - 0.91945) ** 2) ** 0.5 / (0.80554 ** 2 + 0.91945 ** 2) ** 0.5
+assert err < 0.01, err
+f = h5py.File(sys.argv[1] + "/results.h5", "r")
+assert f.attrs["status"] in (b"completed", "completed")
+assert f["nodes/position"].shape == (101, 33)
+assert f["nodes/quaternion"].shape == (101, 44)
+assert f["bodies/b0/modal_coordinates"].shape == (101, 2)
+PY
+ls "$work/out" | grep -q tmp && fail "temporary file left" || ok
+
+expect() {  # name, exit code, expected text, scene text transformation (sed)
+  local name=$1 code=$2 text=$3 script=$4
+  sed "$script" "$work/scene.yaml" > "$work/bad.yaml"
+  rm -rf "$work/bad_out"
+  "$bin/femb-solve" -q "$work/bad.yaml" -o "$work/bad_out" 2> "$work/err.txt" > /dev/null
+  local got=$?
+  [ $got = "$code" ] || { fail "$name: exit $got, want $code ($(cat "$work/err.txt"))"; return; }
+  [ "$(wc -l < "$work/err.txt")" = 1 ] || { fail "$name: not one line: $(cat "$work/err.txt")"; return; }
+  grep -qF -- "$text" "$work/err.txt" || { fail "$name: '$(cat "$work/err.txt")' lacks '$text'"; return; }
+  ok
+}
+expect "unknown joint type" 2 "bad.yaml:18: joints[0].type: unknown joint type 'weld'" 's/type: clamp/type: weld/'
+expect "unknown node" 2 "node 'n42' is not a node of any body" 's/node: n10, force/node: n42, force/'
+expect "unknown body type" 2 "unknown body type 'rigid_blob'" 's/{name: b0, /{name: b0, type: rigid_blob, /'
+expect "missing superelement" 2 "body 'b3': " 's/{name: b3, superelement: segment.h5/{name: b3, superelement: nothere.h5/'
+expect "missing superelement names file" 2 "nothere.h5: cannot open file" 's/{name: b3, superelement: segment.h5/{name: b3, superelement: nothere.h5/'
+expect "load on clamped node" 2 "load on node 'n0', which is clamped" 's/node: n10, force/node: n0, force/'
+expect "unknown analysis" 2 "unknown analysis type 'eigen'" 's/type: static/type: eigen/'
+expect "node placed twice" 2 "node 'n1' is placed at" 's/position: \[0.1, 0, 0\]}, nodes: {A: n1/position: [0.15, 0, 0]}, nodes: {A: n1/'
+# Wrong version superelement file.
+cp "$work/segment.h5" "$work/v2.h5"
+$py -c "import h5py; f=h5py.File('$work/v2.h5','r+'); f.attrs['format_version_major']=2" 
+expect "wrong version" 2 "is not supported by this femb" 's/{name: b3, superelement: segment.h5/{name: b3, superelement: v2.h5/'
+# Numerical failure: K1-only tangent at high load: exit 3, results up to it kept.
+sed 's/{name: b\([0-9]\), superelement: segment.h5,/{name: b\1, superelement: segment.h5, options: {tangent: K1},/' "$work/scene.yaml" > "$work/k1.yaml"
+"$bin/femb-solve" -q "$work/k1.yaml" -o "$work/k1_out" 2> "$work/err.txt" > /dev/null
+code=$?
+[ $code = 3 ] && grep -q "numerical failure: Newton did not converge" "$work/err.txt" && ok || fail "K1 only: exit $code: $(cat "$work/err.txt")"
+[ -s "$work/k1_out/probes.csv" ] && [ -s "$work/k1_out/results.h5" ] && ok || fail "K1 only: results not kept"
+$py -c "import h5py; f=h5py.File('$work/k1_out/results.h5'); s=f.attrs['status']; s = s.decode() if isinstance(s, bytes) else s; assert 'did not converge' in s" && ok || fail "status not stored"
+
+echo "solve cli: $passed passed, $failed failed"
+[ $failed = 0 ]
