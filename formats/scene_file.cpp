@@ -207,7 +207,18 @@ SceneSpec ParseScene(const std::string& text, const std::string& name, const std
     SceneAnalysisSpec& a = scene.analysis;
     YamlValue type = m.Required("type");
     a.type = type.String();
-    if (a.type != "static" && a.type != "dynamic") type.Fail("unknown analysis type '" + a.type + "' (known: static, dynamic)");
+    if (a.type != "static" && a.type != "dynamic" && a.type != "modes") {
+      type.Fail("unknown analysis type '" + a.type + "' (known: static, dynamic, modes)");
+    }
+    if (auto v = m.Optional("count")) {
+      a.mode_count = int(v->Integer());
+      if (a.mode_count < 1) v->Fail("needs at least 1 mode");
+    }
+    if (auto v = m.Optional("about")) {
+      const std::string about = v->String();
+      if (about != "initial" && about != "static") v->Fail("expected initial or static, got '" + about + "'");
+      a.modes_about_static = about == "static";
+    }
     if (auto v = m.Optional("end_time")) a.end_time = v->PositiveNumber();
     if (auto v = m.Optional("steps")) {
       a.steps = int(v->Integer());

@@ -55,7 +55,9 @@ struct SceneProbeSpec {
 };
 
 struct SceneAnalysisSpec {
-  std::string type = "static";  ///< static, dynamic
+  std::string type = "static";  ///< static, dynamic, modes
+  int mode_count = 10;          ///< modes: how many
+  bool modes_about_static = false;  ///< modes: about the static state under the loads at end_time
   double end_time = 1.0;
   int steps = 10;               ///< static: load steps over [0, end_time]
   double step = 1e-3;           ///< dynamic: time step

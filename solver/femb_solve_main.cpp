@@ -1,12 +1,14 @@
 // femb-solve: simulate a scene of superelements (static or dynamic).
 #include <chrono>
 #include <cstdio>
+#include <fstream>
 #include <string>
 #include <vector>
 
 #include "formats/input_error.h"
 #include "formats/scene_file.h"
 #include "solver/analysis/dynamic_analysis.h"
+#include "solver/analysis/modal_analysis.h"
 #include "solver/analysis/static_analysis.h"
 #include "solver/output/results_recorder.h"
 #include "solver/scene/scene_builder.h"
@@ -96,6 +98,43 @@ int main(int argc, char** argv) {
                   total_iterations, Seconds(wall));
       std::fflush(stdout);
     };
+    if (spec.analysis.type == "modes") {
+      femb::SystemState state = femb::InitialState(scene.model);
+      double load_time = 0.0;
+      if (spec.analysis.modes_about_static) {
+        femb::StaticOptions options;
+        options.end_time = spec.analysis.end_time;
+        options.steps = spec.analysis.steps;
+        options.tolerance = spec.analysis.tolerance;
+        const femb::StaticResult r = femb::SolveStatic(scene.model, state, options);
+        if (!r.ok) {
+          recorder.Finish(r.message);
+          std::fprintf(stderr, "femb-solve: %s: numerical failure in the static state for the modes: %s\n",
+                       scene_path.c_str(), r.message.c_str());
+          return 3;
+        }
+        load_time = spec.analysis.end_time;
+      }
+      recorder.Record(load_time, state, Eigen::VectorXd(), 0.0, 0.0, 0.0);
+      const femb::ModalResult modes = femb::LinearizedModes(scene.model, state, load_time, spec.analysis.mode_count);
+      recorder.Finish(modes.ok ? "completed" : modes.message);
+      if (!modes.ok) {
+        std::fprintf(stderr, "femb-solve: %s: numerical failure: %s\n", scene_path.c_str(), modes.message.c_str());
+        return 3;
+      }
+      const std::string path = output + "/modes.csv";
+      {
+        std::ofstream out(path + ".tmp");
+        out << "mode,frequency_hz\n";
+        for (int k = 0; k < modes.frequencies_hz.size(); ++k) {
+          out << k + 1 << "," << modes.frequencies_hz[k] << "\n";
+          if (!quiet) std::printf("femb-solve: mode %3d  %14.6g Hz\n", k + 1, modes.frequencies_hz[k]);
+        }
+      }
+      std::rename((path + ".tmp").c_str(), path.c_str());
+      if (!quiet) std::printf("femb-solve: frequencies in %s\n", path.c_str());
+      return 0;
+    }
     if (spec.analysis.type == "static") {
       femb::SystemState state = femb::InitialState(scene.model);
       recorder.Record(0.0, state, Eigen::VectorXd(), 0.0, 0.0, 0.0);

@@ -10,6 +10,11 @@ StaticResult SolveStatic(const SystemModel& model, SystemState& state, const Sta
   StaticResult result;
   const DofMap dofs(model);
   const double end = options.end_time, nominal = options.end_time / options.steps;
+  // Increments below round-off of the positions also mean convergence (an unloaded state has a
+  // residual of round-off size and no force scale to compare it with).
+  double size = 0.0;
+  for (const Eigen::Vector3d& x : model.node_x0) size = std::max(size, x.norm());
+  if (size == 0.0) size = 1.0;
   double lambda = 0.0, step = nominal;
   int cuts = 0;
   while (lambda < end * (1 - 1e-12)) {
@@ -17,19 +22,20 @@ StaticResult SolveStatic(const SystemModel& model, SystemState& state, const Sta
     SystemState trial = state;
     bool converged = false;
     int it = 0;
-    double r_norm = 0.0, energy = 0.0;
+    double r_norm = 0.0, energy = 0.0, last_step = 1e300;
     for (; it < options.max_iterations; ++it) {
       const SystemForces f = AssembleStatic(model, dofs, trial, target, true);
       if (!f.ok) break;
       r_norm = f.residual.norm();
       energy = f.elastic_energy;
       if (!std::isfinite(r_norm)) break;
-      if (r_norm <= options.tolerance * std::max(f.force_scale, 1e-300) && it > 0) {
+      if (it > 0 && (r_norm <= options.tolerance * std::max(f.force_scale, 1e-300) || last_step <= 1e-13 * size)) {
         converged = true;
         break;
       }
       const Eigen::VectorXd delta = f.tangent.partialPivLu().solve(f.residual);
       if (!delta.allFinite()) break;
+      last_step = delta.norm();
       ApplyIncrement(model, dofs, delta, trial);
     }
     if (!converged) {

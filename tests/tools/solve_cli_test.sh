@@ -37,6 +37,18 @@ assert f["bodies/b0/modal_coordinates"].shape == (101, 2)
 PY
 ls "$work/out" | grep -q tmp && fail "temporary file left" || ok
 
+# Linearized modes of the clamped 10-body tube: the first bending pair equals the ringing
+# frequency of one clamped tube body (19.16 Hz, tests/solver/analysis/flexible_dynamics_test).
+"$bin/femb-solve" -q "$work/scene.yaml" -o "$work/modes" --set analysis.type=modes --set analysis.count=4 \
+  && ok || fail "modes analysis"
+$py - "$work/modes/modes.csv" <<'PY' && ok || fail "modes.csv"
+import csv, sys
+rows = list(csv.DictReader(open(sys.argv[1])))
+assert len(rows) == 4
+f = [float(r["frequency_hz"]) for r in rows]
+assert abs(f[0] - 19.16) < 0.05 and abs(f[1] - f[0]) < 1e-6 * f[0], f
+PY
+
 expect() {  # name, exit code, expected text, scene text transformation (sed)
   local name=$1 code=$2 text=$3 script=$4
   sed "$script" "$work/scene.yaml" > "$work/bad.yaml"
