@@ -181,8 +181,26 @@ SceneSpec ParseScene(const std::string& text, const std::string& name, const std
         }
       } else if (l.type == "gravity") {
         l.g = m.Required("g").Vector3();
+      } else if (l.type == "spring") {
+        l.node = check_node(m.Required("node"));
+        auto node_b = m.Optional("node_b");
+        auto point = m.Optional("point");
+        if (bool(node_b) == bool(point)) item.Fail("a spring needs exactly one of node_b and point for its other end");
+        if (node_b) l.node_b = check_node(*node_b);
+        if (point) l.point = point->Vector3();
+        YamlValue k = m.Required("stiffness");
+        l.stiffness = k.Number();
+        if (l.stiffness < 0) k.Fail("stiffness must be >= 0");
+        if (auto v = m.Optional("damping")) {
+          l.damping = v->Number();
+          if (l.damping < 0) v->Fail("damping must be >= 0");
+        }
+        if (auto v = m.Optional("free_length")) {
+          l.free_length = v->Number();
+          if (l.free_length < 0) v->Fail("free length must be >= 0");
+        }
       } else {
-        type.Fail("unknown load type '" + l.type + "' (known: force, gravity)");
+        type.Fail("unknown load type '" + l.type + "' (known: force, gravity, spring)");
       }
       m.CheckNoUnknownKeys();
       scene.loads.push_back(l);

@@ -38,12 +38,16 @@ struct SceneJointSpec {
 };
 
 struct SceneLoadSpec {
-  std::string type;  ///< force (force and/or moment on a node), gravity
+  std::string type;  ///< force (force and/or moment on a node), gravity, spring
   std::string node;
   Eigen::Vector3d force = Eigen::Vector3d::Zero(), moment = Eigen::Vector3d::Zero();
   bool follower = false;
   std::string function;  ///< name of a time function ("" = linear for static, constant 1 for dynamic)
   Eigen::Vector3d g = Eigen::Vector3d::Zero();
+  // spring: node (end a), node_b or point (end b), stiffness, damping, free_length (< 0: initial)
+  std::string node_b;
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();
+  double stiffness = 0.0, damping = 0.0, free_length = -1.0;
   std::string where;
 };
 

@@ -70,6 +70,11 @@ Assembly AssembleDynamic(const SystemModel& model, const DofMap& dofs, DynamicSt
   AddNodeLoads(model, dofs, s.config, t, loads, matrices ? &out.K : nullptr);
   out.residual += loads;
   out.f_ext += loads;
+  Eigen::VectorXd springs = Eigen::VectorXd::Zero(n);
+  AddSpringDampers(model, dofs, s.config, s.W, springs, matrices ? &out.K : nullptr, matrices ? &out.C : nullptr,
+                   nullptr);
+  out.residual += springs;
+  out.scale = std::max(out.scale, springs.norm());
   out.scale = std::max({out.scale, loads.norm(), 1e-300});
   return out;
 }
@@ -96,6 +101,8 @@ DynamicStepReport Measure(const SystemModel& model, DynamicState& s) {
   DynamicStepReport r;
   r.t = s.t;
   r.external_work = s.external_work;
+  Eigen::VectorXd unused = Eigen::VectorXd::Zero(dofs.n_dofs());
+  AddSpringDampers(model, dofs, s.config, s.W, unused, nullptr, nullptr, &r.elastic_energy);  // spring energy
   for (size_t b = 0; b < model.bodies.size(); ++b) {
     const SuperelementBody& body = model.bodies[b];
     const BodyConfiguration c = BodyConfigurationOf(model, s.config, int(b));

@@ -77,6 +77,8 @@ SystemForces AssembleStatic(const SystemModel& model, const DofMap& dofs, System
   }
   Eigen::VectorXd loads = Eigen::VectorXd::Zero(n);
   AddNodeLoads(model, dofs, state, lambda, loads, with_tangent ? &out.tangent : nullptr);
+  AddSpringDampers(model, dofs, state, Eigen::VectorXd(), loads, with_tangent ? &out.tangent : nullptr, nullptr,
+                   &out.elastic_energy);
   out.residual += loads;
   out.force_scale = std::max(out.force_scale, loads.norm());
   return out;
@@ -101,6 +103,35 @@ void AddNodeLoads(const SystemModel& model, const DofMap& dofs, const SystemStat
       for (int j = 0; j < 3; ++j) {
         const int col = dofs.node_dof(load.node, 3 + j);
         if (col >= 0) (*tangent)(row, col) += stiffness(i, j);
+      }
+    }
+  }
+}
+
+void AddSpringDampers(const SystemModel& model, const DofMap& dofs, const SystemState& state, const Eigen::VectorXd& W,
+                      Eigen::VectorXd& residual, Eigen::MatrixXd* K, Eigen::MatrixXd* C, double* energy) {
+  for (const SpringDamper& s : model.springs) {
+    int rows[6];
+    Eigen::Vector3d x[2], v[2];
+    const int nodes[2] = {s.node_a, s.node_b};
+    for (int e = 0; e < 2; ++e) {
+      const int k = nodes[e];
+      x[e] = k >= 0 ? state.x[k] : s.ground;
+      v[e].setZero();
+      for (int i = 0; i < 3; ++i) {
+        rows[3 * e + i] = k >= 0 ? dofs.node_dof(k, i) : -1;
+        if (rows[3 * e + i] >= 0 && W.size()) v[e][i] = W[rows[3 * e + i]];
+      }
+    }
+    const SpringDamperForces f = EvaluateSpringDamper(s, x[0], x[1], v[0], v[1]);
+    if (energy) *energy += f.energy;
+    for (int i = 0; i < 6; ++i) {
+      if (rows[i] < 0) continue;
+      residual[rows[i]] += f.f[i];
+      for (int j = 0; j < 6; ++j) {
+        if (rows[j] < 0) continue;
+        if (K) (*K)(rows[i], rows[j]) += f.K(i, j);
+        if (C) (*C)(rows[i], rows[j]) += f.C(i, j);
       }
     }
   }

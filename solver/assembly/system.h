@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "solver/body/superelement_body.h"
+#include "solver/forces/spring_damper.h"
 
 namespace femb {
 
@@ -36,6 +37,7 @@ struct SystemModel {
   std::vector<SuperelementBody> bodies;
   std::vector<std::vector<int>> body_nodes;  ///< system node of each interface of each body
   std::vector<NodeLoad> loads;
+  std::vector<SpringDamper> springs;
   Eigen::Vector3d gravity = Eigen::Vector3d::Zero();  ///< uniform acceleration field (dynamic analyses)
 
   int n_nodes() const { return int(node_names.size()); }
@@ -95,6 +97,11 @@ SystemForces AssembleStatic(const SystemModel& model, const DofMap& dofs, System
 /// `tangent` when not null (follower loads).
 void AddNodeLoads(const SystemModel& model, const DofMap& dofs, const SystemState& state, double t,
                   Eigen::VectorXd& residual, Eigen::MatrixXd* tangent);
+
+/// Spring-damper forces added to `residual` (as applied forces), their stiffness and damping
+/// (of -f) to `K`, `C` when not null, their energy to `energy`. W may be empty (static).
+void AddSpringDampers(const SystemModel& model, const DofMap& dofs, const SystemState& state, const Eigen::VectorXd& W,
+                      Eigen::VectorXd& residual, Eigen::MatrixXd* K, Eigen::MatrixXd* C, double* energy);
 
 /// Gathers body b's velocities (xdot, omega per interface node, then etadot) from system
 /// velocities W over the unknowns (grounded nodes: zero).

@@ -85,6 +85,20 @@ Scene BuildScene(const SceneSpec& spec) {
       model.gravity += l.g;
       continue;
     }
+    if (l.type == "spring") {
+      SpringDamper s;
+      s.node_a = scene.node_index.at(l.node);
+      s.node_b = l.node_b.empty() ? -1 : scene.node_index.at(l.node_b);
+      s.ground = l.point;
+      s.stiffness = l.stiffness;
+      s.damping = l.damping;
+      const Eigen::Vector3d xb = s.node_b >= 0 ? model.node_x0[s.node_b] : s.ground;
+      const double initial = (xb - model.node_x0[s.node_a]).norm();
+      if (initial == 0.0) throw InputError(l.where + ": spring ends coincide: its direction is undefined");
+      s.free_length = l.free_length >= 0 ? l.free_length : initial;
+      model.springs.push_back(s);
+      continue;
+    }
     const int k = scene.node_index.at(l.node);
     bool all_fixed = true;
     for (bool f : model.fixed[k]) all_fixed &= f;
