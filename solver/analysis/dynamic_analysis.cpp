@@ -52,18 +52,14 @@ Assembly AssembleDynamic(const SystemModel& model, const DofMap& dofs, DynamicSt
       const Eigen::VectorXd f_acc = Mb * wdot;
       out.scale = std::max({out.scale, f_acc.norm(), (f_in - f_acc).norm()});
     }
-    const std::vector<int> map = BodyDofMap(model, dofs, int(b));
-    for (int i = 0; i < body.n_coordinates(); ++i) {
-      if (map[i] < 0) continue;
-      out.residual[map[i]] += f_grav[i] - f_int[i] - f_in[i];
-      out.f_ext[map[i]] += f_grav[i];
-      if (!matrices) continue;
-      for (int j = 0; j < body.n_coordinates(); ++j) {
-        if (map[j] < 0) continue;
-        out.K(map[i], map[j]) += Kb(i, j);
-        out.C(map[i], map[j]) += Cb(i, j);
-        out.M(map[i], map[j]) += Mb(i, j);
-      }
+    const std::vector<MapEntry> map = BodyMap(model, dofs, int(b));
+    const Eigen::VectorXd r_b = f_grav - f_int - f_in;
+    ScatterBody(map, &r_b, nullptr, &out.residual, nullptr);
+    ScatterBody(map, &f_grav, nullptr, &out.f_ext, nullptr);
+    if (matrices) {
+      ScatterBody(map, nullptr, &Kb, nullptr, &out.K);
+      ScatterBody(map, nullptr, &Cb, nullptr, &out.C);
+      ScatterBody(map, nullptr, &Mb, nullptr, &out.M);
     }
   }
   Eigen::VectorXd loads = Eigen::VectorXd::Zero(n);
@@ -90,9 +86,13 @@ DynamicState InitialDynamicState(const SystemModel& model, const SystemState& co
   s.Wdot = Eigen::VectorXd::Zero(dofs.n_dofs());
   s.t = t0;
   const Assembly a = AssembleDynamic(model, dofs, s, t0, true);
-  s.Wdot = a.M.ldlt().solve(a.residual);
+  ApplyPrescribed(model, dofs, t0, s.config, &s.W, &s.Wdot);
+  const Assembly b = AssembleDynamic(model, dofs, s, t0, true);
+  const Eigen::VectorXd free_acc = SolveFree(dofs, b.M, b.residual - b.M * s.Wdot);
+  for (int j : dofs.solved()) s.Wdot[j] = free_acc[j];
   s.a = s.Wdot;
-  s.f_ext = a.f_ext;
+  s.f_ext = b.f_ext;
+  (void)a;
   return s;
 }
 
@@ -136,6 +136,7 @@ DynamicResult SolveDynamic(const SystemModel& model, DynamicState& state, const 
     next.W = state.W + h * (1 - gamma) * state.a + h * gamma * a_pred;
     const Eigen::VectorXd dq = state.W + h * (0.5 - beta) * state.a + h * beta * a_pred;
     ApplyIncrement(model, dofs, h * dq, next.config);
+    ApplyPrescribed(model, dofs, state.t + h, next.config, &next.W, &next.Wdot);
     const double gamma_p = gamma / (beta * h), beta_p = (1 - alpha_m) / (beta * h * h * (1 - alpha_f));
     const double t_new = state.t + h;
     bool converged = false;
@@ -144,13 +145,13 @@ DynamicResult SolveDynamic(const SystemModel& model, DynamicState& state, const 
     for (; it < options.max_iterations; ++it) {
       const Assembly a = AssembleDynamic(model, dofs, next, t_new, true);
       if (!a.ok || !a.residual.allFinite()) break;
-      if (a.residual.norm() <= options.tolerance * a.scale && it > 0) {
+      if (FreeNorm(dofs, a.residual) <= options.tolerance * a.scale && it > 0) {
         converged = true;
         f_ext_new = a.f_ext;
         break;
       }
       const Eigen::MatrixXd S = a.K + gamma_p * a.C + beta_p * a.M;
-      const Eigen::VectorXd delta = S.partialPivLu().solve(a.residual);
+      const Eigen::VectorXd delta = SolveFree(dofs, S, a.residual);
       if (!delta.allFinite()) break;
       ApplyIncrement(model, dofs, delta, next.config);
       next.W += gamma_p * delta;

@@ -20,20 +20,21 @@ StaticResult SolveStatic(const SystemModel& model, SystemState& state, const Sta
   while (lambda < end * (1 - 1e-12)) {
     const double target = std::min(end, lambda + step);
     SystemState trial = state;
+    ApplyPrescribed(model, dofs, target, trial, nullptr, nullptr);
     bool converged = false;
     int it = 0;
     double r_norm = 0.0, energy = 0.0, last_step = 1e300;
     for (; it < options.max_iterations; ++it) {
       const SystemForces f = AssembleStatic(model, dofs, trial, target, true);
       if (!f.ok) break;
-      r_norm = f.residual.norm();
+      r_norm = FreeNorm(dofs, f.residual);
       energy = f.elastic_energy;
       if (!std::isfinite(r_norm)) break;
       if (it > 0 && (r_norm <= options.tolerance * std::max(f.force_scale, 1e-300) || last_step <= 1e-13 * size)) {
         converged = true;
         break;
       }
-      const Eigen::VectorXd delta = f.tangent.partialPivLu().solve(f.residual);
+      const Eigen::VectorXd delta = SolveFree(dofs, f.tangent, f.residual);
       if (!delta.allFinite()) break;
       last_step = delta.norm();
       ApplyIncrement(model, dofs, delta, trial);

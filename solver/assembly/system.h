@@ -1,7 +1,12 @@
 // A multibody system of superelements on shared 6-DOF nodes, without Lagrange multipliers.
-// Nodes shared by bodies are rigid connections; grounded nodes are removed from the unknowns.
-// Unknowns: (dx, dpi) of every free node (spatial increments), then the modal coordinates of
-// every body. Model (immutable) and State are separate: f(const Model&, State&).
+// Nodes shared by bodies are rigid connections. Each node k moves in a subspace of its spatial
+// increments (dx, dpi): dq_k = S_k dz_k with its own coordinates z_k — S_k = 1 for a free
+// node, nothing for a clamp, [0; 1] for a spherical joint to ground, [0; a] for a revolute joint
+// to ground about the fixed axis a (R = exp(phi a~) R0 exactly), [a; 0] prismatic, [a 0; 0 a]
+// cylindrical. S_k is constant, so these joints add neither geometric nor convective terms.
+// Unknowns: every node's coordinates, then the modal coordinates of every body. A joint
+// coordinate may be prescribed by a time function: it stays in the vector of coordinates but
+// is not solved for. Model (immutable) and State are separate: f(const Model&, State&).
 #pragma once
 
 #include <Eigen/Core>
@@ -31,9 +36,15 @@ struct SystemModel {
   std::vector<std::string> node_names;
   std::vector<Eigen::Vector3d> node_x0;   ///< initial positions
   std::vector<Eigen::Matrix3d> node_R0;   ///< initial rotations
-  /// Per node: which of its 6 components (x, y, z, rx, ry, rz; spatial) are held fixed. All six:
-  /// clamped to ground; the first three: spherical joint to ground.
-  std::vector<std::array<bool, 6>> fixed;
+  /// Per node: the basis S_k (6 x d_k) of its allowed spatial increments (see above).
+  std::vector<Eigen::MatrixXd> motion;
+  /// Prescribed node coordinates: node, coordinate index in z_k, value f(t), f'(t), f''(t).
+  struct Prescribed {
+    int node = -1;
+    int coordinate = 0;
+    std::function<double(double)> value, rate, acceleration;
+  };
+  std::vector<Prescribed> prescribed;
   std::vector<SuperelementBody> bodies;
   std::vector<std::vector<int>> body_nodes;  ///< system node of each interface of each body
   std::vector<NodeLoad> loads;
@@ -44,31 +55,50 @@ struct SystemModel {
 };
 
 struct SystemState {
+  std::vector<Eigen::VectorXd> z;           ///< per node: accumulated coordinates (joint values)
   std::vector<Eigen::Vector3d> x;
   std::vector<Eigen::Matrix3d> R;
   std::vector<Eigen::VectorXd> eta;         ///< per body
   std::vector<FrameSolution> frames;        ///< per body, the last solved floating frame
 };
 
-/// Numbering of the unknowns.
+/// Numbering of the unknowns (coordinates).
 class DofMap {
  public:
   explicit DofMap(const SystemModel& model);
   int n_dofs() const { return n_dofs_; }
-  /// Unknown of component i (0-5) of node k, or -1 when that component is fixed.
-  int node_dof(int k, int i) const { return node_dof_[6 * k + i]; }
-  /// First unknown of body b's modal coordinates.
+  /// First coordinate of node k and its basis S_k (6 x d_k).
+  int node_first(int k) const { return node_first_[k]; }
+  const Eigen::MatrixXd& S(int k) const { return (*motion_)[k]; }
+  int node_count(int k) const { return int((*motion_)[k].cols()); }
+  /// First coordinate of body b's modal coordinates.
   int mode_dof(int b) const { return mode_dof_[b]; }
+  /// Spatial increment or velocity (dx, dpi) of node k from coordinates z.
+  Eigen::Matrix<double, 6, 1> NodeMotion(int k, const Eigen::VectorXd& z) const;
+  /// true for prescribed coordinates (not solved for).
+  bool prescribed(int j) const { return prescribed_[j]; }
+  /// The coordinate of a prescribed entry.
+  int prescribed_index(const SystemModel::Prescribed& p) const { return node_first_[p.node] + p.coordinate; }
+  /// Indices of the coordinates solved for.
+  const std::vector<int>& solved() const { return solved_; }
 
  private:
-  std::vector<int> node_dof_, mode_dof_;
+  const std::vector<Eigen::MatrixXd>* motion_;
+  std::vector<int> node_first_, mode_dof_, solved_;
+  std::vector<bool> prescribed_;
   int n_dofs_ = 0;
 };
 
-/// Holds all 6 components of node k fixed (clamp to ground).
-inline void Clamp(SystemModel& model, int k) { model.fixed[k].fill(true); }
-/// Holds node k's position fixed, rotation free (spherical joint to ground).
-inline void Pin(SystemModel& model, int k) { model.fixed[k] = {true, true, true, false, false, false}; }
+/// Node k clamped to ground.
+void Clamp(SystemModel& model, int k);
+/// Node k's position fixed, rotation free (spherical joint to ground).
+void Pin(SystemModel& model, int k);
+/// Revolute joint to ground about the fixed unit axis a (global): one rotation coordinate.
+void RevoluteToGround(SystemModel& model, int k, const Eigen::Vector3d& axis);
+/// Prismatic joint to ground along a (global): one translation coordinate, rotation fixed.
+void PrismaticToGround(SystemModel& model, int k, const Eigen::Vector3d& axis);
+/// Cylindrical joint to ground: translation along and rotation about a.
+void CylindricalToGround(SystemModel& model, int k, const Eigen::Vector3d& axis);
 
 /// Adds an interface node to `model` at a position and returns its index.
 int AddNode(SystemModel& model, const std::string& name, const Eigen::Vector3d& x,
@@ -103,12 +133,33 @@ void AddNodeLoads(const SystemModel& model, const DofMap& dofs, const SystemStat
 void AddSpringDampers(const SystemModel& model, const DofMap& dofs, const SystemState& state, const Eigen::VectorXd& W,
                       Eigen::VectorXd& residual, Eigen::MatrixXd* K, Eigen::MatrixXd* C, double* energy);
 
-/// Gathers body b's velocities (xdot, omega per interface node, then etadot) from system
-/// velocities W over the unknowns (grounded nodes: zero).
+/// Gathers body b's velocities (xdot, omega per interface node, then etadot) from the
+/// coordinate velocities W.
 Eigen::VectorXd GatherBody(const SystemModel& model, const DofMap& dofs, int b, const Eigen::VectorXd& W);
 
-/// For each local coordinate of body b the system unknown, or -1 (grounded).
-std::vector<int> BodyDofMap(const SystemModel& model, const DofMap& dofs, int b);
+/// The linear map from coordinates to body b's local coordinate increments as (local index,
+/// coordinate, coefficient) entries: dq_b[i] = sum c dz[j].
+struct MapEntry {
+  int local;
+  int coordinate;
+  double coefficient;
+};
+std::vector<MapEntry> BodyMap(const SystemModel& model, const DofMap& dofs, int b);
+
+/// Scatters a body vector f (n_b) and matrix K (n_b x n_b) through the map: F += B^T f,
+/// KK += B^T K B.
+void ScatterBody(const std::vector<MapEntry>& map, const Eigen::VectorXd* f, const Eigen::MatrixXd* K,
+                 Eigen::VectorXd* F, Eigen::MatrixXd* KK);
+
+/// Sets the prescribed coordinates to their values at t: configuration (through the node's
+/// basis), and, when W / Wdot are given, their rates and accelerations.
+void ApplyPrescribed(const SystemModel& model, const DofMap& dofs, double t, SystemState& state,
+                     Eigen::VectorXd* W, Eigen::VectorXd* Wdot);
+
+/// Solves S d = r on the coordinates that are not prescribed (prescribed ones: d = 0).
+Eigen::VectorXd SolveFree(const DofMap& dofs, const Eigen::MatrixXd& S, const Eigen::VectorXd& r);
+/// Norm of r over the coordinates solved for.
+double FreeNorm(const DofMap& dofs, const Eigen::VectorXd& r);
 
 /// Applies an increment of the unknowns: x += dx, R <- exp(dpi~) R, eta += d eta.
 void ApplyIncrement(const SystemModel& model, const DofMap& dofs, const Eigen::VectorXd& delta, SystemState& state);

@@ -66,11 +66,9 @@ void ResultsRecorder::Record(double t, const SystemState& state, const Eigen::Ve
   for (int k = 0; k < n; ++k) {
     pos.segment<3>(3 * k) = state.x[k];
     quat.segment<4>(4 * k) = Quaternion(state.R[k]);
-    for (int i = 0; i < 3; ++i) {
-      const int dv = dofs.node_dof(k, i), dw = dofs.node_dof(k, 3 + i);
-      vel[3 * k + i] = (dv >= 0 && W.size()) ? W[dv] : 0.0;
-      ang[3 * k + i] = (dw >= 0 && W.size()) ? W[dw] : 0.0;
-    }
+    const Eigen::Matrix<double, 6, 1> v = dofs.NodeMotion(k, W);
+    vel.segment<3>(3 * k) = v.head<3>();
+    ang.segment<3>(3 * k) = v.tail<3>();
   }
   time_.push_back(t);
   kinetic_.push_back(kinetic);

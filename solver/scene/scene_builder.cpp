@@ -1,6 +1,7 @@
 #include "solver/scene/scene_builder.h"
 
 #include <cstdio>
+#include <Eigen/Dense>
 #include <filesystem>
 
 #include "formats/input_error.h"
@@ -100,9 +101,7 @@ Scene BuildScene(const SceneSpec& spec) {
       continue;
     }
     const int k = scene.node_index.at(l.node);
-    bool all_fixed = true;
-    for (bool f : model.fixed[k]) all_fixed &= f;
-    if (all_fixed) throw InputError(l.where + ": load on node '" + l.node + "', which is clamped to the ground");
+    if (model.motion[k].cols() == 0) throw InputError(l.where + ": load on node '" + l.node + "', which is clamped to the ground");
     NodeLoad load;
     load.node = k;
     load.force = l.force;
@@ -120,10 +119,12 @@ Scene BuildScene(const SceneSpec& spec) {
   scene.initial_velocity = Eigen::VectorXd::Zero(dofs.n_dofs());
   for (const auto& [node, v] : spec.initial_velocities) {
     const int k = scene.node_index.at(node);
-    for (int i = 0; i < 6; ++i) {
-      const int d = dofs.node_dof(k, i);
-      if (d >= 0) scene.initial_velocity[d] = i < 3 ? v.first[i] : v.second[i - 3];
-    }
+    if (dofs.node_count(k) == 0) continue;
+    Eigen::Matrix<double, 6, 1> v6;
+    v6 << v.first, v.second;
+    // Least squares on the node's motion basis (exact when the velocity is admissible).
+    scene.initial_velocity.segment(dofs.node_first(k), dofs.node_count(k)) =
+        dofs.S(k).colPivHouseholderQr().solve(v6);
   }
   return scene;
 }
