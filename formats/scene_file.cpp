@@ -22,6 +22,12 @@ double TimeFunctionSpec::Evaluate(double t) const {
   if (type == "step") return t >= t_start ? value : 0.0;
   if (type == "pulse") return (t >= t_start && t < t_end) ? value : 0.0;
   if (type == "sine") return offset + amplitude * std::sin(2 * M_PI * frequency * t + phase);
+  if (type == "spin_up") {
+    // theta = (w/Ts)(t^2/2 + (Ts/2pi)^2 (cos(2 pi t/Ts) - 1)) for t < Ts, then w (t - Ts/2).
+    const double Ts = t_end, w = value, c = Ts / (2 * M_PI);
+    if (t >= Ts) return w * (t - 0.5 * Ts);
+    return w / Ts * (0.5 * t * t + c * c * (std::cos(t / c) - 1));
+  }
   // table
   if (t <= table.front().first) return table.front().second;
   if (t >= table.back().first) return table.back().second;
@@ -29,6 +35,36 @@ double TimeFunctionSpec::Evaluate(double t) const {
   const auto& b = *it;
   const auto& a = *(it - 1);
   return a.second + (b.second - a.second) * (t - a.first) / (b.first - a.first);
+}
+
+double TimeFunctionSpec::Rate(double t) const {
+  if (type == "linear") return 1.0;
+  if (type == "ramp") return (t >= t_start && t < t_end) ? value / (t_end - t_start) : 0.0;
+  if (type == "sine") return amplitude * 2 * M_PI * frequency * std::cos(2 * M_PI * frequency * t + phase);
+  if (type == "spin_up") {
+    const double Ts = t_end, w = value, c = Ts / (2 * M_PI);
+    return t >= Ts ? w : w / Ts * (t - c * std::sin(t / c));
+  }
+  if (type == "table") {
+    for (size_t i = 1; i < table.size(); ++i) {
+      if (t >= table[i - 1].first && t < table[i].first) {
+        return (table[i].second - table[i - 1].second) / (table[i].first - table[i - 1].first);
+      }
+    }
+  }
+  return 0.0;  // constant, step, pulse; table outside its range
+}
+
+double TimeFunctionSpec::Acceleration(double t) const {
+  if (type == "sine") {
+    const double w = 2 * M_PI * frequency;
+    return -amplitude * w * w * std::sin(w * t + phase);
+  }
+  if (type == "spin_up") {
+    const double Ts = t_end, w = value, c = Ts / (2 * M_PI);
+    return t >= Ts ? 0.0 : w / Ts * (1 - std::cos(t / c));
+  }
+  return 0.0;
 }
 
 namespace {
@@ -54,6 +90,10 @@ TimeFunctionSpec ParseFunction(const YamlValue& value) {
     f.frequency = m.Required("frequency").Number();
     if (auto v = m.Optional("phase")) f.phase = v->Number();
     if (auto v = m.Optional("offset")) f.offset = v->Number();
+  } else if (f.type == "spin_up") {
+    f.value = m.Required("omega").Number();
+    YamlValue ts = m.Required("t_spin");
+    f.t_end = ts.PositiveNumber();
   } else if (f.type == "table") {
     YamlValue points = m.Required("points");
     for (const YamlValue& p : points.List()) {
@@ -66,7 +106,7 @@ TimeFunctionSpec ParseFunction(const YamlValue& value) {
     }
     if (f.table.empty()) points.Fail("a table needs at least one point");
   } else if (f.type != "linear") {
-    type.Fail("unknown time function type '" + f.type + "' (known: linear, constant, ramp, step, pulse, sine, table)");
+    type.Fail("unknown time function type '" + f.type + "' (known: linear, constant, ramp, step, pulse, sine, table, spin_up)");
   }
   m.CheckNoUnknownKeys();
   return f;
@@ -154,10 +194,25 @@ SceneSpec ParseScene(const std::string& text, const std::string& name, const std
       j.where = item.Where();
       YamlValue type = m.Required("type");
       j.type = type.String();
-      if (j.type != "clamp" && j.type != "spherical") {
-        type.Fail("unknown joint type '" + j.type + "' (known here: clamp, spherical; to ground)");
+      const bool axial = j.type == "revolute" || j.type == "prismatic" || j.type == "cylindrical";
+      if (j.type != "clamp" && j.type != "spherical" && !axial) {
+        type.Fail("unknown joint type '" + j.type +
+                  "' (known here, all to ground: clamp, spherical, revolute, prismatic, cylindrical)");
       }
       j.node = check_node(m.Required("node"));
+      for (const auto& other : scene.joints) {
+        if (other.node == j.node) item.Fail("node '" + j.node + "' already has a joint to ground");
+      }
+      if (axial) {
+        YamlValue axis = m.Required("axis");
+        j.axis = axis.Vector3();
+        if (j.axis.norm() == 0) axis.Fail("axis must not be zero");
+        if (auto v = m.Optional("prescribed")) {
+          if (j.type == "cylindrical") v->Fail("prescribed motion of a cylindrical joint is not supported; use revolute or prismatic");
+          j.prescribed = v->String();
+          if (!scene.functions.count(j.prescribed)) v->Fail("time function '" + j.prescribed + "' is not defined under 'functions'");
+        }
+      }
       m.CheckNoUnknownKeys();
       scene.joints.push_back(j);
     }

@@ -12,12 +12,14 @@ namespace femb {
 
 /// A scalar function of time (or of the pseudo-time of a static analysis).
 struct TimeFunctionSpec {
-  std::string type = "linear";  ///< linear (f = t), constant, ramp, step, sine, table
+  std::string type = "linear";  ///< linear (f = t), constant, ramp, step, pulse, sine, table, spin_up
   double value = 1.0;           ///< constant value; final value of ramp and step
   double t_start = 0.0, t_end = 1.0;  ///< ramp from 0 at t_start to value at t_end; step at t_start
   double amplitude = 0.0, frequency = 0.0, phase = 0.0, offset = 0.0;  ///< sine [Hz]
   std::vector<std::pair<double, double>> table;  ///< (t, f) pairs, linear in between
   double Evaluate(double t) const;
+  double Rate(double t) const;          ///< f'(t) (piecewise: the right derivative)
+  double Acceleration(double t) const;  ///< f''(t) (kinks: 0)
 };
 
 struct SceneBodySpec {
@@ -32,8 +34,10 @@ struct SceneBodySpec {
 };
 
 struct SceneJointSpec {
-  std::string type;  ///< clamp (ground), spherical (to ground)
+  std::string type;  ///< to ground: clamp, spherical, revolute, prismatic, cylindrical
   std::string node;
+  Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();  ///< revolute/prismatic/cylindrical (global)
+  std::string prescribed;  ///< time function of the joint coordinate (angle or travel); "" = free
   std::string where;
 };
 

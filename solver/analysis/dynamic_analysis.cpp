@@ -47,7 +47,7 @@ Assembly AssembleDynamic(const SystemModel& model, const DofMap& dofs, DynamicSt
     if (model.gravity.squaredNorm() > 0) f_grav = body.GravityForce(c, frame, model.gravity);
     // Scale of the forces in balance, each term on its own (for a torque-free body M_g wdot and
     // the gyroscopic terms cancel: their sum is no scale).
-    out.scale = std::max({out.scale, f_int.norm(), f_in.norm(), f_grav.norm()});
+    out.scale = std::max({out.scale, f_int.norm(), f_in.norm(), f_grav.norm(), body.force_floor()});
     if (matrices) {
       const Eigen::VectorXd f_acc = Mb * wdot;
       out.scale = std::max({out.scale, f_acc.norm(), (f_in - f_acc).norm()});

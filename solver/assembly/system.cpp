@@ -134,7 +134,7 @@ SystemForces AssembleStatic(const SystemModel& model, const DofMap& dofs, System
     Eigen::MatrixXd K;
     body.ElasticForce(c, frame, &f, with_tangent ? &K : nullptr);
     out.elastic_energy += body.ElasticEnergy(c, frame);
-    out.force_scale = std::max(out.force_scale, f.norm());
+    out.force_scale = std::max({out.force_scale, f.norm(), body.force_floor()});
     const Eigen::VectorXd minus_f = -f;
     ScatterBody(BodyMap(model, dofs, int(b)), &minus_f, with_tangent ? &K : nullptr, &out.residual,
                 with_tangent ? &out.tangent : nullptr);

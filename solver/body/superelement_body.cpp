@@ -40,6 +40,9 @@ SuperelementBody::SuperelementBody(const Superelement& se, const SuperelementOpt
   }
   Phi_rig0_ = RigidBodyModes(se, se.floating_frame.origin);
   T0_ = Eigen::MatrixXd::Identity(n_coordinates(), n_coordinates()) - Phi_rig0_ * Phi_CB_;
+  double size = 0.0;
+  for (const Eigen::Vector3d& X : X_) size = std::max(size, X.norm());
+  force_floor_ = 1e-4 * K_.cwiseAbs().maxCoeff() * std::max(size, 1e-300);
   initial_frame_.x = placement_x_ + placement_R_ * origin_part_;
   initial_frame_.R = placement_R_;
   initial_frame_.ok = true;

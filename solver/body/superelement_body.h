@@ -70,6 +70,9 @@ class SuperelementBody {
   const Eigen::MatrixXd& K() const { return K_; }
   const Eigen::MatrixXd& M() const { return M_; }
   const SuperelementOptions& options() const { return options_; }
+  /// Force of round-off size for this body: 1e-4 max|K| times its size. Newton tolerances are
+  /// relative to force scales floored by this, so that nearly unloaded states converge.
+  double force_floor() const { return force_floor_; }
 
   /// Undeformed configuration at the placement, and its floating frame.
   BodyConfiguration InitialConfiguration() const;
@@ -139,6 +142,7 @@ class SuperelementBody {
   Eigen::Vector3d placement_x_;
   Eigen::Vector3d origin_part_;
   FrameSolution initial_frame_;
+  double force_floor_ = 0.0;
 };
 
 }  // namespace femb

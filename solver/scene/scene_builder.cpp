@@ -80,6 +80,19 @@ Scene BuildScene(const SceneSpec& spec) {
     const int k = scene.node_index.at(j.node);
     if (j.type == "clamp") Clamp(model, k);
     if (j.type == "spherical") Pin(model, k);
+    if (j.type == "revolute") RevoluteToGround(model, k, j.axis);
+    if (j.type == "prismatic") PrismaticToGround(model, k, j.axis);
+    if (j.type == "cylindrical") CylindricalToGround(model, k, j.axis);
+    if (!j.prescribed.empty()) {
+      const TimeFunctionSpec f = spec.functions.at(j.prescribed);
+      SystemModel::Prescribed p;
+      p.node = k;
+      p.coordinate = 0;
+      p.value = [f](double t) { return f.Evaluate(t); };
+      p.rate = [f](double t) { return f.Rate(t); };
+      p.acceleration = [f](double t) { return f.Acceleration(t); };
+      model.prescribed.push_back(p);
+    }
   }
   for (const SceneLoadSpec& l : spec.loads) {
     if (l.type == "gravity") {
