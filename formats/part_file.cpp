@@ -209,11 +209,7 @@ PartSpec ParsePart(const std::string& text, const std::string& name,
 }
 
 PartSpec ReadPartFile(const std::string& path, const std::vector<std::string>& overrides) {
-  std::ifstream in(path);
-  if (!in) throw InputError(path + ": cannot open part file (does it exist and is it readable?)");
-  std::stringstream text;
-  text << in.rdbuf();
-  return ParsePart(text.str(), path, overrides);
+  return ParsePart(ReadTextFile(path, "part file"), path, overrides);
 }
 
 }  // namespace femb

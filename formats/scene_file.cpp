@@ -336,11 +336,7 @@ SceneSpec ParseScene(const std::string& text, const std::string& name, const std
 }
 
 SceneSpec ReadSceneFile(const std::string& path, const std::vector<std::string>& overrides) {
-  std::ifstream in(path);
-  if (!in) throw InputError(path + ": cannot open scene file (does it exist and is it readable?)");
-  std::stringstream text;
-  text << in.rdbuf();
-  return ParseScene(text.str(), path, overrides);
+  return ParseScene(ReadTextFile(path, "scene file"), path, overrides);
 }
 
 }  // namespace femb

@@ -139,13 +139,15 @@ YamlDocument YamlDocument::LoadString(const std::string& text, const std::string
   return doc;
 }
 
-YamlDocument YamlDocument::LoadFile(const std::string& path) {
+std::string ReadTextFile(const std::string& path, const std::string& what) {
   std::ifstream in(path);
-  if (!in) throw InputError(path + ": cannot open file (does it exist and is it readable?)");
+  if (!in) throw InputError(path + ": cannot open " + what + " (does it exist and is it readable?)");
   std::stringstream text;
   text << in.rdbuf();
-  return LoadString(text.str(), path);
+  return text.str();
 }
+
+YamlDocument YamlDocument::LoadFile(const std::string& path) { return LoadString(ReadTextFile(path, "file"), path); }
 
 void YamlDocument::Set(const std::string& assignment) {
   const size_t eq = assignment.find('=');

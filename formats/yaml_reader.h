@@ -88,4 +88,7 @@ class YamlDocument {
   std::shared_ptr<YamlSource> source_;
 };
 
+/// The whole text of a file; throws InputError "PATH: cannot open WHAT (...)".
+std::string ReadTextFile(const std::string& path, const std::string& what);
+
 }  // namespace femb

@@ -3,6 +3,7 @@
 #include <iostream>
 #include <string>
 
+#include "formats/command_line.h"
 #include "formats/input_error.h"
 #include "formats/matrix_text.h"
 #include "formats/superelement_file.h"
@@ -30,50 +31,15 @@ exit codes: 0 success, 1 a check failed (with --check), 2 bad input or unreadabl
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string path, dump, format = "mtx";
+  std::string dump, format = "mtx";
   bool json = false, check = false;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    auto value = [&](const char* flag) -> std::string {
-      if (i + 1 >= argc) {
-        std::fprintf(stderr, "femb-inspect: %s needs a value (see --help)\n", flag);
-        std::exit(2);
-      }
-      return argv[++i];
-    };
-    if (a == "-h" || a == "--help") {
-      std::fputs(kUsage, stdout);
-      return 0;
-    } else if (a == "--json") {
-      json = true;
-    } else if (a == "--check") {
-      check = true;
-    } else if (a == "--dump") {
-      dump = value("--dump");
-    } else if (a == "--format") {
-      format = value("--format");
-    } else if (!a.empty() && a[0] == '-') {
-      std::fprintf(stderr, "femb-inspect: unknown option '%s' (see --help)\n", a.c_str());
-      return 2;
-    } else if (path.empty()) {
-      path = a;
-    } else {
-      std::fprintf(stderr, "femb-inspect: more than one file given\n");
-      return 2;
-    }
-  }
-  if (path.empty()) {
-    std::fprintf(stderr, "femb-inspect: no superelement file given\n%s", kUsage);
-    return 2;
-  }
-  if (!dump.empty() && dump != "K" && dump != "M" && dump != "PhiCB") {
-    std::fprintf(stderr, "femb-inspect: --dump takes K, M or PhiCB, got '%s'\n", dump.c_str());
-    return 2;
-  }
-  if (format != "mtx" && format != "csv") {
-    std::fprintf(stderr, "femb-inspect: --format takes mtx or csv, got '%s'\n", format.c_str());
-    return 2;
-  }
+  femb::CommandLine cli("femb-inspect", kUsage, "superelement file");
+  cli.Value({"--dump"}, [&](const std::string& v) { dump = v; });
+  cli.Value({"--format"}, [&](const std::string& v) { format = v; });
+  cli.Switch({"--json"}, [&] { json = true; });
+  cli.Switch({"--check"}, [&] { check = true; });
+  if (!cli.Parse(argc, argv)) return cli.exit_code();
+  const std::string path = cli.input();
   try {
     femb::SuperelementReadOptions options;
     options.visualization = false;

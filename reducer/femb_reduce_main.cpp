@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "formats/command_line.h"
 #include "formats/input_error.h"
 #include "formats/part_file.h"
 #include "formats/superelement_file.h"
@@ -35,44 +36,16 @@ exit codes: 0 success, 2 bad input (one line names the file, line and key), 3 nu
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string part_path, output;
+  std::string output;
   std::vector<std::string> overrides;
   bool quiet = false;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    auto value = [&](const char* flag) -> std::string {
-      if (i + 1 >= argc) {
-        std::fprintf(stderr, "femb-reduce: %s needs a value (see --help)\n", flag);
-        std::exit(2);
-      }
-      return argv[++i];
-    };
-    if (a == "-h" || a == "--help") {
-      std::fputs(kUsage, stdout);
-      return 0;
-    } else if (a == "-o" || a == "--output") {
-      output = value("-o");
-    } else if (a == "--full-modes") {
-      overrides.push_back("reduction.full_modes=" + value("--full-modes"));
-    } else if (a == "--set") {
-      overrides.push_back(value("--set"));
-    } else if (a == "-q" || a == "--quiet") {
-      quiet = true;
-    } else if (!a.empty() && a[0] == '-') {
-      std::fprintf(stderr, "femb-reduce: unknown option '%s' (see --help)\n", a.c_str());
-      return 2;
-    } else if (part_path.empty()) {
-      part_path = a;
-    } else {
-      std::fprintf(stderr, "femb-reduce: more than one part file given ('%s', '%s')\n",
-                   part_path.c_str(), a.c_str());
-      return 2;
-    }
-  }
-  if (part_path.empty()) {
-    std::fprintf(stderr, "femb-reduce: no part file given\n%s", kUsage);
-    return 2;
-  }
+  femb::CommandLine cli("femb-reduce", kUsage, "part file");
+  cli.Value({"-o", "--output"}, [&](const std::string& v) { output = v; });
+  cli.Value({"--full-modes"}, [&](const std::string& v) { overrides.push_back("reduction.full_modes=" + v); });
+  cli.Value({"--set"}, [&](const std::string& v) { overrides.push_back(v); });
+  cli.Switch({"-q", "--quiet"}, [&] { quiet = true; });
+  if (!cli.Parse(argc, argv)) return cli.exit_code();
+  const std::string part_path = cli.input();
   try {
     femb::Stopwatch total;
     const femb::PartSpec part = femb::ReadPartFile(part_path, overrides);

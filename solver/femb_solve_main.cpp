@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "formats/command_line.h"
 #include "formats/input_error.h"
 #include "formats/scene_file.h"
 #include "solver/analysis/dynamic_analysis.h"
@@ -39,41 +40,15 @@ exit codes: 0 success, 2 bad input (one line names the file, line and key), 3 nu
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string scene_path, output;
+  std::string output;
   std::vector<std::string> overrides;
   bool quiet = false;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    auto value = [&](const char* flag) -> std::string {
-      if (i + 1 >= argc) {
-        std::fprintf(stderr, "femb-solve: %s needs a value (see --help)\n", flag);
-        std::exit(2);
-      }
-      return argv[++i];
-    };
-    if (a == "-h" || a == "--help") {
-      std::fputs(kUsage, stdout);
-      return 0;
-    } else if (a == "-o" || a == "--output") {
-      output = value("-o");
-    } else if (a == "--set") {
-      overrides.push_back(value("--set"));
-    } else if (a == "-q" || a == "--quiet") {
-      quiet = true;
-    } else if (!a.empty() && a[0] == '-') {
-      std::fprintf(stderr, "femb-solve: unknown option '%s' (see --help)\n", a.c_str());
-      return 2;
-    } else if (scene_path.empty()) {
-      scene_path = a;
-    } else {
-      std::fprintf(stderr, "femb-solve: more than one scene file given\n");
-      return 2;
-    }
-  }
-  if (scene_path.empty()) {
-    std::fprintf(stderr, "femb-solve: no scene file given\n%s", kUsage);
-    return 2;
-  }
+  femb::CommandLine cli("femb-solve", kUsage, "scene file");
+  cli.Value({"-o", "--output"}, [&](const std::string& v) { output = v; });
+  cli.Value({"--set"}, [&](const std::string& v) { overrides.push_back(v); });
+  cli.Switch({"-q", "--quiet"}, [&] { quiet = true; });
+  if (!cli.Parse(argc, argv)) return cli.exit_code();
+  const std::string scene_path = cli.input();
   try {
     const auto wall = std::chrono::steady_clock::now();
     const femb::SceneSpec spec = femb::ReadSceneFile(scene_path, overrides);
