@@ -320,8 +320,8 @@ SceneSpec ParseScene(const std::string& text, const std::string& name, const std
         YamlValue q = pm.Required("quantities");
         for (const YamlValue& qi : q.List()) {
           const std::string s = qi.String();
-          if (s != "position" && s != "rotation" && s != "velocity" && s != "angular_velocity") {
-            qi.Fail("unknown probe quantity '" + s + "' (known: position, rotation, velocity, angular_velocity)");
+          if (s != "position" && s != "rotation" && s != "velocity" && s != "angular_velocity" && s != "joint") {
+            qi.Fail("unknown probe quantity '" + s + "' (known: position, rotation, velocity, angular_velocity, joint)");
           }
           p.quantities.push_back(s);
         }

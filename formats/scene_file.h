@@ -58,7 +58,7 @@ struct SceneLoadSpec {
 struct SceneProbeSpec {
   std::string name;
   std::string node;
-  std::vector<std::string> quantities;  ///< position, rotation, velocity, angular_velocity
+  std::vector<std::string> quantities;  ///< position, rotation, velocity, angular_velocity, joint
   std::string where;
 };
 

@@ -49,6 +49,15 @@ ResultsRecorder::ResultsRecorder(const Scene& scene, const std::string& director
     for (const std::string& q : p.quantities) {
       if (q == "rotation") {
         for (const char* c : wxyz) csv_ << "," << p.name << "." << q << "." << c;
+      } else if (q == "joint") {
+        // The node's joint coordinates (revolute: angle; prismatic: travel; cylindrical: both).
+        const int k = scene.node_index.at(p.node);
+        const int d = int(scene.model.motion[k].cols());
+        if (d == 0 || d >= 3) {
+          throw InputError(p.where + ": probe '" + p.name + "': node '" + p.node +
+                           "' has no revolute, prismatic or cylindrical joint coordinate");
+        }
+        for (int i = 0; i < d; ++i) csv_ << "," << p.name << ".joint." << i;
       } else {
         for (const char* c : xyz) csv_ << "," << p.name << "." << q << "." << c;
       }
@@ -96,6 +105,7 @@ void ResultsRecorder::Record(double t, const SystemState& state, const Eigen::Ve
       if (q == "rotation") for (int i = 0; i < 4; ++i) csv_ << "," << Num(quat[4 * k + i]);
       if (q == "velocity") for (int i = 0; i < 3; ++i) csv_ << "," << Num(vel[3 * k + i]);
       if (q == "angular_velocity") for (int i = 0; i < 3; ++i) csv_ << "," << Num(ang[3 * k + i]);
+      if (q == "joint") for (int i = 0; i < state.z[k].size(); ++i) csv_ << "," << Num(state.z[k][i]);
     }
   }
   csv_ << "," << Num(kinetic) << "," << Num(elastic) << "," << Num(external_work) << "\n";
