@@ -26,6 +26,8 @@ Assembly AssembleDynamic(const SystemModel& model, const DofMap& dofs, DynamicSt
     out.C = Eigen::MatrixXd::Zero(n, n);
     out.M = Eigen::MatrixXd::Zero(n, n);
   }
+  NodeForces node_forces = ZeroNodeForces(model);
+  const std::vector<Eigen::Matrix<double, 6, 1>> node_acc = NodeAccelerations(model, dofs, s.config, s.W, s.Wdot);
   for (size_t b = 0; b < model.bodies.size(); ++b) {
     const SuperelementBody& body = model.bodies[b];
     const BodyConfiguration c = BodyConfigurationOf(model, s.config, int(b));
@@ -37,7 +39,8 @@ Assembly AssembleDynamic(const SystemModel& model, const DofMap& dofs, DynamicSt
       return out;
     }
     s.config.frames[b] = frame;
-    const Eigen::VectorXd w = GatherBody(model, dofs, int(b), s.W), wdot = GatherBody(model, dofs, int(b), s.Wdot);
+    const Eigen::VectorXd w = GatherBody(model, dofs, s.config, int(b), s.W);
+    const Eigen::VectorXd wdot = GatherBodyAcceleration(model, dofs, s.config, int(b), node_acc, s.Wdot);
     Eigen::VectorXd f_int, f_in;
     Eigen::MatrixXd Kb, Mb, Cb;
     body.ElasticForce(c, frame, &f_int, matrices ? &Kb : nullptr);
@@ -52,8 +55,9 @@ Assembly AssembleDynamic(const SystemModel& model, const DofMap& dofs, DynamicSt
       const Eigen::VectorXd f_acc = Mb * wdot;
       out.scale = std::max({out.scale, f_acc.norm(), (f_in - f_acc).norm()});
     }
-    const std::vector<MapEntry> map = BodyMap(model, dofs, int(b));
+    const std::vector<MapEntry> map = BodyMap(model, dofs, s.config, int(b));
     const Eigen::VectorXd r_b = f_grav - f_int - f_in;
+    AddBodyNodeForces(model, int(b), r_b, node_forces);
     ScatterBody(map, &r_b, nullptr, &out.residual, nullptr);
     ScatterBody(map, &f_grav, nullptr, &out.f_ext, nullptr);
     if (matrices) {
@@ -63,14 +67,15 @@ Assembly AssembleDynamic(const SystemModel& model, const DofMap& dofs, DynamicSt
     }
   }
   Eigen::VectorXd loads = Eigen::VectorXd::Zero(n);
-  AddNodeLoads(model, dofs, s.config, t, loads, matrices ? &out.K : nullptr);
+  AddNodeLoads(model, dofs, s.config, t, loads, matrices ? &out.K : nullptr, &node_forces);
   out.residual += loads;
   out.f_ext += loads;
   Eigen::VectorXd springs = Eigen::VectorXd::Zero(n);
   AddSpringDampers(model, dofs, s.config, s.W, springs, matrices ? &out.K : nullptr, matrices ? &out.C : nullptr,
-                   nullptr);
+                   nullptr, &node_forces);
   out.residual += springs;
   out.scale = std::max(out.scale, springs.norm());
+  if (matrices) AddJointGeometricStiffness(model, dofs, s.config, node_forces, out.K);
   out.scale = std::max({out.scale, loads.norm(), 1e-300});
   return out;
 }
@@ -107,7 +112,7 @@ DynamicStepReport Measure(const SystemModel& model, DynamicState& s) {
     const SuperelementBody& body = model.bodies[b];
     const BodyConfiguration c = BodyConfigurationOf(model, s.config, int(b));
     const FrameSolution& frame = s.config.frames[b];
-    const Eigen::VectorXd w = GatherBody(model, dofs, int(b), s.W);
+    const Eigen::VectorXd w = GatherBody(model, dofs, s.config, int(b), s.W);
     r.kinetic_energy += body.KineticEnergy(c, frame, w);
     r.elastic_energy += body.ElasticEnergy(c, frame);
     Eigen::Vector3d L, H;

@@ -20,7 +20,7 @@ ModalResult LinearizedModes(const SystemModel& model, SystemState& state, double
     Eigen::MatrixXd Mb;
     const Eigen::VectorXd w = Eigen::VectorXd::Zero(model.bodies[b].n_coordinates());
     model.bodies[b].InertiaForce(c, state.frames[b], w, w, nullptr, &Mb, nullptr);
-    ScatterBody(BodyMap(model, dofs, int(b)), nullptr, &Mb, nullptr, &M);
+    ScatterBody(BodyMap(model, dofs, state, int(b)), nullptr, &Mb, nullptr, &M);
   }
   // The tangent on SO(3) with spatial increments is symmetric at equilibrium up to the load
   // terms; the symmetric part defines the conservative linearization.

@@ -2,14 +2,45 @@
 
 #include <Eigen/Dense>
 
+#include "formats/input_error.h"
 #include "solver/rotation.h"
 
 namespace femb {
 
 DofMap::DofMap(const SystemModel& model) : motion_(&model.motion) {
-  for (int k = 0; k < model.n_nodes(); ++k) {
+  const int n = model.n_nodes();
+  joint_of_.assign(n, -1);
+  for (size_t j = 0; j < model.joints.size(); ++j) {
+    const int c = model.joints[j].child;
+    if (joint_of_[c] >= 0) {
+      throw InputError("node '" + model.node_names[c] + "' has two parent joints");
+    }
+    joint_of_[c] = int(j);
+  }
+  // Parents before children; a node met again on its own parent chain closes a cycle.
+  std::vector<int> state(n, 0);  // 0 new, 1 on the chain, 2 placed
+  for (int k = 0; k < n; ++k) {
+    std::vector<int> chain;
+    int m = k;
+    while (m >= 0 && state[m] == 0) {
+      state[m] = 1;
+      chain.push_back(m);
+      m = joint_of_[m] >= 0 ? model.joints[joint_of_[m]].parent : -1;
+    }
+    if (m >= 0 && state[m] == 1) {
+      std::string names;
+      for (int c : chain) names += (names.empty() ? "" : " -> ") + model.node_names[c];
+      throw InputError("joint dependency cycle through nodes " + names + " -> " + model.node_names[m]);
+    }
+    for (auto it = chain.rbegin(); it != chain.rend(); ++it) {
+      state[*it] = 2;
+      order_.push_back(*it);
+    }
+  }
+  for (int k = 0; k < n; ++k) {
     node_first_.push_back(n_dofs_);
-    n_dofs_ += int(model.motion[k].cols());
+    node_count_.push_back(joint_of_[k] >= 0 ? model.joints[joint_of_[k]].n_coordinates() : int(model.motion[k].cols()));
+    n_dofs_ += node_count_.back();
   }
   for (const SuperelementBody& body : model.bodies) {
     mode_dof_.push_back(n_dofs_);
@@ -22,9 +53,88 @@ DofMap::DofMap(const SystemModel& model) : motion_(&model.motion) {
   }
 }
 
-Eigen::Matrix<double, 6, 1> DofMap::NodeMotion(int k, const Eigen::VectorXd& z) const {
-  if (node_count(k) == 0 || z.size() == 0) return Eigen::Matrix<double, 6, 1>::Zero();
-  return S(k) * z.segment(node_first_[k], node_count(k));
+Eigen::Matrix<double, 6, 1> NodeMotion(const SystemState& state, int k, const Eigen::VectorXd& dz) {
+  Eigen::Matrix<double, 6, 1> v = Eigen::Matrix<double, 6, 1>::Zero();
+  if (dz.size() == 0) return v;
+  for (const auto& [col, vec] : state.J[k]) v += vec * dz[col];
+  return v;
+}
+
+void UpdateKinematics(const SystemModel& model, const DofMap& dofs, SystemState& state) {
+  state.J.assign(model.n_nodes(), NodeJacobian());
+  for (int k : dofs.order()) {
+    const int j = dofs.joint_of(k);
+    NodeJacobian& J = state.J[k];
+    if (j < 0) {
+      const Eigen::MatrixXd& S = dofs.S(k);
+      for (int c = 0; c < S.cols(); ++c) J.emplace_back(dofs.node_first(k) + c, S.col(c));
+      continue;
+    }
+    const NodeJoint& joint = model.joints[j];
+    const int p = joint.parent;
+    PlaceChild(joint, state.x[p], state.R[p], state.z[k], &state.x[k], &state.R[k]);
+    const JointMaps maps = ComputeJointMaps(joint, state.x[p], state.R[p], state.x[k]);
+    for (const auto& [col, vec] : state.J[p]) {
+      const Eigen::Matrix<double, 6, 1> v = maps.A * vec;
+      if (v.squaredNorm() > 0) J.emplace_back(col, v);
+    }
+    for (int c = 0; c < joint.n_coordinates(); ++c) J.emplace_back(dofs.node_first(k) + c, maps.B.col(c));
+  }
+}
+
+std::vector<Eigen::Matrix<double, 6, 1>> NodeAccelerations(const SystemModel& model, const DofMap& dofs,
+                                                           const SystemState& state, const Eigen::VectorXd& W,
+                                                           const Eigen::VectorXd& Wdot) {
+  std::vector<Eigen::Matrix<double, 6, 1>> acc(model.n_nodes(), Eigen::Matrix<double, 6, 1>::Zero());
+  std::vector<Eigen::Matrix<double, 6, 1>> convective(model.n_nodes(), Eigen::Matrix<double, 6, 1>::Zero());
+  for (int k : dofs.order()) {
+    const int j = dofs.joint_of(k);
+    if (j >= 0) {
+      const NodeJoint& joint = model.joints[j];
+      const int p = joint.parent;
+      const JointMaps maps = ComputeJointMaps(joint, state.x[p], state.R[p], state.x[k]);
+      const Eigen::VectorXd zdot = W.segment(dofs.node_first(k), dofs.node_count(k));
+      convective[k] = ChildConvective(joint, maps, state.x[p], state.R[p], state.x[k], NodeMotion(state, p, W), zdot,
+                                      convective[p]);
+    }
+    acc[k] = NodeMotion(state, k, Wdot) + convective[k];
+  }
+  return acc;
+}
+
+NodeForces ZeroNodeForces(const SystemModel& model) {
+  NodeForces f;
+  f.f.assign(model.n_nodes(), Eigen::Matrix<double, 6, 1>::Zero());
+  return f;
+}
+
+void AddJointGeometricStiffness(const SystemModel& model, const DofMap& dofs, const SystemState& state,
+                                const NodeForces& forces, Eigen::MatrixXd& tangent) {
+  if (model.joints.empty()) return;
+  // Transmitted forces, children before parents: t_p += A^T t_c.
+  std::vector<Eigen::Matrix<double, 6, 1>> t = forces.f;
+  const std::vector<int>& order = dofs.order();
+  for (auto it = order.rbegin(); it != order.rend(); ++it) {
+    const int c = *it, j = dofs.joint_of(c);
+    if (j < 0) continue;
+    const NodeJoint& joint = model.joints[j];
+    const int p = joint.parent;
+    const JointMaps maps = ComputeJointMaps(joint, state.x[p], state.R[p], state.x[c]);
+    const JointGeometric g = ComputeJointGeometric(joint, maps, state.x[p], state.R[p], state.x[c], t[c]);
+    // d pi_p / dz: rotation rows of J_p.
+    const int n = int(tangent.cols());
+    Eigen::MatrixXd Jp = Eigen::MatrixXd::Zero(6, n);
+    for (const auto& [col, vec] : state.J[p]) Jp.col(col) += vec;
+    const Eigen::MatrixXd dpi = Jp.bottomRows(3);
+    const int first = dofs.node_first(c), d = joint.n_coordinates();
+    // residual += J_p^T (A^T t_c) + E_c^T (B^T t_c); tangent = -d residual / dz.
+    tangent -= Jp.transpose() * (g.dAf_dpi * dpi);
+    if (d > 0) {
+      tangent.middleCols(first, d) -= Jp.transpose() * g.dAf_dz;
+      tangent.middleRows(first, d) -= g.dBf_dpi * dpi;
+    }
+    t[p] += maps.A.transpose() * t[c];
+  }
 }
 
 void Clamp(SystemModel& model, int k) { model.motion[k] = Eigen::MatrixXd(6, 0); }
@@ -59,14 +169,16 @@ int AddNode(SystemModel& model, const std::string& name, const Eigen::Vector3d& 
 }
 
 SystemState InitialState(const SystemModel& model) {
+  const DofMap dofs(model);
   SystemState s;
   s.x = model.node_x0;
   s.R = model.node_R0;
-  for (int k = 0; k < model.n_nodes(); ++k) s.z.push_back(Eigen::VectorXd::Zero(model.motion[k].cols()));
+  for (int k = 0; k < model.n_nodes(); ++k) s.z.push_back(Eigen::VectorXd::Zero(dofs.node_count(k)));
   for (const SuperelementBody& body : model.bodies) {
     s.eta.push_back(Eigen::VectorXd::Zero(body.n_modes()));
     s.frames.push_back(body.InitialFrame());
   }
+  UpdateKinematics(model, dofs, s);
   return s;
 }
 
@@ -80,15 +192,14 @@ BodyConfiguration BodyConfigurationOf(const SystemModel& model, const SystemStat
   return c;
 }
 
-std::vector<MapEntry> BodyMap(const SystemModel& model, const DofMap& dofs, int b) {
+std::vector<MapEntry> BodyMap(const SystemModel& model, const DofMap& dofs, const SystemState& state, int b) {
   const SuperelementBody& body = model.bodies[b];
   std::vector<MapEntry> map;
   for (int a = 0; a < body.n_nodes(); ++a) {
     const int k = model.body_nodes[b][a];
-    const Eigen::MatrixXd& S = dofs.S(k);
-    for (int i = 0; i < 6; ++i) {
-      for (int j = 0; j < S.cols(); ++j) {
-        if (S(i, j) != 0.0) map.push_back({6 * a + i, dofs.node_first(k) + j, S(i, j)});
+    for (const auto& [col, vec] : state.J[k]) {
+      for (int i = 0; i < 6; ++i) {
+        if (vec[i] != 0.0) map.push_back({6 * a + i, col, vec[i]});
       }
     }
   }
@@ -107,10 +218,30 @@ void ScatterBody(const std::vector<MapEntry>& map, const Eigen::VectorXd* f, con
   }
 }
 
-Eigen::VectorXd GatherBody(const SystemModel& model, const DofMap& dofs, int b, const Eigen::VectorXd& W) {
-  Eigen::VectorXd w = Eigen::VectorXd::Zero(model.bodies[b].n_coordinates());
-  for (const MapEntry& e : BodyMap(model, dofs, b)) w[e.local] += e.coefficient * W[e.coordinate];
+Eigen::VectorXd GatherBody(const SystemModel& model, const DofMap& dofs, const SystemState& state, int b,
+                           const Eigen::VectorXd& W) {
+  const SuperelementBody& body = model.bodies[b];
+  Eigen::VectorXd w = Eigen::VectorXd::Zero(body.n_coordinates());
+  for (int a = 0; a < body.n_nodes(); ++a) w.segment<6>(6 * a) = NodeMotion(state, model.body_nodes[b][a], W);
+  w.tail(body.n_modes()) = W.segment(dofs.mode_dof(b), body.n_modes());
   return w;
+}
+
+Eigen::VectorXd GatherBodyAcceleration(const SystemModel& model, const DofMap& dofs, const SystemState& state, int b,
+                                       const std::vector<Eigen::Matrix<double, 6, 1>>& node_acc,
+                                       const Eigen::VectorXd& Wdot) {
+  (void)state;
+  const SuperelementBody& body = model.bodies[b];
+  Eigen::VectorXd w = Eigen::VectorXd::Zero(body.n_coordinates());
+  for (int a = 0; a < body.n_nodes(); ++a) w.segment<6>(6 * a) = node_acc[model.body_nodes[b][a]];
+  w.tail(body.n_modes()) = Wdot.segment(dofs.mode_dof(b), body.n_modes());
+  return w;
+}
+
+void AddBodyNodeForces(const SystemModel& model, int b, const Eigen::VectorXd& r_b, NodeForces& forces) {
+  for (size_t a = 0; a < model.body_nodes[b].size(); ++a) {
+    forces.Add(model.body_nodes[b][a], r_b.segment<6>(6 * a));
+  }
 }
 
 SystemForces AssembleStatic(const SystemModel& model, const DofMap& dofs, SystemState& state, double lambda,
@@ -119,6 +250,7 @@ SystemForces AssembleStatic(const SystemModel& model, const DofMap& dofs, System
   const int n = dofs.n_dofs();
   out.residual = Eigen::VectorXd::Zero(n);
   if (with_tangent) out.tangent = Eigen::MatrixXd::Zero(n, n);
+  NodeForces node_forces = ZeroNodeForces(model);
   for (size_t b = 0; b < model.bodies.size(); ++b) {
     const SuperelementBody& body = model.bodies[b];
     const BodyConfiguration c = BodyConfigurationOf(model, state, int(b));
@@ -136,43 +268,50 @@ SystemForces AssembleStatic(const SystemModel& model, const DofMap& dofs, System
     out.elastic_energy += body.ElasticEnergy(c, frame);
     out.force_scale = std::max({out.force_scale, f.norm(), body.force_floor()});
     const Eigen::VectorXd minus_f = -f;
-    ScatterBody(BodyMap(model, dofs, int(b)), &minus_f, with_tangent ? &K : nullptr, &out.residual,
+    ScatterBody(BodyMap(model, dofs, state, int(b)), &minus_f, with_tangent ? &K : nullptr, &out.residual,
                 with_tangent ? &out.tangent : nullptr);
+    AddBodyNodeForces(model, int(b), minus_f, node_forces);
   }
   Eigen::VectorXd loads = Eigen::VectorXd::Zero(n);
-  AddNodeLoads(model, dofs, state, lambda, loads, with_tangent ? &out.tangent : nullptr);
+  AddNodeLoads(model, dofs, state, lambda, loads, with_tangent ? &out.tangent : nullptr, &node_forces);
   AddSpringDampers(model, dofs, state, Eigen::VectorXd(), loads, with_tangent ? &out.tangent : nullptr, nullptr,
-                   &out.elastic_energy);
+                   &out.elastic_energy, &node_forces);
   out.residual += loads;
   out.force_scale = std::max(out.force_scale, loads.norm());
+  if (with_tangent) AddJointGeometricStiffness(model, dofs, state, node_forces, out.tangent);
   return out;
 }
 
 void AddNodeLoads(const SystemModel& model, const DofMap& dofs, const SystemState& state, double t,
-                  Eigen::VectorXd& residual, Eigen::MatrixXd* tangent) {
+                  Eigen::VectorXd& residual, Eigen::MatrixXd* tangent, NodeForces* node_forces) {
+  (void)dofs;
   for (const NodeLoad& load : model.loads) {
-    const Eigen::MatrixXd& S = dofs.S(load.node);
-    if (S.cols() == 0) continue;  // clamped: the support takes it
-    const int first = dofs.node_first(load.node);
+    const NodeJacobian& J = state.J[load.node];
+    if (J.empty()) continue;  // clamped: the support takes it
     const double s = load.Scale(t);
     const Eigen::Matrix3d& R = state.R[load.node];
     const Eigen::Vector3d F = s * (load.follower ? Eigen::Vector3d(R * load.force) : load.force);
     const Eigen::Vector3d Mo = s * (load.follower ? Eigen::Vector3d(R * load.moment) : load.moment);
     Eigen::Matrix<double, 6, 1> f;
     f << F, Mo;
-    residual.segment(first, S.cols()) += S.transpose() * f;
+    if (node_forces) node_forces->Add(load.node, f);
+    for (const auto& [col, vec] : J) residual[col] += vec.dot(f);
     if (tangent && load.follower) {
       // d(R F_loc)/d pi = -(R F_loc)~: enters the tangent of f_int - f_ext with a plus sign.
       Eigen::Matrix<double, 6, 6> K = Eigen::Matrix<double, 6, 6>::Zero();
       K.block<3, 3>(0, 3) = Skew<double>(F);
       K.block<3, 3>(3, 3) = Skew<double>(Mo);
-      tangent->block(first, first, S.cols(), S.cols()) += S.transpose() * K * S;
+      for (const auto& [ci, vi] : J) {
+        for (const auto& [cj, vj] : J) (*tangent)(ci, cj) += vi.dot(K * vj);
+      }
     }
   }
 }
 
 void AddSpringDampers(const SystemModel& model, const DofMap& dofs, const SystemState& state, const Eigen::VectorXd& W,
-                      Eigen::VectorXd& residual, Eigen::MatrixXd* K, Eigen::MatrixXd* C, double* energy) {
+                      Eigen::VectorXd& residual, Eigen::MatrixXd* K, Eigen::MatrixXd* C, double* energy,
+                      NodeForces* node_forces) {
+  (void)dofs;
   for (const SpringDamper& s : model.springs) {
     Eigen::Vector3d x[2], v[2];
     const int nodes[2] = {s.node_a, s.node_b};
@@ -180,17 +319,24 @@ void AddSpringDampers(const SystemModel& model, const DofMap& dofs, const System
     for (int e = 0; e < 2; ++e) {
       const int k = nodes[e];
       x[e] = k >= 0 ? state.x[k] : s.ground;
-      v[e] = k >= 0 ? Eigen::Vector3d(dofs.NodeMotion(k, W).head<3>()) : Eigen::Vector3d::Zero();
+      v[e] = k >= 0 ? Eigen::Vector3d(NodeMotion(state, k, W).head<3>()) : Eigen::Vector3d::Zero();
       if (k < 0) continue;
-      const Eigen::MatrixXd& S = dofs.S(k);
-      for (int i = 0; i < 3; ++i) {
-        for (int j = 0; j < S.cols(); ++j) {
-          if (S(i, j) != 0.0) map.push_back({3 * e + i, dofs.node_first(k) + j, S(i, j)});
+      for (const auto& [col, vec] : state.J[k]) {
+        for (int i = 0; i < 3; ++i) {
+          if (vec[i] != 0.0) map.push_back({3 * e + i, col, vec[i]});
         }
       }
     }
     const SpringDamperForces f = EvaluateSpringDamper(s, x[0], x[1], v[0], v[1]);
     if (energy) *energy += f.energy;
+    if (node_forces) {
+      for (int e = 0; e < 2; ++e) {
+        if (nodes[e] < 0) continue;
+        Eigen::Matrix<double, 6, 1> fe = Eigen::Matrix<double, 6, 1>::Zero();
+        fe.head<3>() = f.f.segment<3>(3 * e);
+        node_forces->Add(nodes[e], fe);
+      }
+    }
     const Eigen::VectorXd fv = f.f;
     const Eigen::MatrixXd Km = f.K, Cm = f.C;
     ScatterBody(map, &fv, K ? &Km : nullptr, &residual, K);
@@ -201,14 +347,22 @@ void AddSpringDampers(const SystemModel& model, const DofMap& dofs, const System
 void ApplyIncrement(const SystemModel& model, const DofMap& dofs, const Eigen::VectorXd& delta, SystemState& state) {
   for (int k = 0; k < model.n_nodes(); ++k) {
     if (dofs.node_count(k) == 0) continue;
-    const Eigen::Matrix<double, 6, 1> d = dofs.NodeMotion(k, delta);
-    state.z[k] += delta.segment(dofs.node_first(k), dofs.node_count(k));
-    state.x[k] += d.head<3>();
+    const Eigen::VectorXd dz = delta.segment(dofs.node_first(k), dofs.node_count(k));
+    state.z[k] += dz;
+    const int j = dofs.joint_of(k);
+    Eigen::Matrix<double, 6, 1> d = Eigen::Matrix<double, 6, 1>::Zero();
+    if (j < 0) {
+      d = dofs.S(k) * dz;
+      state.x[k] += d.head<3>();
+    } else if (model.joints[j].type == JointType::kSpherical) {
+      d.tail<3>() = dz;  // the child's own rotation; its position follows the parent
+    }
     if (d.tail<3>().squaredNorm() > 0) state.R[k] = ExpSO3(Eigen::Vector3d(d.tail<3>())) * state.R[k];
   }
   for (size_t b = 0; b < model.bodies.size(); ++b) {
     state.eta[b] += delta.segment(dofs.mode_dof(int(b)), model.bodies[b].n_modes());
   }
+  UpdateKinematics(model, dofs, state);
 }
 
 void ApplyPrescribed(const SystemModel& model, const DofMap& dofs, double t, SystemState& state, Eigen::VectorXd* W,

@@ -4,6 +4,10 @@
 // node, nothing for a clamp, [0; 1] for a spherical joint to ground, [0; a] for a revolute joint
 // to ground about the fixed axis a (R = exp(phi a~) R0 exactly), [a; 0] prismatic, [a 0; 0 a]
 // cylindrical. S_k is constant, so these joints add neither geometric nor convective terms.
+// A node may instead depend on a parent node through a NodeJoint (solver/joints/node_joint.h)
+// with the joint's own coordinates; its increments then follow dq_c = A dq_p + B dz, composed
+// down the tree into the node Jacobian J_k (dq_k = J_k dz), with the joints' geometric
+// stiffness and convective accelerations.
 // Unknowns: every node's coordinates, then the modal coordinates of every body. A joint
 // coordinate may be prescribed by a time function: it stays in the vector of coordinates but
 // is not solved for. Model (immutable) and State are separate: f(const Model&, State&).
@@ -17,6 +21,7 @@
 
 #include "solver/body/superelement_body.h"
 #include "solver/forces/spring_damper.h"
+#include "solver/joints/node_joint.h"
 
 namespace femb {
 
@@ -45,6 +50,8 @@ struct SystemModel {
     std::function<double(double)> value, rate, acceleration;
   };
   std::vector<Prescribed> prescribed;
+  /// Joints between nodes: each child node depends on its parent (a tree; no cycles).
+  std::vector<NodeJoint> joints;
   std::vector<SuperelementBody> bodies;
   std::vector<std::vector<int>> body_nodes;  ///< system node of each interface of each body
   std::vector<NodeLoad> loads;
@@ -54,8 +61,12 @@ struct SystemModel {
   int n_nodes() const { return int(node_names.size()); }
 };
 
+/// dq_k = J_k dz for one node: sparse columns (coordinate, 6-vector).
+using NodeJacobian = std::vector<std::pair<int, Eigen::Matrix<double, 6, 1>>>;
+
 struct SystemState {
   std::vector<Eigen::VectorXd> z;           ///< per node: accumulated coordinates (joint values)
+  std::vector<NodeJacobian> J;              ///< per node, at this configuration
   std::vector<Eigen::Vector3d> x;
   std::vector<Eigen::Matrix3d> R;
   std::vector<Eigen::VectorXd> eta;         ///< per body
@@ -67,14 +78,18 @@ class DofMap {
  public:
   explicit DofMap(const SystemModel& model);
   int n_dofs() const { return n_dofs_; }
-  /// First coordinate of node k and its basis S_k (6 x d_k).
+  /// First coordinate of node k and how many it has (its basis S_k when independent; its
+  /// joint's coordinates when it depends on a parent).
   int node_first(int k) const { return node_first_[k]; }
+  int node_count(int k) const { return node_count_[k]; }
   const Eigen::MatrixXd& S(int k) const { return (*motion_)[k]; }
-  int node_count(int k) const { return int((*motion_)[k].cols()); }
+  /// The joint making node k dependent, or -1.
+  int joint_of(int k) const { return joint_of_[k]; }
+  /// Nodes, parents before children.
+  const std::vector<int>& order() const { return order_; }
   /// First coordinate of body b's modal coordinates.
   int mode_dof(int b) const { return mode_dof_[b]; }
-  /// Spatial increment or velocity (dx, dpi) of node k from coordinates z.
-  Eigen::Matrix<double, 6, 1> NodeMotion(int k, const Eigen::VectorXd& z) const;
+
   /// true for prescribed coordinates (not solved for).
   bool prescribed(int j) const { return prescribed_[j]; }
   /// The coordinate of a prescribed entry.
@@ -84,7 +99,7 @@ class DofMap {
 
  private:
   const std::vector<Eigen::MatrixXd>* motion_;
-  std::vector<int> node_first_, mode_dof_, solved_;
+  std::vector<int> node_first_, node_count_, joint_of_, order_, mode_dof_, solved_;
   std::vector<bool> prescribed_;
   int n_dofs_ = 0;
 };
@@ -100,12 +115,34 @@ void PrismaticToGround(SystemModel& model, int k, const Eigen::Vector3d& axis);
 /// Cylindrical joint to ground: translation along and rotation about a.
 void CylindricalToGround(SystemModel& model, int k, const Eigen::Vector3d& axis);
 
+/// Spatial increment or velocity (dx, dpi) of node k from coordinate increments or rates.
+Eigen::Matrix<double, 6, 1> NodeMotion(const SystemState& state, int k, const Eigen::VectorXd& dz);
+
+/// Node accelerations J_k Wdot + convective terms of the joints.
+std::vector<Eigen::Matrix<double, 6, 1>> NodeAccelerations(const SystemModel& model, const DofMap& dofs,
+                                                           const SystemState& state, const Eigen::VectorXd& W,
+                                                           const Eigen::VectorXd& Wdot);
+
+/// Places the dependent nodes from their parents and recomputes the node Jacobians.
+void UpdateKinematics(const SystemModel& model, const DofMap& dofs, SystemState& state);
+
+/// Forces in node space (residual sense: applied minus internal) and their derivatives,
+/// mapped to the coordinates by the node Jacobians, plus the joints' geometric stiffness.
+struct NodeForces {
+  std::vector<Eigen::Matrix<double, 6, 1>> f;
+  void Add(int k, const Eigen::Matrix<double, 6, 1>& v) { f[k] += v; }
+};
+NodeForces ZeroNodeForces(const SystemModel& model);
+/// tangent -= d(sum_k J_k^T f_k)/dz at fixed f (the joint maps' configuration dependence).
+void AddJointGeometricStiffness(const SystemModel& model, const DofMap& dofs, const SystemState& state,
+                                const NodeForces& forces, Eigen::MatrixXd& tangent);
+
 /// Adds an interface node to `model` at a position and returns its index.
 int AddNode(SystemModel& model, const std::string& name, const Eigen::Vector3d& x,
             const Eigen::Matrix3d& R = Eigen::Matrix3d::Identity());
 
 /// The initial state: nodes at their initial placement, modes at rest, frames at the bodies'
-/// undeformed frames.
+/// undeformed frames, node Jacobians computed.
 SystemState InitialState(const SystemModel& model);
 
 /// Result of an evaluation of internal and external forces.
@@ -126,16 +163,22 @@ SystemForces AssembleStatic(const SystemModel& model, const DofMap& dofs, System
 /// External nodal loads at time t (or load factor) and their stiffness d(-f_ext)/dq added to
 /// `tangent` when not null (follower loads).
 void AddNodeLoads(const SystemModel& model, const DofMap& dofs, const SystemState& state, double t,
-                  Eigen::VectorXd& residual, Eigen::MatrixXd* tangent);
+                  Eigen::VectorXd& residual, Eigen::MatrixXd* tangent, NodeForces* node_forces = nullptr);
 
 /// Spring-damper forces added to `residual` (as applied forces), their stiffness and damping
 /// (of -f) to `K`, `C` when not null, their energy to `energy`. W may be empty (static).
 void AddSpringDampers(const SystemModel& model, const DofMap& dofs, const SystemState& state, const Eigen::VectorXd& W,
-                      Eigen::VectorXd& residual, Eigen::MatrixXd* K, Eigen::MatrixXd* C, double* energy);
+                      Eigen::VectorXd& residual, Eigen::MatrixXd* K, Eigen::MatrixXd* C, double* energy,
+                      NodeForces* node_forces = nullptr);
 
 /// Gathers body b's velocities (xdot, omega per interface node, then etadot) from the
 /// coordinate velocities W.
-Eigen::VectorXd GatherBody(const SystemModel& model, const DofMap& dofs, int b, const Eigen::VectorXd& W);
+Eigen::VectorXd GatherBody(const SystemModel& model, const DofMap& dofs, const SystemState& state, int b,
+                           const Eigen::VectorXd& W);
+/// Body b's node accelerations (with the joints' convective terms) and modal accelerations.
+Eigen::VectorXd GatherBodyAcceleration(const SystemModel& model, const DofMap& dofs, const SystemState& state, int b,
+                                       const std::vector<Eigen::Matrix<double, 6, 1>>& node_acc,
+                                       const Eigen::VectorXd& Wdot);
 
 /// The linear map from coordinates to body b's local coordinate increments as (local index,
 /// coordinate, coefficient) entries: dq_b[i] = sum c dz[j].
@@ -144,7 +187,9 @@ struct MapEntry {
   int coordinate;
   double coefficient;
 };
-std::vector<MapEntry> BodyMap(const SystemModel& model, const DofMap& dofs, int b);
+std::vector<MapEntry> BodyMap(const SystemModel& model, const DofMap& dofs, const SystemState& state, int b);
+/// Adds body b's local vector (residual sense) to the node forces.
+void AddBodyNodeForces(const SystemModel& model, int b, const Eigen::VectorXd& r_b, NodeForces& forces);
 
 /// Scatters a body vector f (n_b) and matrix K (n_b x n_b) through the map: F += B^T f,
 /// KK += B^T K B.

@@ -75,7 +75,7 @@ void ResultsRecorder::Record(double t, const SystemState& state, const Eigen::Ve
   for (int k = 0; k < n; ++k) {
     pos.segment<3>(3 * k) = state.x[k];
     quat.segment<4>(4 * k) = Quaternion(state.R[k]);
-    const Eigen::Matrix<double, 6, 1> v = dofs.NodeMotion(k, W);
+    const Eigen::Matrix<double, 6, 1> v = NodeMotion(state, k, W);
     vel.segment<3>(3 * k) = v.head<3>();
     ang.segment<3>(3 * k) = v.tail<3>();
   }

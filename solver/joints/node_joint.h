@@ -1,0 +1,75 @@
+// Joints between two nodes without Lagrange multipliers: the child node depends on its parent
+// node and the joint's own coordinates z (DESIGN.md "Joints without Lagrange multipliers").
+//   x_c = x_p + R_p (r0 + s a),  R_c = R_p exp(phi a~) Q0
+// with a the joint axis and r0, Q0 the child's initial placement, all in the parent's frame.
+// rigid: no coordinate; revolute: phi; prismatic: s; cylindrical: (s, phi); spherical: x_c
+// follows the parent, the child's rotation has its own 3 coordinates (spatial increments).
+// Spatial increments map linearly:  dq_c = A dq_p + B dz  with rho = x_c - x_p, g = R_p a:
+//   A = [1, -rho~; 0, 1] (spherical: [1, -rho~; 0, 0]),  B = columns [g; 0] (s), [0; g] (phi),
+//   [0; 1] (spherical rotation).
+// Accelerations add the convective part c_c = A c_p + [omega_p x rhodot; 0] + Bdot zdot with
+// rhodot = omega_p x rho + g sdot, gdot = omega_p x g.
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+
+namespace femb {
+
+enum class JointType { kRigid, kRevolute, kPrismatic, kCylindrical, kSpherical };
+
+/// "rigid", "revolute", ...; throws std::invalid_argument for other names.
+JointType JointTypeFromName(const std::string& name);
+
+struct NodeJoint {
+  JointType type = JointType::kRigid;
+  int child = -1, parent = -1;
+  Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();   ///< unit, parent frame
+  Eigen::Vector3d r0 = Eigen::Vector3d::Zero();      ///< child position, parent frame
+  Eigen::Matrix3d Q0 = Eigen::Matrix3d::Identity();  ///< R_p^T R_c initially
+
+  int n_coordinates() const;
+  /// Index of the translation coordinate s (-1 if none) and of the angle phi (-1 if none).
+  int s_index() const;
+  int phi_index() const;
+};
+
+/// A joint from the initial placements of both nodes; `axis` is global.
+NodeJoint MakeNodeJoint(JointType type, int child, int parent, const Eigen::Vector3d& axis,
+                        const Eigen::Vector3d& x_p, const Eigen::Matrix3d& R_p, const Eigen::Vector3d& x_c,
+                        const Eigen::Matrix3d& R_c);
+
+/// Places the child from the parent and the joint coordinates z. For spherical joints the
+/// child's rotation is its own and is left as it is.
+void PlaceChild(const NodeJoint& j, const Eigen::Vector3d& x_p, const Eigen::Matrix3d& R_p, const Eigen::VectorXd& z,
+                Eigen::Vector3d* x_c, Eigen::Matrix3d* R_c);
+
+/// The maps of dq_c = A dq_p + B dz at a configuration.
+struct JointMaps {
+  Eigen::Matrix<double, 6, 6> A;
+  Eigen::Matrix<double, 6, Eigen::Dynamic> B;
+};
+JointMaps ComputeJointMaps(const NodeJoint& j, const Eigen::Vector3d& x_p, const Eigen::Matrix3d& R_p,
+                           const Eigen::Vector3d& x_c);
+
+/// Convective acceleration of the child: c_c = A c_p + [omega_p x rhodot; 0] + Bdot zdot.
+Eigen::Matrix<double, 6, 1> ChildConvective(const NodeJoint& j, const JointMaps& maps, const Eigen::Vector3d& x_p,
+                                            const Eigen::Matrix3d& R_p, const Eigen::Vector3d& x_c,
+                                            const Eigen::Matrix<double, 6, 1>& w_p, const Eigen::VectorXd& zdot,
+                                            const Eigen::Matrix<double, 6, 1>& c_p);
+
+/// Derivative of (A^T f, B^T f) — the generalized force the child's force f = (F, M) puts on
+/// the parent's increments and the joint coordinates — with respect to the parent's rotation
+/// increment dpi_p and the joint coordinates, at fixed f. Returns the blocks:
+///   dAf_dpi (6 x 3): d(A^T f)/d pi_p,   dAf_dz (6 x d): d(A^T f)/dz,
+///   dBf_dpi (d x 3): d(B^T f)/d pi_p.   (d(B^T f)/dz = 0: the axes are fixed in the parent.)
+struct JointGeometric {
+  Eigen::Matrix<double, 6, 3> dAf_dpi;
+  Eigen::Matrix<double, 6, Eigen::Dynamic> dAf_dz;
+  Eigen::Matrix<double, Eigen::Dynamic, 3> dBf_dpi;
+};
+JointGeometric ComputeJointGeometric(const NodeJoint& j, const JointMaps& maps, const Eigen::Vector3d& x_p,
+                                     const Eigen::Matrix3d& R_p, const Eigen::Vector3d& x_c,
+                                     const Eigen::Matrix<double, 6, 1>& f);
+
+}  // namespace femb
