@@ -195,13 +195,20 @@ SceneSpec ParseScene(const std::string& text, const std::string& name, const std
       YamlValue type = m.Required("type");
       j.type = type.String();
       const bool axial = j.type == "revolute" || j.type == "prismatic" || j.type == "cylindrical";
-      if (j.type != "clamp" && j.type != "spherical" && !axial) {
+      if (j.type != "clamp" && j.type != "spherical" && j.type != "rigid" && !axial) {
         type.Fail("unknown joint type '" + j.type +
-                  "' (known here, all to ground: clamp, spherical, revolute, prismatic, cylindrical)");
+                  "' (known: clamp, spherical, revolute, prismatic, cylindrical, rigid)");
       }
       j.node = check_node(m.Required("node"));
+      if (auto p = m.Optional("parent")) {
+        j.parent = check_node(*p);
+        if (j.parent == j.node) p->Fail("a node cannot be its own parent");
+        if (j.type == "clamp") type.Fail("a clamp holds a node to the ground; between two nodes use 'rigid'");
+      } else if (j.type == "rigid") {
+        type.Fail("a rigid joint needs a 'parent' node (to the ground use 'clamp')");
+      }
       for (const auto& other : scene.joints) {
-        if (other.node == j.node) item.Fail("node '" + j.node + "' already has a joint to ground");
+        if (other.node == j.node) item.Fail("node '" + j.node + "' already has a joint (" + other.where + ")");
       }
       if (axial) {
         YamlValue axis = m.Required("axis");

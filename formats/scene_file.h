@@ -34,8 +34,9 @@ struct SceneBodySpec {
 };
 
 struct SceneJointSpec {
-  std::string type;  ///< to ground: clamp, spherical, revolute, prismatic, cylindrical
+  std::string type;  ///< clamp, spherical, revolute, prismatic, cylindrical, rigid (rigid needs a parent)
   std::string node;
+  std::string parent;  ///< "" = to ground; else the node this one depends on
   Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();  ///< revolute/prismatic/cylindrical (global)
   std::string prescribed;  ///< time function of the joint coordinate (angle or travel); "" = free
   std::string where;

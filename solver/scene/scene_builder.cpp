@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <Eigen/Dense>
 #include <filesystem>
+#include <memory>
 
 #include "formats/input_error.h"
 #include "formats/superelement_file.h"
@@ -78,6 +79,23 @@ Scene BuildScene(const SceneSpec& spec) {
   }
   for (const SceneJointSpec& j : spec.joints) {
     const int k = scene.node_index.at(j.node);
+    if (!j.parent.empty()) {
+      const int p = scene.node_index.at(j.parent);
+      model.joints.push_back(MakeNodeJoint(JointTypeFromName(j.type), k, p, j.axis, model.node_x0[p], model.node_R0[p],
+                                           model.node_x0[k], model.node_R0[k]));
+      model.motion[k] = Eigen::MatrixXd(6, 0);  // the joint's coordinates replace the node's own
+      if (!j.prescribed.empty()) {
+        const TimeFunctionSpec f = spec.functions.at(j.prescribed);
+        SystemModel::Prescribed pr;
+        pr.node = k;
+        pr.coordinate = 0;
+        pr.value = [f](double t) { return f.Evaluate(t); };
+        pr.rate = [f](double t) { return f.Rate(t); };
+        pr.acceleration = [f](double t) { return f.Acceleration(t); };
+        model.prescribed.push_back(pr);
+      }
+      continue;
+    }
     if (j.type == "clamp") Clamp(model, k);
     if (j.type == "spherical") Pin(model, k);
     if (j.type == "revolute") RevoluteToGround(model, k, j.axis);
@@ -128,10 +146,20 @@ Scene BuildScene(const SceneSpec& spec) {
     }
     model.loads.push_back(load);
   }
-  const DofMap dofs(model);
+  std::unique_ptr<DofMap> dofs_ptr;
+  try {
+    dofs_ptr = std::make_unique<DofMap>(model);
+  } catch (const InputError& e) {
+    throw InputError(spec.file + ": joints: " + e.what());
+  }
+  const DofMap& dofs = *dofs_ptr;
   scene.initial_velocity = Eigen::VectorXd::Zero(dofs.n_dofs());
   for (const auto& [node, v] : spec.initial_velocities) {
     const int k = scene.node_index.at(node);
+    if (dofs.joint_of(k) >= 0) {
+      throw InputError(spec.file + ": initial_velocity: node '" + node +
+                       "' depends on a parent through a joint; give the velocity of its parent");
+    }
     if (dofs.node_count(k) == 0) continue;
     Eigen::Matrix<double, 6, 1> v6;
     v6 << v.first, v.second;
