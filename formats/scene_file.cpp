@@ -12,7 +12,7 @@
 namespace femb {
 
 double TimeFunctionSpec::Evaluate(double t) const {
-  if (type == "linear") return t;
+  if (type == "linear") return value * t;
   if (type == "constant") return value;
   if (type == "ramp") {
     if (t <= t_start) return 0.0;
@@ -38,7 +38,7 @@ double TimeFunctionSpec::Evaluate(double t) const {
 }
 
 double TimeFunctionSpec::Rate(double t) const {
-  if (type == "linear") return 1.0;
+  if (type == "linear") return value;
   if (type == "ramp") return (t >= t_start && t < t_end) ? value / (t_end - t_start) : 0.0;
   if (type == "sine") return amplitude * 2 * M_PI * frequency * std::cos(2 * M_PI * frequency * t + phase);
   if (type == "spin_up") {
@@ -105,7 +105,9 @@ TimeFunctionSpec ParseFunction(const YamlValue& value) {
       }
     }
     if (f.table.empty()) points.Fail("a table needs at least one point");
-  } else if (f.type != "linear") {
+  } else if (f.type == "linear") {
+    if (auto v = m.Optional("slope")) f.value = v->Number();
+  } else {
     type.Fail("unknown time function type '" + f.type + "' (known: linear, constant, ramp, step, pulse, sine, table, spin_up)");
   }
   m.CheckNoUnknownKeys();

@@ -12,7 +12,7 @@ namespace femb {
 
 /// A scalar function of time (or of the pseudo-time of a static analysis).
 struct TimeFunctionSpec {
-  std::string type = "linear";  ///< linear (f = t), constant, ramp, step, pulse, sine, table, spin_up
+  std::string type = "linear";  ///< linear (f = slope t), constant, ramp, step, pulse, sine, table, spin_up
   double value = 1.0;           ///< constant value; final value of ramp and step
   double t_start = 0.0, t_end = 1.0;  ///< ramp from 0 at t_start to value at t_end; step at t_start
   double amplitude = 0.0, frequency = 0.0, phase = 0.0, offset = 0.0;  ///< sine [Hz]

@@ -90,14 +90,28 @@ DynamicState InitialDynamicState(const SystemModel& model, const SystemState& co
   s.W = W;
   s.Wdot = Eigen::VectorXd::Zero(dofs.n_dofs());
   s.t = t0;
-  const Assembly a = AssembleDynamic(model, dofs, s, t0, true);
   ApplyPrescribed(model, dofs, t0, s.config, &s.W, &s.Wdot);
+  // Driven start: when no free coordinate was given a velocity but prescribed ones move, start
+  // the free ones with the velocity that makes the elastic forces stationary, K_ff W_f =
+  // -K_fp W_p (the mechanism moves as a whole, no deformation rate) instead of at rest, which
+  // would be an impulsive start.
+  bool free_at_rest = true, driven = false;
+  for (int j = 0; j < dofs.n_dofs(); ++j) {
+    if (dofs.prescribed(j)) driven |= s.W[j] != 0.0;
+    else free_at_rest &= s.W[j] == 0.0;
+  }
+  if (driven && free_at_rest) {
+    SystemState copy = s.config;
+    const SystemForces f = AssembleStatic(model, dofs, copy, t0, true);
+    Eigen::VectorXd rhs = -(f.tangent * s.W);
+    const Eigen::VectorXd W_free = SolveFree(dofs, f.tangent, rhs);
+    for (int j : dofs.solved()) s.W[j] = W_free[j];
+  }
   const Assembly b = AssembleDynamic(model, dofs, s, t0, true);
   const Eigen::VectorXd free_acc = SolveFree(dofs, b.M, b.residual - b.M * s.Wdot);
   for (int j : dofs.solved()) s.Wdot[j] = free_acc[j];
   s.a = s.Wdot;
   s.f_ext = b.f_ext;
-  (void)a;
   return s;
 }
 
