@@ -1,5 +1,6 @@
 #include "formats/scene_file.h"
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <fstream>
@@ -140,9 +141,34 @@ SceneSpec ParseScene(const std::string& text, const std::string& name, const std
       if (other.name == b.name) item.Fail("body name '" + b.name + "' used twice");
     }
     if (auto t = m.Optional("type")) {
-      if (t->String() != "superelement") t->Fail("unknown body type '" + t->String() + "' (known: superelement)");
+      b.type = t->String();
+      if (b.type != "superelement" && b.type != "rigid") {
+        t->Fail("unknown body type '" + b.type + "' (known: superelement, rigid)");
+      }
     }
-    b.superelement = m.Required("superelement").String();
+    if (b.type == "superelement") {
+      b.superelement = m.Required("superelement").String();
+    } else {
+      b.mass = m.Required("mass").PositiveNumber();
+      if (auto v = m.Optional("center_of_mass")) b.center_of_mass = v->Vector3();
+      YamlValue inertia = m.Required("inertia");
+      std::vector<double> I;
+      for (const YamlValue& v : inertia.List()) I.push_back(v.Number());
+      if (I.size() != 3 && I.size() != 6) inertia.Fail("expected [Ixx, Iyy, Izz] or [Ixx, Iyy, Izz, Ixy, Iyz, Izx]");
+      b.inertia.diagonal() << I[0], I[1], I[2];
+      if (I.size() == 6) {
+        b.inertia(0, 1) = b.inertia(1, 0) = I[3];
+        b.inertia(1, 2) = b.inertia(2, 1) = I[4];
+        b.inertia(2, 0) = b.inertia(0, 2) = I[5];
+      }
+      const Eigen::Vector3d p = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(b.inertia).eigenvalues();
+      if (!(p[0] > 0) || p[0] + p[1] < p[2] * (1 - 1e-12)) {
+        inertia.Fail("not a physical inertia tensor (principal moments must be positive and obey the triangle inequality)");
+      }
+      if (auto pts = m.Optional("points")) {
+        for (const auto& [pname, value] : pts->Map().Entries()) b.points[pname] = value.Vector3();
+      }
+    }
     if (auto p = m.Optional("placement")) {
       YamlMap pm = p->Map();
       if (auto v = pm.Optional("position")) b.position = v->Vector3();
@@ -151,8 +177,15 @@ SceneSpec ParseScene(const std::string& text, const std::string& name, const std
     }
     YamlValue node_map = m.Required("nodes");
     for (const auto& [iname, scene_node] : node_map.Map().Entries()) {
+      if (b.type == "rigid" && iname != "com" && !b.points.count(iname)) {
+        scene_node.Fail("rigid body '" + b.name + "' has no point '" + iname + "' (define it under 'points'; 'com' is the centre of mass)");
+      }
       b.nodes[iname] = scene_node.String();
       nodes.insert(scene_node.String());
+    }
+    if (b.type == "rigid" && !b.nodes.count("com")) {
+      b.nodes["com"] = b.name + ".com";
+      nodes.insert(b.nodes["com"]);
     }
     if (auto o = m.Optional("options")) {
       YamlMap om = o->Map();

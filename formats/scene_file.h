@@ -24,7 +24,13 @@ struct TimeFunctionSpec {
 
 struct SceneBodySpec {
   std::string name;
+  std::string type = "superelement";  ///< superelement | rigid
   std::string superelement;      ///< file path (relative paths are relative to the scene file)
+  // rigid: mass, centre of mass and inertia about it (part axes), attachment points (part axes)
+  double mass = 0.0;
+  Eigen::Vector3d center_of_mass = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d inertia = Eigen::Matrix3d::Zero();
+  std::map<std::string, Eigen::Vector3d> points;
   Eigen::Vector3d position = Eigen::Vector3d::Zero();
   Eigen::Vector3d rotation = Eigen::Vector3d::Zero();  ///< rotation vector [rad]
   std::map<std::string, std::string> nodes;  ///< interface name -> scene node name

@@ -6,10 +6,15 @@
 #include <memory>
 
 #include "formats/input_error.h"
+#include "formats/part_file.h"
 #include "formats/superelement_file.h"
 #include "solver/rotation.h"
 
 namespace femb {
+
+namespace {
+Units UnitSystemOf(const std::string& name) { return UnitSystem(name, "units"); }
+}  // namespace
 
 Scene BuildScene(const SceneSpec& spec) {
   Scene scene;
@@ -17,7 +22,55 @@ Scene BuildScene(const SceneSpec& spec) {
   SystemModel& model = scene.model;
   const std::filesystem::path base = std::filesystem::path(spec.file).parent_path();
   std::map<std::string, std::pair<Eigen::Vector3d, std::string>> placed;  // node -> position, by body
+  std::vector<std::pair<int, int>> rigid_attachments;  // (child node, COM node)
   for (const SceneBodySpec& b : spec.bodies) {
+    if (b.type == "rigid") {
+      // A rigid body: one node at the centre of mass carrying the 6 x 6 rigid mass, no
+      // stiffness; its attachment points are rigid offsets (dependent nodes) of that node.
+      Superelement se;
+      se.name = b.name;
+      se.units = UnitSystemOf(spec.units);
+      se.interfaces.push_back({"com", b.center_of_mass, Eigen::Matrix3d::Identity()});
+      se.K = Eigen::MatrixXd::Zero(6, 6);
+      se.M = Eigen::MatrixXd::Zero(6, 6);
+      se.M.topLeftCorner(3, 3) = b.mass * Eigen::Matrix3d::Identity();
+      se.M.bottomRightCorner(3, 3) = b.inertia;
+      se.floating_frame.type = "interface:com";
+      se.floating_frame.origin = b.center_of_mass;
+      se.floating_frame.Phi_CB = Eigen::MatrixXd::Identity(6, 6);
+      se.mass_properties = {b.mass, b.center_of_mass, b.inertia};
+      const Eigen::Matrix3d R = ExpSO3(b.rotation);
+      const std::string com_node = b.nodes.at("com");
+      if (scene.node_index.count(com_node)) {
+        throw InputError(b.where + ": rigid body '" + b.name + "': its centre-of-mass node '" + com_node +
+                         "' is already used by another body");
+      }
+      const int com = AddNode(model, com_node, b.position + R * b.center_of_mass, R);
+      scene.node_index[com_node] = com;
+      placed[com_node] = {model.node_x0[com], b.name};
+      model.bodies.emplace_back(se, SuperelementOptions{}, R, b.position);
+      model.body_nodes.push_back({com});
+      scene.body_names.push_back(b.name);
+      for (const auto& [point, node] : b.nodes) {
+        if (point == "com") continue;
+        const Eigen::Vector3d x = b.position + R * b.points.at(point);
+        auto found = scene.node_index.find(node);
+        int k;
+        if (found == scene.node_index.end()) {
+          k = AddNode(model, node, x, R);
+          scene.node_index[node] = k;
+          placed[node] = {x, b.name};
+        } else {
+          k = found->second;
+          if ((model.node_x0[k] - x).norm() > 1e-9 * std::max(1.0, x.norm())) {
+            throw InputError(b.where + ": rigid body '" + b.name + "': point '" + point + "' at a different place than node '" +
+                             node + "' of body '" + placed[node].second + "'");
+          }
+        }
+        rigid_attachments.emplace_back(k, com);
+      }
+      continue;
+    }
     std::filesystem::path file(b.superelement);
     if (file.is_relative()) file = base / file;
     Superelement se;
@@ -76,6 +129,31 @@ Scene BuildScene(const SceneSpec& spec) {
     model.bodies.emplace_back(se, options, R, b.position);
     model.body_nodes.push_back(nodes);
     scene.body_names.push_back(b.name);
+  }
+  // Rigid offsets: a rigid body's tree is rooted at its centre-of-mass node, or at the one point
+  // that carries a joint (a pendulum's pivot), so that the joint acts on the root.
+  std::map<int, const SceneJointSpec*> joint_on;
+  for (const SceneJointSpec& j : spec.joints) joint_on[scene.node_index.at(j.node)] = &j;
+  std::map<int, int> root_of;  // COM node -> root node
+  for (const auto& [k, com] : rigid_attachments) {
+    if (!joint_on.count(k)) continue;
+    if (root_of.count(com) && root_of[com] != k) {
+      throw InputError(joint_on[k]->where + ": rigid body at node '" + model.node_names[com] + "' has joints on two of its points ('" +
+                       model.node_names[root_of[com]] + "', '" + model.node_names[k] +
+                       "'): a loop of rigid bodies and joints; make one of the connected bodies flexible");
+    }
+    if (joint_on.count(com)) {
+      throw InputError(joint_on[k]->where + ": rigid body at node '" + model.node_names[com] + "' has joints on its centre of mass and on point '" +
+                       model.node_names[k] + "': a loop of rigid bodies and joints");
+    }
+    root_of[com] = k;
+  }
+  for (const auto& [k, com] : rigid_attachments) {
+    const bool rooted_here = root_of.count(com) && root_of[com] == k;
+    const int child = rooted_here ? com : k, parent = rooted_here ? k : com;
+    model.joints.push_back(MakeNodeJoint(JointType::kRigid, child, parent, Eigen::Vector3d::UnitZ(), model.node_x0[parent],
+                                         model.node_R0[parent], model.node_x0[child], model.node_R0[child]));
+    model.motion[child] = Eigen::MatrixXd(6, 0);
   }
   for (const SceneJointSpec& j : spec.joints) {
     const int k = scene.node_index.at(j.node);

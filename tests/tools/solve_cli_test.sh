@@ -95,6 +95,15 @@ err = np.abs(np.unwrap(phi) - 150 * t).max()
 assert err < 1e-5, err  # the crank is a very stiff (not rigid) body: its tip lags elastically
 PY
 
+# Pendulums: a stiff superelement and a rigid body (pivot at one of its points) swing at the
+# rigid pendulum period (closed form with the amplitude correction) within 1e-4.
+mkdir -p "$work/pend"
+cp "$src"/examples/pendulum/rod.yaml "$src"/examples/pendulum/scene.yaml "$work/pend/"
+"$bin/femb-reduce" -q "$work/pend/rod.yaml" -o "$work/pend/rod.h5" && \
+  "$bin/femb-solve" -q "$work/pend/scene.yaml" -o "$work/pend_out" && ok || fail "pendulum"
+$py "$src/examples/pendulum/period.py" "$work/pend_out" > "$work/period.txt" && \
+  awk '{e = $NF < 0 ? -$NF : $NF; if (e > 1e-4) bad = 1} END {exit bad}' "$work/period.txt" && ok || fail "pendulum period: $(cat "$work/period.txt")"
+
 expect() {  # name, exit code, expected text, scene text transformation (sed)
   local name=$1 code=$2 text=$3 script=$4
   sed "$script" "$work/scene.yaml" > "$work/bad.yaml"
@@ -109,6 +118,7 @@ expect() {  # name, exit code, expected text, scene text transformation (sed)
 expect "unknown joint type" 2 "bad.yaml:18: joints[0].type: unknown joint type 'weld'" 's/type: clamp/type: weld/'
 expect "unknown node" 2 "node 'n42' is not a node of any body" 's/node: n10, force/node: n42, force/'
 expect "unknown body type" 2 "unknown body type 'rigid_blob'" 's/{name: b0, /{name: b0, type: rigid_blob, /'
+expect "rigid loop" 2 "a loop of rigid bodies and joints" 's/^joints:/joints:\n  - {type: spherical, node: n9}\n  - {type: spherical, node: n10}/; s/{name: b9, superelement: segment.h5, placement: {position: \[0.9, 0, 0\]}, nodes: {A: n9, B: n10}}/{name: b9, type: rigid, mass: 1, inertia: [1, 1, 1], points: {A: [0, 0, 0], B: [0.1, 0, 0]}, placement: {position: [0.9, 0, 0]}, nodes: {A: n9, B: n10}}/; s/  - {type: force, node: n10, force/  - {type: force, node: n8, force/'
 expect "missing superelement" 2 "body 'b3': " 's/{name: b3, superelement: segment.h5/{name: b3, superelement: nothere.h5/'
 expect "missing superelement names file" 2 "nothere.h5: cannot open file" 's/{name: b3, superelement: segment.h5/{name: b3, superelement: nothere.h5/'
 expect "load on clamped node" 2 "load on node 'n0', which is clamped" 's/node: n10, force/node: n0, force/'
