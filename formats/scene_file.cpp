@@ -352,6 +352,7 @@ SceneSpec ParseScene(const std::string& text, const std::string& name, const std
 
   if (auto outputs = root.Optional("outputs")) {
     YamlMap m = outputs.value().Map();
+    if (auto v = m.Optional("animation")) scene.animation = v->Bool();
     if (auto probes = m.Optional("probes")) {
       for (const YamlValue& item : probes->List()) {
         YamlMap pm = item.Map();

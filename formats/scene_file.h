@@ -92,6 +92,7 @@ struct SceneSpec {
   std::map<std::string, TimeFunctionSpec> functions;
   SceneAnalysisSpec analysis;
   std::vector<SceneProbeSpec> probes;
+  bool animation = true;  ///< write animation.xdmf/.h5 when the superelement files hold meshes
   /// Initial velocity (spatial) of named nodes: (linear, angular).
   std::map<std::string, std::pair<Eigen::Vector3d, Eigen::Vector3d>> initial_velocities;
 };

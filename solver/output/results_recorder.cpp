@@ -96,6 +96,27 @@ void ResultsRecorder::Record(double t, const SystemState& state, const Eigen::Ve
   }
   modal_.push_back(modal);
   frames_.push_back(frames);
+  if (scene_.spec.animation) {
+    std::vector<Eigen::MatrixXd> meshes;
+    for (size_t b = 0; b < model.bodies.size(); ++b) {
+      const auto& mesh = scene_.meshes[b];
+      if (!mesh) {
+        meshes.emplace_back();
+        continue;
+      }
+      const BodyConfiguration c = BodyConfigurationOf(model, state, int(b));
+      const Eigen::VectorXd q = model.bodies[b].LocalCoordinates(c, state.frames[b]);
+      const Eigen::VectorXd u = mesh->shapes * q;
+      Eigen::MatrixXd x(mesh->nodes.rows(), 3);
+      for (int i = 0; i < mesh->nodes.rows(); ++i) {
+        const Eigen::Vector3d X = mesh->nodes.row(i).transpose() - scene_.mesh_origin[b];
+        const Eigen::Vector3d ui = u.segment<3>(mesh->dofs_per_node * i);
+        x.row(i) = (state.frames[b].x + state.frames[b].R * (X + ui)).transpose();
+      }
+      meshes.push_back(x);
+    }
+    mesh_positions_.push_back(meshes);
+  }
 
   csv_ << Num(t);
   for (const SceneProbeSpec& p : scene_.spec.probes) {
@@ -158,6 +179,84 @@ void ResultsRecorder::Finish(const std::string& status) {
   }
   std::filesystem::rename(tmp, h5_path_, ec);
   if (ec) throw InputError(h5_path_ + ": cannot rename into place (" + ec.message() + ")");
+  WriteAnimation();
+}
+
+void ResultsRecorder::WriteAnimation() {
+  // One unstructured grid per output step holding every body's mesh (nodes concatenated, cells
+  // offset; cell data 'body' = body index): a temporal collection that ParaView and meshio read.
+  std::vector<int> with_mesh;
+  long n_nodes = 0, n_cells = 0;
+  std::string cell_type;
+  for (size_t b = 0; b < scene_.meshes.size(); ++b) {
+    if (!scene_.meshes[b]) continue;
+    if (!cell_type.empty() && scene_.meshes[b]->cell_type != cell_type) continue;  // one cell type per grid
+    cell_type = scene_.meshes[b]->cell_type;
+    with_mesh.push_back(int(b));
+    n_nodes += scene_.meshes[b]->nodes.rows();
+    n_cells += scene_.meshes[b]->cells.rows();
+  }
+  if (!scene_.spec.animation || with_mesh.empty() || time_.empty()) return;
+  const int per_cell = int(scene_.meshes[with_mesh[0]]->cells.cols());
+  Eigen::MatrixXi cells(n_cells, per_cell);
+  Eigen::MatrixXd body(n_cells, 1);
+  long node_offset = 0, cell_offset = 0;
+  for (int b : with_mesh) {
+    const Visualization& v = *scene_.meshes[b];
+    cells.middleRows(cell_offset, v.cells.rows()) = v.cells.array() + int(node_offset);
+    body.middleRows(cell_offset, v.cells.rows()).setConstant(b);
+    node_offset += v.nodes.rows();
+    cell_offset += v.cells.rows();
+  }
+  const std::filesystem::path dir(directory_);
+  const std::string h5 = (dir / "animation.h5").string(), xdmf = (dir / "animation.xdmf").string();
+  const std::string pid = std::to_string(::getpid());
+  {
+    h5::Writer w(h5 + ".tmp." + pid);
+    Eigen::MatrixXd x0;
+    w.IntMatrix("/cells", cells);
+    w.Matrix("/body", body);
+    for (size_t s = 0; s < time_.size(); ++s) {
+      Eigen::MatrixXd x(n_nodes, 3);
+      long offset = 0;
+      for (int b : with_mesh) {
+        x.middleRows(offset, mesh_positions_[s][b].rows()) = mesh_positions_[s][b];
+        offset += mesh_positions_[s][b].rows();
+      }
+      w.Matrix("/x_" + std::to_string(s), x);
+      if (s == 0) x0 = x;
+      w.Matrix("/displacement_" + std::to_string(s), x - x0);
+    }
+    w.Close();
+  }
+  const char* topology = cell_type == "line2" ? "Polyline" : cell_type == "tet4" ? "Tetrahedron"
+                       : cell_type == "tet10" ? "Tetrahedron_10" : cell_type == "hex8" ? "Hexahedron" : "Hexahedron_20";
+  std::ofstream out(xdmf + ".tmp." + pid);
+  out << "<?xml version=\"1.0\" ?>\n<Xdmf Version=\"3.0\">\n <Domain>\n"
+      << "  <Grid Name=\"" << scene_.spec.name << "\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
+  for (size_t s = 0; s < time_.size(); ++s) {
+    out << "   <Grid Name=\"step " << s << "\" GridType=\"Uniform\">\n"
+        << "    <Time Value=\"" << Num(time_[s]) << "\"/>\n"
+        << "    <Topology TopologyType=\"" << topology << "\" NumberOfElements=\"" << n_cells << "\"";
+    if (cell_type == "line2") out << " NodesPerElement=\"2\"";
+    out << ">\n     <DataItem Dimensions=\"" << n_cells << " " << per_cell
+        << "\" NumberType=\"Int\" Precision=\"4\" Format=\"HDF\">animation.h5:/cells</DataItem>\n    </Topology>\n"
+        << "    <Geometry GeometryType=\"XYZ\">\n     <DataItem Dimensions=\"" << n_nodes
+        << " 3\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">animation.h5:/x_" << s
+        << "</DataItem>\n    </Geometry>\n"
+        << "    <Attribute Name=\"body\" AttributeType=\"Scalar\" Center=\"Cell\">\n     <DataItem Dimensions=\""
+        << n_cells << " 1\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">animation.h5:/body</DataItem>\n"
+        << "    </Attribute>\n"
+        << "    <Attribute Name=\"displacement\" AttributeType=\"Vector\" Center=\"Node\">\n     <DataItem Dimensions=\""
+        << n_nodes << " 3\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">animation.h5:/displacement_" << s
+        << "</DataItem>\n    </Attribute>\n   </Grid>\n";
+  }
+  out << "  </Grid>\n </Domain>\n</Xdmf>\n";
+  out.close();
+  std::error_code ec;
+  std::filesystem::rename(h5 + ".tmp." + pid, h5, ec);
+  if (!ec) std::filesystem::rename(xdmf + ".tmp." + pid, xdmf, ec);
+  if (ec) throw InputError(xdmf + ": cannot rename into place (" + ec.message() + ")");
 }
 
 }  // namespace femb

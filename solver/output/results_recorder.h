@@ -2,7 +2,9 @@
 // floating frames of every body and the energies per output step, and a CSV of the requested
 // probes that always ends with kinetic_energy,elastic_energy,external_work. Both are written
 // to temporary names and renamed by Finish(), which is also called after a numerical failure
-// so the results up to it are kept. Layout: formats/RESULTS_FORMAT.md.
+// so the results up to it are kept. Layout: formats/SCENE_FORMAT.md. When the superelement
+// files hold meshes and mode shapes, animation.xdmf + animation.h5 give the deformed meshes of
+// every output step for ParaView: x(X) = x_j + R_j (X - X_j + u(X)), u = shapes * q_loc.
 #pragma once
 
 #include <fstream>
@@ -35,6 +37,8 @@ class ResultsRecorder {
   std::vector<Eigen::VectorXd> positions_, quaternions_, velocities_, angular_velocities_;
   std::vector<std::vector<Eigen::VectorXd>> modal_;     // per step, per body
   std::vector<std::vector<Eigen::VectorXd>> frames_;    // per step, per body: x (3), quaternion (4)
+  std::vector<std::vector<Eigen::MatrixXd>> mesh_positions_;  // per step, per body with a mesh
+  void WriteAnimation();
 };
 
 }  // namespace femb

@@ -51,6 +51,8 @@ Scene BuildScene(const SceneSpec& spec) {
       model.bodies.emplace_back(se, SuperelementOptions{}, R, b.position);
       model.body_nodes.push_back({com});
       scene.body_names.push_back(b.name);
+      scene.meshes.emplace_back();
+      scene.mesh_origin.push_back(b.center_of_mass);
       for (const auto& [point, node] : b.nodes) {
         if (point == "com") continue;
         const Eigen::Vector3d x = b.position + R * b.points.at(point);
@@ -76,7 +78,7 @@ Scene BuildScene(const SceneSpec& spec) {
     Superelement se;
     try {
       SuperelementReadOptions options;
-      options.visualization = false;
+      options.visualization = spec.animation;
       se = ReadSuperelementFile(file.string(), options);
     } catch (const InputError& e) {
       throw InputError(b.where + ": body '" + b.name + "': " + e.what());
@@ -129,6 +131,8 @@ Scene BuildScene(const SceneSpec& spec) {
     model.bodies.emplace_back(se, options, R, b.position);
     model.body_nodes.push_back(nodes);
     scene.body_names.push_back(b.name);
+    scene.meshes.push_back(se.visualization);
+    scene.mesh_origin.push_back(se.floating_frame.origin);
   }
   // Rigid offsets: a rigid body's tree is rooted at its centre-of-mass node, or at the one point
   // that carries a joint (a pendulum's pivot), so that the joint acts on the root.

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <map>
+#include <optional>
 #include <string>
 
 #include "formats/scene_file.h"
@@ -17,6 +18,10 @@ struct Scene {
   std::map<std::string, int> node_index;
   std::vector<std::string> body_names;
   Eigen::VectorXd initial_velocity;  ///< over the unknowns
+  /// Per body: the mesh and mode shapes of its superelement file (animation), if any, and the
+  /// floating frame origin they refer to (part axes).
+  std::vector<std::optional<Visualization>> meshes;
+  std::vector<Eigen::Vector3d> mesh_origin;
 };
 
 /// Throws InputError for: a missing or wrong-version superelement file, an interface name the

@@ -36,6 +36,21 @@ assert f["nodes/quaternion"].shape == (101, 44)
 assert f["bodies/b0/modal_coordinates"].shape == (101, 2)
 PY
 ls "$work/out" | grep -q tmp && fail "temporary file left" || ok
+# The ParaView animation: readable by meshio (an independent XDMF reader); the deformed mesh
+# passes through the system nodes (mesh node 0 of body i is interface A = scene node n_i).
+$py - "$work/out" <<'PY' && ok || fail "animation"
+import sys, meshio, h5py, numpy as np
+reader = meshio.xdmf.TimeSeriesReader(sys.argv[1] + "/animation.xdmf")
+points, cells = reader.read_points_cells()
+assert cells[0].type == "line" and points.shape == (50, 3), (cells[0].type, points.shape)
+assert reader.num_steps == 101
+t, point_data, cell_data = reader.read_data(100)
+assert t == 100.0
+deformed = points + point_data["displacement"]
+nodes = h5py.File(sys.argv[1] + "/results.h5", "r")["nodes/position"][100].reshape(-1, 3)
+for i in range(10):
+    assert np.abs(deformed[5 * i] - nodes[i]).max() < 1e-12, i   # 5 mesh nodes per body
+PY
 
 # Linearized modes of the clamped 10-body tube: the first bending pair equals the ringing
 # frequency of one clamped tube body (19.16 Hz, tests/solver/analysis/flexible_dynamics_test).
