@@ -122,7 +122,7 @@ int main(int argc, char** argv) {
           scene.model, state, options, [&](const femb::StaticStepReport& s, const femb::SystemState& st) {
             ++step_count;
             total_iterations += s.iterations;
-            if (step_count % spec.analysis.output_every == 0) recorder.Record(s.lambda, st, Eigen::VectorXd(), 0.0, s.elastic_energy, 0.0);
+            if (step_count % spec.analysis.output_every == 0) recorder.Record(s.lambda, st, Eigen::VectorXd(), 0.0, s.elastic_energy, s.external_work);
             progress(s.lambda, false);
           });
       ok = r.ok;

@@ -15,7 +15,8 @@ StaticResult SolveStatic(const SystemModel& model, SystemState& state, const Sta
   double size = 0.0;
   for (const Eigen::Vector3d& x : model.node_x0) size = std::max(size, x.norm());
   if (size == 0.0) size = 1.0;
-  double lambda = 0.0, step = nominal;
+  double lambda = 0.0, step = nominal, work = 0.0;
+  Eigen::VectorXd loads_before = Eigen::VectorXd::Zero(dofs.n_dofs());
   int cuts = 0;
   while (lambda < end * (1 - 1e-12)) {
     const double target = std::min(end, lambda + step);
@@ -24,11 +25,13 @@ StaticResult SolveStatic(const SystemModel& model, SystemState& state, const Sta
     bool converged = false;
     int it = 0;
     double r_norm = 0.0, energy = 0.0, last_step = 1e300;
+    Eigen::VectorXd travelled = Eigen::VectorXd::Zero(dofs.n_dofs()), loads_after;
     for (; it < options.max_iterations; ++it) {
       const SystemForces f = AssembleStatic(model, dofs, trial, target, true);
       if (!f.ok) break;
       r_norm = FreeNorm(dofs, f.residual);
       energy = f.elastic_energy;
+      loads_after = f.loads;
       if (!std::isfinite(r_norm)) break;
       if (it > 0 && (r_norm <= options.tolerance * std::max(f.force_scale, 1e-300) || last_step <= 1e-13 * size)) {
         converged = true;
@@ -37,6 +40,7 @@ StaticResult SolveStatic(const SystemModel& model, SystemState& state, const Sta
       const Eigen::VectorXd delta = SolveFree(dofs, f.tangent, f.residual);
       if (!delta.allFinite()) break;
       last_step = delta.norm();
+      travelled += delta;
       ApplyIncrement(model, dofs, delta, trial);
     }
     if (!converged) {
@@ -52,9 +56,12 @@ StaticResult SolveStatic(const SystemModel& model, SystemState& state, const Sta
       ++cuts;
       continue;
     }
+    // Prescribed coordinates moved too (ApplyPrescribed): their loads are reactions, not counted.
+    work += 0.5 * (loads_before + loads_after).dot(travelled);
+    loads_before = loads_after;
     state = trial;
     lambda = target;
-    StaticStepReport report{lambda, it, r_norm, energy};
+    StaticStepReport report{lambda, it, r_norm, energy, work};
     result.steps.push_back(report);
     if (on_step) on_step(report, state);
     // Grow back towards the nominal step after easy steps.

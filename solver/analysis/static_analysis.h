@@ -23,6 +23,7 @@ struct StaticStepReport {
   int iterations = 0;
   double residual = 0.0;
   double elastic_energy = 0.0;
+  double external_work = 0.0;  ///< work of the nodal loads so far (trapezoidal rule per step)
 };
 
 struct StaticResult {

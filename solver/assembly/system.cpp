@@ -274,6 +274,7 @@ SystemForces AssembleStatic(const SystemModel& model, const DofMap& dofs, System
   }
   Eigen::VectorXd loads = Eigen::VectorXd::Zero(n);
   AddNodeLoads(model, dofs, state, lambda, loads, with_tangent ? &out.tangent : nullptr, &node_forces);
+  out.loads = loads;
   AddSpringDampers(model, dofs, state, Eigen::VectorXd(), loads, with_tangent ? &out.tangent : nullptr, nullptr,
                    &out.elastic_energy, &node_forces);
   out.residual += loads;

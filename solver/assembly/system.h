@@ -153,6 +153,7 @@ struct SystemForces {
   Eigen::MatrixXd tangent;        ///< d(f_int - lambda f_ext)/d(unknowns)
   double elastic_energy = 0.0;
   double force_scale = 0.0;       ///< largest norm of the internal or external force terms
+  Eigen::VectorXd loads;          ///< the nodal loads alone, over the coordinates (for their work)
 };
 
 /// Solves every body's floating frame (updating state.frames) and assembles the static

@@ -36,6 +36,19 @@ assert f["nodes/quaternion"].shape == (101, 44)
 assert f["bodies/b0/modal_coordinates"].shape == (101, 2)
 PY
 ls "$work/out" | grep -q tmp && fail "temporary file left" || ok
+# A conservative static problem: the work of the load equals the strain energy, up to the
+# trapezoidal rule's error, which falls 4x when the load steps are halved.
+"$bin/femb-solve" -q "$work/scene.yaml" -o "$work/out200" --set analysis.steps=200 || fail "200 steps"
+$py - "$work/out/probes.csv" "$work/out200/probes.csv" <<'PY' && ok || fail "static work"
+import csv, sys
+def gap(path):
+    last = list(csv.DictReader(open(path)))[-1]
+    W, U = float(last["external_work"]), float(last["elastic_energy"])
+    return abs(W - U) / U
+g100, g200 = gap(sys.argv[1]), gap(sys.argv[2])
+print("work - energy:", g100, g200)
+assert g100 < 5e-3 and 3.5 < g100 / g200 < 4.5, (g100, g200)
+PY
 # The ParaView animation: readable by meshio (an independent XDMF reader); the deformed mesh
 # passes through the system nodes (mesh node 0 of body i is interface A = scene node n_i).
 $py - "$work/out" <<'PY' && ok || fail "animation"
