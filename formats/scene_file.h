@@ -80,6 +80,7 @@ struct SceneAnalysisSpec {
   double tolerance = 1e-8;
   int max_iterations = 25;
   int output_every = 1;
+  bool reuse_jacobian = false;  ///< dynamic: keep the factorized iteration matrix while it converges
 };
 
 struct SceneSpec {

@@ -137,6 +137,7 @@ int main(int argc, char** argv) {
       options.rho_inf = spec.analysis.rho_inf;
       options.tolerance = spec.analysis.tolerance;
       options.max_iterations = spec.analysis.max_iterations;
+      options.reuse_jacobian = spec.analysis.reuse_jacobian;
       const femb::DynamicResult r = femb::SolveDynamic(
           scene.model, state, options, [&](const femb::DynamicStepReport& s, const femb::DynamicState& st) {
             ++step_count;
@@ -148,6 +149,7 @@ int main(int argc, char** argv) {
           });
       ok = r.ok;
       if (!ok) status = r.message;
+      if (!quiet) std::printf("femb-solve: %ld factorizations of the iteration matrix\n", r.factorizations);
     }
     recorder.Finish(status);
     progress(spec.analysis.end_time, true);

@@ -144,8 +144,9 @@ DynamicResult SolveDynamic(const SystemModel& model, DynamicState& state, const 
   const double rho = std::clamp(options.rho_inf, 0.0, 1.0);
   const double alpha_m = (2 * rho - 1) / (rho + 1), alpha_f = rho / (rho + 1);
   const double gamma = 0.5 + alpha_f - alpha_m, beta = 0.25 * (gamma + 0.5) * (gamma + 0.5);
-  double h = options.step;
+  double h = options.step, factored_h = -1.0;
   int cuts = 0;
+  FreeSolver solver;
   while (state.t < options.end_time - 1e-12 * options.end_time) {
     h = std::min(h, options.end_time - state.t);
     DynamicState next = state;
@@ -161,6 +162,8 @@ DynamicResult SolveDynamic(const SystemModel& model, DynamicState& state, const 
     bool converged = false;
     int it = 0;
     Eigen::VectorXd f_ext_new;
+    if (h != factored_h) solver.Invalidate();
+    int with_this_factor = 0;
     for (; it < options.max_iterations; ++it) {
       const Assembly a = AssembleDynamic(model, dofs, next, t_new, true);
       if (!a.ok || !a.residual.allFinite()) break;
@@ -169,8 +172,14 @@ DynamicResult SolveDynamic(const SystemModel& model, DynamicState& state, const 
         f_ext_new = a.f_ext;
         break;
       }
-      const Eigen::MatrixXd S = a.K + gamma_p * a.C + beta_p * a.M;
-      const Eigen::VectorXd delta = SolveFree(dofs, S, a.residual);
+      if (!options.reuse_jacobian || !solver.valid() || with_this_factor >= options.reuse_max_iterations) {
+        solver.Factor(dofs, a.K + gamma_p * a.C + beta_p * a.M);
+        factored_h = h;
+        with_this_factor = 0;
+        ++result.factorizations;
+      }
+      ++with_this_factor;
+      const Eigen::VectorXd delta = solver.Solve(a.residual);
       if (!delta.allFinite()) break;
       ApplyIncrement(model, dofs, delta, next.config);
       next.W += gamma_p * delta;

@@ -20,6 +20,10 @@ struct DynamicOptions {
   int max_iterations = 20;
   double tolerance = 1e-9;    ///< ||residual|| <= tol * (force scale of the step)
   int max_cuts = 8;           ///< halvings of the step before giving up
+  /// Keep the factorized iteration matrix across iterations and steps; refactor only when a
+  /// step needs more than `reuse_max_iterations` iterations with it (or the step size changes).
+  bool reuse_jacobian = false;
+  int reuse_max_iterations = 6;
 };
 
 struct DynamicState {
@@ -46,6 +50,7 @@ struct DynamicResult {
   std::string message;
   long steps = 0;
   long newton_iterations = 0;
+  long factorizations = 0;  ///< of the iteration matrix
 };
 
 /// Initial state: configuration and velocities given; accelerations from M_g wdot = f_ext -

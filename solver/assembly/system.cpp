@@ -394,6 +394,25 @@ Eigen::VectorXd SolveFree(const DofMap& dofs, const Eigen::MatrixXd& S, const Ei
   return d;
 }
 
+void FreeSolver::Factor(const DofMap& dofs, const Eigen::MatrixXd& S) {
+  free_ = dofs.solved();
+  Eigen::MatrixXd Sf(free_.size(), free_.size());
+  for (size_t i = 0; i < free_.size(); ++i) {
+    for (size_t j = 0; j < free_.size(); ++j) Sf(i, j) = S(free_[i], free_[j]);
+  }
+  lu_.compute(Sf);
+  valid_ = true;
+}
+
+Eigen::VectorXd FreeSolver::Solve(const Eigen::VectorXd& r) const {
+  Eigen::VectorXd rf(free_.size());
+  for (size_t i = 0; i < free_.size(); ++i) rf[i] = r[free_[i]];
+  const Eigen::VectorXd df = lu_.solve(rf);
+  Eigen::VectorXd d = Eigen::VectorXd::Zero(r.size());
+  for (size_t i = 0; i < free_.size(); ++i) d[free_[i]] = df[i];
+  return d;
+}
+
 double FreeNorm(const DofMap& dofs, const Eigen::VectorXd& r) {
   double s = 0;
   for (int j : dofs.solved()) s += r[j] * r[j];

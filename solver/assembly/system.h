@@ -14,6 +14,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <Eigen/LU>
 #include <array>
 #include <functional>
 #include <string>
@@ -204,6 +205,20 @@ void ApplyPrescribed(const SystemModel& model, const DofMap& dofs, double t, Sys
 
 /// Solves S d = r on the coordinates that are not prescribed (prescribed ones: d = 0).
 Eigen::VectorXd SolveFree(const DofMap& dofs, const Eigen::MatrixXd& S, const Eigen::VectorXd& r);
+
+/// The same with a kept factorization (Jacobian reuse): Factor once, Solve many times.
+class FreeSolver {
+ public:
+  void Factor(const DofMap& dofs, const Eigen::MatrixXd& S);
+  Eigen::VectorXd Solve(const Eigen::VectorXd& r) const;
+  bool valid() const { return valid_; }
+  void Invalidate() { valid_ = false; }
+
+ private:
+  std::vector<int> free_;
+  Eigen::PartialPivLU<Eigen::MatrixXd> lu_;
+  bool valid_ = false;
+};
 /// Norm of r over the coordinates solved for.
 double FreeNorm(const DofMap& dofs, const Eigen::VectorXd& r);
 
