@@ -229,10 +229,10 @@ SceneSpec ParseScene(const std::string& text, const std::string& name, const std
       j.where = item.Where();
       YamlValue type = m.Required("type");
       j.type = type.String();
-      const bool axial = j.type == "revolute" || j.type == "prismatic" || j.type == "cylindrical";
+      const bool axial = j.type == "revolute" || j.type == "prismatic" || j.type == "cylindrical" || j.type == "universal";
       if (j.type != "clamp" && j.type != "spherical" && j.type != "rigid" && !axial) {
         type.Fail("unknown joint type '" + j.type +
-                  "' (known: clamp, spherical, revolute, prismatic, cylindrical, rigid)");
+                  "' (known: clamp, spherical, revolute, prismatic, cylindrical, universal, rigid)");
       }
       j.node = check_node(m.Required("node"));
       if (auto p = m.Optional("parent")) {
@@ -249,8 +249,17 @@ SceneSpec ParseScene(const std::string& text, const std::string& name, const std
         YamlValue axis = m.Required("axis");
         j.axis = axis.Vector3();
         if (j.axis.norm() == 0) axis.Fail("axis must not be zero");
+        if (j.type == "universal") {
+          YamlValue axis2 = m.Required("axis2");
+          j.axis2 = axis2.Vector3();
+          if (std::abs(j.axis.normalized().dot(j.axis2.normalized())) > 1e-6) {
+            axis2.Fail("the two axes of a universal joint must be perpendicular");
+          }
+        }
         if (auto v = m.Optional("prescribed")) {
-          if (j.type == "cylindrical") v->Fail("prescribed motion of a cylindrical joint is not supported; use revolute or prismatic");
+          if (j.type == "cylindrical" || j.type == "universal") {
+            v->Fail("prescribed motion of a " + j.type + " joint is not supported; use revolute or prismatic");
+          }
           j.prescribed = v->String();
           if (!scene.functions.count(j.prescribed)) v->Fail("time function '" + j.prescribed + "' is not defined under 'functions'");
         }

@@ -43,7 +43,8 @@ struct SceneJointSpec {
   std::string type;  ///< clamp, spherical, revolute, prismatic, cylindrical, rigid (rigid needs a parent)
   std::string node;
   std::string parent;  ///< "" = to ground; else the node this one depends on
-  Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();  ///< revolute/prismatic/cylindrical (global)
+  Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();  ///< revolute/prismatic/cylindrical/universal (global)
+  Eigen::Vector3d axis2 = Eigen::Vector3d::UnitY();  ///< universal: second axis (global at t = 0)
   std::string prescribed;  ///< time function of the joint coordinate (angle or travel); "" = free
   std::string where;
 };

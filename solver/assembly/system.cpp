@@ -73,7 +73,7 @@ void UpdateKinematics(const SystemModel& model, const DofMap& dofs, SystemState&
     const NodeJoint& joint = model.joints[j];
     const int p = joint.parent;
     PlaceChild(joint, state.x[p], state.R[p], state.z[k], &state.x[k], &state.R[k]);
-    const JointMaps maps = ComputeJointMaps(joint, state.x[p], state.R[p], state.x[k]);
+    const JointMaps maps = ComputeJointMaps(joint, state.x[p], state.R[p], state.x[k], state.z[k]);
     for (const auto& [col, vec] : state.J[p]) {
       const Eigen::Matrix<double, 6, 1> v = maps.A * vec;
       if (v.squaredNorm() > 0) J.emplace_back(col, v);
@@ -92,7 +92,7 @@ std::vector<Eigen::Matrix<double, 6, 1>> NodeAccelerations(const SystemModel& mo
     if (j >= 0) {
       const NodeJoint& joint = model.joints[j];
       const int p = joint.parent;
-      const JointMaps maps = ComputeJointMaps(joint, state.x[p], state.R[p], state.x[k]);
+      const JointMaps maps = ComputeJointMaps(joint, state.x[p], state.R[p], state.x[k], state.z[k]);
       const Eigen::VectorXd zdot = W.segment(dofs.node_first(k), dofs.node_count(k));
       convective[k] = ChildConvective(joint, maps, state.x[p], state.R[p], state.x[k], NodeMotion(state, p, W), zdot,
                                       convective[p]);
@@ -119,7 +119,7 @@ void AddJointGeometricStiffness(const SystemModel& model, const DofMap& dofs, co
     if (j < 0) continue;
     const NodeJoint& joint = model.joints[j];
     const int p = joint.parent;
-    const JointMaps maps = ComputeJointMaps(joint, state.x[p], state.R[p], state.x[c]);
+    const JointMaps maps = ComputeJointMaps(joint, state.x[p], state.R[p], state.x[c], state.z[c]);
     const JointGeometric g = ComputeJointGeometric(joint, maps, state.x[p], state.R[p], state.x[c], t[c]);
     // d pi_p / dz: rotation rows of J_p.
     const int n = int(tangent.cols());
@@ -132,6 +132,7 @@ void AddJointGeometricStiffness(const SystemModel& model, const DofMap& dofs, co
     if (d > 0) {
       tangent.middleCols(first, d) -= Jp.transpose() * g.dAf_dz;
       tangent.middleRows(first, d) -= g.dBf_dpi * dpi;
+      tangent.block(first, first, d, d) -= g.dBf_dz;
     }
     t[p] += maps.A.transpose() * t[c];
   }

@@ -3,7 +3,9 @@
 //   x_c = x_p + R_p (r0 + s a),  R_c = R_p exp(phi a~) Q0
 // with a the joint axis and r0, Q0 the child's initial placement, all in the parent's frame.
 // rigid: no coordinate; revolute: phi; prismatic: s; cylindrical: (s, phi); spherical: x_c
-// follows the parent, the child's rotation has its own 3 coordinates (spatial increments).
+// follows the parent, the child's rotation has its own 3 coordinates (spatial increments);
+// universal: (phi1, phi2) with R_c = R_p exp(phi1 a1~) exp(phi2 a2~) Q0 (a2 in the frame turned
+// by phi1), omega_c = omega_p + g1 phi1dot + g2 phi2dot, g1 = R_p a1, g2 = R_p exp(phi1 a1~) a2.
 // Spatial increments map linearly:  dq_c = A dq_p + B dz  with rho = x_c - x_p, g = R_p a:
 //   A = [1, -rho~; 0, 1] (spherical: [1, -rho~; 0, 0]),  B = columns [g; 0] (s), [0; g] (phi),
 //   [0; 1] (spherical rotation).
@@ -16,7 +18,7 @@
 
 namespace femb {
 
-enum class JointType { kRigid, kRevolute, kPrismatic, kCylindrical, kSpherical };
+enum class JointType { kRigid, kRevolute, kPrismatic, kCylindrical, kSpherical, kUniversal };
 
 /// "rigid", "revolute", ...; throws std::invalid_argument for other names.
 JointType JointTypeFromName(const std::string& name);
@@ -25,6 +27,7 @@ struct NodeJoint {
   JointType type = JointType::kRigid;
   int child = -1, parent = -1;
   Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();   ///< unit, parent frame
+  Eigen::Vector3d axis2 = Eigen::Vector3d::UnitY();  ///< universal: second axis, parent frame at phi1 = 0
   Eigen::Vector3d r0 = Eigen::Vector3d::Zero();      ///< child position, parent frame
   Eigen::Matrix3d Q0 = Eigen::Matrix3d::Identity();  ///< R_p^T R_c initially
 
@@ -34,10 +37,10 @@ struct NodeJoint {
   int phi_index() const;
 };
 
-/// A joint from the initial placements of both nodes; `axis` is global.
+/// A joint from the initial placements of both nodes; axes are global.
 NodeJoint MakeNodeJoint(JointType type, int child, int parent, const Eigen::Vector3d& axis,
                         const Eigen::Vector3d& x_p, const Eigen::Matrix3d& R_p, const Eigen::Vector3d& x_c,
-                        const Eigen::Matrix3d& R_c);
+                        const Eigen::Matrix3d& R_c, const Eigen::Vector3d& axis2 = Eigen::Vector3d::UnitY());
 
 /// Places the child from the parent and the joint coordinates z. For spherical joints the
 /// child's rotation is its own and is left as it is.
@@ -52,6 +55,10 @@ struct JointMaps {
 JointMaps ComputeJointMaps(const NodeJoint& j, const Eigen::Vector3d& x_p, const Eigen::Matrix3d& R_p,
                            const Eigen::Vector3d& x_c);
 
+/// The maps of dq_c = A dq_p + B dz at a configuration (z: the joint's coordinates).
+JointMaps ComputeJointMaps(const NodeJoint& j, const Eigen::Vector3d& x_p, const Eigen::Matrix3d& R_p,
+                           const Eigen::Vector3d& x_c, const Eigen::VectorXd& z);
+
 /// Convective acceleration of the child: c_c = A c_p + [omega_p x rhodot; 0] + Bdot zdot.
 Eigen::Matrix<double, 6, 1> ChildConvective(const NodeJoint& j, const JointMaps& maps, const Eigen::Vector3d& x_p,
                                             const Eigen::Matrix3d& R_p, const Eigen::Vector3d& x_c,
@@ -62,11 +69,12 @@ Eigen::Matrix<double, 6, 1> ChildConvective(const NodeJoint& j, const JointMaps&
 /// the parent's increments and the joint coordinates — with respect to the parent's rotation
 /// increment dpi_p and the joint coordinates, at fixed f. Returns the blocks:
 ///   dAf_dpi (6 x 3): d(A^T f)/d pi_p,   dAf_dz (6 x d): d(A^T f)/dz,
-///   dBf_dpi (d x 3): d(B^T f)/d pi_p.   (d(B^T f)/dz = 0: the axes are fixed in the parent.)
+///   dBf_dpi (d x 3): d(B^T f)/d pi_p,   dBf_dz (d x d): d(B^T f)/dz (universal: g2 turns with phi1).
 struct JointGeometric {
   Eigen::Matrix<double, 6, 3> dAf_dpi;
   Eigen::Matrix<double, 6, Eigen::Dynamic> dAf_dz;
   Eigen::Matrix<double, Eigen::Dynamic, 3> dBf_dpi;
+  Eigen::MatrixXd dBf_dz;
 };
 JointGeometric ComputeJointGeometric(const NodeJoint& j, const JointMaps& maps, const Eigen::Vector3d& x_p,
                                      const Eigen::Matrix3d& R_p, const Eigen::Vector3d& x_c,

@@ -164,7 +164,7 @@ Scene BuildScene(const SceneSpec& spec) {
     if (!j.parent.empty()) {
       const int p = scene.node_index.at(j.parent);
       model.joints.push_back(MakeNodeJoint(JointTypeFromName(j.type), k, p, j.axis, model.node_x0[p], model.node_R0[p],
-                                           model.node_x0[k], model.node_R0[k]));
+                                           model.node_x0[k], model.node_R0[k], j.axis2));
       model.motion[k] = Eigen::MatrixXd(6, 0);  // the joint's coordinates replace the node's own
       if (!j.prescribed.empty()) {
         const TimeFunctionSpec f = spec.functions.at(j.prescribed);
@@ -176,6 +176,14 @@ Scene BuildScene(const SceneSpec& spec) {
         pr.acceleration = [f](double t) { return f.Acceleration(t); };
         model.prescribed.push_back(pr);
       }
+      continue;
+    }
+    if (j.type == "universal") {
+      // To the ground: the parent is a hidden clamped node at the joint.
+      const int ground = AddNode(model, j.node + ".ground", model.node_x0[k], Eigen::Matrix3d::Identity());
+      Clamp(model, ground);
+      model.joints.push_back(MakeNodeJoint(JointType::kUniversal, k, ground, j.axis, model.node_x0[ground],
+                                           model.node_R0[ground], model.node_x0[k], model.node_R0[k], j.axis2));
       continue;
     }
     if (j.type == "clamp") Clamp(model, k);

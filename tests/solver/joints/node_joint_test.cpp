@@ -28,15 +28,16 @@ Superelement Rod(double L, int modes, const std::string& frame = "center_of_mass
       ", floating_frame: " + frame + "}\n");
 }
 
-// A chain of four rods, node pairs at the joints: n1 -> n2 revolute (axis z), n3 -> n4
-// prismatic (axis x), n5 -> n6 spherical, n7 -> n8 cylindrical (axis y). n0 clamped.
+// A chain of six rods, node pairs at the joints: revolute (axis z), prismatic (axis x),
+// spherical, cylindrical (axis y), universal (axes z, y). The first node is clamped.
 SystemModel Chain(const Superelement& se, double L) {
   SystemModel model;
-  const JointType types[4] = {JointType::kRevolute, JointType::kPrismatic, JointType::kSpherical, JointType::kCylindrical};
-  const Eigen::Vector3d axes[4] = {Eigen::Vector3d::UnitZ(), Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitZ(),
-                                   Eigen::Vector3d::UnitY()};
+  const JointType types[5] = {JointType::kRevolute, JointType::kPrismatic, JointType::kSpherical,
+                              JointType::kCylindrical, JointType::kUniversal};
+  const Eigen::Vector3d axes[5] = {Eigen::Vector3d::UnitZ(), Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitZ(),
+                                   Eigen::Vector3d::UnitY(), Eigen::Vector3d::UnitZ()};
   AddNode(model, "n0", Eigen::Vector3d::Zero());
-  for (int b = 0; b < 5; ++b) {
+  for (int b = 0; b < 6; ++b) {
     const Eigen::Vector3d x0(b * L, 0, 0);
     if (b > 0) AddNode(model, "c" + std::to_string(b), x0);  // child at the body start
     const int start = model.n_nodes() - 1;
@@ -46,7 +47,8 @@ SystemModel Chain(const Superelement& se, double L) {
     if (b > 0) {
       const int parent = start - 1, child = start;
       model.joints.push_back(MakeNodeJoint(types[b - 1], child, parent, axes[b - 1], model.node_x0[parent],
-                                           model.node_R0[parent], model.node_x0[child], model.node_R0[child]));
+                                           model.node_R0[parent], model.node_x0[child], model.node_R0[child],
+                                           Eigen::Vector3d::UnitY()));
     }
   }
   Clamp(model, 0);
@@ -122,10 +124,25 @@ TEST(NodeJoint, ConstraintsHoldExactlyAtAnyConfiguration) {
       EXPECT_LT(offset.cross(j.axis).norm(), 1e-12);
       EXPECT_LT((rel * j.axis - j.axis).norm(), 1e-12);
     }
+    if (j.type == JointType::kUniversal) {
+      // Same point; the child's second axis stays perpendicular to the parent's first axis.
+      EXPECT_LT(offset.norm(), 1e-12);
+      EXPECT_LT(std::abs(j.axis.dot(rel * j.Q0.transpose() * j.axis2)), 1e-12);
+    }
   }
 }
 
-TEST(NodeJoint, FlexibleDoublePendulumConservesEnergy) {
+void DoublePendulum(JointType second, const Eigen::Vector3d& spin);
+
+TEST(NodeJoint, FlexibleDoublePendulumConservesEnergy) { DoublePendulum(JointType::kRevolute, Eigen::Vector3d::Zero()); }
+
+TEST(NodeJoint, SpatialDoublePendulumWithAUniversalJointConservesEnergy) {
+  // The second rod hangs from a universal joint (axes z and y) and starts with a spin about its
+  // own axis, so that it swings out of the plane: the universal joint's convective terms matter.
+  DoublePendulum(JointType::kUniversal, Eigen::Vector3d(3.0, 0, 0));
+}
+
+void DoublePendulum(JointType second, const Eigen::Vector3d& spin) {
   // Two 0.5 m rods: the first on a revolute joint to ground at n0 (axis z), the second hinged
   // to its tip by a revolute joint between nodes; gravity -y; released horizontal. Energy:
   // kinetic + elastic - work of gravity stays constant (rho_inf = 1); the joint's convective
@@ -142,11 +159,18 @@ TEST(NodeJoint, FlexibleDoublePendulumConservesEnergy) {
   model.bodies.emplace_back(se, SuperelementOptions{}, Eigen::Matrix3d::Identity(), Eigen::Vector3d(L, 0, 0));
   model.body_nodes.push_back({2, 3});
   RevoluteToGround(model, 0, Eigen::Vector3d::UnitZ());
-  model.joints.push_back(MakeNodeJoint(JointType::kRevolute, 2, 1, Eigen::Vector3d::UnitZ(), model.node_x0[1],
-                                       model.node_R0[1], model.node_x0[2], model.node_R0[2]));
+  model.joints.push_back(MakeNodeJoint(second, 2, 1, Eigen::Vector3d::UnitZ(), model.node_x0[1], model.node_R0[1],
+                                       model.node_x0[2], model.node_R0[2], Eigen::Vector3d::UnitY()));
   model.gravity = Eigen::Vector3d(0, -9.81, 0);
+  double max_z = 0;
   auto run = [&](double h, double* drift, double* min_y) {
-    DynamicState s = InitialDynamicState(model, InitialState(model), Eigen::VectorXd::Zero(DofMap(model).n_dofs()));
+    const DofMap dofs(model);
+    Eigen::VectorXd W0 = Eigen::VectorXd::Zero(dofs.n_dofs());
+    if (spin.squaredNorm() > 0) {
+      // Joint rates giving the second rod's tip the out-of-plane velocity spin x (L, 0, 0).
+      W0[dofs.node_first(2) + 1] = spin.x();
+    }
+    DynamicState s = InitialDynamicState(model, InitialState(model), W0);
     const DynamicStepReport r0 = Measure(model, s);
     DynamicOptions options;
     options.step = h;
@@ -159,6 +183,7 @@ TEST(NodeJoint, FlexibleDoublePendulumConservesEnergy) {
                   const double E = r.kinetic_energy + r.elastic_energy - r.external_work;
                   *drift = std::max(*drift, std::abs(E - (r0.kinetic_energy + r0.elastic_energy)) / scale);
                   *min_y = std::min(*min_y, st.config.x[3].y());
+                  max_z = std::max(max_z, std::abs(st.config.x[3].z()));
                   // The hinge: nodes n1 and n2 coincide exactly.
                   EXPECT_LT((st.config.x[1] - st.config.x[2]).norm(), 1e-12);
                 }).ok);
@@ -169,6 +194,7 @@ TEST(NodeJoint, FlexibleDoublePendulumConservesEnergy) {
   std::printf("[ info ] energy error / (2 m g L): %.2e (h = 2 ms), %.2e (1 ms); lowest tip y %.4f m\n", drift_coarse,
               drift_fine, y_fine);
   EXPECT_LT(y_fine, -0.5);        // it swings down
+  if (second == JointType::kUniversal) EXPECT_GT(max_z, 0.05);  // and out of the plane
   EXPECT_LT(drift_fine, 1e-3);
   EXPECT_GT(drift_coarse / drift_fine, 3.0);  // second order: the error is the integrator's
 }
