@@ -12,7 +12,7 @@ struct Assembly {
   std::string message;
   Eigen::VectorXd residual;  // f_ext + f_grav - f_int - f_in
   Eigen::VectorXd f_ext;     // nodal loads and gravity, for the work
-  Eigen::MatrixXd K, C, M;
+  SystemMatrix K, C, M;
   double scale = 0.0;
 };
 
@@ -21,11 +21,7 @@ Assembly AssembleDynamic(const SystemModel& model, const DofMap& dofs, DynamicSt
   const int n = dofs.n_dofs();
   out.residual = Eigen::VectorXd::Zero(n);
   out.f_ext = Eigen::VectorXd::Zero(n);
-  if (matrices) {
-    out.K = Eigen::MatrixXd::Zero(n, n);
-    out.C = Eigen::MatrixXd::Zero(n, n);
-    out.M = Eigen::MatrixXd::Zero(n, n);
-  }
+  Triplets K, C, M;
   NodeForces node_forces = ZeroNodeForces(model);
   const std::vector<Eigen::Matrix<double, 6, 1>> node_acc = NodeAccelerations(model, dofs, s.config, s.W, s.Wdot);
   for (size_t b = 0; b < model.bodies.size(); ++b) {
@@ -61,21 +57,26 @@ Assembly AssembleDynamic(const SystemModel& model, const DofMap& dofs, DynamicSt
     ScatterBody(map, &r_b, nullptr, &out.residual, nullptr);
     ScatterBody(map, &f_grav, nullptr, &out.f_ext, nullptr);
     if (matrices) {
-      ScatterBody(map, nullptr, &Kb, nullptr, &out.K);
-      ScatterBody(map, nullptr, &Cb, nullptr, &out.C);
-      ScatterBody(map, nullptr, &Mb, nullptr, &out.M);
+      ScatterBody(map, nullptr, &Kb, nullptr, &K);
+      ScatterBody(map, nullptr, &Cb, nullptr, &C);
+      ScatterBody(map, nullptr, &Mb, nullptr, &M);
     }
   }
   Eigen::VectorXd loads = Eigen::VectorXd::Zero(n);
-  AddNodeLoads(model, dofs, s.config, t, loads, matrices ? &out.K : nullptr, &node_forces);
+  AddNodeLoads(model, dofs, s.config, t, loads, matrices ? &K : nullptr, &node_forces);
   out.residual += loads;
   out.f_ext += loads;
   Eigen::VectorXd springs = Eigen::VectorXd::Zero(n);
-  AddSpringDampers(model, dofs, s.config, s.W, springs, matrices ? &out.K : nullptr, matrices ? &out.C : nullptr,
+  AddSpringDampers(model, dofs, s.config, s.W, springs, matrices ? &K : nullptr, matrices ? &C : nullptr,
                    nullptr, &node_forces);
   out.residual += springs;
   out.scale = std::max(out.scale, springs.norm());
-  if (matrices) AddJointGeometricStiffness(model, dofs, s.config, node_forces, out.K);
+  if (matrices) {
+    AddJointGeometricStiffness(model, dofs, s.config, node_forces, K);
+    out.K = ToMatrix(n, K);
+    out.C = ToMatrix(n, C);
+    out.M = ToMatrix(n, M);
+  }
   out.scale = std::max({out.scale, loads.norm(), 1e-300});
   return out;
 }
@@ -173,7 +174,8 @@ DynamicResult SolveDynamic(const SystemModel& model, DynamicState& state, const 
         break;
       }
       if (!options.reuse_jacobian || !solver.valid() || with_this_factor >= options.reuse_max_iterations) {
-        solver.Factor(dofs, a.K + gamma_p * a.C + beta_p * a.M);
+        const SystemMatrix S = a.K + gamma_p * a.C + beta_p * a.M;
+        if (!solver.Factor(dofs, S)) break;
         factored_h = h;
         with_this_factor = 0;
         ++result.factorizations;

@@ -14,22 +14,24 @@ ModalResult LinearizedModes(const SystemModel& model, SystemState& state, double
     return result;
   }
   const int n = dofs.n_dofs();
-  Eigen::MatrixXd M = Eigen::MatrixXd::Zero(n, n);
+  Triplets M_entries;
   for (size_t b = 0; b < model.bodies.size(); ++b) {
     const BodyConfiguration c = BodyConfigurationOf(model, state, int(b));
     Eigen::MatrixXd Mb;
     const Eigen::VectorXd w = Eigen::VectorXd::Zero(model.bodies[b].n_coordinates());
     model.bodies[b].InertiaForce(c, state.frames[b], w, w, nullptr, &Mb, nullptr);
-    ScatterBody(BodyMap(model, dofs, state, int(b)), nullptr, &Mb, nullptr, &M);
+    ScatterBody(BodyMap(model, dofs, state, int(b)), nullptr, &Mb, nullptr, &M_entries);
   }
   // The tangent on SO(3) with spatial increments is symmetric at equilibrium up to the load
   // terms; the symmetric part defines the conservative linearization.
+  const Eigen::MatrixXd M(ToMatrix(n, M_entries));
+  const Eigen::MatrixXd tangent(forces.tangent);
   // Prescribed coordinates are held at their values: modes of the others.
   const std::vector<int>& free = dofs.solved();
   Eigen::MatrixXd K(free.size(), free.size()), Mf(free.size(), free.size());
   for (size_t i = 0; i < free.size(); ++i) {
     for (size_t j = 0; j < free.size(); ++j) {
-      K(i, j) = 0.5 * (forces.tangent(free[i], free[j]) + forces.tangent(free[j], free[i]));
+      K(i, j) = 0.5 * (tangent(free[i], free[j]) + tangent(free[j], free[i]));
       Mf(i, j) = 0.5 * (M(free[i], free[j]) + M(free[j], free[i]));
     }
   }

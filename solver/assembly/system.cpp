@@ -1,6 +1,7 @@
 #include "solver/assembly/system.h"
 
 #include <Eigen/Dense>
+#include <cmath>
 
 #include "formats/input_error.h"
 #include "solver/rotation.h"
@@ -109,7 +110,7 @@ NodeForces ZeroNodeForces(const SystemModel& model) {
 }
 
 void AddJointGeometricStiffness(const SystemModel& model, const DofMap& dofs, const SystemState& state,
-                                const NodeForces& forces, Eigen::MatrixXd& tangent) {
+                                const NodeForces& forces, Triplets& tangent) {
   if (model.joints.empty()) return;
   // Transmitted forces, children before parents: t_p += A^T t_c.
   std::vector<Eigen::Matrix<double, 6, 1>> t = forces.f;
@@ -121,18 +122,27 @@ void AddJointGeometricStiffness(const SystemModel& model, const DofMap& dofs, co
     const int p = joint.parent;
     const JointMaps maps = ComputeJointMaps(joint, state.x[p], state.R[p], state.x[c], state.z[c]);
     const JointGeometric g = ComputeJointGeometric(joint, maps, state.x[p], state.R[p], state.x[c], t[c]);
-    // d pi_p / dz: rotation rows of J_p.
-    const int n = int(tangent.cols());
-    Eigen::MatrixXd Jp = Eigen::MatrixXd::Zero(6, n);
-    for (const auto& [col, vec] : state.J[p]) Jp.col(col) += vec;
-    const Eigen::MatrixXd dpi = Jp.bottomRows(3);
     const int first = dofs.node_first(c), d = joint.n_coordinates();
-    // residual += J_p^T (A^T t_c) + E_c^T (B^T t_c); tangent = -d residual / dz.
-    tangent -= Jp.transpose() * (g.dAf_dpi * dpi);
-    if (d > 0) {
-      tangent.middleCols(first, d) -= Jp.transpose() * g.dAf_dz;
-      tangent.middleRows(first, d) -= g.dBf_dpi * dpi;
-      tangent.block(first, first, d, d) -= g.dBf_dz;
+    // residual += J_p^T (A^T t_c) + E_c^T (B^T t_c); tangent = -d residual / dz, with
+    // d pi_p / dz the rotation rows of J_p (sparse columns).
+    for (const auto& [ci, vi] : state.J[p]) {
+      for (const auto& [cj, vj] : state.J[p]) {
+        const double v = vi.dot(g.dAf_dpi * vj.tail<3>());
+        if (v != 0.0) tangent.emplace_back(ci, cj, -v);
+      }
+      for (int k = 0; k < d; ++k) {
+        const double v = vi.dot(g.dAf_dz.col(k));
+        if (v != 0.0) tangent.emplace_back(ci, first + k, -v);
+      }
+    }
+    for (int k = 0; k < d; ++k) {
+      for (const auto& [cj, vj] : state.J[p]) {
+        const double v = g.dBf_dpi.row(k).dot(vj.tail<3>());
+        if (v != 0.0) tangent.emplace_back(first + k, cj, -v);
+      }
+      for (int l = 0; l < d; ++l) {
+        if (g.dBf_dz(k, l) != 0.0) tangent.emplace_back(first + k, first + l, -g.dBf_dz(k, l));
+      }
     }
     t[p] += maps.A.transpose() * t[c];
   }
@@ -209,14 +219,21 @@ std::vector<MapEntry> BodyMap(const SystemModel& model, const DofMap& dofs, cons
 }
 
 void ScatterBody(const std::vector<MapEntry>& map, const Eigen::VectorXd* f, const Eigen::MatrixXd* K,
-                 Eigen::VectorXd* F, Eigen::MatrixXd* KK) {
+                 Eigen::VectorXd* F, Triplets* KK) {
   for (const MapEntry& a : map) {
     if (f && F) (*F)[a.coordinate] += a.coefficient * (*f)[a.local];
     if (!K || !KK) continue;
     for (const MapEntry& b : map) {
-      (*KK)(a.coordinate, b.coordinate) += a.coefficient * b.coefficient * (*K)(a.local, b.local);
+      const double v = a.coefficient * b.coefficient * (*K)(a.local, b.local);
+      if (v != 0.0) KK->emplace_back(a.coordinate, b.coordinate, v);
     }
   }
+}
+
+SystemMatrix ToMatrix(int n, const Triplets& triplets) {
+  SystemMatrix A(n, n);
+  A.setFromTriplets(triplets.begin(), triplets.end());
+  return A;
 }
 
 Eigen::VectorXd GatherBody(const SystemModel& model, const DofMap& dofs, const SystemState& state, int b,
@@ -250,7 +267,7 @@ SystemForces AssembleStatic(const SystemModel& model, const DofMap& dofs, System
   SystemForces out;
   const int n = dofs.n_dofs();
   out.residual = Eigen::VectorXd::Zero(n);
-  if (with_tangent) out.tangent = Eigen::MatrixXd::Zero(n, n);
+  Triplets tangent;
   NodeForces node_forces = ZeroNodeForces(model);
   for (size_t b = 0; b < model.bodies.size(); ++b) {
     const SuperelementBody& body = model.bodies[b];
@@ -270,22 +287,25 @@ SystemForces AssembleStatic(const SystemModel& model, const DofMap& dofs, System
     out.force_scale = std::max({out.force_scale, f.norm(), body.force_floor()});
     const Eigen::VectorXd minus_f = -f;
     ScatterBody(BodyMap(model, dofs, state, int(b)), &minus_f, with_tangent ? &K : nullptr, &out.residual,
-                with_tangent ? &out.tangent : nullptr);
+                with_tangent ? &tangent : nullptr);
     AddBodyNodeForces(model, int(b), minus_f, node_forces);
   }
   Eigen::VectorXd loads = Eigen::VectorXd::Zero(n);
-  AddNodeLoads(model, dofs, state, lambda, loads, with_tangent ? &out.tangent : nullptr, &node_forces);
+  AddNodeLoads(model, dofs, state, lambda, loads, with_tangent ? &tangent : nullptr, &node_forces);
   out.loads = loads;
-  AddSpringDampers(model, dofs, state, Eigen::VectorXd(), loads, with_tangent ? &out.tangent : nullptr, nullptr,
+  AddSpringDampers(model, dofs, state, Eigen::VectorXd(), loads, with_tangent ? &tangent : nullptr, nullptr,
                    &out.elastic_energy, &node_forces);
   out.residual += loads;
   out.force_scale = std::max(out.force_scale, loads.norm());
-  if (with_tangent) AddJointGeometricStiffness(model, dofs, state, node_forces, out.tangent);
+  if (with_tangent) {
+    AddJointGeometricStiffness(model, dofs, state, node_forces, tangent);
+    out.tangent = ToMatrix(n, tangent);
+  }
   return out;
 }
 
 void AddNodeLoads(const SystemModel& model, const DofMap& dofs, const SystemState& state, double t,
-                  Eigen::VectorXd& residual, Eigen::MatrixXd* tangent, NodeForces* node_forces) {
+                  Eigen::VectorXd& residual, Triplets* tangent, NodeForces* node_forces) {
   (void)dofs;
   for (const NodeLoad& load : model.loads) {
     const NodeJacobian& J = state.J[load.node];
@@ -304,14 +324,14 @@ void AddNodeLoads(const SystemModel& model, const DofMap& dofs, const SystemStat
       K.block<3, 3>(0, 3) = Skew<double>(F);
       K.block<3, 3>(3, 3) = Skew<double>(Mo);
       for (const auto& [ci, vi] : J) {
-        for (const auto& [cj, vj] : J) (*tangent)(ci, cj) += vi.dot(K * vj);
+        for (const auto& [cj, vj] : J) tangent->emplace_back(ci, cj, vi.dot(K * vj));
       }
     }
   }
 }
 
 void AddSpringDampers(const SystemModel& model, const DofMap& dofs, const SystemState& state, const Eigen::VectorXd& W,
-                      Eigen::VectorXd& residual, Eigen::MatrixXd* K, Eigen::MatrixXd* C, double* energy,
+                      Eigen::VectorXd& residual, Triplets* K, Triplets* C, double* energy,
                       NodeForces* node_forces) {
   (void)dofs;
   for (const SpringDamper& s : model.springs) {
@@ -380,38 +400,44 @@ void ApplyPrescribed(const SystemModel& model, const DofMap& dofs, double t, Sys
   ApplyIncrement(model, dofs, delta, state);
 }
 
-Eigen::VectorXd SolveFree(const DofMap& dofs, const Eigen::MatrixXd& S, const Eigen::VectorXd& r) {
-  const std::vector<int>& f = dofs.solved();
-  Eigen::VectorXd d = Eigen::VectorXd::Zero(r.size());
-  if (f.size() == size_t(r.size())) return S.partialPivLu().solve(r);
-  Eigen::MatrixXd Sf(f.size(), f.size());
-  Eigen::VectorXd rf(f.size());
-  for (size_t i = 0; i < f.size(); ++i) {
-    rf[i] = r[f[i]];
-    for (size_t j = 0; j < f.size(); ++j) Sf(i, j) = S(f[i], f[j]);
-  }
-  const Eigen::VectorXd df = Sf.partialPivLu().solve(rf);
-  for (size_t i = 0; i < f.size(); ++i) d[f[i]] = df[i];
-  return d;
-}
-
-void FreeSolver::Factor(const DofMap& dofs, const Eigen::MatrixXd& S) {
+bool FreeSolver::Factor(const DofMap& dofs, const SystemMatrix& S) {
   free_ = dofs.solved();
-  Eigen::MatrixXd Sf(free_.size(), free_.size());
-  for (size_t i = 0; i < free_.size(); ++i) {
-    for (size_t j = 0; j < free_.size(); ++j) Sf(i, j) = S(free_[i], free_[j]);
+  const int n = int(free_.size());
+  std::vector<int> position(S.rows(), -1);
+  for (int i = 0; i < n; ++i) position[free_[i]] = i;
+  Triplets entries;
+  entries.reserve(S.nonZeros());
+  for (int col = 0; col < S.outerSize(); ++col) {
+    for (SystemMatrix::InnerIterator it(S, col); it; ++it) {
+      if (position[it.row()] >= 0 && position[col] >= 0) entries.emplace_back(position[it.row()], position[col], it.value());
+    }
   }
-  lu_.compute(Sf);
-  valid_ = true;
+  const SystemMatrix Sf = ToMatrix(n, entries);
+  sparse_ = n > kDenseLimit;
+  if (sparse_) {
+    sparse_lu_ = std::make_shared<Eigen::SparseLU<SystemMatrix, Eigen::COLAMDOrdering<int>>>();
+    sparse_lu_->compute(Sf);
+    valid_ = sparse_lu_->info() == Eigen::Success;
+  } else {
+    dense_.compute(Eigen::MatrixXd(Sf));
+    valid_ = true;
+  }
+  return valid_;
 }
 
 Eigen::VectorXd FreeSolver::Solve(const Eigen::VectorXd& r) const {
   Eigen::VectorXd rf(free_.size());
   for (size_t i = 0; i < free_.size(); ++i) rf[i] = r[free_[i]];
-  const Eigen::VectorXd df = lu_.solve(rf);
+  const Eigen::VectorXd df = sparse_ ? Eigen::VectorXd(sparse_lu_->solve(rf)) : Eigen::VectorXd(dense_.solve(rf));
   Eigen::VectorXd d = Eigen::VectorXd::Zero(r.size());
   for (size_t i = 0; i < free_.size(); ++i) d[free_[i]] = df[i];
   return d;
+}
+
+Eigen::VectorXd SolveFree(const DofMap& dofs, const SystemMatrix& S, const Eigen::VectorXd& r) {
+  FreeSolver solver;
+  if (!solver.Factor(dofs, S)) return Eigen::VectorXd::Constant(r.size(), std::nan(""));
+  return solver.Solve(r);
 }
 
 double FreeNorm(const DofMap& dofs, const Eigen::VectorXd& r) {

@@ -15,6 +15,9 @@
 
 #include <Eigen/Core>
 #include <Eigen/LU>
+#include <Eigen/SparseCore>
+#include <Eigen/SparseLU>
+#include <memory>
 #include <array>
 #include <functional>
 #include <string>
@@ -61,6 +64,12 @@ struct SystemModel {
 
   int n_nodes() const { return int(node_names.size()); }
 };
+
+/// System matrices are sparse (assembled from triplets); the solver factorizes them densely
+/// below kDenseLimit free coordinates and with SparseLU above.
+using SystemMatrix = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
+using Triplets = std::vector<Eigen::Triplet<double>>;
+inline constexpr int kDenseLimit = 400;
 
 /// dq_k = J_k dz for one node: sparse columns (coordinate, 6-vector).
 using NodeJacobian = std::vector<std::pair<int, Eigen::Matrix<double, 6, 1>>>;
@@ -136,7 +145,7 @@ struct NodeForces {
 NodeForces ZeroNodeForces(const SystemModel& model);
 /// tangent -= d(sum_k J_k^T f_k)/dz at fixed f (the joint maps' configuration dependence).
 void AddJointGeometricStiffness(const SystemModel& model, const DofMap& dofs, const SystemState& state,
-                                const NodeForces& forces, Eigen::MatrixXd& tangent);
+                                const NodeForces& forces, Triplets& tangent);
 
 /// Adds an interface node to `model` at a position and returns its index.
 int AddNode(SystemModel& model, const std::string& name, const Eigen::Vector3d& x,
@@ -151,7 +160,7 @@ struct SystemForces {
   bool ok = true;
   std::string message;            ///< what failed (a floating frame did not converge, ...)
   Eigen::VectorXd residual;       ///< lambda f_ext - f_int over the unknowns
-  Eigen::MatrixXd tangent;        ///< d(f_int - lambda f_ext)/d(unknowns)
+  SystemMatrix tangent;           ///< d(f_int - lambda f_ext)/d(unknowns)
   double elastic_energy = 0.0;
   double force_scale = 0.0;       ///< largest norm of the internal or external force terms
   Eigen::VectorXd loads;          ///< the nodal loads alone, over the coordinates (for their work)
@@ -165,12 +174,12 @@ SystemForces AssembleStatic(const SystemModel& model, const DofMap& dofs, System
 /// External nodal loads at time t (or load factor) and their stiffness d(-f_ext)/dq added to
 /// `tangent` when not null (follower loads).
 void AddNodeLoads(const SystemModel& model, const DofMap& dofs, const SystemState& state, double t,
-                  Eigen::VectorXd& residual, Eigen::MatrixXd* tangent, NodeForces* node_forces = nullptr);
+                  Eigen::VectorXd& residual, Triplets* tangent, NodeForces* node_forces = nullptr);
 
 /// Spring-damper forces added to `residual` (as applied forces), their stiffness and damping
 /// (of -f) to `K`, `C` when not null, their energy to `energy`. W may be empty (static).
 void AddSpringDampers(const SystemModel& model, const DofMap& dofs, const SystemState& state, const Eigen::VectorXd& W,
-                      Eigen::VectorXd& residual, Eigen::MatrixXd* K, Eigen::MatrixXd* C, double* energy,
+                      Eigen::VectorXd& residual, Triplets* K, Triplets* C, double* energy,
                       NodeForces* node_forces = nullptr);
 
 /// Gathers body b's velocities (xdot, omega per interface node, then etadot) from the
@@ -196,28 +205,35 @@ void AddBodyNodeForces(const SystemModel& model, int b, const Eigen::VectorXd& r
 /// Scatters a body vector f (n_b) and matrix K (n_b x n_b) through the map: F += B^T f,
 /// KK += B^T K B.
 void ScatterBody(const std::vector<MapEntry>& map, const Eigen::VectorXd* f, const Eigen::MatrixXd* K,
-                 Eigen::VectorXd* F, Eigen::MatrixXd* KK);
+                 Eigen::VectorXd* F, Triplets* KK);
+
+/// Builds an n x n sparse matrix from triplets (duplicates summed).
+SystemMatrix ToMatrix(int n, const Triplets& triplets);
 
 /// Sets the prescribed coordinates to their values at t: configuration (through the node's
 /// basis), and, when W / Wdot are given, their rates and accelerations.
 void ApplyPrescribed(const SystemModel& model, const DofMap& dofs, double t, SystemState& state,
                      Eigen::VectorXd* W, Eigen::VectorXd* Wdot);
 
-/// Solves S d = r on the coordinates that are not prescribed (prescribed ones: d = 0).
-Eigen::VectorXd SolveFree(const DofMap& dofs, const Eigen::MatrixXd& S, const Eigen::VectorXd& r);
+/// Solves S d = r on the coordinates that are not prescribed (prescribed ones: d = 0);
+/// dense LU below kDenseLimit free coordinates, SparseLU (COLAMD ordering) above.
+Eigen::VectorXd SolveFree(const DofMap& dofs, const SystemMatrix& S, const Eigen::VectorXd& r);
 
 /// The same with a kept factorization (Jacobian reuse): Factor once, Solve many times.
+/// Factor returns false when the matrix is singular.
 class FreeSolver {
  public:
-  void Factor(const DofMap& dofs, const Eigen::MatrixXd& S);
+  bool Factor(const DofMap& dofs, const SystemMatrix& S);
   Eigen::VectorXd Solve(const Eigen::VectorXd& r) const;
   bool valid() const { return valid_; }
   void Invalidate() { valid_ = false; }
+  bool sparse() const { return sparse_; }
 
  private:
   std::vector<int> free_;
-  Eigen::PartialPivLU<Eigen::MatrixXd> lu_;
-  bool valid_ = false;
+  Eigen::PartialPivLU<Eigen::MatrixXd> dense_;
+  std::shared_ptr<Eigen::SparseLU<SystemMatrix, Eigen::COLAMDOrdering<int>>> sparse_lu_;
+  bool valid_ = false, sparse_ = false;
 };
 /// Norm of r over the coordinates solved for.
 double FreeNorm(const DofMap& dofs, const Eigen::VectorXd& r);
