@@ -5,3 +5,5 @@ cd "$(dirname "$0")/.."
 bash scripts/setup.sh >/dev/null
 bash scripts/build.sh >/dev/null
 build/bin/beam_reduction_benchmark
+echo
+build/bin/solver_scaling_benchmark

@@ -1,0 +1,56 @@
+// Solver scaling: a chain of N flexible bodies (tube segments, 2 internal modes each) clamped
+// at one end and falling under gravity; time per dynamic step and Newton iterations per step
+// for N = 1, 10, 100, 1000. Prints what it measured on this run.
+#include <chrono>
+#include <cstdio>
+#include <string>
+
+#include "formats/part_file.h"
+#include "reducer/reduce_part.h"
+#include "solver/analysis/dynamic_analysis.h"
+
+int main() {
+  std::printf("Solver scaling: chain of N tube superelements (2 modes each), clamped, gravity, generalized-alpha\n\n");
+  std::printf("%6s %12s %10s %14s %16s %18s\n", "bodies", "coordinates", "steps", "s per step", "Newton its/step",
+              "ms per step/body");
+  for (int n_bodies : {1, 10, 100, 1000}) {
+    const double Lb = 1.0 / n_bodies;
+    const femb::PartSpec part = femb::ParsePart(
+        "name: seg\ntype: beam\nmaterial: {E: 70.0e9, nu: 0.3, rho: 2700}\n"
+        "section: {shape: tube, outer_radius: 0.01, wall: 0.001}\n"
+        "beam:\n  points: {A: [0, 0, 0], B: [" + std::to_string(Lb) + ", 0, 0]}\n"
+        "  segments: [{from: A, to: B, elements: 2}]\n"
+        "interfaces: [{name: A}, {name: B}]\nreduction: {internal_modes: 2, keep_mesh: false}\n",
+        "bench.yaml");
+    const femb::ReduceResult reduced = femb::ReducePart(part, nullptr);
+    if (!reduced.ok) return 3;
+    femb::SystemModel model;
+    for (int i = 0; i <= n_bodies; ++i) femb::AddNode(model, "n" + std::to_string(i), Eigen::Vector3d(i * Lb, 0, 0));
+    femb::Clamp(model, 0);
+    for (int i = 0; i < n_bodies; ++i) {
+      model.bodies.emplace_back(reduced.superelement, femb::SuperelementOptions{}, Eigen::Matrix3d::Identity(),
+                                Eigen::Vector3d(i * Lb, 0, 0));
+      model.body_nodes.push_back({i, i + 1});
+    }
+    model.gravity = Eigen::Vector3d(0, -9.81, 0);
+    const femb::DofMap dofs(model);
+    femb::DynamicState s =
+        femb::InitialDynamicState(model, femb::InitialState(model), Eigen::VectorXd::Zero(dofs.n_dofs()));
+    femb::DynamicOptions options;
+    options.step = 1e-3;
+    const int steps = n_bodies >= 1000 ? 5 : 20;
+    options.end_time = steps * options.step;
+    options.rho_inf = 0.8;
+    const auto start = std::chrono::steady_clock::now();
+    const femb::DynamicResult r = femb::SolveDynamic(model, s, options);
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (!r.ok) {
+      std::printf("%6d failed: %s\n", n_bodies, r.message.c_str());
+      continue;
+    }
+    std::printf("%6d %12d %10ld %14.4f %16.2f %18.3f\n", n_bodies, dofs.n_dofs(), r.steps, seconds / r.steps,
+                double(r.newton_iterations) / r.steps, 1e3 * seconds / r.steps / n_bodies);
+    std::fflush(stdout);
+  }
+  return 0;
+}
