@@ -95,6 +95,14 @@ void ResultsRecorder::Record(double t, const SystemState& state, const Eigen::Ve
     frames.push_back(f);
   }
   modal_.push_back(modal);
+  // Joint coordinates: the coordinates of every node that has a joint (revolute angle,
+  // prismatic travel, ...), in node order.
+  std::vector<double> joint_values;
+  for (int k = 0; k < n; ++k) {
+    if (!JointNode(k)) continue;
+    for (int i = 0; i < state.z[k].size(); ++i) joint_values.push_back(state.z[k][i]);
+  }
+  joints_.push_back(Eigen::Map<Eigen::VectorXd>(joint_values.data(), long(joint_values.size())));
   frames_.push_back(frames);
   if (scene_.spec.animation) {
     std::vector<Eigen::MatrixXd> meshes;
@@ -132,6 +140,17 @@ void ResultsRecorder::Record(double t, const SystemState& state, const Eigen::Ve
   csv_ << "," << Num(kinetic) << "," << Num(elastic) << "," << Num(external_work) << "\n";
 }
 
+bool ResultsRecorder::JointNode(int k) const {
+  // A node with joint coordinates: dependent on a parent, or moving in a 1-2 dimensional basis
+  // (revolute, prismatic, cylindrical to the ground). Free (6) and spherical (3) nodes: no.
+  const SystemModel& model = scene_.model;
+  for (const NodeJoint& j : model.joints) {
+    if (j.child == k) return true;
+  }
+  const long d = model.motion[k].cols();
+  return d == 1 || d == 2;
+}
+
 void ResultsRecorder::Finish(const std::string& status) {
   csv_.close();
   std::error_code ec;
@@ -156,6 +175,14 @@ void ResultsRecorder::Finish(const std::string& status) {
     w.Matrix("/nodes/quaternion", Stack(quaternions_, 4 * n));
     w.Matrix("/nodes/velocity", Stack(velocities_, 3 * n));
     w.Matrix("/nodes/angular_velocity", Stack(angular_velocities_, 3 * n));
+    std::vector<std::string> labels;
+    const DofMap dofs(model);
+    for (int k = 0; k < n; ++k) {
+      if (!JointNode(k)) continue;
+      for (int i = 0; i < dofs.node_count(k); ++i) labels.push_back(model.node_names[k] + "." + std::to_string(i));
+    }
+    w.Strings("/nodes/joint_coordinate_labels", labels);
+    w.Matrix("/nodes/joint_coordinates", Stack(joints_, int(labels.size())));
     w.CreateGroup("/energy");
     w.Vector("/energy/kinetic", Eigen::Map<const Eigen::VectorXd>(kinetic_.data(), long(kinetic_.size())));
     w.Vector("/energy/elastic", Eigen::Map<const Eigen::VectorXd>(elastic_.data(), long(elastic_.size())));

@@ -34,11 +34,12 @@ class ResultsRecorder {
   std::string directory_, csv_path_, h5_path_, csv_tmp_;
   std::ofstream csv_;
   std::vector<double> time_, kinetic_, elastic_, work_;
-  std::vector<Eigen::VectorXd> positions_, quaternions_, velocities_, angular_velocities_;
+  std::vector<Eigen::VectorXd> positions_, quaternions_, velocities_, angular_velocities_, joints_;
   std::vector<std::vector<Eigen::VectorXd>> modal_;     // per step, per body
   std::vector<std::vector<Eigen::VectorXd>> frames_;    // per step, per body: x (3), quaternion (4)
   std::vector<std::vector<Eigen::MatrixXd>> mesh_positions_;  // per step, per body with a mesh
   void WriteAnimation();
+  bool JointNode(int k) const;
 };
 
 }  // namespace femb
