@@ -14,6 +14,17 @@ namespace femb {
 
 namespace {
 Units UnitSystemOf(const std::string& name) { return UnitSystem(name, "units"); }
+
+// Node k's first joint coordinate follows the time function f (value, rate, acceleration).
+SystemModel::Prescribed PrescribedBy(const TimeFunctionSpec& f, int k) {
+  SystemModel::Prescribed p;
+  p.node = k;
+  p.coordinate = 0;
+  p.value = [f](double t) { return f.Evaluate(t); };
+  p.rate = [f](double t) { return f.Rate(t); };
+  p.acceleration = [f](double t) { return f.Acceleration(t); };
+  return p;
+}
 }  // namespace
 
 Scene BuildScene(const SceneSpec& spec) {
@@ -166,16 +177,7 @@ Scene BuildScene(const SceneSpec& spec) {
       model.joints.push_back(MakeNodeJoint(JointTypeFromName(j.type), k, p, j.axis, model.node_x0[p], model.node_R0[p],
                                            model.node_x0[k], model.node_R0[k], j.axis2));
       model.motion[k] = Eigen::MatrixXd(6, 0);  // the joint's coordinates replace the node's own
-      if (!j.prescribed.empty()) {
-        const TimeFunctionSpec f = spec.functions.at(j.prescribed);
-        SystemModel::Prescribed pr;
-        pr.node = k;
-        pr.coordinate = 0;
-        pr.value = [f](double t) { return f.Evaluate(t); };
-        pr.rate = [f](double t) { return f.Rate(t); };
-        pr.acceleration = [f](double t) { return f.Acceleration(t); };
-        model.prescribed.push_back(pr);
-      }
+      if (!j.prescribed.empty()) model.prescribed.push_back(PrescribedBy(spec.functions.at(j.prescribed), k));
       continue;
     }
     if (j.type == "universal") {
@@ -191,16 +193,7 @@ Scene BuildScene(const SceneSpec& spec) {
     if (j.type == "revolute") RevoluteToGround(model, k, j.axis);
     if (j.type == "prismatic") PrismaticToGround(model, k, j.axis);
     if (j.type == "cylindrical") CylindricalToGround(model, k, j.axis);
-    if (!j.prescribed.empty()) {
-      const TimeFunctionSpec f = spec.functions.at(j.prescribed);
-      SystemModel::Prescribed p;
-      p.node = k;
-      p.coordinate = 0;
-      p.value = [f](double t) { return f.Evaluate(t); };
-      p.rate = [f](double t) { return f.Rate(t); };
-      p.acceleration = [f](double t) { return f.Acceleration(t); };
-      model.prescribed.push_back(p);
-    }
+    if (!j.prescribed.empty()) model.prescribed.push_back(PrescribedBy(spec.functions.at(j.prescribed), k));
   }
   for (const SceneLoadSpec& l : spec.loads) {
     if (l.type == "gravity") {
