@@ -1,0 +1,205 @@
+#include "reducer/fe/solid_element.h"
+
+#include <Eigen/Dense>
+#include <cstdio>
+
+#include "formats/input_error.h"
+
+namespace femb {
+namespace {
+
+// Gauss-Legendre on [-1, 1].
+void GaussLegendre(int n, std::vector<double>* x, std::vector<double>* w) {
+  switch (n) {
+    case 2: *x = {-0.5773502691896257, 0.5773502691896257}; *w = {1.0, 1.0}; break;
+    case 3: *x = {-0.7745966692414834, 0.0, 0.7745966692414834};
+            *w = {0.5555555555555556, 0.8888888888888888, 0.5555555555555556}; break;
+    default: *x = {-0.8611363115940526, -0.3399810435848563, 0.3399810435848563, 0.8611363115940526};
+             *w = {0.3478548451374538, 0.6521451548625461, 0.6521451548625461, 0.3478548451374538}; break;
+  }
+}
+
+// gmsh HEX8 corner signs and HEX20 edge nodes (pairs of corners).
+constexpr int kHexCorner[8][3] = {{-1, -1, -1}, {1, -1, -1}, {1, 1, -1}, {-1, 1, -1},
+                                  {-1, -1, 1},  {1, -1, 1},  {1, 1, 1},  {-1, 1, 1}};
+constexpr int kHex20Edge[12][2] = {{0, 1}, {0, 3}, {0, 4}, {1, 2}, {1, 5}, {2, 3},
+                                   {2, 6}, {3, 7}, {4, 5}, {4, 7}, {5, 6}, {6, 7}};
+// gmsh TET10 edge nodes 4..9.
+constexpr int kTet10Edge[6][2] = {{0, 1}, {1, 2}, {0, 2}, {0, 3}, {2, 3}, {1, 3}};
+
+}  // namespace
+
+int SolidNodeCount(SolidType type) {
+  switch (type) {
+    case SolidType::kTet4: return 4;
+    case SolidType::kTet10: return 10;
+    case SolidType::kHex8: return 8;
+    case SolidType::kHex20: return 20;
+  }
+  return 0;
+}
+
+std::string SolidTypeName(SolidType type) {
+  switch (type) {
+    case SolidType::kTet4: return "tet4";
+    case SolidType::kTet10: return "tet10";
+    case SolidType::kHex8: return "hex8";
+    case SolidType::kHex20: return "hex20";
+  }
+  return "";
+}
+
+void SolidShapeFunctions(SolidType type, const Eigen::Vector3d& p, Eigen::VectorXd* N, Eigen::MatrixXd* dN) {
+  const int n = SolidNodeCount(type);
+  N->setZero(n);
+  dN->setZero(n, 3);
+  if (type == SolidType::kTet4 || type == SolidType::kTet10) {
+    // Barycentric L = (1 - x - y - z, x, y, z) and dL/d(x, y, z).
+    const double L[4] = {1 - p.x() - p.y() - p.z(), p.x(), p.y(), p.z()};
+    const Eigen::Vector3d dL[4] = {Eigen::Vector3d(-1, -1, -1), Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitY(),
+                                   Eigen::Vector3d::UnitZ()};
+    if (type == SolidType::kTet4) {
+      for (int i = 0; i < 4; ++i) {
+        (*N)[i] = L[i];
+        dN->row(i) = dL[i].transpose();
+      }
+      return;
+    }
+    for (int i = 0; i < 4; ++i) {
+      (*N)[i] = L[i] * (2 * L[i] - 1);
+      dN->row(i) = ((4 * L[i] - 1) * dL[i]).transpose();
+    }
+    for (int e = 0; e < 6; ++e) {
+      const int a = kTet10Edge[e][0], b = kTet10Edge[e][1];
+      (*N)[4 + e] = 4 * L[a] * L[b];
+      dN->row(4 + e) = (4 * (L[a] * dL[b] + L[b] * dL[a])).transpose();
+    }
+    return;
+  }
+  if (type == SolidType::kHex8) {
+    for (int i = 0; i < 8; ++i) {
+      const double a = kHexCorner[i][0], b = kHexCorner[i][1], c = kHexCorner[i][2];
+      const double fa = 1 + a * p.x(), fb = 1 + b * p.y(), fc = 1 + c * p.z();
+      (*N)[i] = fa * fb * fc / 8;
+      dN->row(i) << a * fb * fc / 8, fa * b * fc / 8, fa * fb * c / 8;
+    }
+    return;
+  }
+  // HEX20 serendipity.
+  for (int i = 0; i < 8; ++i) {
+    const double a = kHexCorner[i][0], b = kHexCorner[i][1], c = kHexCorner[i][2];
+    const double fa = 1 + a * p.x(), fb = 1 + b * p.y(), fc = 1 + c * p.z();
+    const double s = a * p.x() + b * p.y() + c * p.z() - 2;
+    (*N)[i] = fa * fb * fc * s / 8;
+    dN->row(i) << a * fb * fc * (s + fa) / 8, b * fa * fc * (s + fb) / 8, c * fa * fb * (s + fc) / 8;
+  }
+  for (int e = 0; e < 12; ++e) {
+    const int i = kHex20Edge[e][0], j = kHex20Edge[e][1];
+    // Mid-edge node: the coordinate along the edge is 0, the two others are the corners' signs.
+    double m[3];
+    int along = 0;
+    for (int d = 0; d < 3; ++d) {
+      m[d] = 0.5 * (kHexCorner[i][d] + kHexCorner[j][d]);
+      if (m[d] == 0) along = d;
+    }
+    double f[3], df[3];
+    for (int d = 0; d < 3; ++d) {
+      if (d == along) {
+        f[d] = 1 - p[d] * p[d];
+        df[d] = -2 * p[d];
+      } else {
+        f[d] = 1 + m[d] * p[d];
+        df[d] = m[d];
+      }
+    }
+    (*N)[8 + e] = f[0] * f[1] * f[2] / 4;
+    dN->row(8 + e) << df[0] * f[1] * f[2] / 4, f[0] * df[1] * f[2] / 4, f[0] * f[1] * df[2] / 4;
+  }
+}
+
+void SolidQuadrature(SolidType type, std::vector<Eigen::Vector3d>* points, std::vector<double>* weights) {
+  points->clear();
+  weights->clear();
+  std::vector<double> x, w;
+  if (type == SolidType::kHex8 || type == SolidType::kHex20) {
+    GaussLegendre(type == SolidType::kHex8 ? 2 : 3, &x, &w);
+    for (size_t i = 0; i < x.size(); ++i)
+      for (size_t j = 0; j < x.size(); ++j)
+        for (size_t k = 0; k < x.size(); ++k) {
+          points->emplace_back(x[i], x[j], x[k]);
+          weights->push_back(w[i] * w[j] * w[k]);
+        }
+    return;
+  }
+  // Collapsed cube [0,1]^3 -> tetrahedron: (a, b(1-a), c(1-a)(1-b)), Jacobian (1-a)^2 (1-b).
+  GaussLegendre(4, &x, &w);
+  for (size_t i = 0; i < x.size(); ++i)
+    for (size_t j = 0; j < x.size(); ++j)
+      for (size_t k = 0; k < x.size(); ++k) {
+        const double a = 0.5 * (x[i] + 1), b = 0.5 * (x[j] + 1), c = 0.5 * (x[k] + 1);
+        points->emplace_back(a, b * (1 - a), c * (1 - a) * (1 - b));
+        weights->push_back(w[i] * w[j] * w[k] / 8 * (1 - a) * (1 - a) * (1 - b));
+      }
+}
+
+Eigen::Matrix<double, 6, 6> IsotropicElasticity(double E, double nu) {
+  const double lambda = E * nu / ((1 + nu) * (1 - 2 * nu)), mu = E / (2 * (1 + nu));
+  Eigen::Matrix<double, 6, 6> D = Eigen::Matrix<double, 6, 6>::Zero();
+  D.topLeftCorner<3, 3>().setConstant(lambda);
+  D.topLeftCorner<3, 3>().diagonal().array() += 2 * mu;
+  D.bottomRightCorner<3, 3>().diagonal().setConstant(mu);
+  return D;
+}
+
+SolidElementMatrices ComputeSolidElement(SolidType type, const Eigen::MatrixXd& X, const MaterialSpec& material,
+                                         long element_id) {
+  const int n = SolidNodeCount(type);
+  SolidElementMatrices out;
+  out.K = Eigen::MatrixXd::Zero(3 * n, 3 * n);
+  out.M = Eigen::MatrixXd::Zero(3 * n, 3 * n);
+  const Eigen::Matrix<double, 6, 6> D = IsotropicElasticity(material.E, material.nu);
+  std::vector<Eigen::Vector3d> points;
+  std::vector<double> weights;
+  SolidQuadrature(type, &points, &weights);
+  Eigen::VectorXd N;
+  Eigen::MatrixXd dN;
+  // Scale for the degeneracy test: det J relative to the element's size cubed.
+  const double size = (X.rowwise() - X.colwise().mean()).rowwise().norm().maxCoeff();
+  for (size_t q = 0; q < points.size(); ++q) {
+    SolidShapeFunctions(type, points[q], &N, &dN);
+    const Eigen::Matrix3d J = X.transpose() * dN;  // dx/dxi
+    const double det = J.determinant();
+    if (!(det > 1e-10 * size * size * size)) {
+      char buffer[200];
+      std::snprintf(buffer, sizeof buffer, "element %ld (%s): inverted or degenerate (det J = %.3g at a quadrature point)",
+                    element_id, SolidTypeName(type).c_str(), det);
+      throw InputError(buffer);
+    }
+    const Eigen::MatrixXd dNdx = dN * J.inverse();  // n x 3
+    Eigen::MatrixXd B = Eigen::MatrixXd::Zero(6, 3 * n);
+    for (int a = 0; a < n; ++a) {
+      const double gx = dNdx(a, 0), gy = dNdx(a, 1), gz = dNdx(a, 2);
+      B(0, 3 * a) = gx;
+      B(1, 3 * a + 1) = gy;
+      B(2, 3 * a + 2) = gz;
+      B(3, 3 * a + 1) = gz;
+      B(3, 3 * a + 2) = gy;
+      B(4, 3 * a) = gz;
+      B(4, 3 * a + 2) = gx;
+      B(5, 3 * a) = gy;
+      B(5, 3 * a + 1) = gx;
+    }
+    const double dV = det * weights[q];
+    out.volume += dV;
+    out.K.noalias() += dV * B.transpose() * D * B;
+    for (int a = 0; a < n; ++a)
+      for (int b = 0; b < n; ++b) {
+        const double m = material.rho * N[a] * N[b] * dV;
+        for (int d = 0; d < 3; ++d) out.M(3 * a + d, 3 * b + d) += m;
+      }
+  }
+  out.K = 0.5 * (out.K + out.K.transpose()).eval();
+  return out;
+}
+
+}  // namespace femb

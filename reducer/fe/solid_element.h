@@ -1,0 +1,40 @@
+// Isoparametric solid elements for linear elasticity: TET4, TET10, HEX8, HEX20 (node order of
+// gmsh), consistent mass, full integration:
+//   K = int B^T D B dV,  M = int rho N^T N dV  (3 DOFs per node: u_x, u_y, u_z; node-major)
+// with D the isotropic elasticity matrix (Voigt order xx, yy, zz, yz, xz, xy; engineering
+// shear strains). Quadrature: Gauss-Legendre 2^3 (HEX8), 3^3 (HEX20); tetrahedra by a collapsed
+// (Duffy) 4^3 Gauss rule, exact to degree 5 on the reference tetrahedron (TET10 mass: 4).
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+
+#include "formats/part_file.h"
+
+namespace femb {
+
+enum class SolidType { kTet4, kTet10, kHex8, kHex20 };
+
+int SolidNodeCount(SolidType type);
+std::string SolidTypeName(SolidType type);  ///< "tet4", ...
+
+struct SolidElementMatrices {
+  Eigen::MatrixXd K, M;  ///< (3 n) x (3 n)
+  double volume = 0.0;
+};
+
+/// `X`: n x 3 node coordinates. Throws InputError "element <id>: inverted or degenerate
+/// (det J = ... at a quadrature point)" when the mapping is not orientation-preserving.
+SolidElementMatrices ComputeSolidElement(SolidType type, const Eigen::MatrixXd& X, const MaterialSpec& material,
+                                         long element_id);
+
+/// Shape functions (n) and their derivatives (n x 3) at a reference point.
+void SolidShapeFunctions(SolidType type, const Eigen::Vector3d& xi, Eigen::VectorXd* N, Eigen::MatrixXd* dN);
+
+/// Reference-element quadrature (points, weights).
+void SolidQuadrature(SolidType type, std::vector<Eigen::Vector3d>* points, std::vector<double>* weights);
+
+/// 6 x 6 isotropic elasticity matrix.
+Eigen::Matrix<double, 6, 6> IsotropicElasticity(double E, double nu);
+
+}  // namespace femb
