@@ -1,6 +1,7 @@
 #include "formats/part_file.h"
 
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <map>
 #include <sstream>
@@ -152,11 +153,40 @@ PartSpec ParsePart(const std::string& text, const std::string& name,
   part.name = root.Required("name").String();
   YamlValue type = root.Required("type");
   part.type = type.String();
-  if (part.type != "beam") type.Fail("unknown part type '" + part.type + "' (known: beam)");
+  if (part.type != "beam" && part.type != "solid") type.Fail("unknown part type '" + part.type + "' (known: beam, solid)");
   if (auto u = root.Optional("units")) part.units = UnitSystem(u->String(), u->Where());
   part.material = ParseMaterial(root.Required("material"));
-  part.beam.section = ParseSection(root.Required("section"));
-  ParseBeam(root.Required("beam"), part);
+  if (part.type == "beam") {
+    part.beam.section = ParseSection(root.Required("section"));
+    ParseBeam(root.Required("beam"), part);
+  } else {
+    YamlValue geometry = root.Required("geometry");
+    YamlMap g = geometry.Map();
+    part.solid.where = geometry.Where();
+    if (auto shape = g.Optional("shape")) {
+      part.solid.shape = shape->String();
+      if (part.solid.shape != "box") shape->Fail("unknown built-in shape '" + part.solid.shape + "' (known: box)");
+      YamlValue size = g.Required("size");
+      part.solid.size = size.Vector3();
+      if (!(part.solid.size.minCoeff() > 0)) size.Fail("box edge lengths must be positive");
+    } else {
+      YamlValue file = g.Required("file");
+      std::filesystem::path f(file.String());
+      if (f.is_relative()) f = std::filesystem::path(name).parent_path() / f;
+      if (!std::filesystem::exists(f)) file.Fail("geometry file '" + f.string() + "' not found");
+      part.solid.file = f.string();
+    }
+    g.CheckNoUnknownKeys();
+    if (auto mesh = root.Optional("mesh")) {
+      YamlMap m = mesh->Map();
+      if (auto v = m.Optional("size")) part.solid.element_size = v->PositiveNumber();
+      if (auto v = m.Optional("order")) {
+        part.solid.order = int(v->Integer());
+        if (part.solid.order != 1 && part.solid.order != 2) v->Fail("element order must be 1 or 2");
+      }
+      m.CheckNoUnknownKeys();
+    }
+  }
 
   auto interfaces = root.Optional("interfaces");
   if (!interfaces || interfaces->List().empty()) {
@@ -168,15 +198,26 @@ PartSpec ParsePart(const std::string& text, const std::string& name,
     InterfaceSpec spec;
     spec.where = item.Where();
     spec.name = m.Required("name").String();
-    YamlValue point = m.Optional("point").value_or(m.Required("name"));
-    const std::string point_name = point.String();
-    for (size_t i = 0; i < part.beam.point_names.size(); ++i) {
-      if (part.beam.point_names[i] == point_name) spec.point = int(i);
+    if (part.type == "beam") {
+      YamlValue point = m.Optional("point").value_or(m.Required("name"));
+      const std::string point_name = point.String();
+      for (size_t i = 0; i < part.beam.point_names.size(); ++i) {
+        if (part.beam.point_names[i] == point_name) spec.point = int(i);
+      }
+      if (spec.point < 0) point.Fail("interface point '" + point_name + "' not found in beam.points");
+      for (const auto& other : part.interfaces) {
+        if (other.point == spec.point) item.Fail("point '" + point_name + "' is already interface '" + other.name + "'");
+      }
+    } else {
+      spec.group = m.Required("group").String();
+      if (auto c = m.Optional("coupling")) {
+        spec.coupling = c->String();
+        if (spec.coupling != "rbe2") c->Fail("unknown coupling '" + spec.coupling + "' (known: rbe2; rbe3 is not implemented yet)");
+      }
+      if (auto p = m.Optional("point")) spec.location = p->Vector3();
     }
-    if (spec.point < 0) point.Fail("interface point '" + point_name + "' not found in beam.points");
     for (const auto& other : part.interfaces) {
       if (other.name == spec.name) item.Fail("interface name '" + spec.name + "' used twice");
-      if (other.point == spec.point) item.Fail("point '" + point_name + "' is already interface '" + other.name + "'");
     }
     m.CheckNoUnknownKeys();
     part.interfaces.push_back(spec);

@@ -49,6 +49,21 @@ struct BeamSpec {
 struct InterfaceSpec {
   std::string name;
   int point = -1;  ///< index into BeamSpec::points (beam parts)
+  // solid parts: the node set (gmsh physical surface group; box: xmin ... zmax), the coupling
+  // and the interface point (default: the centroid of the node set)
+  std::string group;
+  std::string coupling = "rbe2";
+  std::optional<Eigen::Vector3d> location;
+  std::string where;
+};
+
+/// A solid part: a built-in shape or a geometry/mesh file, meshed by gmsh.
+struct SolidSpec {
+  std::string shape;                              ///< "box" or "" (file)
+  Eigen::Vector3d size = Eigen::Vector3d::Ones();  ///< box edge lengths [length], corner at the origin
+  std::string file;                               ///< geometry or mesh file (resolved path)
+  double element_size = 0.0;                      ///< target element size [length]
+  int order = 2;                                  ///< 1: TET4/HEX8, 2: TET10/HEX20
   std::string where;
 };
 
@@ -64,10 +79,11 @@ struct PartSpec {
   std::string file;
   std::string text_hash;  ///< FNV-1a 64-bit of the file text (after --set), hex
   std::string name;
-  std::string type;       ///< "beam"
+  std::string type;       ///< "beam" or "solid"
   Units units;
   MaterialSpec material;
   BeamSpec beam;
+  SolidSpec solid;
   std::vector<InterfaceSpec> interfaces;
   ReductionSpec reduction;
 };

@@ -4,6 +4,7 @@
 
 #include "formats/input_error.h"
 #include "reducer/fe/beam_model.h"
+#include "reducer/fe/solid_model.h"
 #include "reducer/reduction/craig_bampton.h"
 #include "reducer/reduction/floating_frame.h"
 #include "reducer/reduction/full_modes.h"
@@ -23,7 +24,7 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
   };
 
   Stopwatch clock;
-  const FeModel model = BuildBeamModel(part);
+  const FeModel model = part.type == "solid" ? BuildSolidModel(part) : BuildBeamModel(part);
   char detail[200];
   std::snprintf(detail, sizeof detail, "%ld nodes, %ld %s elements, %ld DOFs", model.n_nodes(),
                 model.n_elements(), model.element_type.c_str(), model.n_dofs());
@@ -63,7 +64,7 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
     v.cells = model.cells;
     v.cell_type = model.cell_type;
     v.dofs_per_node = model.dofs_per_node;
-    v.shapes = cb.shapes;
+    v.shapes = model.mesh_map.size() ? Eigen::MatrixXd(model.mesh_map * cb.shapes) : cb.shapes;
     se.visualization = std::move(v);
   }
   prov.femb_version = FEMB_VERSION;

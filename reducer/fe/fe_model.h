@@ -36,6 +36,10 @@ struct FeModel {
   /// nullopt when `x` lies outside the material.
   std::function<std::optional<SparseMatrix>(const Eigen::Vector3d& x)> interpolate_at;
 
+  /// Solids: mesh DOFs (3 per mesh node) = mesh_map * model DOFs (the RBE2 couplings eliminate
+  /// the coupled nodes in favour of the 6-DOF interface nodes). Empty for beams (identity).
+  SparseMatrix mesh_map;
+
   long n_dofs() const { return long(K.rows()); }
   long n_nodes() const { return long(nodes.rows()); }
   long n_elements() const { return long(cells.rows()); }

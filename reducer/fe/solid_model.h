@@ -1,0 +1,18 @@
+// Solid parts: gmsh mesh -> solid elements -> K, M on the mesh DOFs -> interface couplings.
+// RBE2 (rigid): every node of the interface's node set moves with the 6-DOF interface node,
+//   u_s = u_k + theta_k x (x_s - x_k), i.e. mesh DOFs = T * model DOFs with T built from
+//   [1, -(x_s - x_k)~] blocks; K = T^T K_mesh T, M = T^T M_mesh T. It stiffens the coupled face
+//   (use it for a bolted flange or a shaft seat that is truly rigid).
+// The interface point defaults to the centroid of the node set.
+#pragma once
+
+#include "formats/part_file.h"
+#include "reducer/fe/fe_model.h"
+
+namespace femb {
+
+/// Throws InputError for a missing or empty node set, node sets that overlap, or an inverted
+/// element (named).
+FeModel BuildSolidModel(const PartSpec& part);
+
+}  // namespace femb

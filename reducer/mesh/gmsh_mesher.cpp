@@ -1,0 +1,132 @@
+#include "reducer/mesh/gmsh_mesher.h"
+
+#include <gmsh.h>
+
+#include <cmath>
+#include <unordered_map>
+
+#include "formats/input_error.h"
+
+namespace femb {
+namespace {
+
+// One gmsh session at a time, finalized on every path.
+struct GmshSession {
+  GmshSession() {
+    gmsh::initialize();
+    gmsh::option::setNumber("General.Terminal", 0);
+    gmsh::option::setNumber("General.NumThreads", 1);
+  }
+  ~GmshSession() { gmsh::finalize(); }
+};
+
+bool SolidTypeOfGmsh(int gmsh_type, SolidType* type) {
+  switch (gmsh_type) {
+    case 4: *type = SolidType::kTet4; return true;
+    case 11: *type = SolidType::kTet10; return true;
+    case 5: *type = SolidType::kHex8; return true;
+    case 17: *type = SolidType::kHex20; return true;
+    default: return false;
+  }
+}
+
+}  // namespace
+
+SolidMesh MeshWithGmsh(const MeshRequest& r) {
+  GmshSession session;
+  SolidMesh mesh;
+  std::map<std::string, std::vector<int>> surface_entities;  // node set name -> surface tags
+  try {
+    if (r.shape == "box") {
+      gmsh::model::add("box");
+      const int volume = gmsh::model::occ::addBox(0, 0, 0, r.size.x(), r.size.y(), r.size.z());
+      gmsh::model::occ::synchronize();
+      gmsh::vectorpair faces;
+      gmsh::model::getBoundary({{3, volume}}, faces, false, false, false);
+      for (const auto& [dim, tag] : faces) {
+        double x0, y0, z0, x1, y1, z1;
+        gmsh::model::getBoundingBox(dim, tag, x0, y0, z0, x1, y1, z1);
+        // OpenCASCADE pads bounding boxes slightly: a face is flat in the direction where its
+        // extent is (nearly) zero; min or max by where its middle lies.
+        const double tol = 1e-4 * r.size.minCoeff();
+        const Eigen::Vector3d lo(x0, y0, z0), hi(x1, y1, z1);
+        const char* names[3][2] = {{"xmin", "xmax"}, {"ymin", "ymax"}, {"zmin", "zmax"}};
+        for (int d = 0; d < 3; ++d) {
+          if (hi[d] - lo[d] < tol) surface_entities[names[d][0.5 * (lo[d] + hi[d]) > 0.5 * r.size[d]]].push_back(tag);
+        }
+      }
+    } else {
+      gmsh::open(r.file);
+      gmsh::vectorpair groups;
+      gmsh::model::getPhysicalGroups(groups, 2);
+      for (const auto& [dim, tag] : groups) {
+        std::string name;
+        gmsh::model::getPhysicalName(dim, tag, name);
+        std::vector<int> entities;
+        gmsh::model::getEntitiesForPhysicalGroup(dim, tag, entities);
+        if (name.empty()) name = std::to_string(tag);
+        surface_entities[name] = entities;
+      }
+    }
+    std::vector<int> types;
+    std::vector<std::vector<std::size_t>> element_tags, element_nodes;
+    gmsh::model::mesh::getElements(types, element_tags, element_nodes, 3);
+    if (types.empty()) {
+      if (r.element_size > 0) {
+        gmsh::option::setNumber("Mesh.MeshSizeMax", r.element_size);
+        gmsh::option::setNumber("Mesh.MeshSizeMin", 0.5 * r.element_size);
+      }
+      gmsh::model::mesh::generate(3);
+      if (r.order == 2) gmsh::model::mesh::setOrder(2);
+      gmsh::model::mesh::getElements(types, element_tags, element_nodes, 3);
+    }
+    std::vector<std::size_t> node_tags;
+    std::vector<double> coords, params;
+    gmsh::model::mesh::getNodes(node_tags, coords, params, -1, -1, false, false);
+    std::unordered_map<std::size_t, int> index;
+    mesh.nodes.resize(long(node_tags.size()), 3);
+    for (size_t i = 0; i < node_tags.size(); ++i) {
+      index[node_tags[i]] = int(i);
+      mesh.nodes.row(long(i)) << coords[3 * i], coords[3 * i + 1], coords[3 * i + 2];
+    }
+    int chosen = -1;
+    for (size_t t = 0; t < types.size(); ++t) {
+      SolidType type;
+      if (!SolidTypeOfGmsh(types[t], &type)) {
+        throw InputError((r.where.empty() ? r.file : r.where) + ": gmsh element type " + std::to_string(types[t]) +
+                         " is not supported (use tetrahedra or hexahedra of order 1 or 2)");
+      }
+      if (chosen >= 0) {
+        throw InputError((r.where.empty() ? r.file : r.where) + ": mixed volume element types are not supported yet");
+      }
+      chosen = int(t);
+      mesh.type = type;
+    }
+    if (chosen < 0) {
+      throw InputError((r.where.empty() ? r.file : r.where) + ": the mesh has no volume elements");
+    }
+    const int per = SolidNodeCount(mesh.type);
+    const auto& conn = element_nodes[chosen];
+    mesh.cells.resize(long(conn.size() / per), per);
+    for (size_t e = 0; e < conn.size() / per; ++e)
+      for (int a = 0; a < per; ++a) mesh.cells(long(e), a) = index.at(conn[e * per + a]);
+    for (const auto& [name, entities] : surface_entities) {
+      std::vector<int>& set = mesh.node_sets[name];
+      for (int tag : entities) {
+        std::vector<std::size_t> tags;
+        std::vector<double> c, p;
+        gmsh::model::mesh::getNodes(tags, c, p, 2, tag, true, false);
+        for (std::size_t t : tags) set.push_back(index.at(t));
+      }
+      std::sort(set.begin(), set.end());
+      set.erase(std::unique(set.begin(), set.end()), set.end());
+    }
+  } catch (const InputError&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw InputError((r.file.empty() ? r.where : r.file) + ": gmsh failed: " + e.what());
+  }
+  return mesh;
+}
+
+}  // namespace femb

@@ -1,0 +1,35 @@
+// Meshing with the gmsh C++ API: built-in shapes (box) or a geometry/mesh file (.step, .stp,
+// .brep, .geo, .msh), volume elements of order 1 or 2, and named node sets (gmsh physical
+// surface groups; for the box: xmin, xmax, ymin, ymax, zmin, zmax).
+#pragma once
+
+#include <Eigen/Core>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "reducer/fe/solid_element.h"
+
+namespace femb {
+
+struct SolidMesh {
+  Eigen::MatrixXd nodes;  ///< n x 3
+  SolidType type = SolidType::kTet10;
+  Eigen::MatrixXi cells;  ///< n_cells x nodes per cell, 0-based, gmsh node order
+  std::map<std::string, std::vector<int>> node_sets;
+};
+
+struct MeshRequest {
+  std::string shape;            ///< "box" or "" (file)
+  Eigen::Vector3d size = Eigen::Vector3d::Ones();
+  std::string file;             ///< geometry or mesh file
+  double element_size = 0.0;    ///< target element size [length]
+  int order = 2;
+  std::string where;            ///< location for messages
+};
+
+/// Throws InputError (naming `where` or the file) for an unreadable file, no volume elements,
+/// or unsupported element types.
+SolidMesh MeshWithGmsh(const MeshRequest& request);
+
+}  // namespace femb
