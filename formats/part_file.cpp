@@ -212,7 +212,7 @@ PartSpec ParsePart(const std::string& text, const std::string& name,
       spec.group = m.Required("group").String();
       if (auto c = m.Optional("coupling")) {
         spec.coupling = c->String();
-        if (spec.coupling != "rbe2") c->Fail("unknown coupling '" + spec.coupling + "' (known: rbe2; rbe3 is not implemented yet)");
+        if (spec.coupling != "rbe2" && spec.coupling != "rbe3") c->Fail("unknown coupling '" + spec.coupling + "' (known: rbe2, rbe3)");
       }
       if (auto p = m.Optional("point")) spec.location = p->Vector3();
     }

@@ -90,7 +90,7 @@ FeModel BuildSolidModel(const PartSpec& part) {
     for (int node : set->second) {
       if (owner[node] >= 0) {
         throw InputError(i.where + ": interface '" + i.name + "': node set '" + i.group + "' shares nodes with interface '" +
-                         part.interfaces[owner[node]].name + "' (rigid couplings must not overlap)");
+                         part.interfaces[owner[node]].name + "' (couplings must not overlap)");
       }
       owner[node] = int(k);
       centroid += mesh->nodes.row(node).transpose();
@@ -99,27 +99,97 @@ FeModel BuildSolidModel(const PartSpec& part) {
     model.interface_names.push_back(i.name);
     model.interface_positions.push_back(i.location ? *i.location : centroid);
   }
-  std::vector<int> kept(n_nodes, -1);
+  // RBE3 (distributing): the interface motion is the least-squares rigid fit of its node set,
+  //   u_k = u_c + theta x (x_k - c),  u_c = mean(u_i),  theta = A^-1 sum r_i x u_i,
+  //   A = sum (|r_i|^2 1 - r_i r_i^T), r_i = x_i - c,
+  // i.e. q_k = W u_set. Six set DOFs (the pivots of a column-pivoted QR of W) are made
+  // dependent: u_dep = W_dep^-1 (q_k - W_ind u_ind). A change of coordinates: no stiffness added.
+  std::vector<int> dependent_of(3 * n_nodes, -1);  // mesh DOF -> RBE3 interface index
+  struct Rbe3 {
+    std::vector<int> dofs;      // set DOFs (mesh numbering)
+    Eigen::MatrixXd W;          // 6 x dofs
+    std::vector<int> dep;       // positions in dofs of the 6 dependent DOFs
+    Eigen::MatrixXd Wdep_inv;   // 6 x 6
+  };
+  std::vector<Rbe3> rbe3(part.interfaces.size());
+  for (size_t k = 0; k < part.interfaces.size(); ++k) {
+    if (part.interfaces[k].coupling != "rbe3") continue;
+    const std::vector<int>& set = mesh->node_sets.at(part.interfaces[k].group);
+    const int ns = int(set.size());
+    Eigen::Vector3d c = Eigen::Vector3d::Zero();
+    for (int node : set) c += mesh->nodes.row(node).transpose();
+    c /= ns;
+    Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
+    for (int node : set) {
+      const Eigen::Vector3d r = mesh->nodes.row(node).transpose() - c;
+      A += r.squaredNorm() * Eigen::Matrix3d::Identity() - r * r.transpose();
+    }
+    if (ns < 3 || std::abs(A.determinant()) < 1e-12 * std::pow(A.trace(), 3)) {
+      throw InputError(part.interfaces[k].where + ": interface '" + part.interfaces[k].name +
+                       "': an RBE3 coupling needs at least 3 nodes not on one line");
+    }
+    const Eigen::Matrix3d Ainv = A.inverse();
+    const Eigen::Vector3d d = model.interface_positions[k] - c;
+    Rbe3& r3 = rbe3[k];
+    r3.W = Eigen::MatrixXd::Zero(6, 3 * ns);
+    for (int a = 0; a < ns; ++a) {
+      const Eigen::Vector3d r = mesh->nodes.row(set[a]).transpose() - c;
+      const Eigen::Matrix3d Wtheta = Ainv * SkewOf(r);
+      r3.W.block<3, 3>(3, 3 * a) = Wtheta;
+      r3.W.block<3, 3>(0, 3 * a) = Eigen::Matrix3d::Identity() / ns - SkewOf(d) * Wtheta;
+      for (int i = 0; i < 3; ++i) r3.dofs.push_back(3 * set[a] + i);
+    }
+    Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(r3.W);
+    Eigen::MatrixXd Wdep(6, 6);
+    for (int j = 0; j < 6; ++j) {
+      r3.dep.push_back(int(qr.colsPermutation().indices()[j]));
+      Wdep.col(j) = r3.W.col(r3.dep.back());
+      dependent_of[r3.dofs[r3.dep.back()]] = int(k);
+    }
+    r3.Wdep_inv = Wdep.inverse();
+  }
+  // Model coordinates: every mesh DOF that is neither in an RBE2 set nor an RBE3 dependent DOF,
+  // then 6 per interface.
+  std::vector<int> kept(3 * n_nodes, -1);
   int n_kept = 0;
   for (int s = 0; s < n_nodes; ++s) {
-    if (owner[s] < 0) {
-      kept[s] = n_kept;
-      n_kept += 3;
+    const bool rbe2 = owner[s] >= 0 && part.interfaces[owner[s]].coupling == "rbe2";
+    for (int d = 0; d < 3; ++d) {
+      if (!rbe2 && dependent_of[3 * s + d] < 0) kept[3 * s + d] = n_kept++;
     }
   }
   const int n_model = n_kept + 6 * int(part.interfaces.size());
   std::vector<Eigen::Triplet<double>> t_entries;
   for (int s = 0; s < n_nodes; ++s) {
-    if (owner[s] < 0) {
-      for (int d = 0; d < 3; ++d) t_entries.emplace_back(3 * s + d, kept[s] + d, 1.0);
+    if (owner[s] >= 0 && part.interfaces[owner[s]].coupling == "rbe2") {
+      const int base = n_kept + 6 * owner[s];
+      const Eigen::Matrix3d arm = -SkewOf(mesh->nodes.row(s).transpose() - model.interface_positions[owner[s]]);
+      for (int d = 0; d < 3; ++d) {
+        t_entries.emplace_back(3 * s + d, base + d, 1.0);
+        for (int c = 0; c < 3; ++c) {
+          if (arm(d, c) != 0.0) t_entries.emplace_back(3 * s + d, base + 3 + c, arm(d, c));
+        }
+      }
       continue;
     }
-    const int base = n_kept + 6 * owner[s];
-    const Eigen::Matrix3d arm = -SkewOf(mesh->nodes.row(s).transpose() - model.interface_positions[owner[s]]);
     for (int d = 0; d < 3; ++d) {
-      t_entries.emplace_back(3 * s + d, base + d, 1.0);
-      for (int c = 0; c < 3; ++c) {
-        if (arm(d, c) != 0.0) t_entries.emplace_back(3 * s + d, base + 3 + c, arm(d, c));
+      if (kept[3 * s + d] >= 0) t_entries.emplace_back(3 * s + d, kept[3 * s + d], 1.0);
+    }
+  }
+  for (size_t k = 0; k < rbe3.size(); ++k) {
+    const Rbe3& r3 = rbe3[k];
+    if (r3.dep.empty()) continue;
+    const int base = n_kept + 6 * int(k);
+    // u_dep = Wdep^-1 q - Wdep^-1 W_ind u_ind.
+    const Eigen::MatrixXd G = -r3.Wdep_inv * r3.W;  // 6 x set DOFs (dependent columns ignored)
+    for (int j = 0; j < 6; ++j) {
+      const int row = r3.dofs[r3.dep[j]];
+      for (int c = 0; c < 6; ++c) {
+        if (r3.Wdep_inv(j, c) != 0.0) t_entries.emplace_back(row, base + c, r3.Wdep_inv(j, c));
+      }
+      for (size_t a = 0; a < r3.dofs.size(); ++a) {
+        const int col = kept[r3.dofs[a]];
+        if (col >= 0 && G(j, long(a)) != 0.0) t_entries.emplace_back(row, col, G(j, long(a)));
       }
     }
   }

@@ -65,6 +65,32 @@ TEST(SolidModel, CantileverBarMatchesBeamTheoryWithin1Percent) {
   }
 }
 
+TEST(SolidModel, Rbe2IsStifferThanRbe3) {
+  // Clamp the root (RBE2), couple the tip face by RBE2 or RBE3 and compare the static tip
+  // compliance (the reduced K of the tip node with the root clamped: exact statics).
+  auto tip_compliance = [](const std::string& coupling) {
+    const Superelement se = test::Reduce(
+        Bar("[{name: root, group: xmin}, {name: tip, group: xmax, coupling: " + coupling + "}]", 0),
+        {"reduction.full_modes=8"});
+    const Eigen::MatrixXd K_tip = se.K.block(6, 6, 6, 6);
+    return std::make_pair(Eigen::MatrixXd(K_tip.inverse()), se.full_free_free_frequencies_hz);
+  };
+  const auto [C2, f2] = tip_compliance("rbe2");
+  const auto [C3, f3] = tip_compliance("rbe3");
+  // Rigid coupling constrains the face: smaller compliance in every direction, the difference
+  // positive semi-definite, and every free-free frequency at least as high (interlacing).
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> diff(0.5 * (C3 - C2 + (C3 - C2).transpose()));
+  EXPECT_GT(diff.eigenvalues().minCoeff(), -1e-9 * C3.norm());
+  for (int i = 0; i < 6; ++i) EXPECT_LE(C2(i, i), C3(i, i) * (1 + 1e-12)) << i;
+  for (int k = 6; k < f2.size(); ++k) EXPECT_GE(f2[k], f3[k] * (1 - 1e-9)) << k;
+  // Both tip deflections near Timoshenko beam theory: PL^3/3EI + PL/(kGA).
+  const double E = 2.1e11, G = E / 2.6, b = 0.05, I = b * b * b * b / 12, k = 10 * 1.3 / (12 + 11 * 0.3);
+  const double beam = 1.0 / (3 * E * I) + 1.0 / (k * G * b * b);
+  std::printf("[ info ] tip compliance u_y: RBE2 %.6e, RBE3 %.6e, beam theory %.6e m/N\n", C2(1, 1), C3(1, 1), beam);
+  EXPECT_NEAR(C2(1, 1), beam, 0.01 * beam);
+  EXPECT_NEAR(C3(1, 1), beam, 0.01 * beam);
+}
+
 TEST(SolidModel, MissingNodeSetIsNamed) {
   const std::string message = test::ThrownMessage([] { test::Reduce(Bar("[{name: root, group: xlow}]", 2)); });
   EXPECT_NE(message.find("interface 'root': node set 'xlow' not found in the mesh (known: xmax, xmin, ymax, ymin, zmax, zmin)"),
