@@ -6,6 +6,7 @@
 #include <memory>
 
 #include "formats/input_error.h"
+#include "reducer/fe/connectivity.h"
 #include "reducer/fe/timoshenko_beam.h"
 
 namespace femb {
@@ -89,6 +90,9 @@ FeModel BuildBeamModel(const PartSpec& part) {
   model.K.setFromTriplets(k_entries.begin(), k_entries.end());
   model.M.setFromTriplets(m_entries.begin(), m_entries.end());
 
+  std::vector<int> interface_nodes;
+  for (const InterfaceSpec& i : part.interfaces) interface_nodes.push_back(i.point);
+  CheckRegionsHeldByInterfaces(model.cells, model.nodes, interface_nodes, part.file);
   for (const InterfaceSpec& i : part.interfaces) {
     model.interface_names.push_back(i.name);
     model.interface_positions.push_back(spec.points[i.point]);

@@ -4,6 +4,7 @@
 #include <memory>
 
 #include "formats/input_error.h"
+#include "reducer/fe/connectivity.h"
 #include "reducer/fe/solid_element.h"
 #include "reducer/mesh/gmsh_mesher.h"
 
@@ -150,6 +151,11 @@ FeModel BuildSolidModel(const PartSpec& part) {
   }
   // Model coordinates: every mesh DOF that is neither in an RBE2 set nor an RBE3 dependent DOF,
   // then 6 per interface.
+  std::vector<int> coupled;
+  for (int s = 0; s < n_nodes; ++s) {
+    if (owner[s] >= 0) coupled.push_back(s);
+  }
+  CheckRegionsHeldByInterfaces(mesh->cells, mesh->nodes, coupled, part.solid.where);
   std::vector<int> kept(3 * n_nodes, -1);
   int n_kept = 0;
   for (int s = 0; s < n_nodes; ++s) {

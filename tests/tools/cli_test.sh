@@ -89,6 +89,7 @@ expect_input_error "nu range" "Poisson's ratio must be in (-1, 0.5), got 0.7" "$
 expect_input_error "zero length" "zero-length element" "$(variant 's/B: \[0.3, 0.0, 0.0\]/B: [0.0, 0.0, 0.0]/' zero)"
 expect_input_error "interface not found" "interface point 'Q' not found" "$(variant 's/{name: B}/{name: B, point: Q}/' iface)"
 expect_input_error "no interface" "no interface defined" "$(variant '/^interfaces:/,/name: B}/d' none)"
+expect_input_error "region held by no interface" "a mesh region of 3 nodes around (0.15, 1, 0) is connected to no interface" "$(variant 's/    B: \[0.3, 0.0, 0.0\]/    B: [0.3, 0.0, 0.0]\n    C: [0.0, 1.0, 0.0]\n    D: [0.3, 1.0, 0.0]/; s/    - {from: A, to: B, elements: 10}/    - {from: A, to: B, elements: 10}\n    - {from: C, to: D, elements: 2}/' island)"
 expect_input_error "too many modes" "exceeds the 54 interior DOFs" "$good" --set reduction.internal_modes=500
 expect_input_error "bad --set" "--set reduction.floating_frame: unknown floating frame 'centroid'" "$good" --set reduction.floating_frame=centroid
 
