@@ -9,10 +9,11 @@
 #include "formats/superelement_file.h"
 #include "inspect/report.h"
 #include "inspect/superelement_checks.h"
+#include "inspect/vtu_writer.h"
 
 namespace {
 
-constexpr const char* kUsage = R"(usage: femb-inspect FILE.h5 [--json] [--check] [--dump K|M|PhiCB [--format mtx|csv]]
+constexpr const char* kUsage = R"(usage: femb-inspect FILE.h5 [--json] [--check] [--dump K|M|PhiCB [--format mtx|csv]] [--vtu DIR]
 
 Shows a superelement file: units, interfaces, floating frame, mass properties, the 6x6 rigid-body
 mass matrix, a label for every reduced coordinate, reduced vs full free-free frequencies, checks.
@@ -23,6 +24,8 @@ options:
                         exactly 6 rigid-body modes, Phi_CB Phi_rig0 = 1)
   --dump K|M|PhiCB      print that matrix to stdout (full precision)
   --format mtx|csv      Matrix Market (default) or CSV for --dump
+  --vtu DIR             write every reduced coordinate's shape as DIR/<name>_<i>.vtu (ParaView;
+                        needs the mesh in the file: reduction.keep_mesh)
   -h, --help            this text
 
 exit codes: 0 success, 1 a check failed (with --check), 2 bad input or unreadable file.
@@ -31,19 +34,25 @@ exit codes: 0 success, 1 a check failed (with --check), 2 bad input or unreadabl
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string dump, format = "mtx";
+  std::string dump, format = "mtx", vtu;
   bool json = false, check = false;
   femb::CommandLine cli("femb-inspect", kUsage, "superelement file");
   cli.Value({"--dump"}, [&](const std::string& v) { dump = v; });
   cli.Value({"--format"}, [&](const std::string& v) { format = v; });
+  cli.Value({"--vtu"}, [&](const std::string& v) { vtu = v; });
   cli.Switch({"--json"}, [&] { json = true; });
   cli.Switch({"--check"}, [&] { check = true; });
   if (!cli.Parse(argc, argv)) return cli.exit_code();
   const std::string path = cli.input();
   try {
     femb::SuperelementReadOptions options;
-    options.visualization = false;
+    options.visualization = !vtu.empty();
     const femb::Superelement se = femb::ReadSuperelementFile(path, options);
+    if (!vtu.empty()) {
+      const int written = femb::WriteModeShapesVtu(se, vtu);
+      std::printf("femb-inspect: wrote %d mode shapes to %s/%s_*.vtu\n", written, vtu.c_str(), se.name.c_str());
+      return 0;
+    }
     if (!dump.empty()) {
       const Eigen::MatrixXd& A = dump == "K" ? se.K : dump == "M" ? se.M : se.floating_frame.Phi_CB;
       if (format == "mtx") {

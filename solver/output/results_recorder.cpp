@@ -8,6 +8,7 @@
 
 #include "formats/hdf5_file.h"
 #include "formats/input_error.h"
+#include "formats/vtk_cells.h"
 
 namespace femb {
 namespace {
@@ -230,7 +231,7 @@ void ResultsRecorder::WriteAnimation() {
   long node_offset = 0, cell_offset = 0;
   for (int b : with_mesh) {
     const Visualization& v = *scene_.meshes[b];
-    cells.middleRows(cell_offset, v.cells.rows()) = v.cells.array() + int(node_offset);
+    cells.middleRows(cell_offset, v.cells.rows()) = ToVtkOrder(v.cell_type, v.cells).array() + int(node_offset);
     body.middleRows(cell_offset, v.cells.rows()).setConstant(b);
     node_offset += v.nodes.rows();
     cell_offset += v.cells.rows();
@@ -256,8 +257,7 @@ void ResultsRecorder::WriteAnimation() {
     }
     w.Close();
   }
-  const char* topology = cell_type == "line2" ? "Polyline" : cell_type == "tet4" ? "Tetrahedron"
-                       : cell_type == "tet10" ? "Tetrahedron_10" : cell_type == "hex8" ? "Hexahedron" : "Hexahedron_20";
+  const std::string topology = XdmfTopology(cell_type);
   std::ofstream out(xdmf + ".tmp." + pid);
   out << "<?xml version=\"1.0\" ?>\n<Xdmf Version=\"3.0\">\n <Domain>\n"
       << "  <Grid Name=\"" << scene_.spec.name << "\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";

@@ -153,6 +153,20 @@ outputs:
     - {name: tip, node: tip, quantities: [position]}
 YAML
 "$bin/femb-solve" -q "$work/solid/scene.yaml" -o "$work/solid/out" && ok || fail "solid scene"
+# Mode shapes as VTU: one file per reduced coordinate; quadratic tetrahedra in VTK node order
+# (edge nodes 7, 8, 9 at the middles of edges 0-3, 1-3, 2-3).
+"$bin/femb-inspect" "$work/solid/bar.h5" --vtu "$work/solid/vtu" > /dev/null && ok || fail "--vtu"
+$py - "$work/solid/vtu" <<'PY' && ok || fail "vtu content"
+import sys, glob, meshio, numpy as np
+files = sorted(glob.glob(sys.argv[1] + "/solid_bar_*.vtu"))
+assert len(files) == 18, len(files)
+m = meshio.read(files[12])
+assert m.cells[0].type == "tetra10"
+c, p = m.cells[0].data, m.points
+for node, (a, b) in ((7, (0, 3)), (8, (1, 3)), (9, (2, 3)), (4, (0, 1)), (5, (1, 2)), (6, (0, 2))):
+    assert np.abs(p[c[:, node]] - 0.5 * (p[c[:, a]] + p[c[:, b]])).max() < 1e-9, node
+assert np.abs(m.point_data["displacement"]).max() > 0
+PY
 $py - "$work/solid/out" <<'PY' && ok || fail "solid animation"
 import sys, meshio, numpy as np
 reader = meshio.xdmf.TimeSeriesReader(sys.argv[1] + "/animation.xdmf")

@@ -1,0 +1,19 @@
+// Cell types and node orders of VTK/XDMF for femb's cells (stored in gmsh node order).
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+namespace femb {
+
+/// VTK cell type id: line2 3, tet4 10, hex8 12, tet10 24, hex20 25. Throws InputError otherwise.
+int VtkCellType(const std::string& cell_type);
+
+/// XDMF topology name: Polyline, Tetrahedron, Hexahedron, Tetrahedron_10, Hexahedron_20.
+std::string XdmfTopology(const std::string& cell_type);
+
+/// cells (gmsh order) -> cells in VTK/XDMF node order (they differ for tet10 and hex20).
+Eigen::MatrixXi ToVtkOrder(const std::string& cell_type, const Eigen::MatrixXi& cells);
+
+}  // namespace femb
