@@ -64,6 +64,7 @@ struct SolidSpec {
   std::string file;                               ///< geometry or mesh file (resolved path)
   double element_size = 0.0;                      ///< target element size [length]
   int order = 2;                                  ///< 1: TET4/HEX8, 2: TET10/HEX20
+  bool hexahedra = false;                         ///< mesh.elements: hexahedra (box only)
   std::string where;
 };
 

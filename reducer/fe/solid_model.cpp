@@ -51,6 +51,7 @@ FeModel BuildSolidModel(const PartSpec& part) {
   request.file = part.solid.file;
   request.element_size = part.solid.element_size;
   request.order = part.solid.order;
+  request.hexahedra = part.solid.hexahedra;
   request.where = part.solid.where;
   auto mesh = std::make_shared<SolidMesh>(MeshWithGmsh(request));
   const int n_nodes = int(mesh->nodes.rows()), per = SolidNodeCount(mesh->type);

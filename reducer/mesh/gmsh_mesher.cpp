@@ -2,6 +2,7 @@
 
 #include <gmsh.h>
 
+#include <algorithm>
 #include <cmath>
 #include <unordered_map>
 
@@ -43,6 +44,26 @@ SolidMesh MeshWithGmsh(const MeshRequest& r) {
       gmsh::model::occ::synchronize();
       gmsh::vectorpair faces;
       gmsh::model::getBoundary({{3, volume}}, faces, false, false, false);
+      if (r.hexahedra) {
+        // Structured: transfinite curves (nodes from the element size), recombined faces,
+        // transfinite volume -> hexahedra.
+        gmsh::vectorpair curves;
+        gmsh::model::getBoundary({{3, volume}}, curves, false, false, true);
+        for (const auto& [dim, tag] : curves) {
+          if (dim != 1) continue;
+          double x0, y0, z0, x1, y1, z1;
+          gmsh::model::getBoundingBox(dim, tag, x0, y0, z0, x1, y1, z1);
+          const double length = std::max({x1 - x0, y1 - y0, z1 - z0});
+          const double h = r.element_size > 0 ? r.element_size : r.size.maxCoeff() / 10;
+          gmsh::model::mesh::setTransfiniteCurve(tag, std::max(2, int(std::lround(length / h)) + 1));
+        }
+        for (const auto& [dim, tag] : faces) {
+          gmsh::model::mesh::setTransfiniteSurface(tag);
+          gmsh::model::mesh::setRecombine(2, tag);
+        }
+        gmsh::model::mesh::setTransfiniteVolume(volume);
+        gmsh::option::setNumber("Mesh.SecondOrderIncomplete", 1);  // HEX20, not HEX27
+      }
       for (const auto& [dim, tag] : faces) {
         double x0, y0, z0, x1, y1, z1;
         gmsh::model::getBoundingBox(dim, tag, x0, y0, z0, x1, y1, z1);
@@ -56,6 +77,7 @@ SolidMesh MeshWithGmsh(const MeshRequest& r) {
         }
       }
     } else {
+      if (r.hexahedra) throw InputError(r.where + ": hexahedral meshing is available for the built-in box only");
       gmsh::open(r.file);
       gmsh::vectorpair groups;
       gmsh::model::getPhysicalGroups(groups, 2);

@@ -25,6 +25,7 @@ struct MeshRequest {
   std::string file;             ///< geometry or mesh file
   double element_size = 0.0;    ///< target element size [length]
   int order = 2;
+  bool hexahedra = false;       ///< structured hexahedra (built-in box only): HEX8 / HEX20
   std::string where;            ///< location for messages
 };
 
