@@ -16,6 +16,15 @@
 
 namespace {
 
+femb::StaticOptions StaticOptionsOf(const femb::SceneAnalysisSpec& a) {
+  femb::StaticOptions options;
+  options.end_time = a.end_time;
+  options.steps = a.steps;
+  options.tolerance = a.tolerance;
+  options.max_iterations = a.max_iterations;
+  return options;
+}
+
 double Seconds(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
@@ -77,11 +86,7 @@ int main(int argc, char** argv) {
       femb::SystemState state = femb::InitialState(scene.model);
       double load_time = 0.0;
       if (spec.analysis.modes_about_static) {
-        femb::StaticOptions options;
-        options.end_time = spec.analysis.end_time;
-        options.steps = spec.analysis.steps;
-        options.tolerance = spec.analysis.tolerance;
-        const femb::StaticResult r = femb::SolveStatic(scene.model, state, options);
+        const femb::StaticResult r = femb::SolveStatic(scene.model, state, StaticOptionsOf(spec.analysis));
         if (!r.ok) {
           recorder.Finish(r.message);
           std::fprintf(stderr, "femb-solve: %s: numerical failure in the static state for the modes: %s\n",
@@ -113,13 +118,8 @@ int main(int argc, char** argv) {
     if (spec.analysis.type == "static") {
       femb::SystemState state = femb::InitialState(scene.model);
       recorder.Record(0.0, state, Eigen::VectorXd(), 0.0, 0.0, 0.0);
-      femb::StaticOptions options;
-      options.end_time = spec.analysis.end_time;
-      options.steps = spec.analysis.steps;
-      options.tolerance = spec.analysis.tolerance;
-      options.max_iterations = spec.analysis.max_iterations;
       const femb::StaticResult r = femb::SolveStatic(
-          scene.model, state, options, [&](const femb::StaticStepReport& s, const femb::SystemState& st) {
+          scene.model, state, StaticOptionsOf(spec.analysis), [&](const femb::StaticStepReport& s, const femb::SystemState& st) {
             ++step_count;
             total_iterations += s.iterations;
             if (step_count % spec.analysis.output_every == 0) recorder.Record(s.lambda, st, Eigen::VectorXd(), 0.0, s.elastic_energy, s.external_work);
