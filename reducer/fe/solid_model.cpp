@@ -7,6 +7,7 @@
 #include "reducer/fe/connectivity.h"
 #include "reducer/fe/solid_element.h"
 #include "reducer/mesh/gmsh_mesher.h"
+#include "reducer/mesh/meshio_import.h"
 
 namespace femb {
 namespace {
@@ -53,7 +54,9 @@ FeModel BuildSolidModel(const PartSpec& part) {
   request.order = part.solid.order;
   request.hexahedra = part.solid.hexahedra;
   request.where = part.solid.where;
-  auto mesh = std::make_shared<SolidMesh>(MeshWithGmsh(request));
+  auto mesh = std::make_shared<SolidMesh>(request.file.empty() || IsGmshFile(request.file)
+                                               ? MeshWithGmsh(request)
+                                               : ImportWithMeshio(request.file, part.solid.where));
   const int n_nodes = int(mesh->nodes.rows()), per = SolidNodeCount(mesh->type);
 
   // Element matrices on the mesh DOFs.

@@ -57,6 +57,37 @@ import meshio; m = meshio.read('$work/vtu/beam_rod_013.vtu')
 assert m.cells[0].type == 'line' and set(m.point_data) == {'displacement', 'rotation'}" && ok || fail "vtu beam content"
 "$bin/femb-reduce" -q "$src/examples/beam_rod/part.yaml" -o "$work/nomesh.h5" --set reduction.keep_mesh=false
 "$bin/femb-inspect" "$work/nomesh.h5" --vtu "$work/vtu2" 2> "$work/err.txt"; [ $? = 2 ] && grep -q "no mesh and mode shapes stored" "$work/err.txt" && ok || fail "--vtu without mesh"
+# A foreign mesh through the meshio bridge: an Abaqus .inp hex block with node sets.
+mkdir -p "$work/inp"
+$py - "$work/inp/block.inp" <<'PY'
+import sys, meshio, numpy as np
+nx, ny, nz = 10, 2, 2
+xs, ys, zs = np.linspace(0, 1, nx + 1), np.linspace(0, 0.1, ny + 1), np.linspace(0, 0.1, nz + 1)
+idx = lambda i, j, k: (i * (ny + 1) + j) * (nz + 1) + k
+pts = np.array([[x, y, z] for x in xs for y in ys for z in zs])
+cells = [[idx(i, j, k), idx(i + 1, j, k), idx(i + 1, j + 1, k), idx(i, j + 1, k), idx(i, j, k + 1), idx(i + 1, j, k + 1),
+          idx(i + 1, j + 1, k + 1), idx(i, j + 1, k + 1)] for i in range(nx) for j in range(ny) for k in range(nz)]
+sets = {"LEFT": np.where(pts[:, 0] == 0)[0], "RIGHT": np.where(pts[:, 0] == 1)[0]}
+meshio.write(sys.argv[1], meshio.Mesh(pts, [("hexahedron", np.array(cells))], point_sets=sets))
+PY
+cat > "$work/inp/part.yaml" <<'YAML'
+name: block
+type: solid
+material: {E: 2.1e11, nu: 0.3, rho: 7850}
+geometry: {file: block.inp}
+interfaces:
+  - {name: root, group: LEFT}
+  - {name: tip, group: RIGHT, coupling: rbe3}
+reduction: {internal_modes: 4, floating_frame: mean_axes}
+YAML
+"$bin/femb-reduce" -q "$work/inp/part.yaml" -o "$work/inp/block.h5" && "$bin/femb-inspect" "$work/inp/block.h5" --check --json > "$work/inp/j.json" \
+  && $py -c "import json; j = json.load(open('$work/inp/j.json')); assert abs(j['mass'] - 78.5) < 1e-9 and j['n_full_dofs'] == 276" \
+  && ok || fail "meshio .inp import"
+echo "not a mesh" > "$work/inp/junk.vtu"
+sed 's/block.inp/junk.vtu/' "$work/inp/part.yaml" > "$work/inp/junk.yaml"
+"$bin/femb-reduce" -q "$work/inp/junk.yaml" -o "$work/inp/junk.h5" 2> "$work/err.txt"; code=$?
+[ $code = 2 ] && grep -q "junk.vtu: cannot read with meshio" "$work/err.txt" && [ ! -e "$work/inp/junk.h5" ] && ok || fail "bad foreign mesh: $code $(cat "$work/err.txt")"
+
 # --set works under the documented names.
 "$bin/femb-reduce" -q "$src/examples/beam_rod/part.yaml" -o "$work/m8.h5" --set reduction.internal_modes=8 \
   --set reduction.floating_frame=mean_axes || fail "--set"
