@@ -29,8 +29,9 @@ NAMES = {"tetra": "tet4", "tetra10": "tet10", "hexahedron": "hex8", "hexahedron2
 def main(src, dst):
     try:
         mesh = meshio.read(src)
-    except Exception as e:  # meshio raises many kinds
-        sys.stderr.write("%s: cannot read with meshio: %s\n" % (src, e))
+    except (Exception, SystemExit) as e:  # meshio raises many kinds, and sometimes exits
+        reason = "not a mesh meshio can read" if isinstance(e, SystemExit) else str(e)
+        sys.stderr.write("%s: cannot read with meshio: %s\n" % (src, reason))
         return 2
     volume = [c for c in mesh.cells if c.type in NAMES]
     if not volume:
