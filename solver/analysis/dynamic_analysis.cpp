@@ -36,7 +36,7 @@ Assembly AssembleDynamic(const SystemModel& model, const DofMap& dofs, DynamicSt
     }
     s.config.frames[b] = frame;
     const Eigen::VectorXd w = GatherBody(model, dofs, s.config, int(b), s.W);
-    const Eigen::VectorXd wdot = GatherBodyAcceleration(model, dofs, s.config, int(b), node_acc, s.Wdot);
+    const Eigen::VectorXd wdot = GatherBodyAcceleration(model, dofs, int(b), node_acc, s.Wdot);
     Eigen::VectorXd f_int, f_in;
     Eigen::MatrixXd Kb, Mb, Cb;
     body.ElasticForce(c, frame, &f_int, matrices ? &Kb : nullptr);
@@ -63,11 +63,11 @@ Assembly AssembleDynamic(const SystemModel& model, const DofMap& dofs, DynamicSt
     }
   }
   Eigen::VectorXd loads = Eigen::VectorXd::Zero(n);
-  AddNodeLoads(model, dofs, s.config, t, loads, matrices ? &K : nullptr, &node_forces);
+  AddNodeLoads(model, s.config, t, loads, matrices ? &K : nullptr, &node_forces);
   out.residual += loads;
   out.f_ext += loads;
   Eigen::VectorXd springs = Eigen::VectorXd::Zero(n);
-  AddSpringDampers(model, dofs, s.config, s.W, springs, matrices ? &K : nullptr, matrices ? &C : nullptr,
+  AddSpringDampers(model, s.config, s.W, springs, matrices ? &K : nullptr, matrices ? &C : nullptr,
                    nullptr, &node_forces);
   out.residual += springs;
   out.scale = std::max(out.scale, springs.norm());
@@ -122,7 +122,7 @@ DynamicStepReport Measure(const SystemModel& model, DynamicState& s) {
   r.t = s.t;
   r.external_work = s.external_work;
   Eigen::VectorXd unused = Eigen::VectorXd::Zero(dofs.n_dofs());
-  AddSpringDampers(model, dofs, s.config, s.W, unused, nullptr, nullptr, &r.elastic_energy);  // spring energy
+  AddSpringDampers(model, s.config, s.W, unused, nullptr, nullptr, &r.elastic_energy);  // spring energy
   for (size_t b = 0; b < model.bodies.size(); ++b) {
     const SuperelementBody& body = model.bodies[b];
     const BodyConfiguration c = BodyConfigurationOf(model, s.config, int(b));

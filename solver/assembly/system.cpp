@@ -245,10 +245,9 @@ Eigen::VectorXd GatherBody(const SystemModel& model, const DofMap& dofs, const S
   return w;
 }
 
-Eigen::VectorXd GatherBodyAcceleration(const SystemModel& model, const DofMap& dofs, const SystemState& state, int b,
+Eigen::VectorXd GatherBodyAcceleration(const SystemModel& model, const DofMap& dofs, int b,
                                        const std::vector<Eigen::Matrix<double, 6, 1>>& node_acc,
                                        const Eigen::VectorXd& Wdot) {
-  (void)state;
   const SuperelementBody& body = model.bodies[b];
   Eigen::VectorXd w = Eigen::VectorXd::Zero(body.n_coordinates());
   for (int a = 0; a < body.n_nodes(); ++a) w.segment<6>(6 * a) = node_acc[model.body_nodes[b][a]];
@@ -291,9 +290,9 @@ SystemForces AssembleStatic(const SystemModel& model, const DofMap& dofs, System
     AddBodyNodeForces(model, int(b), minus_f, node_forces);
   }
   Eigen::VectorXd loads = Eigen::VectorXd::Zero(n);
-  AddNodeLoads(model, dofs, state, lambda, loads, with_tangent ? &tangent : nullptr, &node_forces);
+  AddNodeLoads(model, state, lambda, loads, with_tangent ? &tangent : nullptr, &node_forces);
   out.loads = loads;
-  AddSpringDampers(model, dofs, state, Eigen::VectorXd(), loads, with_tangent ? &tangent : nullptr, nullptr,
+  AddSpringDampers(model, state, Eigen::VectorXd(), loads, with_tangent ? &tangent : nullptr, nullptr,
                    &out.elastic_energy, &node_forces);
   out.residual += loads;
   out.force_scale = std::max(out.force_scale, loads.norm());
@@ -304,9 +303,8 @@ SystemForces AssembleStatic(const SystemModel& model, const DofMap& dofs, System
   return out;
 }
 
-void AddNodeLoads(const SystemModel& model, const DofMap& dofs, const SystemState& state, double t,
-                  Eigen::VectorXd& residual, Triplets* tangent, NodeForces* node_forces) {
-  (void)dofs;
+void AddNodeLoads(const SystemModel& model, const SystemState& state, double t, Eigen::VectorXd& residual,
+                  Triplets* tangent, NodeForces* node_forces) {
   for (const NodeLoad& load : model.loads) {
     const NodeJacobian& J = state.J[load.node];
     if (J.empty()) continue;  // clamped: the support takes it
@@ -330,10 +328,8 @@ void AddNodeLoads(const SystemModel& model, const DofMap& dofs, const SystemStat
   }
 }
 
-void AddSpringDampers(const SystemModel& model, const DofMap& dofs, const SystemState& state, const Eigen::VectorXd& W,
-                      Eigen::VectorXd& residual, Triplets* K, Triplets* C, double* energy,
-                      NodeForces* node_forces) {
-  (void)dofs;
+void AddSpringDampers(const SystemModel& model, const SystemState& state, const Eigen::VectorXd& W,
+                      Eigen::VectorXd& residual, Triplets* K, Triplets* C, double* energy, NodeForces* node_forces) {
   for (const SpringDamper& s : model.springs) {
     Eigen::Vector3d x[2], v[2];
     const int nodes[2] = {s.node_a, s.node_b};

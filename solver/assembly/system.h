@@ -173,12 +173,12 @@ SystemForces AssembleStatic(const SystemModel& model, const DofMap& dofs, System
 
 /// External nodal loads at time t (or load factor) and their stiffness d(-f_ext)/dq added to
 /// `tangent` when not null (follower loads).
-void AddNodeLoads(const SystemModel& model, const DofMap& dofs, const SystemState& state, double t,
-                  Eigen::VectorXd& residual, Triplets* tangent, NodeForces* node_forces = nullptr);
+void AddNodeLoads(const SystemModel& model, const SystemState& state, double t, Eigen::VectorXd& residual,
+                  Triplets* tangent, NodeForces* node_forces = nullptr);
 
 /// Spring-damper forces added to `residual` (as applied forces), their stiffness and damping
 /// (of -f) to `K`, `C` when not null, their energy to `energy`. W may be empty (static).
-void AddSpringDampers(const SystemModel& model, const DofMap& dofs, const SystemState& state, const Eigen::VectorXd& W,
+void AddSpringDampers(const SystemModel& model, const SystemState& state, const Eigen::VectorXd& W,
                       Eigen::VectorXd& residual, Triplets* K, Triplets* C, double* energy,
                       NodeForces* node_forces = nullptr);
 
@@ -187,7 +187,7 @@ void AddSpringDampers(const SystemModel& model, const DofMap& dofs, const System
 Eigen::VectorXd GatherBody(const SystemModel& model, const DofMap& dofs, const SystemState& state, int b,
                            const Eigen::VectorXd& W);
 /// Body b's node accelerations (with the joints' convective terms) and modal accelerations.
-Eigen::VectorXd GatherBodyAcceleration(const SystemModel& model, const DofMap& dofs, const SystemState& state, int b,
+Eigen::VectorXd GatherBodyAcceleration(const SystemModel& model, const DofMap& dofs, int b,
                                        const std::vector<Eigen::Matrix<double, 6, 1>>& node_acc,
                                        const Eigen::VectorXd& Wdot);
 

@@ -196,8 +196,7 @@ void SuperelementBody::VelocityMaps(const BodyConfiguration& c, const FrameSolut
   *U = frame.R * (kin.Z * Rbar_t).bottomRows(3);
 }
 
-Eigen::VectorXd SuperelementBody::QuadraticInertia(const BodyConfiguration& c, const Eigen::MatrixXd& P,
-                                                   const Eigen::MatrixXd& U, const Eigen::MatrixXd& Mg,
+Eigen::VectorXd SuperelementBody::QuadraticInertia(const Eigen::MatrixXd& U, const Eigen::MatrixXd& Mg,
                                                    const BodyVelocity& w) const {
   const int n = n_coordinates();
   const Eigen::Vector3d omega_j = U * w;
@@ -218,8 +217,6 @@ Eigen::VectorXd SuperelementBody::QuadraticInertia(const BodyConfiguration& c, c
       out.segment<3>(6 * a + 3) += (omega_j - omega).cross(Eigen::Vector3d(p.segment<3>(6 * a + 3)));
     }
   }
-  (void)c;
-  (void)P;
   out += Mg * (G * w) - G.transpose() * p;
   return out;
 }
@@ -233,7 +230,7 @@ void SuperelementBody::InertiaForce(const BodyConfiguration& c, const FrameSolut
   const Eigen::MatrixXd Mg = P.transpose() * M_ * P;
   if (f_in) {
     *f_in = Mg * wdot;
-    if (options_.quadratic_velocity_terms) *f_in += QuadraticInertia(c, P, U, Mg, w);
+    if (options_.quadratic_velocity_terms) *f_in += QuadraticInertia(U, Mg, w);
   }
   if (mass) *mass = Mg;
   if (gyroscopic) {
@@ -241,10 +238,10 @@ void SuperelementBody::InertiaForce(const BodyConfiguration& c, const FrameSolut
     if (!options_.quadratic_velocity_terms) return;
     // g(w) is quadratic: Dg(w) e = [g(w + s e) - g(w) - g(s e)] / s exactly, for any s > 0.
     const double s = std::max(w.norm(), 1.0);
-    const Eigen::VectorXd g0 = QuadraticInertia(c, P, U, Mg, w);
+    const Eigen::VectorXd g0 = QuadraticInertia(U, Mg, w);
     for (int i = 0; i < n; ++i) {
       const Eigen::VectorXd e = s * Eigen::VectorXd::Unit(n, i);
-      gyroscopic->col(i) = (QuadraticInertia(c, P, U, Mg, w + e) - g0 - QuadraticInertia(c, P, U, Mg, e)) / s;
+      gyroscopic->col(i) = (QuadraticInertia(U, Mg, w + e) - g0 - QuadraticInertia(U, Mg, e)) / s;
     }
   }
 }

@@ -128,8 +128,7 @@ class SuperelementBody {
   // P (system velocities -> local velocities) and the frame's angular velocity map U (3 x n).
   void VelocityMaps(const BodyConfiguration& c, const FrameSolution& frame, Eigen::MatrixXd* P, Eigen::MatrixXd* U) const;
   // The quadratic part of f_in: M_g G w + (Omega_P - Omega_hat) p - G^T p.
-  Eigen::VectorXd QuadraticInertia(const BodyConfiguration& c, const Eigen::MatrixXd& P, const Eigen::MatrixXd& U,
-                                   const Eigen::MatrixXd& Mg, const BodyVelocity& w) const;
+  Eigen::VectorXd QuadraticInertia(const Eigen::MatrixXd& U, const Eigen::MatrixXd& Mg, const BodyVelocity& w) const;
   Eigen::MatrixXd Phi_rig0_;
 
   int n_nodes_ = 0, n_modes_ = 0;
