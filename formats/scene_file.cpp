@@ -319,9 +319,17 @@ SceneSpec ParseScene(const std::string& text, const std::string& name, const std
       std::pair<Eigen::Vector3d, Eigen::Vector3d> v{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
       if (auto x = m.Optional("linear")) v.first = x->Vector3();
       if (auto x = m.Optional("angular")) v.second = x->Vector3();
+      auto joint = m.Optional("joint");
       m.CheckNoUnknownKeys();
       if (!nodes.count(node)) value.Fail("node '" + node + "' is not a node of any body");
-      scene.initial_velocities[node] = v;
+      if (joint) {
+        if (m.Optional("linear") || m.Optional("angular")) value.Fail("give either joint rates or linear/angular velocities");
+        std::vector<double> rates;
+        for (const YamlValue& r : joint->List()) rates.push_back(r.Number());
+        scene.initial_joint_rates[node] = rates;
+      } else {
+        scene.initial_velocities[node] = v;
+      }
     }
   }
 

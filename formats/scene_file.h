@@ -97,6 +97,8 @@ struct SceneSpec {
   bool animation = true;  ///< write animation.xdmf/.h5 when the superelement files hold meshes
   /// Initial velocity (spatial) of named nodes: (linear, angular).
   std::map<std::string, std::pair<Eigen::Vector3d, Eigen::Vector3d>> initial_velocities;
+  /// Initial joint rates of named nodes that have a joint (revolute: angular rate, ...).
+  std::map<std::string, std::vector<double>> initial_joint_rates;
 };
 
 /// Reads a scene file with "key.path=value" overrides applied first. Throws InputError naming

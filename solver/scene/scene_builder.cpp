@@ -250,6 +250,16 @@ Scene BuildScene(const SceneSpec& spec) {
     scene.initial_velocity.segment(dofs.node_first(k), dofs.node_count(k)) =
         dofs.S(k).colPivHouseholderQr().solve(v6);
   }
+  for (const auto& [node, rates] : spec.initial_joint_rates) {
+    const int k = scene.node_index.at(node);
+    const bool has_joint = dofs.joint_of(k) >= 0 || (dofs.node_count(k) > 0 && dofs.node_count(k) < 3);
+    if (!has_joint || int(rates.size()) != dofs.node_count(k)) {
+      throw InputError(spec.file + ": initial_velocity: node '" + node + "' has " +
+                       (has_joint ? std::to_string(dofs.node_count(k)) + " joint coordinates" : std::string("no joint")) +
+                       ", got " + std::to_string(rates.size()) + " joint rates");
+    }
+    for (size_t i = 0; i < rates.size(); ++i) scene.initial_velocity[dofs.node_first(k) + int(i)] = rates[i];
+  }
   return scene;
 }
 

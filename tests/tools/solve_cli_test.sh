@@ -153,6 +153,16 @@ outputs:
     - {name: tip, node: tip, quantities: [position]}
 YAML
 "$bin/femb-solve" -q "$work/solid/scene.yaml" -o "$work/solid/out" && ok || fail "solid scene"
+# Initial joint rates: the pendulums started with 2 rad/s at their pivot joints have kinetic
+# energy from the first output; a wrong number of rates is an input error.
+cat "$work/pend/scene.yaml" > "$work/pend/rate.yaml"
+printf 'initial_velocity:\n  pivot_rod: {joint: [2.0]}\n  pivot_block: {joint: [2.0]}\n' >> "$work/pend/rate.yaml"
+"$bin/femb-solve" -q "$work/pend/rate.yaml" -o "$work/pend_rate" --set analysis.end_time=0.02 && ok || fail "joint rates"
+$py -c "
+import csv; rows = list(csv.DictReader(open('$work/pend_rate/probes.csv')))
+assert float(rows[0]['kinetic_energy']) > 0, rows[0]['kinetic_energy']" && ok || fail "joint rates: no initial kinetic energy"
+printf 'initial_velocity:\n  pivot_rod: {joint: [2.0, 1.0]}\n' | cat "$work/pend/scene.yaml" - > "$work/pend/bad_rate.yaml"
+"$bin/femb-solve" -q "$work/pend/bad_rate.yaml" -o "$work/pend_bad" 2> "$work/err.txt"; [ $? = 2 ] && grep -q "has 1 joint coordinates, got 2 joint rates" "$work/err.txt" && ok || fail "bad joint rates: $(cat "$work/err.txt")"
 # Mode shapes as VTU: one file per reduced coordinate; quadratic tetrahedra in VTK node order
 # (edge nodes 7, 8, 9 at the middles of edges 0-3, 1-3, 2-3).
 "$bin/femb-inspect" "$work/solid/bar.h5" --vtu "$work/solid/vtu" > /dev/null && ok || fail "--vtu"
