@@ -185,9 +185,7 @@ PartSpec ParsePart(const std::string& text, const std::string& name,
         if (part.solid.order != 1 && part.solid.order != 2) v->Fail("element order must be 1 or 2");
       }
       if (auto v = m.Optional("elements")) {
-        const std::string e = v->String();
-        if (e != "tetrahedra" && e != "hexahedra") v->Fail("expected tetrahedra or hexahedra, got '" + e + "'");
-        part.solid.hexahedra = e == "hexahedra";
+        part.solid.hexahedra = v->OneOf({"tetrahedra", "hexahedra"}) == "hexahedra";
         if (part.solid.hexahedra && part.solid.shape != "box") v->Fail("hexahedra are available for the built-in box only");
       }
       m.CheckNoUnknownKeys();

@@ -189,22 +189,10 @@ SceneSpec ParseScene(const std::string& text, const std::string& name, const std
     }
     if (auto o = m.Optional("options")) {
       YamlMap om = o->Map();
-      if (auto v = om.Optional("transformations")) {
-        const std::string t = v->String();
-        if (t != "exact" && t != "approximated") v->Fail("expected exact or approximated, got '" + t + "'");
-        b.approximated = t == "approximated";
-      }
-      if (auto v = om.Optional("tangent")) {
-        const std::string t = v->String();
-        if (t != "full" && t != "K1") v->Fail("expected full or K1, got '" + t + "'");
-        b.full_tangent = t == "full";
-      }
+      if (auto v = om.Optional("transformations")) b.approximated = v->OneOf({"exact", "approximated"}) == "approximated";
+      if (auto v = om.Optional("tangent")) b.full_tangent = v->OneOf({"full", "K1"}) == "full";
       if (auto v = om.Optional("quadratic_velocity_terms")) b.quadratic_velocity_terms = v->Bool();
-      if (auto v = om.Optional("inertia_option")) {
-        const std::string t = v->String();
-        if (t != "A" && t != "B") v->Fail("expected A or B (Cardona's options), got '" + t + "'");
-        b.option_b = t == "B";
-      }
+      if (auto v = om.Optional("inertia_option")) b.option_b = v->OneOf({"A", "B"}, "(Cardona's options)") == "B";
       if (auto v = om.Optional("modal_damping")) {
         b.modal_damping = v->Number();
         if (b.modal_damping < 0) v->Fail("damping ratio must be >= 0");
@@ -346,11 +334,7 @@ SceneSpec ParseScene(const std::string& text, const std::string& name, const std
       a.mode_count = int(v->Integer());
       if (a.mode_count < 1) v->Fail("needs at least 1 mode");
     }
-    if (auto v = m.Optional("about")) {
-      const std::string about = v->String();
-      if (about != "initial" && about != "static") v->Fail("expected initial or static, got '" + about + "'");
-      a.modes_about_static = about == "static";
-    }
+    if (auto v = m.Optional("about")) a.modes_about_static = v->OneOf({"initial", "static"}) == "static";
     if (auto v = m.Optional("end_time")) a.end_time = v->PositiveNumber();
     if (auto v = m.Optional("steps")) {
       a.steps = int(v->Integer());

@@ -61,6 +61,18 @@ std::string YamlValue::String() const {
   return node_.Scalar();
 }
 
+std::string YamlValue::OneOf(const std::vector<std::string>& allowed, const std::string& note) const {
+  const std::string s = String();
+  for (const std::string& a : allowed) {
+    if (s == a) return s;
+  }
+  std::string list;
+  for (size_t i = 0; i < allowed.size(); ++i) {
+    list += (i == 0 ? "" : i + 1 == allowed.size() ? " or " : ", ") + allowed[i];
+  }
+  Fail("expected " + list + (note.empty() ? "" : " " + note) + ", got '" + s + "'");
+}
+
 Eigen::Vector3d YamlValue::Vector3() const {
   if (!node_.IsSequence() || node_.size() != 3) Fail("expected a list of 3 numbers [x, y, z]");
   Eigen::Vector3d v;

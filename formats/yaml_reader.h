@@ -33,6 +33,8 @@ class YamlValue {
   long NonNegativeInteger() const;
   bool Bool() const;
   std::string String() const;
+  /// A string that must be one of `allowed`; fails "expected a or b, got 'x'" (+ `note`).
+  std::string OneOf(const std::vector<std::string>& allowed, const std::string& note = "") const;
   Eigen::Vector3d Vector3() const;
   YamlMap Map() const;
   std::vector<YamlValue> List() const;

@@ -104,6 +104,15 @@ TEST(PartFile, BadOverridesAreNamed) {
   EXPECT_NE(Error(kGood, {"novalue"}).find("expected key.path=value"), std::string::npos);
 }
 
+TEST(PartFile, ChoicesListTheAllowedValues) {
+  const std::string solid =
+      "name: s\ntype: solid\nmaterial: {E: 1, nu: 0.3, rho: 1}\ngeometry: {shape: box, size: [1, 1, 1]}\n"
+      "mesh: {elements: prisms}\ninterfaces: [{name: A, group: xmin}]\n";
+  const std::string message = Error(solid);
+  EXPECT_NE(message.find("part.yaml:5: mesh.elements: expected tetrahedra or hexahedra, got 'prisms'"), std::string::npos)
+      << message;
+}
+
 TEST(PartFile, MissingFileIsNamed) {
   const std::string message = test::ThrownMessage([] { ReadPartFile("/nonexistent/part.yaml"); });
   EXPECT_NE(message.find("/nonexistent/part.yaml: cannot open part file"), std::string::npos) << message;

@@ -205,6 +205,7 @@ expect "rigid loop" 2 "a loop of rigid bodies and joints" 's/^joints:/joints:\n 
 expect "missing superelement" 2 "body 'b3': " 's/{name: b3, superelement: segment.h5/{name: b3, superelement: nothere.h5/'
 expect "missing superelement names file" 2 "nothere.h5: cannot open file" 's/{name: b3, superelement: segment.h5/{name: b3, superelement: nothere.h5/'
 expect "load on clamped node" 2 "load on node 'n0', which is clamped" 's/node: n10, force/node: n0, force/'
+expect "bad option value" 2 "bodies[0].options.tangent: expected full or K1, got 'K2'" 's/{name: b0, superelement: segment.h5,/{name: b0, superelement: segment.h5, options: {tangent: K2},/'
 expect "unknown analysis" 2 "unknown analysis type 'eigen'" 's/type: static/type: eigen/'
 expect "node placed twice" 2 "node 'n1' is placed at" 's/position: \[0.1, 0, 0\]}, nodes: {A: n1/position: [0.15, 0, 0]}, nodes: {A: n1/'
 # Wrong version superelement file.
