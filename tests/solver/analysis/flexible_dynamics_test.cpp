@@ -20,6 +20,17 @@ Superelement Tube(int modes) {
       "interfaces: [{name: A}, {name: B}]\nreduction: {internal_modes: " + std::to_string(modes) + "}\n");
 }
 
+// One tube body on nodes A (x = 0, clamped) and B (x = 1).
+SystemModel ClampedTube(const Superelement& se, const SuperelementOptions& options = {}) {
+  SystemModel model;
+  AddNode(model, "A", Eigen::Vector3d::Zero());
+  AddNode(model, "B", Eigen::Vector3d(1, 0, 0));
+  Clamp(model, 0);
+  model.bodies.emplace_back(se, options);
+  model.body_nodes.push_back({0, 1});
+  return model;
+}
+
 TEST(FlexibleDynamics, ClampedBodyRingsAtTheReducedModelsFirstFrequency) {
   const Superelement se = Tube(4);
   // Reference: eigenvalues of the reduced model with interface A clamped.
@@ -28,12 +39,7 @@ TEST(FlexibleDynamics, ClampedBodyRingsAtTheReducedModelsFirstFrequency) {
   Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> eig(K, M);
   const double f1 = std::sqrt(eig.eigenvalues()[0]) / (2 * M_PI);
 
-  SystemModel model;
-  AddNode(model, "A", Eigen::Vector3d::Zero());
-  AddNode(model, "B", Eigen::Vector3d(1, 0, 0));
-  Clamp(model, 0);
-  model.bodies.emplace_back(se, SuperelementOptions{});
-  model.body_nodes.push_back({0, 1});
+  SystemModel model = ClampedTube(se);
   // A small vertical tip impulse: 1 N for 1 ms.
   NodeLoad pulse;
   pulse.node = 1;
@@ -122,12 +128,7 @@ TEST(FlexibleDynamics, FreeSpinningFlexibleBodyConservesEnergyAndMomentum) {
 
 TEST(FlexibleDynamics, JacobianReuseGivesTheSameMotionWithFewerFactorizations) {
   const Superelement se = Tube(4);
-  SystemModel model;
-  AddNode(model, "A", Eigen::Vector3d::Zero());
-  AddNode(model, "B", Eigen::Vector3d(1, 0, 0));
-  Clamp(model, 0);
-  model.bodies.emplace_back(se, SuperelementOptions{});
-  model.body_nodes.push_back({0, 1});
+  SystemModel model = ClampedTube(se);
   model.gravity = Eigen::Vector3d(0, -9.81, 0);  // the tube sags and rings under its weight
   auto run = [&](bool reuse, DynamicResult* result) {
     DynamicState s = InitialDynamicState(model, InitialState(model), Eigen::VectorXd::Zero(DofMap(model).n_dofs()));
@@ -152,16 +153,11 @@ TEST(FlexibleDynamics, ModalDampingDecaysTheRingingAtTheGivenRatio) {
   // first one, set ringing, decays with the modal damping ratio zeta: the amplitude falls by
   // exp(-2 pi zeta / sqrt(1 - zeta^2)) per period (logarithmic decrement).
   const Superelement se = Tube(4);
-  SystemModel model;
-  AddNode(model, "A", Eigen::Vector3d::Zero());
-  AddNode(model, "B", Eigen::Vector3d(1, 0, 0));
-  Clamp(model, 0);
-  Clamp(model, 1);
   const double zeta = 0.02;
   SuperelementOptions options;
   options.modal_damping = zeta;
-  model.bodies.emplace_back(se, options);
-  model.body_nodes.push_back({0, 1});
+  SystemModel model = ClampedTube(se, options);
+  Clamp(model, 1);
   const DofMap dofs(model);
   Eigen::VectorXd W = Eigen::VectorXd::Zero(dofs.n_dofs());
   W[dofs.mode_dof(0)] = 1.0;  // first internal mode set ringing
