@@ -1,6 +1,9 @@
 #include "reducer/fe/solid_element.h"
 
 #include <Eigen/Dense>
+#include <algorithm>
+#include <array>
+#include <cmath>
 #include <cstdio>
 
 #include "formats/input_error.h"
@@ -131,15 +134,28 @@ void SolidQuadrature(SolidType type, std::vector<Eigen::Vector3d>* points, std::
         }
     return;
   }
-  // Collapsed cube [0,1]^3 -> tetrahedron: (a, b(1-a), c(1-a)(1-b)), Jacobian (1-a)^2 (1-b).
-  GaussLegendre(4, &x, &w);
-  for (size_t i = 0; i < x.size(); ++i)
-    for (size_t j = 0; j < x.size(); ++j)
-      for (size_t k = 0; k < x.size(); ++k) {
-        const double a = 0.5 * (x[i] + 1), b = 0.5 * (x[j] + 1), c = 0.5 * (x[k] + 1);
-        points->emplace_back(a, b * (1 - a), c * (1 - a) * (1 - b));
-        weights->push_back(w[i] * w[j] * w[k] / 8 * (1 - a) * (1 - a) * (1 - b));
-      }
+  // Symmetric tetrahedron rules in barycentric coordinates (weights sum to the volume 1/6).
+  // Each orbit: a barycentric point and all its distinct permutations.
+  auto orbit = [&](const std::array<double, 4>& l, double weight) {
+    std::array<double, 4> p = l;
+    std::sort(p.begin(), p.end());
+    do {
+      points->emplace_back(p[1], p[2], p[3]);
+      weights->push_back(weight / 6);
+    } while (std::next_permutation(p.begin(), p.end()));
+  };
+  if (type == SolidType::kTet4) {
+    // 4 points, degree 2: exact for the consistent mass of linear shape functions.
+    const double a = (5 - std::sqrt(5.0)) / 20;
+    orbit({a, a, a, 1 - 3 * a}, 0.25);
+    return;
+  }
+  // 14 points, degree 5, positive weights (Walkington; Jaskowiec & Sukumar): exact for the
+  // quadratic-shape-function mass (degree 4) and the stiffness of straight-sided TET10.
+  const double a1 = 0.31088591926330060980, a2 = 0.092735250310891226402, b = 0.045503704125649649492;
+  orbit({a1, a1, a1, 1 - 3 * a1}, 0.11268792571801585080);
+  orbit({a2, a2, a2, 1 - 3 * a2}, 0.073493043116361949544);
+  orbit({b, b, 0.5 - b, 0.5 - b}, 0.042546020777081466438);
 }
 
 Eigen::Matrix<double, 6, 6> IsotropicElasticity(double E, double nu) {

@@ -7,6 +7,7 @@
 
 #include <Eigen/Dense>
 #include <random>
+#include <tuple>
 
 #include "test_util.h"
 
@@ -48,19 +49,24 @@ Eigen::MatrixXd Distorted(SolidType type, bool perturb) {
 
 const MaterialSpec kSteel{2.1e11, 0.3, 7850};
 
-TEST(SolidElement, TetrahedronQuadratureIsExactToDegreeFive) {
+TEST(SolidElement, TetrahedronQuadratureIsExactToItsDegree) {
+  // TET10: 14 points, degree 5; TET4: 4 points, degree 2 (exact monomial integrals over the
+  // reference tetrahedron: a! b! c! / (a + b + c + 3)!).
+  for (const auto& [type, degree, count] : {std::tuple{SolidType::kTet10, 5, 14}, std::tuple{SolidType::kTet4, 2, 4}}) {
   std::vector<Eigen::Vector3d> p;
   std::vector<double> w;
-  SolidQuadrature(SolidType::kTet10, &p, &w);
+  SolidQuadrature(type, &p, &w);
+  EXPECT_EQ(int(p.size()), count);
   auto factorial = [](int k) { double f = 1; for (int i = 2; i <= k; ++i) f *= i; return f; };
-  for (int a = 0; a <= 5; ++a)
-    for (int b = 0; a + b <= 5; ++b)
-      for (int c = 0; a + b + c <= 5; ++c) {
+  for (int a = 0; a <= degree; ++a)
+    for (int b = 0; a + b <= degree; ++b)
+      for (int c = 0; a + b + c <= degree; ++c) {
         double sum = 0;
         for (size_t q = 0; q < p.size(); ++q) sum += w[q] * std::pow(p[q].x(), a) * std::pow(p[q].y(), b) * std::pow(p[q].z(), c);
         const double exact = factorial(a) * factorial(b) * factorial(c) / factorial(a + b + c + 3);
-        EXPECT_NEAR(sum, exact, 1e-14) << a << b << c;
+        EXPECT_NEAR(sum, exact, 1e-14) << SolidTypeName(type) << " " << a << b << c;
       }
+  }
 }
 
 TEST(SolidElement, ShapeFunctionsInterpolateAndSumToOne) {
