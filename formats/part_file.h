@@ -73,6 +73,7 @@ struct ReductionSpec {
   std::string floating_frame = "center_of_mass";
   bool keep_mesh = true;  ///< store the mesh and mode shapes (visualization group)
   int full_modes = 0;     ///< K lowest nonzero free-free frequencies of the full model
+  double memory_limit_gb = 0;  ///< refuse when the Cholesky factor would exceed it (0: MemAvailable)
   std::string where_floating_frame;
 };
 

@@ -10,13 +10,15 @@
 #include "formats/input_error.h"
 #include "formats/part_file.h"
 #include "formats/superelement_file.h"
+#include "reducer/linalg/sparse_cholesky.h"
 #include "reducer/reduce_part.h"
 
 namespace {
 
 constexpr const char* kUsage = R"(usage: femb-reduce PART.yaml [-o OUT.h5] [--full-modes K] [--set key=value]... [--quiet]
 
-Reduces a part (beam polyline; see formats/PART_FORMAT.md) to a Craig-Bampton superelement file
+Reduces a part (beam polyline or solid: gmsh geometry, built-in shape or mesh file; see
+formats/PART_FORMAT.md) to a Craig-Bampton superelement file
 (HDF5; see formats/SUPERELEMENT_FORMAT.md).
 
 options:
@@ -30,7 +32,8 @@ options:
   -q, --quiet           no progress lines
   -h, --help            this text
 
-exit codes: 0 success, 2 bad input (one line names the file, line and key), 3 numerical failure.
+exit codes: 0 success, 2 bad input (one line names the file, line and key), 3 numerical failure,
+  4 refused: the Cholesky factor would not fit in memory (the line says how much it needs).
 )";
 
 }  // namespace
@@ -57,6 +60,11 @@ int main(int argc, char** argv) {
       std::fflush(stdout);
     };
     femb::ReduceResult result = femb::ReducePart(part, progress);
+    if (!result.ok && result.too_big) {
+      std::fprintf(stderr, "femb-reduce: %s: refused: %s (no output written)\n", part_path.c_str(),
+                   result.message.c_str());
+      return 4;
+    }
     if (!result.ok) {
       std::fprintf(stderr, "femb-reduce: %s: numerical failure: %s (no output written)\n",
                    part_path.c_str(), result.message.c_str());
@@ -66,9 +74,9 @@ int main(int argc, char** argv) {
     femb::WriteSuperelementFile(result.superelement, output);
     progress("write", write_clock.Seconds(), output);
     if (!quiet) {
-      std::printf("femb-reduce: wrote %s (%d reduced DOFs from %ld) in %.3f s\n", output.c_str(),
-                  result.superelement.n_reduced_dofs(), result.superelement.n_full_dofs,
-                  total.Seconds());
+      std::printf("femb-reduce: wrote %s (%d reduced DOFs from %ld) in %.3f s, peak memory %.3g GB\n",
+                  output.c_str(), result.superelement.n_reduced_dofs(), result.superelement.n_full_dofs,
+                  total.Seconds(), femb::PeakResidentBytes() / 1e9);
     }
     return 0;
   } catch (const femb::InputError& e) {

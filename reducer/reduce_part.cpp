@@ -1,10 +1,12 @@
 #include "reducer/reduce_part.h"
 
+#include <algorithm>
 #include <cstdio>
 
 #include "formats/input_error.h"
 #include "reducer/fe/beam_model.h"
 #include "reducer/fe/solid_model.h"
+#include "reducer/linalg/sparse_cholesky.h"
 #include "reducer/reduction/craig_bampton.h"
 #include "reducer/reduction/floating_frame.h"
 #include "reducer/reduction/full_modes.h"
@@ -24,11 +26,16 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
   };
 
   Stopwatch clock;
-  const FeModel model = part.type == "solid" ? BuildSolidModel(part) : BuildBeamModel(part);
   char detail[200];
-  std::snprintf(detail, sizeof detail, "%ld nodes, %ld %s elements, %ld DOFs", model.n_nodes(),
-                model.n_elements(), model.element_type.c_str(), model.n_dofs());
-  report("mesh+assembly", clock.Seconds(), detail);
+  FeModel model;
+  if (part.type == "solid") {
+    model = BuildSolidModel(part, report);
+  } else {
+    model = BuildBeamModel(part);
+    std::snprintf(detail, sizeof detail, "%ld nodes, %ld %s elements, %ld DOFs", model.n_nodes(),
+                  model.n_elements(), model.element_type.c_str(), model.n_dofs());
+    report("mesh+assembly", clock.Seconds(), detail);
+  }
 
   const long n_interior = long(InteriorDofs(model).size());
   if (part.reduction.internal_modes > n_interior) {
@@ -36,9 +43,25 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
                      std::to_string(part.reduction.internal_modes) + " exceeds the " +
                      std::to_string(n_interior) + " interior DOFs of the mesh (refine it or keep fewer modes)");
   }
-  const CraigBamptonResult cb = CraigBamptonReduce(model, part.reduction.internal_modes, report);
+  // Memory for the factor of K_ii: what is left beside the dense blocks the reduction keeps
+  // (constraint modes, Lanczos vectors, the mode shapes of the full model).
+  const int n_b = 6 * int(model.interface_names.size()), m = part.reduction.internal_modes;
+  const double dense_bytes = 8.0 * double(model.n_dofs()) * (2.0 * (n_b + m) + 2.0 * m + 20.0);
+  const double limit = part.reduction.memory_limit_gb > 0 ? part.reduction.memory_limit_gb * 1e9
+                                                          : AvailableMemoryBytes();
+  const double factor_budget = limit > 0 ? std::max(limit - dense_bytes, 0.1 * limit) : 0.0;
+  const CraigBamptonResult cb = CraigBamptonReduce(model, part.reduction.internal_modes, report, 200, factor_budget);
   if (!cb.ok) {
+    result.too_big = cb.factorization.too_big;
     result.message = cb.message;
+    if (result.too_big) {
+      char why[160];
+      std::snprintf(why, sizeof why, " (%s; %.3g GB kept for the dense blocks of the reduction)",
+                    part.reduction.memory_limit_gb > 0 ? "reduction.memory_limit_gb" : "MemAvailable", dense_bytes / 1e9);
+      result.message += std::string(why) +
+                        ": coarsen the mesh (mesh.size), use first-order elements (mesh.order: 1), or run on a "
+                        "machine with more memory";
+    }
     return result;
   }
 

@@ -12,6 +12,7 @@ namespace femb {
 struct ReduceResult {
   bool ok = false;
   std::string message;  ///< numerical failure, when !ok
+  bool too_big = false;  ///< refused: the factor would not fit in memory (message says how much)
   Superelement superelement;
 };
 

@@ -1,6 +1,7 @@
 #include "reducer/fe/solid_model.h"
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <memory>
 
 #include "formats/input_error.h"
@@ -45,7 +46,80 @@ bool Locate(const SolidMesh& mesh, int e, const Eigen::Vector3d& x, Eigen::Vecto
 
 }  // namespace
 
-FeModel BuildSolidModel(const PartSpec& part) {
+void AssembleSolid(const SolidMesh& mesh, const MaterialSpec& material, SparseMatrix* K, SparseMatrix* M) {
+  const int n_nodes = int(mesh.nodes.rows()), per = SolidNodeCount(mesh.type);
+  const long n_cells = mesh.cells.rows();
+  // Node graph in CSR form: neighbours (including the node itself) sorted ascending.
+  std::vector<std::vector<int>> cells_of(n_nodes);
+  for (long e = 0; e < n_cells; ++e)
+    for (int a = 0; a < per; ++a) cells_of[mesh.cells(e, a)].push_back(int(e));
+  std::vector<long> start(n_nodes + 1, 0);
+  std::vector<int> adjacent;
+  std::vector<int> scratch;
+  for (int s = 0; s < n_nodes; ++s) {
+    scratch.clear();
+    for (int e : cells_of[s])
+      for (int a = 0; a < per; ++a) scratch.push_back(mesh.cells(e, a));
+    std::sort(scratch.begin(), scratch.end());
+    scratch.erase(std::unique(scratch.begin(), scratch.end()), scratch.end());
+    adjacent.insert(adjacent.end(), scratch.begin(), scratch.end());
+    start[s + 1] = long(adjacent.size());
+  }
+  cells_of = {};
+  // Column 3s+d of K holds rows 3t+e for every neighbour t, e = 0..2; of M rows 3t+d.
+  const long n = 3L * n_nodes, nnz_node = start[n_nodes];
+  auto shape = [&](SparseMatrix* A, int block) {
+    *A = SparseMatrix(n, n);
+    A->resizeNonZeros(3 * block * nnz_node);
+    int* outer = A->outerIndexPtr();
+    int* inner = A->innerIndexPtr();
+    long p = 0;
+    for (int s = 0; s < n_nodes; ++s)
+      for (int d = 0; d < 3; ++d) {
+        outer[3 * s + d] = int(p);
+        for (long k = start[s]; k < start[s + 1]; ++k) {
+          if (block == 3) {
+            for (int e = 0; e < 3; ++e) inner[p++] = 3 * adjacent[k] + e;
+          } else {
+            inner[p++] = 3 * adjacent[k] + d;
+          }
+        }
+      }
+    outer[n] = int(p);
+    std::fill(A->valuePtr(), A->valuePtr() + p, 0.0);
+  };
+  if (3.0 * 3.0 * double(nnz_node) > 2e9) throw InputError("mesh too large: more than 2^31 stiffness entries");
+  shape(K, 3);
+  shape(M, 1);
+  double* kv = K->valuePtr();
+  double* mv = M->valuePtr();
+  Eigen::MatrixXd X(per, 3);
+  std::vector<long> offset(per * per);  // position of node b in the neighbour list of node a
+  for (long e = 0; e < n_cells; ++e) {
+    for (int a = 0; a < per; ++a) X.row(a) = mesh.nodes.row(mesh.cells(e, a));
+    const SolidElementMatrices em = ComputeSolidElement(mesh.type, X, material, e);
+    for (int a = 0; a < per; ++a) {
+      const int s = mesh.cells(e, a);
+      const int* first = adjacent.data() + start[s];
+      const int* last = adjacent.data() + start[s + 1];
+      for (int b = 0; b < per; ++b) offset[a * per + b] = std::lower_bound(first, last, mesh.cells(e, b)) - first;
+    }
+    for (int a = 0; a < per; ++a) {  // column node
+      const int s = mesh.cells(e, a);
+      for (int d = 0; d < 3; ++d) {
+        const long k_col = K->outerIndexPtr()[3 * s + d], m_col = M->outerIndexPtr()[3 * s + d];
+        for (int b = 0; b < per; ++b) {  // row node
+          const long k = offset[a * per + b];
+          for (int c = 0; c < 3; ++c) kv[k_col + 3 * k + c] += em.K(3 * b + c, 3 * a + d);
+          mv[m_col + k] += em.M(3 * b + d, 3 * a + d);
+        }
+      }
+    }
+  }
+}
+
+FeModel BuildSolidModel(const PartSpec& part, const ProgressFn& progress) {
+  Stopwatch clock;
   MeshRequest request;
   request.shape = part.solid.shape;
   request.size = part.solid.size;
@@ -57,26 +131,22 @@ FeModel BuildSolidModel(const PartSpec& part) {
   auto mesh = std::make_shared<SolidMesh>(request.file.empty() || IsGmshFile(request.file)
                                                ? MeshWithGmsh(request)
                                                : ImportWithMeshio(request.file, part.solid.where));
-  const int n_nodes = int(mesh->nodes.rows()), per = SolidNodeCount(mesh->type);
+  const int n_nodes = int(mesh->nodes.rows());
+  if (progress) {
+    progress("mesh", clock.Seconds(),
+             std::to_string(n_nodes) + " nodes, " + std::to_string(mesh->cells.rows()) + " " +
+                 SolidTypeName(mesh->type) + " elements" + (request.file.empty() ? "" : " from " + request.file));
+  }
 
   // Element matrices on the mesh DOFs.
-  std::vector<Eigen::Triplet<double>> k_entries, m_entries;
-  Eigen::MatrixXd X(per, 3);
-  for (int e = 0; e < mesh->cells.rows(); ++e) {
-    for (int a = 0; a < per; ++a) X.row(a) = mesh->nodes.row(mesh->cells(e, a));
-    const SolidElementMatrices em = ComputeSolidElement(mesh->type, X, part.material, e);
-    for (int a = 0; a < per; ++a)
-      for (int b = 0; b < per; ++b)
-        for (int i = 0; i < 3; ++i)
-          for (int j = 0; j < 3; ++j) {
-            const int r = 3 * mesh->cells(e, a) + i, c = 3 * mesh->cells(e, b) + j;
-            k_entries.emplace_back(r, c, em.K(3 * a + i, 3 * b + j));
-            if (i == j) m_entries.emplace_back(r, c, em.M(3 * a + i, 3 * b + j));
-          }
+  clock.Restart();
+  SparseMatrix K_mesh, M_mesh;
+  AssembleSolid(*mesh, part.material, &K_mesh, &M_mesh);
+  if (progress) {
+    progress("assembly", clock.Seconds(),
+             std::to_string(3L * n_nodes) + " mesh DOFs, " + std::to_string(K_mesh.nonZeros()) + " stiffness entries");
   }
-  SparseMatrix K_mesh(3 * n_nodes, 3 * n_nodes), M_mesh(3 * n_nodes, 3 * n_nodes);
-  K_mesh.setFromTriplets(k_entries.begin(), k_entries.end());
-  M_mesh.setFromTriplets(m_entries.begin(), m_entries.end());
+  clock.Restart();
 
   // Interface couplings (RBE2).
   std::vector<int> owner(n_nodes, -1);
@@ -205,10 +275,21 @@ FeModel BuildSolidModel(const PartSpec& part) {
   }
   SparseMatrix T(3 * n_nodes, n_model);
   T.setFromTriplets(t_entries.begin(), t_entries.end());
-  model.K = SparseMatrix(T.transpose() * K_mesh * T);
-  model.M = SparseMatrix(T.transpose() * M_mesh * T);
-  model.K = 0.5 * (model.K + SparseMatrix(model.K.transpose()));
-  model.M = 0.5 * (model.M + SparseMatrix(model.M.transpose()));
+  // T^T A T as two column-major products (an explicit T^T avoids Eigen's row-major temporaries),
+  // then symmetrized so that round-off leaves no asymmetry.
+  const SparseMatrix Tt = T.transpose();
+  auto congruence = [&](SparseMatrix& A) {
+    SparseMatrix AT = A * T;
+    A = SparseMatrix();
+    SparseMatrix B = Tt * AT;
+    AT = SparseMatrix();
+    const SparseMatrix Bt = B.transpose();
+    B += Bt;
+    B *= 0.5;
+    return B;
+  };
+  model.K = congruence(K_mesh);
+  model.M = congruence(M_mesh);
   for (size_t k = 0; k < part.interfaces.size(); ++k) {
     std::vector<FullDof> dofs;
     for (int d = 0; d < 6; ++d) dofs.push_back({n_kept + 6 * int(k) + d});
@@ -220,6 +301,10 @@ FeModel BuildSolidModel(const PartSpec& part) {
   model.cells = mesh->cells;
   model.cell_type = SolidTypeName(mesh->type);
   model.element_type = SolidTypeName(mesh->type);
+  if (progress) {
+    progress("couplings", clock.Seconds(),
+             std::to_string(part.interfaces.size()) + " interfaces, " + std::to_string(model.n_dofs()) + " model DOFs, " + std::to_string(model.K.nonZeros()) + " stiffness entries");
+  }
 
   // Material point interpolation: displacement and small rotation (curl / 2) at x.
   model.interpolate_at = [mesh, T](const Eigen::Vector3d& x) -> std::optional<SparseMatrix> {

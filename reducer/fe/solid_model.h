@@ -8,11 +8,19 @@
 
 #include "formats/part_file.h"
 #include "reducer/fe/fe_model.h"
+#include "reducer/mesh/gmsh_mesher.h"
+#include "reducer/progress.h"
 
 namespace femb {
 
 /// Throws InputError for a missing or empty node set, node sets that overlap, or an inverted
 /// element (named).
-FeModel BuildSolidModel(const PartSpec& part);
+/// Reports the stages mesh, assembly and couplings through `progress` (may be null).
+FeModel BuildSolidModel(const PartSpec& part, const ProgressFn& progress = nullptr);
+
+/// Symmetric K and M of the mesh DOFs (3 per node) assembled into a sparsity pattern computed
+/// once from the node graph: K with full 3 x 3 node blocks, M with their diagonals only
+/// (consistent mass couples like components). No triplet lists: memory is the matrices.
+void AssembleSolid(const SolidMesh& mesh, const MaterialSpec& material, SparseMatrix* K, SparseMatrix* M);
 
 }  // namespace femb

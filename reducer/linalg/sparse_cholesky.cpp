@@ -1,6 +1,11 @@
 #include "reducer/linalg/sparse_cholesky.h"
 
+#include <sys/resource.h>
+
 #include <Eigen/CholmodSupport>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
 
 namespace femb {
 namespace {
@@ -37,14 +42,33 @@ SparseCholesky::SparseCholesky() : impl_(std::make_unique<Impl>()) {
 
 SparseCholesky::~SparseCholesky() = default;
 
-FactorizationInfo SparseCholesky::Compute(const SparseMatrix& A) {
+double AvailableMemoryBytes() {
+  std::ifstream in("/proc/meminfo");
+  std::string line;
+  while (std::getline(in, line)) {
+    std::istringstream fields(line);
+    std::string key;
+    double kib = 0;
+    if (fields >> key >> kib && key == "MemAvailable:") return kib * 1024.0;
+  }
+  return 0.0;
+}
+
+double PeakResidentBytes() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return double(usage.ru_maxrss) * 1024.0;  // Linux: kilobytes
+}
+
+FactorizationInfo SparseCholesky::Compute(const SparseMatrix& A, double memory_limit_bytes) {
   FactorizationInfo info;
   rows_ = A.rows();
   if (A.rows() == 0) {
     info.ok = true;
     return info;
   }
-  impl_->solver.compute(A);
+  // Symbolic analysis: ordering and supernodes fix the size of L and the flop count.
+  impl_->solver.analyzePattern(A);
   const cholmod_common& c = impl_->solver.cholmod();
   const cholmod_factor* L = impl_->solver.factor();
   info.flops = c.fl;
@@ -53,6 +77,16 @@ FactorizationInfo SparseCholesky::Compute(const SparseMatrix& A) {
     info.factor_entries = L->is_super ? double(L->xsize) : double(c.lnz);
     info.factor_bytes = 8.0 * info.factor_entries;
   }
+  if (memory_limit_bytes > 0 && info.factor_bytes > memory_limit_bytes) {
+    char buffer[200];
+    std::snprintf(buffer, sizeof buffer, "the Cholesky factor would need %.3g GB, more than the %.3g GB available",
+                  info.factor_bytes / 1e9, memory_limit_bytes / 1e9);
+    info.ok = false;
+    info.too_big = true;
+    info.message = buffer;
+    return info;
+  }
+  impl_->solver.factorize(A);
   if (impl_->solver.info() != Eigen::Success || c.status == CHOLMOD_NOT_POSDEF) {
     info.ok = false;
     info.message = "matrix is not positive definite (CHOLMOD stopped at column " +

@@ -19,7 +19,13 @@ struct FactorizationInfo {
   double factor_bytes = 0;    ///< memory of L
   double flops = 0;           ///< floating-point operations of the numeric factorization
   std::string ordering;       ///< ordering CHOLMOD used ("metis", "amd", ...)
+  bool too_big = false;       ///< refused before the numeric factorization: L would exceed the memory limit
 };
+
+/// MemAvailable of /proc/meminfo in bytes (0 when unknown).
+double AvailableMemoryBytes();
+/// Peak resident memory of this process so far, bytes.
+double PeakResidentBytes();
 
 class SparseCholesky {
  public:
@@ -28,8 +34,10 @@ class SparseCholesky {
   SparseCholesky(const SparseCholesky&) = delete;
   SparseCholesky& operator=(const SparseCholesky&) = delete;
 
-  /// Factorizes the symmetric positive definite A (lower triangle is read).
-  FactorizationInfo Compute(const SparseMatrix& A);
+  /// Factorizes the symmetric positive definite A (lower triangle is read). The symbolic
+  /// analysis (ordering, supernodes) comes first and gives the size of L; when
+  /// `memory_limit_bytes` > 0 and L would be larger, nothing more is done (info.too_big).
+  FactorizationInfo Compute(const SparseMatrix& A, double memory_limit_bytes = 0);
   /// X = A^-1 B. Precondition: Compute() succeeded.
   Eigen::MatrixXd Solve(const Eigen::MatrixXd& B) const;
   void Solve(const double* b, double* x) const;

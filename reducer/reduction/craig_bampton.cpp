@@ -21,25 +21,38 @@ struct Blocks {
 
 Blocks Partition(const SparseMatrix& A, const std::vector<int>& interior_index,
                  const std::vector<int>& boundary_index, int n_i, int n_b) {
-  std::vector<Eigen::Triplet<double>> ii, ib;
+  // Interior and boundary indices keep the order of A, so each block fills column by column
+  // with rows ascending: built in place, no triplet list (A may hold 1e8 entries).
   Blocks out;
   out.bb = Eigen::MatrixXd::Zero(n_b, n_b);
+  out.ii.resize(n_i, n_i);
+  out.ib.resize(n_i, n_b);
+  out.ii.reserve(A.nonZeros());
+  std::vector<std::vector<std::pair<int, double>>> ib_cols(n_b);
   for (int col = 0; col < A.outerSize(); ++col) {
+    const int ci = interior_index[col], cb = boundary_index[col];
+    if (ci >= 0) out.ii.startVec(ci);
     for (SparseMatrix::InnerIterator it(A, col); it; ++it) {
-      const int r = int(it.row());
-      if (interior_index[r] >= 0 && interior_index[col] >= 0) {
-        ii.emplace_back(interior_index[r], interior_index[col], it.value());
-      } else if (interior_index[r] >= 0 && boundary_index[col] >= 0) {
-        ib.emplace_back(interior_index[r], boundary_index[col], it.value());
-      } else if (boundary_index[r] >= 0 && boundary_index[col] >= 0) {
-        out.bb(boundary_index[r], boundary_index[col]) += it.value();
+      const int ri = interior_index[it.row()], rb = boundary_index[it.row()];
+      if (ri >= 0 && ci >= 0) {
+        out.ii.insertBack(ri, ci) = it.value();
+      } else if (ri >= 0 && cb >= 0) {
+        ib_cols[cb].emplace_back(ri, it.value());
+      } else if (rb >= 0 && cb >= 0) {
+        out.bb(rb, cb) += it.value();
       }
     }
   }
-  out.ii.resize(n_i, n_i);
-  out.ib.resize(n_i, n_b);
-  out.ii.setFromTriplets(ii.begin(), ii.end());
-  out.ib.setFromTriplets(ib.begin(), ib.end());
+  out.ii.finalize();
+  out.ii.makeCompressed();
+  std::size_t n_ib = 0;
+  for (const auto& c : ib_cols) n_ib += c.size();
+  out.ib.reserve(long(n_ib));
+  for (int c = 0; c < n_b; ++c) {
+    out.ib.startVec(c);
+    for (const auto& [r, v] : ib_cols[c]) out.ib.insertBack(r, c) = v;
+  }
+  out.ib.finalize();
   return out;
 }
 
@@ -58,7 +71,7 @@ std::vector<int> InteriorDofs(const FeModel& model) {
 }
 
 CraigBamptonResult CraigBamptonReduce(const FeModel& model, int internal_modes,
-                                      const ProgressFn& progress, long dense_limit) {
+                                      const ProgressFn& progress, long dense_limit, double memory_limit_bytes) {
   CraigBamptonResult r;
   Stopwatch clock;
   const int n = int(model.n_dofs());
@@ -83,8 +96,12 @@ CraigBamptonResult CraigBamptonReduce(const FeModel& model, int internal_modes,
   // One factorization of K_ii (METIS ordering, supernodal).
   clock.Restart();
   SparseCholesky factor;
-  r.factorization = factor.Compute(K.ii);
+  r.factorization = factor.Compute(K.ii, memory_limit_bytes);
   const double t_factor = clock.Seconds();
+  if (r.factorization.too_big) {
+    r.message = r.factorization.message;
+    return r;
+  }
   if (!r.factorization.ok) {
     r.message = "K_ii (stiffness with all interfaces clamped) is singular: " + r.factorization.message +
                 "; some part of the model is not held by any interface";

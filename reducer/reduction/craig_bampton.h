@@ -28,9 +28,11 @@ struct CraigBamptonResult {
   bool dense_eigen = false;
 };
 
-/// `internal_modes` fixed-interface modes are kept. Reports stages through `progress`.
+/// `internal_modes` fixed-interface modes are kept. Reports stages through `progress`. With
+/// `memory_limit_bytes` > 0, refuses (factorization.too_big) when the factor of K_ii would not fit.
 CraigBamptonResult CraigBamptonReduce(const FeModel& model, int internal_modes,
-                                      const ProgressFn& progress, long dense_limit = 200);
+                                      const ProgressFn& progress, long dense_limit = 200,
+                                      double memory_limit_bytes = 0);
 
 /// The interior DOFs (all DOFs not used by an interface), ascending.
 std::vector<int> InteriorDofs(const FeModel& model);
