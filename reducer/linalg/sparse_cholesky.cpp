@@ -3,6 +3,7 @@
 #include <sys/resource.h>
 
 #include <Eigen/CholmodSupport>
+#include <chrono>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
@@ -68,7 +69,9 @@ FactorizationInfo SparseCholesky::Compute(const SparseMatrix& A, double memory_l
     return info;
   }
   // Symbolic analysis: ordering and supernodes fix the size of L and the flop count.
+  auto t0 = std::chrono::steady_clock::now();
   impl_->solver.analyzePattern(A);
+  info.analyze_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const cholmod_common& c = impl_->solver.cholmod();
   const cholmod_factor* L = impl_->solver.factor();
   info.flops = c.fl;
@@ -86,7 +89,9 @@ FactorizationInfo SparseCholesky::Compute(const SparseMatrix& A, double memory_l
     info.message = buffer;
     return info;
   }
+  t0 = std::chrono::steady_clock::now();
   impl_->solver.factorize(A);
+  info.numeric_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (impl_->solver.info() != Eigen::Success || c.status == CHOLMOD_NOT_POSDEF) {
     info.ok = false;
     info.message = "matrix is not positive definite (CHOLMOD stopped at column " +

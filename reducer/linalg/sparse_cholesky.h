@@ -18,6 +18,8 @@ struct FactorizationInfo {
   double factor_entries = 0;  ///< nonzeros stored in L
   double factor_bytes = 0;    ///< memory of L
   double flops = 0;           ///< floating-point operations of the numeric factorization
+  double analyze_seconds = 0; ///< ordering and symbolic factorization
+  double numeric_seconds = 0; ///< numeric factorization (the flops above)
   std::string ordering;       ///< ordering CHOLMOD used ("metis", "amd", ...)
   bool too_big = false;       ///< refused before the numeric factorization: L would exceed the memory limit
 };

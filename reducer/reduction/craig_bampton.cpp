@@ -111,8 +111,10 @@ CraigBamptonResult CraigBamptonReduce(const FeModel& model, int internal_modes,
     progress("factorize K_ii", t_factor,
              Format("%.0f interior DOFs, factor %.3g MB, %.3g GFLOP, %.2f GFLOP/s", n_i,
                     r.factorization.factor_bytes / 1e6, r.factorization.flops / 1e9,
-                    r.factorization.flops / 1e9 / std::max(t_factor, 1e-9)) +
-                 ", ordering " + r.factorization.ordering);
+                    r.factorization.flops / 1e9 / std::max(r.factorization.numeric_seconds, 1e-9)) +
+                 Format(" (numeric %.3g s; ordering %.3g s, ", r.factorization.numeric_seconds,
+                        r.factorization.analyze_seconds) +
+                 r.factorization.ordering + ")");
   }
 
   // Static constraint modes Psi_c = -K_ii^-1 K_ib.
