@@ -123,6 +123,75 @@ void ParseBeam(const YamlValue& value, PartSpec& part) {
 
 }  // namespace
 
+namespace {
+
+// Plausible ranges per unit system: densities from foams to tungsten, moduli from rubber to
+// 1000 x steel (stand-ins for rigid parts), parts from 1 mm to 50 m. A value outside its system's range but inside another's
+// is the signature of mixed units.
+struct UnitRange {
+  const char* system;
+  double rho_lo, rho_hi, E_lo, E_hi, length_lo, length_hi;
+  const char* rho_unit;
+  const char* E_unit;
+  const char* length_unit;
+};
+constexpr UnitRange kUnitRanges[] = {
+    {"SI", 5.0, 3.0e4, 1.0e6, 1.0e15, 1.0e-3, 50.0, "kg/m^3", "Pa", "m"},
+    {"mm-t-s", 5.0e-12, 3.0e-8, 1.0, 1.0e9, 1.0, 5.0e4, "t/mm^3", "MPa", "mm"},
+    {"mm-kg-ms", 5.0e-9, 3.0e-5, 1.0e-3, 1.0e6, 1.0, 5.0e4, "kg/mm^3", "GPa", "mm"},
+};
+
+const UnitRange& RangeOf(const std::string& system) {
+  for (const UnitRange& r : kUnitRanges)
+    if (system == r.system) return r;
+  return kUnitRanges[0];
+}
+
+// "it looks like mm-t-s" for the systems whose range holds `value` (member selects the range).
+std::string LooksLike(double value, double UnitRange::*lo, double UnitRange::*hi, const std::string& declared) {
+  std::string systems;
+  for (const UnitRange& r : kUnitRanges) {
+    if (declared != r.system && value >= r.*lo && value <= r.*hi) systems += (systems.empty() ? "" : " or ") + std::string(r.system);
+  }
+  return systems.empty() ? "" : "; it looks like " + systems + " (mixed units?)";
+}
+
+std::string Implausible(const char* what, double value, const std::string& system, const char* unit, double lo,
+                        double hi, const std::string& looks_like) {
+  char buffer[300];
+  std::snprintf(buffer, sizeof buffer, "%s = %.4g is implausible for units %s (%s, expected %.3g .. %.3g)%s; fix the "
+                "value or 'units', or set check_units: false", what, value, system.c_str(), unit, lo, hi,
+                looks_like.c_str());
+  return buffer;
+}
+
+void CheckMaterialUnits(const PartSpec& part, const YamlValue& material) {
+  const UnitRange& r = RangeOf(part.units.system);
+  YamlMap m = material.Map();
+  const double rho = part.material.rho, E = part.material.E;
+  if (rho < r.rho_lo || rho > r.rho_hi) {
+    m.Required("rho").Fail(Implausible("rho", rho, part.units.system, r.rho_unit, r.rho_lo, r.rho_hi,
+                                       LooksLike(rho, &UnitRange::rho_lo, &UnitRange::rho_hi, part.units.system)));
+  }
+  if (E < r.E_lo || E > r.E_hi) {
+    m.Required("E").Fail(Implausible("E", E, part.units.system, r.E_unit, r.E_lo, r.E_hi,
+                                     LooksLike(E, &UnitRange::E_lo, &UnitRange::E_hi, part.units.system)));
+  }
+}
+
+}  // namespace
+
+void CheckPartSize(const PartSpec& part, double diagonal, const std::string& where) {
+  if (!part.check_units) return;
+  const UnitRange& r = RangeOf(part.units.system);
+  if (diagonal < r.length_lo || diagonal > r.length_hi) {
+    throw InputError(where + ": " + Implausible("part size (bounding-box diagonal)", diagonal, part.units.system,
+                                                r.length_unit, r.length_lo, r.length_hi,
+                                                LooksLike(diagonal, &UnitRange::length_lo, &UnitRange::length_hi,
+                                                          part.units.system)));
+  }
+}
+
 Units UnitSystem(const std::string& name, const std::string& where) {
   Units u;
   u.system = name;
@@ -155,10 +224,19 @@ PartSpec ParsePart(const std::string& text, const std::string& name,
   part.type = type.String();
   if (part.type != "beam" && part.type != "solid") type.Fail("unknown part type '" + part.type + "' (known: beam, solid)");
   if (auto u = root.Optional("units")) part.units = UnitSystem(u->String(), u->Where());
+  if (auto v = root.Optional("check_units")) part.check_units = v->Bool();
   part.material = ParseMaterial(root.Required("material"));
+  if (part.check_units) CheckMaterialUnits(part, root.Required("material"));
   if (part.type == "beam") {
     part.beam.section = ParseSection(root.Required("section"));
     ParseBeam(root.Required("beam"), part);
+    Eigen::Vector3d lo = part.beam.points[0], hi = lo;
+    for (const auto& p : part.beam.points) {
+      lo = lo.cwiseMin(p);
+      hi = hi.cwiseMax(p);
+    }
+    YamlValue beam = root.Required("beam");
+    CheckPartSize(part, (hi - lo).norm(), beam.Where() + ".points");
   } else {
     YamlValue geometry = root.Required("geometry");
     YamlMap g = geometry.Map();
@@ -169,6 +247,7 @@ PartSpec ParsePart(const std::string& text, const std::string& name,
       YamlValue size = g.Required("size");
       part.solid.size = size.Vector3();
       if (!(part.solid.size.minCoeff() > 0)) size.Fail("box edge lengths must be positive");
+      CheckPartSize(part, part.solid.size.norm(), size.Where());
     } else {
       YamlValue file = g.Required("file");
       std::filesystem::path f(file.String());

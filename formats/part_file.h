@@ -88,7 +88,13 @@ struct PartSpec {
   SolidSpec solid;
   std::vector<InterfaceSpec> interfaces;
   ReductionSpec reduction;
+  bool check_units = true;  ///< flag implausible (mixed-unit) density, modulus and part size
 };
+
+/// Mixed-unit check of a part's overall size (bounding-box diagonal) against its unit system:
+/// throws InputError "`where`: ... looks like <other system>" when implausible (a part of
+/// 1 .. 50000 mm). No-op when part.check_units is false.
+void CheckPartSize(const PartSpec& part, double diagonal, const std::string& where);
 
 /// Reads and checks a part file; `overrides` are "key.path=value" strings applied first.
 /// Throws InputError naming FILE:LINE and the key for any problem.

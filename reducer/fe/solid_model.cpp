@@ -132,6 +132,10 @@ FeModel BuildSolidModel(const PartSpec& part, const ProgressFn& progress) {
                                                ? MeshWithGmsh(request)
                                                : ImportWithMeshio(request.file, part.solid.where));
   const int n_nodes = int(mesh->nodes.rows());
+  if (n_nodes > 0) {
+    const Eigen::Vector3d lo = mesh->nodes.colwise().minCoeff(), hi = mesh->nodes.colwise().maxCoeff();
+    CheckPartSize(part, (hi - lo).norm(), part.solid.where + " (" + (request.file.empty() ? part.solid.shape : request.file) + ")");
+  }
   if (progress) {
     progress("mesh", clock.Seconds(),
              std::to_string(n_nodes) + " nodes, " + std::to_string(mesh->cells.rows()) + " " +

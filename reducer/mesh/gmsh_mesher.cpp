@@ -147,6 +147,10 @@ SolidMesh MeshWithGmsh(const MeshRequest& r) {
     throw;
   } catch (const std::exception& e) {
     throw InputError((r.file.empty() ? r.where : r.file) + ": gmsh failed: " + e.what());
+  } catch (const std::string& e) {  // the gmsh API throws its last error message as a string
+    throw InputError((r.file.empty() ? r.where : r.file) + ": gmsh failed: " + e);
+  } catch (...) {
+    throw InputError((r.file.empty() ? r.where : r.file) + ": gmsh failed (unknown error)");
   }
   return mesh;
 }

@@ -23,7 +23,9 @@ bool IsGmshFile(const std::string& path) {
 }
 
 SolidMesh ImportWithMeshio(const std::string& path, const std::string& where) {
-  const std::string python = "/usr/bin/python3";
+  // Debian's python3 sees python3-meshio; FEMB_PYTHON names another interpreter that has meshio.
+  const char* env = std::getenv("FEMB_PYTHON");
+  const std::string python = env && *env ? env : "/usr/bin/python3";
   if (!std::filesystem::exists(python)) {
     throw InputError(where + ": reading " + path + " needs Debian's python3 and meshio: apt-get install python3-meshio");
   }

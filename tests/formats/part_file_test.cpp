@@ -49,7 +49,8 @@ TEST(PartFile, GoodFileParses) {
 
 TEST(PartFile, SetOverridesKeys) {
   const PartSpec p = ParsePart(kGood, "part.yaml",
-                               {"reduction.internal_modes=7", "reduction.floating_frame=mean_axes", "units=mm-t-s"});
+                               {"reduction.internal_modes=7", "reduction.floating_frame=mean_axes", "units=mm-t-s",
+                                "check_units=false"});
   EXPECT_EQ(p.reduction.internal_modes, 7);
   EXPECT_EQ(p.reduction.floating_frame, "mean_axes");
   EXPECT_EQ(p.units.length, "mm");
@@ -104,12 +105,30 @@ TEST(PartFile, BadOverridesAreNamed) {
   EXPECT_NE(Error(kGood, {"novalue"}).find("expected key.path=value"), std::string::npos);
 }
 
+// Mixed units: a value plausible only in another unit system names that system; check_units:
+// false lets a deliberate outlier through.
+TEST(PartFile, MixedUnitsAreFlagged) {
+  const std::string rho = Error(Replace(kGood, "rho: 7870", "rho: 7.87e-9"));
+  EXPECT_NE(rho.find("part.yaml:3: material.rho: rho = 7.87e-09 is implausible for units SI (kg/m^3"), std::string::npos) << rho;
+  EXPECT_NE(rho.find("it looks like mm-t-s or mm-kg-ms (mixed units?)"), std::string::npos) << rho;
+  const std::string E = Error(Replace(kGood, "E: 2.0e11", "E: 2.0e5"));
+  EXPECT_NE(E.find("material.E: E = 2e+05 is implausible for units SI (Pa"), std::string::npos) << E;
+  EXPECT_NE(E.find("it looks like mm-t-s"), std::string::npos) << E;
+  const std::string size = Error(Replace(kGood, "B: [0.3, 0, 0]", "B: [300, 0, 0]"));
+  EXPECT_NE(size.find("beam.points: part size (bounding-box diagonal) = 300 is implausible for units SI (m"), std::string::npos)
+      << size;
+  const std::string mm = Error(kGood, {"units=mm-t-s"});
+  EXPECT_NE(mm.find("rho = 7870 is implausible for units mm-t-s (t/mm^3, expected 5e-12 .. 3e-08); it looks like SI"),
+            std::string::npos) << mm;
+  EXPECT_NO_THROW(ParsePart(Replace(kGood, "rho: 7870", "rho: 7.87e-9"), "part.yaml", {"check_units=false"}));
+}
+
 TEST(PartFile, ChoicesListTheAllowedValues) {
   const std::string solid =
-      "name: s\ntype: solid\nmaterial: {E: 1, nu: 0.3, rho: 1}\ngeometry: {shape: box, size: [1, 1, 1]}\n"
+      "name: s\ntype: solid\ncheck_units: false\nmaterial: {E: 1, nu: 0.3, rho: 1}\ngeometry: {shape: box, size: [1, 1, 1]}\n"
       "mesh: {elements: prisms}\ninterfaces: [{name: A, group: xmin}]\n";
   const std::string message = Error(solid);
-  EXPECT_NE(message.find("part.yaml:5: mesh.elements: expected tetrahedra or hexahedra, got 'prisms'"), std::string::npos)
+  EXPECT_NE(message.find("part.yaml:6: mesh.elements: expected tetrahedra or hexahedra, got 'prisms'"), std::string::npos)
       << message;
 }
 

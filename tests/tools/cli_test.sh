@@ -88,6 +88,58 @@ sed 's/block.inp/junk.vtu/' "$work/inp/part.yaml" > "$work/inp/junk.yaml"
 "$bin/femb-reduce" -q "$work/inp/junk.yaml" -o "$work/inp/junk.h5" 2> "$work/err.txt"; code=$?
 [ $code = 2 ] && grep -q "junk.vtu: cannot read with meshio" "$work/err.txt" && [ ! -e "$work/inp/junk.h5" ] && ok || fail "bad foreign mesh: $code $(cat "$work/err.txt")"
 
+# Solid parts, bad input: each gives exit code 2, one line naming the file and what is wrong,
+# and no output file.
+mkdir -p "$work/solid"
+solid_error() {  # name, expected text, part file
+  local out="$work/solid/$1.h5"
+  "$bin/femb-reduce" -q "$3" -o "$out" 2> "$work/solid/err.txt"; local code=$?
+  if [ $code = 2 ] && [ "$(wc -l < "$work/solid/err.txt")" = 1 ] && grep -qF "$2" "$work/solid/err.txt" && [ ! -e "$out" ]; then
+    ok
+  else
+    fail "solid $1: exit $code, $(cat "$work/solid/err.txt")"
+  fi
+}
+solid_part() {  # file name, geometry line, interfaces line, [extra lines]
+  printf 'name: s\ntype: solid\nunits: SI\nmaterial: {E: 2.1e11, nu: 0.3, rho: 7850}\n%s\nmesh: {size: 0.02, order: 2}\ninterfaces: %s\n%s' \
+    "$2" "$3" "${4:-}" > "$work/solid/$1"
+  echo "$work/solid/$1"
+}
+echo "this is not a STEP file" > "$work/solid/broken.step"
+solid_error "unreadable CAD" "broken.step: gmsh failed" \
+  "$(solid_part cad.yaml 'geometry: {file: broken.step}' '[{name: A, group: a}]')"
+cat > "$work/solid/flat.geo" <<'GEO'
+SetFactory("OpenCASCADE");
+Rectangle(1) = {0, 0, 0, 0.1, 0.1};
+Physical Surface("face") = {1};
+GEO
+solid_error "no volume elements" "the mesh has no volume elements" \
+  "$(solid_part flat.yaml 'geometry: {file: flat.geo}' '[{name: A, group: face}]')"
+cat > "$work/solid/two.geo" <<'GEO'
+SetFactory("OpenCASCADE");
+Box(1) = {0, 0, 0, 0.1, 0.02, 0.02};
+Box(2) = {0.2, 0, 0, 0.1, 0.02, 0.02};
+Physical Surface("end") = {1};
+Physical Surface("empty") = {};
+Physical Volume("all") = {1, 2};
+GEO
+solid_error "missing physical group" "interface 'A': node set 'hole' not found in the mesh (known: end)" \
+  "$(solid_part group.yaml 'geometry: {file: two.geo}' '[{name: A, group: hole}]')"
+solid_error "region held by no interface" "is connected to no interface" \
+  "$(solid_part island.yaml 'geometry: {file: two.geo}' '[{name: A, group: end}]')"
+solid_error "mixed units" "it looks like mm-t-s or mm-kg-ms (mixed units?)" \
+  "$(solid_part mm.yaml 'geometry: {shape: box, size: [1000, 50, 50]}' '[{name: A, group: xmin}]')"
+printf '*NODE\n1, 0, 0, 0\n2, 1, 0, 0\n3, 0, 1, 0\n4, 0, 0, 1\n*ELEMENT, TYPE=C3D4\n1, 1, 2, 3, 4\n*NSET, NSET=A\n1, 2, 3\n' > "$work/solid/tet.inp"
+printf '#!/bin/sh\nexec /usr/bin/python3 -S "$@"\n' > "$work/solid/python-without-meshio"
+chmod +x "$work/solid/python-without-meshio"
+FEMB_PYTHON="$work/solid/python-without-meshio" solid_error "meshio not installed" "meshio is not installed: apt-get install python3-meshio" \
+  "$(solid_part inp.yaml 'geometry: {file: tet.inp}' '[{name: A, group: A}]')"
+# Memory guard: a factor larger than the limit is refused before the numeric factorization.
+"$bin/femb-reduce" -q "$src/examples/solid_bar/part.yaml" -o "$work/solid/big.h5" --set reduction.memory_limit_gb=0.001 \
+  2> "$work/solid/err.txt"; code=$?
+[ $code = 4 ] && grep -q "the Cholesky factor would need" "$work/solid/err.txt" && grep -q "coarsen the mesh" "$work/solid/err.txt" \
+  && [ ! -e "$work/solid/big.h5" ] && ok || fail "memory guard: exit $code, $(cat "$work/solid/err.txt")"
+
 # --set works under the documented names.
 "$bin/femb-reduce" -q "$src/examples/beam_rod/part.yaml" -o "$work/m8.h5" --set reduction.internal_modes=8 \
   --set reduction.floating_frame=mean_axes || fail "--set"
