@@ -1,5 +1,6 @@
 #include "formats/part_file.h"
 
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -242,12 +243,23 @@ PartSpec ParsePart(const std::string& text, const std::string& name,
     YamlMap g = geometry.Map();
     part.solid.where = geometry.Where();
     if (auto shape = g.Optional("shape")) {
-      part.solid.shape = shape->String();
-      if (part.solid.shape != "box") shape->Fail("unknown built-in shape '" + part.solid.shape + "' (known: box)");
-      YamlValue size = g.Required("size");
-      part.solid.size = size.Vector3();
-      if (!(part.solid.size.minCoeff() > 0)) size.Fail("box edge lengths must be positive");
-      CheckPartSize(part, part.solid.size.norm(), size.Where());
+      part.solid.shape = shape->OneOf({"box", "plate", "cylinder", "tube"});
+      if (part.solid.shape == "box" || part.solid.shape == "plate") {
+        YamlValue size = g.Required("size");
+        part.solid.size = size.Vector3();
+        if (!(part.solid.size.minCoeff() > 0)) size.Fail("edge lengths must be positive");
+        CheckPartSize(part, part.solid.size.norm(), size.Where());
+      } else {
+        part.solid.radius = g.Required("radius").PositiveNumber();
+        YamlValue length = g.Required("length");
+        part.solid.length = length.PositiveNumber();
+        if (part.solid.shape == "tube") {
+          YamlValue inner = g.Required("inner_radius");
+          part.solid.inner_radius = inner.PositiveNumber();
+          if (part.solid.inner_radius >= part.solid.radius) inner.Fail("inner_radius must be smaller than radius");
+        }
+        CheckPartSize(part, std::hypot(2 * part.solid.radius, part.solid.length), length.Where());
+      }
     } else {
       YamlValue file = g.Required("file");
       std::filesystem::path f(file.String());
@@ -265,7 +277,9 @@ PartSpec ParsePart(const std::string& text, const std::string& name,
       }
       if (auto v = m.Optional("elements")) {
         part.solid.hexahedra = v->OneOf({"tetrahedra", "hexahedra"}) == "hexahedra";
-        if (part.solid.hexahedra && part.solid.shape != "box") v->Fail("hexahedra are available for the built-in box only");
+        if (part.solid.hexahedra && part.solid.shape != "box" && part.solid.shape != "plate") {
+          v->Fail("hexahedra are available for the built-in box and plate only");
+        }
       }
       m.CheckNoUnknownKeys();
     }

@@ -59,8 +59,9 @@ struct InterfaceSpec {
 
 /// A solid part: a built-in shape or a geometry/mesh file, meshed by gmsh.
 struct SolidSpec {
-  std::string shape;                              ///< "box" or "" (file)
-  Eigen::Vector3d size = Eigen::Vector3d::Ones();  ///< box edge lengths [length], corner at the origin
+  std::string shape;                              ///< "box", "plate", "cylinder", "tube" or "" (file)
+  Eigen::Vector3d size = Eigen::Vector3d::Ones();  ///< box/plate edge lengths [length], corner at the origin
+  double radius = 0.0, inner_radius = 0.0, length = 0.0;  ///< cylinder/tube along z from the origin
   std::string file;                               ///< geometry or mesh file (resolved path)
   double element_size = 0.0;                      ///< target element size [length]
   int order = 2;                                  ///< 1: TET4/HEX8, 2: TET10/HEX20

@@ -30,7 +30,11 @@ struct FeModel {
   /// axes. For beams these are DOFs of interface nodes directly.
   std::vector<std::string> interface_names;
   std::vector<Eigen::Vector3d> interface_positions;
-  std::vector<std::vector<FullDof>> interface_dofs;  ///< 6 full DOFs per interface
+  std::vector<std::vector<FullDof>> interface_dofs;  ///< 6 full DOFs per interface (empty: see below)
+  /// Interfaces tied by a distributing (RBE3) coupling are not DOFs of the model: their six
+  /// coordinates are q_k = W_k u, a weighted rigid fit of the node set. interface_weights[k] is
+  /// W_k (6 x n_dofs) for those and has no rows for DOF interfaces (or is absent for beams).
+  std::vector<SparseMatrix> interface_weights;
 
   /// (u, theta) of the material point at `x` as a 6 x n_dofs matrix acting on full DOF vectors;
   /// nullopt when `x` lies outside the material.

@@ -123,6 +123,9 @@ FeModel BuildSolidModel(const PartSpec& part, const ProgressFn& progress) {
   MeshRequest request;
   request.shape = part.solid.shape;
   request.size = part.solid.size;
+  request.radius = part.solid.radius;
+  request.inner_radius = part.solid.inner_radius;
+  request.length = part.solid.length;
   request.file = part.solid.file;
   request.element_size = part.solid.element_size;
   request.order = part.solid.order;
@@ -181,14 +184,12 @@ FeModel BuildSolidModel(const PartSpec& part, const ProgressFn& progress) {
   // RBE3 (distributing): the interface motion is the least-squares rigid fit of its node set,
   //   u_k = u_c + theta x (x_k - c),  u_c = mean(u_i),  theta = A^-1 sum r_i x u_i,
   //   A = sum (|r_i|^2 1 - r_i r_i^T), r_i = x_i - c,
-  // i.e. q_k = W u_set. Six set DOFs (the pivots of a column-pivoted QR of W) are made
-  // dependent: u_dep = W_dep^-1 (q_k - W_ind u_ind). A change of coordinates: no stiffness added.
-  std::vector<int> dependent_of(3 * n_nodes, -1);  // mesh DOF -> RBE3 interface index
+  // i.e. q_k = W u_set. The set's DOFs stay free DOFs of the model and q_k = W u is a
+  // constraint that the Craig-Bampton reduction imposes through multipliers (no stiffness added,
+  // no dense coupling of the set).
   struct Rbe3 {
-    std::vector<int> dofs;      // set DOFs (mesh numbering)
-    Eigen::MatrixXd W;          // 6 x dofs
-    std::vector<int> dep;       // positions in dofs of the 6 dependent DOFs
-    Eigen::MatrixXd Wdep_inv;   // 6 x 6
+    std::vector<int> dofs;  // set DOFs (mesh numbering)
+    Eigen::MatrixXd W;      // 6 x dofs
   };
   std::vector<Rbe3> rbe3(part.interfaces.size());
   for (size_t k = 0; k < part.interfaces.size(); ++k) {
@@ -218,17 +219,8 @@ FeModel BuildSolidModel(const PartSpec& part, const ProgressFn& progress) {
       r3.W.block<3, 3>(0, 3 * a) = Eigen::Matrix3d::Identity() / ns - SkewOf(d) * Wtheta;
       for (int i = 0; i < 3; ++i) r3.dofs.push_back(3 * set[a] + i);
     }
-    Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(r3.W);
-    Eigen::MatrixXd Wdep(6, 6);
-    for (int j = 0; j < 6; ++j) {
-      r3.dep.push_back(int(qr.colsPermutation().indices()[j]));
-      Wdep.col(j) = r3.W.col(r3.dep.back());
-      dependent_of[r3.dofs[r3.dep.back()]] = int(k);
-    }
-    r3.Wdep_inv = Wdep.inverse();
   }
-  // Model coordinates: every mesh DOF that is neither in an RBE2 set nor an RBE3 dependent DOF,
-  // then 6 per interface.
+  // Model coordinates: every mesh DOF not in an RBE2 set, then 6 per RBE2 interface.
   std::vector<int> coupled;
   for (int s = 0; s < n_nodes; ++s) {
     if (owner[s] >= 0) coupled.push_back(s);
@@ -239,14 +231,21 @@ FeModel BuildSolidModel(const PartSpec& part, const ProgressFn& progress) {
   for (int s = 0; s < n_nodes; ++s) {
     const bool rbe2 = owner[s] >= 0 && part.interfaces[owner[s]].coupling == "rbe2";
     for (int d = 0; d < 3; ++d) {
-      if (!rbe2 && dependent_of[3 * s + d] < 0) kept[3 * s + d] = n_kept++;
+      if (!rbe2) kept[3 * s + d] = n_kept++;
     }
   }
-  const int n_model = n_kept + 6 * int(part.interfaces.size());
+  std::vector<int> rbe2_base(part.interfaces.size(), -1);
+  int n_model = n_kept;
+  for (size_t k = 0; k < part.interfaces.size(); ++k) {
+    if (part.interfaces[k].coupling == "rbe2") {
+      rbe2_base[k] = n_model;
+      n_model += 6;
+    }
+  }
   std::vector<Eigen::Triplet<double>> t_entries;
   for (int s = 0; s < n_nodes; ++s) {
     if (owner[s] >= 0 && part.interfaces[owner[s]].coupling == "rbe2") {
-      const int base = n_kept + 6 * owner[s];
+      const int base = rbe2_base[owner[s]];
       const Eigen::Matrix3d arm = -SkewOf(mesh->nodes.row(s).transpose() - model.interface_positions[owner[s]]);
       for (int d = 0; d < 3; ++d) {
         t_entries.emplace_back(3 * s + d, base + d, 1.0);
@@ -256,26 +255,7 @@ FeModel BuildSolidModel(const PartSpec& part, const ProgressFn& progress) {
       }
       continue;
     }
-    for (int d = 0; d < 3; ++d) {
-      if (kept[3 * s + d] >= 0) t_entries.emplace_back(3 * s + d, kept[3 * s + d], 1.0);
-    }
-  }
-  for (size_t k = 0; k < rbe3.size(); ++k) {
-    const Rbe3& r3 = rbe3[k];
-    if (r3.dep.empty()) continue;
-    const int base = n_kept + 6 * int(k);
-    // u_dep = Wdep^-1 q - Wdep^-1 W_ind u_ind.
-    const Eigen::MatrixXd G = -r3.Wdep_inv * r3.W;  // 6 x set DOFs (dependent columns ignored)
-    for (int j = 0; j < 6; ++j) {
-      const int row = r3.dofs[r3.dep[j]];
-      for (int c = 0; c < 6; ++c) {
-        if (r3.Wdep_inv(j, c) != 0.0) t_entries.emplace_back(row, base + c, r3.Wdep_inv(j, c));
-      }
-      for (size_t a = 0; a < r3.dofs.size(); ++a) {
-        const int col = kept[r3.dofs[a]];
-        if (col >= 0 && G(j, long(a)) != 0.0) t_entries.emplace_back(row, col, G(j, long(a)));
-      }
-    }
+    for (int d = 0; d < 3; ++d) t_entries.emplace_back(3 * s + d, kept[3 * s + d], 1.0);
   }
   SparseMatrix T(3 * n_nodes, n_model);
   T.setFromTriplets(t_entries.begin(), t_entries.end());
@@ -296,8 +276,18 @@ FeModel BuildSolidModel(const PartSpec& part, const ProgressFn& progress) {
   model.M = congruence(M_mesh);
   for (size_t k = 0; k < part.interfaces.size(); ++k) {
     std::vector<FullDof> dofs;
-    for (int d = 0; d < 6; ++d) dofs.push_back({n_kept + 6 * int(k) + d});
+    SparseMatrix W(0, n_model);
+    if (rbe2_base[k] >= 0) {
+      for (int d = 0; d < 6; ++d) dofs.push_back({rbe2_base[k] + d});
+    } else {
+      std::vector<Eigen::Triplet<double>> w;
+      for (size_t a = 0; a < rbe3[k].dofs.size(); ++a)
+        for (int i = 0; i < 6; ++i) w.emplace_back(i, kept[rbe3[k].dofs[a]], rbe3[k].W(i, long(a)));
+      W.resize(6, n_model);
+      W.setFromTriplets(w.begin(), w.end());
+    }
     model.interface_dofs.push_back(dofs);
+    model.interface_weights.push_back(W);
   }
   model.mesh_map = T;
   model.dofs_per_node = 3;

@@ -3,6 +3,10 @@
 //   u_s = u_k + theta_k x (x_s - x_k), i.e. mesh DOFs = T * model DOFs with T built from
 //   [1, -(x_s - x_k)~] blocks; K = T^T K_mesh T, M = T^T M_mesh T. It stiffens the coupled face
 //   (use it for a bolted flange or a shaft seat that is truly rigid).
+// RBE3 (distributing): the interface's six coordinates are the least-squares rigid fit of its
+//   node set, q_k = W_k u; the set stays free (no stiffness added: a bearing seat, a load
+//   introduction that must not stiffen the part). The reduction imposes q = W u as a constraint
+//   (FeModel::interface_weights).
 // The interface point defaults to the centroid of the node set.
 #pragma once
 

@@ -38,7 +38,32 @@ SolidMesh MeshWithGmsh(const MeshRequest& r) {
   SolidMesh mesh;
   std::map<std::string, std::vector<int>> surface_entities;  // node set name -> surface tags
   try {
-    if (r.shape == "box") {
+    if (r.shape == "cylinder" || r.shape == "tube") {
+      gmsh::model::add(r.shape);
+      int volume = gmsh::model::occ::addCylinder(0, 0, 0, 0, 0, r.length, r.radius);
+      if (r.shape == "tube") {
+        const int bore = gmsh::model::occ::addCylinder(0, 0, -0.1 * r.length, 0, 0, 1.2 * r.length, r.inner_radius);
+        gmsh::vectorpair out;
+        std::vector<gmsh::vectorpair> map;
+        gmsh::model::occ::cut({{3, volume}}, {{3, bore}}, out, map);
+        volume = out.at(0).second;
+      }
+      gmsh::model::occ::synchronize();
+      gmsh::vectorpair faces;
+      gmsh::model::getBoundary({{3, volume}}, faces, false, false, false);
+      const double tol = 1e-4 * std::min(r.radius, r.length);
+      for (const auto& [dim, tag] : faces) {
+        double x0, y0, z0, x1, y1, z1;
+        gmsh::model::getBoundingBox(dim, tag, x0, y0, z0, x1, y1, z1);
+        if (z1 - z0 < tol + 1e-3 * r.length) {
+          surface_entities[0.5 * (z0 + z1) < 0.5 * r.length ? "bottom" : "top"].push_back(tag);
+        } else {
+          const double half_width = 0.5 * (x1 - x0);
+          surface_entities[std::abs(half_width - r.radius) < std::abs(half_width - r.inner_radius) ? "outer" : "inner"]
+              .push_back(tag);
+        }
+      }
+    } else if (r.shape == "box" || r.shape == "plate") {
       gmsh::model::add("box");
       const int volume = gmsh::model::occ::addBox(0, 0, 0, r.size.x(), r.size.y(), r.size.z());
       gmsh::model::occ::synchronize();

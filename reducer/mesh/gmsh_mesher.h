@@ -1,6 +1,9 @@
-// Meshing with the gmsh C++ API: built-in shapes (box) or a geometry/mesh file (.step, .stp,
-// .brep, .geo, .msh), volume elements of order 1 or 2, and named node sets (gmsh physical
-// surface groups; for the box: xmin, xmax, ymin, ymax, zmin, zmax).
+// Meshing with the gmsh C++ API: built-in shapes or a geometry/mesh file (.step, .stp, .brep,
+// .geo, .msh), volume elements of order 1 or 2, and named node sets (gmsh physical surface
+// groups). Built-in shapes and their face sets:
+//   box, plate (a box, usually thin): corner at the origin; xmin, xmax, ymin, ymax, zmin, zmax
+//   cylinder: axis z from the origin; bottom (z = 0), top (z = length), outer
+//   tube: the same with a bore; bottom, top, outer, inner
 #pragma once
 
 #include <Eigen/Core>
@@ -20,8 +23,9 @@ struct SolidMesh {
 };
 
 struct MeshRequest {
-  std::string shape;            ///< "box" or "" (file)
+  std::string shape;            ///< "box", "plate", "cylinder", "tube" or "" (file)
   Eigen::Vector3d size = Eigen::Vector3d::Ones();
+  double radius = 0.0, inner_radius = 0.0, length = 0.0;  ///< cylinder / tube along z
   std::string file;             ///< geometry or mesh file
   double element_size = 0.0;    ///< target element size [length]
   int order = 2;

@@ -1,5 +1,8 @@
 #include "reducer/reduction/craig_bampton.h"
 
+#include <Eigen/Cholesky>
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 
 #include "reducer/linalg/generalized_eigen.h"
@@ -75,28 +78,71 @@ CraigBamptonResult CraigBamptonReduce(const FeModel& model, int internal_modes,
   CraigBamptonResult r;
   Stopwatch clock;
   const int n = int(model.n_dofs());
-  std::vector<int> boundary;
-  for (const auto& dofs : model.interface_dofs) {
-    for (FullDof d : dofs) boundary.push_back(d.value);
+  const int n_interfaces = int(model.interface_names.size());
+  // Reduced coordinates: 6 per interface in order, then the modes. A DOF interface's six
+  // coordinates are boundary DOFs b; a distributing (RBE3) interface's are constraint rows
+  // q = W u on the interior DOFs.
+  std::vector<int> boundary, boundary_coordinate, constraint_coordinate;
+  std::vector<const SparseMatrix*> weights;
+  for (int k = 0; k < n_interfaces; ++k) {
+    const bool constrained = k < int(model.interface_weights.size()) && model.interface_weights[k].rows() > 0;
+    if (constrained) {
+      weights.push_back(&model.interface_weights[k]);
+      for (int d = 0; d < 6; ++d) constraint_coordinate.push_back(6 * k + d);
+      continue;
+    }
+    for (int d = 0; d < 6; ++d) {
+      boundary.push_back(model.interface_dofs[k][d].value);
+      boundary_coordinate.push_back(6 * k + d);
+    }
   }
   const std::vector<int> interior = InteriorDofs(model);
-  const int n_b = int(boundary.size()), n_i = int(interior.size());
+  const int n_b = int(boundary.size()), n_i = int(interior.size()), n_c = int(constraint_coordinate.size());
   std::vector<int> interior_index(n, -1), boundary_index(n, -1);
   for (int k = 0; k < n_i; ++k) interior_index[interior[k]] = k;
   for (int k = 0; k < n_b; ++k) boundary_index[boundary[k]] = k;
-  if (internal_modes > n_i) {
+  if (internal_modes > n_i - n_c) {
     r.message = "reduction.internal_modes = " + std::to_string(internal_modes) + " exceeds the " +
-                std::to_string(n_i) + " interior DOFs of the model";
+                std::to_string(n_i - n_c) + " interior DOFs of the model";
     return r;
   }
 
   const Blocks K = Partition(model.K, interior_index, boundary_index, n_i, n_b);
   const Blocks M = Partition(model.M, interior_index, boundary_index, n_i, n_b);
+  // W^T on the interior DOFs (n_i x n_c), sparse: nonzero only on the coupled node sets.
+  SparseMatrix Wt(n_i, n_c);
+  {
+    std::vector<Eigen::Triplet<double>> entries;
+    int row = 0;
+    for (const SparseMatrix* W : weights) {
+      for (int col = 0; col < W->outerSize(); ++col)
+        for (SparseMatrix::InnerIterator it(*W, col); it; ++it) {
+          if (interior_index[col] < 0) {
+            r.message = "an RBE3 interface weights a DOF of another interface's coupling";
+            return r;
+          }
+          entries.emplace_back(interior_index[col], row + int(it.row()), it.value());
+        }
+      row += 6;
+    }
+    Wt.setFromTriplets(entries.begin(), entries.end());
+  }
 
-  // One factorization of K_ii (METIS ordering, supernodal).
+  // One factorization (METIS ordering, supernodal) of K_ii, or, when no interface is a DOF
+  // interface (every interface distributing), of K_ii + s M_ii: K_ii itself then still has the
+  // six rigid-body modes that only the constraints W u = q remove.
   clock.Restart();
+  double shift = 0.0;
+  if (n_b == 0) {
+    double max_ratio = 0.0;
+    for (int j = 0; j < n_i; ++j) {
+      const double m = M.ii.coeff(j, j);
+      if (m > 0) max_ratio = std::max(max_ratio, K.ii.coeff(j, j) / m);
+    }
+    shift = 1e-8 * max_ratio;
+  }
   SparseCholesky factor;
-  r.factorization = factor.Compute(K.ii, memory_limit_bytes);
+  r.factorization = factor.Compute(shift > 0 ? SparseMatrix(K.ii + shift * M.ii) : K.ii, memory_limit_bytes);
   const double t_factor = clock.Seconds();
   if (r.factorization.too_big) {
     r.message = r.factorization.message;
@@ -117,14 +163,62 @@ CraigBamptonResult CraigBamptonReduce(const FeModel& model, int internal_modes,
                  r.factorization.ordering + ")");
   }
 
-  // Static constraint modes Psi_c = -K_ii^-1 K_ib.
+  // Solves on the constrained space W x = 0 (Lagrange multipliers eliminated through the
+  // 6r x 6r Schur complement S = W F^-1 W^T, F the factored matrix):
+  //   F x + W^T mu = z, W x = 0   =>   x = F^-1 z - Y S^-1 W F^-1 z,  Y = F^-1 W^T.
   clock.Restart();
-  const Eigen::MatrixXd Psi_c = -factor.Solve(Eigen::MatrixXd(K.ib));
-  if (progress) progress("static modes", clock.Seconds(), Format("%.0f constraint modes", n_b));
+  const Eigen::MatrixXd Y = n_c > 0 ? factor.Solve(Eigen::MatrixXd(Wt)) : Eigen::MatrixXd(n_i, 0);
+  const Eigen::LDLT<Eigen::MatrixXd> S(Eigen::MatrixXd(Wt.transpose() * Y));
+  auto constrained_solve = [&](const Eigen::MatrixXd& z) {
+    Eigen::MatrixXd x = factor.Solve(z);
+    if (n_c > 0) x -= Y * S.solve(Eigen::MatrixXd(Wt.transpose() * x));
+    return x;
+  };
+  // With the shift s, the solution for K itself by the fixed point x = F_c^-1 (z + s M x): it
+  // contracts by s / lambda_1 (about 1e-2 or less).
+  bool refined = true;
+  auto stiffness_solve = [&](const Eigen::MatrixXd& z) {
+    Eigen::MatrixXd x = constrained_solve(z);
+    if (shift == 0.0) return x;
+    double previous = HUGE_VAL;
+    for (int it = 0; it < 60; ++it) {
+      const Eigen::MatrixXd next = constrained_solve(z + shift * (M.ii * x));
+      const double change = (next - x).norm() / std::max(next.norm(), 1e-300);
+      x = next;
+      // Converged, or stalled at the round-off of the shifted factor (measured ~1e-12).
+      if (change <= 1e-11 || (change < 1e-9 && change > 0.5 * previous)) return x;
+      previous = change;
+    }
+    refined = false;
+    return x;
+  };
+  // Static modes: a DOF interface moved by a unit motion with the others held (K_ii x = -K_ib,
+  // W x = 0); a distributing interface's six coordinates set to unit values (W x = e_j) at
+  // least strain energy: x0 = Y S^-1 (stationary for F; corrected for K when shifted).
+  Eigen::MatrixXd Psi_b = n_b > 0 ? Eigen::MatrixXd(-stiffness_solve(Eigen::MatrixXd(K.ib))) : Eigen::MatrixXd(n_i, 0);
+  Eigen::MatrixXd Psi_c(n_i, n_c);
+  if (n_c > 0) {
+    Psi_c = Y * S.solve(Eigen::MatrixXd::Identity(n_c, n_c));
+    if (shift > 0) Psi_c += stiffness_solve(-(K.ii * Psi_c));
+  }
+  if (!refined) {
+    r.message = "static modes of the distributing (RBE3) interfaces did not converge (no DOF interface holds the part)";
+    return r;
+  }
+  if (progress) {
+    progress("static modes", clock.Seconds(),
+             Format("%.0f constraint modes, %.0f linear solves", n_b + n_c, double(factor.solves())));
+  }
 
-  // Fixed-interface modes, shift-invert around 0 on the same factor.
+  // Fixed-interface modes, shift-invert around -shift on the same factor, on W x = 0.
   clock.Restart();
-  const EigenResult eig = LowestEigenpairs(K.ii, M.ii, internal_modes, 0.0, factor, dense_limit);
+  const ShiftInvertFn solve = [&](const double* b, double* x) {
+    Eigen::Map<const Eigen::VectorXd> bv(b, n_i);
+    Eigen::Map<Eigen::VectorXd> xv(x, n_i);
+    xv = constrained_solve(Eigen::MatrixXd(bv));
+  };
+  const Eigen::MatrixXd C = Eigen::MatrixXd(Wt.transpose());
+  const EigenResult eig = LowestConstrainedEigenpairs(K.ii, M.ii, C, internal_modes, -shift, solve, dense_limit);
   if (!eig.ok) {
     r.message = "fixed-interface eigen solve failed: " + eig.message;
     return r;
@@ -140,32 +234,26 @@ CraigBamptonResult CraigBamptonReduce(const FeModel& model, int internal_modes,
                  (eig.dense ? ", dense solver (small interior)" : ", shift-invert Lanczos"));
   }
 
-  // Projection.
+  // Projection K_r = Phi^T K Phi, M_r = Phi^T M Phi with Phi the full fields of the reduced
+  // coordinates. The static and modal blocks of K_r are K-orthogonal exactly (the modes satisfy
+  // W x = 0 and the static modes are stationary), and Phi_i^T K Phi_i = Lambda: both set exactly.
   clock.Restart();
-  const int m = internal_modes, n_r = n_b + m;
-  r.K = Eigen::MatrixXd::Zero(n_r, n_r);
-  r.M = Eigen::MatrixXd::Zero(n_r, n_r);
-  const Eigen::MatrixXd Mii_Psi = M.ii * Psi_c;
-  const Eigen::MatrixXd K_ib_dense(K.ib), M_ib_dense(M.ib);
-  r.K.topLeftCorner(n_b, n_b) = K.bb + K_ib_dense.transpose() * Psi_c;
-  for (int k = 0; k < m; ++k) r.K(n_b + k, n_b + k) = r.lambda[k];
-  r.M.topLeftCorner(n_b, n_b) =
-      M.bb + M_ib_dense.transpose() * Psi_c + Psi_c.transpose() * M_ib_dense + Psi_c.transpose() * Mii_Psi;
-  if (m > 0) {
-    const Eigen::MatrixXd M_bq = (M_ib_dense.transpose() + Mii_Psi.transpose()) * Phi_i;
-    r.M.block(0, n_b, n_b, m) = M_bq;
-    r.M.block(n_b, 0, m, n_b) = M_bq.transpose();
-    r.M.bottomRightCorner(m, m) = Phi_i.transpose() * (M.ii * Phi_i);
-  }
-  r.K = 0.5 * (r.K + r.K.transpose()).eval();
-  r.M = 0.5 * (r.M + r.M.transpose()).eval();
-
+  const int m = internal_modes, n_r = 6 * n_interfaces + m;
   r.shapes = Eigen::MatrixXd::Zero(n, n_r);
-  for (int k = 0; k < n_b; ++k) r.shapes(boundary[k], k) = 1.0;
+  for (int k = 0; k < n_b; ++k) r.shapes(boundary[k], boundary_coordinate[k]) = 1.0;
   for (int k = 0; k < n_i; ++k) {
-    r.shapes.row(interior[k]).head(n_b) = Psi_c.row(k);
+    for (int j = 0; j < n_b; ++j) r.shapes(interior[k], boundary_coordinate[j]) = Psi_b(k, j);
+    for (int j = 0; j < n_c; ++j) r.shapes(interior[k], constraint_coordinate[j]) = Psi_c(k, j);
     if (m > 0) r.shapes.row(interior[k]).tail(m) = Phi_i.row(k);
   }
+  const int n_s = 6 * n_interfaces;
+  const Eigen::MatrixXd static_shapes = r.shapes.leftCols(n_s);
+  r.K = Eigen::MatrixXd::Zero(n_r, n_r);
+  r.K.topLeftCorner(n_s, n_s) = static_shapes.transpose() * (model.K * static_shapes);
+  for (int k = 0; k < m; ++k) r.K(n_s + k, n_s + k) = r.lambda[k];
+  r.M = r.shapes.transpose() * (model.M * r.shapes);
+  r.K = 0.5 * (r.K + r.K.transpose()).eval();
+  r.M = 0.5 * (r.M + r.M.transpose()).eval();
   if (progress) progress("projection", clock.Seconds(), Format("%.0f reduced DOFs", n_r));
   r.ok = true;
   return r;
