@@ -104,7 +104,8 @@ def main():
         flop = float(re.search(r"([\d.e+]+) GFLOP,", d["factorize K_ii"]).group(1))
         factor_mb = float(re.search(r"factor ([\d.e+]+) MB", d["factorize K_ii"]).group(1))
         solves = int(re.search(r"(\d+) linear solves", d["eigen solve"]).group(1))
-        rate = flop / s["factorize K_ii"]
+        numeric = float(re.search(r"numeric ([\d.e+-]+) s", d["factorize K_ii"]).group(1))
+        rate = flop / numeric
         reduction = t_mesh + sum(v for k, v in s.items() if k not in ("full modes", "mesh"))
         core = s["factorize K_ii"] + s["static modes"] + s["eigen solve"]
         red, full = j["free_free_frequencies_hz"][6:16], j["full_free_free_frequencies_hz"][6:16]

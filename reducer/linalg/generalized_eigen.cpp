@@ -123,4 +123,118 @@ EigenResult LowestConstrainedEigenpairs(const SparseMatrix& K, const SparseMatri
   return result;
 }
 
+EigenResult BlockLanczosEigenpairs(const SparseMatrix& K, const SparseMatrix& M, const Eigen::MatrixXd& C, int nev,
+                                   double sigma, const BlockShiftInvertFn& solve, int block, double tol,
+                                   long* block_solves) {
+  EigenResult result;
+  const long n = K.rows();
+  const long n_free = n - C.rows();
+  if (nev <= 0) {
+    result.ok = true;
+    result.vectors.resize(n, 0);
+    return result;
+  }
+  if (nev > n_free) {
+    result.message = "asked for " + std::to_string(nev) + " eigenpairs of a " + std::to_string(n_free) + "-DOF problem";
+    return result;
+  }
+  const long max_basis = std::min<long>(n_free, std::max<long>(12L * nev, 200));
+  long passes = 0;
+  // A X = (K - sigma M)^-1 M X on C x = 0, from M X.
+  auto apply = [&](const Eigen::MatrixXd& MX) {
+    ++passes;
+    result.linear_solves += MX.cols();
+    return solve(MX);
+  };
+  // M-orthonormalizes W (with MW = M W carried along: sparse products with M are the costly
+  // part after the solves) by Cholesky QR twice, dropping directions that vanish.
+  auto orthonormalize = [&](Eigen::MatrixXd& W, Eigen::MatrixXd& MW) {
+    for (int pass = 0; pass < 2; ++pass) {
+      const Eigen::MatrixXd G = W.transpose() * MW;
+      Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(0.5 * (G + G.transpose()));
+      const double top = es.eigenvalues().maxCoeff();
+      std::vector<int> keep;
+      for (int k = 0; k < G.rows(); ++k)
+        if (es.eigenvalues()[k] > 1e-20 * top && es.eigenvalues()[k] > 0) keep.push_back(k);
+      Eigen::MatrixXd basis(G.rows(), long(keep.size()));
+      for (size_t k = 0; k < keep.size(); ++k)
+        basis.col(long(k)) = es.eigenvectors().col(keep[k]) / std::sqrt(es.eigenvalues()[keep[k]]);
+      W = W * basis;
+      MW = MW * basis;
+    }
+  };
+  // Basis V (M-orthonormal), A V and M V, stored in matrices that grow by half their width
+  // when full (no copy of the whole basis at every step); m columns are in use.
+  Eigen::MatrixXd V(n, 0), MV(n, 0), T(0, 0);
+  long m = 0;
+  auto reserve = [&](long columns) {
+    if (columns <= V.cols()) return;
+    const long capacity = std::min(max_basis + block, std::max(columns, V.cols() + V.cols() / 2));
+    V.conservativeResize(n, capacity);
+    MV.conservativeResize(n, capacity);
+  };
+  // Start in the operator's range (inside C x = 0).
+  const Eigen::MatrixXd start = Eigen::MatrixXd::Random(n, block);
+  Eigen::MatrixXd Q = apply(M * start);
+  Eigen::MatrixXd MQ = M * Q;
+  orthonormalize(Q, MQ);
+  while (true) {
+    if (Q.cols() == 0) {
+      result.message = "block Lanczos: the Krylov space was exhausted";
+      return result;
+    }
+    const long add = Q.cols();
+    const Eigen::MatrixXd AQ = apply(MQ);
+    reserve(m + add);
+    V.middleCols(m, add) = Q;
+    MV.middleCols(m, add) = MQ;
+    m += add;
+    // Rayleigh-Ritz: T = V^T M A V (symmetric: A is self-adjoint in the M inner product),
+    // grown by the new block's rows and columns.
+    T.conservativeResize(m, m);
+    const Eigen::MatrixXd new_cols = MV.leftCols(m).transpose() * AQ;
+    T.rightCols(add) = new_cols;
+    T.bottomRows(add) = new_cols.transpose();
+    // The next block's direction: A Q orthogonalized against the whole basis (twice). With the
+    // block Lanczos relation A V = V T + W E^T, a Ritz pair (theta, V y) has the residual
+    // A V y - theta V y = W y_new (y_new: y's rows of the newest block), so its M-norm is
+    // sqrt(y_new^T (W^T M W) y_new): no n-sized work to test convergence.
+    Eigen::MatrixXd W = AQ;
+    for (int pass = 0; pass < 2; ++pass) W -= V.leftCols(m) * (MV.leftCols(m).transpose() * W);
+    Eigen::MatrixXd MW = M * W;
+    const Eigen::MatrixXd G = W.transpose() * MW;
+    if (m >= nev) {
+      Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(0.5 * (T + T.transpose()));
+      bool converged = true;
+      for (int k = 0; k < nev && converged; ++k) {
+        const long col = m - 1 - k;  // largest theta = nearest the shift
+        const double theta = es.eigenvalues()[col];
+        const Eigen::VectorXd y_new = es.eigenvectors().col(col).tail(add);
+        converged = std::sqrt(std::max(y_new.dot(G * y_new), 0.0)) <= tol * std::abs(theta);
+      }
+      if (converged) {
+        Eigen::MatrixXd Y(m, nev);
+        result.lambda.resize(nev);
+        for (int k = 0; k < nev; ++k) {
+          result.lambda[k] = sigma + 1.0 / es.eigenvalues()[m - 1 - k];
+          Y.col(k) = es.eigenvectors().col(m - 1 - k);
+        }
+        result.vectors = V.leftCols(m) * Y;
+        break;
+      }
+    }
+    if (m + block > max_basis) {
+      result.message = "block Lanczos did not converge with " + std::to_string(m) + " basis vectors";
+      return result;
+    }
+    orthonormalize(W, MW);
+    Q = std::move(W);
+    MQ = std::move(MW);
+  }
+  if (block_solves) *block_solves = passes;
+  SortAscending(result);
+  result.ok = true;
+  return result;
+}
+
 }  // namespace femb
