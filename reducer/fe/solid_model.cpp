@@ -46,72 +46,150 @@ bool Locate(const SolidMesh& mesh, int e, const Eigen::Vector3d& x, Eigen::Vecto
 
 }  // namespace
 
-void AssembleSolid(const SolidMesh& mesh, const MaterialSpec& material, SparseMatrix* K, SparseMatrix* M) {
-  const int n_nodes = int(mesh.nodes.rows()), per = SolidNodeCount(mesh.type);
+void AssembleSolid(const SolidMesh& mesh, const MaterialSpec& material, const SolidDofMap& map, SparseMatrix* K,
+                   SparseMatrix* M) {
+  const int per = SolidNodeCount(mesh.type);
   const long n_cells = mesh.cells.rows();
-  // Node graph in CSR form: neighbours (including the node itself) sorted ascending.
-  std::vector<std::vector<int>> cells_of(n_nodes);
+  const int n_model_nodes = int(map.first_dof.size());
+  // Model-node graph in CSR form: neighbours (including the node itself) sorted by first DOF
+  // (model nodes are numbered in DOF order, so sorting by number sorts the rows).
+  std::vector<std::vector<int>> cells_of(n_model_nodes);
   for (long e = 0; e < n_cells; ++e)
-    for (int a = 0; a < per; ++a) cells_of[mesh.cells(e, a)].push_back(int(e));
-  std::vector<long> start(n_nodes + 1, 0);
+    for (int a = 0; a < per; ++a) {
+      std::vector<int>& c = cells_of[map.model_node[mesh.cells(e, a)]];
+      if (c.empty() || c.back() != int(e)) c.push_back(int(e));
+    }
+  std::vector<long> start(n_model_nodes + 1, 0);
   std::vector<int> adjacent;
   std::vector<int> scratch;
-  for (int s = 0; s < n_nodes; ++s) {
+  for (int P = 0; P < n_model_nodes; ++P) {
     scratch.clear();
-    for (int e : cells_of[s])
-      for (int a = 0; a < per; ++a) scratch.push_back(mesh.cells(e, a));
+    for (int e : cells_of[P])
+      for (int a = 0; a < per; ++a) scratch.push_back(map.model_node[mesh.cells(e, a)]);
     std::sort(scratch.begin(), scratch.end());
     scratch.erase(std::unique(scratch.begin(), scratch.end()), scratch.end());
     adjacent.insert(adjacent.end(), scratch.begin(), scratch.end());
-    start[s + 1] = long(adjacent.size());
+    start[P + 1] = long(adjacent.size());
   }
   cells_of = {};
-  // Column 3s+d of K holds rows 3t+e for every neighbour t, e = 0..2; of M rows 3t+d.
-  const long n = 3L * n_nodes, nnz_node = start[n_nodes];
-  auto shape = [&](SparseMatrix* A, int block) {
+  // Every column of model node P has the same rows: all DOFs of each neighbour Q for K; for M
+  // only the like component when P and Q are both free 3-DOF nodes (consistent mass couples
+  // like components), all DOFs of Q otherwise. prefix_*[k]: offset of neighbour k's rows.
+  auto mass_rows = [&](int P, int Q) { return map.dofs[P] == 3 && map.dofs[Q] == 3 ? 1 : map.dofs[Q]; };
+  std::vector<long> prefix_k(adjacent.size()), prefix_m(adjacent.size());
+  std::vector<long> length_k(n_model_nodes), length_m(n_model_nodes);
+  double entries_k = 0;
+  for (int P = 0; P < n_model_nodes; ++P) {
+    long lk = 0, lm = 0;
+    for (long k = start[P]; k < start[P + 1]; ++k) {
+      prefix_k[k] = lk;
+      prefix_m[k] = lm;
+      lk += map.dofs[adjacent[k]];
+      lm += mass_rows(P, adjacent[k]);
+    }
+    length_k[P] = lk;
+    length_m[P] = lm;
+    entries_k += double(lk) * map.dofs[P];
+  }
+  if (entries_k > 2e9) throw InputError("mesh too large: more than 2^31 stiffness entries");
+  const long n = map.n_dofs;
+  auto shape = [&](SparseMatrix* A, bool mass) {
     *A = SparseMatrix(n, n);
-    A->resizeNonZeros(3 * block * nnz_node);
+    long total = 0;
+    for (int P = 0; P < n_model_nodes; ++P) total += map.dofs[P] * (mass ? length_m[P] : length_k[P]);
+    A->resizeNonZeros(total);
     int* outer = A->outerIndexPtr();
     int* inner = A->innerIndexPtr();
     long p = 0;
-    for (int s = 0; s < n_nodes; ++s)
-      for (int d = 0; d < 3; ++d) {
-        outer[3 * s + d] = int(p);
-        for (long k = start[s]; k < start[s + 1]; ++k) {
-          if (block == 3) {
-            for (int e = 0; e < 3; ++e) inner[p++] = 3 * adjacent[k] + e;
+    for (int P = 0; P < n_model_nodes; ++P)
+      for (int d = 0; d < map.dofs[P]; ++d) {
+        outer[map.first_dof[P] + d] = int(p);
+        for (long k = start[P]; k < start[P + 1]; ++k) {
+          const int Q = adjacent[k];
+          if (mass && mass_rows(P, Q) == 1) {
+            inner[p++] = map.first_dof[Q] + d;
           } else {
-            inner[p++] = 3 * adjacent[k] + d;
+            for (int c = 0; c < map.dofs[Q]; ++c) inner[p++] = map.first_dof[Q] + c;
           }
         }
       }
     outer[n] = int(p);
     std::fill(A->valuePtr(), A->valuePtr() + p, 0.0);
   };
-  if (3.0 * 3.0 * double(nnz_node) > 2e9) throw InputError("mesh too large: more than 2^31 stiffness entries");
-  shape(K, 3);
-  shape(M, 1);
+  shape(K, false);
+  shape(M, true);
   double* kv = K->valuePtr();
   double* mv = M->valuePtr();
+  const int* k_outer = K->outerIndexPtr();
+  const int* m_outer = M->outerIndexPtr();
   Eigen::MatrixXd X(per, 3);
-  std::vector<long> offset(per * per);  // position of node b in the neighbour list of node a
+  std::vector<int> nodes;         // the element's model nodes, ascending
+  std::vector<int> local_offset;  // their first column in the element's model DOFs
+  std::vector<int> a_of;          // uncoupled element: element node of the i-th model node
+  Eigen::MatrixXd Te, Ke, Me;
   for (long e = 0; e < n_cells; ++e) {
     for (int a = 0; a < per; ++a) X.row(a) = mesh.nodes.row(mesh.cells(e, a));
     const SolidElementMatrices em = ComputeSolidElement(mesh.type, X, material, e);
-    for (int a = 0; a < per; ++a) {
-      const int s = mesh.cells(e, a);
-      const int* first = adjacent.data() + start[s];
-      const int* last = adjacent.data() + start[s + 1];
-      for (int b = 0; b < per; ++b) offset[a * per + b] = std::lower_bound(first, last, mesh.cells(e, b)) - first;
+    nodes.clear();
+    for (int a = 0; a < per; ++a) nodes.push_back(map.model_node[mesh.cells(e, a)]);
+    std::sort(nodes.begin(), nodes.end());
+    nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
+    local_offset.assign(nodes.size() + 1, 0);
+    for (size_t i = 0; i < nodes.size(); ++i) local_offset[i + 1] = local_offset[i] + map.dofs[nodes[i]];
+    const int n_e = local_offset.back();
+    // Element matrices on the model DOFs: T_e^T K_e T_e (T_e = 1 when no node is coupled).
+    const bool coupled = n_e != 3 * per || int(nodes.size()) != per;
+    const Eigen::MatrixXd* ke = &em.K;
+    const Eigen::MatrixXd* me = &em.M;
+    if (coupled) {
+      Te.setZero(3 * per, n_e);
+      for (int a = 0; a < per; ++a) {
+        const int s = mesh.cells(e, a);
+        const int P = map.model_node[s];
+        const int col = local_offset[std::lower_bound(nodes.begin(), nodes.end(), P) - nodes.begin()];
+        Te.block<3, 3>(3 * a, col).setIdentity();
+        if (map.dofs[P] == 6) Te.block<3, 3>(3 * a, col + 3) = map.arm[s];
+      }
+      Ke = Te.transpose() * em.K * Te;
+      Me = Te.transpose() * em.M * Te;
+      ke = &Ke;
+      me = &Me;
+    } else {
+      // Uncoupled: element node a_of[i] is the i-th model node in ascending order.
+      a_of.resize(per);
+      for (int a = 0; a < per; ++a) {
+        const long i = std::lower_bound(nodes.begin(), nodes.end(), map.model_node[mesh.cells(e, a)]) - nodes.begin();
+        a_of[i] = a;
+      }
     }
-    for (int a = 0; a < per; ++a) {  // column node
-      const int s = mesh.cells(e, a);
-      for (int d = 0; d < 3; ++d) {
-        const long k_col = K->outerIndexPtr()[3 * s + d], m_col = M->outerIndexPtr()[3 * s + d];
-        for (int b = 0; b < per; ++b) {  // row node
-          const long k = offset[a * per + b];
-          for (int c = 0; c < 3; ++c) kv[k_col + 3 * k + c] += em.K(3 * b + c, 3 * a + d);
-          mv[m_col + k] += em.M(3 * b + d, 3 * a + d);
+    // Scatter: column DOF (P, d), row DOF (Q, c).
+    for (size_t i = 0; i < nodes.size(); ++i) {
+      const int P = nodes[i];
+      const int* first = adjacent.data() + start[P];
+      const int* last = adjacent.data() + start[P + 1];
+      for (size_t j = 0; j < nodes.size(); ++j) {
+        const int Q = nodes[j];
+        const long k = start[P] + (std::lower_bound(first, last, Q) - first);
+        const bool diagonal_mass = mass_rows(P, Q) == 1;
+        for (int d = 0; d < map.dofs[P]; ++d) {
+          // Local column of (P, d) and rows of Q in the element matrices; for an uncoupled
+          // element the local numbering is the element's node order, not the sorted one.
+          int col_local, row_local;
+          if (coupled) {
+            col_local = local_offset[i] + d;
+            row_local = local_offset[j];
+          } else {
+            col_local = 3 * a_of[i] + d;
+            row_local = 3 * a_of[j];
+          }
+          const long kc = k_outer[map.first_dof[P] + d] + prefix_k[k];
+          for (int c = 0; c < map.dofs[Q]; ++c) kv[kc + c] += (*ke)(row_local + c, col_local);
+          const long mc = m_outer[map.first_dof[P] + d] + prefix_m[k];
+          if (diagonal_mass) {
+            mv[mc] += (*me)(row_local + d, col_local);
+          } else {
+            for (int c = 0; c < map.dofs[Q]; ++c) mv[mc + c] += (*me)(row_local + c, col_local);
+          }
         }
       }
     }
@@ -145,14 +223,6 @@ FeModel BuildSolidModel(const PartSpec& part, const ProgressFn& progress) {
                  SolidTypeName(mesh->type) + " elements" + (request.file.empty() ? "" : " from " + request.file));
   }
 
-  // Element matrices on the mesh DOFs.
-  clock.Restart();
-  SparseMatrix K_mesh, M_mesh;
-  AssembleSolid(*mesh, part.material, &K_mesh, &M_mesh);
-  if (progress) {
-    progress("assembly", clock.Seconds(),
-             std::to_string(3L * n_nodes) + " mesh DOFs, " + std::to_string(K_mesh.nonZeros()) + " stiffness entries");
-  }
   clock.Restart();
 
   // Interface couplings (RBE2).
@@ -259,21 +329,40 @@ FeModel BuildSolidModel(const PartSpec& part, const ProgressFn& progress) {
   }
   SparseMatrix T(3 * n_nodes, n_model);
   T.setFromTriplets(t_entries.begin(), t_entries.end());
-  // T^T A T as two column-major products (an explicit T^T avoids Eigen's row-major temporaries),
-  // then symmetrized so that round-off leaves no asymmetry.
-  const SparseMatrix Tt = T.transpose();
-  auto congruence = [&](SparseMatrix& A) {
-    SparseMatrix AT = A * T;
-    A = SparseMatrix();
-    SparseMatrix B = Tt * AT;
-    AT = SparseMatrix();
-    const SparseMatrix Bt = B.transpose();
-    B += Bt;
-    B *= 0.5;
-    return B;
-  };
-  model.K = congruence(K_mesh);
-  model.M = congruence(M_mesh);
+  if (progress) {
+    progress("couplings", clock.Seconds(),
+             std::to_string(part.interfaces.size()) + " interfaces, " + std::to_string(n_model) + " model DOFs");
+  }
+
+  // Element matrices straight onto the model DOFs (RBE2 folded in per element).
+  clock.Restart();
+  SolidDofMap map;
+  map.n_dofs = n_model;
+  map.model_node.assign(n_nodes, -1);
+  map.arm.assign(n_nodes, Eigen::Matrix3d::Zero());
+  std::vector<int> interface_node(part.interfaces.size(), -1);
+  for (int s = 0; s < n_nodes; ++s) {
+    if (kept[3 * s] < 0) continue;
+    map.model_node[s] = int(map.first_dof.size());
+    map.first_dof.push_back(kept[3 * s]);
+    map.dofs.push_back(3);
+  }
+  for (size_t k = 0; k < part.interfaces.size(); ++k) {
+    if (rbe2_base[k] < 0) continue;
+    interface_node[k] = int(map.first_dof.size());
+    map.first_dof.push_back(rbe2_base[k]);
+    map.dofs.push_back(6);
+  }
+  for (int s = 0; s < n_nodes; ++s) {
+    if (kept[3 * s] >= 0) continue;
+    map.model_node[s] = interface_node[owner[s]];
+    map.arm[s] = -SkewOf(mesh->nodes.row(s).transpose() - model.interface_positions[owner[s]]);
+  }
+  AssembleSolid(*mesh, part.material, map, &model.K, &model.M);
+  if (progress) {
+    progress("assembly", clock.Seconds(),
+             std::to_string(mesh->cells.rows()) + " elements, " + std::to_string(model.K.nonZeros()) + " stiffness entries");
+  }
   for (size_t k = 0; k < part.interfaces.size(); ++k) {
     std::vector<FullDof> dofs;
     SparseMatrix W(0, n_model);
@@ -295,10 +384,6 @@ FeModel BuildSolidModel(const PartSpec& part, const ProgressFn& progress) {
   model.cells = mesh->cells;
   model.cell_type = SolidTypeName(mesh->type);
   model.element_type = SolidTypeName(mesh->type);
-  if (progress) {
-    progress("couplings", clock.Seconds(),
-             std::to_string(part.interfaces.size()) + " interfaces, " + std::to_string(model.n_dofs()) + " model DOFs, " + std::to_string(model.K.nonZeros()) + " stiffness entries");
-  }
 
   // Material point interpolation: displacement and small rotation (curl / 2) at x.
   model.interpolate_at = [mesh, T](const Eigen::Vector3d& x) -> std::optional<SparseMatrix> {

@@ -22,9 +22,22 @@ namespace femb {
 /// Reports the stages mesh, assembly and couplings through `progress` (may be null).
 FeModel BuildSolidModel(const PartSpec& part, const ProgressFn& progress = nullptr);
 
-/// Symmetric K and M of the mesh DOFs (3 per node) assembled into a sparsity pattern computed
-/// once from the node graph: K with full 3 x 3 node blocks, M with their diagonals only
-/// (consistent mass couples like components). No triplet lists: memory is the matrices.
-void AssembleSolid(const SolidMesh& mesh, const MaterialSpec& material, SparseMatrix* K, SparseMatrix* M);
+/// How mesh node s enters the model: its displacement is T_s q_P, P = model_node[s], whose
+/// model DOFs are first_dof[P] .. first_dof[P] + dofs[P] - 1: 3 for a free node (T_s = 1), 6 for
+/// an RBE2 interface node (T_s = [1, arm[s]], arm = -(x_s - x_k)~). Model nodes are numbered in
+/// the order of their first DOF.
+struct SolidDofMap {
+  std::vector<int> model_node;       ///< per mesh node
+  std::vector<int> first_dof, dofs;  ///< per model node
+  std::vector<Eigen::Matrix3d> arm;  ///< per mesh node (RBE2 nodes only)
+  int n_dofs = 0;
+};
+
+/// Symmetric K and M on the model DOFs, RBE2 couplings folded in element by element
+/// (T_e^T K_e T_e), assembled into a sparsity pattern computed once from the model-node graph:
+/// K with full node blocks, M with the diagonals only between free nodes (consistent mass
+/// couples like components). No triplet lists and no sparse products: memory is the matrices.
+void AssembleSolid(const SolidMesh& mesh, const MaterialSpec& material, const SolidDofMap& map, SparseMatrix* K,
+                   SparseMatrix* M);
 
 }  // namespace femb

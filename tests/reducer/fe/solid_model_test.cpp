@@ -141,7 +141,9 @@ TEST(SolidModel, CylinderAndTubeHaveTheMassPropertiesOfTheirGeometry) {
     // of the cylinder), within a tenth of an element (the mesh is unstructured).
     EXPECT_LT(se.interfaces[0].position.head<2>().norm(), 1.5e-3);
     EXPECT_LT(se.interfaces[1].position.head<2>().norm(), 1.5e-3);
-    if (!tube) EXPECT_LT(std::abs(se.interfaces[0].position.z()), 1e-9);
+    if (!tube) {
+      EXPECT_LT(std::abs(se.interfaces[0].position.z()), 1e-9);
+    }
   }
 }
 
