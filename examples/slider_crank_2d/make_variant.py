@@ -43,9 +43,9 @@ with open(os.path.join(out, "scene.yaml"), "w") as f:
 name: slider_crank_2d_{n}
 units: SI
 bodies:
-  - {{name: crank, superelement: {here}/crank.h5, nodes: {{O: O, A: A}}}}
+  - {{name: crank, superelement: {os.path.relpath(os.path.join(here, "crank.h5"), out)}, nodes: {{O: O, A: A}}}}
 {bodies}
-  - {{name: slider, superelement: {here}/slider.h5, placement: {{position: [0.45, 0, 0]}}, nodes: {{S: slider}}}}
+  - {{name: slider, superelement: {os.path.relpath(os.path.join(here, "slider.h5"), out)}, placement: {{position: [0.45, 0, 0]}}, nodes: {{S: slider}}}}
 joints:
   - {{type: revolute, node: O, axis: [0, 0, 1], prescribed: crank_angle}}
   - {{type: revolute, node: rod_a, parent: A, axis: [0, 0, 1]}}

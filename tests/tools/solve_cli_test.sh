@@ -106,7 +106,7 @@ PY
 # slider stays on its line, the crank angle is the prescribed 150 t.
 mkdir -p "$work/sc"
 cp "$src"/examples/slider_crank_2d/*.yaml "$work/sc/"
-for part in crank rod slider; do "$bin/femb-reduce" -q "$work/sc/$part.yaml" -o "$work/sc/$part.h5" || fail "reduce $part"; done
+for part in crank rod_2 slider; do "$bin/femb-reduce" -q "$work/sc/$part.yaml" -o "$work/sc/$part.h5" || fail "reduce $part"; done
 "$bin/femb-solve" -q "$work/sc/scene.yaml" -o "$work/sc_out" --set analysis.end_time=0.02 && ok || fail "slider crank"
 $py - "$work/sc_out" <<'PY' && ok || fail "slider crank results"
 import sys, h5py, numpy as np
