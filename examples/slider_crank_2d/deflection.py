@@ -3,9 +3,9 @@
 through rod_a and rod_b (positive to the left of a -> b, in the x-y plane), against the crank
 angle. Compares runs with a reference run, prints extremes and RMS errors, writes a PNG.
 
-usage: deflection.py REFERENCE_DIR [LABEL=RUN_DIR ...] [--png FILE] [--tol REL]
-Exit 1 when --tol is given and a run's RMS error over the whole history exceeds REL times the
-reference's peak deflection.
+usage: deflection.py REFERENCE_DIR [LABEL=RUN_DIR[@TOL] ...] [--png FILE]
+Exit 1 when a run's RMS error over the whole history exceeds its TOL (a fraction of the
+reference's peak deflection).
 """
 import argparse
 import csv
@@ -50,7 +50,6 @@ def main():
     ap.add_argument("reference")
     ap.add_argument("runs", nargs="*")
     ap.add_argument("--png")
-    ap.add_argument("--tol", type=float)
     a = ap.parse_args()
     ref_angle, ref_w = load(a.reference)
     peak = max(abs(v) for v in ref_w)
@@ -59,13 +58,17 @@ def main():
     bad = False
     for item in a.runs:
         label, run = item.split("=", 1)
+        tol = None
+        if "@" in run:
+            run, tol = run.rsplit("@", 1)
+            tol = float(tol)
         angle, w = load(run)
         err = [wi - interpolate(ref_angle, ref_w, ai) for ai, wi in zip(angle, w)]
         rms = math.sqrt(sum(e * e for e in err) / len(err))
         print(f"{label:>12}: {min(w) * 1e3:+.4f} .. {max(w) * 1e3:+.4f} mm, RMS error {rms * 1e3:.4f} mm "
-              f"= {rms / peak:.2%} of the reference peak")
-        if a.tol is not None and rms > a.tol * peak:
-            print(f"{label}: RMS error above the tolerance {a.tol:.1%} of the peak", file=sys.stderr)
+              f"= {rms / peak:.2%} of the reference peak" + (f" (tolerance {tol:.1%})" if tol else ""))
+        if tol is not None and rms > tol * peak:
+            print(f"{label}: RMS error above the tolerance {tol:.1%} of the peak", file=sys.stderr)
             bad = True
         curves.append((label, angle, w))
     if a.png:

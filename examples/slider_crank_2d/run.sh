@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # The seeds' 2D slider-crank (thesis 5.2) end to end: reduce the crank, the slider and the rod
-# segments, simulate three crank revolutions with the rod in 2 superelements (scene.yaml) and,
-# as the reference, in 10 superelements at half the step, then print the rod midpoint
-# deflection extremes and the error, and plot the deflection against the crank angle.
+# segments; simulate three crank revolutions (150 rad/s) with the rod in 2 superelements
+# (scene.yaml, the thesis's model), 4 and 10; compare the rod midpoint deflection with a
+# reference of 20 superelements at half the step; print extremes and RMS errors; plot them.
 # Usage: bash examples/slider_crank_2d/run.sh [OUTDIR]     (default out/slider_crank_2d)
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
@@ -12,14 +12,24 @@ mkdir -p "$out"
 for part in crank slider rod_2; do
   "$bin/femb-reduce" -q "$here/$part.yaml" -o "$here/$part.h5"
 done
-echo "slider_crank_2d: rod in 2 superelements (scene.yaml), h = 10 us"
-"$bin/femb-solve" "$here/scene.yaml" -o "$out/2_bodies"
-echo "slider_crank_2d: reference, rod in 10 superelements, h = 5 us"
-/usr/bin/python3 "$here/make_variant.py" 10 "$out/ref_10_bodies" 5e-6 > /dev/null
-"$bin/femb-reduce" -q "$out/ref_10_bodies/rod_10.yaml" -o "$out/ref_10_bodies/rod_10.h5"
-"$bin/femb-solve" "$out/ref_10_bodies/scene.yaml" -o "$out/ref_10_bodies"
-# The 2-body model against the 10-body reference: RMS error over the whole history within 5%
-# of the peak deflection (measured: see README.md).
-/usr/bin/python3 "$here/deflection.py" "$out/ref_10_bodies" "2 bodies=$out/2_bodies" \
-  --png "$out/midpoint_deflection.png" --tol 0.05
-echo "results: $out/2_bodies/{results.h5,probes.csv}, $out/ref_10_bodies/, plot $out/midpoint_deflection.png"
+run() {  # name, scene
+  local start=$SECONDS
+  "$bin/femb-solve" -q "$2" -o "$out/$1"
+  echo "slider_crank_2d: $1 done in $((SECONDS - start)) s"
+}
+run 2_bodies "$here/scene.yaml"
+for n in 4 10 20; do
+  dir="$out/${n}_bodies"
+  step=1e-5
+  [ $n = 20 ] && dir="$out/reference_20_bodies" && step=5e-6
+  /usr/bin/python3 "$here/make_variant.py" $n "$dir" $step > /dev/null
+  "$bin/femb-reduce" -q "$dir/rod_$n.yaml" -o "$dir/rod_$n.h5"
+  run "$(basename "$dir")" "$dir/scene.yaml"
+done
+# Tolerances (RMS error over the whole history, fraction of the reference peak): the models
+# converge with the number of bodies because each body is linear inside (the rod's axial force,
+# up to ~12% of its buckling load, changes its bending only through the bodies' relative
+# rotations); measured 7.1%, 1.7%, 0.21%.
+/usr/bin/python3 "$here/deflection.py" "$out/reference_20_bodies" "2 bodies=$out/2_bodies@0.10" \
+  "4 bodies=$out/4_bodies@0.03" "10 bodies=$out/10_bodies@0.005" --png "$out/midpoint_deflection.png"
+echo "results: $out/<model>/{results.h5,probes.csv,animation.xdmf}; plot $out/midpoint_deflection.png"
