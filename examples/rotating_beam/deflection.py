@@ -1,0 +1,78 @@
+#!/usr/bin/python3
+"""Tip deflection of the rotating beam relative to the line through the hinge and the beam's
+current centre of mass (the mean of its equal bodies' centre-of-mass floating frames), positive
+ahead in the direction of rotation; runs against a reference (RMS over time, relative to the
+reference's largest deflection); exit 1 above a run's tolerance; optional PNG.
+
+usage: deflection.py REFERENCE_DIR LABEL=RUN_DIR[@TOL] ... [--png FILE]
+"""
+import argparse
+import math
+import sys
+
+import h5py
+import numpy as np
+
+
+def load(run):
+    f = h5py.File(f"{run}/results.h5", "r")
+    t = f["time"][:]
+    names = [n.decode() if isinstance(n, bytes) else n for n in f["nodes/names"][:]]
+    pos = f["nodes/position"][:].reshape(len(t), len(names), 3)
+    tip = max((n for n in names if n.startswith("n")), key=lambda n: int(n[1:]))
+    hinge, end = pos[:, names.index("n0")], pos[:, names.index(tip)]
+    com = np.mean([f[f"bodies/{b}/floating_frame"][:, :3] for b in f["bodies"]], axis=0)
+    u = com - hinge
+    u /= np.linalg.norm(u, axis=1)[:, None]
+    r = end - hinge
+    return t, u[:, 0] * r[:, 1] - u[:, 1] * r[:, 0]
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("reference")
+    ap.add_argument("runs", nargs="+")
+    ap.add_argument("--png")
+    a = ap.parse_args()
+    t_ref, w_ref = load(a.reference)
+    peak = np.abs(w_ref).max()
+    print(f"reference {a.reference}: tip deflection {w_ref.min() * 1e3:+.3f} .. {w_ref.max() * 1e3:+.3f} mm")
+    bad, curves = False, [("reference", t_ref, w_ref)]
+    for item in a.runs:
+        label, run = item.split("=", 1)
+        tol = None
+        if "@" in run:
+            run, tol = run.rsplit("@", 1)
+            tol = float(tol)
+        t, w = load(run)
+        rms = math.sqrt(np.mean((w - np.interp(t, t_ref, w_ref)) ** 2))
+        line = (f"{label:>12}: tip deflection {w.min() * 1e3:+.3f} .. {w.max() * 1e3:+.3f} mm, RMS error "
+                f"{rms * 1e3:.3f} mm = {rms / peak:.2%} of the reference peak")
+        if tol is not None:
+            line += f" (tolerance {tol:.1%})"
+            if rms > tol * peak:
+                line += "  FAIL"
+                bad = True
+        print(line)
+        curves.append((label, t, w))
+    if a.png:
+        import matplotlib
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+        fig, ax = plt.subplots(figsize=(7, 4))
+        for label, t, w in curves:
+            ax.plot(t, w * 1e3, label=label, lw=2.5 if label == "reference" else 1.2,
+                    ls="-" if label == "reference" else "--")
+        ax.set_xlabel("time [s]")
+        ax.set_ylabel("tip deflection [mm]")
+        ax.set_title("rotating beam (100 rad/s), 50 N tip pulse for 0.01 s")
+        ax.grid(True, alpha=0.3)
+        ax.legend()
+        fig.tight_layout()
+        fig.savefig(a.png, dpi=120)
+        print(f"plot: {a.png}")
+    sys.exit(1 if bad else 0)
+
+
+if __name__ == "__main__":
+    main()
