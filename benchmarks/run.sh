@@ -12,3 +12,6 @@ echo
 # SOLID_SIZES=1e5,3e5 for a quick run.
 command -v ccx > /dev/null || apt-get install -y -q calculix-ccx > /dev/null
 /usr/bin/python3 benchmarks/solid_reduction_benchmark.py build/bin --sizes "${SOLID_SIZES:-1e5,3e5,1e6}"
+echo
+# Error vs run time on the 2D slider-crank (about 6 minutes): table and PNG.
+/usr/bin/python3 benchmarks/error_vs_time.py build/bin --png out/error_vs_time.png
