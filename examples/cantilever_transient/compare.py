@@ -8,7 +8,11 @@ usage: compare.py REFERENCE_DIR LABEL=RUN_DIR[@TOL] ... [--png FILE]
 import argparse
 import csv
 import math
+import os
 import sys
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+import histories  # noqa: E402
 
 
 def load(run):
@@ -42,41 +46,17 @@ def main():
     x_free = ref[0][1]
     peak = max(math.hypot(x - x_free, y) for _, x, y in ref)
     print(f"reference {a.reference}: largest tip displacement {peak:.4f} m")
-    bad, curves = False, [("reference", ref)]
+    ok, curves = True, [("reference", [p[0] for p in ref], [p[2] for p in ref])]
     for item in a.runs:
-        label, run = item.split("=", 1)
-        tol = None
-        if "@" in run:
-            run, tol = run.rsplit("@", 1)
-            tol = float(tol)
+        label, run, tol = histories.parse_run(item)
         hist = load(run)
         err = [math.hypot(x - at(ref, t)[1], y - at(ref, t)[2]) for t, x, y in hist]
-        rms = math.sqrt(sum(e * e for e in err) / len(err))
-        line = f"{label:>28}: RMS tip error {rms * 1e3:.2f} mm = {rms / peak:.2%} of the largest tip displacement"
-        if tol is not None:
-            line += f" (tolerance {tol:.1%})"
-            if rms > tol * peak:
-                line += "  FAIL"
-                bad = True
-        print(line)
-        curves.append((label, hist))
+        ok &= histories.check(label, err, peak, tol, detail="tip ")
+        curves.append((label, [p[0] for p in hist], [p[2] for p in hist]))
     if a.png:
-        import matplotlib
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-        fig, ax = plt.subplots(figsize=(7, 4))
-        for label, h in curves:
-            ax.plot([p[0] for p in h], [p[2] for p in h], label=label, lw=2.5 if label == "reference" else 1.2,
-                    ls="-" if label == "reference" else "--")
-        ax.set_xlabel("time [s]")
-        ax.set_ylabel("tip y [m]")
-        ax.set_title("transient cantilever, tip force 0 -> 2500 N in 0.05 s")
-        ax.grid(True, alpha=0.3)
-        ax.legend(fontsize=8)
-        fig.tight_layout()
-        fig.savefig(a.png, dpi=120)
-        print(f"plot: {a.png}")
-    sys.exit(1 if bad else 0)
+        histories.plot(curves, a.png, "time [s]", "tip y [m]", "transient cantilever, tip force 0 -> 2500 N in 0.05 s",
+                       y_scale=1.0)
+    sys.exit(0 if ok else 1)
 
 
 if __name__ == "__main__":

@@ -7,11 +7,14 @@ reference's largest deflection); exit 1 above a run's tolerance; optional PNG.
 usage: deflection.py REFERENCE_DIR LABEL=RUN_DIR[@TOL] ... [--png FILE]
 """
 import argparse
-import math
+import os
 import sys
 
 import h5py
 import numpy as np
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+import histories  # noqa: E402
 
 
 def load(run):
@@ -37,41 +40,16 @@ def main():
     t_ref, w_ref = load(a.reference)
     peak = np.abs(w_ref).max()
     print(f"reference {a.reference}: tip deflection {w_ref.min() * 1e3:+.3f} .. {w_ref.max() * 1e3:+.3f} mm")
-    bad, curves = False, [("reference", t_ref, w_ref)]
+    ok, curves = True, [("reference", t_ref, w_ref)]
     for item in a.runs:
-        label, run = item.split("=", 1)
-        tol = None
-        if "@" in run:
-            run, tol = run.rsplit("@", 1)
-            tol = float(tol)
+        label, run, tol = histories.parse_run(item)
         t, w = load(run)
-        rms = math.sqrt(np.mean((w - np.interp(t, t_ref, w_ref)) ** 2))
-        line = (f"{label:>12}: tip deflection {w.min() * 1e3:+.3f} .. {w.max() * 1e3:+.3f} mm, RMS error "
-                f"{rms * 1e3:.3f} mm = {rms / peak:.2%} of the reference peak")
-        if tol is not None:
-            line += f" (tolerance {tol:.1%})"
-            if rms > tol * peak:
-                line += "  FAIL"
-                bad = True
-        print(line)
+        err = list(w - np.interp(t, t_ref, w_ref))
+        ok &= histories.check(label, err, peak, tol, detail=f"tip deflection {w.min() * 1e3:+.3f} .. {w.max() * 1e3:+.3f} mm, ")
         curves.append((label, t, w))
     if a.png:
-        import matplotlib
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-        fig, ax = plt.subplots(figsize=(7, 4))
-        for label, t, w in curves:
-            ax.plot(t, w * 1e3, label=label, lw=2.5 if label == "reference" else 1.2,
-                    ls="-" if label == "reference" else "--")
-        ax.set_xlabel("time [s]")
-        ax.set_ylabel("tip deflection [mm]")
-        ax.set_title("rotating beam (100 rad/s), 50 N tip pulse for 0.01 s")
-        ax.grid(True, alpha=0.3)
-        ax.legend()
-        fig.tight_layout()
-        fig.savefig(a.png, dpi=120)
-        print(f"plot: {a.png}")
-    sys.exit(1 if bad else 0)
+        histories.plot(curves, a.png, "time [s]", "tip deflection [mm]", "rotating beam (100 rad/s), 50 N tip pulse for 0.01 s")
+    sys.exit(0 if ok else 1)
 
 
 if __name__ == "__main__":

@@ -10,7 +10,11 @@ reference's peak deflection).
 import argparse
 import csv
 import math
+import os
 import sys
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+import histories  # noqa: E402
 
 
 def load(run_dir):
@@ -55,39 +59,17 @@ def main():
     peak = max(abs(v) for v in ref_w)
     print(f"reference {a.reference}: midpoint deflection {min(ref_w) * 1e3:+.4f} .. {max(ref_w) * 1e3:+.4f} mm")
     curves = [("reference", ref_angle, ref_w)]
-    bad = False
+    ok = True
     for item in a.runs:
-        label, run = item.split("=", 1)
-        tol = None
-        if "@" in run:
-            run, tol = run.rsplit("@", 1)
-            tol = float(tol)
+        label, run, tol = histories.parse_run(item)
         angle, w = load(run)
         err = [wi - interpolate(ref_angle, ref_w, ai) for ai, wi in zip(angle, w)]
-        rms = math.sqrt(sum(e * e for e in err) / len(err))
-        print(f"{label:>12}: {min(w) * 1e3:+.4f} .. {max(w) * 1e3:+.4f} mm, RMS error {rms * 1e3:.4f} mm "
-              f"= {rms / peak:.2%} of the reference peak" + (f" (tolerance {tol:.1%})" if tol else ""))
-        if tol is not None and rms > tol * peak:
-            print(f"{label}: RMS error above the tolerance {tol:.1%} of the peak", file=sys.stderr)
-            bad = True
+        ok &= histories.check(label, err, peak, tol, detail=f"{min(w) * 1e3:+.4f} .. {max(w) * 1e3:+.4f} mm, ")
         curves.append((label, angle, w))
     if a.png:
-        import matplotlib
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-        fig, ax = plt.subplots(figsize=(7, 4))
-        for label, angle, w in curves:
-            ax.plot(angle, [v * 1e3 for v in w], label=label, lw=2.5 if label == "reference" else 1.2,
-                    ls="-" if label == "reference" else "--")
-        ax.set_xlabel("crank angle [rad]")
-        ax.set_ylabel("rod midpoint deflection [mm]")
-        ax.set_title("2D slider-crank, flexible rod (thesis 5.2)")
-        ax.grid(True, alpha=0.3)
-        ax.legend()
-        fig.tight_layout()
-        fig.savefig(a.png, dpi=120)
-        print(f"plot: {a.png}")
-    sys.exit(1 if bad else 0)
+        histories.plot(curves, a.png, "crank angle [rad]", "rod midpoint deflection [mm]",
+                       "2D slider-crank, flexible rod (thesis 5.2)")
+    sys.exit(0 if ok else 1)
 
 
 if __name__ == "__main__":
