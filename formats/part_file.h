@@ -72,7 +72,10 @@ struct SolidSpec {
 struct ReductionSpec {
   int internal_modes = 10;
   std::string floating_frame = "center_of_mass";
-  bool keep_mesh = true;  ///< store the mesh and mode shapes (visualization group)
+  /// Store the mesh and mode shapes (visualization group); unset: only for models up to
+  /// kKeepMeshMaxDofs DOFs (the shapes take n_dofs x n_reduced doubles).
+  std::optional<bool> keep_mesh;
+  static constexpr long kKeepMeshMaxDofs = 200000;
   int full_modes = 0;     ///< K lowest nonzero free-free frequencies of the full model
   double memory_limit_gb = 0;  ///< refuse when the Cholesky factor would exceed it (0: MemAvailable)
   std::string where_floating_frame;

@@ -81,7 +81,8 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
   se.mass_properties = ComputeMassProperties(se);
   se.floating_frame = ComputeFloatingFrame(part.reduction.floating_frame,
                                            part.reduction.where_floating_frame, se, model, cb.shapes);
-  if (part.reduction.keep_mesh) {
+  const bool keep_mesh = part.reduction.keep_mesh.value_or(model.n_dofs() <= ReductionSpec::kKeepMeshMaxDofs);
+  if (keep_mesh) {
     Visualization v;
     v.nodes = model.nodes;
     v.cells = model.cells;
@@ -96,7 +97,8 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
   prov.element_type = model.element_type;
   prov.n_nodes = model.n_nodes();
   prov.n_elements = model.n_elements();
-  report("frame+mass", clock.Seconds(), "floating frame " + se.floating_frame.type);
+  report("frame+mass", clock.Seconds(), "floating frame " + se.floating_frame.type +
+                                             (keep_mesh ? ", mesh and mode shapes kept" : ", mesh and mode shapes not kept (reduction.keep_mesh)"));
 
   if (part.reduction.full_modes > 0) {
     clock.Restart();

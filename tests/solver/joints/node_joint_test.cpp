@@ -119,7 +119,9 @@ TEST(NodeJoint, ConstraintsHoldExactlyAtAnyConfiguration) {
       EXPECT_LT((rel - Eigen::Matrix3d::Identity()).norm(), 1e-12);
       EXPECT_LT(offset.cross(j.axis).norm(), 1e-12);  // travel along the axis only
     }
-    if (j.type == JointType::kSpherical) EXPECT_LT(offset.norm(), 1e-12);
+    if (j.type == JointType::kSpherical) {
+      EXPECT_LT(offset.norm(), 1e-12);
+    }
     if (j.type == JointType::kCylindrical) {
       EXPECT_LT(offset.cross(j.axis).norm(), 1e-12);
       EXPECT_LT((rel * j.axis - j.axis).norm(), 1e-12);
@@ -195,7 +197,9 @@ void DoublePendulum(JointType second, const Eigen::Vector3d& spin) {
               drift_fine, y_fine);
   EXPECT_LT(y_fine, -0.5);        // it swings down
   // and out of the plane (measured 0.043 m; planar motion would keep z at round-off)
-  if (second == JointType::kUniversal) EXPECT_GT(max_z, 0.01);
+  if (second == JointType::kUniversal) {
+    EXPECT_GT(max_z, 0.01);
+  }
   EXPECT_LT(drift_fine, 1e-3);
   EXPECT_GT(drift_coarse / drift_fine, 3.0);  // second order: the error is the integrator's
 }
