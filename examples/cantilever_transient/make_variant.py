@@ -8,25 +8,14 @@ usage: make_variant.py OUTDIR N FRAME [STEP] [END_TIME]
 import os
 import sys
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+import tube  # noqa: E402
+
 out, n, frame = sys.argv[1], int(sys.argv[2]), sys.argv[3]
 step = float(sys.argv[4]) if len(sys.argv) > 4 else 5e-4
 end = float(sys.argv[5]) if len(sys.argv) > 5 else 0.25
 os.makedirs(out, exist_ok=True)
-L = 1.0 / n
-with open(os.path.join(out, "seg.yaml"), "w") as g:
-    g.write(f"""# 1/{n} of the seeds' cantilever tube: outer radius 0.01 m, wall 0.001 m, E = 70 GPa, rho = 2700 kg/m^3.
-name: seg
-type: beam
-units: SI
-material: {{E: 70.0e9, nu: 0.3, rho: 2700}}
-section: {{shape: tube, outer_radius: 0.01, wall: 0.001}}
-beam:
-  theory: euler_bernoulli
-  points: {{A: [0, 0, 0], B: [{L!r}, 0, 0]}}
-  segments: [{{from: A, to: B, elements: {max(4, 40 // n)}}}]
-interfaces: [{{name: A}}, {{name: B}}]
-reduction: {{internal_modes: {4 if n < 3 else 2}, floating_frame: '{frame}'}}
-""")
+L = tube.write_segment(out, n, frame)
 bodies = "\n".join(f"  - {{name: b{k}, superelement: seg.h5, placement: {{position: [{k * L!r}, 0, 0]}}, "
                    f"nodes: {{A: n{k}, B: n{k + 1}}}}}" for k in range(n))
 with open(os.path.join(out, "scene.yaml"), "w") as g:

@@ -36,6 +36,21 @@ class SolveShiftInvertOp {
   mutable long calls_ = 0;
 };
 
+// No eigenpairs asked (ok, no vectors) or more than the n_free unconstrained DOFs (an error):
+// true when `result` is final.
+bool NothingToSolve(int nev, long n, long n_free, EigenResult* result) {
+  if (nev <= 0) {
+    result->ok = true;
+    result->vectors.resize(n, 0);
+    return true;
+  }
+  if (nev > n_free) {
+    result->message = "asked for " + std::to_string(nev) + " eigenpairs of a " + std::to_string(n_free) + "-DOF problem";
+    return true;
+  }
+  return false;
+}
+
 void SortAscending(EigenResult& r) {
   std::vector<int> order(r.lambda.size());
   std::iota(order.begin(), order.end(), 0);
@@ -63,16 +78,7 @@ EigenResult LowestConstrainedEigenpairs(const SparseMatrix& K, const SparseMatri
   EigenResult result;
   const long n = K.rows();
   const long n_free = n - C.rows();
-  if (nev <= 0) {
-    result.ok = true;
-    result.vectors.resize(n, 0);
-    return result;
-  }
-  if (nev > n_free) {
-    result.message = "asked for " + std::to_string(nev) + " eigenpairs of a " + std::to_string(n_free) +
-                     "-DOF problem";
-    return result;
-  }
+  if (NothingToSolve(nev, n, n_free, &result)) return result;
   if (n <= dense_limit || 2 * nev + 1 > n_free) {
     // Basis Z of the null space of C (all of R^n without constraints).
     Eigen::MatrixXd Z = Eigen::MatrixXd::Identity(n, n);
@@ -129,15 +135,7 @@ EigenResult BlockLanczosEigenpairs(const SparseMatrix& K, const SparseMatrix& M,
   EigenResult result;
   const long n = K.rows();
   const long n_free = n - C.rows();
-  if (nev <= 0) {
-    result.ok = true;
-    result.vectors.resize(n, 0);
-    return result;
-  }
-  if (nev > n_free) {
-    result.message = "asked for " + std::to_string(nev) + " eigenpairs of a " + std::to_string(n_free) + "-DOF problem";
-    return result;
-  }
+  if (NothingToSolve(nev, n, n_free, &result)) return result;
   const long max_basis = std::min<long>(n_free, std::max<long>(12L * nev, 200));
   long passes = 0;
   // A X = (K - sigma M)^-1 M X on C x = 0, from M X.
