@@ -46,3 +46,31 @@ def plot(curves, png, xlabel, ylabel, title, y_scale=1e3):
     fig.tight_layout()
     fig.savefig(png, dpi=120)
     print(f"plot: {png}")
+
+
+def load_columns(run_dir, *columns):
+    """Columns of RUN_DIR/probes.csv as lists of floats, in the order asked."""
+    import csv
+    with open(f"{run_dir}/probes.csv") as f:
+        rows = list(csv.DictReader(f))
+    missing = [c for c in columns if rows and c not in rows[0]]
+    if missing:
+        sys.exit(f"{run_dir}/probes.csv: no column {missing[0]}")
+    return [[float(r[c]) for r in rows] for c in columns]
+
+
+def interpolate(xs, ys, x):
+    """Piecewise linear y(x) on ascending xs; clamped to the ends."""
+    if x <= xs[0]:
+        return ys[0]
+    if x >= xs[-1]:
+        return ys[-1]
+    lo, hi = 0, len(xs) - 1
+    while hi - lo > 1:
+        mid = (lo + hi) // 2
+        if xs[mid] <= x:
+            lo = mid
+        else:
+            hi = mid
+    t = (x - xs[lo]) / (xs[hi] - xs[lo])
+    return ys[lo] + t * (ys[hi] - ys[lo])

@@ -1,7 +1,9 @@
 #!/usr/bin/python3
 """Rod midpoint deflection of the slider-crank: the distance of probe rod_mid from the line
-through rod_a and rod_b (positive to the left of a -> b, in the x-y plane), against the crank
-angle. Compares runs with a reference run, prints extremes and RMS errors, writes a PNG.
+through rod_a and rod_b along the rod's y axis, y = z x (b - a) / |z x (b - a)| (the horizontal
+normal of the rod: in the planar mechanism, to the left of a -> b in the x-y plane; in the
+spatial one, the rod's local y axis, which its universal joint keeps horizontal), against the
+crank angle. Compares runs with a reference run, prints extremes and RMS errors, writes a PNG.
 
 usage: deflection.py REFERENCE_DIR [LABEL=RUN_DIR[@TOL] ...] [--png FILE]
 Exit 1 when a run's RMS error over the whole history exceeds its TOL (a fraction of the
@@ -26,27 +28,10 @@ def load(run_dir):
         b = [float(r[f"rod_b.position.{c}"]) for c in "xy"]
         m = [float(r[f"rod_mid.position.{c}"]) for c in "xy"]
         d = [b[0] - a[0], b[1] - a[1]]
-        length = math.hypot(*d)
-        # signed distance: (m - a) . n, n = ez x d / |d|
-        w.append(((m[0] - a[0]) * -d[1] + (m[1] - a[1]) * d[0]) / length)
+        # signed distance: (m - a) . y, y = ez x d / |ez x d| (no z component)
+        w.append(((m[0] - a[0]) * -d[1] + (m[1] - a[1]) * d[0]) / math.hypot(*d))
         angle.append(float(r["crank.joint.0"]))
     return angle, w
-
-
-def interpolate(xs, ys, x):
-    lo, hi = 0, len(xs) - 1
-    if x <= xs[0]:
-        return ys[0]
-    if x >= xs[-1]:
-        return ys[-1]
-    while hi - lo > 1:
-        mid = (lo + hi) // 2
-        if xs[mid] <= x:
-            lo = mid
-        else:
-            hi = mid
-    t = (x - xs[lo]) / (xs[hi] - xs[lo])
-    return ys[lo] + t * (ys[hi] - ys[lo])
 
 
 def main():
@@ -54,6 +39,7 @@ def main():
     ap.add_argument("reference")
     ap.add_argument("runs", nargs="*")
     ap.add_argument("--png")
+    ap.add_argument("--title", default="2D slider-crank, flexible rod (thesis 5.2)")
     a = ap.parse_args()
     ref_angle, ref_w = load(a.reference)
     peak = max(abs(v) for v in ref_w)
@@ -63,12 +49,12 @@ def main():
     for item in a.runs:
         label, run, tol = histories.parse_run(item)
         angle, w = load(run)
-        err = [wi - interpolate(ref_angle, ref_w, ai) for ai, wi in zip(angle, w)]
+        err = [wi - histories.interpolate(ref_angle, ref_w, ai) for ai, wi in zip(angle, w)]
         ok &= histories.check(label, err, peak, tol, detail=f"{min(w) * 1e3:+.4f} .. {max(w) * 1e3:+.4f} mm, ")
         curves.append((label, angle, w))
     if a.png:
         histories.plot(curves, a.png, "crank angle [rad]", "rod midpoint deflection [mm]",
-                       "2D slider-crank, flexible rod (thesis 5.2)")
+                       a.title)
     sys.exit(0 if ok else 1)
 
 
