@@ -80,6 +80,18 @@ void Writer::Vector(const std::string& name, const Eigen::VectorXd& value) {
   WriteDoubles(name, {hsize_t(value.size())}, value.data());
 }
 
+void Writer::FloatMatrix(const std::string& name, const Eigen::MatrixXf& value) {
+  Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> row_major = value;
+  hsize_t shape[2] = {hsize_t(value.rows()), hsize_t(value.cols())};
+  Handle space = Own(H5Screate_simple(2, shape, nullptr));
+  Handle set = Own(H5Dcreate2(file_.id(), name.c_str(), H5T_IEEE_F32LE, space.id(), H5P_DEFAULT,
+                              H5P_DEFAULT, H5P_DEFAULT));
+  if (set.id() < 0 ||
+      H5Dwrite(set.id(), H5T_NATIVE_FLOAT, H5S_ALL, H5S_ALL, H5P_DEFAULT, row_major.data()) < 0) {
+    throw InputError(path_ + ": cannot write dataset " + name);
+  }
+}
+
 void Writer::Scalar(const std::string& name, double value) { WriteDoubles(name, {}, &value); }
 
 void Writer::IntMatrix(const std::string& name, const Eigen::MatrixXi& value) {

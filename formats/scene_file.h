@@ -95,6 +95,7 @@ struct SceneSpec {
   SceneAnalysisSpec analysis;
   std::vector<SceneProbeSpec> probes;
   bool animation = true;  ///< write animation.xdmf/.h5 when the superelement files hold meshes
+  int animation_every = 1;  ///< one animation frame per this many output steps
   /// Initial velocity (spatial) of named nodes: (linear, angular).
   std::map<std::string, std::pair<Eigen::Vector3d, Eigen::Vector3d>> initial_velocities;
   /// Initial joint rates of named nodes that have a joint (revolute: angular rate, ...).

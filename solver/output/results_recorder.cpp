@@ -105,8 +105,8 @@ void ResultsRecorder::Record(double t, const SystemState& state, const Eigen::Ve
   }
   joints_.push_back(Eigen::Map<Eigen::VectorXd>(joint_values.data(), long(joint_values.size())));
   frames_.push_back(frames);
-  if (scene_.spec.animation) {
-    std::vector<Eigen::MatrixXd> meshes;
+  if (scene_.spec.animation && (time_.size() - 1) % size_t(scene_.spec.animation_every) == 0) {
+    std::vector<Eigen::MatrixXf> meshes;
     for (size_t b = 0; b < model.bodies.size(); ++b) {
       const auto& mesh = scene_.meshes[b];
       if (!mesh) {
@@ -116,14 +116,15 @@ void ResultsRecorder::Record(double t, const SystemState& state, const Eigen::Ve
       const BodyConfiguration c = BodyConfigurationOf(model, state, int(b));
       const Eigen::VectorXd q = model.bodies[b].LocalCoordinates(c, state.frames[b]);
       const Eigen::VectorXd u = mesh->shapes * q;
-      Eigen::MatrixXd x(mesh->nodes.rows(), 3);
+      Eigen::MatrixXf x(mesh->nodes.rows(), 3);
       for (int i = 0; i < mesh->nodes.rows(); ++i) {
         const Eigen::Vector3d X = mesh->nodes.row(i).transpose() - scene_.mesh_origin[b];
         const Eigen::Vector3d ui = u.segment<3>(mesh->dofs_per_node * i);
-        x.row(i) = (state.frames[b].x + state.frames[b].R * (X + ui)).transpose();
+        x.row(i) = (state.frames[b].x + state.frames[b].R * (X + ui)).transpose().cast<float>();
       }
       meshes.push_back(x);
     }
+    frame_time_.push_back(time_.back());
     mesh_positions_.push_back(meshes);
   }
 
@@ -224,7 +225,7 @@ void ResultsRecorder::WriteAnimation() {
     n_nodes += scene_.meshes[b]->nodes.rows();
     n_cells += scene_.meshes[b]->cells.rows();
   }
-  if (!scene_.spec.animation || with_mesh.empty() || time_.empty()) return;
+  if (!scene_.spec.animation || with_mesh.empty() || frame_time_.empty()) return;
   const int per_cell = int(scene_.meshes[with_mesh[0]]->cells.cols());
   Eigen::MatrixXi cells(n_cells, per_cell);
   Eigen::MatrixXd body(n_cells, 1);
@@ -241,19 +242,19 @@ void ResultsRecorder::WriteAnimation() {
   const std::string pid = std::to_string(::getpid());
   {
     h5::Writer w(h5 + ".tmp." + pid);
-    Eigen::MatrixXd x0;
+    Eigen::MatrixXf x0;
     w.IntMatrix("/cells", cells);
     w.Matrix("/body", body);
-    for (size_t s = 0; s < time_.size(); ++s) {
-      Eigen::MatrixXd x(n_nodes, 3);
+    for (size_t s = 0; s < frame_time_.size(); ++s) {
+      Eigen::MatrixXf x(n_nodes, 3);
       long offset = 0;
       for (int b : with_mesh) {
         x.middleRows(offset, mesh_positions_[s][b].rows()) = mesh_positions_[s][b];
         offset += mesh_positions_[s][b].rows();
       }
-      w.Matrix("/x_" + std::to_string(s), x);
+      w.FloatMatrix("/x_" + std::to_string(s), x);
       if (s == 0) x0 = x;
-      w.Matrix("/displacement_" + std::to_string(s), x - x0);
+      w.FloatMatrix("/displacement_" + std::to_string(s), x - x0);
     }
     w.Close();
   }
@@ -261,21 +262,21 @@ void ResultsRecorder::WriteAnimation() {
   std::ofstream out(xdmf + ".tmp." + pid);
   out << "<?xml version=\"1.0\" ?>\n<Xdmf Version=\"3.0\">\n <Domain>\n"
       << "  <Grid Name=\"" << scene_.spec.name << "\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
-  for (size_t s = 0; s < time_.size(); ++s) {
+  for (size_t s = 0; s < frame_time_.size(); ++s) {
     out << "   <Grid Name=\"step " << s << "\" GridType=\"Uniform\">\n"
-        << "    <Time Value=\"" << Num(time_[s]) << "\"/>\n"
+        << "    <Time Value=\"" << Num(frame_time_[s]) << "\"/>\n"
         << "    <Topology TopologyType=\"" << topology << "\" NumberOfElements=\"" << n_cells << "\"";
     if (cell_type == "line2") out << " NodesPerElement=\"2\"";
     out << ">\n     <DataItem Dimensions=\"" << n_cells << " " << per_cell
         << "\" NumberType=\"Int\" Precision=\"4\" Format=\"HDF\">animation.h5:/cells</DataItem>\n    </Topology>\n"
         << "    <Geometry GeometryType=\"XYZ\">\n     <DataItem Dimensions=\"" << n_nodes
-        << " 3\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">animation.h5:/x_" << s
+        << " 3\" NumberType=\"Float\" Precision=\"4\" Format=\"HDF\">animation.h5:/x_" << s
         << "</DataItem>\n    </Geometry>\n"
         << "    <Attribute Name=\"body\" AttributeType=\"Scalar\" Center=\"Cell\">\n     <DataItem Dimensions=\""
         << n_cells << " 1\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">animation.h5:/body</DataItem>\n"
         << "    </Attribute>\n"
         << "    <Attribute Name=\"displacement\" AttributeType=\"Vector\" Center=\"Node\">\n     <DataItem Dimensions=\""
-        << n_nodes << " 3\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">animation.h5:/displacement_" << s
+        << n_nodes << " 3\" NumberType=\"Float\" Precision=\"4\" Format=\"HDF\">animation.h5:/displacement_" << s
         << "</DataItem>\n    </Attribute>\n   </Grid>\n";
   }
   out << "  </Grid>\n </Domain>\n</Xdmf>\n";

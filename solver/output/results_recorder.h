@@ -37,7 +37,10 @@ class ResultsRecorder {
   std::vector<Eigen::VectorXd> positions_, quaternions_, velocities_, angular_velocities_, joints_;
   std::vector<std::vector<Eigen::VectorXd>> modal_;     // per step, per body
   std::vector<std::vector<Eigen::VectorXd>> frames_;    // per step, per body: x (3), quaternion (4)
-  std::vector<std::vector<Eigen::MatrixXd>> mesh_positions_;  // per step, per body with a mesh
+  // Per animation frame (every animation_every-th output step): its time, and per body with a
+  // mesh the deformed node positions (single precision: a solid part's mesh is large).
+  std::vector<double> frame_time_;
+  std::vector<std::vector<Eigen::MatrixXf>> mesh_positions_;
   void WriteAnimation();
   bool JointNode(int k) const;
 };
