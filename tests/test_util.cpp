@@ -2,11 +2,49 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <sstream>
 
 #include "reducer/reduce_part.h"
 
 namespace femb::test {
+
+// Elastica of a cantilever under a tip load P that stays vertical: theta(s) the downward
+// rotation, EI theta'' = -P cos(theta), theta(0) = 0, theta'(L) = 0. Its first integral
+// EI theta'^2 / 2 = P (sin theta_L - sin theta) gives theta'(0) = sqrt(2 P sin(theta_L) / EI) for
+// a tip angle theta_L in (0, pi/2); shooting on theta_L by bisection: the arc length at which
+// theta' first reaches 0 (theta = theta_L) grows monotonically with theta_L and must equal L.
+// RK4, 4000 steps.
+// Returns the tip (horizontal shortening, downward deflection).
+Eigen::Vector2d ElasticaTip(double P, double EI, double L) {
+  auto shoot = [&](double theta_L, Eigen::Vector2d* tip) {
+    const int n = 4000;
+    const double h = L / n;
+    Eigen::Vector4d y(0, std::sqrt(2 * P * std::sin(theta_L) / EI), 0, 0);  // theta, theta', x, w
+    auto rhs = [&](const Eigen::Vector4d& s) {
+      return Eigen::Vector4d(s[1], -P / EI * std::cos(s[0]), std::cos(s[0]), std::sin(s[0]));
+    };
+    bool stopped = false;  // theta' reached 0 before s = L
+    for (int i = 0; i < n; ++i) {
+      const Eigen::Vector4d k1 = rhs(y), k2 = rhs(y + 0.5 * h * k1), k3 = rhs(y + 0.5 * h * k2), k4 = rhs(y + h * k3);
+      y += h / 6 * (k1 + 2 * k2 + 2 * k3 + k4);
+      stopped |= y[1] < 0;
+    }
+    if (tip) *tip = Eigen::Vector2d(L - y[2], y[3]);
+    return stopped;
+  };
+  double lo = 1e-9, hi = M_PI / 2 - 1e-12;
+  EXPECT_TRUE(shoot(lo, nullptr));
+  EXPECT_FALSE(shoot(hi, nullptr));
+  for (int i = 0; i < 100; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (shoot(mid, nullptr) ? lo : hi) = mid;
+  }
+  Eigen::Vector2d tip;
+  shoot(0.5 * (lo + hi), &tip);
+  return tip;
+}
+
 
 std::string StraightBeamYaml(double L, int elements, const std::string& section,
                              const std::string& material, const std::string& interfaces,

@@ -1,6 +1,7 @@
 // Helpers shared by the tests: parts built from text, reduced in memory.
 #pragma once
 
+#include <Eigen/Core>
 #include <string>
 
 #include "formats/part_file.h"
@@ -13,6 +14,11 @@ namespace femb::test {
 std::string StraightBeamYaml(double L, int elements, const std::string& section,
                              const std::string& material, const std::string& interfaces,
                              const std::string& extra = "");
+
+/// Elastica of a clamped inextensible Euler-Bernoulli cantilever (bending stiffness EI, length
+/// L) under a tip force P that stays perpendicular to the undeformed axis, by shooting with RK4
+/// (4000 steps) on the tip angle: the tip's (horizontal shortening, deflection).
+Eigen::Vector2d ElasticaTip(double P, double EI, double L);
 
 /// Parses and reduces; fails the calling test on error.
 Superelement Reduce(const std::string& yaml, const std::vector<std::string>& overrides = {});

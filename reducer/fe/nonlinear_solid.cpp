@@ -1,0 +1,231 @@
+#include "reducer/fe/nonlinear_solid.h"
+
+#include <Eigen/Dense>
+#include <Eigen/SparseCholesky>
+#include <cmath>
+#include <cstdio>
+
+#include "formats/input_error.h"
+
+namespace femb {
+namespace {
+
+using Vector6 = Eigen::Matrix<double, 6, 1>;
+
+// dN/dX (n x 3) and dV at every quadrature point of one element; throws for inverted elements.
+void ElementPoints(SolidType type, const Eigen::MatrixXd& X, long element_id, std::vector<Eigen::MatrixXd>* dNdX,
+                   std::vector<double>* dV) {
+  std::vector<Eigen::Vector3d> points;
+  std::vector<double> weights;
+  SolidQuadrature(type, &points, &weights);
+  Eigen::VectorXd N;
+  Eigen::MatrixXd dN;
+  const double size = (X.rowwise() - X.colwise().mean()).rowwise().norm().maxCoeff();
+  for (size_t q = 0; q < points.size(); ++q) {
+    SolidShapeFunctions(type, points[q], &N, &dN);
+    const Eigen::Matrix3d J = X.transpose() * dN;
+    const double det = J.determinant();
+    if (!(det > 1e-10 * size * size * size)) {
+      char buffer[200];
+      std::snprintf(buffer, sizeof buffer, "element %ld (%s): inverted or degenerate (det J = %.3g at a quadrature point)",
+                    element_id, SolidTypeName(type).c_str(), det);
+      throw InputError(buffer);
+    }
+    dNdX->push_back(dN * J.inverse());
+    dV->push_back(det * weights[q]);
+  }
+}
+
+// One quadrature point: adds its energy, force and (optionally) tangent to the element's.
+// `U` is the element's displacements as n x 3.
+void AddPoint(const Eigen::MatrixXd& g, double dV, const Eigen::Matrix<double, 6, 6>& D, const Eigen::MatrixXd& U,
+              NonlinearElementState* out, bool with_tangent) {
+  const int n = int(g.rows());
+  const Eigen::Matrix3d G = U.transpose() * g;  // G_ij = d u_i / d X_j
+  const Eigen::Matrix3d F = Eigen::Matrix3d::Identity() + G;
+  const Eigen::Matrix3d E = 0.5 * (G + G.transpose() + G.transpose() * G);
+  Vector6 Ev;
+  Ev << E(0, 0), E(1, 1), E(2, 2), 2 * E(1, 2), 2 * E(0, 2), 2 * E(0, 1);
+  const Vector6 Sv = D * Ev;
+  Eigen::Matrix3d S;
+  S << Sv[0], Sv[5], Sv[4], Sv[5], Sv[1], Sv[3], Sv[4], Sv[3], Sv[2];
+  out->energy += 0.5 * Ev.dot(Sv) * dV;
+  const Eigen::Matrix3d P = F * S;  // first Piola-Kirchhoff stress
+  const Eigen::MatrixXd f = g * P.transpose() * dV;  // n x 3: f_a = P grad N_a
+  for (int a = 0; a < n; ++a) out->force.segment<3>(3 * a) += f.row(a).transpose();
+  if (!with_tangent) return;
+  Eigen::MatrixXd B(6, 3 * n);
+  for (int a = 0; a < n; ++a)
+    for (int i = 0; i < 3; ++i) {
+      const Eigen::Vector3d fi = F.row(i).transpose(), ga = g.row(a).transpose();
+      B.col(3 * a + i) << fi[0] * ga[0], fi[1] * ga[1], fi[2] * ga[2], fi[1] * ga[2] + fi[2] * ga[1],
+          fi[0] * ga[2] + fi[2] * ga[0], fi[0] * ga[1] + fi[1] * ga[0];
+    }
+  out->tangent.noalias() += dV * B.transpose() * D * B;
+  const Eigen::MatrixXd H = dV * g * S * g.transpose();  // geometric stiffness, n x n
+  for (int a = 0; a < n; ++a)
+    for (int b = 0; b < n; ++b)
+      for (int i = 0; i < 3; ++i) out->tangent(3 * a + i, 3 * b + i) += H(a, b);
+}
+
+Eigen::MatrixXd AsRows(const Eigen::VectorXd& u_e) {
+  return Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>>(u_e.data(), u_e.size() / 3, 3);
+}
+
+}  // namespace
+
+NonlinearElementState SvkSolidElement(SolidType type, const Eigen::MatrixXd& X, const MaterialSpec& material,
+                                      const Eigen::VectorXd& u, bool with_tangent) {
+  const int n = SolidNodeCount(type);
+  std::vector<Eigen::MatrixXd> dNdX;
+  std::vector<double> dV;
+  ElementPoints(type, X, 0, &dNdX, &dV);
+  NonlinearElementState out;
+  out.force = Eigen::VectorXd::Zero(3 * n);
+  if (with_tangent) out.tangent = Eigen::MatrixXd::Zero(3 * n, 3 * n);
+  const Eigen::Matrix<double, 6, 6> D = IsotropicElasticity(material.E, material.nu);
+  const Eigen::MatrixXd U = AsRows(u);
+  for (size_t q = 0; q < dNdX.size(); ++q) AddPoint(dNdX[q], dV[q], D, U, &out, with_tangent);
+  if (with_tangent) out.tangent = 0.5 * (out.tangent + out.tangent.transpose()).eval();
+  return out;
+}
+
+SvkSolidMesh::SvkSolidMesh(SolidType type, const Eigen::MatrixXd& nodes, const Eigen::MatrixXi& cells,
+                           const MaterialSpec& material)
+    : n_per_cell_(SolidNodeCount(type)),
+      n_nodes_(nodes.rows()),
+      cells_(cells),
+      D_(IsotropicElasticity(material.E, material.nu)) {
+  std::vector<Eigen::Vector3d> points;
+  std::vector<double> weights;
+  SolidQuadrature(type, &points, &weights);
+  points_per_cell_ = int(points.size());
+  dNdX_.reserve(size_t(cells.rows()) * points.size());
+  dV_.reserve(dNdX_.capacity());
+  Eigen::MatrixXd X(n_per_cell_, 3);
+  for (long c = 0; c < cells.rows(); ++c) {
+    for (int a = 0; a < n_per_cell_; ++a) X.row(a) = nodes.row(cells(c, a));
+    ElementPoints(type, X, c + 1, &dNdX_, &dV_);
+  }
+}
+
+template <class Visit>
+void SvkSolidMesh::ForEachPoint(const Eigen::VectorXd& u, Visit visit) const {
+  Eigen::VectorXd u_e(3 * n_per_cell_);
+  for (long c = 0; c < cells_.rows(); ++c) {
+    for (int a = 0; a < n_per_cell_; ++a) u_e.segment<3>(3 * a) = u.segment<3>(3 * long(cells_(c, a)));
+    const Eigen::MatrixXd U = AsRows(u_e);
+    visit(c, U, size_t(c) * points_per_cell_);
+  }
+}
+
+double SvkSolidMesh::Energy(const Eigen::VectorXd& u) const {
+  double energy = 0.0;
+  NonlinearElementState e;
+  ForEachPoint(u, [&](long, const Eigen::MatrixXd& U, size_t first) {
+    e.energy = 0.0;
+    e.force = Eigen::VectorXd::Zero(3 * n_per_cell_);
+    for (int q = 0; q < points_per_cell_; ++q) AddPoint(dNdX_[first + q], dV_[first + q], D_, U, &e, false);
+    energy += e.energy;
+  });
+  return energy;
+}
+
+Eigen::VectorXd SvkSolidMesh::Force(const Eigen::VectorXd& u) const {
+  Eigen::VectorXd f = Eigen::VectorXd::Zero(n_dofs());
+  NonlinearElementState e;
+  ForEachPoint(u, [&](long c, const Eigen::MatrixXd& U, size_t first) {
+    e.force = Eigen::VectorXd::Zero(3 * n_per_cell_);
+    for (int q = 0; q < points_per_cell_; ++q) AddPoint(dNdX_[first + q], dV_[first + q], D_, U, &e, false);
+    for (int a = 0; a < n_per_cell_; ++a) f.segment<3>(3 * long(cells_(c, a))) += e.force.segment<3>(3 * a);
+  });
+  return f;
+}
+
+SparseMatrix SvkSolidMesh::Tangent(const Eigen::VectorXd& u) const {
+  std::vector<Eigen::Triplet<double>> triplets;
+  triplets.reserve(size_t(cells_.rows()) * 9 * n_per_cell_ * n_per_cell_);
+  NonlinearElementState e;
+  ForEachPoint(u, [&](long c, const Eigen::MatrixXd& U, size_t first) {
+    e.force = Eigen::VectorXd::Zero(3 * n_per_cell_);
+    e.tangent = Eigen::MatrixXd::Zero(3 * n_per_cell_, 3 * n_per_cell_);
+    for (int q = 0; q < points_per_cell_; ++q) AddPoint(dNdX_[first + q], dV_[first + q], D_, U, &e, true);
+    for (int a = 0; a < n_per_cell_; ++a)
+      for (int b = 0; b < n_per_cell_; ++b)
+        for (int i = 0; i < 3; ++i)
+          for (int k = 0; k < 3; ++k)
+            triplets.emplace_back(3 * cells_(c, a) + i, 3 * cells_(c, b) + k,
+                                  0.5 * (e.tangent(3 * a + i, 3 * b + k) + e.tangent(3 * b + k, 3 * a + i)));
+  });
+  SparseMatrix K(n_dofs(), n_dofs());
+  K.setFromTriplets(triplets.begin(), triplets.end());
+  return K;
+}
+
+NonlinearStaticResult SolveNonlinearStatic(const SvkSolidMesh& solid, const SparseMatrix& T_in,
+                                           const std::vector<int>& prescribed_dofs,
+                                           const Eigen::VectorXd& prescribed_values, const Eigen::VectorXd& f_ext,
+                                           int steps, double tolerance, int max_iterations) {
+  SparseMatrix T = T_in;
+  if (T.size() == 0) {
+    T.resize(solid.n_dofs(), solid.n_dofs());
+    T.setIdentity();
+  }
+  const long n = T.cols();
+  std::vector<char> fixed(size_t(n), 0);
+  for (int d : prescribed_dofs) fixed[size_t(d)] = 1;
+  std::vector<int> free;
+  for (long d = 0; d < n; ++d)
+    if (!fixed[size_t(d)]) free.push_back(int(d));
+  // Selection of the free DOFs: S (n x n_free).
+  SparseMatrix S(n, long(free.size()));
+  {
+    std::vector<Eigen::Triplet<double>> t;
+    for (size_t k = 0; k < free.size(); ++k) t.emplace_back(free[k], int(k), 1.0);
+    S.setFromTriplets(t.begin(), t.end());
+  }
+  const SparseMatrix TS = T * S;
+  NonlinearStaticResult result;
+  Eigen::VectorXd u = Eigen::VectorXd::Zero(n);
+  for (int step = 1; step <= steps; ++step) {
+    const double lambda = double(step) / steps;
+    for (size_t k = 0; k < prescribed_dofs.size(); ++k) u[prescribed_dofs[k]] = lambda * prescribed_values[long(k)];
+    int it = 0;
+    Eigen::VectorXd r;
+    for (;; ++it) {
+      const Eigen::VectorXd f_model = T.transpose() * solid.Force(T * u);
+      r = f_model - lambda * f_ext;
+      const Eigen::VectorXd r_free = S.transpose() * r;
+      const double scale = std::max({(lambda * f_ext).norm(), (r - S * r_free).norm(), 1e-300});
+      if (!std::isfinite(r_free.norm())) {
+        result.converged = false;
+        result.message = "residual is not finite at load factor " + std::to_string(lambda);
+        return result;
+      }
+      if (it > 0 && r_free.norm() <= tolerance * scale) break;
+      if (it == max_iterations) {
+        result.converged = false;
+        char buffer[200];
+        std::snprintf(buffer, sizeof buffer, "no convergence at load factor %.4g after %d Newton iterations (residual %.3g of %.3g)",
+                      lambda, it, r_free.norm(), scale);
+        result.message = buffer;
+        return result;
+      }
+      const SparseMatrix K = SparseMatrix(TS.transpose() * solid.Tangent(T * u) * TS);
+      Eigen::SimplicialLDLT<SparseMatrix> solver(K);
+      if (solver.info() != Eigen::Success) {
+        result.converged = false;
+        result.message = "singular tangent at load factor " + std::to_string(lambda);
+        return result;
+      }
+      u -= S * solver.solve(r_free);
+    }
+    result.load_factor.push_back(lambda);
+    result.u.push_back(u);
+    result.reaction.push_back(r);
+    result.iterations.push_back(it);
+  }
+  return result;
+}
+
+}  // namespace femb

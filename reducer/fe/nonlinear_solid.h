@@ -1,0 +1,72 @@
+// Geometrically nonlinear solids (issue 6): total Lagrangian, Green-Lagrange strain, St. Venant-
+// Kirchhoff material on the same elements and quadrature as the linear model.
+//   G = grad_X u,  F = 1 + G,  E = (G + G^T + G^T G) / 2,  S = D E (Voigt, engineering shear),
+//   W = int E : S / 2 dV,  f_a = int F S grad N_a dV,
+//   K_ab = int [ (grad N_a . S grad N_b) 1 + B_a^T D B_b ] dV,  B_a = d E / d u_a = sym(F^T (e_i x grad N_a)).
+// The strain is quadratic in u, so the internal force is exactly cubic in u: its expansion about
+// u = 0 is K0 u + f2(u, u) + f3(u, u, u), the basis of the modal derivatives (thesis 8.3) and of
+// the reduced polynomial internal force. At u = 0 the tangent is the linear stiffness of
+// solid_element.h.
+#pragma once
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "formats/part_file.h"
+#include "reducer/fe/fe_model.h"
+#include "reducer/fe/solid_element.h"
+
+namespace femb {
+
+struct NonlinearElementState {
+  double energy = 0.0;
+  Eigen::VectorXd force;    ///< 3 n
+  Eigen::MatrixXd tangent;  ///< 3 n x 3 n (only when asked)
+};
+
+/// One element: `X` n x 3 node coordinates, `u` its 3 n displacements (node-major).
+NonlinearElementState SvkSolidElement(SolidType type, const Eigen::MatrixXd& X, const MaterialSpec& material,
+                                      const Eigen::VectorXd& u, bool with_tangent);
+
+/// A whole mesh (3 DOFs per mesh node, node-major), quadrature data computed once.
+class SvkSolidMesh {
+ public:
+  SvkSolidMesh(SolidType type, const Eigen::MatrixXd& nodes, const Eigen::MatrixXi& cells,
+               const MaterialSpec& material);
+  long n_dofs() const { return 3 * n_nodes_; }
+  double Energy(const Eigen::VectorXd& u) const;
+  Eigen::VectorXd Force(const Eigen::VectorXd& u) const;
+  /// Symmetric, both triangles stored.
+  SparseMatrix Tangent(const Eigen::VectorXd& u) const;
+
+ private:
+  // Per quadrature point: dN/dX (n x 3) and the volume weight; per element, its points.
+  template <class Visit>
+  void ForEachPoint(const Eigen::VectorXd& u, Visit visit) const;
+  int n_per_cell_;
+  long n_nodes_;
+  Eigen::MatrixXi cells_;
+  Eigen::Matrix<double, 6, 6> D_;
+  int points_per_cell_;
+  std::vector<Eigen::MatrixXd> dNdX_;  ///< cell-major, points_per_cell_ per cell
+  std::vector<double> dV_;
+};
+
+/// Static equilibrium of a full nonlinear model by Newton with load stepping:
+///   T^T f(T u) = lambda f_ext  on the free model DOFs, u = prescribed values on the others
+///   (the prescribed values are scaled by lambda too), lambda = 1/steps ... 1.
+/// `T` maps model DOFs to mesh DOFs (FeModel::mesh_map; identity when empty).
+struct NonlinearStaticResult {
+  std::vector<double> load_factor;
+  std::vector<Eigen::VectorXd> u;         ///< model DOFs per converged step
+  std::vector<Eigen::VectorXd> reaction;  ///< T^T f(T u) - lambda f_ext on all model DOFs
+  std::vector<int> iterations;
+  bool converged = true;
+  std::string message;  ///< why it stopped, when not converged
+};
+NonlinearStaticResult SolveNonlinearStatic(const SvkSolidMesh& solid, const SparseMatrix& T,
+                                           const std::vector<int>& prescribed_dofs,
+                                           const Eigen::VectorXd& prescribed_values, const Eigen::VectorXd& f_ext,
+                                           int steps, double tolerance = 1e-9, int max_iterations = 30);
+
+}  // namespace femb
