@@ -340,6 +340,26 @@ PartSpec ParsePart(const std::string& text, const std::string& name,
     if (auto v = m.Optional("keep_mesh")) part.reduction.keep_mesh = v->Bool();
     if (auto v = m.Optional("full_modes")) part.reduction.full_modes = int(v->NonNegativeInteger());
     if (auto v = m.Optional("memory_limit_gb")) part.reduction.memory_limit_gb = v->PositiveNumber();
+    if (auto v = m.Optional("modal_derivatives")) {
+      ModalDerivativeSpec& d = part.reduction.modal_derivatives;
+      d.where = v->Where();
+      if (v->IsScalar()) {
+        d.enabled = v->Bool();
+      } else {
+        d.enabled = true;
+        YamlMap dm = v->Map();
+        if (auto o = dm.Optional("of")) d.of = o->OneOf({"all", "static", "internal"}, "(which coordinates are paired)");
+        if (auto t = dm.Optional("tolerance")) d.tolerance = t->PositiveNumber();
+        if (auto p = dm.Optional("pairs")) {
+          for (const YamlValue& item : p->List()) {
+            const std::vector<YamlValue> ij = item.List();
+            if (ij.size() != 2) item.Fail("a pair is two reduced coordinate indices, e.g. [1, 7]");
+            d.pairs.emplace_back(int(ij[0].NonNegativeInteger()), int(ij[1].NonNegativeInteger()));
+          }
+        }
+        dm.CheckNoUnknownKeys();
+      }
+    }
     m.CheckNoUnknownKeys();
   }
   if (part.reduction.where_floating_frame.empty()) part.reduction.where_floating_frame = name;

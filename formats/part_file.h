@@ -69,8 +69,19 @@ struct SolidSpec {
   std::string where;
 };
 
+/// Modal derivatives (thesis 8.3): theta_ij = -K_ii^-1 (dK/dq_j) phi_i of pairs of reduced
+/// coordinates' shapes, zero at the interfaces, deflated against the basis and M-orthonormalized.
+struct ModalDerivativeSpec {
+  bool enabled = false;
+  std::string of = "all";  ///< all | static | internal: every pair (i <= j) of those coordinates
+  std::vector<std::pair<int, int>> pairs;  ///< explicit reduced coordinate indices (then 'of' unused)
+  double tolerance = 1e-4;  ///< drop a vector whose M-norm falls below this fraction when deflated
+  std::string where;
+};
+
 struct ReductionSpec {
   int internal_modes = 10;
+  ModalDerivativeSpec modal_derivatives;
   std::string floating_frame = "center_of_mass";
   /// Store the mesh and mode shapes (visualization group); unset: only for models up to
   /// kKeepMeshMaxDofs DOFs (the shapes take n_dofs x n_reduced doubles).

@@ -10,6 +10,21 @@ std::string ReducedCoordinateLabel(const Superelement& se, int i) {
     return se.interfaces[i / 6].name + "." + kComponents[i % 6];
   }
   int mode = i - se.n_interface_dofs();
+  if (mode >= se.n_internal_modes()) {
+    const int d = mode - se.n_internal_modes();
+    std::string label = "derivative " + std::to_string(d + 1);
+    if (d < int(se.modal_derivative_pairs.size())) {
+      const auto [a, b] = se.modal_derivative_pairs[size_t(d)];
+      const auto base = [&](int k) {
+        return k < se.n_interface_dofs() + se.n_internal_modes() ? ReducedCoordinateLabel(se, k) : std::to_string(k);
+      };
+      std::string la = base(a), lb = base(b);
+      for (std::string* l : {&la, &lb})
+        if (l->rfind("mode ", 0) == 0) *l = l->substr(0, l->find(" ("));
+      label += " (" + la + " x " + lb + ")";
+    }
+    return label;
+  }
   char buffer[64];
   std::snprintf(buffer, sizeof buffer, "mode %d (%.6g Hz)", mode + 1,
                 se.internal_frequencies_hz[mode]);

@@ -83,6 +83,9 @@ struct Superelement {
   long n_full_dofs = 0;
   Eigen::VectorXd full_free_free_frequencies_hz;  ///< optional (empty when not computed)
   long n_modal_derivatives = 0;
+  /// The reduced coordinates (i, j) whose shapes each modal derivative differentiates:
+  /// theta = -K_ii^-1 (dK/dq_j) phi_i before deflation (n_modal_derivatives pairs).
+  std::vector<std::pair<int, int>> modal_derivative_pairs;
   std::optional<Visualization> visualization;
   Provenance provenance;
 
@@ -92,7 +95,8 @@ struct Superelement {
   int n_reduced_dofs() const { return int(K.rows()); }
 };
 
-/// Label of reduced coordinate i, e.g. "A.u_x", "B.theta_z", "mode 3 (512.4 Hz)".
+/// Label of reduced coordinate i, e.g. "A.u_x", "B.theta_z", "mode 3 (512.4 Hz)",
+/// "derivative 2 (B.u_y x mode 1)".
 std::string ReducedCoordinateLabel(const Superelement& se, int i);
 
 /// Rigid-body modes of the interface coordinates about `origin` (thesis 3.20):

@@ -52,6 +52,12 @@ void WriteContent(const Superelement& se, h5::Writer& w) {
   w.Attribute("/reduced", "n_internal_modes", long(se.n_internal_modes()));
   w.Attribute("/reduced", "n_modal_derivatives", se.n_modal_derivatives);
   w.Vector("/reduced/internal_frequencies_hz", se.internal_frequencies_hz);
+  if (se.n_modal_derivatives > 0) {
+    Eigen::MatrixXi pairs(long(se.modal_derivative_pairs.size()), 2);
+    for (size_t k = 0; k < se.modal_derivative_pairs.size(); ++k)
+      pairs.row(long(k)) << se.modal_derivative_pairs[k].first, se.modal_derivative_pairs[k].second;
+    w.IntMatrix("/reduced/modal_derivative_pairs", pairs);
+  }
 
   w.CreateGroup("/floating_frame");
   w.Attribute("/floating_frame", "type", se.floating_frame.type);
@@ -185,6 +191,11 @@ Superelement ReadSuperelementFile(const std::string& path, const SuperelementRea
   RequireShape(r, "/reduced/M", n, n);
   se.K = r.Matrix("/reduced/K");
   se.M = r.Matrix("/reduced/M");
+  if (se.n_modal_derivatives > 0) {
+    RequireShape(r, "/reduced/modal_derivative_pairs", se.n_modal_derivatives, 2);
+    const Eigen::MatrixXi pairs = r.IntMatrix("/reduced/modal_derivative_pairs");
+    for (long k = 0; k < pairs.rows(); ++k) se.modal_derivative_pairs.emplace_back(pairs(k, 0), pairs(k, 1));
+  }
 
   se.floating_frame.type = r.StringAttribute("/floating_frame", "type");
   RequireShape(r, "/floating_frame/origin", 3, -1);

@@ -2,9 +2,11 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <memory>
 
 #include "formats/input_error.h"
 #include "reducer/fe/beam_model.h"
+#include "reducer/fe/nonlinear_solid.h"
 #include "reducer/fe/solid_model.h"
 #include "reducer/linalg/sparse_cholesky.h"
 #include "reducer/reduction/craig_bampton.h"
@@ -16,6 +18,36 @@
 #endif
 
 namespace femb {
+namespace {
+
+// The pairs of Craig-Bampton coordinates whose modal derivatives are asked for.
+std::vector<std::pair<int, int>> DerivativePairs(const PartSpec& part, int n_interface_dofs, int n_cb) {
+  const ModalDerivativeSpec& spec = part.reduction.modal_derivatives;
+  if (!spec.pairs.empty()) {
+    for (const auto& [i, j] : spec.pairs) {
+      if (i >= n_cb || j >= n_cb) {
+        throw InputError(spec.where + ".pairs: [" + std::to_string(i) + ", " +
+                         std::to_string(j) + "] is not a pair of the " + std::to_string(n_cb) +
+                         " Craig-Bampton coordinates (0-based: interfaces' 6 each, then the internal modes)");
+      }
+    }
+    return spec.pairs;
+  }
+  const int first = spec.of == "internal" ? n_interface_dofs : 0;
+  const int last = spec.of == "static" ? n_interface_dofs : n_cb;
+  std::vector<std::pair<int, int>> pairs;
+  for (int i = first; i < last; ++i)
+    for (int j = i; j < last; ++j) pairs.emplace_back(i, j);
+  return pairs;
+}
+
+SolidType SolidTypeOf(const std::string& name) {
+  for (SolidType t : {SolidType::kTet4, SolidType::kTet10, SolidType::kHex8, SolidType::kHex20})
+    if (SolidTypeName(t) == name) return t;
+  throw InputError("no solid element type '" + name + "'");
+}
+
+}  // namespace
 
 ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
   ReduceResult result;
@@ -50,7 +82,40 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
   const double limit = part.reduction.memory_limit_gb > 0 ? part.reduction.memory_limit_gb * 1e9
                                                           : AvailableMemoryBytes();
   const double factor_budget = limit > 0 ? std::max(limit - dense_bytes, 0.1 * limit) : 0.0;
-  const CraigBamptonResult cb = CraigBamptonReduce(model, part.reduction.internal_modes, report, 200, factor_budget);
+  // Modal derivatives: (dK/dq_j) phi_i = 2 f2(phi_i, phi_j), the symmetric bilinear part of the
+  // cubic internal force f(u) = K u + f2(u, u) + f3(u, u, u) of the Green-Lagrange model, by the
+  // exact polarization identity 8 f2(a, b) = [f(a + b) - f(a - b)] - [f(b - a) - f(-a - b)]
+  // (the linear and cubic terms cancel), evaluated at displacements scaled to 1e-6 of the part
+  // size (round-off ~1e-10 relative).
+  DerivativeRequest request;
+  std::unique_ptr<SvkSolidMesh> solid;
+  if (part.reduction.modal_derivatives.enabled) {
+    if (part.type != "solid") {
+      throw InputError(part.reduction.modal_derivatives.where +
+                       ": only solid parts so far (the beam's moderate-rotation "
+                       "kernel is not implemented); model the flexure with type: solid");
+    }
+    request.pairs = DerivativePairs(part, n_b, n_b + m);
+    request.tolerance = part.reduction.modal_derivatives.tolerance;
+    solid = std::make_unique<SvkSolidMesh>(SolidTypeOf(model.cell_type), model.nodes, model.cells, part.material);
+    const double size = (model.nodes.colwise().maxCoeff() - model.nodes.colwise().minCoeff()).norm();
+    request.stiffness_derivative = [&, size](const Eigen::MatrixXd& shapes, const std::vector<std::pair<int, int>>& pairs) {
+      const SparseMatrix& T = model.mesh_map;
+      const Eigen::MatrixXd mesh_shapes = T * shapes;
+      Eigen::MatrixXd out(model.n_dofs(), long(pairs.size()));
+      for (size_t k = 0; k < pairs.size(); ++k) {
+        const Eigen::VectorXd a0 = mesh_shapes.col(pairs[k].first), b0 = mesh_shapes.col(pairs[k].second);
+        const double sa = 1e-6 * size / std::max(a0.cwiseAbs().maxCoeff(), 1e-300);
+        const double sb = 1e-6 * size / std::max(b0.cwiseAbs().maxCoeff(), 1e-300);
+        const Eigen::VectorXd a = sa * a0, b = sb * b0;
+        const Eigen::VectorXd f2 = ((solid->Force(a + b) - solid->Force(a - b)) - (solid->Force(b - a) - solid->Force(-a - b))) / 8;
+        out.col(long(k)) = T.transpose() * (2 * f2 / (sa * sb));
+      }
+      return out;
+    };
+  }
+  const CraigBamptonResult cb = CraigBamptonReduce(model, part.reduction.internal_modes, report, 200, factor_budget,
+                                                   request.pairs.empty() ? nullptr : &request);
   if (!cb.ok) {
     result.too_big = cb.factorization.too_big;
     result.message = cb.message;
@@ -78,6 +143,8 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
   se.internal_frequencies_hz.resize(cb.lambda.size());
   for (int k = 0; k < cb.lambda.size(); ++k) se.internal_frequencies_hz[k] = FrequencyHz(cb.lambda[k]);
   se.n_full_dofs = model.n_dofs();
+  se.n_modal_derivatives = long(cb.derivative_pairs.size());
+  se.modal_derivative_pairs = cb.derivative_pairs;
   se.mass_properties = ComputeMassProperties(se);
   se.floating_frame = ComputeFloatingFrame(part.reduction.floating_frame,
                                            part.reduction.where_floating_frame, se, model, cb.shapes);

@@ -92,14 +92,15 @@ SolidMesh MeshWithGmsh(const MeshRequest& r) {
       for (const auto& [dim, tag] : faces) {
         double x0, y0, z0, x1, y1, z1;
         gmsh::model::getBoundingBox(dim, tag, x0, y0, z0, x1, y1, z1);
-        // OpenCASCADE pads bounding boxes slightly: a face is flat in the direction where its
-        // extent is (nearly) zero; min or max by where its middle lies.
-        const double tol = 1e-4 * r.size.minCoeff();
+        // OpenCASCADE pads bounding boxes (by ~1e-7 absolute, more than a thin plate's relative
+        // tolerance): a face is flat in the direction of its smallest extent relative to the
+        // box; min or max by where its middle lies.
         const Eigen::Vector3d lo(x0, y0, z0), hi(x1, y1, z1);
+        const Eigen::Vector3d extent = (hi - lo).cwiseQuotient(r.size);
+        int d = 0;
+        extent.minCoeff(&d);
         const char* names[3][2] = {{"xmin", "xmax"}, {"ymin", "ymax"}, {"zmin", "zmax"}};
-        for (int d = 0; d < 3; ++d) {
-          if (hi[d] - lo[d] < tol) surface_entities[names[d][0.5 * (lo[d] + hi[d]) > 0.5 * r.size[d]]].push_back(tag);
-        }
+        surface_entities[names[d][0.5 * (lo[d] + hi[d]) > 0.5 * r.size[d]]].push_back(tag);
       }
     } else {
       if (r.hexahedra) throw InputError(r.where + ": hexahedral meshing is available for the built-in box only");

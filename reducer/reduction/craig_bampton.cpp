@@ -1,6 +1,7 @@
 #include "reducer/reduction/craig_bampton.h"
 
 #include <Eigen/Cholesky>
+#include <Eigen/SparseCholesky>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -68,6 +69,30 @@ Blocks Partition(const SparseMatrix& A, const std::vector<int>& interior_index,
 
 }  // namespace
 
+Eigen::MatrixXd RigidFields(const FeModel& model) {
+  const long n = model.n_dofs();
+  auto rigid = [](const Eigen::Vector3d& x, bool with_rotation) {
+    Eigen::MatrixXd r = Eigen::MatrixXd::Zero(with_rotation ? 6 : 3, 6);
+    r.topLeftCorner<3, 3>().setIdentity();
+    r.block<3, 3>(0, 3) << 0, x.z(), -x.y(), -x.z(), 0, x.x(), x.y(), -x.x(), 0;  // theta x x = -x~ theta
+    if (with_rotation) r.bottomRightCorner<3, 3>().setIdentity();
+    return r;
+  };
+  if (model.mesh_map.size() == 0) {  // beams: 6 DOFs per node
+    Eigen::MatrixXd R(n, 6);
+    for (long k = 0; k < model.n_nodes(); ++k) R.middleRows(6 * k, 6) = rigid(model.nodes.row(k).transpose(), true);
+    return R;
+  }
+  // Solids: the mesh field is rigid; the model field is the one T maps onto it (least squares,
+  // exact: T maps rigid model motions, RBE2 nodes included, to rigid mesh motions).
+  const SparseMatrix& T = model.mesh_map;
+  Eigen::MatrixXd R_mesh(T.rows(), 6);
+  for (long k = 0; k < model.n_nodes(); ++k) R_mesh.middleRows(3 * k, 3) = rigid(model.nodes.row(k).transpose(), false);
+  const SparseMatrix TtT = SparseMatrix(T.transpose() * T);
+  Eigen::SimplicialLDLT<SparseMatrix> normal(TtT);
+  return normal.solve(Eigen::MatrixXd(T.transpose() * R_mesh));
+}
+
 std::vector<int> InteriorDofs(const FeModel& model) {
   std::vector<char> is_boundary(model.n_dofs(), 0);
   for (const auto& dofs : model.interface_dofs) {
@@ -81,7 +106,8 @@ std::vector<int> InteriorDofs(const FeModel& model) {
 }
 
 CraigBamptonResult CraigBamptonReduce(const FeModel& model, int internal_modes,
-                                      const ProgressFn& progress, long dense_limit, double memory_limit_bytes) {
+                                      const ProgressFn& progress, long dense_limit, double memory_limit_bytes,
+                                      const DerivativeRequest* derivatives) {
   CraigBamptonResult r;
   Stopwatch clock;
   const int n = int(model.n_dofs());
@@ -203,6 +229,19 @@ CraigBamptonResult CraigBamptonReduce(const FeModel& model, int internal_modes,
   // W x = 0); a distributing interface's six coordinates set to unit values (W x = e_j) at
   // least strain energy: x0 = Y S^-1 (stationary for F; corrected for K when shifted).
   Eigen::MatrixXd Psi_b = n_b > 0 ? Eigen::MatrixXd(-stiffness_solve(Eigen::MatrixXd(K.ib))) : Eigen::MatrixXd(n_i, 0);
+  // Rigid motions exactly: mathematically the static modes reproduce them (Psi_b R_b = R_i for
+  // the rigid fields R); in floating point only to cond(K_ii) times the round-off of K R = 0,
+  // which a thin part (a 0.5 mm leaf: 3e-8) makes visible in Phi_CB Phi_rig0 = 1. A rank-6
+  // correction Psi_b += (R_i - Psi_b R_b) (R_b^T R_b)^-1 R_b^T restores it to round-off; it
+  // changes the static modes by that residual only. (DOF interfaces only.)
+  if (n_b > 0 && n_c == 0) {
+    const Eigen::MatrixXd R = RigidFields(model);
+    Eigen::MatrixXd R_b(n_b, 6), R_i(n_i, 6);
+    for (int k = 0; k < n_b; ++k) R_b.row(k) = R.row(boundary[k]);
+    for (int k = 0; k < n_i; ++k) R_i.row(k) = R.row(interior[k]);
+    const Eigen::MatrixXd G = R_b.transpose() * R_b;
+    Psi_b += (R_i - Psi_b * R_b) * G.ldlt().solve(R_b.transpose());
+  }
   Eigen::MatrixXd Psi_c(n_i, n_c);
   if (n_c > 0) {
     Psi_c = Y * S.solve(Eigen::MatrixXd::Identity(n_c, n_c));
@@ -251,14 +290,48 @@ CraigBamptonResult CraigBamptonReduce(const FeModel& model, int internal_modes,
   // modal blocks of K_r are K-orthogonal and Phi_i^T K Phi_i = Lambda up to the eigen solve's
   // residual; femb-inspect shows both).
   clock.Restart();
-  const int m = internal_modes, n_r = 6 * n_interfaces + m;
-  r.shapes = Eigen::MatrixXd::Zero(n, n_r);
-  for (int k = 0; k < n_b; ++k) r.shapes(boundary[k], boundary_coordinate[k]) = 1.0;
+  const int m = internal_modes, n_cb = 6 * n_interfaces + m;
+  Eigen::MatrixXd shapes = Eigen::MatrixXd::Zero(n, n_cb);
+  for (int k = 0; k < n_b; ++k) shapes(boundary[k], boundary_coordinate[k]) = 1.0;
   for (int k = 0; k < n_i; ++k) {
-    for (int j = 0; j < n_b; ++j) r.shapes(interior[k], boundary_coordinate[j]) = Psi_b(k, j);
-    for (int j = 0; j < n_c; ++j) r.shapes(interior[k], constraint_coordinate[j]) = Psi_c(k, j);
-    if (m > 0) r.shapes.row(interior[k]).tail(m) = Phi_i.row(k);
+    for (int j = 0; j < n_b; ++j) shapes(interior[k], boundary_coordinate[j]) = Psi_b(k, j);
+    for (int j = 0; j < n_c; ++j) shapes(interior[k], constraint_coordinate[j]) = Psi_c(k, j);
+    if (m > 0) shapes.row(interior[k]).tail(m) = Phi_i.row(k);
   }
+  // Modal derivatives: interior solves with the interfaces held, deflation, normalization.
+  Eigen::MatrixXd Theta(n_i, 0);
+  if (derivatives && !derivatives->pairs.empty()) {
+    const Eigen::MatrixXd dK = derivatives->stiffness_derivative(shapes, derivatives->pairs);
+    Eigen::MatrixXd z(n_i, dK.cols());
+    for (int k = 0; k < n_i; ++k) z.row(k) = -dK.row(interior[k]);
+    const Eigen::MatrixXd raw = stiffness_solve(z);
+    Theta.resize(n_i, raw.cols());
+    int kept = 0;
+    for (long c = 0; c < raw.cols(); ++c) {
+      Eigen::VectorXd v = raw.col(c);
+      const double before = std::sqrt(std::max(v.dot(M.ii * v), 0.0));
+      for (int pass = 0; pass < 2; ++pass) {
+        if (m > 0) v -= Phi_i * (Phi_i.transpose() * (M.ii * v));
+        if (kept > 0) v -= Theta.leftCols(kept) * (Theta.leftCols(kept).transpose() * (M.ii * v));
+      }
+      const double after = std::sqrt(std::max(v.dot(M.ii * v), 0.0));
+      if (!(before > 0) || after <= derivatives->tolerance * before) continue;
+      Theta.col(kept++) = v / after;
+      r.derivative_pairs.push_back(derivatives->pairs[size_t(c)]);
+    }
+    Theta.conservativeResize(n_i, kept);
+    if (progress) {
+      progress("modal derivatives", clock.Seconds(),
+               Format("%.0f of %.0f kept (deflation tolerance ", double(kept), double(raw.cols())) +
+                   Format("%.1e), %.0f linear solves", derivatives->tolerance, double(raw.cols())));
+    }
+    clock.Restart();
+  }
+  const int d = int(Theta.cols()), n_r = n_cb + d;
+  r.shapes = Eigen::MatrixXd::Zero(n, n_r);
+  r.shapes.leftCols(n_cb) = shapes;
+  for (int k = 0; k < n_i; ++k)
+    if (d > 0) r.shapes.row(interior[k]).tail(d) = Theta.row(k);
   const Eigen::MatrixXd K_shapes = model.K * r.shapes;  // evaluated first: Eigen would nest it lazily
   r.K = r.shapes.transpose() * K_shapes;
   const Eigen::MatrixXd M_shapes = model.M * r.shapes;

@@ -5,17 +5,35 @@
 //   basis                     Phi = [1 0; Psi_c Phi_i]
 //   reduced                   K_r = Phi^T K Phi = [K_bb + K_bi Psi_c, 0; 0, Lambda]
 //                             M_r = Phi^T M Phi
-// ordered [interface 1 (u, theta), ..., interface N, internal modes].
+// ordered [interface 1 (u, theta), ..., interface N, internal modes, modal derivatives].
+// Modal derivatives (thesis 8.3, after Idelsohn & Cardona and Wu & Tiso): for pairs (i, j) of
+// the basis vectors, theta_ij = -K_ii^-1 ((dK/dq_j) phi_i)_i with the interfaces held (8.22-8.23:
+// zero at the interface DOFs, W theta = 0 at RBE3 interfaces), on the same factor; then deflated
+// against the internal modes and the derivatives kept so far in the M_ii inner product (twice,
+// classical Gram-Schmidt), dropped when less than `tolerance` of the M-norm remains, and
+// M-normalized.
 #pragma once
 
 #include <Eigen/Core>
+#include <functional>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "reducer/fe/fe_model.h"
 #include "reducer/linalg/sparse_cholesky.h"
 #include "reducer/progress.h"
 
 namespace femb {
+
+struct DerivativeRequest {
+  std::vector<std::pair<int, int>> pairs;  ///< indices into the Craig-Bampton coordinates
+  double tolerance = 1e-4;
+  /// (dK/dq_j) phi_i on the full model DOFs, one column per pair, given the Craig-Bampton
+  /// shapes (n_full x (6N + m)).
+  std::function<Eigen::MatrixXd(const Eigen::MatrixXd& shapes, const std::vector<std::pair<int, int>>& pairs)>
+      stiffness_derivative;
+};
 
 struct CraigBamptonResult {
   bool ok = false;
@@ -26,13 +44,19 @@ struct CraigBamptonResult {
   FactorizationInfo factorization;
   long eigen_linear_solves = 0;
   bool dense_eigen = false;
+  std::vector<std::pair<int, int>> derivative_pairs;  ///< of the derivatives kept, in order
 };
 
 /// `internal_modes` fixed-interface modes are kept. Reports stages through `progress`. With
 /// `memory_limit_bytes` > 0, refuses (factorization.too_big) when the factor of K_ii would not fit.
+/// `derivatives` (optional) appends modal derivatives to the basis.
 CraigBamptonResult CraigBamptonReduce(const FeModel& model, int internal_modes,
                                       const ProgressFn& progress, long dense_limit = 200,
-                                      double memory_limit_bytes = 0);
+                                      double memory_limit_bytes = 0, const DerivativeRequest* derivatives = nullptr);
+
+/// The six rigid-body motions (translations, rotations about the part origin) as fields on the
+/// model DOFs, n_dofs x 6.
+Eigen::MatrixXd RigidFields(const FeModel& model);
 
 /// The interior DOFs (all DOFs not used by an interface), ascending.
 std::vector<int> InteriorDofs(const FeModel& model);
