@@ -2,6 +2,7 @@
 // Written and read by superelement_file.h; the on-disk schema is in SUPERELEMENT_FORMAT.md.
 #pragma once
 
+#include "formats/reduced_polynomial.h"
 #include <Eigen/Core>
 #include <optional>
 #include <string>
@@ -86,6 +87,9 @@ struct Superelement {
   /// The reduced coordinates (i, j) whose shapes each modal derivative differentiates:
   /// theta = -K_ii^-1 (dK/dq_j) phi_i before deflation (n_modal_derivatives pairs).
   std::vector<std::pair<int, int>> modal_derivative_pairs;
+  /// With modal derivatives: the quadratic and cubic coefficients of the reduced Green-Lagrange
+  /// internal force (reduced_polynomial.h); the solver then uses it in place of K q.
+  std::optional<PolynomialStiffness> polynomial;
   std::optional<Visualization> visualization;
   Provenance provenance;
 

@@ -58,6 +58,11 @@ void WriteContent(const Superelement& se, h5::Writer& w) {
       pairs.row(long(k)) << se.modal_derivative_pairs[k].first, se.modal_derivative_pairs[k].second;
     w.IntMatrix("/reduced/modal_derivative_pairs", pairs);
   }
+  if (se.polynomial) {
+    w.CreateGroup("/reduced/polynomial");
+    w.Matrix("/reduced/polynomial/A", se.polynomial->A);
+    w.Matrix("/reduced/polynomial/B", se.polynomial->B);
+  }
 
   w.CreateGroup("/floating_frame");
   w.Attribute("/floating_frame", "type", se.floating_frame.type);
@@ -195,6 +200,12 @@ Superelement ReadSuperelementFile(const std::string& path, const SuperelementRea
     RequireShape(r, "/reduced/modal_derivative_pairs", se.n_modal_derivatives, 2);
     const Eigen::MatrixXi pairs = r.IntMatrix("/reduced/modal_derivative_pairs");
     for (long k = 0; k < pairs.rows(); ++k) se.modal_derivative_pairs.emplace_back(pairs(k, 0), pairs(k, 1));
+  }
+  if (r.Exists("/reduced/polynomial")) {
+    const long P = n * (n + 1) / 2;
+    RequireShape(r, "/reduced/polynomial/A", n, P);
+    RequireShape(r, "/reduced/polynomial/B", P, P);
+    se.polynomial = PolynomialStiffness{r.Matrix("/reduced/polynomial/A"), r.Matrix("/reduced/polynomial/B")};
   }
 
   se.floating_frame.type = r.StringAttribute("/floating_frame", "type");

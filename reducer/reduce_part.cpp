@@ -145,6 +145,26 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
   se.n_full_dofs = model.n_dofs();
   se.n_modal_derivatives = long(cb.derivative_pairs.size());
   se.modal_derivative_pairs = cb.derivative_pairs;
+  if (solid && se.n_modal_derivatives > 0) {
+    // The reduced internal force on the whole basis (static and internal modes, derivatives)
+    // is the cubic polynomial of reduced_polynomial.h; its linear part equals K_r.
+    Stopwatch tensors;
+    ReducedPolynomial poly = ReduceSvk(*solid, Eigen::MatrixXd(model.mesh_map * cb.shapes));
+    const double mismatch = (poly.K - cb.K).norm() / cb.K.norm();
+    if (mismatch > 1e-8) {
+      result.message = "the polynomial internal force's linear part differs from K_r by " + std::to_string(mismatch);
+      return result;
+    }
+    se.polynomial = PolynomialStiffness{std::move(poly.A), std::move(poly.B)};
+    const long nr = se.K.rows(), P = nr * (nr + 1) / 2;
+    std::snprintf(detail, sizeof detail,
+                  "quadratic %ld x %ld + cubic %ld x %ld coefficients (%.3g MB; symmetric pairs: %.0fx smaller than "
+                  "n^3 + n^4), linear part = K_r to %.1e",
+                  nr, P, P, P, 8.0 * (nr * P + P * P) / 1e6,
+                  double(nr * nr * nr + nr * nr * nr * nr) / double(nr * P + P * P), mismatch);
+    report("nonlinear force", tensors.Seconds(), detail);
+    clock.Restart();
+  }
   se.mass_properties = ComputeMassProperties(se);
   se.floating_frame = ComputeFloatingFrame(part.reduction.floating_frame,
                                            part.reduction.where_floating_frame, se, model, cb.shapes);

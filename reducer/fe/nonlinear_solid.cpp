@@ -1,6 +1,7 @@
 #include "reducer/fe/nonlinear_solid.h"
 
 #include <Eigen/Dense>
+#include <Eigen/Cholesky>
 #include <Eigen/SparseCholesky>
 #include <cmath>
 #include <cstdio>
@@ -160,6 +161,58 @@ SparseMatrix SvkSolidMesh::Tangent(const Eigen::VectorXd& u) const {
   SparseMatrix K(n_dofs(), n_dofs());
   K.setFromTriplets(triplets.begin(), triplets.end());
   return K;
+}
+
+ReducedPolynomial ReduceSvk(const SvkSolidMesh& solid, const Eigen::MatrixXd& mesh_shapes) {
+  const int n = int(mesh_shapes.cols()), P = n * (n + 1) / 2, ne = solid.n_per_cell_;
+  ReducedPolynomial r;
+  r.K = Eigen::MatrixXd::Zero(n, n);
+  r.A = Eigen::MatrixXd::Zero(n, P);
+  r.B = Eigen::MatrixXd::Zero(P, P);
+  // D = C^T C: B accumulates (C Q)^T (C Q) over the points, stacked into blocks of rows (one
+  // BLAS product per block).
+  const Eigen::Matrix<double, 6, 6> C = solid.D_.llt().matrixU();
+  constexpr int kPointsPerBlock = 64;
+  Eigen::MatrixXd stack(6 * kPointsPerBlock, P);
+  int stacked = 0;
+  auto flush = [&]() {
+    if (stacked == 0) return;
+    const auto Y = stack.topRows(6 * stacked);
+    r.B.noalias() += Y.transpose() * Y;
+    stacked = 0;
+  };
+  std::vector<Eigen::Matrix3d> G(static_cast<size_t>(n));
+  Eigen::MatrixXd L(6, n), Q(6, P), U(ne, 3);
+  Eigen::MatrixXd element(3 * ne, n);
+  for (long c = 0; c < solid.cells_.rows(); ++c) {
+    for (int a = 0; a < ne; ++a) element.middleRows(3 * a, 3) = mesh_shapes.middleRows(3 * long(solid.cells_(c, a)), 3);
+    for (int q = 0; q < solid.points_per_cell_; ++q) {
+      const size_t point = size_t(c) * solid.points_per_cell_ + q;
+      const Eigen::MatrixXd& g = solid.dNdX_[point];
+      const double dV = solid.dV_[point];
+      for (int j = 0; j < n; ++j) {
+        for (int a = 0; a < ne; ++a) U.row(a) = element.block(3 * a, j, 3, 1).transpose();
+        G[size_t(j)] = U.transpose() * g;
+        const Eigen::Matrix3d& Gj = G[size_t(j)];
+        L.col(j) << Gj(0, 0), Gj(1, 1), Gj(2, 2), Gj(1, 2) + Gj(2, 1), Gj(0, 2) + Gj(2, 0), Gj(0, 1) + Gj(1, 0);
+      }
+      int p = 0;
+      for (int j = 0; j < n; ++j)
+        for (int k = j; k < n; ++k, ++p) {
+          const Eigen::Matrix3d S = 0.5 * (G[size_t(j)].transpose() * G[size_t(k)] + G[size_t(k)].transpose() * G[size_t(j)]);
+          Q.col(p) << S(0, 0), S(1, 1), S(2, 2), 2 * S(1, 2), 2 * S(0, 2), 2 * S(0, 1);
+        }
+      const Eigen::MatrixXd DL = solid.D_ * L;
+      r.K.noalias() += dV * L.transpose() * DL;
+      r.A.noalias() += (0.5 * dV) * DL.transpose() * Q;
+      stack.middleRows(6 * stacked, 6) = std::sqrt(dV / 8) * (C * Q);
+      if (++stacked == kPointsPerBlock) flush();
+    }
+  }
+  flush();
+  r.K = 0.5 * (r.K + r.K.transpose()).eval();
+  r.B = 0.5 * (r.B + r.B.transpose()).eval();
+  return r;
 }
 
 NonlinearStaticResult SolveNonlinearStatic(const SvkSolidMesh& solid, const SparseMatrix& T_in,

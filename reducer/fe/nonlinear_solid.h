@@ -24,6 +24,18 @@ struct NonlinearElementState {
   Eigen::MatrixXd tangent;  ///< 3 n x 3 n (only when asked)
 };
 
+/// The reduced internal force of u = V q on a mesh: with the Green-Lagrange strain it is
+/// exactly cubic in q (thesis 8.3). Pair index p = (j, k), j <= k, in the order (0,0), (0,1), ...,
+/// (0,n-1), (1,1), ...; z_p(q) = m_p q_j q_k with m_p = 1 (j = k) or 2 (j < k). At a quadrature
+/// point the Voigt strain is E = L q + Q z / 2 with L_j = E_lin(v_j), Q_p = Voigt of
+/// (G_j^T G_k + G_k^T G_j) / 2. The strain energy is then
+///   W(q) = q^T K q / 2 + q^T A z + z^T B z,  K = int L^T D L,  A = int L^T D Q / 2,
+///   B = int Q^T D Q / 8   (n x n, n x P, P x P; P = n (n + 1) / 2),
+/// and f(q) = dW/dq, K_t(q) = d2W/dq2 (reduced_polynomial.h evaluates them).
+struct ReducedPolynomial {
+  Eigen::MatrixXd K, A, B;
+};
+
 /// One element: `X` n x 3 node coordinates, `u` its 3 n displacements (node-major).
 NonlinearElementState SvkSolidElement(SolidType type, const Eigen::MatrixXd& X, const MaterialSpec& material,
                                       const Eigen::VectorXd& u, bool with_tangent);
@@ -38,6 +50,7 @@ class SvkSolidMesh {
   Eigen::VectorXd Force(const Eigen::VectorXd& u) const;
   /// Symmetric, both triangles stored.
   SparseMatrix Tangent(const Eigen::VectorXd& u) const;
+  friend ReducedPolynomial ReduceSvk(const SvkSolidMesh& solid, const Eigen::MatrixXd& mesh_shapes);
 
  private:
   // Per quadrature point: dN/dX (n x 3) and the volume weight; per element, its points.
@@ -51,6 +64,9 @@ class SvkSolidMesh {
   std::vector<Eigen::MatrixXd> dNdX_;  ///< cell-major, points_per_cell_ per cell
   std::vector<double> dV_;
 };
+
+/// `mesh_shapes`: the basis on the mesh DOFs (3 per node), n_mesh x n. See ReducedPolynomial.
+ReducedPolynomial ReduceSvk(const SvkSolidMesh& solid, const Eigen::MatrixXd& mesh_shapes);
 
 /// Static equilibrium of a full nonlinear model by Newton with load stepping:
 ///   T^T f(T u) = lambda f_ext  on the free model DOFs, u = prescribed values on the others
