@@ -192,6 +192,9 @@ SceneSpec ParseScene(const std::string& text, const std::string& name, const std
       if (auto v = om.Optional("transformations")) b.approximated = v->OneOf({"exact", "approximated"}) == "approximated";
       if (auto v = om.Optional("tangent")) b.full_tangent = v->OneOf({"full", "K1"}) == "full";
       if (auto v = om.Optional("quadratic_velocity_terms")) b.quadratic_velocity_terms = v->Bool();
+      if (auto v = om.Optional("internal_force")) {
+        b.polynomial_force = v->OneOf({"polynomial", "linear"}, "(polynomial: the file's Green-Lagrange force when it has modal derivatives)") == "polynomial";
+      }
       if (auto v = om.Optional("inertia_option")) b.option_b = v->OneOf({"A", "B"}, "(Cardona's options)") == "B";
       if (auto v = om.Optional("modal_damping")) {
         b.modal_damping = v->Number();

@@ -35,6 +35,7 @@ struct SceneBodySpec {
   Eigen::Vector3d rotation = Eigen::Vector3d::Zero();  ///< rotation vector [rad]
   std::map<std::string, std::string> nodes;  ///< interface name -> scene node name
   bool approximated = false, full_tangent = true, quadratic_velocity_terms = true, option_b = false;
+  bool polynomial_force = true;  ///< use the file's polynomial internal force when it has one
   double modal_damping = 0.0;    ///< damping ratio of the internal modes
   std::string where;
 };

@@ -43,6 +43,7 @@ SuperelementBody::SuperelementBody(const Superelement& se, const SuperelementOpt
   double size = 0.0;
   for (const Eigen::Vector3d& X : X_) size = std::max(size, X.norm());
   force_floor_ = 1e-4 * K_.cwiseAbs().maxCoeff() * std::max(size, 1e-300);
+  if (options_.polynomial_force && se.polynomial) polynomial_ = se.polynomial;
   initial_frame_.x = placement_x_ + placement_R_ * origin_part_;
   initial_frame_.R = placement_R_;
   initial_frame_.ok = true;
@@ -122,9 +123,17 @@ FrameSolution SuperelementBody::SolveFrame(const BodyConfiguration& c, const Fra
   return frame;
 }
 
+Eigen::VectorXd SuperelementBody::LocalForce(const Eigen::VectorXd& q) const {
+  return polynomial_ ? PolynomialForce(K_, *polynomial_, q) : Eigen::VectorXd(K_ * q);
+}
+
+Eigen::MatrixXd SuperelementBody::LocalTangent(const Eigen::VectorXd& q) const {
+  return polynomial_ ? PolynomialTangent(K_, *polynomial_, q) : K_;
+}
+
 double SuperelementBody::ElasticEnergy(const BodyConfiguration& c, const FrameSolution& frame) const {
   const Eigen::VectorXd q = LocalCoordinates(c, frame);
-  return 0.5 * q.dot(K_ * q);
+  return polynomial_ ? PolynomialEnergy(K_, *polynomial_, q) : 0.5 * q.dot(K_ * q);
 }
 
 void SuperelementBody::ElasticForce(const BodyConfiguration& c, const FrameSolution& frame, Eigen::VectorXd* f,
@@ -132,7 +141,7 @@ void SuperelementBody::ElasticForce(const BodyConfiguration& c, const FrameSolut
   const int n = n_coordinates();
   const Eigen::VectorXd q = LocalCoordinates(c, frame);
   const Kinematics kin = ComputeKinematics(q);
-  const Eigen::VectorXd Q = K_ * q;
+  const Eigen::VectorXd Q = LocalForce(q);
   const Eigen::VectorXd Qhat = options_.approximated ? Eigen::VectorXd(T0_.transpose() * Q)
                                                      : Eigen::VectorXd(kin.B.transpose() * Q);
   // Rbar: R_j on every node's force and moment, identity on modal rows.
@@ -145,10 +154,11 @@ void SuperelementBody::ElasticForce(const BodyConfiguration& c, const FrameSolut
   if (!tangent) return;
 
   Eigen::MatrixXd Kt;
+  const Eigen::MatrixXd Kq = LocalTangent(q);
   if (options_.approximated) {
-    Kt = T0_.transpose() * K_ * kin.B;
+    Kt = T0_.transpose() * Kq * kin.B;
   } else {
-    Kt = kin.B.transpose() * K_ * kin.B;  // K1
+    Kt = kin.B.transpose() * Kq * kin.B;  // K1
   }
   if (options_.full_tangent) {
     // Fhat, Mhat (n x 6) from Qhat: node rows [0, F~; 0, 0] and [0, 0; 0, M~].

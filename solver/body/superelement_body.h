@@ -12,6 +12,9 @@
 //   S = Phi_CB D Phi_rig, Z = S^-1 Phi_CB D       (thesis 3.17 with D)
 //   T = 1 - Phi_rig Z                              (thesis 3.18)
 // Elastic force, the gradient of V = q_loc^T K q_loc / 2:  f = Rbar B^T K q_loc  (thesis 4.12).
+// With modal derivatives (thesis 8.3) V is the file's quartic polynomial (Green-Lagrange inside
+// the body) and K q_loc becomes its gradient Q(q_loc), K its Hessian in K1; K2-K4 use Q as they
+// are written.
 // Tangent (exact derivative, checked against finite differences), local part of
 // K_t = Rbar (K1 + K2 + K3 + K4) Rbar^T:
 //   K1 = B^T K B                                   (thesis 4.25)
@@ -24,6 +27,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <optional>
 #include <vector>
 
 #include "formats/superelement.h"
@@ -36,6 +40,9 @@ struct SuperelementOptions {
   bool quadratic_velocity_terms = true;  ///< false: inertia force M_g wdot only (thesis 4.11 remark)
   bool cardona_option_b = false;  ///< angular velocities in node frames R_k^T (Cardona's option B)
   double modal_damping = 0.0;     ///< damping ratio zeta of the internal modes: f = 2 zeta omega etadot
+  /// With modal derivatives in the file: the local internal force is its cubic polynomial
+  /// (formats/reduced_polynomial.h, Green-Lagrange inside the body) instead of K q_loc.
+  bool polynomial_force = true;
 };
 
 /// Velocities of one body's system coordinates: per node xdot_k, omega_k (spatial), then etadot.
@@ -134,6 +141,10 @@ class SuperelementBody {
   int n_nodes_ = 0, n_modes_ = 0;
   SuperelementOptions options_;
   Eigen::MatrixXd K_, M_, Phi_CB_;
+  std::optional<PolynomialStiffness> polynomial_;  ///< set when the file has it and the option is on
+  // Local internal force and its tangent: K q or the polynomial's.
+  Eigen::VectorXd LocalForce(const Eigen::VectorXd& q) const;
+  Eigen::MatrixXd LocalTangent(const Eigen::VectorXd& q) const;
   std::vector<Eigen::Vector3d> X_;    ///< node positions relative to the frame origin, frame axes
   std::vector<Eigen::Matrix3d> R0_;   ///< node orientations relative to the frame
   Eigen::MatrixXd T0_;                ///< 1 - Phi_rig0 Phi_CB (approximated option)

@@ -104,6 +104,7 @@ Scene BuildScene(const SceneSpec& spec) {
     options.full_tangent = b.full_tangent;
     options.quadratic_velocity_terms = b.quadratic_velocity_terms;
     options.cardona_option_b = b.option_b;
+    options.polynomial_force = b.polynomial_force;
     options.modal_damping = b.modal_damping;
     std::vector<int> nodes;
     for (const auto& [iname, _] : b.nodes) {

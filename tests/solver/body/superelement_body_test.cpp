@@ -86,7 +86,14 @@ void CheckAgainstFiniteDifferences(const Superelement& se, const SuperelementOpt
   Eigen::VectorXd f_fd(n);
   for (int i = 0; i < n; ++i) {
     const Eigen::VectorXd e = Eigen::VectorXd::Unit(n, i);
-    const double h = 1e-6;
+    // Node coordinates: 1e-6 (m, rad). Modal coordinates are mass-normalized: one unit moves the
+    // body by ~1/sqrt(mass), so their step is 1e-6 of the body size in displacement (a 2 g leaf:
+    // 2e-9); a coordinate that turns the floating frame strongly (a thin leaf's torsion mode) gets
+    // a proportionally smaller one.
+    double size = 0.0;
+    for (const InterfaceNode& node : se.interfaces) size = std::max(size, (node.position - se.mass_properties.center_of_mass).norm());
+    const double h = (i < se.n_interface_dofs() ? 1e-6 : 1e-6 * size * std::sqrt(se.mass_properties.mass)) /
+                     std::max(1.0, se.floating_frame.Phi_CB.col(i).norm());
     const Evaluation plus = Evaluate(body, Perturb(c, e, h), frame);
     const Evaluation minus = Evaluate(body, Perturb(c, e, -h), frame);
     K_fd.col(i) = (plus.f - minus.f) / (2 * h);
@@ -113,6 +120,37 @@ TEST(SuperelementBody, ExactTangentMatchesFiniteDifferences) {
 TEST(SuperelementBody, ApproximatedTransformationTangentMatchesFiniteDifferences) {
   CheckAgainstFiniteDifferences(Rod("center_of_mass"), {true, true}, 0.3);
   CheckAgainstFiniteDifferences(Tee(), {true, true}, 0.3);
+}
+
+TEST(SuperelementBody, PolynomialInternalForceTangentMatchesFiniteDifferences) {
+  // A solid leaf spring with modal derivatives: the local force is the Green-Lagrange polynomial;
+  // force = energy gradient and the full tangent (its Hessian in K1, K2-K4 from the force) are
+  // checked like the linear body's, and the polynomial changes the force.
+  const Superelement se = test::Reduce(
+      "name: leaf\ntype: solid\nmaterial: {E: 2.1e11, nu: 0.3, rho: 7850}\n"
+      "geometry: {shape: box, size: [0.05, 0.01, 0.0005]}\n"
+      "mesh: {size: 0.0025, order: 2, elements: hexahedra}\n"
+      "interfaces: [{name: A, group: xmin}, {name: B, group: xmax}]\n"
+      "reduction: {internal_modes: 2, modal_derivatives: {pairs: [[8, 8], [7, 7], [8, 12]]}}\n");
+  ASSERT_TRUE(se.polynomial.has_value());
+  ASSERT_EQ(se.n_modal_derivatives, 3);
+  {
+    SuperelementOptions lin;
+    lin.polynomial_force = false;
+    SCOPED_TRACE("linear");
+    CheckAgainstFiniteDifferences(se, lin, 0.05);
+  }
+  CheckAgainstFiniteDifferences(se, {false, true}, 0.05);
+  CheckAgainstFiniteDifferences(se, {true, true}, 0.05);
+  SuperelementOptions linear;
+  linear.polynomial_force = false;
+  const SuperelementBody with(se, {}), without(se, linear);
+  const BodyConfiguration c = Deformed(with, 0.05, 3);
+  const FrameSolution frame = with.SolveFrame(c, with.GuessFrame(c));
+  Eigen::VectorXd f1, f2;
+  with.ElasticForce(c, frame, &f1, nullptr);
+  without.ElasticForce(c, frame, &f2, nullptr);
+  EXPECT_GT((f1 - f2).norm(), 1e-3 * f2.norm());
 }
 
 TEST(SuperelementBody, TangentIsSymmetricAtEquilibriumFreeConfiguration) {
