@@ -145,11 +145,16 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
   se.n_full_dofs = model.n_dofs();
   se.n_modal_derivatives = long(cb.derivative_pairs.size());
   se.modal_derivative_pairs = cb.derivative_pairs;
+  se.mass_properties = ComputeMassProperties(se);
+  se.floating_frame = ComputeFloatingFrame(part.reduction.floating_frame,
+                                           part.reduction.where_floating_frame, se, model, cb.shapes);
   if (solid && se.n_modal_derivatives > 0) {
     // The reduced internal force on the whole basis (static and internal modes, derivatives)
     // is the cubic polynomial of reduced_polynomial.h; its linear part equals K_r.
     Stopwatch tensors;
-    ReducedPolynomial poly = ReduceSvk(*solid, Eigen::MatrixXd(model.mesh_map * cb.shapes));
+    const Eigen::MatrixXd mesh_shapes = model.mesh_map * cb.shapes;
+    ReducedPolynomial poly = ReduceSvk(*solid, mesh_shapes,
+                                       InterfaceRotationCompletion(model.nodes, mesh_shapes, model.interface_positions, se.floating_frame.origin));
     const double mismatch = (poly.K - cb.K).norm() / cb.K.norm();
     if (mismatch > 1e-8) {
       result.message = "the polynomial internal force's linear part differs from K_r by " + std::to_string(mismatch);
@@ -165,9 +170,6 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
     report("nonlinear force", tensors.Seconds(), detail);
     clock.Restart();
   }
-  se.mass_properties = ComputeMassProperties(se);
-  se.floating_frame = ComputeFloatingFrame(part.reduction.floating_frame,
-                                           part.reduction.where_floating_frame, se, model, cb.shapes);
   const bool keep_mesh = part.reduction.keep_mesh.value_or(model.n_dofs() <= ReductionSpec::kKeepMeshMaxDofs);
   if (keep_mesh) {
     Visualization v;

@@ -163,7 +163,39 @@ SparseMatrix SvkSolidMesh::Tangent(const Eigen::VectorXd& u) const {
   return K;
 }
 
-ReducedPolynomial ReduceSvk(const SvkSolidMesh& solid, const Eigen::MatrixXd& mesh_shapes) {
+std::vector<std::pair<int, Eigen::VectorXd>> InterfaceRotationCompletion(const Eigen::MatrixXd& mesh_nodes,
+                                                                          const Eigen::MatrixXd& mesh_shapes,
+                                                                          const std::vector<Eigen::Vector3d>& interface_points,
+                                                                          const Eigen::Vector3d& origin) {
+  const int n = int(mesh_shapes.cols());
+  const long n_nodes = mesh_nodes.rows();
+  auto pair_index = [n](int j, int k) { return j * n - j * (j - 1) / 2 + (k - j); };  // j <= k
+  auto skew = [](const Eigen::Vector3d& v) {
+    Eigen::Matrix3d s;
+    s << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;
+    return s;
+  };
+  std::vector<std::pair<int, Eigen::VectorXd>> fields;
+  for (size_t k = 0; k < interface_points.size(); ++k) {
+    const int first = 6 * int(k);
+    for (int a = 0; a < 3; ++a)
+      for (int b = a; b < 3; ++b) {
+        const Eigen::Matrix3d Ea = skew(Eigen::Vector3d::Unit(a)), Eb = skew(Eigen::Vector3d::Unit(b));
+        const Eigen::Matrix3d C = 0.25 * (Ea * Eb + Eb * Ea);  // sym(e_a~ e_b~) / 2
+        Eigen::VectorXd W(3 * n_nodes);
+        for (long i = 0; i < n_nodes; ++i) {
+          const double phi = mesh_shapes(3 * i, first);  // x component of interface k's u_x mode
+          W.segment<3>(3 * i) = phi * C * (mesh_nodes.row(i).transpose() - origin);
+        }
+        W -= mesh_shapes.middleCols(first, 3) * (C * (interface_points[k] - origin));
+        fields.emplace_back(pair_index(first + 3 + a, first + 3 + b), std::move(W));
+      }
+  }
+  return fields;
+}
+
+ReducedPolynomial ReduceSvk(const SvkSolidMesh& solid, const Eigen::MatrixXd& mesh_shapes,
+                            const std::vector<std::pair<int, Eigen::VectorXd>>& pair_fields) {
   const int n = int(mesh_shapes.cols()), P = n * (n + 1) / 2, ne = solid.n_per_cell_;
   ReducedPolynomial r;
   r.K = Eigen::MatrixXd::Zero(n, n);
@@ -184,8 +216,13 @@ ReducedPolynomial ReduceSvk(const SvkSolidMesh& solid, const Eigen::MatrixXd& me
   std::vector<Eigen::Matrix3d> G(static_cast<size_t>(n));
   Eigen::MatrixXd L(6, n), Q(6, P), U(ne, 3);
   Eigen::MatrixXd element(3 * ne, n);
+  const int n_fields = int(pair_fields.size());
+  Eigen::MatrixXd field_element(3 * ne, n_fields);
   for (long c = 0; c < solid.cells_.rows(); ++c) {
     for (int a = 0; a < ne; ++a) element.middleRows(3 * a, 3) = mesh_shapes.middleRows(3 * long(solid.cells_(c, a)), 3);
+    for (int f = 0; f < n_fields; ++f)
+      for (int a = 0; a < ne; ++a)
+        field_element.block(3 * a, f, 3, 1) = pair_fields[size_t(f)].second.segment<3>(3 * long(solid.cells_(c, a)));
     for (int q = 0; q < solid.points_per_cell_; ++q) {
       const size_t point = size_t(c) * solid.points_per_cell_ + q;
       const Eigen::MatrixXd& g = solid.dNdX_[point];
@@ -202,6 +239,13 @@ ReducedPolynomial ReduceSvk(const SvkSolidMesh& solid, const Eigen::MatrixXd& me
           const Eigen::Matrix3d S = 0.5 * (G[size_t(j)].transpose() * G[size_t(k)] + G[size_t(k)].transpose() * G[size_t(j)]);
           Q.col(p) << S(0, 0), S(1, 1), S(2, 2), 2 * S(1, 2), 2 * S(0, 2), 2 * S(0, 1);
         }
+      for (int f = 0; f < n_fields; ++f) {
+        for (int a = 0; a < ne; ++a) U.row(a) = field_element.block(3 * a, f, 3, 1).transpose();
+        const Eigen::Matrix3d Gw = U.transpose() * g;
+        Eigen::Matrix<double, 6, 1> e;
+        e << Gw(0, 0), Gw(1, 1), Gw(2, 2), Gw(1, 2) + Gw(2, 1), Gw(0, 2) + Gw(2, 0), Gw(0, 1) + Gw(1, 0);
+        Q.col(pair_fields[size_t(f)].first) += 2 * e;
+      }
       const Eigen::MatrixXd DL = solid.D_ * L;
       r.K.noalias() += dV * L.transpose() * DL;
       r.A.noalias() += (0.5 * dV) * DL.transpose() * Q;
@@ -245,6 +289,7 @@ NonlinearStaticResult SolveNonlinearStatic(const SvkSolidMesh& solid, const Spar
     for (size_t k = 0; k < prescribed_dofs.size(); ++k) u[prescribed_dofs[k]] = lambda * prescribed_values[long(k)];
     int it = 0;
     Eigen::VectorXd r;
+    double last_step = HUGE_VAL;  // ||du|| of the last Newton correction
     for (;; ++it) {
       const Eigen::VectorXd f_model = T.transpose() * solid.Force(T * u);
       r = f_model - lambda * f_ext;
@@ -255,7 +300,9 @@ NonlinearStaticResult SolveNonlinearStatic(const SvkSolidMesh& solid, const Spar
         result.message = "residual is not finite at load factor " + std::to_string(lambda);
         return result;
       }
-      if (it > 0 && r_free.norm() <= tolerance * scale) break;
+      // Converged: the residual, or (when round-off in the large internal forces of a stiff
+      // part keeps it above that) the displacement correction at round-off level.
+      if (it > 0 && (r_free.norm() <= tolerance * scale || last_step <= 1e-12 * u.norm())) break;
       if (it == max_iterations) {
         result.converged = false;
         char buffer[200];
@@ -271,7 +318,9 @@ NonlinearStaticResult SolveNonlinearStatic(const SvkSolidMesh& solid, const Spar
         result.message = "singular tangent at load factor " + std::to_string(lambda);
         return result;
       }
-      u -= S * solver.solve(r_free);
+      const Eigen::VectorXd du = S * solver.solve(r_free);
+      last_step = du.norm();
+      u -= du;
     }
     result.load_factor.push_back(lambda);
     result.u.push_back(u);

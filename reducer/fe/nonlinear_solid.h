@@ -50,7 +50,8 @@ class SvkSolidMesh {
   Eigen::VectorXd Force(const Eigen::VectorXd& u) const;
   /// Symmetric, both triangles stored.
   SparseMatrix Tangent(const Eigen::VectorXd& u) const;
-  friend ReducedPolynomial ReduceSvk(const SvkSolidMesh& solid, const Eigen::MatrixXd& mesh_shapes);
+  friend ReducedPolynomial ReduceSvk(const SvkSolidMesh& solid, const Eigen::MatrixXd& mesh_shapes,
+                                     const std::vector<std::pair<int, Eigen::VectorXd>>& pair_fields);
 
  private:
   // Per quadrature point: dN/dX (n x 3) and the volume weight; per element, its points.
@@ -66,11 +67,36 @@ class SvkSolidMesh {
 };
 
 /// `mesh_shapes`: the basis on the mesh DOFs (3 per node), n_mesh x n. See ReducedPolynomial.
-ReducedPolynomial ReduceSvk(const SvkSolidMesh& solid, const Eigen::MatrixXd& mesh_shapes);
+/// `pair_fields` (p, W_p): second-order displacement fields u = V q + sum_p z_p W_p whose linear
+/// strain joins the quadratic strain, Q_p += 2 E_lin(W_p) (their higher-order terms are dropped:
+/// the strain stays quadratic in q). Used for the second-order rotation of interface faces.
+ReducedPolynomial ReduceSvk(const SvkSolidMesh& solid, const Eigen::MatrixXd& mesh_shapes,
+                            const std::vector<std::pair<int, Eigen::VectorXd>>& pair_fields = {});
+
+/// The second-order completion of the interface rotations of a solid part (RBE2 faces): with
+/// linear static modes a local rotation theta of interface k moves its face by theta x r only,
+/// which the Green-Lagrange strain sees as a stretch theta^2 / 2 (at 0.09 rad on a 0.5 mm leaf
+/// the polynomial body came out 38% too stiff). A finite rotation moves the face by
+/// (R(theta) - 1) r = theta x r + theta~^2 r / 2 + O(theta^3). For each pair p = (a, b), a <= b,
+/// of interface k's rotation coordinates (C_p = sym(e_a~ e_b~) / 2, positions from the frame
+/// origin o):
+///   W_p = phi_k(x) C_p (x - o) - Psi_k C_p (X_k - o),
+/// phi_k the smooth weight that is 1 on face k and 0 on the others (the axial component of the
+/// static mode of interface k's translation along x; the phi_k add up to 1), Psi_k the static
+/// modes of interface k's translations. On face k it is C_p (x - X_k), the face's own second-order
+/// rotation; and for a rigid rotation of the whole part (all theta_k equal, u_k = (R - 1) X_k)
+/// the second-order field is exactly theta~^2 (x - o) / 2, strain-free. Pair indices p refer to
+/// the n reduced coordinates (reduced_polynomial.h).
+std::vector<std::pair<int, Eigen::VectorXd>> InterfaceRotationCompletion(const Eigen::MatrixXd& mesh_nodes,
+                                                                          const Eigen::MatrixXd& mesh_shapes,
+                                                                          const std::vector<Eigen::Vector3d>& interface_points,
+                                                                          const Eigen::Vector3d& origin);
 
 /// Static equilibrium of a full nonlinear model by Newton with load stepping:
 ///   T^T f(T u) = lambda f_ext  on the free model DOFs, u = prescribed values on the others
-///   (the prescribed values are scaled by lambda too), lambda = 1/steps ... 1.
+///   (the prescribed values are scaled by lambda too), lambda = 1/steps ... 1. Converged when the
+///   free residual is below tolerance x max(|lambda f_ext|, |reactions|) or the Newton correction
+///   is below 1e-12 |u| (round-off in a stiff part's internal forces).
 /// `T` maps model DOFs to mesh DOFs (FeModel::mesh_map; identity when empty).
 struct NonlinearStaticResult {
   std::vector<double> load_factor;

@@ -25,6 +25,17 @@ SystemModel::Prescribed PrescribedBy(const TimeFunctionSpec& f, int k) {
   p.acceleration = [f](double t) { return f.Acceleration(t); };
   return p;
 }
+// A node that cannot move: no coordinates of its own and, if it hangs on a joint, a joint
+// without coordinates on a parent that cannot move either.
+bool FixedToGround(const SystemModel& model, int k) {
+  if (model.motion[k].cols() > 0) return false;
+  for (const NodeJoint& j : model.joints) {
+    if (j.child != k) continue;
+    return j.n_coordinates() == 0 && FixedToGround(model, j.parent);
+  }
+  return true;
+}
+
 }  // namespace
 
 Scene BuildScene(const SceneSpec& spec) {
@@ -216,7 +227,7 @@ Scene BuildScene(const SceneSpec& spec) {
       continue;
     }
     const int k = scene.node_index.at(l.node);
-    if (model.motion[k].cols() == 0) throw InputError(l.where + ": load on node '" + l.node + "', which is clamped to the ground");
+    if (FixedToGround(model, k)) throw InputError(l.where + ": load on node '" + l.node + "', which is clamped to the ground");
     NodeLoad load;
     load.node = k;
     load.force = l.force;

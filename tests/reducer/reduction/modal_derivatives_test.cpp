@@ -155,6 +155,47 @@ TEST(ModalDerivatives, ReducedPolynomialForceIsTheProjectedFullForce) {
   EXPECT_EQ(back.polynomial->B, se.polynomial->B);
 }
 
+TEST(ModalDerivatives, FiniteRigidRotationCostsNoStrainEnergyWithTheRotationCompletion) {
+  // Local coordinates of the whole leaf turned rigidly by theta about y (interfaces at X_k from
+  // the frame origin): u_k = (R - 1) X_k, theta_k = theta e_y, modes 0. The linear static modes
+  // move the faces by theta x r only, which Green-Lagrange reads as a stretch theta^2 / 2; the
+  // second-order completion of the face rotation (nonlinear_solid.h) removes it to higher order.
+  const PartSpec part = ParsePart(Leaf(", modal_derivatives: {pairs: [[8, 8]]}"), "leaf.yaml");
+  const ReduceResult r = ReducePart(part, nullptr);
+  ASSERT_TRUE(r.ok) << r.message;
+  const Superelement& se = r.superelement;
+  const FeModel model = BuildSolidModel(part);
+  const SvkSolidMesh solid(SolidType::kHex20, model.nodes, model.cells, part.material);
+  const Eigen::MatrixXd& V = se.visualization->shapes;
+  const ReducedPolynomial plain = ReduceSvk(solid, V);  // without the completion
+  std::vector<Eigen::Vector3d> points;
+  for (const InterfaceNode& node : se.interfaces) points.push_back(node.position);
+  const ReducedPolynomial completed =
+      ReduceSvk(solid, V, InterfaceRotationCompletion(se.visualization->nodes, V, points, se.floating_frame.origin));
+  EXPECT_LT((completed.B - se.polynomial->B).norm(), 1e-12 * completed.B.norm());  // what the reducer stored
+  const PolynomialStiffness without{plain.A, plain.B};
+  const int n = se.n_reduced_dofs();
+  for (double theta : {0.05, 0.1}) {
+    const Eigen::Matrix3d R = Eigen::AngleAxisd(theta, Eigen::Vector3d::UnitY()).toRotationMatrix();
+    Eigen::VectorXd q = Eigen::VectorXd::Zero(n);
+    for (int k = 0; k < 2; ++k) {
+      const Eigen::Vector3d X = se.interfaces[size_t(k)].position - se.floating_frame.origin;
+      q.segment<3>(6 * k) = (R - Eigen::Matrix3d::Identity()) * X;
+      q[6 * k + 4] = theta;
+    }
+    // Reference scale: the energy of bending the leaf to that end rotation, K q for the rotation
+    // coordinates of one end alone.
+    Eigen::VectorXd bend = Eigen::VectorXd::Zero(n);
+    bend[10] = theta;
+    const double scale = 0.5 * bend.dot(se.K * bend);
+    const double with_completion = PolynomialEnergy(se.K, *se.polynomial, q) / scale;
+    const double linear_faces = PolynomialEnergy(se.K, without, q) / scale;
+    std::printf("[ info ] rigid rotation %.2f rad: strain energy / bending energy %.2e with the completion, %.2e without\n",
+                theta, with_completion, linear_faces);
+    EXPECT_LT(std::abs(with_completion), 0.05 * linear_faces);
+  }
+}
+
 TEST(ModalDerivatives, BadRequestsNameThePartFile) {
   const std::string bad = test::ThrownMessage(
       [] { ReducePart(ParsePart(Leaf(", modal_derivatives: {pairs: [[3, 99]]}"), "leaf.yaml"), nullptr); });
