@@ -262,7 +262,8 @@ ReducedPolynomial ReduceSvk(const SvkSolidMesh& solid, const Eigen::MatrixXd& me
 NonlinearStaticResult SolveNonlinearStatic(const SvkSolidMesh& solid, const SparseMatrix& T_in,
                                            const std::vector<int>& prescribed_dofs,
                                            const Eigen::VectorXd& prescribed_values, const Eigen::VectorXd& f_ext,
-                                           int steps, double tolerance, int max_iterations) {
+                                           int steps, double tolerance, int max_iterations,
+                                           const Eigen::VectorXd* u_start) {
   SparseMatrix T = T_in;
   if (T.size() == 0) {
     T.resize(solid.n_dofs(), solid.n_dofs());
@@ -283,7 +284,7 @@ NonlinearStaticResult SolveNonlinearStatic(const SvkSolidMesh& solid, const Spar
   }
   const SparseMatrix TS = T * S;
   NonlinearStaticResult result;
-  Eigen::VectorXd u = Eigen::VectorXd::Zero(n);
+  Eigen::VectorXd u = u_start ? *u_start : Eigen::VectorXd::Zero(n);  // free DOFs start there
   for (int step = 1; step <= steps; ++step) {
     const double lambda = double(step) / steps;
     for (size_t k = 0; k < prescribed_dofs.size(); ++k) u[prescribed_dofs[k]] = lambda * prescribed_values[long(k)];

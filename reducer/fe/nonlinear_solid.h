@@ -96,7 +96,8 @@ std::vector<std::pair<int, Eigen::VectorXd>> InterfaceRotationCompletion(const E
 ///   T^T f(T u) = lambda f_ext  on the free model DOFs, u = prescribed values on the others
 ///   (the prescribed values are scaled by lambda too), lambda = 1/steps ... 1. Converged when the
 ///   free residual is below tolerance x max(|lambda f_ext|, |reactions|) or the Newton correction
-///   is below 1e-12 |u| (round-off in a stiff part's internal forces).
+///   is below 1e-12 |u| (round-off in a stiff part's internal forces). `u_start`: the free DOFs'
+///   first guess (continuation); zero when null.
 /// `T` maps model DOFs to mesh DOFs (FeModel::mesh_map; identity when empty).
 struct NonlinearStaticResult {
   std::vector<double> load_factor;
@@ -109,6 +110,7 @@ struct NonlinearStaticResult {
 NonlinearStaticResult SolveNonlinearStatic(const SvkSolidMesh& solid, const SparseMatrix& T,
                                            const std::vector<int>& prescribed_dofs,
                                            const Eigen::VectorXd& prescribed_values, const Eigen::VectorXd& f_ext,
-                                           int steps, double tolerance = 1e-9, int max_iterations = 30);
+                                           int steps, double tolerance = 1e-9, int max_iterations = 30,
+                                           const Eigen::VectorXd* u_start = nullptr);
 
 }  // namespace femb
