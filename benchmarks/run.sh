@@ -16,3 +16,6 @@ echo
 # Error vs run time on the 2D slider-crank and the spinning beam (about 8 minutes): tables, PNGs.
 mkdir -p out
 /usr/bin/python3 benchmarks/error_vs_time.py build/bin --png-prefix out/error_vs_time_
+echo
+# Modal derivatives: error vs run time on the cross-flexure pivot (about 2 minutes).
+/usr/bin/python3 benchmarks/flexure_error_vs_time.py build/bin --png out/flexure_error_vs_time.png

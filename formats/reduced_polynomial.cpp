@@ -1,19 +1,26 @@
 #include "formats/reduced_polynomial.h"
 
+#include <Eigen/SparseCore>
+#include <vector>
+
 namespace femb {
 namespace {
 
-// J = dz/dq (P x n): row p = (j, k) holds m_p q_k at column j and m_p q_j at column k.
-Eigen::MatrixXd PairJacobian(const Eigen::VectorXd& q) {
+// J = dz/dq (P x n), sparse: row p = (j, k) holds m_p q_k at column j and m_p q_j at column k.
+// (Dense, J^T B J would cost P^2 n flops; sparse, P n^2.)
+Eigen::SparseMatrix<double> PairJacobian(const Eigen::VectorXd& q) {
   const int n = int(q.size());
-  Eigen::MatrixXd J = Eigen::MatrixXd::Zero(n * (n + 1) / 2, n);
+  std::vector<Eigen::Triplet<double>> entries;
+  entries.reserve(size_t(n) * (n + 1));
   int p = 0;
   for (int j = 0; j < n; ++j)
     for (int k = j; k < n; ++k, ++p) {
       const double m = j == k ? 1.0 : 2.0;
-      J(p, j) += m * q[k];
-      J(p, k) += m * q[j];
+      entries.emplace_back(p, j, m * q[k]);
+      entries.emplace_back(p, k, m * q[j]);
     }
+  Eigen::SparseMatrix<double> J(n * (n + 1) / 2, n);
+  J.setFromTriplets(entries.begin(), entries.end());  // sums the two entries of a diagonal pair
   return J;
 }
 
@@ -47,15 +54,18 @@ double PolynomialEnergy(const Eigen::MatrixXd& K, const PolynomialStiffness& p, 
 
 Eigen::VectorXd PolynomialForce(const Eigen::MatrixXd& K, const PolynomialStiffness& p, const Eigen::VectorXd& q) {
   const Eigen::VectorXd z = PairProducts(q);
-  const Eigen::MatrixXd J = PairJacobian(q);
-  return K * q + p.A * z + J.transpose() * (p.A.transpose() * q + 2 * (p.B * z));
+  const Eigen::SparseMatrix<double> J = PairJacobian(q);
+  const Eigen::VectorXd w = p.A.transpose() * q + 2 * (p.B * z);
+  return K * q + p.A * z + J.transpose() * w;
 }
 
 Eigen::MatrixXd PolynomialTangent(const Eigen::MatrixXd& K, const PolynomialStiffness& p, const Eigen::VectorXd& q) {
   const Eigen::VectorXd z = PairProducts(q);
-  const Eigen::MatrixXd J = PairJacobian(q);
+  const Eigen::SparseMatrix<double> J = PairJacobian(q);
   const Eigen::MatrixXd AJ = p.A * J;
-  Eigen::MatrixXd T = K + AJ + AJ.transpose() + 2 * J.transpose() * p.B * J;
+  const Eigen::MatrixXd BJ = p.B * J;
+  Eigen::MatrixXd T = K + AJ + AJ.transpose();
+  T.noalias() += 2 * (J.transpose() * BJ);
   AddPairHessian(p.A.transpose() * q + 2 * (p.B * z), &T);
   return 0.5 * (T + T.transpose());
 }
