@@ -6,6 +6,7 @@
 
 #include "formats/input_error.h"
 #include "reducer/fe/beam_model.h"
+#include "reducer/fe/nonlinear_beam.h"
 #include "reducer/fe/nonlinear_solid.h"
 #include "reducer/fe/solid_model.h"
 #include "reducer/linalg/sparse_cholesky.h"
@@ -83,24 +84,26 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
                                                           : AvailableMemoryBytes();
   const double factor_budget = limit > 0 ? std::max(limit - dense_bytes, 0.1 * limit) : 0.0;
   // Modal derivatives: (dK/dq_j) phi_i = 2 f2(phi_i, phi_j), the symmetric bilinear part of the
-  // cubic internal force f(u) = K u + f2(u, u) + f3(u, u, u) of the Green-Lagrange model, by the
-  // exact polarization identity 8 f2(a, b) = [f(a + b) - f(a - b)] - [f(b - a) - f(-a - b)]
-  // (the linear and cubic terms cancel), evaluated at displacements scaled to 1e-6 of the part
-  // size (round-off ~1e-10 relative).
+  // cubic internal force f(u) = K u + f2(u, u) + f3(u, u, u) of the nonlinear model (solids:
+  // Green-Lagrange; beams: moderate rotation), by the exact polarization identity
+  // 8 f2(a, b) = [f(a + b) - f(a - b)] - [f(b - a) - f(-a - b)] (the linear and cubic terms
+  // cancel), evaluated at displacements scaled to 1e-6 of the part size (round-off ~1e-10).
   DerivativeRequest request;
-  std::unique_ptr<SvkSolidMesh> solid;
+  std::unique_ptr<NonlinearModel> nonlinear;
+  SparseMatrix to_model_dofs = model.mesh_map;  // the nonlinear model's DOFs = this x model DOFs
   if (part.reduction.modal_derivatives.enabled) {
-    if (part.type != "solid") {
-      throw InputError(part.reduction.modal_derivatives.where +
-                       ": only solid parts so far (the beam's moderate-rotation "
-                       "kernel is not implemented); model the flexure with type: solid");
-    }
     request.pairs = DerivativePairs(part, n_b, n_b + m);
     request.tolerance = part.reduction.modal_derivatives.tolerance;
-    solid = std::make_unique<SvkSolidMesh>(SolidTypeOf(model.cell_type), model.nodes, model.cells, part.material);
+    if (part.type == "solid") {
+      nonlinear = std::make_unique<SvkSolidMesh>(SolidTypeOf(model.cell_type), model.nodes, model.cells, part.material);
+    } else {
+      nonlinear = std::make_unique<VonKarmanBeams>(part);
+      to_model_dofs.resize(model.n_dofs(), model.n_dofs());
+      to_model_dofs.setIdentity();
+    }
     const double size = (model.nodes.colwise().maxCoeff() - model.nodes.colwise().minCoeff()).norm();
     request.stiffness_derivative = [&, size](const Eigen::MatrixXd& shapes, const std::vector<std::pair<int, int>>& pairs) {
-      const SparseMatrix& T = model.mesh_map;
+      const SparseMatrix& T = to_model_dofs;
       const Eigen::MatrixXd mesh_shapes = T * shapes;
       Eigen::MatrixXd out(model.n_dofs(), long(pairs.size()));
       for (size_t k = 0; k < pairs.size(); ++k) {
@@ -108,7 +111,8 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
         const double sa = 1e-6 * size / std::max(a0.cwiseAbs().maxCoeff(), 1e-300);
         const double sb = 1e-6 * size / std::max(b0.cwiseAbs().maxCoeff(), 1e-300);
         const Eigen::VectorXd a = sa * a0, b = sb * b0;
-        const Eigen::VectorXd f2 = ((solid->Force(a + b) - solid->Force(a - b)) - (solid->Force(b - a) - solid->Force(-a - b))) / 8;
+        const Eigen::VectorXd f2 =
+            ((nonlinear->Force(a + b) - nonlinear->Force(a - b)) - (nonlinear->Force(b - a) - nonlinear->Force(-a - b))) / 8;
         out.col(long(k)) = T.transpose() * (2 * f2 / (sa * sb));
       }
       return out;
@@ -148,13 +152,16 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
   se.mass_properties = ComputeMassProperties(se);
   se.floating_frame = ComputeFloatingFrame(part.reduction.floating_frame,
                                            part.reduction.where_floating_frame, se, model, cb.shapes);
-  if (solid && se.n_modal_derivatives > 0) {
+  if (nonlinear && se.n_modal_derivatives > 0) {
     // The reduced internal force on the whole basis (static and internal modes, derivatives)
     // is the cubic polynomial of reduced_polynomial.h; its linear part equals K_r.
     Stopwatch tensors;
-    const Eigen::MatrixXd mesh_shapes = model.mesh_map * cb.shapes;
-    ReducedPolynomial poly = ReduceSvk(*solid, mesh_shapes,
-                                       InterfaceRotationCompletion(model.nodes, mesh_shapes, model.interface_positions, se.floating_frame.origin));
+    const Eigen::MatrixXd mesh_shapes = to_model_dofs * cb.shapes;
+    const auto completion = InterfaceRotationCompletion(model.nodes, mesh_shapes, model.interface_positions,
+                                                        se.floating_frame.origin, part.type == "solid" ? 3 : 6);
+    ReducedPolynomial poly = part.type == "solid"
+                                 ? ReduceSvk(static_cast<const SvkSolidMesh&>(*nonlinear), mesh_shapes, completion)
+                                 : ReduceVonKarman(static_cast<const VonKarmanBeams&>(*nonlinear), mesh_shapes, completion);
     const double mismatch = (poly.K - cb.K).norm() / cb.K.norm();
     if (mismatch > 1e-8) {
       result.message = "the polynomial internal force's linear part differs from K_r by " + std::to_string(mismatch);

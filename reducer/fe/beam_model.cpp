@@ -12,12 +12,6 @@
 namespace femb {
 namespace {
 
-struct BeamElement {
-  int n1, n2;
-  Eigen::Matrix3d R;
-  std::shared_ptr<const TimoshenkoBeam> beam;
-};
-
 Eigen::Vector3d Orientation(const BeamSpec& beam, const Eigen::Vector3d& axis) {
   if (beam.orientation) return *beam.orientation;
   if (std::abs(axis.normalized().dot(Eigen::Vector3d::UnitY())) < 0.999) return Eigen::Vector3d::UnitY();
@@ -26,7 +20,7 @@ Eigen::Vector3d Orientation(const BeamSpec& beam, const Eigen::Vector3d& axis) {
 
 }  // namespace
 
-FeModel BuildBeamModel(const PartSpec& part) {
+std::vector<BeamElement> BeamElements(const PartSpec& part, std::vector<Eigen::Vector3d>* nodes_out) {
   const BeamSpec& spec = part.beam;
   std::vector<Eigen::Vector3d> nodes(spec.points.begin(), spec.points.end());
   std::vector<BeamElement> elements;
@@ -53,6 +47,14 @@ FeModel BuildBeamModel(const PartSpec& part) {
       previous = next;
     }
   }
+  *nodes_out = nodes;
+  return elements;
+}
+
+FeModel BuildBeamModel(const PartSpec& part) {
+  const BeamSpec& spec = part.beam;
+  std::vector<Eigen::Vector3d> nodes;
+  const std::vector<BeamElement> elements = BeamElements(part, &nodes);
 
   FeModel model;
   model.dofs_per_node = 6;

@@ -166,7 +166,7 @@ SparseMatrix SvkSolidMesh::Tangent(const Eigen::VectorXd& u) const {
 std::vector<std::pair<int, Eigen::VectorXd>> InterfaceRotationCompletion(const Eigen::MatrixXd& mesh_nodes,
                                                                           const Eigen::MatrixXd& mesh_shapes,
                                                                           const std::vector<Eigen::Vector3d>& interface_points,
-                                                                          const Eigen::Vector3d& origin) {
+                                                                          const Eigen::Vector3d& origin, int dofs_per_node) {
   const int n = int(mesh_shapes.cols());
   const long n_nodes = mesh_nodes.rows();
   auto pair_index = [n](int j, int k) { return j * n - j * (j - 1) / 2 + (k - j); };  // j <= k
@@ -182,10 +182,10 @@ std::vector<std::pair<int, Eigen::VectorXd>> InterfaceRotationCompletion(const E
       for (int b = a; b < 3; ++b) {
         const Eigen::Matrix3d Ea = skew(Eigen::Vector3d::Unit(a)), Eb = skew(Eigen::Vector3d::Unit(b));
         const Eigen::Matrix3d C = 0.25 * (Ea * Eb + Eb * Ea);  // sym(e_a~ e_b~) / 2
-        Eigen::VectorXd W(3 * n_nodes);
+        Eigen::VectorXd W = Eigen::VectorXd::Zero(dofs_per_node * n_nodes);
         for (long i = 0; i < n_nodes; ++i) {
-          const double phi = mesh_shapes(3 * i, first);  // x component of interface k's u_x mode
-          W.segment<3>(3 * i) = phi * C * (mesh_nodes.row(i).transpose() - origin);
+          const double phi = mesh_shapes(dofs_per_node * i, first);  // x component of interface k's u_x mode
+          W.segment<3>(dofs_per_node * i) = phi * C * (mesh_nodes.row(i).transpose() - origin);
         }
         W -= mesh_shapes.middleCols(first, 3) * (C * (interface_points[k] - origin));
         fields.emplace_back(pair_index(first + 3 + a, first + 3 + b), std::move(W));
@@ -197,22 +197,8 @@ std::vector<std::pair<int, Eigen::VectorXd>> InterfaceRotationCompletion(const E
 ReducedPolynomial ReduceSvk(const SvkSolidMesh& solid, const Eigen::MatrixXd& mesh_shapes,
                             const std::vector<std::pair<int, Eigen::VectorXd>>& pair_fields) {
   const int n = int(mesh_shapes.cols()), P = n * (n + 1) / 2, ne = solid.n_per_cell_;
-  ReducedPolynomial r;
-  r.K = Eigen::MatrixXd::Zero(n, n);
-  r.A = Eigen::MatrixXd::Zero(n, P);
-  r.B = Eigen::MatrixXd::Zero(P, P);
-  // D = C^T C: B accumulates (C Q)^T (C Q) over the points, stacked into blocks of rows (one
-  // BLAS product per block).
-  const Eigen::Matrix<double, 6, 6> C = solid.D_.llt().matrixU();
-  constexpr int kPointsPerBlock = 64;
-  Eigen::MatrixXd stack(6 * kPointsPerBlock, P);
-  int stacked = 0;
-  auto flush = [&]() {
-    if (stacked == 0) return;
-    const auto Y = stack.topRows(6 * stacked);
-    r.B.noalias() += Y.transpose() * Y;
-    stacked = 0;
-  };
+  PolynomialAccumulator accumulator(n);
+  const Eigen::Matrix<double, 6, 6> C = solid.D_.llt().matrixU();  // D = C^T C
   std::vector<Eigen::Matrix3d> G(static_cast<size_t>(n));
   Eigen::MatrixXd L(6, n), Q(6, P), U(ne, 3);
   Eigen::MatrixXd element(3 * ne, n);
@@ -246,20 +232,45 @@ ReducedPolynomial ReduceSvk(const SvkSolidMesh& solid, const Eigen::MatrixXd& me
         e << Gw(0, 0), Gw(1, 1), Gw(2, 2), Gw(1, 2) + Gw(2, 1), Gw(0, 2) + Gw(2, 0), Gw(0, 1) + Gw(1, 0);
         Q.col(pair_fields[size_t(f)].first) += 2 * e;
       }
-      const Eigen::MatrixXd DL = solid.D_ * L;
-      r.K.noalias() += dV * L.transpose() * DL;
-      r.A.noalias() += (0.5 * dV) * DL.transpose() * Q;
-      stack.middleRows(6 * stacked, 6) = std::sqrt(dV / 8) * (C * Q);
-      if (++stacked == kPointsPerBlock) flush();
+      accumulator.Add(dV, C, L, Q);
     }
   }
-  flush();
-  r.K = 0.5 * (r.K + r.K.transpose()).eval();
-  r.B = 0.5 * (r.B + r.B.transpose()).eval();
-  return r;
+  return accumulator.Finish();
 }
 
-NonlinearStaticResult SolveNonlinearStatic(const SvkSolidMesh& solid, const SparseMatrix& T_in,
+PolynomialAccumulator::PolynomialAccumulator(int n) {
+  const int P = n * (n + 1) / 2;
+  r_.K = Eigen::MatrixXd::Zero(n, n);
+  r_.A = Eigen::MatrixXd::Zero(n, P);
+  r_.B = Eigen::MatrixXd::Zero(P, P);
+  stack_.resize(6 * kPointsPerBlock, P);
+}
+
+void PolynomialAccumulator::Add(double dV, const Eigen::Matrix<double, 6, 6>& C, const Eigen::MatrixXd& L,
+                                const Eigen::MatrixXd& Q) {
+  const Eigen::MatrixXd CL = C * L;
+  r_.K.noalias() += dV * CL.transpose() * CL;
+  r_.A.noalias() += (0.5 * dV) * CL.transpose() * (C * Q);
+  // B gathers (C Q)^T (C Q) dV / 8, stacked into blocks of rows (one BLAS product each).
+  stack_.middleRows(6 * stacked_, 6) = std::sqrt(dV / 8) * (C * Q);
+  if (++stacked_ == kPointsPerBlock) Flush();
+}
+
+void PolynomialAccumulator::Flush() {
+  if (stacked_ == 0) return;
+  const auto Y = stack_.topRows(6 * stacked_);
+  r_.B.noalias() += Y.transpose() * Y;
+  stacked_ = 0;
+}
+
+ReducedPolynomial PolynomialAccumulator::Finish() {
+  Flush();
+  r_.K = 0.5 * (r_.K + r_.K.transpose()).eval();
+  r_.B = 0.5 * (r_.B + r_.B.transpose()).eval();
+  return std::move(r_);
+}
+
+NonlinearStaticResult SolveNonlinearStatic(const NonlinearModel& solid, const SparseMatrix& T_in,
                                            const std::vector<int>& prescribed_dofs,
                                            const Eigen::VectorXd& prescribed_values, const Eigen::VectorXd& f_ext,
                                            int steps, double tolerance, int max_iterations,

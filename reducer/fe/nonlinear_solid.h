@@ -40,16 +40,43 @@ struct ReducedPolynomial {
 NonlinearElementState SvkSolidElement(SolidType type, const Eigen::MatrixXd& X, const MaterialSpec& material,
                                       const Eigen::VectorXd& u, bool with_tangent);
 
+/// A geometrically nonlinear model on some DOF vector: strain energy, its gradient (the internal
+/// force) and Hessian (the tangent, symmetric, both triangles stored).
+class NonlinearModel {
+ public:
+  virtual ~NonlinearModel() = default;
+  virtual long n_dofs() const = 0;
+  virtual double Energy(const Eigen::VectorXd& u) const = 0;
+  virtual Eigen::VectorXd Force(const Eigen::VectorXd& u) const = 0;
+  virtual SparseMatrix Tangent(const Eigen::VectorXd& u) const = 0;
+};
+
+/// Accumulates the reduced polynomial (ReducedPolynomial) over quadrature points: at each, the
+/// weight dV, a factor C of the 6 x 6 stiffness D = C^T C (Cholesky, or the square root of a
+/// diagonal D, zeros allowed), the linear strain rows L (6 x n) and the quadratic ones Q (6 x P).
+class PolynomialAccumulator {
+ public:
+  explicit PolynomialAccumulator(int n);
+  void Add(double dV, const Eigen::Matrix<double, 6, 6>& C, const Eigen::MatrixXd& L, const Eigen::MatrixXd& Q);
+  ReducedPolynomial Finish();
+
+ private:
+  void Flush();
+  static constexpr int kPointsPerBlock = 64;
+  ReducedPolynomial r_;
+  Eigen::MatrixXd stack_;
+  int stacked_ = 0;
+};
+
 /// A whole mesh (3 DOFs per mesh node, node-major), quadrature data computed once.
-class SvkSolidMesh {
+class SvkSolidMesh : public NonlinearModel {
  public:
   SvkSolidMesh(SolidType type, const Eigen::MatrixXd& nodes, const Eigen::MatrixXi& cells,
                const MaterialSpec& material);
-  long n_dofs() const { return 3 * n_nodes_; }
-  double Energy(const Eigen::VectorXd& u) const;
-  Eigen::VectorXd Force(const Eigen::VectorXd& u) const;
-  /// Symmetric, both triangles stored.
-  SparseMatrix Tangent(const Eigen::VectorXd& u) const;
+  long n_dofs() const override { return 3 * n_nodes_; }
+  double Energy(const Eigen::VectorXd& u) const override;
+  Eigen::VectorXd Force(const Eigen::VectorXd& u) const override;
+  SparseMatrix Tangent(const Eigen::VectorXd& u) const override;
   friend ReducedPolynomial ReduceSvk(const SvkSolidMesh& solid, const Eigen::MatrixXd& mesh_shapes,
                                      const std::vector<std::pair<int, Eigen::VectorXd>>& pair_fields);
 
@@ -87,10 +114,13 @@ ReducedPolynomial ReduceSvk(const SvkSolidMesh& solid, const Eigen::MatrixXd& me
 /// rotation; and for a rigid rotation of the whole part (all theta_k equal, u_k = (R - 1) X_k)
 /// the second-order field is exactly theta~^2 (x - o) / 2, strain-free. Pair indices p refer to
 /// the n reduced coordinates (reduced_polynomial.h).
+/// `dofs_per_node`: 3 (solid mesh) or 6 (beam nodes: translations first; the rotation rows of
+/// W_p hold only the -Psi_k term).
 std::vector<std::pair<int, Eigen::VectorXd>> InterfaceRotationCompletion(const Eigen::MatrixXd& mesh_nodes,
                                                                           const Eigen::MatrixXd& mesh_shapes,
                                                                           const std::vector<Eigen::Vector3d>& interface_points,
-                                                                          const Eigen::Vector3d& origin);
+                                                                          const Eigen::Vector3d& origin,
+                                                                          int dofs_per_node = 3);
 
 /// Static equilibrium of a full nonlinear model by Newton with load stepping:
 ///   T^T f(T u) = lambda f_ext  on the free model DOFs, u = prescribed values on the others
@@ -107,7 +137,7 @@ struct NonlinearStaticResult {
   bool converged = true;
   std::string message;  ///< why it stopped, when not converged
 };
-NonlinearStaticResult SolveNonlinearStatic(const SvkSolidMesh& solid, const SparseMatrix& T,
+NonlinearStaticResult SolveNonlinearStatic(const NonlinearModel& solid, const SparseMatrix& T,
                                            const std::vector<int>& prescribed_dofs,
                                            const Eigen::VectorXd& prescribed_values, const Eigen::VectorXd& f_ext,
                                            int steps, double tolerance = 1e-9, int max_iterations = 30,

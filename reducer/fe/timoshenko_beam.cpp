@@ -108,11 +108,32 @@ Eigen::Matrix<double, 6, 12> TimoshenkoBeam::StrainInterpolation(double xi) cons
   return B;
 }
 
-Matrix12d TimoshenkoBeam::LocalStiffness() const {
+Eigen::Matrix<double, 6, 1> TimoshenkoBeam::SectionStiffness() const {
   const double E = material_.E, G = E / (2.0 * (1.0 + material_.nu));
   Eigen::Matrix<double, 6, 1> D;
   D << E * section_.A, G * section_.J, E * section_.Iz, section_.ky * G * section_.A,
       E * section_.Iy, section_.kz * G * section_.A;
+  return D;
+}
+
+std::vector<TimoshenkoBeam::QuadraturePoint> TimoshenkoBeam::QuadraturePoints() const {
+  std::vector<QuadraturePoint> points(4);
+  for (int g = 0; g < 4; ++g) {
+    QuadraturePoint& p = points[size_t(g)];
+    p.B = StrainInterpolation(kGaussX[g]);
+    p.weight = kGaussW[g] * L_;
+    p.slope.setZero();
+    const BendingShapes y = Bending(kGaussX[g], L_, Phi_y_), z = Bending(kGaussX[g], L_, Phi_z_);
+    for (int a = 0; a < 4; ++a) {
+      p.slope(0, kPlaneY[a]) = y.dN[a];               // v'
+      p.slope(1, kPlaneZ[a]) = kSignZ[a] * z.dN[a];   // w'
+    }
+  }
+  return points;
+}
+
+Matrix12d TimoshenkoBeam::LocalStiffness() const {
+  const Eigen::Matrix<double, 6, 1> D = SectionStiffness();
   Matrix12d K = Matrix12d::Zero();
   for (int g = 0; g < 4; ++g) {
     const auto B = StrainInterpolation(kGaussX[g]);

@@ -12,6 +12,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <vector>
 
 #include "formats/part_file.h"
 #include "reducer/fe/beam_section.h"
@@ -37,6 +38,18 @@ class TimoshenkoBeam {
   Matrix12d LocalMass() const;
   /// Local displacement and rotation (u, theta) at xi = x/L in [0, 1] from the 12 local DOFs.
   Matrix6x12d LocalInterpolation(double xi) const;
+
+  /// The quadrature of LocalStiffness (4 Gauss points): per point the strain rows B (axial u',
+  /// torsion, bending t_z', shear, bending (-t_y)', shear), the slopes v', w' of the transverse
+  /// displacements (2 x 12; the moderate-rotation axial strain is u' + (v'^2 + w'^2) / 2) and the
+  /// weight (times L). SectionStiffness: the diagonal of D (EA, GJ, EIz, kGA, EIy, kGA).
+  struct QuadraturePoint {
+    Eigen::Matrix<double, 6, 12> B;
+    Eigen::Matrix<double, 2, 12> slope;
+    double weight = 0.0;
+  };
+  std::vector<QuadraturePoint> QuadraturePoints() const;
+  Eigen::Matrix<double, 6, 1> SectionStiffness() const;
 
   double Phi_y() const { return Phi_y_; }  ///< shear parameter of bending in x-y (uses Iz, ky)
   double Phi_z() const { return Phi_z_; }  ///< shear parameter of bending in x-z (uses Iy, kz)
