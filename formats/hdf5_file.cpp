@@ -59,14 +59,14 @@ void Writer::CreateGroup(const std::string& group) {
   if (g.id() < 0) throw InputError(path_ + ": cannot create group " + group);
 }
 
-void Writer::WriteDoubles(const std::string& name, const std::vector<hsize_t>& shape,
-                          const double* data) {
+void Writer::WriteData(const std::string& name, const std::vector<hsize_t>& shape, hid_t file_type,
+                       hid_t memory_type, const void* data) {
   Handle space = Own(shape.empty() ? H5Screate(H5S_SCALAR)
                                    : H5Screate_simple(int(shape.size()), shape.data(), nullptr));
-  Handle set = Own(H5Dcreate2(file_.id(), name.c_str(), H5T_IEEE_F64LE, space.id(), H5P_DEFAULT,
+  Handle set = Own(H5Dcreate2(file_.id(), name.c_str(), file_type, space.id(), H5P_DEFAULT,
                               H5P_DEFAULT, H5P_DEFAULT));
   if (set.id() < 0 ||
-      H5Dwrite(set.id(), H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, data) < 0) {
+      H5Dwrite(set.id(), memory_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data) < 0) {
     throw InputError(path_ + ": cannot write dataset " + name);
   }
 }
@@ -82,28 +82,14 @@ void Writer::Vector(const std::string& name, const Eigen::VectorXd& value) {
 
 void Writer::FloatMatrix(const std::string& name, const Eigen::MatrixXf& value) {
   Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> row_major = value;
-  hsize_t shape[2] = {hsize_t(value.rows()), hsize_t(value.cols())};
-  Handle space = Own(H5Screate_simple(2, shape, nullptr));
-  Handle set = Own(H5Dcreate2(file_.id(), name.c_str(), H5T_IEEE_F32LE, space.id(), H5P_DEFAULT,
-                              H5P_DEFAULT, H5P_DEFAULT));
-  if (set.id() < 0 ||
-      H5Dwrite(set.id(), H5T_NATIVE_FLOAT, H5S_ALL, H5S_ALL, H5P_DEFAULT, row_major.data()) < 0) {
-    throw InputError(path_ + ": cannot write dataset " + name);
-  }
+  WriteData(name, {hsize_t(value.rows()), hsize_t(value.cols())}, H5T_IEEE_F32LE, H5T_NATIVE_FLOAT, row_major.data());
 }
 
 void Writer::Scalar(const std::string& name, double value) { WriteDoubles(name, {}, &value); }
 
 void Writer::IntMatrix(const std::string& name, const Eigen::MatrixXi& value) {
   Eigen::Matrix<int, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> row_major = value;
-  hsize_t shape[2] = {hsize_t(value.rows()), hsize_t(value.cols())};
-  Handle space = Own(H5Screate_simple(2, shape, nullptr));
-  Handle set = Own(H5Dcreate2(file_.id(), name.c_str(), H5T_STD_I32LE, space.id(), H5P_DEFAULT,
-                              H5P_DEFAULT, H5P_DEFAULT));
-  if (set.id() < 0 ||
-      H5Dwrite(set.id(), H5T_NATIVE_INT, H5S_ALL, H5S_ALL, H5P_DEFAULT, row_major.data()) < 0) {
-    throw InputError(path_ + ": cannot write dataset " + name);
-  }
+  WriteData(name, {hsize_t(value.rows()), hsize_t(value.cols())}, H5T_STD_I32LE, H5T_NATIVE_INT, row_major.data());
 }
 
 void Writer::Strings(const std::string& name, const std::vector<std::string>& value) {

@@ -47,7 +47,13 @@ class Writer {
   void Close();
 
  private:
-  void WriteDoubles(const std::string& name, const std::vector<hsize_t>& shape, const double* data);
+  /// One dataset of the given shape (empty: scalar), stored as `file_type`, read from `data`
+  /// as `memory_type`.
+  void WriteData(const std::string& name, const std::vector<hsize_t>& shape, hid_t file_type, hid_t memory_type,
+                 const void* data);
+  void WriteDoubles(const std::string& name, const std::vector<hsize_t>& shape, const double* data) {
+    WriteData(name, shape, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, data);
+  }
   std::string path_;
   Handle file_;
 };

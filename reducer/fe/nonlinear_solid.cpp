@@ -6,34 +6,19 @@
 #include <cmath>
 #include <cstdio>
 
-#include "formats/input_error.h"
 
 namespace femb {
 namespace {
 
 using Vector6 = Eigen::Matrix<double, 6, 1>;
 
-// dN/dX (n x 3) and dV at every quadrature point of one element; throws for inverted elements.
+// dN/dX (n x 3) and dV at every quadrature point of one element (solid_element.h); throws for
+// inverted elements.
 void ElementPoints(SolidType type, const Eigen::MatrixXd& X, long element_id, std::vector<Eigen::MatrixXd>* dNdX,
                    std::vector<double>* dV) {
-  std::vector<Eigen::Vector3d> points;
-  std::vector<double> weights;
-  SolidQuadrature(type, &points, &weights);
-  Eigen::VectorXd N;
-  Eigen::MatrixXd dN;
-  const double size = (X.rowwise() - X.colwise().mean()).rowwise().norm().maxCoeff();
-  for (size_t q = 0; q < points.size(); ++q) {
-    SolidShapeFunctions(type, points[q], &N, &dN);
-    const Eigen::Matrix3d J = X.transpose() * dN;
-    const double det = J.determinant();
-    if (!(det > 1e-10 * size * size * size)) {
-      char buffer[200];
-      std::snprintf(buffer, sizeof buffer, "element %ld (%s): inverted or degenerate (det J = %.3g at a quadrature point)",
-                    element_id, SolidTypeName(type).c_str(), det);
-      throw InputError(buffer);
-    }
-    dNdX->push_back(dN * J.inverse());
-    dV->push_back(det * weights[q]);
+  for (SolidPoint& p : SolidElementPoints(type, X, element_id)) {
+    dNdX->push_back(std::move(p.dNdX));
+    dV->push_back(p.dV);
   }
 }
 

@@ -167,22 +167,16 @@ Eigen::Matrix<double, 6, 6> IsotropicElasticity(double E, double nu) {
   return D;
 }
 
-SolidElementMatrices ComputeSolidElement(SolidType type, const Eigen::MatrixXd& X, const MaterialSpec& material,
-                                         long element_id) {
-  const int n = SolidNodeCount(type);
-  SolidElementMatrices out;
-  out.K = Eigen::MatrixXd::Zero(3 * n, 3 * n);
-  out.M = Eigen::MatrixXd::Zero(3 * n, 3 * n);
-  const Eigen::Matrix<double, 6, 6> D = IsotropicElasticity(material.E, material.nu);
+std::vector<SolidPoint> SolidElementPoints(SolidType type, const Eigen::MatrixXd& X, long element_id) {
   std::vector<Eigen::Vector3d> points;
   std::vector<double> weights;
   SolidQuadrature(type, &points, &weights);
-  Eigen::VectorXd N;
   Eigen::MatrixXd dN;
   // Scale for the degeneracy test: det J relative to the element's size cubed.
   const double size = (X.rowwise() - X.colwise().mean()).rowwise().norm().maxCoeff();
+  std::vector<SolidPoint> out(points.size());
   for (size_t q = 0; q < points.size(); ++q) {
-    SolidShapeFunctions(type, points[q], &N, &dN);
+    SolidShapeFunctions(type, points[q], &out[q].N, &dN);
     const Eigen::Matrix3d J = X.transpose() * dN;  // dx/dxi
     const double det = J.determinant();
     if (!(det > 1e-10 * size * size * size)) {
@@ -191,7 +185,22 @@ SolidElementMatrices ComputeSolidElement(SolidType type, const Eigen::MatrixXd& 
                     element_id, SolidTypeName(type).c_str(), det);
       throw InputError(buffer);
     }
-    const Eigen::MatrixXd dNdx = dN * J.inverse();  // n x 3
+    out[q].dNdX = dN * J.inverse();
+    out[q].dV = det * weights[q];
+  }
+  return out;
+}
+
+SolidElementMatrices ComputeSolidElement(SolidType type, const Eigen::MatrixXd& X, const MaterialSpec& material,
+                                         long element_id) {
+  const int n = SolidNodeCount(type);
+  SolidElementMatrices out;
+  out.K = Eigen::MatrixXd::Zero(3 * n, 3 * n);
+  out.M = Eigen::MatrixXd::Zero(3 * n, 3 * n);
+  const Eigen::Matrix<double, 6, 6> D = IsotropicElasticity(material.E, material.nu);
+  for (const SolidPoint& p : SolidElementPoints(type, X, element_id)) {
+    const Eigen::MatrixXd& dNdx = p.dNdX;  // n x 3
+    const Eigen::VectorXd& N = p.N;
     Eigen::MatrixXd B = Eigen::MatrixXd::Zero(6, 3 * n);
     for (int a = 0; a < n; ++a) {
       const double gx = dNdx(a, 0), gy = dNdx(a, 1), gz = dNdx(a, 2);
@@ -205,7 +214,7 @@ SolidElementMatrices ComputeSolidElement(SolidType type, const Eigen::MatrixXd& 
       B(5, 3 * a) = gy;
       B(5, 3 * a + 1) = gx;
     }
-    const double dV = det * weights[q];
+    const double dV = p.dV;
     out.volume += dV;
     out.K.noalias() += dV * B.transpose() * D * B;
     for (int a = 0; a < n; ++a)

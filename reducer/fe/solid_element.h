@@ -8,6 +8,7 @@
 
 #include <Eigen/Core>
 #include <string>
+#include <vector>
 
 #include "formats/part_file.h"
 
@@ -27,6 +28,16 @@ struct SolidElementMatrices {
 /// (det J = ... at a quadrature point)" when the mapping is not orientation-preserving.
 SolidElementMatrices ComputeSolidElement(SolidType type, const Eigen::MatrixXd& X, const MaterialSpec& material,
                                          long element_id);
+
+/// The quadrature of one element in physical coordinates: per point the shape functions N (n),
+/// their gradient dN/dX (n x 3) and the volume weight dV = det J w. Throws InputError "element
+/// <id>: inverted or degenerate (det J = ... at a quadrature point)" when det J <= 1e-10 size^3.
+struct SolidPoint {
+  Eigen::VectorXd N;
+  Eigen::MatrixXd dNdX;
+  double dV = 0.0;
+};
+std::vector<SolidPoint> SolidElementPoints(SolidType type, const Eigen::MatrixXd& X, long element_id);
 
 /// Shape functions (n) and their derivatives (n x 3) at a reference point.
 void SolidShapeFunctions(SolidType type, const Eigen::Vector3d& xi, Eigen::VectorXd* N, Eigen::MatrixXd* dN);
