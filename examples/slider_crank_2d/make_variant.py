@@ -10,6 +10,9 @@ rod_a, rod_mid, rod_b (position), slider (position, joint).
 import os
 import sys
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+import rod  # noqa: E402
+
 n, out = int(sys.argv[1]), sys.argv[2]
 step = float(sys.argv[3]) if len(sys.argv) > 3 else 1.0e-5
 modes = int(sys.argv[4]) if len(sys.argv) > 4 and sys.argv[4] else (4 if n <= 2 else 2)
@@ -18,24 +21,8 @@ if n < 2 or n % 2:
     sys.exit("make_variant.py: N must be even and >= 2")
 here = os.path.dirname(os.path.abspath(__file__))
 os.makedirs(out, exist_ok=True)
-L = 0.3 / n
-elements = max(4, 20 // n)
-with open(os.path.join(out, f"rod_{n}.yaml"), "w") as f:
-    f.write(f"""# One of {n} segments of the slider-crank's rod (L = 0.3 m, d = 6 mm, E = 0.2e12 Pa, rho = 7870).
-name: rod_{n}
-type: beam
-units: SI
-material: {{E: 2.0e11, nu: 0.3, rho: 7870}}
-section: {{shape: circle, diameter: 0.006}}
-beam:
-  theory: euler_bernoulli
-  points: {{A: [0, 0, 0], B: [{L!r}, 0, 0]}}
-  segments: [{{from: A, to: B, elements: {elements}}}]
-interfaces: [{{name: A}}, {{name: B}}]
-reduction: {{internal_modes: {modes}, floating_frame: center_of_mass}}
-""")
-names = ["rod_a"] + [f"rod_{i}" for i in range(1, n)] + ["rod_b"]
-names[n // 2] = "rod_mid"
+L = rod.write_segment(out, n, modes)
+names = rod.node_names(n)
 bodies = "\n".join(
     f"  - {{name: rod{i}, superelement: rod_{n}.h5, placement: {{position: [{0.15 + i * L!r}, 0, 0]}}, "
     f"nodes: {{A: {names[i]}, B: {names[i + 1]}}}{options}}}" for i in range(n))

@@ -17,6 +17,9 @@ import math
 import os
 import sys
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+import rod  # noqa: E402
+
 n, out = int(sys.argv[1]), sys.argv[2]
 step = float(sys.argv[3]) if len(sys.argv) > 3 else 1.0e-5
 modes = int(sys.argv[4]) if len(sys.argv) > 4 and sys.argv[4] else (4 if n <= 2 else 2)
@@ -26,10 +29,10 @@ if n < 2 or n % 2:
 here = os.path.dirname(os.path.abspath(__file__))
 os.makedirs(out, exist_ok=True)
 
-d, crank, rod = 0.1, 0.15, 0.3
+d, crank, length = 0.1, 0.15, rod.LENGTH
 pin = [0.0, d, crank]
-slider = [math.sqrt(rod**2 - d**2 - crank**2), 0.0, 0.0]
-ex = [(s - p) / rod for s, p in zip(slider, pin)]              # rod axis
+slider = [math.sqrt(length**2 - d**2 - crank**2), 0.0, 0.0]
+ex = [(s - p) / length for s, p in zip(slider, pin)]              # rod axis
 ey = [-ex[1], ex[0], 0.0]                                       # z x ex: horizontal
 ey = [c / math.hypot(ey[0], ey[1]) for c in ey]
 ez = [ex[1] * ey[2] - ex[2] * ey[1], ex[2] * ey[0] - ex[0] * ey[2], ex[0] * ey[1] - ex[1] * ey[0]]
@@ -45,24 +48,8 @@ def rotation_vector(c0, c1, c2):
 
 
 rot = ", ".join(f"{v:.15g}" for v in rotation_vector(ex, ey, ez))
-L = rod / n
-elements = max(4, 20 // n)
-with open(os.path.join(out, f"rod_{n}.yaml"), "w") as f:
-    f.write(f"""# One of {n} segments of the slider-crank's rod (L = 0.3 m, d = 6 mm, E = 0.2e12 Pa, rho = 7870).
-name: rod_{n}
-type: beam
-units: SI
-material: {{E: 2.0e11, nu: 0.3, rho: 7870}}
-section: {{shape: circle, diameter: 0.006}}
-beam:
-  theory: euler_bernoulli
-  points: {{A: [0, 0, 0], B: [{L!r}, 0, 0]}}
-  segments: [{{from: A, to: B, elements: {elements}}}]
-interfaces: [{{name: A}}, {{name: B}}]
-reduction: {{internal_modes: {modes}, floating_frame: center_of_mass}}
-""")
-names = ["rod_a"] + [f"rod_{i}" for i in range(1, n)] + ["rod_b"]
-names[n // 2] = "rod_mid"
+L = rod.write_segment(out, n, modes)
+names = rod.node_names(n)
 
 
 def point(i):
