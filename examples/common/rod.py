@@ -32,3 +32,18 @@ def node_names(n):
     names = ["rod_a"] + [f"rod_{i}" for i in range(1, n)] + ["rod_b"]
     names[n // 2] = "rod_mid"
     return names
+
+
+def parse_args(argv):
+    """make_variant.py N OUTDIR [STEP] [MODES] [OPTIONS] -> (n, out, step, modes, options text);
+    creates OUTDIR. N must be even (the rod midpoint is then a node). MODES defaults to 4 per body
+    for 2 bodies, 2 above; OPTIONS is a YAML flow map of the rod bodies' options."""
+    import sys
+    n, out = int(argv[1]), argv[2]
+    step = float(argv[3]) if len(argv) > 3 else 1.0e-5
+    modes = int(argv[4]) if len(argv) > 4 and argv[4] else (4 if n <= 2 else 2)
+    options = f", options: {argv[5]}" if len(argv) > 5 and argv[5] else ""
+    if n < 2 or n % 2:
+        sys.exit("make_variant.py: N must be even and >= 2")
+    os.makedirs(out, exist_ok=True)
+    return n, out, step, modes, options

@@ -13,14 +13,8 @@ import sys
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
 import rod  # noqa: E402
 
-n, out = int(sys.argv[1]), sys.argv[2]
-step = float(sys.argv[3]) if len(sys.argv) > 3 else 1.0e-5
-modes = int(sys.argv[4]) if len(sys.argv) > 4 and sys.argv[4] else (4 if n <= 2 else 2)
-options = f", options: {sys.argv[5]}" if len(sys.argv) > 5 and sys.argv[5] else ""
-if n < 2 or n % 2:
-    sys.exit("make_variant.py: N must be even and >= 2")
+n, out, step, modes, options = rod.parse_args(sys.argv)
 here = os.path.dirname(os.path.abspath(__file__))
-os.makedirs(out, exist_ok=True)
 L = rod.write_segment(out, n, modes)
 names = rod.node_names(n)
 bodies = "\n".join(
