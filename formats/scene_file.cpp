@@ -348,6 +348,7 @@ SceneSpec ParseScene(const std::string& text, const std::string& name, const std
       a.rho_inf = v->Number();
       if (a.rho_inf < 0 || a.rho_inf > 1) v->Fail("rho_inf must be in [0, 1]");
     }
+    if (auto v = m.Optional("integrator")) a.integrator = v->OneOf({"generalized_alpha", "midpoint"});
     if (auto v = m.Optional("tolerance")) a.tolerance = v->PositiveNumber();
     if (auto v = m.Optional("max_iterations")) a.max_iterations = int(v->NonNegativeInteger());
     if (auto v = m.Optional("output_every")) a.output_every = std::max(1, int(v->NonNegativeInteger()));

@@ -79,6 +79,9 @@ struct SceneAnalysisSpec {
   int steps = 10;               ///< static: load steps over [0, end_time]
   double step = 1e-3;           ///< dynamic: time step
   double rho_inf = 0.9;
+  /// dynamic: generalized_alpha (numerical damping by rho_inf) or midpoint (momentum-conserving,
+  /// no damping; solver/analysis/dynamic_analysis.h)
+  std::string integrator = "generalized_alpha";
   double tolerance = 1e-8;
   int max_iterations = 25;
   int output_every = 1;

@@ -135,6 +135,7 @@ int main(int argc, char** argv) {
       options.step = spec.analysis.step;
       options.end_time = spec.analysis.end_time;
       options.rho_inf = spec.analysis.rho_inf;
+      if (spec.analysis.integrator == "midpoint") options.integrator = femb::Integrator::kMidpoint;
       options.tolerance = spec.analysis.tolerance;
       options.max_iterations = spec.analysis.max_iterations;
       options.reuse_jacobian = spec.analysis.reuse_jacobian;

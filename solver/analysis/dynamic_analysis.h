@@ -1,8 +1,14 @@
-// Dynamic analysis: Lie-group generalized-alpha (Arnold & Bruls 2007, Bruls & Cardona 2010) on
-// the nodes' SE(3)-like coordinates (x_k, R_k) with spatial velocities, rotations updated by
-// R <- exp(h dq~) R; Newton with the full iteration matrix S = K_t + gamma' C_t + beta' M_g
-// (the configuration dependence of the inertia forces is left out of S: it costs iterations,
-// not accuracy); step cutting when Newton diverges.
+// Dynamic analysis, two integrators on the nodes' coordinates (x_k, R_k) with spatial
+// velocities:
+// - Lie-group generalized-alpha (Arnold & Bruls 2007, Bruls & Cardona 2010), rotations updated
+//   by R <- exp(h dq~) R; Newton with the iteration matrix S = K_t + gamma' C_t + beta' M_g (the
+//   configuration dependence of the inertia forces is left out of S: it costs iterations, not
+//   accuracy); numerical damping by rho_inf.
+// - Momentum-conserving midpoint (dynamic_analysis.cpp; Simo & Wong 1991 for rigid bodies):
+//   the momentum balance over the step at the mid configuration, node rotations advanced by the
+//   mean convected angular velocity. Conserves linear and angular momentum exactly for free
+//   systems (flexible ones too) and, for rigid bodies, the kinetic energy; no numerical damping.
+// Both cut the step when Newton diverges.
 #pragma once
 
 #include <functional>
@@ -13,7 +19,13 @@
 
 namespace femb {
 
+enum class Integrator {
+  kGeneralizedAlpha,  ///< Lie-group generalized-alpha, numerical damping set by rho_inf
+  kMidpoint,          ///< momentum-conserving midpoint (Simo-Wong for rigid bodies), no damping
+};
+
 struct DynamicOptions {
+  Integrator integrator = Integrator::kGeneralizedAlpha;
   double step = 1e-3;         ///< time step h [time]
   double end_time = 1.0;
   double rho_inf = 0.9;       ///< spectral radius at infinity in [0, 1]; 1: no numerical damping

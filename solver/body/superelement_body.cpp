@@ -206,13 +206,9 @@ void SuperelementBody::VelocityMaps(const BodyConfiguration& c, const FrameSolut
   *U = frame.R * (kin.Z * Rbar_t).bottomRows(3);
 }
 
-Eigen::VectorXd SuperelementBody::QuadraticInertia(const Eigen::MatrixXd& U, const Eigen::MatrixXd& Mg,
-                                                   const BodyVelocity& w) const {
+Eigen::MatrixXd SuperelementBody::VelocityMapRate(const Eigen::MatrixXd& U, const BodyVelocity& w) const {
   const int n = n_coordinates();
-  const Eigen::Vector3d omega_j = U * w;
   Eigen::MatrixXd G = Eigen::MatrixXd::Zero(n, n);
-  Eigen::VectorXd out = Eigen::VectorXd::Zero(n);
-  const Eigen::VectorXd p = Mg * w;
   for (int a = 0; a < n_nodes_; ++a) {
     const Eigen::Vector3d xdot = w.segment<3>(6 * a), omega = w.segment<3>(6 * a + 3);
     G.middleRows<3>(6 * a) = Skew<double>(xdot) * U;
@@ -221,13 +217,24 @@ Eigen::VectorXd SuperelementBody::QuadraticInertia(const Eigen::MatrixXd& U, con
     } else {
       G.middleRows<3>(6 * a + 3) = Skew<double>(omega) * U;
     }
+  }
+  return G;
+}
+
+Eigen::VectorXd SuperelementBody::QuadraticInertia(const Eigen::MatrixXd& U, const Eigen::MatrixXd& Mg,
+                                                   const BodyVelocity& w) const {
+  const Eigen::Vector3d omega_j = U * w;
+  const Eigen::MatrixXd G = VelocityMapRate(U, w);
+  const Eigen::VectorXd p = Mg * w;
+  Eigen::VectorXd out = Mg * (G * w) - G.transpose() * p;
+  for (int a = 0; a < n_nodes_; ++a) {
+    const Eigen::Vector3d omega = w.segment<3>(6 * a + 3);
     // (Omega_P - Omega_hat) p: translation rows omega_j~, rotation rows omega_j~ - omega_a~ (A), 0 (B).
     out.segment<3>(6 * a) += omega_j.cross(Eigen::Vector3d(p.segment<3>(6 * a)));
     if (!options_.cardona_option_b) {
       out.segment<3>(6 * a + 3) += (omega_j - omega).cross(Eigen::Vector3d(p.segment<3>(6 * a + 3)));
     }
   }
-  out += Mg * (G * w) - G.transpose() * p;
   return out;
 }
 
@@ -275,11 +282,27 @@ double SuperelementBody::KineticEnergy(const BodyConfiguration& c, const FrameSo
   return 0.5 * v.dot(M_ * v);
 }
 
-void SuperelementBody::Momentum(const BodyConfiguration& c, const FrameSolution& frame, const BodyVelocity& w,
-                                Eigen::Vector3d* linear, Eigen::Vector3d* angular) const {
+Eigen::VectorXd SuperelementBody::GeneralizedMomentum(const BodyConfiguration& c, const FrameSolution& frame,
+                                                      const BodyVelocity& w) const {
   Eigen::MatrixXd P, U;
   VelocityMaps(c, frame, &P, &U);
-  const Eigen::VectorXd p = P.transpose() * (M_ * (P * w));
+  return P.transpose() * (M_ * (P * w));
+}
+
+Eigen::VectorXd SuperelementBody::MomentumSource(const BodyConfiguration& c, const FrameSolution& frame,
+                                                 const BodyVelocity& w, const Eigen::VectorXd& p) const {
+  Eigen::MatrixXd P, U;
+  VelocityMaps(c, frame, &P, &U);
+  Eigen::VectorXd out = VelocityMapRate(U, w).transpose() * p;
+  for (int a = 0; a < n_nodes_; ++a) {
+    out.segment<3>(6 * a + 3) += Eigen::Vector3d(w.segment<3>(6 * a + 3)).cross(Eigen::Vector3d(p.segment<3>(6 * a + 3)));
+  }
+  return out;
+}
+
+void SuperelementBody::Momentum(const BodyConfiguration& c, const FrameSolution& frame, const BodyVelocity& w,
+                                Eigen::Vector3d* linear, Eigen::Vector3d* angular) const {
+  const Eigen::VectorXd p = GeneralizedMomentum(c, frame, w);
   linear->setZero();
   angular->setZero();
   for (int a = 0; a < n_nodes_; ++a) {

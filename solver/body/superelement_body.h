@@ -121,6 +121,19 @@ class SuperelementBody {
   /// Kinetic energy v^T M v / 2.
   double KineticEnergy(const BodyConfiguration& c, const FrameSolution& frame, const BodyVelocity& w) const;
 
+  /// Generalized momentum p = M_g w = P^T M P w (per node: linear momentum, spatial angular
+  /// momentum about the node; then the modal momenta).
+  Eigen::VectorXd GeneralizedMomentum(const BodyConfiguration& c, const FrameSolution& frame, const BodyVelocity& w) const;
+
+  /// The momentum balance in the form dp/dt = s(q, w, p) + applied - elastic forces, with
+  ///   s = G^T p + Omega_hat p    (dT/dq at fixed spatial velocities, and omega_k x p_k on the
+  /// rotation rows from the spatial velocities of SO(3)), so that f_in = dp/dt - s. Here p is
+  /// any vector (the midpoint scheme passes the mean momentum of the step). For every p, s has
+  /// no resultant and its moment about the origin is sum_k p_x,k x xdot_k: this is what makes the
+  /// midpoint scheme of dynamic_analysis.h conserve linear and angular momentum exactly.
+  Eigen::VectorXd MomentumSource(const BodyConfiguration& c, const FrameSolution& frame, const BodyVelocity& w,
+                                 const Eigen::VectorXd& p) const;
+
   /// Linear momentum and angular momentum about the global origin (Noether: sums of the
   /// generalized momenta p = M_g w of the nodes).
   void Momentum(const BodyConfiguration& c, const FrameSolution& frame, const BodyVelocity& w,
@@ -134,6 +147,8 @@ class SuperelementBody {
   Kinematics ComputeKinematics(const Eigen::VectorXd& q_loc) const;
   // P (system velocities -> local velocities) and the frame's angular velocity map U (3 x n).
   void VelocityMaps(const BodyConfiguration& c, const FrameSolution& frame, Eigen::MatrixXd* P, Eigen::MatrixXd* U) const;
+  // G of d(P w) = P G dq at fixed w (n x n), from U and the velocities.
+  Eigen::MatrixXd VelocityMapRate(const Eigen::MatrixXd& U, const BodyVelocity& w) const;
   // The quadratic part of f_in: M_g G w + (Omega_P - Omega_hat) p - G^T p.
   Eigen::VectorXd QuadraticInertia(const Eigen::MatrixXd& U, const Eigen::MatrixXd& Mg, const BodyVelocity& w) const;
   Eigen::MatrixXd Phi_rig0_;

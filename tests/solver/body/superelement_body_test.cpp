@@ -306,6 +306,18 @@ TEST(SuperelementBody, InertiaForceIsTheLagrangianDerivativeAlongAMotion) {
   Eigen::VectorXd f_in;
   body.InertiaForce(c, body.SolveFrame(c, body.GuessFrame(c)), w, wdot, &f_in, nullptr, nullptr);
   EXPECT_NEAR(w.dot(f_in), power_fd, 1e-5 * std::abs(power_fd));
+
+  // Momentum form used by the midpoint integrator: f_in = dp/dt - s(q, w, p), p = M_g w,
+  // s = MomentumSource; dp/dt by central differences along the same motion.
+  auto momentum = [&](double time) {
+    const BodyConfiguration ct = config(time);
+    return body.GeneralizedMomentum(ct, body.SolveFrame(ct, body.GuessFrame(ct)), velocity(time));
+  };
+  const Eigen::VectorXd pdot = (momentum(t + dt) - momentum(t - dt)) / (2 * dt);
+  const FrameSolution frame = body.SolveFrame(c, body.GuessFrame(c));
+  const Eigen::VectorXd balance = pdot - body.MomentumSource(c, frame, w, body.GeneralizedMomentum(c, frame, w));
+  EXPECT_LT((balance - f_in).norm(), 1e-5 * f_in.norm()) << "f_in " << f_in.transpose() << "\nbalance "
+                                                           << balance.transpose();
 }
 
 }  // namespace
