@@ -258,15 +258,18 @@ std::vector<RotationNode> RotationNodes(const SystemModel& model, const DofMap& 
 }
 
 // The step's increment Delta of the coordinates (spatial rotation vectors log(R_n+1 R_n^T) on
-// the rotation triples), the end velocities it implies, and the mid configuration.
+// the rotation triples), the end velocities it implies, the mid configuration, and the first-
+// order maps of the end coordinates' increments (delta, as Newton applies them at n+1) to the
+// mid configuration and to the end velocities.
 struct MidpointKinematics {
   Eigen::VectorXd delta;  // Delta
-  SystemState mid;        // z_n + Delta / 2
+  SystemState mid;        // q_m
+  SystemMatrix T;         // d q_m / d delta: 1/2 off the rotation nodes
+  SystemMatrix V;         // d W_n+1 / d delta: 2/h off the rotation nodes
 };
 
-MidpointKinematics Midpoint(const SystemModel& model, const DofMap& dofs,
-                            const std::vector<RotationNode>& triples, const DynamicState& s0, double h,
-                            DynamicState& s1) {
+MidpointKinematics Midpoint(const SystemModel& model, const DofMap& dofs, const std::vector<RotationNode>& nodes,
+                            const DynamicState& s0, double h, DynamicState& s1) {
   MidpointKinematics k;
   const int n = dofs.n_dofs();
   k.delta = Eigen::VectorXd::Zero(n);
@@ -278,29 +281,64 @@ MidpointKinematics Midpoint(const SystemModel& model, const DofMap& dofs,
   for (size_t b = 0; b < model.bodies.size(); ++b) {
     k.delta.segment(dofs.mode_dof(int(b)), model.bodies[b].n_modes()) = s1.config.eta[b] - s0.config.eta[b];
   }
-  for (const RotationNode& r : triples) {
-    k.delta.segment<3>(r.rotation) = LogSO3(s1.config.R[r.node] * s0.config.R[r.node].transpose());
-  }
-  // End velocities from the kinematics (prescribed coordinates keep their given rates).
+  // Every other coordinate: z_n+1 - z_n = h (W_n + W_n+1) / 2, z_m = z_n + Delta / 2.
   Eigen::VectorXd W1 = 2.0 / h * k.delta - s0.W;
-  Eigen::VectorXd half = 0.5 * k.delta;  // increment to the mid configuration
-  for (const RotationNode& r : triples) {
+  Eigen::VectorXd half = 0.5 * k.delta;
+  std::vector<bool> in_block(n, false);
+  Triplets T, V;
+  auto add_block = [](Triplets& t, int row, int col, const Eigen::Matrix3d& block) {
+    for (int i = 0; i < 3; ++i) {
+      for (int j = 0; j < 3; ++j) t.emplace_back(row + i, col + j, block(i, j));
+    }
+  };
+  for (const RotationNode& r : nodes) {
     const Eigen::Matrix3d& R0 = s0.config.R[r.node];
     const Eigen::Matrix3d& R1 = s1.config.R[r.node];
-    const Eigen::Vector3d Omega_m = R0.transpose() * k.delta.segment<3>(r.rotation) / h;
-    W1.segment<3>(r.rotation) = R1 * (2.0 * Omega_m - R0.transpose() * s0.W.segment<3>(r.rotation));
+    const Eigen::Vector3d dpi = LogSO3(R1 * R0.transpose());
+    k.delta.segment<3>(r.rotation) = dpi;
+    half.segment<3>(r.rotation) = 0.5 * dpi;
+    const Eigen::Vector3d Omega_m = R0.transpose() * dpi / h;
+    const Eigen::Vector3d omega1 = R1 * (2.0 * Omega_m - R0.transpose() * s0.W.segment<3>(r.rotation));
+    W1.segment<3>(r.rotation) = omega1;
+    for (int i = 0; i < 3; ++i) in_block[r.rotation + i] = true;
+    // An end increment delta (R_n+1 <- exp(delta~) R_n+1) changes Delta_pi by J_l^-1(Delta_pi)
+    // delta: the mid rotation exp(Delta_pi~ / 2) R_n by A delta / 2, A = J_l(Delta_pi / 2)
+    // J_l^-1(Delta_pi), and omega_n+1 by [2/h R_n+1 R_n^T J_l^-1(Delta_pi) - omega_n+1~] delta.
+    const Eigen::Matrix3d Jinv = LeftJacobianInverse<double>(dpi);
+    const Eigen::Matrix3d A = LeftJacobianInverse<double>(Eigen::Vector3d(0.5 * dpi)).inverse() * Jinv;
+    add_block(T, r.rotation, r.rotation, 0.5 * A);
+    add_block(V, r.rotation, r.rotation, 2.0 / h * R1 * R0.transpose() * Jinv - Skew<double>(omega1));
     if (r.translation < 0) continue;
     // Free node: the step is the SE(3) exponential of the mean convected twist (V, Omega),
     // V = R^T xdot: x_n+1 = x_n + R_n J_l(h Omega_m) h V_m. A rigid motion of constant twist is
     // then exact for every node of a body (chords and rotations agree).
-    const Eigen::Vector3d V_m =
-        LeftJacobianInverse<double>(Eigen::Vector3d(h * Omega_m)) * (R0.transpose() * k.delta.segment<3>(r.translation)) / h;
-    W1.segment<3>(r.translation) = R1 * (2.0 * V_m - R0.transpose() * s0.W.segment<3>(r.translation));
+    const Eigen::Vector3d dx = k.delta.segment<3>(r.translation);
+    const Eigen::Matrix3d Jinv_step = LeftJacobianInverse<double>(Eigen::Vector3d(h * Omega_m));
+    const Eigen::Vector3d V_m = Jinv_step * (R0.transpose() * dx) / h;
+    const Eigen::Vector3d xdot1 = R1 * (2.0 * V_m - R0.transpose() * s0.W.segment<3>(r.translation));
+    W1.segment<3>(r.translation) = xdot1;
     // Mid configuration on the same SE(3) geodesic (not the chord midpoint: at the chord
-    // midpoint a spinning body would look compressed, by (omega h)^2 / 8 of its radius).
+    // midpoint a spinning body would look compressed, by (omega h)^2 / 8 of its radius). In
+    // spatial form x_m - x_n = A Delta_x / 2; its change with the end rotation is Delta_x~ / 8
+    // to first order.
     const Eigen::Matrix3d J_half = LeftJacobianInverse<double>(Eigen::Vector3d(0.5 * h * Omega_m)).inverse();
     half.segment<3>(r.translation) = R0 * (J_half * (0.5 * h * V_m));
+    for (int i = 0; i < 3; ++i) in_block[r.translation + i] = true;
+    add_block(T, r.translation, r.translation, 0.5 * A);
+    add_block(T, r.translation, r.rotation, Skew<double>(dx) / 8.0);
+    // xdot_n+1: 2/h R_n+1 J_l^-1(h Omega_m) R_n^T per end translation; per end rotation
+    // -xdot_n+1~ (turning R_n+1) + R_n+1 V_m~ R_n^T (through Omega_m), to first order.
+    add_block(V, r.translation, r.translation, 2.0 / h * R1 * Jinv_step * R0.transpose());
+    add_block(V, r.translation, r.rotation, -Skew<double>(xdot1) + R1 * Skew<double>(V_m) * R0.transpose());
   }
+  for (int j = 0; j < n; ++j) {
+    if (in_block[j]) continue;
+    T.emplace_back(j, j, 0.5);
+    V.emplace_back(j, j, 2.0 / h);
+  }
+  k.T = ToMatrix(n, T);
+  k.V = ToMatrix(n, V);
+  // End velocities from the kinematics (prescribed coordinates keep their given rates).
   for (int j : dofs.solved()) s1.W[j] = W1[j];
   k.mid = s0.config;
   ApplyIncrement(model, dofs, half, k.mid);
@@ -342,11 +380,14 @@ Assembly AssembleMidpoint(const SystemModel& model, const DofMap& dofs, const Dy
       wm.segment<3>(6 * a + 3) = LogSO3(s1.config.R[node] * s0.config.R[node].transpose()) / h;
     }
     wm.tail(body.n_modes()) = (s1.config.eta[b] - s0.config.eta[b]) / h;
-    Eigen::VectorXd f_in, f_int, unused;
+    Eigen::VectorXd f_in, f_int;
     Eigen::MatrixXd Kb, Mb, Cb;
-    body.InertiaForce(cm, fm, wm, Eigen::VectorXd::Zero(body.n_coordinates()), &unused, &Mb, &Cb);
+    // M_g at the end of the step: the 2/h^2 term of the iteration matrix is d p_n+1 / h; at
+    // the mid configuration it would be off by O(omega h) and leave a 1/h error.
+    body.InertiaForce(c1, f1, w1, Eigen::VectorXd::Zero(body.n_coordinates()), nullptr, &Mb, nullptr);
     const Eigen::VectorXd w0 = GatherBody(model, dofs, s0.config, int(b), s0.W);
     const Eigen::VectorXd f_acc = Mb * (w1 - w0) / h;
+    Cb.setZero(body.n_coordinates(), body.n_coordinates());
     if (body.options().quadratic_velocity_terms) {
       // Source terms with the node motion of each half step, so that their moment matches the
       // change of sum x_k x p_k exactly: x_m is not the mean of x_n and x_n+1.
@@ -358,6 +399,15 @@ Assembly AssembleMidpoint(const SystemModel& model, const DofMap& dofs, const Dy
       }
       f_in = (p1 - p0[b]) / h -
              0.5 * (body.MomentumSource(cm, fm, w_second, p1) + body.MomentumSource(cm, fm, w_first, p0[b]));
+      // Iteration matrix: with dp_n+1 = (M_g V + D) delta (V = d W_n+1 / d delta ~ 2/h,
+      // D = d p / dq at fixed w) and dw_a ~ delta / h,
+      //   d f_in / d delta = [M_g V + D - d_w s(p_mean) - (d_p s) M_g] / h + O(1).
+      // All the 1/h terms are needed (and M_g at n+1, V with its O(omega) part): each is
+      // O(omega h) of the leading one, and without them Newton contracts only by ~omega h per
+      // iteration, or worse on stiff, lightly inertial directions such as a tube's torsion.
+      Eigen::MatrixXd d_w, d_p;
+      body.MomentumSourceDerivatives(cm, fm, wm, 0.5 * (p0[b] + p1), &d_w, &d_p);
+      Cb = body.MomentumDerivative(c1, f1, w1) - d_w - d_p * Mb;
     } else {
       f_in = f_acc;
     }
@@ -415,14 +465,16 @@ StepOutcome MidpointStep(const SystemModel& model, const DofMap& dofs, const Dyn
     if (FreeNorm(dofs, a.residual) <= options.tolerance * a.scale && out.iterations > 0) {
       out.converged = true;
       next.t = state.t + h;
-      next.Wdot = (next.W - state.W) / h;  // mean acceleration over the step
-      next.a = next.Wdot;
+      // a: the mean acceleration over the step (t_n+1/2); Wdot: extrapolated to t_n+1 from
+      // the last two means (the predictor's acceleration; also what the output reports).
+      next.a = (next.W - state.W) / h;
+      next.Wdot = 1.5 * next.a - 0.5 * state.a;
       next.external_work += work;
       next.f_ext = a.f_ext;
       return out;
     }
-    // d Delta = delta: dW_n+1 ~ 2 delta / h, dq_m ~ delta / 2, dw_m = delta / h.
-    if (!matrix.Update(dofs, options, h, [&] { return SystemMatrix(0.5 * a.K + (1.0 / h) * a.C + (2.0 / (h * h)) * a.M); })) {
+    // Newton's increment delta at n+1: dW_n+1 = V delta, dq_m = T delta, dw_m ~ delta / h.
+    if (!matrix.Update(dofs, options, h, [&] { return SystemMatrix(a.K * k.T + (1.0 / h) * (a.C + a.M * k.V)); })) {
       return out;
     }
     const Eigen::VectorXd delta = matrix.solver.Solve(a.residual);

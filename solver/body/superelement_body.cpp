@@ -289,6 +289,50 @@ Eigen::VectorXd SuperelementBody::GeneralizedMomentum(const BodyConfiguration& c
   return P.transpose() * (M_ * (P * w));
 }
 
+Eigen::MatrixXd SuperelementBody::MomentumDerivative(const BodyConfiguration& c, const FrameSolution& frame,
+                                                     const BodyVelocity& w) const {
+  Eigen::MatrixXd P, U;
+  VelocityMaps(c, frame, &P, &U);
+  const Eigen::MatrixXd Mg = P.transpose() * M_ * P;
+  const Eigen::VectorXd p = Mg * w;
+  // dp = dP^T mu + M_g G dq, mu = M P w; P^T turns each node block with R_j (or R_k).
+  Eigen::MatrixXd D = Mg * VelocityMapRate(U, w);
+  for (int a = 0; a < n_nodes_; ++a) {
+    D.middleRows<3>(6 * a) -= Skew<double>(Eigen::Vector3d(p.segment<3>(6 * a))) * U;
+    const Eigen::Matrix3d p_rot = Skew<double>(Eigen::Vector3d(p.segment<3>(6 * a + 3)));
+    if (options_.cardona_option_b) {
+      D.block<3, 3>(6 * a + 3, 6 * a + 3) -= p_rot;
+    } else {
+      D.middleRows<3>(6 * a + 3) -= p_rot * U;
+    }
+  }
+  return D;
+}
+
+void SuperelementBody::MomentumSourceDerivatives(const BodyConfiguration& c, const FrameSolution& frame,
+                                                 const BodyVelocity& w, const Eigen::VectorXd& p, Eigen::MatrixXd* d_w,
+                                                 Eigen::MatrixXd* d_p) const {
+  const int n = n_coordinates();
+  Eigen::MatrixXd P, U;
+  VelocityMaps(c, frame, &P, &U);
+  // s = G(w)^T p + Omega_hat(w) p is bilinear in (w, p).
+  *d_p = VelocityMapRate(U, w).transpose();
+  d_w->setZero(n, n);
+  for (int a = 0; a < n_nodes_; ++a) {
+    const Eigen::Vector3d omega = w.segment<3>(6 * a + 3);
+    d_p->block<3, 3>(6 * a + 3, 6 * a + 3) += Skew<double>(omega);
+    // G(e)^T p = U^T (p_x~ e_x + p_pi~ e_pi) (option A); Omega_hat(e) p = -p_pi~ e_pi.
+    const Eigen::Matrix3d px = Skew<double>(Eigen::Vector3d(p.segment<3>(6 * a)));
+    const Eigen::Matrix3d pr = Skew<double>(Eigen::Vector3d(p.segment<3>(6 * a + 3)));
+    d_w->middleCols<3>(6 * a) += U.transpose() * px;
+    if (!options_.cardona_option_b) {
+      d_w->middleCols<3>(6 * a + 3) += U.transpose() * pr;
+      d_w->block<3, 3>(6 * a + 3, 6 * a + 3) -= pr;
+    }
+    // Option B: the node's own G block (p_pi~ e) and Omega_hat(e) p (-p_pi~ e) cancel.
+  }
+}
+
 Eigen::VectorXd SuperelementBody::MomentumSource(const BodyConfiguration& c, const FrameSolution& frame,
                                                  const BodyVelocity& w, const Eigen::VectorXd& p) const {
   Eigen::MatrixXd P, U;

@@ -125,6 +125,15 @@ class SuperelementBody {
   /// momentum about the node; then the modal momenta).
   Eigen::VectorXd GeneralizedMomentum(const BodyConfiguration& c, const FrameSolution& frame, const BodyVelocity& w) const;
 
+  /// Derivatives of MomentumSource s(q, w, p) with respect to w and to p (both n x n; s is
+  /// bilinear in w and p).
+  void MomentumSourceDerivatives(const BodyConfiguration& c, const FrameSolution& frame, const BodyVelocity& w,
+                                 const Eigen::VectorXd& p, Eigen::MatrixXd* d_w, Eigen::MatrixXd* d_p) const;
+
+  /// d p / d q at fixed w (n x n; per node (dx, dpi) spatial, then d eta): the configuration
+  /// derivative of the generalized momentum, for the midpoint scheme's iteration matrix.
+  Eigen::MatrixXd MomentumDerivative(const BodyConfiguration& c, const FrameSolution& frame, const BodyVelocity& w) const;
+
   /// The momentum balance in the form dp/dt = s(q, w, p) + applied - elastic forces, with
   ///   s = G^T p + Omega_hat p    (dT/dq at fixed spatial velocities, and omega_k x p_k on the
   /// rotation rows from the spatial velocities of SO(3)), so that f_in = dp/dt - s. Here p is

@@ -266,6 +266,48 @@ TEST(SuperelementBody, GyroscopicMatrixMatchesFiniteDifferencesAndMassIsPtMP) {
   }
 }
 
+TEST(SuperelementBody, MomentumDerivativesMatchFiniteDifferences) {
+  // d(M_g w)/dq at fixed spatial velocities w, options A and B, against central differences of
+  // GeneralizedMomentum (the frame re-solved at each perturbed configuration); the derivatives
+  // of MomentumSource in w and p likewise.
+  for (bool option_b : {false, true}) {
+    SuperelementOptions options;
+    options.cardona_option_b = option_b;
+    const SuperelementBody body(Tee(), options);
+    const BodyConfiguration c = Deformed(body, 0.1, 5);
+    const FrameSolution frame = body.SolveFrame(c, body.GuessFrame(c));
+    const int n = body.n_coordinates();
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    Eigen::VectorXd w(n);
+    for (int i = 0; i < n; ++i) w[i] = u(rng);
+    const Eigen::MatrixXd D = body.MomentumDerivative(c, frame, w);
+    Eigen::MatrixXd fd(n, n);
+    const double eps = 1e-6;
+    for (int i = 0; i < n; ++i) {
+      const Eigen::VectorXd e = Eigen::VectorXd::Unit(n, i);
+      const BodyConfiguration cp = Perturb(c, e, eps), cm = Perturb(c, e, -eps);
+      fd.col(i) = (body.GeneralizedMomentum(cp, body.SolveFrame(cp, frame), w) -
+                   body.GeneralizedMomentum(cm, body.SolveFrame(cm, frame), w)) / (2 * eps);
+    }
+    EXPECT_LT((D - fd).norm(), 1e-6 * fd.norm()) << (option_b ? "option B" : "option A");
+
+    // MomentumSource derivatives in w and p (bilinear: central differences are exact up to
+    // round-off).
+    Eigen::VectorXd p(n);
+    for (int i = 0; i < n; ++i) p[i] = u(rng);
+    Eigen::MatrixXd d_w, d_p, fd_w(n, n), fd_p(n, n);
+    body.MomentumSourceDerivatives(c, frame, w, p, &d_w, &d_p);
+    for (int i = 0; i < n; ++i) {
+      const Eigen::VectorXd e = Eigen::VectorXd::Unit(n, i);
+      fd_w.col(i) = (body.MomentumSource(c, frame, w + e, p) - body.MomentumSource(c, frame, w - e, p)) / 2.0;
+      fd_p.col(i) = (body.MomentumSource(c, frame, w, p + e) - body.MomentumSource(c, frame, w, p - e)) / 2.0;
+    }
+    EXPECT_LT((d_w - fd_w).norm(), 1e-12 * fd_w.norm()) << (option_b ? "option B" : "option A");
+    EXPECT_LT((d_p - fd_p).norm(), 1e-12 * fd_p.norm()) << (option_b ? "option B" : "option A");
+  }
+}
+
 TEST(SuperelementBody, InertiaForceIsTheLagrangianDerivativeAlongAMotion) {
   // Along a smooth motion q(t), d/dt (dT/dw) - (dT/dq) = f_in and the power balance
   // dT/dt = w . f_in holds for the exact inertia force. Check the power balance with central
