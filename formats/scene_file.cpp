@@ -353,6 +353,7 @@ SceneSpec ParseScene(const std::string& text, const std::string& name, const std
     if (auto v = m.Optional("max_iterations")) a.max_iterations = int(v->NonNegativeInteger());
     if (auto v = m.Optional("output_every")) a.output_every = std::max(1, int(v->NonNegativeInteger()));
     if (auto v = m.Optional("jacobian_reuse")) a.reuse_jacobian = v->Bool();
+    if (auto v = m.Optional("gyroscopic_tangent")) a.gyroscopic_tangent = v->Bool();
     m.CheckNoUnknownKeys();
   }
 

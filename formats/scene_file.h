@@ -86,6 +86,7 @@ struct SceneAnalysisSpec {
   int max_iterations = 25;
   int output_every = 1;
   bool reuse_jacobian = false;  ///< dynamic: keep the factorized iteration matrix while it converges
+  bool gyroscopic_tangent = false;  ///< generalized-alpha: configuration derivative of the quadratic velocity terms in S
 };
 
 struct SceneSpec {

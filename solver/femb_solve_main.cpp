@@ -139,6 +139,7 @@ int main(int argc, char** argv) {
       options.tolerance = spec.analysis.tolerance;
       options.max_iterations = spec.analysis.max_iterations;
       options.reuse_jacobian = spec.analysis.reuse_jacobian;
+      options.full_inertia_tangent = spec.analysis.gyroscopic_tangent;
       const femb::DynamicResult r = femb::SolveDynamic(
           scene.model, state, options, [&](const femb::DynamicStepReport& s, const femb::DynamicState& st) {
             ++step_count;

@@ -18,7 +18,8 @@ struct Assembly {
   double scale = 0.0;
 };
 
-Assembly AssembleDynamic(const SystemModel& model, const DofMap& dofs, DynamicState& s, double t, bool matrices) {
+Assembly AssembleDynamic(const SystemModel& model, const DofMap& dofs, DynamicState& s, double t, bool matrices,
+                         bool full_inertia_tangent = false) {
   Assembly out;
   const int n = dofs.n_dofs();
   out.residual = Eigen::VectorXd::Zero(n);
@@ -43,6 +44,9 @@ Assembly AssembleDynamic(const SystemModel& model, const DofMap& dofs, DynamicSt
     Eigen::MatrixXd Kb, Mb, Cb;
     body.ElasticForce(c, frame, &f_int, matrices ? &Kb : nullptr);
     body.InertiaForce(c, frame, w, wdot, &f_in, matrices ? &Mb : nullptr, matrices ? &Cb : nullptr);
+    // Configuration derivative of the inertia force: d(M_g wdot)/dq exactly; that of the
+    // quadratic velocity terms by central differences with options.full_inertia_tangent.
+    if (matrices) Kb += body.InertiaConfigurationTangent(c, frame, w, wdot, full_inertia_tangent);
     body.AddModalDamping(w, f_in, matrices ? &Cb : nullptr);
     Eigen::VectorXd f_grav = Eigen::VectorXd::Zero(body.n_coordinates());
     if (model.gravity.squaredNorm() > 0) f_grav = body.GravityForce(c, frame, model.gravity);
@@ -186,7 +190,7 @@ StepOutcome GeneralizedAlphaStep(const SystemModel& model, const DofMap& dofs, c
   const double t_new = state.t + h;
   StepOutcome out;
   for (; out.iterations < options.max_iterations; ++out.iterations) {
-    const Assembly a = AssembleDynamic(model, dofs, next, t_new, true);
+    const Assembly a = AssembleDynamic(model, dofs, next, t_new, true, options.full_inertia_tangent);
     if (!a.ok || !a.residual.allFinite()) return out;
     if (FreeNorm(dofs, a.residual) <= options.tolerance * a.scale && out.iterations > 0) {
       out.converged = true;

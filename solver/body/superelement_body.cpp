@@ -263,6 +263,42 @@ void SuperelementBody::InertiaForce(const BodyConfiguration& c, const FrameSolut
   }
 }
 
+Eigen::MatrixXd SuperelementBody::InertiaConfigurationTangent(const BodyConfiguration& c, const FrameSolution& frame,
+                                                              const BodyVelocity& w, const BodyVelocity& wdot,
+                                                              bool quadratic) const {
+  Eigen::MatrixXd tangent = MomentumDerivative(c, frame, wdot);
+  if (!quadratic || !options_.quadratic_velocity_terms) return tangent;
+  double size = 0.0;
+  for (const Eigen::Vector3d& X : X_) size = std::max(size, X.norm());
+  const int n = n_coordinates();
+  for (int i = 0; i < n; ++i) {
+    Eigen::VectorXd g[2];
+    double step = 1e-7;
+    for (int side = 0; side < 2; ++side) {
+      BodyConfiguration p = c;
+      const double e = side == 0 ? 1.0 : -1.0;
+      if (i < 6 * n_nodes_) {
+        const int a = i / 6, k = i % 6;
+        if (k < 3) {
+          step = 1e-7 * std::max(size, 1e-3);
+          p.x[a][k] += e * step;
+        } else {
+          p.R[a] = ExpSO3(e * step * Eigen::Vector3d::Unit(k - 3)) * p.R[a];
+        }
+      } else {
+        // Mass-normalized modal coordinates: scale by the body's mass (eta ~ sqrt(m) x length).
+        step = 1e-7 * std::max(size, 1e-3) * std::sqrt(std::max(M_(0, 0), 1e-300));
+        p.eta[i - 6 * n_nodes_] += e * step;
+      }
+      Eigen::MatrixXd P, U;
+      VelocityMaps(p, SolveFrame(p, frame), &P, &U);
+      g[side] = QuadraticInertia(U, P.transpose() * M_ * P, w);
+    }
+    tangent.col(i) += (g[0] - g[1]) / (2 * step);
+  }
+  return tangent;
+}
+
 void SuperelementBody::AddModalDamping(const BodyVelocity& w, Eigen::VectorXd& f, Eigen::MatrixXd* C) const {
   if (options_.modal_damping <= 0.0) return;
   for (int m = 0; m < n_modes_; ++m) {

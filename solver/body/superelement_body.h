@@ -114,6 +114,13 @@ class SuperelementBody {
                     const BodyVelocity& wdot, Eigen::VectorXd* f_in, Eigen::MatrixXd* mass,
                     Eigen::MatrixXd* gyroscopic) const;
 
+  /// d f_in / dq at fixed (w, wdot): d(M_g wdot)/dq = MomentumDerivative(c, frame, wdot)
+  /// (exact), plus with `quadratic` the configuration derivative of the quadratic velocity terms
+  /// by central differences (2n evaluations with the frame re-solved; steps 1e-7 of the body
+  /// size, 1e-7 rad, 1e-7 of the modal scale).
+  Eigen::MatrixXd InertiaConfigurationTangent(const BodyConfiguration& c, const FrameSolution& frame,
+                                              const BodyVelocity& w, const BodyVelocity& wdot, bool quadratic) const;
+
   /// Modal damping force 2 zeta omega_i etadot_i on the internal-mode rows and its derivative
   /// with respect to w (added to `f` and `C`).
   void AddModalDamping(const BodyVelocity& w, Eigen::VectorXd& f, Eigen::MatrixXd* C) const;

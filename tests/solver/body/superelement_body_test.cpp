@@ -269,7 +269,7 @@ TEST(SuperelementBody, GyroscopicMatrixMatchesFiniteDifferencesAndMassIsPtMP) {
 TEST(SuperelementBody, MomentumDerivativesMatchFiniteDifferences) {
   // d(M_g w)/dq at fixed spatial velocities w, options A and B, against central differences of
   // GeneralizedMomentum (the frame re-solved at each perturbed configuration); the derivatives
-  // of MomentumSource in w and p likewise.
+  // of MomentumSource in w and p likewise, and the inertia force's configuration derivative.
   for (bool option_b : {false, true}) {
     SuperelementOptions options;
     options.cardona_option_b = option_b;
@@ -305,6 +305,27 @@ TEST(SuperelementBody, MomentumDerivativesMatchFiniteDifferences) {
     }
     EXPECT_LT((d_w - fd_w).norm(), 1e-12 * fd_w.norm()) << (option_b ? "option B" : "option A");
     EXPECT_LT((d_p - fd_p).norm(), 1e-12 * fd_p.norm()) << (option_b ? "option B" : "option A");
+
+    // Configuration derivative of the inertia force: d(M_g wdot)/dq (analytic) against central
+    // differences of f_in at w = 0 (where f_in = M_g wdot exactly), and the full derivative
+    // (quadratic terms by differences inside the body) against differences of f_in.
+    Eigen::VectorXd wdot(n);
+    for (int i = 0; i < n; ++i) wdot[i] = u(rng);
+    const Eigen::VectorXd zero = Eigen::VectorXd::Zero(n);
+    for (bool full : {false, true}) {
+      const Eigen::MatrixXd K_in = body.InertiaConfigurationTangent(c, frame, full ? w : zero, wdot, full);
+      Eigen::MatrixXd fd_in(n, n);
+      for (int i = 0; i < n; ++i) {
+        const Eigen::VectorXd e = Eigen::VectorXd::Unit(n, i);
+        const BodyConfiguration cp = Perturb(c, e, eps), cm = Perturb(c, e, -eps);
+        Eigen::VectorXd fp, fm;
+        body.InertiaForce(cp, body.SolveFrame(cp, frame), full ? w : zero, wdot, &fp, nullptr, nullptr);
+        body.InertiaForce(cm, body.SolveFrame(cm, frame), full ? w : zero, wdot, &fm, nullptr, nullptr);
+        fd_in.col(i) = (fp - fm) / (2 * eps);
+      }
+      EXPECT_LT((K_in - fd_in).norm(), 1e-5 * fd_in.norm()) << (option_b ? "option B" : "option A")
+                                                             << (full ? ", full" : ", M_g wdot");
+    }
   }
 }
 
