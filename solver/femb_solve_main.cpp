@@ -130,7 +130,8 @@ int main(int argc, char** argv) {
     } else {
       femb::DynamicState state = femb::InitialDynamicState(scene.model, femb::InitialState(scene.model), scene.initial_velocity);
       const femb::DynamicStepReport r0 = femb::Measure(scene.model, state);
-      recorder.Record(0.0, state.config, state.W, r0.kinetic_energy, r0.elastic_energy, 0.0);
+      recorder.Record(0.0, state.config, state.W, r0.kinetic_energy, r0.elastic_energy, 0.0, r0.linear_momentum,
+                      r0.angular_momentum);
       femb::DynamicOptions options;
       options.step = spec.analysis.step;
       options.end_time = spec.analysis.end_time;
@@ -145,7 +146,8 @@ int main(int argc, char** argv) {
             ++step_count;
             total_iterations += s.iterations;
             if (step_count % spec.analysis.output_every == 0) {
-              recorder.Record(s.t, st.config, st.W, s.kinetic_energy, s.elastic_energy, s.external_work);
+              recorder.Record(s.t, st.config, st.W, s.kinetic_energy, s.elastic_energy, s.external_work,
+                              s.linear_momentum, s.angular_momentum);
             }
             progress(s.t, false);
           });

@@ -68,7 +68,8 @@ ResultsRecorder::ResultsRecorder(const Scene& scene, const std::string& director
 }
 
 void ResultsRecorder::Record(double t, const SystemState& state, const Eigen::VectorXd& W, double kinetic,
-                             double elastic, double external_work) {
+                             double elastic, double external_work, const Eigen::Vector3d& linear_momentum,
+                             const Eigen::Vector3d& angular_momentum) {
   const SystemModel& model = scene_.model;
   const DofMap dofs(model);
   const int n = model.n_nodes();
@@ -84,6 +85,9 @@ void ResultsRecorder::Record(double t, const SystemState& state, const Eigen::Ve
   kinetic_.push_back(kinetic);
   elastic_.push_back(elastic);
   work_.push_back(external_work);
+  Eigen::VectorXd momentum(6);
+  momentum << linear_momentum, angular_momentum;
+  momentum_.push_back(momentum);
   positions_.push_back(pos);
   quaternions_.push_back(quat);
   velocities_.push_back(vel);
@@ -189,6 +193,9 @@ void ResultsRecorder::Finish(const std::string& status) {
     w.Vector("/energy/kinetic", Eigen::Map<const Eigen::VectorXd>(kinetic_.data(), long(kinetic_.size())));
     w.Vector("/energy/elastic", Eigen::Map<const Eigen::VectorXd>(elastic_.data(), long(elastic_.size())));
     w.Vector("/energy/external_work", Eigen::Map<const Eigen::VectorXd>(work_.data(), long(work_.size())));
+    const Eigen::MatrixXd momentum = Stack(momentum_, 6);
+    w.Matrix("/energy/linear_momentum", momentum.leftCols(3));
+    w.Matrix("/energy/angular_momentum", momentum.rightCols(3));
     w.CreateGroup("/bodies");
     for (size_t b = 0; b < model.bodies.size(); ++b) {
       const std::string g = "/bodies/" + scene_.body_names[b];
