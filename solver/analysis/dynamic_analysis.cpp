@@ -18,25 +18,66 @@ struct Assembly {
   double scale = 0.0;
 };
 
+// The triplets of an assembly in progress and the node forces for the joints' stiffness.
+struct AssemblyParts {
+  Triplets K, C, M;
+  NodeForces node_forces;
+};
+
+Assembly StartAssembly(const SystemModel& model, const DofMap& dofs, AssemblyParts& parts) {
+  Assembly out;
+  out.residual = Eigen::VectorXd::Zero(dofs.n_dofs());
+  out.f_ext = Eigen::VectorXd::Zero(dofs.n_dofs());
+  parts.node_forces = ZeroNodeForces(model);
+  return out;
+}
+
+// Solves body b's floating frame from `guess` (or, failing that, from node 0); false with the
+// message in `out` when it does not converge.
+bool SolveBodyFrame(const SuperelementBody& body, int b, const BodyConfiguration& c, const FrameSolution& guess,
+                    FrameSolution* frame, Assembly& out) {
+  *frame = body.SolveFrame(c, guess);
+  if (!frame->ok) *frame = body.SolveFrame(c, body.GuessFrame(c));
+  if (frame->ok) return true;
+  out.ok = false;
+  out.message = "floating frame of body " + std::to_string(b) + " did not converge";
+  return false;
+}
+
+// Nodal loads at t, spring-dampers at velocities W (both on `config`), the joints' geometric
+// stiffness, and the matrices built (when `matrices`).
+void FinishAssembly(const SystemModel& model, const DofMap& dofs, const SystemState& config, double t,
+                    const Eigen::VectorXd& W, bool matrices, AssemblyParts& parts, Assembly& out) {
+  const int n = dofs.n_dofs();
+  Eigen::VectorXd loads = Eigen::VectorXd::Zero(n);
+  AddNodeLoads(model, config, t, loads, matrices ? &parts.K : nullptr, &parts.node_forces);
+  out.residual += loads;
+  out.f_ext += loads;
+  Eigen::VectorXd springs = Eigen::VectorXd::Zero(n);
+  AddSpringDampers(model, config, W, springs, matrices ? &parts.K : nullptr, matrices ? &parts.C : nullptr, nullptr,
+                   &parts.node_forces);
+  out.residual += springs;
+  if (matrices) {
+    AddJointGeometricStiffness(model, dofs, config, parts.node_forces, parts.K);
+    out.K = ToMatrix(n, parts.K);
+    out.C = ToMatrix(n, parts.C);
+    out.M = ToMatrix(n, parts.M);
+  }
+  out.scale = std::max({out.scale, springs.norm(), loads.norm(), 1e-300});
+}
+
 Assembly AssembleDynamic(const SystemModel& model, const DofMap& dofs, DynamicState& s, double t, bool matrices,
                          bool full_inertia_tangent = false) {
-  Assembly out;
-  const int n = dofs.n_dofs();
-  out.residual = Eigen::VectorXd::Zero(n);
-  out.f_ext = Eigen::VectorXd::Zero(n);
-  Triplets K, C, M;
-  NodeForces node_forces = ZeroNodeForces(model);
+  AssemblyParts parts;
+  Assembly out = StartAssembly(model, dofs, parts);
+  Triplets &K = parts.K, &C = parts.C, &M = parts.M;
+  NodeForces& node_forces = parts.node_forces;
   const std::vector<Eigen::Matrix<double, 6, 1>> node_acc = NodeAccelerations(model, dofs, s.config, s.W, s.Wdot);
   for (size_t b = 0; b < model.bodies.size(); ++b) {
     const SuperelementBody& body = model.bodies[b];
     const BodyConfiguration c = BodyConfigurationOf(model, s.config, int(b));
-    FrameSolution frame = body.SolveFrame(c, s.config.frames[b]);
-    if (!frame.ok) frame = body.SolveFrame(c, body.GuessFrame(c));
-    if (!frame.ok) {
-      out.ok = false;
-      out.message = "floating frame of body " + std::to_string(b) + " did not converge";
-      return out;
-    }
+    FrameSolution frame;
+    if (!SolveBodyFrame(body, int(b), c, s.config.frames[b], &frame, out)) return out;
     s.config.frames[b] = frame;
     const Eigen::VectorXd w = GatherBody(model, dofs, s.config, int(b), s.W);
     const Eigen::VectorXd wdot = GatherBodyAcceleration(model, dofs, int(b), node_acc, s.Wdot);
@@ -68,22 +109,7 @@ Assembly AssembleDynamic(const SystemModel& model, const DofMap& dofs, DynamicSt
       ScatterBody(map, nullptr, &Mb, nullptr, &M);
     }
   }
-  Eigen::VectorXd loads = Eigen::VectorXd::Zero(n);
-  AddNodeLoads(model, s.config, t, loads, matrices ? &K : nullptr, &node_forces);
-  out.residual += loads;
-  out.f_ext += loads;
-  Eigen::VectorXd springs = Eigen::VectorXd::Zero(n);
-  AddSpringDampers(model, s.config, s.W, springs, matrices ? &K : nullptr, matrices ? &C : nullptr,
-                   nullptr, &node_forces);
-  out.residual += springs;
-  out.scale = std::max(out.scale, springs.norm());
-  if (matrices) {
-    AddJointGeometricStiffness(model, dofs, s.config, node_forces, K);
-    out.K = ToMatrix(n, K);
-    out.C = ToMatrix(n, C);
-    out.M = ToMatrix(n, M);
-  }
-  out.scale = std::max({out.scale, loads.norm(), 1e-300});
+  FinishAssembly(model, dofs, s.config, t, s.W, matrices, parts, out);
   return out;
 }
 
@@ -354,24 +380,15 @@ MidpointKinematics Midpoint(const SystemModel& model, const DofMap& dofs, const 
 Assembly AssembleMidpoint(const SystemModel& model, const DofMap& dofs, const DynamicState& s0,
                           const std::vector<Eigen::VectorXd>& p0, double h, MidpointKinematics& k, DynamicState& s1,
                           double& f_ext_work) {
-  Assembly out;
-  const int n = dofs.n_dofs();
-  out.residual = Eigen::VectorXd::Zero(n);
-  out.f_ext = Eigen::VectorXd::Zero(n);
-  Triplets K, C, M;
-  NodeForces node_forces = ZeroNodeForces(model);
-  const Eigen::VectorXd W_mid = k.delta / h;
+  AssemblyParts parts;
+  Assembly out = StartAssembly(model, dofs, parts);
   for (size_t b = 0; b < model.bodies.size(); ++b) {
     const SuperelementBody& body = model.bodies[b];
     const BodyConfiguration c1 = BodyConfigurationOf(model, s1.config, int(b));
     const BodyConfiguration cm = BodyConfigurationOf(model, k.mid, int(b));
-    FrameSolution f1 = body.SolveFrame(c1, s1.config.frames[b]);
-    FrameSolution fm = body.SolveFrame(cm, s0.config.frames[b]);
-    if (!f1.ok || !fm.ok) {
-      out.ok = false;
-      out.message = "floating frame of body " + std::to_string(b) + " did not converge";
-      return out;
-    }
+    FrameSolution f1, fm;
+    if (!SolveBodyFrame(body, int(b), c1, s1.config.frames[b], &f1, out)) return out;
+    if (!SolveBodyFrame(body, int(b), cm, s0.config.frames[b], &fm, out)) return out;
     s1.config.frames[b] = f1;
     k.mid.frames[b] = fm;
     const Eigen::VectorXd w1 = GatherBody(model, dofs, s1.config, int(b), s1.W);
@@ -424,24 +441,13 @@ Assembly AssembleMidpoint(const SystemModel& model, const DofMap& dofs, const Dy
     out.scale = std::max({out.scale, f_int.norm(), f_in.norm(), f_grav.norm(), body.force_floor(), f_acc.norm()});
     const std::vector<MapEntry> map = BodyMap(model, dofs, k.mid, int(b));
     const Eigen::VectorXd r_b = f_grav - f_int - f_in;
-    AddBodyNodeForces(model, int(b), r_b, node_forces);
-    ScatterBody(map, &r_b, &Kb, &out.residual, &K);
-    ScatterBody(map, &f_grav, &Cb, &out.f_ext, &C);
-    ScatterBody(map, nullptr, &Mb, nullptr, &M);
+    AddBodyNodeForces(model, int(b), r_b, parts.node_forces);
+    ScatterBody(map, &r_b, &Kb, &out.residual, &parts.K);
+    ScatterBody(map, &f_grav, &Cb, &out.f_ext, &parts.C);
+    ScatterBody(map, nullptr, &Mb, nullptr, &parts.M);
   }
-  const double t_mid = s0.t + 0.5 * h;
-  Eigen::VectorXd loads = Eigen::VectorXd::Zero(n);
-  AddNodeLoads(model, k.mid, t_mid, loads, &K, &node_forces);
-  out.residual += loads;
-  out.f_ext += loads;
-  Eigen::VectorXd springs = Eigen::VectorXd::Zero(n);
-  AddSpringDampers(model, k.mid, W_mid, springs, &K, &C, nullptr, &node_forces);
-  out.residual += springs;
-  AddJointGeometricStiffness(model, dofs, k.mid, node_forces, K);
-  out.K = ToMatrix(n, K);
-  out.C = ToMatrix(n, C);
-  out.M = ToMatrix(n, M);
-  out.scale = std::max({out.scale, springs.norm(), loads.norm(), 1e-300});
+  // Loads at the mid time and configuration, spring-dampers at the mean rates Delta / h.
+  FinishAssembly(model, dofs, k.mid, s0.t + 0.5 * h, k.delta / h, true, parts, out);
   f_ext_work = out.f_ext.dot(k.delta);
   return out;
 }
