@@ -392,7 +392,9 @@ Assembly AssembleMidpoint(const SystemModel& model, const DofMap& dofs, const Dy
     s1.config.frames[b] = f1;
     k.mid.frames[b] = fm;
     const Eigen::VectorXd w1 = GatherBody(model, dofs, s1.config, int(b), s1.W);
-    const Eigen::VectorXd p1 = body.GeneralizedMomentum(c1, f1, w1);
+    // Velocity maps at the end and at the mid configuration, shared by the momentum terms.
+    const BodyVelocityMaps maps1 = body.Maps(c1, f1), maps_m = body.Maps(cm, fm);
+    const Eigen::VectorXd p1 = body.GeneralizedMomentum(maps1, w1);
     // Node motion over the step.
     Eigen::VectorXd wm(body.n_coordinates());
     for (int a = 0; a < body.n_nodes(); ++a) {
@@ -405,7 +407,7 @@ Assembly AssembleMidpoint(const SystemModel& model, const DofMap& dofs, const Dy
     Eigen::MatrixXd Kb, Mb, Cb;
     // M_g at the end of the step: the 2/h^2 term of the iteration matrix is d p_n+1 / h; at
     // the mid configuration it would be off by O(omega h) and leave a 1/h error.
-    body.InertiaForce(c1, f1, w1, Eigen::VectorXd::Zero(body.n_coordinates()), nullptr, &Mb, nullptr);
+    Mb = maps1.Mg;
     const Eigen::VectorXd w0 = GatherBody(model, dofs, s0.config, int(b), s0.W);
     const Eigen::VectorXd f_acc = Mb * (w1 - w0) / h;
     Cb.setZero(body.n_coordinates(), body.n_coordinates());
@@ -419,7 +421,7 @@ Assembly AssembleMidpoint(const SystemModel& model, const DofMap& dofs, const Dy
         w_first.segment<3>(6 * a) = 2.0 * (k.mid.x[node] - s0.config.x[node]) / h;
       }
       f_in = (p1 - p0[b]) / h -
-             0.5 * (body.MomentumSource(cm, fm, w_second, p1) + body.MomentumSource(cm, fm, w_first, p0[b]));
+             0.5 * (body.MomentumSource(maps_m, w_second, p1) + body.MomentumSource(maps_m, w_first, p0[b]));
       // Iteration matrix: with dp_n+1 = (M_g V + D) delta (V = d W_n+1 / d delta ~ 2/h,
       // D = d p / dq at fixed w) and dw_a ~ delta / h,
       //   d f_in / d delta = [M_g V + D - d_w s(p_mean) - (d_p s) M_g] / h + O(1).
@@ -427,8 +429,8 @@ Assembly AssembleMidpoint(const SystemModel& model, const DofMap& dofs, const Dy
       // O(omega h) of the leading one, and without them Newton contracts only by ~omega h per
       // iteration, or worse on stiff, lightly inertial directions such as a tube's torsion.
       Eigen::MatrixXd d_w, d_p;
-      body.MomentumSourceDerivatives(cm, fm, wm, 0.5 * (p0[b] + p1), &d_w, &d_p);
-      Cb = body.MomentumDerivative(c1, f1, w1) - d_w - d_p * Mb;
+      body.MomentumSourceDerivatives(maps_m, wm, 0.5 * (p0[b] + p1), &d_w, &d_p);
+      Cb = body.MomentumDerivative(maps1, w1) - d_w - d_p * Mb;
     } else {
       f_in = f_acc;
     }
@@ -460,7 +462,7 @@ StepOutcome MidpointStep(const SystemModel& model, const DofMap& dofs, const Dyn
   std::vector<Eigen::VectorXd> p0;
   for (size_t b = 0; b < model.bodies.size(); ++b) {
     const BodyConfiguration c = BodyConfigurationOf(model, state.config, int(b));
-    p0.push_back(model.bodies[b].GeneralizedMomentum(c, state.config.frames[b],
+    p0.push_back(model.bodies[b].GeneralizedMomentum(model.bodies[b].Maps(c, state.config.frames[b]),
                                                      GatherBody(model, dofs, state.config, int(b), state.W)));
   }
   // Predictor: the configuration reached with the current velocity and acceleration.

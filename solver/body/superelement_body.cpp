@@ -266,7 +266,7 @@ void SuperelementBody::InertiaForce(const BodyConfiguration& c, const FrameSolut
 Eigen::MatrixXd SuperelementBody::InertiaConfigurationTangent(const BodyConfiguration& c, const FrameSolution& frame,
                                                               const BodyVelocity& w, const BodyVelocity& wdot,
                                                               bool quadratic) const {
-  Eigen::MatrixXd tangent = MomentumDerivative(c, frame, wdot);
+  Eigen::MatrixXd tangent = MomentumDerivative(Maps(c, frame), wdot);
   if (!quadratic || !options_.quadratic_velocity_terms) return tangent;
   double size = 0.0;
   for (const Eigen::Vector3d& X : X_) size = std::max(size, X.norm());
@@ -318,21 +318,22 @@ double SuperelementBody::KineticEnergy(const BodyConfiguration& c, const FrameSo
   return 0.5 * v.dot(M_ * v);
 }
 
-Eigen::VectorXd SuperelementBody::GeneralizedMomentum(const BodyConfiguration& c, const FrameSolution& frame,
-                                                      const BodyVelocity& w) const {
-  Eigen::MatrixXd P, U;
-  VelocityMaps(c, frame, &P, &U);
-  return P.transpose() * (M_ * (P * w));
+BodyVelocityMaps SuperelementBody::Maps(const BodyConfiguration& c, const FrameSolution& frame) const {
+  BodyVelocityMaps maps;
+  VelocityMaps(c, frame, &maps.P, &maps.U);
+  maps.Mg = maps.P.transpose() * M_ * maps.P;
+  return maps;
 }
 
-Eigen::MatrixXd SuperelementBody::MomentumDerivative(const BodyConfiguration& c, const FrameSolution& frame,
-                                                     const BodyVelocity& w) const {
-  Eigen::MatrixXd P, U;
-  VelocityMaps(c, frame, &P, &U);
-  const Eigen::MatrixXd Mg = P.transpose() * M_ * P;
-  const Eigen::VectorXd p = Mg * w;
+Eigen::VectorXd SuperelementBody::GeneralizedMomentum(const BodyVelocityMaps& maps, const BodyVelocity& w) const {
+  return maps.Mg * w;
+}
+
+Eigen::MatrixXd SuperelementBody::MomentumDerivative(const BodyVelocityMaps& maps, const BodyVelocity& w) const {
+  const Eigen::MatrixXd& U = maps.U;
+  const Eigen::VectorXd p = maps.Mg * w;
   // dp = dP^T mu + M_g G dq, mu = M P w; P^T turns each node block with R_j (or R_k).
-  Eigen::MatrixXd D = Mg * VelocityMapRate(U, w);
+  Eigen::MatrixXd D = maps.Mg * VelocityMapRate(U, w);
   for (int a = 0; a < n_nodes_; ++a) {
     D.middleRows<3>(6 * a) -= Skew<double>(Eigen::Vector3d(p.segment<3>(6 * a))) * U;
     const Eigen::Matrix3d p_rot = Skew<double>(Eigen::Vector3d(p.segment<3>(6 * a + 3)));
@@ -345,12 +346,11 @@ Eigen::MatrixXd SuperelementBody::MomentumDerivative(const BodyConfiguration& c,
   return D;
 }
 
-void SuperelementBody::MomentumSourceDerivatives(const BodyConfiguration& c, const FrameSolution& frame,
-                                                 const BodyVelocity& w, const Eigen::VectorXd& p, Eigen::MatrixXd* d_w,
+void SuperelementBody::MomentumSourceDerivatives(const BodyVelocityMaps& maps, const BodyVelocity& w,
+                                                 const Eigen::VectorXd& p, Eigen::MatrixXd* d_w,
                                                  Eigen::MatrixXd* d_p) const {
   const int n = n_coordinates();
-  Eigen::MatrixXd P, U;
-  VelocityMaps(c, frame, &P, &U);
+  const Eigen::MatrixXd& U = maps.U;
   // s = G(w)^T p + Omega_hat(w) p is bilinear in (w, p).
   *d_p = VelocityMapRate(U, w).transpose();
   d_w->setZero(n, n);
@@ -369,11 +369,9 @@ void SuperelementBody::MomentumSourceDerivatives(const BodyConfiguration& c, con
   }
 }
 
-Eigen::VectorXd SuperelementBody::MomentumSource(const BodyConfiguration& c, const FrameSolution& frame,
-                                                 const BodyVelocity& w, const Eigen::VectorXd& p) const {
-  Eigen::MatrixXd P, U;
-  VelocityMaps(c, frame, &P, &U);
-  Eigen::VectorXd out = VelocityMapRate(U, w).transpose() * p;
+Eigen::VectorXd SuperelementBody::MomentumSource(const BodyVelocityMaps& maps, const BodyVelocity& w,
+                                                 const Eigen::VectorXd& p) const {
+  Eigen::VectorXd out = VelocityMapRate(maps.U, w).transpose() * p;
   for (int a = 0; a < n_nodes_; ++a) {
     out.segment<3>(6 * a + 3) += Eigen::Vector3d(w.segment<3>(6 * a + 3)).cross(Eigen::Vector3d(p.segment<3>(6 * a + 3)));
   }
@@ -382,7 +380,7 @@ Eigen::VectorXd SuperelementBody::MomentumSource(const BodyConfiguration& c, con
 
 void SuperelementBody::Momentum(const BodyConfiguration& c, const FrameSolution& frame, const BodyVelocity& w,
                                 Eigen::Vector3d* linear, Eigen::Vector3d* angular) const {
-  const Eigen::VectorXd p = GeneralizedMomentum(c, frame, w);
+  const Eigen::VectorXd p = GeneralizedMomentum(Maps(c, frame), w);
   linear->setZero();
   angular->setZero();
   for (int a = 0; a < n_nodes_; ++a) {

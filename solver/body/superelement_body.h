@@ -63,6 +63,13 @@ struct FrameSolution {
   bool ok = false;
 };
 
+/// A body's velocity maps at one configuration, for evaluating several momentum terms there:
+/// P (system velocities -> local velocities), U (the floating frame's angular velocity map,
+/// 3 x n) and M_g = P^T M P.
+struct BodyVelocityMaps {
+  Eigen::MatrixXd P, U, Mg;
+};
+
 /// Immutable model of one superelement (from its file) plus its placement in the scene.
 class SuperelementBody {
  public:
@@ -128,27 +135,30 @@ class SuperelementBody {
   /// Kinetic energy v^T M v / 2.
   double KineticEnergy(const BodyConfiguration& c, const FrameSolution& frame, const BodyVelocity& w) const;
 
+  /// Velocity maps at a configuration (BodyVelocityMaps), shared by the momentum terms below.
+  BodyVelocityMaps Maps(const BodyConfiguration& c, const FrameSolution& frame) const;
+
   /// Generalized momentum p = M_g w = P^T M P w (per node: linear momentum, spatial angular
   /// momentum about the node; then the modal momenta).
-  Eigen::VectorXd GeneralizedMomentum(const BodyConfiguration& c, const FrameSolution& frame, const BodyVelocity& w) const;
-
-  /// Derivatives of MomentumSource s(q, w, p) with respect to w and to p (both n x n; s is
-  /// bilinear in w and p).
-  void MomentumSourceDerivatives(const BodyConfiguration& c, const FrameSolution& frame, const BodyVelocity& w,
-                                 const Eigen::VectorXd& p, Eigen::MatrixXd* d_w, Eigen::MatrixXd* d_p) const;
+  Eigen::VectorXd GeneralizedMomentum(const BodyVelocityMaps& maps, const BodyVelocity& w) const;
 
   /// d p / d q at fixed w (n x n; per node (dx, dpi) spatial, then d eta): the configuration
-  /// derivative of the generalized momentum, for the midpoint scheme's iteration matrix.
-  Eigen::MatrixXd MomentumDerivative(const BodyConfiguration& c, const FrameSolution& frame, const BodyVelocity& w) const;
+  /// derivative of the generalized momentum (midpoint iteration matrix; with w = wdot, the
+  /// configuration derivative of M_g wdot).
+  Eigen::MatrixXd MomentumDerivative(const BodyVelocityMaps& maps, const BodyVelocity& w) const;
 
   /// The momentum balance in the form dp/dt = s(q, w, p) + applied - elastic forces, with
   ///   s = G^T p + Omega_hat p    (dT/dq at fixed spatial velocities, and omega_k x p_k on the
   /// rotation rows from the spatial velocities of SO(3)), so that f_in = dp/dt - s. Here p is
-  /// any vector (the midpoint scheme passes the mean momentum of the step). For every p, s has
+  /// any vector (the midpoint scheme passes the momenta of the step's ends). For every p, s has
   /// no resultant and its moment about the origin is sum_k p_x,k x xdot_k: this is what makes the
   /// midpoint scheme of dynamic_analysis.h conserve linear and angular momentum exactly.
-  Eigen::VectorXd MomentumSource(const BodyConfiguration& c, const FrameSolution& frame, const BodyVelocity& w,
-                                 const Eigen::VectorXd& p) const;
+  Eigen::VectorXd MomentumSource(const BodyVelocityMaps& maps, const BodyVelocity& w, const Eigen::VectorXd& p) const;
+
+  /// Derivatives of MomentumSource s(q, w, p) with respect to w and to p (both n x n; s is
+  /// bilinear in w and p).
+  void MomentumSourceDerivatives(const BodyVelocityMaps& maps, const BodyVelocity& w, const Eigen::VectorXd& p,
+                                 Eigen::MatrixXd* d_w, Eigen::MatrixXd* d_p) const;
 
   /// Linear momentum and angular momentum about the global origin (Noether: sums of the
   /// generalized momenta p = M_g w of the nodes).

@@ -281,14 +281,14 @@ TEST(SuperelementBody, MomentumDerivativesMatchFiniteDifferences) {
     std::uniform_real_distribution<double> u(-1.0, 1.0);
     Eigen::VectorXd w(n);
     for (int i = 0; i < n; ++i) w[i] = u(rng);
-    const Eigen::MatrixXd D = body.MomentumDerivative(c, frame, w);
+    const Eigen::MatrixXd D = body.MomentumDerivative(body.Maps(c, frame), w);
     Eigen::MatrixXd fd(n, n);
     const double eps = 1e-6;
     for (int i = 0; i < n; ++i) {
       const Eigen::VectorXd e = Eigen::VectorXd::Unit(n, i);
       const BodyConfiguration cp = Perturb(c, e, eps), cm = Perturb(c, e, -eps);
-      fd.col(i) = (body.GeneralizedMomentum(cp, body.SolveFrame(cp, frame), w) -
-                   body.GeneralizedMomentum(cm, body.SolveFrame(cm, frame), w)) / (2 * eps);
+      fd.col(i) = (body.GeneralizedMomentum(body.Maps(cp, body.SolveFrame(cp, frame)), w) -
+                   body.GeneralizedMomentum(body.Maps(cm, body.SolveFrame(cm, frame)), w)) / (2 * eps);
     }
     EXPECT_LT((D - fd).norm(), 1e-6 * fd.norm()) << (option_b ? "option B" : "option A");
 
@@ -297,11 +297,12 @@ TEST(SuperelementBody, MomentumDerivativesMatchFiniteDifferences) {
     Eigen::VectorXd p(n);
     for (int i = 0; i < n; ++i) p[i] = u(rng);
     Eigen::MatrixXd d_w, d_p, fd_w(n, n), fd_p(n, n);
-    body.MomentumSourceDerivatives(c, frame, w, p, &d_w, &d_p);
+    const BodyVelocityMaps maps = body.Maps(c, frame);
+    body.MomentumSourceDerivatives(body.Maps(c, frame), w, p, &d_w, &d_p);
     for (int i = 0; i < n; ++i) {
       const Eigen::VectorXd e = Eigen::VectorXd::Unit(n, i);
-      fd_w.col(i) = (body.MomentumSource(c, frame, w + e, p) - body.MomentumSource(c, frame, w - e, p)) / 2.0;
-      fd_p.col(i) = (body.MomentumSource(c, frame, w, p + e) - body.MomentumSource(c, frame, w, p - e)) / 2.0;
+      fd_w.col(i) = (body.MomentumSource(maps, w + e, p) - body.MomentumSource(maps, w - e, p)) / 2.0;
+      fd_p.col(i) = (body.MomentumSource(maps, w, p + e) - body.MomentumSource(maps, w, p - e)) / 2.0;
     }
     EXPECT_LT((d_w - fd_w).norm(), 1e-12 * fd_w.norm()) << (option_b ? "option B" : "option A");
     EXPECT_LT((d_p - fd_p).norm(), 1e-12 * fd_p.norm()) << (option_b ? "option B" : "option A");
@@ -374,11 +375,12 @@ TEST(SuperelementBody, InertiaForceIsTheLagrangianDerivativeAlongAMotion) {
   // s = MomentumSource; dp/dt by central differences along the same motion.
   auto momentum = [&](double time) {
     const BodyConfiguration ct = config(time);
-    return body.GeneralizedMomentum(ct, body.SolveFrame(ct, body.GuessFrame(ct)), velocity(time));
+    return body.GeneralizedMomentum(body.Maps(ct, body.SolveFrame(ct, body.GuessFrame(ct))), velocity(time));
   };
   const Eigen::VectorXd pdot = (momentum(t + dt) - momentum(t - dt)) / (2 * dt);
   const FrameSolution frame = body.SolveFrame(c, body.GuessFrame(c));
-  const Eigen::VectorXd balance = pdot - body.MomentumSource(c, frame, w, body.GeneralizedMomentum(c, frame, w));
+  const BodyVelocityMaps maps = body.Maps(c, frame);
+  const Eigen::VectorXd balance = pdot - body.MomentumSource(maps, w, body.GeneralizedMomentum(maps, w));
   EXPECT_LT((balance - f_in).norm(), 1e-5 * f_in.norm()) << "f_in " << f_in.transpose() << "\nbalance "
                                                            << balance.transpose();
 }
