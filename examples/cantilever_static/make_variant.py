@@ -9,6 +9,9 @@ import os
 import sys
 from fractions import Fraction
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+import tube  # noqa: E402
+
 out, fractions = sys.argv[1], [Fraction(f) for f in sys.argv[2].split(",")]
 options = sys.argv[3] if len(sys.argv) > 3 else None
 if sum(fractions) != 1:
@@ -16,20 +19,8 @@ if sum(fractions) != 1:
 os.makedirs(out, exist_ok=True)
 lengths = sorted(set(fractions))
 for i, f in enumerate(lengths):
-    with open(os.path.join(out, f"seg_{i}.yaml"), "w") as g:
-        g.write(f"""# {f} of the seeds' cantilever tube (outer radius 0.01 m, wall 0.001 m, E = 70 GPa).
-name: seg_{i}
-type: beam
-units: SI
-material: {{E: 70.0e9, nu: 0.3, rho: 2700}}
-section: {{shape: tube, outer_radius: 0.01, wall: 0.001}}
-beam:
-  theory: euler_bernoulli
-  points: {{A: [0, 0, 0], B: [{float(f)!r}, 0, 0]}}
-  segments: [{{from: A, to: B, elements: {max(4, round(40 * f))}}}]
-interfaces: [{{name: A}}, {{name: B}}]
-reduction: {{internal_modes: 2, floating_frame: center_of_mass}}
-""")
+    tube.write_part(os.path.join(out, f"seg_{i}.yaml"), f"seg_{i}", float(f), max(4, round(40 * f)), 2,
+                    "center_of_mass", f"{f} of the seeds' cantilever tube (outer radius 0.01 m, wall 0.001 m, E = 70 GPa).")
 bodies, x = [], Fraction(0)
 for k, f in enumerate(fractions):
     opts = f", options: {options}" if options else ""
