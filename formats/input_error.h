@@ -13,4 +13,11 @@ class InputError : public std::runtime_error {
   explicit InputError(const std::string& message) : std::runtime_error(message) {}
 };
 
+/// A request refused because it would exceed a resource limit (memory, element count); the
+/// message gives the estimate and the limit. Mains map it to exit code 4.
+class ResourceLimitError : public std::runtime_error {
+ public:
+  explicit ResourceLimitError(const std::string& message) : std::runtime_error(message) {}
+};
+
 }  // namespace femb

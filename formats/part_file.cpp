@@ -275,6 +275,7 @@ PartSpec ParsePart(const std::string& text, const std::string& name,
         part.solid.order = int(v->Integer());
         if (part.solid.order != 1 && part.solid.order != 2) v->Fail("element order must be 1 or 2");
       }
+      if (auto v = m.Optional("max_elements")) part.solid.max_elements = long(v->PositiveNumber());
       if (auto v = m.Optional("elements")) {
         part.solid.hexahedra = v->OneOf({"tetrahedra", "hexahedra"}) == "hexahedra";
         if (part.solid.hexahedra && part.solid.shape != "box" && part.solid.shape != "plate") {

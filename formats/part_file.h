@@ -66,6 +66,7 @@ struct SolidSpec {
   double element_size = 0.0;                      ///< target element size [length]
   int order = 2;                                  ///< 1: TET4/HEX8, 2: TET10/HEX20
   bool hexahedra = false;                         ///< mesh.elements: hexahedra (box only)
+  long max_elements = 3000000;                    ///< mesh.max_elements: refuse larger estimated meshes
   std::string where;
 };
 

@@ -117,7 +117,7 @@ std::string TextSummary(const Superelement& se, const SuperelementAnalysis& a, c
   }
 
   s += "\nChecks:\n";
-  for (const Check& c : a.checks) s += F("  %-20s %-4s %s\n", c.name.c_str(), c.ok ? "ok" : "FAIL", c.detail.c_str());
+  for (const Check& c : a.checks) s += F("  %-24s %-4s %s\n", c.name.c_str(), c.ok ? "ok" : "FAIL", c.detail.c_str());
   return s;
 }
 

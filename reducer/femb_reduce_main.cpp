@@ -8,6 +8,7 @@
 
 #include "formats/command_line.h"
 #include "formats/input_error.h"
+#include "formats/superelement_checks.h"
 #include "formats/part_file.h"
 #include "formats/superelement_file.h"
 #include "reducer/linalg/sparse_cholesky.h"
@@ -70,6 +71,18 @@ int main(int argc, char** argv) {
                    part_path.c_str(), result.message.c_str());
       return 3;
     }
+    // The file's contract (formats/superelement_checks.h): a model that fails it is not written.
+    femb::Stopwatch check_clock;
+    const femb::SuperelementChecks checks = femb::CheckSuperelement(result.superelement);
+    if (const femb::Check* c = checks.first_failure()) {
+      std::fprintf(stderr,
+                   "femb-reduce: %s: numerical failure: the reduced model fails check %s: %s; the part may be "
+                   "nearly a mechanism (a region held by a connection many orders of magnitude softer than the "
+                   "rest) or ill-conditioned (no output written)\n",
+                   part_path.c_str(), c->name.c_str(), c->detail.c_str());
+      return 3;
+    }
+    progress("checks", check_clock.Seconds(), std::to_string(checks.checks.size()) + " checks passed");
     femb::Stopwatch write_clock;
     femb::WriteSuperelementFile(result.superelement, output);
     progress("write", write_clock.Seconds(), output);
@@ -79,6 +92,9 @@ int main(int argc, char** argv) {
                   total.Seconds(), femb::PeakResidentBytes() / 1e9);
     }
     return 0;
+  } catch (const femb::ResourceLimitError& e) {
+    std::fprintf(stderr, "femb-reduce: %s: refused: %s (no output written)\n", part_path.c_str(), e.what());
+    return 4;
   } catch (const femb::InputError& e) {
     std::fprintf(stderr, "femb-reduce: %s\n", e.what());
     return 2;

@@ -152,6 +152,19 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
   se.mass_properties = ComputeMassProperties(se);
   se.floating_frame = ComputeFloatingFrame(part.reduction.floating_frame,
                                            part.reduction.where_floating_frame, se, model, cb.shapes);
+  {
+    // Rigid motions cost no energy exactly: K_r <- T0^T K_r T0 with T0 = 1 - Phi_rig0 Phi_CB
+    // (thesis 3.17-3.20 at the undeformed state; T0 Phi_rig0 = 0 as Phi_CB Phi_rig0 = 1). It
+    // removes only the round-off of K_r Phi_rig0 = 0 (||K Phi_rig0|| ~ eps ||K_full||), which for a
+    // body with one interface and no modes, whose K_r is nothing but that round-off, made stray
+    // "rigid-body frequencies" of a fraction of a hertz.
+    const Eigen::MatrixXd Phi_rig0 = RigidBodyModes(se, se.floating_frame.origin);
+    const Eigen::MatrixXd T0 =
+        Eigen::MatrixXd::Identity(se.K.rows(), se.K.cols()) - Phi_rig0 * se.floating_frame.Phi_CB;
+    const Eigen::MatrixXd K_T0 = se.K * T0;
+    se.K = T0.transpose() * K_T0;
+    se.K = 0.5 * (se.K + se.K.transpose()).eval();
+  }
   if (nonlinear && se.n_modal_derivatives > 0) {
     // The reduced internal force on the whole basis (static and internal modes, derivatives)
     // is the cubic polynomial of reduced_polynomial.h; its linear part equals K_r.

@@ -204,6 +204,7 @@ FeModel BuildSolidModel(const PartSpec& part, const ProgressFn& progress) {
   request.radius = part.solid.radius;
   request.inner_radius = part.solid.inner_radius;
   request.length = part.solid.length;
+  request.max_elements = part.solid.max_elements;
   request.file = part.solid.file;
   request.element_size = part.solid.element_size;
   request.order = part.solid.order;

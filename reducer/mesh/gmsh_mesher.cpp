@@ -31,6 +31,39 @@ bool SolidTypeOfGmsh(int gmsh_type, SolidType* type) {
   }
 }
 
+// The geometry's volume: OpenCASCADE's mass of its volumes, or, for the built-in kernel (no
+// mass query), its bounding box (an upper bound).
+double GeometryVolume() {
+  gmsh::vectorpair volumes;
+  gmsh::model::getEntities(volumes, 3);
+  double total = 0.0;
+  try {
+    for (const auto& [dim, tag] : volumes) {
+      double mass = 0.0;
+      gmsh::model::occ::getMass(dim, tag, mass);
+      total += mass;
+    }
+    if (total > 0) return total;
+  } catch (...) {
+  }
+  double x0, y0, z0, x1, y1, z1;
+  gmsh::model::getBoundingBox(-1, -1, x0, y0, z0, x1, y1, z1);
+  return std::max(x1 - x0, 0.0) * std::max(y1 - y0, 0.0) * std::max(z1 - z0, 0.0);
+}
+
+void RequireElementBudget(const MeshRequest& r) {
+  const double h = r.element_size, volume = GeometryVolume();
+  const double estimate = (r.hexahedra ? 1.0 : 6.0) * volume / (h * h * h);
+  if (estimate <= double(r.max_elements)) return;
+  char buffer[400];
+  std::snprintf(buffer, sizeof buffer,
+                "%s: mesh.size %.4g on a geometry of volume %.4g would give about %.3g elements, more than "
+                "mesh.max_elements = %ld: use a larger mesh.size (%.4g gives about %ld) or raise mesh.max_elements",
+                r.where.c_str(), h, volume, estimate, r.max_elements,
+                h * std::cbrt(estimate / double(r.max_elements)), r.max_elements);
+  throw ResourceLimitError(buffer);
+}
+
 }  // namespace
 
 SolidMesh MeshWithGmsh(const MeshRequest& r) {
@@ -120,6 +153,7 @@ SolidMesh MeshWithGmsh(const MeshRequest& r) {
     std::vector<std::vector<std::size_t>> element_tags, element_nodes;
     gmsh::model::mesh::getElements(types, element_tags, element_nodes, 3);
     if (types.empty()) {
+      if (r.element_size > 0) RequireElementBudget(r);
       if (r.element_size > 0) {
         gmsh::option::setNumber("Mesh.MeshSizeMax", r.element_size);
         gmsh::option::setNumber("Mesh.MeshSizeMin", 0.5 * r.element_size);
@@ -170,6 +204,8 @@ SolidMesh MeshWithGmsh(const MeshRequest& r) {
       set.erase(std::unique(set.begin(), set.end()), set.end());
     }
   } catch (const InputError&) {
+    throw;
+  } catch (const ResourceLimitError&) {
     throw;
   } catch (const std::exception& e) {
     throw InputError((r.file.empty() ? r.where : r.file) + ": gmsh failed: " + e.what());

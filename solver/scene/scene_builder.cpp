@@ -7,6 +7,7 @@
 
 #include "formats/input_error.h"
 #include "formats/part_file.h"
+#include "formats/superelement_checks.h"
 #include "formats/superelement_file.h"
 #include "solver/rotation.h"
 
@@ -34,6 +35,25 @@ bool FixedToGround(const SystemModel& model, int k) {
     return j.n_coordinates() == 0 && FixedToGround(model, j.parent);
   }
   return true;
+}
+
+// Joints that share a point (spherical, revolute, universal; cylindrical up to a shift along its
+// axis) refuse nodes that are apart at t = 0: the offset would silently become a rigid arm of
+// the parent (node_joint.h: x_c = x_p + R_p r0). Tolerance 1e-6 of the scene's size.
+void RequireJointGap(const SceneJointSpec& j, const Eigen::Vector3d& x_p, const Eigen::Vector3d& x_c,
+                     double scene_length) {
+  Eigen::Vector3d gap = x_c - x_p;
+  if (j.type == "cylindrical") gap -= gap.dot(j.axis.normalized()) * j.axis.normalized();
+  if (j.type != "spherical" && j.type != "revolute" && j.type != "universal" && j.type != "cylindrical") return;
+  const double tolerance = 1e-6 * std::max(scene_length, 1e-3 * std::max(x_p.norm(), x_c.norm()));
+  if (gap.norm() <= tolerance) return;
+  char buffer[400];
+  std::snprintf(buffer, sizeof buffer,
+                ": %s joint between nodes '%s' and '%s': the nodes are %.6g apart at t = 0 (gap (%.6g, %.6g, %.6g)%s); "
+                "a %s joint needs them at one point: move the bodies or use a rigid joint for an offset",
+                j.type.c_str(), j.node.c_str(), j.parent.c_str(), gap.norm(), gap.x(), gap.y(), gap.z(),
+                j.type == "cylindrical" ? " across the axis" : "", j.type.c_str());
+  throw InputError(j.where + buffer);
 }
 
 }  // namespace
@@ -102,6 +122,7 @@ Scene BuildScene(const SceneSpec& spec) {
       SuperelementReadOptions options;
       options.visualization = spec.animation;
       se = ReadSuperelementFile(file.string(), options);
+      RequireValidSuperelement(se, file.string());
     } catch (const InputError& e) {
       throw InputError(b.where + ": body '" + b.name + "': " + e.what());
     }
@@ -182,10 +203,17 @@ Scene BuildScene(const SceneSpec& spec) {
                                          model.node_R0[parent], model.node_x0[child], model.node_R0[child]));
     model.motion[child] = Eigen::MatrixXd(6, 0);
   }
+  double scene_length = 0.0;  // the bounding box diagonal of the nodes: the scale of position tolerances
+  {
+    Eigen::Vector3d lo = Eigen::Vector3d::Constant(HUGE_VAL), hi = -lo;
+    for (const Eigen::Vector3d& x : model.node_x0) lo = lo.cwiseMin(x), hi = hi.cwiseMax(x);
+    if (model.n_nodes() > 1) scene_length = (hi - lo).norm();
+  }
   for (const SceneJointSpec& j : spec.joints) {
     const int k = scene.node_index.at(j.node);
     if (!j.parent.empty()) {
       const int p = scene.node_index.at(j.parent);
+      RequireJointGap(j, model.node_x0[p], model.node_x0[k], scene_length);
       model.joints.push_back(MakeNodeJoint(JointTypeFromName(j.type), k, p, j.axis, model.node_x0[p], model.node_R0[p],
                                            model.node_x0[k], model.node_R0[k], j.axis2));
       model.motion[k] = Eigen::MatrixXd(6, 0);  // the joint's coordinates replace the node's own
@@ -207,6 +235,14 @@ Scene BuildScene(const SceneSpec& spec) {
     if (j.type == "cylindrical") CylindricalToGround(model, k, j.axis);
     if (!j.prescribed.empty()) model.prescribed.push_back(PrescribedBy(spec.functions.at(j.prescribed), k));
   }
+ // The joint graph (cycles, two parents) before anything walks it.
+  std::unique_ptr<DofMap> dofs_ptr;
+  try {
+    dofs_ptr = std::make_unique<DofMap>(model);
+  } catch (const InputError& e) {
+    throw InputError(spec.file + ": joints: " + e.what());
+  }
+  const DofMap& dofs = *dofs_ptr;
   for (const SceneLoadSpec& l : spec.loads) {
     if (l.type == "gravity") {
       model.gravity += l.g;
@@ -241,13 +277,6 @@ Scene BuildScene(const SceneSpec& spec) {
     }
     model.loads.push_back(load);
   }
-  std::unique_ptr<DofMap> dofs_ptr;
-  try {
-    dofs_ptr = std::make_unique<DofMap>(model);
-  } catch (const InputError& e) {
-    throw InputError(spec.file + ": joints: " + e.what());
-  }
-  const DofMap& dofs = *dofs_ptr;
   scene.initial_velocity = Eigen::VectorXd::Zero(dofs.n_dofs());
   for (const auto& [node, v] : spec.initial_velocities) {
     const int k = scene.node_index.at(node);

@@ -3,6 +3,11 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <functional>
+
+#include "formats/input_error.h"
+
 #include "test_util.h"
 
 namespace femb {
@@ -59,6 +64,54 @@ TEST(SuperelementChecks, EachDefectIsCaught) {
     se.floating_frame.Phi_CB(0, 0) += 0.1;
     EXPECT_FALSE(Passed(AnalyzeSuperelement(se), "floating_frame"));
   }
+  {
+    Superelement se = Good();
+    se.interfaces[1].orientation(0, 1) += 1e-3;
+    EXPECT_FALSE(Passed(AnalyzeSuperelement(se), "interface_orientations"));
+  }
+  {
+    Superelement se = Good();
+    se.mass_properties.mass *= 1.01;
+    EXPECT_FALSE(Passed(AnalyzeSuperelement(se), "mass"));
+  }
+  {
+    Superelement se = Good();
+    se.n_modal_derivatives = 1;
+    se.modal_derivative_pairs = {{0, 99}};
+    EXPECT_FALSE(Passed(AnalyzeSuperelement(se), "modal_derivative_pairs"));
+  }
+}
+
+// A NaN or Inf anywhere is named by dataset and entry (a NaN once made the symmetry check report
+// max|A - A^T| = 0, and crashed femb-solve in Phi_CB, the origin or the interface frames).
+TEST(SuperelementChecks, EveryNonFiniteDatasetIsNamed) {
+  const double nan = std::nan(""), inf = HUGE_VAL;
+  const std::vector<std::pair<std::string, std::function<void(Superelement&)>>> cases = {
+      {"/reduced/K", [&](Superelement& se) { se.K(3, 3) = nan; }},
+      {"/reduced/M", [&](Superelement& se) { se.M(0, 5) = -inf; }},
+      {"/floating_frame/Phi_CB", [&](Superelement& se) { se.floating_frame.Phi_CB(0, 0) = nan; }},
+      {"/floating_frame/origin", [&](Superelement& se) { se.floating_frame.origin[1] = inf; }},
+      {"/interfaces/positions", [&](Superelement& se) { se.interfaces[1].position[0] = nan; }},
+      {"/interfaces/orientations", [&](Superelement& se) { se.interfaces[0].orientation(1, 1) = nan; }},
+      {"/mass_properties/inertia_com", [&](Superelement& se) { se.mass_properties.inertia_com(2, 2) = nan; }},
+      {"/reduced/internal_frequencies_hz", [&](Superelement& se) { se.internal_frequencies_hz[0] = inf; }}};
+  for (const auto& [dataset, corrupt] : cases) {
+    Superelement se = Good();
+    corrupt(se);
+    const SuperelementChecks c = CheckSuperelement(se);
+    ASSERT_NE(c.first_failure(), nullptr) << dataset;
+    EXPECT_EQ(c.first_failure()->name, "finite") << dataset;
+    EXPECT_EQ(c.first_failure()->dataset, dataset);
+    EXPECT_EQ(c.checks.size(), 1u) << "later checks are not evaluated on non-finite data";
+    try {
+      RequireValidSuperelement(se, "part.h5");
+      ADD_FAILURE() << dataset << " accepted";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("part.h5: " + dataset + ": check finite failed"), std::string::npos)
+          << e.what();
+    }
+  }
+  EXPECT_NO_THROW(RequireValidSuperelement(Good(), "part.h5"));
 }
 
 }  // namespace

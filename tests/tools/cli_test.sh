@@ -151,6 +151,12 @@ assert abs(a['mass'] - b['mass']) < 5e-3 * a['mass'] and abs(a['mass'] - 0.6969)
   2> "$work/solid/err.txt"; code=$?
 [ $code = 4 ] && grep -q "the Cholesky factor would need" "$work/solid/err.txt" && grep -q "coarsen the mesh" "$work/solid/err.txt" \
   && [ ! -e "$work/solid/big.h5" ] && ok || fail "memory guard: exit $code, $(cat "$work/solid/err.txt")"
+# Element-count guard: mesh.size 1e-5 on a 0.1 m bar is refused before gmsh meshes (it once ran
+# with no output and no end in sight).
+timeout 60 "$bin/femb-reduce" -q "$src/examples/solid_bar/part.yaml" -o "$work/solid/huge.h5" --set mesh.size=1e-5 \
+  2> "$work/solid/err.txt"; code=$?
+[ $code = 4 ] && [ "$(wc -l < "$work/solid/err.txt")" = 1 ] && grep -q "more than mesh.max_elements = 3000000" "$work/solid/err.txt" \
+  && [ ! -e "$work/solid/huge.h5" ] && ok || fail "element guard: exit $code, $(cat "$work/solid/err.txt")"
 
 # --set works under the documented names.
 "$bin/femb-reduce" -q "$src/examples/beam_rod/part.yaml" -o "$work/m8.h5" --set reduction.internal_modes=8 \

@@ -231,6 +231,21 @@ expect "node placed twice" 2 "node 'n1' is placed at" 's/position: \[0.1, 0, 0\]
 cp "$work/segment.h5" "$work/v2.h5"
 $py -c "import h5py; f=h5py.File('$work/v2.h5','r+'); f.attrs['format_version_major']=2" 
 expect "wrong version" 2 "is not supported by this femb" 's/{name: b3, superelement: segment.h5/{name: b3, superelement: v2.h5/'
+# Corrupt superelement files: one line naming the file, the dataset and the check (a NaN in
+# Phi_CB, the origin or the interface frames once crashed femb-solve; an indefinite M ran to the end).
+for case in "Phi_CB:/floating_frame/Phi_CB:(0,0):nan:check finite" "origin:/floating_frame/origin:(1,):inf:check finite" \
+            "positions:/interfaces/positions:(1,0):nan:check finite" "orientations:/interfaces/orientations:(0,4):nan:check finite" \
+            "K:/reduced/K:(3,3):nan:check finite" "M:/reduced/M:(2,2):-1.0:check M_positive_definite"; do
+  IFS=: read -r name dataset index value check <<< "$case"
+  cp "$work/segment.h5" "$work/bad_$name.h5"
+  $py -c "import h5py; f=h5py.File('$work/bad_$name.h5','r+'); a=f['$dataset'][...]; a[$index]=float('$value'); f['$dataset'][...]=a"
+  expect "corrupt $name" 2 "bad_$name.h5: $dataset: $check failed" "s/{name: b3, superelement: segment.h5/{name: b3, superelement: bad_$name.h5/"
+done
+# The joint graph is checked before anything walks it (a cycle with a load on it once hung).
+expect "joint cycle" 2 "joint dependency cycle through nodes" 's/^joints:/joints:\n  - {type: rigid, node: n3, parent: n5}\n  - {type: rigid, node: n5, parent: n7}\n  - {type: rigid, node: n7, parent: n3}/'
+expect "two parents" 2 "node 'n3' already has a joint" 's/^joints:/joints:\n  - {type: rigid, node: n3, parent: n5}\n  - {type: rigid, node: n3, parent: n7}/'
+# A joint whose nodes are apart at t = 0 (the gap would silently become a rigid arm).
+expect "joint gap" 2 "revolute joint between nodes 'n3' and 'n5': the nodes are 0.2 apart" 's/^joints:/joints:\n  - {type: revolute, node: n3, parent: n5, axis: [0, 0, 1]}/'
 # Numerical failure: K1-only tangent at high load: exit 3, results up to it kept.
 sed 's/{name: b\([0-9]\), superelement: segment.h5,/{name: b\1, superelement: segment.h5, options: {tangent: K1},/' "$work/scene.yaml" > "$work/k1.yaml"
 "$bin/femb-solve" -q "$work/k1.yaml" -o "$work/k1_out" 2> "$work/err.txt" > /dev/null

@@ -1,0 +1,163 @@
+#include "formats/superelement_checks.h"
+
+#include <Eigen/Dense>
+#include <cmath>
+#include <cstdio>
+
+#include "formats/input_error.h"
+
+namespace femb {
+namespace {
+
+std::string Sci(const char* fmt, double v) {
+  char buffer[128];
+  std::snprintf(buffer, sizeof buffer, fmt, v);
+  return buffer;
+}
+
+// The first entry of A that is NaN or infinite, as "(row, col) = value"; empty when all are finite.
+std::string FirstNonFinite(const Eigen::MatrixXd& A) {
+  for (Eigen::Index j = 0; j < A.cols(); ++j)
+    for (Eigen::Index i = 0; i < A.rows(); ++i)
+      if (!std::isfinite(A(i, j))) {
+        char buffer[96];
+        std::snprintf(buffer, sizeof buffer, "entry (%ld, %ld) is %g", long(i), long(j), A(i, j));
+        return buffer;
+      }
+  return "";
+}
+
+Check Finite(const Superelement& se) {
+  std::vector<std::pair<std::string, Eigen::MatrixXd>> datasets = {
+      {"/reduced/K", se.K},
+      {"/reduced/M", se.M},
+      {"/reduced/internal_frequencies_hz", se.internal_frequencies_hz},
+      {"/floating_frame/Phi_CB", se.floating_frame.Phi_CB},
+      {"/floating_frame/origin", se.floating_frame.origin},
+      {"/floating_frame/orientation", se.floating_frame.orientation},
+      {"/mass_properties/mass", Eigen::MatrixXd::Constant(1, 1, se.mass_properties.mass)},
+      {"/mass_properties/center_of_mass", se.mass_properties.center_of_mass},
+      {"/mass_properties/inertia_com", se.mass_properties.inertia_com}};
+  Eigen::MatrixXd positions(se.interfaces.size(), 3), orientations(se.interfaces.size(), 9);
+  for (size_t k = 0; k < se.interfaces.size(); ++k) {
+    positions.row(Eigen::Index(k)) = se.interfaces[k].position.transpose();
+    orientations.row(Eigen::Index(k)) = Eigen::Map<const Eigen::Matrix<double, 1, 9>>(se.interfaces[k].orientation.data());
+  }
+  datasets.emplace_back("/interfaces/positions", positions);
+  datasets.emplace_back("/interfaces/orientations", orientations);
+  if (se.floating_frame.cardona_weights.size() > 0) {
+    datasets.emplace_back("/floating_frame/cardona_weights", se.floating_frame.cardona_weights);
+  }
+  if (se.polynomial) {
+    datasets.emplace_back("/reduced/polynomial/A", se.polynomial->A);
+    datasets.emplace_back("/reduced/polynomial/B", se.polynomial->B);
+  }
+  if (se.visualization) {
+    datasets.emplace_back("/visualization/nodes", se.visualization->nodes);
+    datasets.emplace_back("/visualization/shapes", se.visualization->shapes);
+  }
+  for (const auto& [name, A] : datasets) {
+    const std::string bad = FirstNonFinite(A);
+    if (!bad.empty()) return {"finite", false, name + " " + bad, name};
+  }
+  return {"finite", true, "every number of the datasets is finite", ""};
+}
+
+Check Symmetric(const std::string& name, const std::string& dataset, const Eigen::MatrixXd& A) {
+  const double scale = A.cwiseAbs().maxCoeff();
+  const double asym = (A - A.transpose()).cwiseAbs().maxCoeff();
+  const double rel = scale > 0 ? asym / scale : 0.0;
+  return {name, rel <= 1e-10, Sci("max|A - A^T| / max|A| = %.3g", rel), dataset};
+}
+
+}  // namespace
+
+bool SuperelementChecks::all_ok() const { return first_failure() == nullptr; }
+
+const Check* SuperelementChecks::first_failure() const {
+  for (const Check& c : checks)
+    if (!c.ok) return &c;
+  return nullptr;
+}
+
+SuperelementChecks CheckSuperelement(const Superelement& se) {
+  SuperelementChecks a;
+  a.checks.push_back(Finite(se));
+  if (!a.checks.back().ok) return a;  // the other figures would be meaningless
+  a.checks.push_back(Symmetric("K_symmetric", "/reduced/K", se.K));
+  a.checks.push_back(Symmetric("M_symmetric", "/reduced/M", se.M));
+  const Eigen::MatrixXd Ms = 0.5 * (se.M + se.M.transpose());
+  const Eigen::MatrixXd Ks = 0.5 * (se.K + se.K.transpose());
+
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> m_eig(Ms, Eigen::EigenvaluesOnly);
+  const double m_min = m_eig.eigenvalues().size() ? m_eig.eigenvalues()[0] : 0.0;
+  const bool m_pd = Eigen::LLT<Eigen::MatrixXd>(Ms).info() == Eigen::Success && m_min > 0.0;
+  a.checks.push_back({"M_positive_definite", m_pd, Sci("smallest eigenvalue of M %.6g", m_min), "/reduced/M"});
+
+  const Eigen::MatrixXd Phi_rig0 = RigidBodyModes(se, se.floating_frame.origin);
+  if (m_pd) {
+    Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> eig(Ks, Ms, Eigen::EigenvaluesOnly);
+    a.lambda = eig.eigenvalues();
+    const double lmax = a.lambda.size() ? a.lambda.cwiseAbs().maxCoeff() : 0.0;
+    for (int k = 0; k < a.lambda.size(); ++k) a.rigid_body_mode_count += std::abs(a.lambda[k]) <= 1e-8 * lmax;
+  }
+  const double k_norm = se.K.norm(), phi_norm = Phi_rig0.norm();
+  const double residual = (k_norm > 0 && phi_norm > 0) ? (se.K * Phi_rig0).norm() / (k_norm * phi_norm) : 0.0;
+  a.checks.push_back({"rigid_body_modes", m_pd && a.rigid_body_mode_count == 6 && residual <= 1e-8,
+                      (m_pd ? std::to_string(a.rigid_body_mode_count) : std::string("(M not positive definite:) ?")) +
+                          " eigenvalues with |lambda| <= 1e-8 max|lambda| (need 6), " +
+                          Sci("||K Phi_rig0|| / (||K|| ||Phi_rig0||) = %.3g", residual),
+                      "/reduced/K"});
+  const double frame_error =
+      (se.floating_frame.Phi_CB * Phi_rig0 - Eigen::Matrix<double, 6, 6>::Identity()).cwiseAbs().maxCoeff();
+  a.checks.push_back({"floating_frame", frame_error <= 1e-8, Sci("max|Phi_CB Phi_rig0 - 1| = %.3g", frame_error),
+                      "/floating_frame/Phi_CB"});
+
+  double orientation_error = 0.0;
+  std::string worst;
+  for (const InterfaceNode& node : se.interfaces) {
+    const Eigen::Matrix3d& R = node.orientation;
+    const double e = std::max((R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff(),
+                              std::abs(R.determinant() - 1.0));
+    if (e > orientation_error) orientation_error = e, worst = node.name;
+  }
+  a.checks.push_back({"interface_orientations", orientation_error <= 1e-9,
+                      Sci("max|R^T R - 1|, |det R - 1| = %.3g", orientation_error) +
+                          (worst.empty() ? "" : " (interface '" + worst + "')"),
+                      "/interfaces/orientations"});
+
+  const int n = se.n_reduced_dofs();
+  std::string bad_pair;
+  if (long(se.modal_derivative_pairs.size()) != se.n_modal_derivatives) {
+    bad_pair = std::to_string(se.modal_derivative_pairs.size()) + " pairs for " +
+               std::to_string(se.n_modal_derivatives) + " modal derivatives";
+  }
+  for (size_t k = 0; k < se.modal_derivative_pairs.size() && bad_pair.empty(); ++k) {
+    const auto [i, j] = se.modal_derivative_pairs[k];
+    if (i < 0 || j < 0 || i >= n || j >= n) {
+      bad_pair = "pair " + std::to_string(k) + " (" + std::to_string(i) + ", " + std::to_string(j) +
+                 ") is outside the " + std::to_string(n) + " reduced coordinates";
+    }
+  }
+  a.checks.push_back({"modal_derivative_pairs", bad_pair.empty(),
+                      bad_pair.empty() ? std::to_string(se.modal_derivative_pairs.size()) + " pairs in range" : bad_pair,
+                      "/reduced/modal_derivative_pairs"});
+
+  const double m_reduced = (Phi_rig0.col(0).transpose() * se.M * Phi_rig0.col(0))(0, 0);
+  const double mass_error =
+      std::abs(m_reduced - se.mass_properties.mass) / std::max(std::abs(m_reduced), 1e-300);
+  a.checks.push_back({"mass", mass_error <= 1e-6,
+                      Sci("stored mass %.9g", se.mass_properties.mass) + Sci(", from the reduced M %.9g", m_reduced),
+                      "/mass_properties/mass"});
+  return a;
+}
+
+void RequireValidSuperelement(const Superelement& se, const std::string& path) {
+  const SuperelementChecks a = CheckSuperelement(se);
+  if (const Check* c = a.first_failure()) {
+    throw InputError(path + ": " + (c->dataset.empty() ? std::string("") : c->dataset + ": ") + "check " + c->name +
+                     " failed: " + c->detail + " (femb-inspect --check lists every check; re-run femb-reduce)");
+  }
+}
+
+}  // namespace femb
