@@ -162,20 +162,41 @@ CraigBamptonResult CraigBamptonReduce(const FeModel& model, int internal_modes,
   }
 
   // One factorization (METIS ordering, supernodal) of K_ii, or, when no interface is a DOF
-  // interface (every interface distributing), of K_ii + s M_ii: K_ii itself then still has the
-  // six rigid-body modes that only the constraints W u = q remove.
+  // interface (every interface distributing), of the augmented F = K_ii + a W_1^T W_1, W_1 the
+  // six (unit-normalized) constraint rows of the first RBE3 interface: K_ii alone still has the
+  // six rigid-body modes that only the constraints W u = q remove, and W_1 alone removes them.
+  // Every solve below is on W x = 0 or W x = e_j, where F and K_ii give the same answer: on
+  // W x = 0, F x = K_ii x; on W x = e_j the extra a W_1^T (W_1 x) is a constraint force that the
+  // multipliers absorb. So the static modes, the fixed-interface modes and the modal derivatives
+  // are those of K_ii exactly, at any scale of the part (no shift, no iteration); a only sets the
+  // conditioning: the mean diagonal of K_ii over the DOFs W_1 weights.
   clock.Restart();
-  double shift = 0.0;
+  SparseMatrix F_augmented;
   if (n_b == 0) {
-    double max_ratio = 0.0;
+    Eigen::MatrixXd W1 = Eigen::MatrixXd(Wt.leftCols(6));  // n_i x 6 (dense columns, sparse support)
+    for (int c = 0; c < 6; ++c) W1.col(c) /= std::max(W1.col(c).norm(), 1e-300);
+    double diagonal = 0.0;
+    int touched = 0;
+    std::vector<Eigen::Triplet<double>> entries;
+    std::vector<int> support;
     for (int j = 0; j < n_i; ++j) {
-      const double m = M.ii.coeff(j, j);
-      if (m > 0) max_ratio = std::max(max_ratio, K.ii.coeff(j, j) / m);
+      if (W1.row(j).squaredNorm() == 0.0) continue;
+      support.push_back(j);
+      diagonal += K.ii.coeff(j, j);
+      ++touched;
     }
-    shift = 1e-8 * max_ratio;
+    const double a = touched > 0 ? diagonal / touched : 1.0;
+    for (int i : support)
+      for (int j : support) {
+        const double v = a * W1.row(i).dot(W1.row(j));
+        if (v != 0.0) entries.emplace_back(i, j, v);
+      }
+    SparseMatrix augmentation(n_i, n_i);
+    augmentation.setFromTriplets(entries.begin(), entries.end());
+    F_augmented = K.ii + augmentation;
   }
   SparseCholesky factor;
-  r.factorization = factor.Compute(shift > 0 ? SparseMatrix(K.ii + shift * M.ii) : K.ii, memory_limit_bytes);
+  r.factorization = factor.Compute(n_b == 0 ? F_augmented : K.ii, memory_limit_bytes);
   const double t_factor = clock.Seconds();
   if (r.factorization.too_big) {
     r.message = r.factorization.message;
@@ -207,27 +228,10 @@ CraigBamptonResult CraigBamptonReduce(const FeModel& model, int internal_modes,
     if (n_c > 0) x -= Y * S.solve(Eigen::MatrixXd(Wt.transpose() * x));
     return x;
   };
-  // With the shift s, the solution for K itself by the fixed point x = F_c^-1 (z + s M x): it
-  // contracts by s / lambda_1 (about 1e-2 or less).
-  bool refined = true;
-  auto stiffness_solve = [&](const Eigen::MatrixXd& z) {
-    Eigen::MatrixXd x = constrained_solve(z);
-    if (shift == 0.0) return x;
-    double previous = HUGE_VAL;
-    for (int it = 0; it < 60; ++it) {
-      const Eigen::MatrixXd next = constrained_solve(z + shift * (M.ii * x));
-      const double change = (next - x).norm() / std::max(next.norm(), 1e-300);
-      x = next;
-      // Converged, or stalled at the round-off of the shifted factor (measured ~1e-12).
-      if (change <= 1e-11 || (change < 1e-9 && change > 0.5 * previous)) return x;
-      previous = change;
-    }
-    refined = false;
-    return x;
-  };
+  const auto& stiffness_solve = constrained_solve;
   // Static modes: a DOF interface moved by a unit motion with the others held (K_ii x = -K_ib,
   // W x = 0); a distributing interface's six coordinates set to unit values (W x = e_j) at
-  // least strain energy: x0 = Y S^-1 (stationary for F; corrected for K when shifted).
+  // least strain energy: x0 = Y S^-1 (stationary for F, and so for K_ii: see the factorization above).
   Eigen::MatrixXd Psi_b = n_b > 0 ? Eigen::MatrixXd(-stiffness_solve(Eigen::MatrixXd(K.ib))) : Eigen::MatrixXd(n_i, 0);
   // Rigid motions exactly: mathematically the static modes reproduce them (Psi_b R_b = R_i for
   // the rigid fields R); in floating point only to cond(K_ii) times the round-off of K R = 0,
@@ -245,18 +249,13 @@ CraigBamptonResult CraigBamptonReduce(const FeModel& model, int internal_modes,
   Eigen::MatrixXd Psi_c(n_i, n_c);
   if (n_c > 0) {
     Psi_c = Y * S.solve(Eigen::MatrixXd::Identity(n_c, n_c));
-    if (shift > 0) Psi_c += stiffness_solve(-(K.ii * Psi_c));
-  }
-  if (!refined) {
-    r.message = "static modes of the distributing (RBE3) interfaces did not converge (no DOF interface holds the part)";
-    return r;
   }
   if (progress) {
     progress("static modes", clock.Seconds(),
              Format("%.0f constraint modes, %.0f linear solves", n_b + n_c, double(factor.solves())));
   }
 
-  // Fixed-interface modes, shift-invert around -shift on the same factor, on W x = 0.
+  // Fixed-interface modes, shift-invert around 0 on the same factor, on W x = 0.
   clock.Restart();
   const ShiftInvertFn solve = [&](const double* b, double* x) {
     Eigen::Map<const Eigen::VectorXd> bv(b, n_i);
@@ -267,8 +266,8 @@ CraigBamptonResult CraigBamptonReduce(const FeModel& model, int internal_modes,
   long passes = 0;
   const EigenResult eig =
       n_i <= dense_limit || 2 * internal_modes + 1 > n_i - n_c
-          ? LowestConstrainedEigenpairs(K.ii, M.ii, C, internal_modes, -shift, solve, dense_limit)
-          : BlockLanczosEigenpairs(K.ii, M.ii, C, internal_modes, -shift, constrained_solve, kLanczosBlock, kLanczosTolerance, &passes);
+          ? LowestConstrainedEigenpairs(K.ii, M.ii, C, internal_modes, 0.0, solve, dense_limit)
+          : BlockLanczosEigenpairs(K.ii, M.ii, C, internal_modes, 0.0, constrained_solve, kLanczosBlock, kLanczosTolerance, &passes);
   if (!eig.ok) {
     r.message = "fixed-interface eigen solve failed: " + eig.message;
     return r;
