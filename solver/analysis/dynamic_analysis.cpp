@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "solver/analysis/singularity.h"
 #include "solver/rotation.h"
 
 namespace femb {
@@ -196,6 +197,7 @@ struct IterationMatrix {
 struct StepOutcome {
   bool converged = false;
   int iterations = 0;
+  SystemMatrix singular_matrix;  ///< the iteration matrix when its factorization failed
 };
 
 // One generalized-alpha step of size h from `state` into `next` (Arnold & Bruls 2007).
@@ -227,9 +229,16 @@ StepOutcome GeneralizedAlphaStep(const SystemModel& model, const DofMap& dofs, c
       next.f_ext = a.f_ext;
       return out;
     }
-    if (!matrix.Update(dofs, options, h, [&] { return SystemMatrix(a.K + gamma_p * a.C + beta_p * a.M); })) return out;
+    const auto S = [&] { return SystemMatrix(a.K + gamma_p * a.C + beta_p * a.M); };
+    if (!matrix.Update(dofs, options, h, S)) {
+      out.singular_matrix = S();
+      return out;
+    }
     const Eigen::VectorXd delta = matrix.solver.Solve(a.residual);
-    if (!delta.allFinite()) return out;
+    if (!delta.allFinite()) {
+      out.singular_matrix = S();
+      return out;
+    }
     ApplyIncrement(model, dofs, delta, next.config);
     next.W += gamma_p * delta;
     next.Wdot += beta_p * delta;
@@ -486,11 +495,16 @@ StepOutcome MidpointStep(const SystemModel& model, const DofMap& dofs, const Dyn
       return out;
     }
     // Newton's increment delta at n+1: dW_n+1 = V delta, dq_m = T delta, dw_m ~ delta / h.
-    if (!matrix.Update(dofs, options, h, [&] { return SystemMatrix(a.K * k.T + (1.0 / h) * (a.C + a.M * k.V)); })) {
+    const auto S = [&] { return SystemMatrix(a.K * k.T + (1.0 / h) * (a.C + a.M * k.V)); };
+    if (!matrix.Update(dofs, options, h, S)) {
+      out.singular_matrix = S();
       return out;
     }
     const Eigen::VectorXd delta = matrix.solver.Solve(a.residual);
-    if (!delta.allFinite()) return out;
+    if (!delta.allFinite()) {
+      out.singular_matrix = S();
+      return out;
+    }
     ApplyIncrement(model, dofs, delta, next.config);
   }
   return out;
@@ -513,6 +527,14 @@ DynamicResult SolveDynamic(const SystemModel& model, DynamicState& state, const 
     const StepOutcome step = options.integrator == Integrator::kMidpoint
                                  ? MidpointStep(model, dofs, options, triples, state, h, matrix, next)
                                  : GeneralizedAlphaStep(model, dofs, options, state, h, matrix, next);
+    if (!step.converged && result.steps == 0 && cuts == 0 && step.singular_matrix.size() > 0) {
+      // The first iteration matrix is singular: the model's, not the step's.
+      const std::string why = DescribeSingular(model, dofs, state.config, step.singular_matrix);
+      if (!why.empty()) {
+        result.message = "iteration matrix at the start: " + why;
+        return result;
+      }
+    }
     if (!step.converged) {
       matrix.solver.Invalidate();
       if (cuts >= options.max_cuts) {

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdio>
 
+#include "solver/analysis/singularity.h"
+
 namespace femb {
 StaticResult SolveStatic(const SystemModel& model, SystemState& state, const StaticOptions& options,
                          const std::function<void(const StaticStepReport&, const SystemState&)>& on_step) {
@@ -37,8 +39,21 @@ StaticResult SolveStatic(const SystemModel& model, SystemState& state, const Sta
         converged = true;
         break;
       }
-      const Eigen::VectorXd delta = SolveFree(dofs, f.tangent, f.residual);
-      if (!delta.allFinite()) break;
+      FreeSolver solver;
+      const bool regular = solver.Factor(dofs, f.tangent);
+      const Eigen::VectorXd delta = regular ? solver.Solve(f.residual) : Eigen::VectorXd();
+      if (!regular || !delta.allFinite()) {
+        // At the start, a singular tangent is the model's, not the step's: name the free motion
+        // instead of cutting steps.
+        if (result.steps.empty() && it == 0) {
+          const std::string why = DescribeSingular(model, dofs, trial, f.tangent);
+          if (!why.empty()) {
+            result.message = "static tangent at the start: " + why;
+            return result;
+          }
+        }
+        break;
+      }
       last_step = delta.norm();
       travelled += delta;
       ApplyIncrement(model, dofs, delta, trial);

@@ -401,11 +401,23 @@ bool FreeSolver::Factor(const DofMap& dofs, const SystemMatrix& S) {
   const int n = int(free_.size());
   std::vector<int> position(S.rows(), -1);
   for (int i = 0; i < n; ++i) position[free_[i]] = i;
+  // Symmetric scaling to unit diagonal, D S D with d_i = 1 / sqrt|s_ii|: translations,
+  // rotations and modal coordinates in any units then factor alike, and the dense path can tell
+  // a singular matrix (reciprocal condition estimate below 1e-15) from a badly scaled one.
+  scale_.setOnes(n);
+  for (int col = 0; col < S.outerSize(); ++col) {
+    for (SystemMatrix::InnerIterator it(S, col); it; ++it) {
+      if (it.row() == col && position[col] >= 0 && std::abs(it.value()) > 0) {
+        scale_[position[col]] = 1.0 / std::sqrt(std::abs(it.value()));
+      }
+    }
+  }
   Triplets entries;
   entries.reserve(S.nonZeros());
   for (int col = 0; col < S.outerSize(); ++col) {
     for (SystemMatrix::InnerIterator it(S, col); it; ++it) {
-      if (position[it.row()] >= 0 && position[col] >= 0) entries.emplace_back(position[it.row()], position[col], it.value());
+      const int i = position[it.row()], j = position[col];
+      if (i >= 0 && j >= 0) entries.emplace_back(i, j, scale_[i] * it.value() * scale_[j]);
     }
   }
   const SystemMatrix Sf = ToMatrix(n, entries);
@@ -416,17 +428,18 @@ bool FreeSolver::Factor(const DofMap& dofs, const SystemMatrix& S) {
     valid_ = sparse_lu_->info() == Eigen::Success;
   } else {
     dense_.compute(Eigen::MatrixXd(Sf));
-    valid_ = true;
+    const double rcond = n > 0 ? dense_.rcond() : 1.0;
+    valid_ = std::isfinite(rcond) && rcond > 1e-15;
   }
   return valid_;
 }
 
 Eigen::VectorXd FreeSolver::Solve(const Eigen::VectorXd& r) const {
   Eigen::VectorXd rf(free_.size());
-  for (size_t i = 0; i < free_.size(); ++i) rf[i] = r[free_[i]];
+  for (size_t i = 0; i < free_.size(); ++i) rf[i] = scale_[Eigen::Index(i)] * r[free_[i]];
   const Eigen::VectorXd df = sparse_ ? Eigen::VectorXd(sparse_lu_->solve(rf)) : Eigen::VectorXd(dense_.solve(rf));
   Eigen::VectorXd d = Eigen::VectorXd::Zero(r.size());
-  for (size_t i = 0; i < free_.size(); ++i) d[free_[i]] = df[i];
+  for (size_t i = 0; i < free_.size(); ++i) d[free_[i]] = scale_[Eigen::Index(i)] * df[Eigen::Index(i)];
   return d;
 }
 

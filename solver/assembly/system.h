@@ -58,6 +58,7 @@ struct SystemModel {
   std::vector<NodeJoint> joints;
   std::vector<SuperelementBody> bodies;
   std::vector<std::vector<int>> body_nodes;  ///< system node of each interface of each body
+  std::vector<std::string> body_names;       ///< for messages (may be empty)
   std::vector<NodeLoad> loads;
   std::vector<SpringDamper> springs;
   Eigen::Vector3d gravity = Eigen::Vector3d::Zero();  ///< uniform acceleration field (dynamic analyses)
@@ -220,7 +221,8 @@ void ApplyPrescribed(const SystemModel& model, const DofMap& dofs, double t, Sys
 Eigen::VectorXd SolveFree(const DofMap& dofs, const SystemMatrix& S, const Eigen::VectorXd& r);
 
 /// The same with a kept factorization (Jacobian reuse): Factor once, Solve many times.
-/// Factor returns false when the matrix is singular.
+/// The matrix is scaled to unit diagonal first (D S D). Factor returns false when the matrix is
+/// singular: a zero pivot, or (dense) a reciprocal condition estimate of D S D below 1e-15.
 class FreeSolver {
  public:
   bool Factor(const DofMap& dofs, const SystemMatrix& S);
@@ -231,6 +233,7 @@ class FreeSolver {
 
  private:
   std::vector<int> free_;
+  Eigen::VectorXd scale_;  ///< d_i = 1 / sqrt|s_ii| over the free coordinates
   Eigen::PartialPivLU<Eigen::MatrixXd> dense_;
   std::shared_ptr<Eigen::SparseLU<SystemMatrix, Eigen::COLAMDOrdering<int>>> sparse_lu_;
   bool valid_ = false, sparse_ = false;

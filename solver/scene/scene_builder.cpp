@@ -93,6 +93,7 @@ Scene BuildScene(const SceneSpec& spec) {
       model.bodies.emplace_back(se, SuperelementOptions{}, R, b.position);
       model.body_nodes.push_back({com});
       scene.body_names.push_back(b.name);
+      model.body_names.push_back(b.name);
       scene.meshes.emplace_back();
       scene.mesh_origin.push_back(b.center_of_mass);
       for (const auto& [point, node] : b.nodes) {
@@ -175,6 +176,7 @@ Scene BuildScene(const SceneSpec& spec) {
     model.bodies.emplace_back(se, options, R, b.position);
     model.body_nodes.push_back(nodes);
     scene.body_names.push_back(b.name);
+    model.body_names.push_back(b.name);
     scene.meshes.push_back(se.visualization);
     scene.mesh_origin.push_back(se.floating_frame.origin);
   }

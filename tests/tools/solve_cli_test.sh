@@ -246,6 +246,9 @@ expect "joint cycle" 2 "joint dependency cycle through nodes" 's/^joints:/joints
 expect "two parents" 2 "node 'n3' already has a joint" 's/^joints:/joints:\n  - {type: rigid, node: n3, parent: n5}\n  - {type: rigid, node: n3, parent: n7}/'
 # A joint whose nodes are apart at t = 0 (the gap would silently become a rigid arm).
 expect "joint gap" 2 "revolute joint between nodes 'n3' and 'n5': the nodes are 0.2 apart" 's/^joints:/joints:\n  - {type: revolute, node: n3, parent: n5, axis: [0, 0, 1]}/'
+# A singular system is diagnosed, not reported as "Newton did not converge": the free motion is named.
+expect "free static body" 3 "static tangent at the start: the system matrix is singular (6 free motions" 's/type: clamp, node: n0/type: rigid, node: n1, parent: n2/'
+expect "pinned cantilever" 3 "(3 free motions, smallest/largest singular value" 's/type: clamp, node: n0/type: spherical, node: n0/'
 # Numerical failure: K1-only tangent at high load: exit 3, results up to it kept.
 sed 's/{name: b\([0-9]\), superelement: segment.h5,/{name: b\1, superelement: segment.h5, options: {tangent: K1},/' "$work/scene.yaml" > "$work/k1.yaml"
 "$bin/femb-solve" -q "$work/k1.yaml" -o "$work/k1_out" 2> "$work/err.txt" > /dev/null
