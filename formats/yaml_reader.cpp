@@ -174,26 +174,59 @@ void YamlDocument::Set(const std::string& assignment) {
   } catch (const YAML::Exception& e) {
     throw InputError("--set " + assignment + ": value is not valid YAML: " + e.msg);
   }
-  std::vector<std::string> parts;
+  // Key path: components separated by '.', each a key optionally followed by list indices
+  // ("bodies[1].options.modal_damping"). Steps: (key, -1) or ("", index).
+  std::vector<std::pair<std::string, long>> steps;
   std::stringstream ss(key);
   for (std::string part; std::getline(ss, part, '.');) {
-    if (part.empty()) throw InputError("--set " + assignment + ": empty component in key path");
-    parts.push_back(part);
+    const size_t bracket = part.find('[');
+    const std::string name = part.substr(0, bracket);
+    if (name.empty()) throw InputError("--set " + assignment + ": empty key in key path");
+    steps.emplace_back(name, -1);
+    for (size_t at = bracket; at != std::string::npos;) {
+      const size_t close = part.find(']', at);
+      const std::string digits = close == std::string::npos ? "" : part.substr(at + 1, close - at - 1);
+      if (digits.empty() || digits.size() > 9 || digits.find_first_not_of("0123456789") != std::string::npos ||
+          (close + 1 < part.size() && part[close + 1] != '[')) {
+        throw InputError("--set " + assignment + ": malformed list index in '" + part + "' (expected key[N])");
+      }
+      steps.emplace_back("", std::stol(digits));
+      at = close + 1 < part.size() ? close + 1 : std::string::npos;
+    }
   }
+  if (steps.back().second >= 0) throw InputError("--set " + assignment + ": the key path must end with a key");
   // yaml-cpp nodes are handles: walk down by reassigning node references.
   std::vector<YAML::Node> chain{root_};
-  for (size_t i = 0; i + 1 < parts.size(); ++i) {
-    YAML::Node next = chain.back()[parts[i]];
-    if (next.IsDefined() && !next.IsNull() && !next.IsMap()) {
-      throw InputError("--set " + assignment + ": '" + parts[i] + "' is not a mapping in " + file());
+  std::string walked;
+  for (size_t i = 0; i + 1 < steps.size(); ++i) {
+    const auto& [name, index] = steps[i];
+    if (index >= 0) {
+      const YAML::Node list = chain.back();
+      if (!list.IsSequence() || index >= long(list.size())) {
+        throw InputError("--set " + assignment + ": '" + walked + "' has no item " + std::to_string(index) + " in " +
+                         file() + (list.IsSequence() ? " (it has " + std::to_string(list.size()) + ")" : " (not a list)"));
+      }
+      walked += "[" + std::to_string(index) + "]";
+      chain.push_back(list[std::size_t(index)]);
+      continue;
+    }
+    walked += (walked.empty() ? "" : ".") + name;
+    YAML::Node next = chain.back()[name];
+    const bool indexed = steps[i + 1].second >= 0;
+    if (next.IsDefined() && !next.IsNull() && !indexed && !next.IsMap()) {
+      throw InputError("--set " + assignment + ": '" + name + "' is not a mapping in " + file());
     }
     if (!next.IsDefined() || next.IsNull()) {
-      chain.back()[parts[i]] = YAML::Node(YAML::NodeType::Map);
-      next = chain.back()[parts[i]];
+      if (indexed) throw InputError("--set " + assignment + ": '" + walked + "' is not a list in " + file());
+      chain.back()[name] = YAML::Node(YAML::NodeType::Map);
+      next = chain.back()[name];
     }
     chain.push_back(next);
   }
-  chain.back()[parts.back()] = value;
+  if (!chain.back().IsMap() && chain.back().IsDefined() && !chain.back().IsNull()) {
+    throw InputError("--set " + assignment + ": '" + walked + "' is not a mapping in " + file());
+  }
+  chain.back()[steps.back().first] = value;
   source_->overridden.insert(key);
 }
 

@@ -127,6 +127,7 @@ int main(int argc, char** argv) {
           });
       ok = r.ok;
       if (!ok) status = r.message;
+      for (const std::string& w : r.warnings) std::printf("femb-solve: warning: %s\n", w.c_str());
     } else {
       femb::DynamicState state = femb::InitialDynamicState(scene.model, femb::InitialState(scene.model), scene.initial_velocity);
       const femb::DynamicStepReport r0 = femb::Measure(scene.model, state);
@@ -153,6 +154,7 @@ int main(int argc, char** argv) {
           });
       ok = r.ok;
       if (!ok) status = r.message;
+      for (const std::string& w : r.warnings) std::printf("femb-solve: warning: %s\n", w.c_str());
       if (!quiet) std::printf("femb-solve: %ld factorizations of the iteration matrix\n", r.factorizations);
     }
     recorder.Finish(status);

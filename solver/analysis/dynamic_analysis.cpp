@@ -17,6 +17,7 @@ struct Assembly {
   Eigen::VectorXd f_ext;     // nodal loads and gravity, for the work
   SystemMatrix K, C, M;
   double scale = 0.0;
+  double roundoff = 0.0;  // residual noise from the round-off of absolute positions
 };
 
 // The triplets of an assembly in progress and the node forces for the joints' stiffness.
@@ -95,6 +96,7 @@ Assembly AssembleDynamic(const SystemModel& model, const DofMap& dofs, DynamicSt
     // Scale of the forces in balance, each term on its own (for a torque-free body M_g wdot and
     // the gyroscopic terms cancel: their sum is no scale).
     out.scale = std::max({out.scale, f_int.norm(), f_in.norm(), f_grav.norm(), body.force_floor()});
+    out.roundoff += body.RoundOffForce(c);
     if (matrices) {
       const Eigen::VectorXd f_acc = Mb * wdot;
       out.scale = std::max({out.scale, f_acc.norm(), (f_in - f_acc).norm()});
@@ -115,6 +117,15 @@ Assembly AssembleDynamic(const SystemModel& model, const DofMap& dofs, DynamicSt
 }
 
 }  // namespace
+
+// The generalized forces the prescribed motions exert: minus the residual on the prescribed
+// coordinates (zero elsewhere).
+Eigen::VectorXd DriveForces(const DofMap& dofs, const Eigen::VectorXd& residual) {
+  Eigen::VectorXd f = Eigen::VectorXd::Zero(residual.size());
+  for (int j = 0; j < dofs.n_dofs(); ++j)
+    if (dofs.prescribed(j)) f[j] = -residual[j];
+  return f;
+}
 
 DynamicState InitialDynamicState(const SystemModel& model, const SystemState& config, const Eigen::VectorXd& W,
                                  double t0) {
@@ -146,6 +157,9 @@ DynamicState InitialDynamicState(const SystemModel& model, const SystemState& co
   for (int j : dofs.solved()) s.Wdot[j] = free_acc[j];
   s.a = s.Wdot;
   s.f_ext = b.f_ext;
+  Eigen::VectorXd added = Eigen::VectorXd::Zero(dofs.n_dofs());
+  for (int j : dofs.solved()) added[j] = s.Wdot[j];
+  s.f_drive = DriveForces(dofs, b.residual - b.M * added);
   return s;
 }
 
@@ -217,16 +231,19 @@ StepOutcome GeneralizedAlphaStep(const SystemModel& model, const DofMap& dofs, c
   const double gamma_p = gamma / (beta * h), beta_p = (1 - alpha_m) / (beta * h * h * (1 - alpha_f));
   const double t_new = state.t + h;
   StepOutcome out;
+  const double tolerance = std::max(options.tolerance, kRoundOffTolerance);
   for (; out.iterations < options.max_iterations; ++out.iterations) {
     const Assembly a = AssembleDynamic(model, dofs, next, t_new, true, options.full_inertia_tangent);
     if (!a.ok || !a.residual.allFinite()) return out;
-    if (FreeNorm(dofs, a.residual) <= options.tolerance * a.scale && out.iterations > 0) {
+    if (FreeNorm(dofs, a.residual) <= std::max(tolerance * a.scale, a.roundoff) && out.iterations > 0) {
       out.converged = true;
       next.a += (1 - alpha_f) / (1 - alpha_m) * next.Wdot;
       next.t = t_new;
       // External work by the trapezoidal rule on the increment h (W_n + W_n+1) / 2.
       next.external_work += 0.5 * (state.f_ext + a.f_ext).dot(h * 0.5 * (state.W + next.W));
       next.f_ext = a.f_ext;
+      next.f_drive = DriveForces(dofs, a.residual);
+      next.drive_work += 0.5 * (state.f_drive + next.f_drive).dot(h * 0.5 * (state.W + next.W));
       return out;
     }
     const auto S = [&] { return SystemMatrix(a.K + gamma_p * a.C + beta_p * a.M); };
@@ -450,6 +467,7 @@ Assembly AssembleMidpoint(const SystemModel& model, const DofMap& dofs, const Dy
     // Scale: each term on its own (for a torque-free body the momentum change and the source
     // cancel; M_g (w_n+1 - w_n) / h is the size of the inertia force).
     out.scale = std::max({out.scale, f_int.norm(), f_in.norm(), f_grav.norm(), body.force_floor(), f_acc.norm()});
+    out.roundoff += body.RoundOffForce(c1);
     const std::vector<MapEntry> map = BodyMap(model, dofs, k.mid, int(b));
     const Eigen::VectorXd r_b = f_grav - f_int - f_in;
     AddBodyNodeForces(model, int(b), r_b, parts.node_forces);
@@ -478,12 +496,13 @@ StepOutcome MidpointStep(const SystemModel& model, const DofMap& dofs, const Dyn
   ApplyIncrement(model, dofs, h * state.W + 0.5 * h * h * state.Wdot, next.config);
   ApplyPrescribed(model, dofs, state.t + h, next.config, &next.W, &next.Wdot);
   StepOutcome out;
+  const double tolerance = std::max(options.tolerance, kRoundOffTolerance);
   for (; out.iterations < options.max_iterations; ++out.iterations) {
     MidpointKinematics k = Midpoint(model, dofs, triples, state, h, next);
     double work = 0.0;
     const Assembly a = AssembleMidpoint(model, dofs, state, p0, h, k, next, work);
     if (!a.ok || !a.residual.allFinite()) return out;
-    if (FreeNorm(dofs, a.residual) <= options.tolerance * a.scale && out.iterations > 0) {
+    if (FreeNorm(dofs, a.residual) <= std::max(tolerance * a.scale, a.roundoff) && out.iterations > 0) {
       out.converged = true;
       next.t = state.t + h;
       // a: the mean acceleration over the step (t_n+1/2); Wdot: extrapolated to t_n+1 from
@@ -492,6 +511,8 @@ StepOutcome MidpointStep(const SystemModel& model, const DofMap& dofs, const Dyn
       next.Wdot = 1.5 * next.a - 0.5 * state.a;
       next.external_work += work;
       next.f_ext = a.f_ext;
+      next.f_drive = DriveForces(dofs, a.residual);
+      next.drive_work += next.f_drive.dot(k.delta);
       return out;
     }
     // Newton's increment delta at n+1: dW_n+1 = V delta, dq_m = T delta, dw_m ~ delta / h.
@@ -520,8 +541,31 @@ DynamicResult SolveDynamic(const SystemModel& model, DynamicState& state, const 
   double h = options.step;
   int cuts = 0;
   IterationMatrix matrix;
-  while (state.t < options.end_time - 1e-12 * options.end_time) {
-    h = std::min(h, options.end_time - state.t);
+  // Time is counted in steps: t = t_base + n h while the step stays nominal (summing h over 1e6
+  // steps drifted by 1e-8 s and left a last step of 1e-8 s that Newton could not take), and a
+  // remainder below 1% of a step is merged into the last one.
+  double t_base = state.t;
+  long n_nominal = 0;
+  // Energy balance E = T + U - W_loads - W_drives: constant for a conservative system, falling
+  // with damping (modal, dampers, generalized-alpha's rho_inf < 1). Growth is numerical: a step
+  // too long for the stiffest modes (generalized-alpha with rho_inf near 1 on stiff modes; the
+  // midpoint scheme's elastic force is not an exact discrete gradient). Above 5% of the energy
+  // scale (the largest of T + U and the works so far) it is said once; above 25% the run stops.
+  constexpr double kEnergyWarn = 0.05, kEnergyStop = 0.25;
+  const DynamicStepReport start = Measure(model, state);
+  const double E0 = start.kinetic_energy + start.elastic_energy;
+  double energy_scale = std::abs(E0);
+  bool warned = false;
+  if (options.tolerance < kRoundOffTolerance) {
+    char buffer[200];
+    std::snprintf(buffer, sizeof buffer,
+                  "analysis.tolerance %.3g is below the round-off floor of the residual; using %.0e", options.tolerance,
+                  kRoundOffTolerance);
+    result.warnings.push_back(buffer);
+  }
+  while (state.t < options.end_time - 1e-12 * std::max(std::abs(options.end_time), options.step)) {
+    const double remaining = options.end_time - state.t;
+    if (remaining <= 1.01 * h) h = remaining;
     DynamicState next;
     matrix.with_this_factor = 0;  // a step may use the kept factor for reuse_max_iterations iterations
     const StepOutcome step = options.integrator == Integrator::kMidpoint
@@ -549,14 +593,37 @@ DynamicResult SolveDynamic(const SystemModel& model, DynamicState& state, const 
       ++cuts;
       continue;
     }
+    if (h == options.step) {
+      next.t = t_base + double(++n_nominal) * options.step;
+    } else {
+      t_base = next.t;
+      n_nominal = 0;
+    }
+    if (options.end_time - next.t < 1e-9 * h) next.t = options.end_time;
     state = next;
     result.steps += 1;
     result.newton_iterations += step.iterations;
-    if (on_step) {
-      DynamicStepReport r = Measure(model, state);
-      r.h = h;
-      r.iterations = step.iterations;
-      on_step(r, state);
+    DynamicStepReport r = Measure(model, state);
+    r.h = h;
+    r.iterations = step.iterations;
+    if (on_step) on_step(r, state);
+    const double energy = r.kinetic_energy + r.elastic_energy;
+    energy_scale = std::max({energy_scale, std::abs(energy), std::abs(state.external_work), std::abs(state.drive_work)});
+    const double growth = energy - state.external_work - state.drive_work - E0;
+    if (energy_scale > 0 && growth > kEnergyWarn * energy_scale) {
+      char buffer[400];
+      std::snprintf(buffer, sizeof buffer,
+                    "the energy grew by %.3g (%.1f%% of %.3g) at t = %.6g beyond the work of the loads and drives: "
+                    "numerically unstable at step %.3g; reduce analysis.step%s",
+                    growth, 100 * growth / energy_scale, energy_scale, state.t, h,
+                    options.integrator == Integrator::kGeneralizedAlpha ? " or analysis.rho_inf" : "");
+      if (growth > kEnergyStop * energy_scale) {
+        result.message = buffer;
+        result.factorizations = matrix.factorizations;
+        return result;
+      }
+      if (!warned) result.warnings.push_back(buffer);
+      warned = true;
     }
     if (cuts > 0 && step.iterations <= 4) {
       h = std::min(options.step, 2 * h);

@@ -51,6 +51,10 @@ struct DynamicState {
   double t = 0.0;
   double external_work = 0.0;
   Eigen::VectorXd f_ext;  ///< external forces (nodal loads, gravity) at t, for the work
+  /// Work done by the prescribed motions (the drives): their generalized forces f_drive = -r_p
+  /// (the residual on the prescribed coordinates at convergence) times their increments.
+  double drive_work = 0.0;
+  Eigen::VectorXd f_drive;
 };
 
 struct DynamicStepReport {
@@ -65,6 +69,7 @@ struct DynamicStepReport {
 struct DynamicResult {
   bool ok = false;
   std::string message;
+  std::vector<std::string> warnings;  ///< said once each (energy growth below the stop limit)
   long steps = 0;
   long newton_iterations = 0;
   long factorizations = 0;  ///< of the iteration matrix

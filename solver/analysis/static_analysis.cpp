@@ -7,6 +7,29 @@
 #include "solver/analysis/singularity.h"
 
 namespace femb {
+namespace {
+
+// Negative eigenvalues of the symmetric part of S on the free coordinates (inertia of a pivoted
+// LDL^T), or -1 above the dense limit.
+int NegativeEigenvalues(const DofMap& dofs, const SystemMatrix& S) {
+  const std::vector<int>& free = dofs.solved();
+  const int n = int(free.size());
+  if (n == 0 || n > kDenseLimit) return -1;
+  std::vector<int> position(S.rows(), -1);
+  for (int i = 0; i < n; ++i) position[free[i]] = i;
+  Eigen::MatrixXd A = Eigen::MatrixXd::Zero(n, n);
+  for (int col = 0; col < S.outerSize(); ++col)
+    for (SystemMatrix::InnerIterator it(S, col); it; ++it)
+      if (position[it.row()] >= 0 && position[col] >= 0) A(position[it.row()], position[col]) += it.value();
+  const Eigen::MatrixXd sym = 0.5 * (A + A.transpose());
+  const Eigen::LDLT<Eigen::MatrixXd> ldlt(sym);
+  int negative = 0;
+  for (int i = 0; i < n; ++i) negative += ldlt.vectorD()[i] < 0;
+  return negative;
+}
+
+}  // namespace
+
 StaticResult SolveStatic(const SystemModel& model, SystemState& state, const StaticOptions& options,
                          const std::function<void(const StaticStepReport&, const SystemState&)>& on_step) {
   StaticResult result;
@@ -20,6 +43,17 @@ StaticResult SolveStatic(const SystemModel& model, SystemState& state, const Sta
   double lambda = 0.0, step = nominal, work = 0.0;
   Eigen::VectorXd loads_before = Eigen::VectorXd::Zero(dofs.n_dofs());
   int cuts = 0;
+  const double tolerance = std::max(options.tolerance, kRoundOffTolerance);
+  if (options.tolerance < kRoundOffTolerance) {
+    char buffer[200];
+    std::snprintf(buffer, sizeof buffer,
+                  "analysis.tolerance %.3g is below the round-off floor of the residual; using %.0e", options.tolerance,
+                  kRoundOffTolerance);
+    result.warnings.push_back(buffer);
+  }
+  int last_negative = -1;
+  double last_sign_lambda = 0.0;
+  int sign_reports = 0;
   while (lambda < end * (1 - 1e-12)) {
     const double target = std::min(end, lambda + step);
     SystemState trial = state;
@@ -35,12 +69,32 @@ StaticResult SolveStatic(const SystemModel& model, SystemState& state, const Sta
       energy = f.elastic_energy;
       loads_after = f.loads;
       if (!std::isfinite(r_norm)) break;
-      if (it > 0 && (r_norm <= options.tolerance * std::max(f.force_scale, 1e-300) || last_step <= 1e-13 * size)) {
+      if (it > 0 && (r_norm <= std::max(tolerance * std::max(f.force_scale, 1e-300), f.roundoff) || last_step <= 1e-13 * size)) {
         converged = true;
         break;
       }
       FreeSolver solver;
       const bool regular = solver.Factor(dofs, f.tangent);
+      if (regular && it == 0) {
+        // Stability at the start of the step: the negative eigenvalues of the tangent's
+        // symmetric part (Sylvester's inertia of its pivoted LDL^T; dense systems only). A change
+        // between two steps is a limit point or a bifurcation, also a double one (a column of
+        // round section buckles in two planes at once: det(K) keeps its sign there).
+        const int negative = NegativeEigenvalues(dofs, f.tangent);
+        if (negative >= 0 && last_negative >= 0 && negative != last_negative && sign_reports++ < 5) {
+          char buffer[400];
+          std::snprintf(buffer, sizeof buffer,
+                        "the tangent's negative eigenvalues went from %d to %d between pseudo-time %.6g and %.6g: "
+                        "a limit or bifurcation point (snap-through or buckling) was crossed%s",
+                        last_negative, negative, last_sign_lambda, target,
+                        negative > last_negative ? "; a perfect structure stays on its unstable branch (add an "
+                                                   "imperfection to follow the buckled one)"
+                                                 : "");
+          result.warnings.push_back(buffer);
+        }
+        last_negative = negative;
+        last_sign_lambda = target;
+      }
       const Eigen::VectorXd delta = regular ? solver.Solve(f.residual) : Eigen::VectorXd();
       if (!regular || !delta.allFinite()) {
         // At the start, a singular tangent is the model's, not the step's: name the free motion

@@ -15,7 +15,7 @@ struct StaticOptions {
   int steps = 10;             ///< equal pseudo-time steps to end_time
   int max_iterations = 25;    ///< Newton iterations per step
   int max_cuts = 6;           ///< halvings of a step before giving up
-  double tolerance = 1e-8;    ///< ||residual|| <= tol * (largest force term of the step)
+  double tolerance = 1e-8;    ///< ||residual|| <= tol * (largest force term of the step); at least kRoundOffTolerance
 };
 
 struct StaticStepReport {
@@ -29,6 +29,9 @@ struct StaticStepReport {
 struct StaticResult {
   bool ok = false;
   std::string message;                  ///< why it stopped early
+  /// Said once each: the tangent's determinant changed sign (a limit or bifurcation point), a
+  /// tolerance below the round-off floor.
+  std::vector<std::string> warnings;
   std::vector<StaticStepReport> steps;  ///< converged steps
 };
 

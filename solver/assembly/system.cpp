@@ -284,6 +284,7 @@ SystemForces AssembleStatic(const SystemModel& model, const DofMap& dofs, System
     body.ElasticForce(c, frame, &f, with_tangent ? &K : nullptr);
     out.elastic_energy += body.ElasticEnergy(c, frame);
     out.force_scale = std::max({out.force_scale, f.norm(), body.force_floor()});
+    out.roundoff += body.RoundOffForce(c);
     const Eigen::VectorXd minus_f = -f;
     ScatterBody(BodyMap(model, dofs, state, int(b)), &minus_f, with_tangent ? &K : nullptr, &out.residual,
                 with_tangent ? &tangent : nullptr);
@@ -401,23 +402,11 @@ bool FreeSolver::Factor(const DofMap& dofs, const SystemMatrix& S) {
   const int n = int(free_.size());
   std::vector<int> position(S.rows(), -1);
   for (int i = 0; i < n; ++i) position[free_[i]] = i;
-  // Symmetric scaling to unit diagonal, D S D with d_i = 1 / sqrt|s_ii|: translations,
-  // rotations and modal coordinates in any units then factor alike, and the dense path can tell
-  // a singular matrix (reciprocal condition estimate below 1e-15) from a badly scaled one.
-  scale_.setOnes(n);
-  for (int col = 0; col < S.outerSize(); ++col) {
-    for (SystemMatrix::InnerIterator it(S, col); it; ++it) {
-      if (it.row() == col && position[col] >= 0 && std::abs(it.value()) > 0) {
-        scale_[position[col]] = 1.0 / std::sqrt(std::abs(it.value()));
-      }
-    }
-  }
   Triplets entries;
   entries.reserve(S.nonZeros());
   for (int col = 0; col < S.outerSize(); ++col) {
     for (SystemMatrix::InnerIterator it(S, col); it; ++it) {
-      const int i = position[it.row()], j = position[col];
-      if (i >= 0 && j >= 0) entries.emplace_back(i, j, scale_[i] * it.value() * scale_[j]);
+      if (position[it.row()] >= 0 && position[col] >= 0) entries.emplace_back(position[it.row()], position[col], it.value());
     }
   }
   const SystemMatrix Sf = ToMatrix(n, entries);
@@ -426,20 +415,38 @@ bool FreeSolver::Factor(const DofMap& dofs, const SystemMatrix& S) {
     sparse_lu_ = std::make_shared<Eigen::SparseLU<SystemMatrix, Eigen::COLAMDOrdering<int>>>();
     sparse_lu_->compute(Sf);
     valid_ = sparse_lu_->info() == Eigen::Success;
-  } else {
-    dense_.compute(Eigen::MatrixXd(Sf));
-    const double rcond = n > 0 ? dense_.rcond() : 1.0;
-    valid_ = std::isfinite(rcond) && rcond > 1e-15;
+    return valid_;
   }
+  const Eigen::MatrixXd A(Sf);
+  dense_.compute(A);
+  valid_ = A.allFinite();
+  if (!valid_ || n == 0) return valid_;
+  // Singular or not is a property of the matrix scaled to unit diagonal, D A D with
+  // d_i = 1 / sqrt|a_ii| (translations, rotations and modal coordinates in any units alike): its
+  // inverse D^-1 A^-1 D^-1 is probed with the factor on two fixed +-1 vectors (an O(n^2) estimate
+  // of ||(D A D)^-1||); singular when ||D A D|| ||(D A D)^-1|| > 1e15. The solve itself stays
+  // unscaled, so regular systems are solved exactly as before.
+  Eigen::VectorXd d(n);
+  for (int i = 0; i < n; ++i) d[i] = std::abs(A(i, i)) > 0 ? 1.0 / std::sqrt(std::abs(A(i, i))) : 1.0;
+  const double norm = (d.asDiagonal() * A * d.asDiagonal()).cwiseAbs().colwise().sum().maxCoeff();
+  double inverse = 0.0;
+  for (int probe = 0; probe < 2; ++probe) {
+    Eigen::VectorXd x(n);
+    for (int i = 0; i < n; ++i) x[i] = ((i * (probe + 3) + probe) % 5 < 2) ? -1.0 : 1.0;
+    const Eigen::VectorXd y = d.cwiseInverse().asDiagonal() * dense_.solve(Eigen::VectorXd(d.cwiseInverse().asDiagonal() * x));
+    if (!y.allFinite()) return valid_ = false;
+    inverse = std::max(inverse, y.lpNorm<1>() / x.lpNorm<1>());
+  }
+  valid_ = norm * inverse < 1e15;
   return valid_;
 }
 
 Eigen::VectorXd FreeSolver::Solve(const Eigen::VectorXd& r) const {
   Eigen::VectorXd rf(free_.size());
-  for (size_t i = 0; i < free_.size(); ++i) rf[i] = scale_[Eigen::Index(i)] * r[free_[i]];
+  for (size_t i = 0; i < free_.size(); ++i) rf[i] = r[free_[i]];
   const Eigen::VectorXd df = sparse_ ? Eigen::VectorXd(sparse_lu_->solve(rf)) : Eigen::VectorXd(dense_.solve(rf));
   Eigen::VectorXd d = Eigen::VectorXd::Zero(r.size());
-  for (size_t i = 0; i < free_.size(); ++i) d[free_[i]] = scale_[Eigen::Index(i)] * df[Eigen::Index(i)];
+  for (size_t i = 0; i < free_.size(); ++i) d[free_[i]] = df[i];
   return d;
 }
 

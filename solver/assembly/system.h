@@ -71,6 +71,9 @@ struct SystemModel {
 using SystemMatrix = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
 using Triplets = std::vector<Eigen::Triplet<double>>;
 inline constexpr int kDenseLimit = 400;
+/// Newton tolerances (residual relative to the force scale) below this are under the round-off
+/// floor of the residual: the analyses use this instead and say so.
+inline constexpr double kRoundOffTolerance = 1e-13;
 
 /// dq_k = J_k dz for one node: sparse columns (coordinate, 6-vector).
 using NodeJacobian = std::vector<std::pair<int, Eigen::Matrix<double, 6, 1>>>;
@@ -164,6 +167,7 @@ struct SystemForces {
   SystemMatrix tangent;           ///< d(f_int - lambda f_ext)/d(unknowns)
   double elastic_energy = 0.0;
   double force_scale = 0.0;       ///< largest norm of the internal or external force terms
+  double roundoff = 0.0;          ///< residual noise from the round-off of absolute positions
   Eigen::VectorXd loads;          ///< the nodal loads alone, over the coordinates (for their work)
 };
 
@@ -221,8 +225,8 @@ void ApplyPrescribed(const SystemModel& model, const DofMap& dofs, double t, Sys
 Eigen::VectorXd SolveFree(const DofMap& dofs, const SystemMatrix& S, const Eigen::VectorXd& r);
 
 /// The same with a kept factorization (Jacobian reuse): Factor once, Solve many times.
-/// The matrix is scaled to unit diagonal first (D S D). Factor returns false when the matrix is
-/// singular: a zero pivot, or (dense) a reciprocal condition estimate of D S D below 1e-15.
+/// Factor returns false when the matrix is singular: a zero pivot or, dense, a condition
+/// estimate of the matrix scaled to unit diagonal (D S D) above 1e15.
 class FreeSolver {
  public:
   bool Factor(const DofMap& dofs, const SystemMatrix& S);
@@ -233,7 +237,6 @@ class FreeSolver {
 
  private:
   std::vector<int> free_;
-  Eigen::VectorXd scale_;  ///< d_i = 1 / sqrt|s_ii| over the free coordinates
   Eigen::PartialPivLU<Eigen::MatrixXd> dense_;
   std::shared_ptr<Eigen::SparseLU<SystemMatrix, Eigen::COLAMDOrdering<int>>> sparse_lu_;
   bool valid_ = false, sparse_ = false;

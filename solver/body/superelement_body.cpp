@@ -1,6 +1,7 @@
 #include "solver/body/superelement_body.h"
 
 #include <Eigen/Dense>
+#include <limits>
 
 #include "formats/input_error.h"
 #include "solver/rotation.h"
@@ -42,7 +43,8 @@ SuperelementBody::SuperelementBody(const Superelement& se, const SuperelementOpt
   T0_ = Eigen::MatrixXd::Identity(n_coordinates(), n_coordinates()) - Phi_rig0_ * Phi_CB_;
   double size = 0.0;
   for (const Eigen::Vector3d& X : X_) size = std::max(size, X.norm());
-  force_floor_ = 1e-4 * K_.cwiseAbs().maxCoeff() * std::max(size, 1e-300);
+  k_max_ = K_.cwiseAbs().maxCoeff();
+  force_floor_ = 1e-4 * k_max_ * std::max(size, 1e-300);
   if (options_.polynomial_force && se.polynomial) polynomial_ = se.polynomial;
   initial_frame_.x = placement_x_ + placement_R_ * origin_part_;
   initial_frame_.R = placement_R_;
@@ -97,17 +99,26 @@ FrameSolution SuperelementBody::GuessFrame(const BodyConfiguration& c) const {
   return frame;
 }
 
+double SuperelementBody::RoundOffForce(const BodyConfiguration& c) const {
+  double x = 0.0;
+  for (const Eigen::Vector3d& xk : c.x) x = std::max(x, xk.norm());
+  return 16.0 * std::sqrt(double(n_coordinates())) * std::numeric_limits<double>::epsilon() * k_max_ * x;
+}
+
 FrameSolution SuperelementBody::SolveFrame(const BodyConfiguration& c, const FrameSolution& guess) const {
   FrameSolution frame = guess;
   frame.ok = false;
-  double scale = 1.0;
-  for (int k = 0; k < n_nodes_; ++k) scale = std::max(scale, X_[k].norm());
+  // Translations relative to the body size, plus the round-off of the absolute positions (a
+  // body 1e4 m from the origin knows its node positions to 2e-12 m only); rotations as they are.
+  double size = 0.0, far = 0.0;
+  for (int k = 0; k < n_nodes_; ++k) size = std::max(size, X_[k].norm());
+  for (const Eigen::Vector3d& x : c.x) far = std::max(far, x.norm());
+  const double tolerance = 1e-13 * size + 32 * std::numeric_limits<double>::epsilon() * far;
   for (int it = 0; it < 30; ++it) {
     const Eigen::VectorXd q = LocalCoordinates(c, frame);
     Eigen::Matrix<double, 6, 1> g = Phi_CB_ * q;
     frame.iterations = it;
-    // Translations relative to the body size, rotations as they are.
-    if (g.head<3>().norm() <= 1e-13 * scale && g.tail<3>().norm() <= 1e-13) {
+    if (g.head<3>().norm() <= std::max(tolerance, 1e-300) && g.tail<3>().norm() <= 1e-13) {
       // A root with local rotations beyond kMaxLocalRotation is a spurious branch of the log
       // map (far start), not an elastic state: report failure.
       frame.ok = true;

@@ -87,6 +87,10 @@ class SuperelementBody {
   /// Force of round-off size for this body: 1e-4 max|K| times its size. Newton tolerances are
   /// relative to force scales floored by this, so that nearly unloaded states converge.
   double force_floor() const { return force_floor_; }
+  /// The residual noise that the round-off of absolute node positions of magnitude |x| causes
+  /// in the elastic force: 16 sqrt(n) eps max|K| |x|. Far from the origin (1e4 m) it exceeds a
+  /// relative Newton tolerance; the analyses accept a residual below it.
+  double RoundOffForce(const BodyConfiguration& c) const;
 
   /// Undeformed configuration at the placement, and its floating frame.
   BodyConfiguration InitialConfiguration() const;
@@ -194,6 +198,7 @@ class SuperelementBody {
   Eigen::Vector3d origin_part_;
   FrameSolution initial_frame_;
   double force_floor_ = 0.0;
+  double k_max_ = 0.0;  ///< max|K|
 };
 
 }  // namespace femb

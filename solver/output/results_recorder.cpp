@@ -75,7 +75,7 @@ void ResultsRecorder::Record(double t, const SystemState& state, const Eigen::Ve
   const int n = model.n_nodes();
   Eigen::VectorXd pos(3 * n), quat(4 * n), vel(3 * n), ang(3 * n);
   for (int k = 0; k < n; ++k) {
-    pos.segment<3>(3 * k) = state.x[k];
+    pos.segment<3>(3 * k) = state.x[k] + scene_.origin;
     quat.segment<4>(4 * k) = Quaternion(state.R[k]);
     const Eigen::Matrix<double, 6, 1> v = NodeMotion(state, k, W);
     vel.segment<3>(3 * k) = v.head<3>();
@@ -86,7 +86,7 @@ void ResultsRecorder::Record(double t, const SystemState& state, const Eigen::Ve
   elastic_.push_back(elastic);
   work_.push_back(external_work);
   Eigen::VectorXd momentum(6);
-  momentum << linear_momentum, angular_momentum;
+  momentum << linear_momentum, angular_momentum + scene_.origin.cross(linear_momentum);  // about the global origin
   momentum_.push_back(momentum);
   positions_.push_back(pos);
   quaternions_.push_back(quat);
@@ -96,7 +96,7 @@ void ResultsRecorder::Record(double t, const SystemState& state, const Eigen::Ve
   for (size_t b = 0; b < model.bodies.size(); ++b) {
     modal.push_back(state.eta[b]);
     Eigen::VectorXd f(7);
-    f << state.frames[b].x, Quaternion(state.frames[b].R);
+    f << state.frames[b].x + scene_.origin, Quaternion(state.frames[b].R);
     frames.push_back(f);
   }
   modal_.push_back(modal);
@@ -124,7 +124,7 @@ void ResultsRecorder::Record(double t, const SystemState& state, const Eigen::Ve
       for (int i = 0; i < mesh->nodes.rows(); ++i) {
         const Eigen::Vector3d X = mesh->nodes.row(i).transpose() - scene_.mesh_origin[b];
         const Eigen::Vector3d ui = u.segment<3>(mesh->dofs_per_node * i);
-        x.row(i) = (state.frames[b].x + state.frames[b].R * (X + ui)).transpose().cast<float>();
+        x.row(i) = (scene_.origin + state.frames[b].x + state.frames[b].R * (X + ui)).transpose().cast<float>();
       }
       meshes.push_back(x);
     }

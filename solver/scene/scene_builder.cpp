@@ -65,7 +65,10 @@ Scene BuildScene(const SceneSpec& spec) {
   const std::filesystem::path base = std::filesystem::path(spec.file).parent_path();
   std::map<std::string, std::pair<Eigen::Vector3d, std::string>> placed;  // node -> position, by body
   std::vector<std::pair<int, int>> rigid_attachments;  // (child node, COM node)
-  for (const SceneBodySpec& b : spec.bodies) {
+  for (const SceneBodySpec& b : spec.bodies) scene.origin += b.position / double(spec.bodies.size());
+  for (const SceneBodySpec& b_spec : spec.bodies) {
+    SceneBodySpec b = b_spec;
+    b.position -= scene.origin;
     if (b.type == "rigid") {
       // A rigid body: one node at the centre of mass carrying the 6 x 6 rigid mass, no
       // stiffness; its attachment points are rigid offsets (dependent nodes) of that node.
@@ -166,8 +169,9 @@ Scene BuildScene(const SceneSpec& spec) {
         const auto& [x_other, other] = placed[node];
         if ((x - x_other).norm() > 1e-9 * std::max(1.0, x.norm())) {
           char buffer[300];
+          const Eigen::Vector3d xa = x + scene.origin, xb = x_other + scene.origin;
           std::snprintf(buffer, sizeof buffer, "node '%s' is placed at (%.6g, %.6g, %.6g) by body '%s' but at (%.6g, %.6g, %.6g) by body '%s'",
-                        node.c_str(), x.x(), x.y(), x.z(), b.name.c_str(), x_other.x(), x_other.y(), x_other.z(), other.c_str());
+                        node.c_str(), xa.x(), xa.y(), xa.z(), b.name.c_str(), xb.x(), xb.y(), xb.z(), other.c_str());
           throw InputError(b.where + ": " + buffer);
         }
       }
@@ -254,7 +258,7 @@ Scene BuildScene(const SceneSpec& spec) {
       SpringDamper s;
       s.node_a = scene.node_index.at(l.node);
       s.node_b = l.node_b.empty() ? -1 : scene.node_index.at(l.node_b);
-      s.ground = l.point;
+      s.ground = l.point - scene.origin;
       s.stiffness = l.stiffness;
       s.damping = l.damping;
       const Eigen::Vector3d xb = s.node_b >= 0 ? model.node_x0[s.node_b] : s.ground;

@@ -17,6 +17,11 @@ struct Scene {
   SystemModel model;
   std::map<std::string, int> node_index;
   std::vector<std::string> body_names;
+  /// The model is computed in coordinates relative to this point (the mean of the bodies'
+  /// placements): a scene placed 1e4 m from the origin is then solved as accurately as one at
+  /// the origin. Node positions in the model and its states are relative to it; the results
+  /// writer adds it back.
+  Eigen::Vector3d origin = Eigen::Vector3d::Zero();
   Eigen::VectorXd initial_velocity;  ///< over the unknowns
   /// Per body: the mesh and mode shapes of its superelement file (animation), if any, and the
   /// floating frame origin they refer to (part axes).

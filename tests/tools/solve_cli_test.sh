@@ -246,6 +246,11 @@ expect "joint cycle" 2 "joint dependency cycle through nodes" 's/^joints:/joints
 expect "two parents" 2 "node 'n3' already has a joint" 's/^joints:/joints:\n  - {type: rigid, node: n3, parent: n5}\n  - {type: rigid, node: n3, parent: n7}/'
 # A joint whose nodes are apart at t = 0 (the gap would silently become a rigid arm).
 expect "joint gap" 2 "revolute joint between nodes 'n3' and 'n5': the nodes are 0.2 apart" 's/^joints:/joints:\n  - {type: revolute, node: n3, parent: n5, axis: [0, 0, 1]}/'
+# --set reaches list items by index (the docs say any key); a bad index is one line, exit 2.
+"$bin/femb-solve" -q "$work/scene.yaml" -o "$work/set_out" --set 'bodies[1].options.tangent=K7' 2> "$work/err.txt"; code=$?
+[ $code = 2 ] && grep -qF -- "--set bodies[1].options.tangent: expected full or K1, got 'K7'" "$work/err.txt" && ok || fail "--set list item: exit $code $(cat "$work/err.txt")"
+"$bin/femb-solve" -q "$work/scene.yaml" -o "$work/set_out" --set 'bodies[10].options.tangent=K1' 2> "$work/err.txt"; code=$?
+[ $code = 2 ] && grep -qF "'bodies' has no item 10 in" "$work/err.txt" && ok || fail "--set index out of range: exit $code $(cat "$work/err.txt")"
 # A singular system is diagnosed, not reported as "Newton did not converge": the free motion is named.
 expect "free static body" 3 "static tangent at the start: the system matrix is singular (6 free motions" 's/type: clamp, node: n0/type: rigid, node: n1, parent: n2/'
 expect "pinned cantilever" 3 "(3 free motions, smallest/largest singular value" 's/type: clamp, node: n0/type: spherical, node: n0/'

@@ -1,0 +1,51 @@
+#!/usr/bin/env bash
+# Third CI stage: libFuzzer targets (tests/fuzz) built with clang, AddressSanitizer and
+# UndefinedBehaviorSanitizer in build-fuzz/, each run for FEMB_FUZZ_SECONDS (default 60) from a
+# seed corpus made of the examples' files. A crash, a hang (10 s per input) or an exception that
+# is not an InputError stops the run; the input is kept in build-fuzz/artifacts/ and becomes a
+# regression test. Needs build/bin/femb-reduce (scripts/build.sh) for the seed superelement.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+seconds=${FEMB_FUZZ_SECONDS:-60}
+missing=()
+for p in clang libclang-rt-14-dev; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+  sudo_cmd=""; [ "$(id -u)" -ne 0 ] && sudo_cmd="sudo"
+  $sudo_cmd apt-get update -q
+  DEBIAN_FRONTEND=noninteractive $sudo_cmd apt-get install -y -q --no-install-recommends "${missing[@]}"
+fi
+targets=(yaml_fuzz part_fuzz scene_fuzz superelement_fuzz)
+CC=clang CXX=clang++ cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DFEMB_FUZZ=ON \
+  -DFEMB_BUILD_TESTS=OFF >/dev/null
+cmake --build build-fuzz -j "$(nproc)" --target "${targets[@]}" -- --no-print-directory -s 2>&1 | grep -v "^\[" || true
+
+work=$(pwd)/build-fuzz/work
+rm -rf "$work" && mkdir -p "$work" build-fuzz/artifacts
+build/bin/femb-reduce -q examples/pendulum/rod.yaml -o "$work/seg.h5"
+for t in "${targets[@]}"; do mkdir -p "$work/corpus_$t"; done
+i=0
+for f in $(git ls-files 'examples/*.yaml'); do
+  i=$((i + 1))
+  cp "$f" "$work/corpus_yaml_fuzz/$i.yaml"
+  if grep -q '^type: \(beam\|solid\)' "$f"; then cp "$f" "$work/corpus_part_fuzz/$i.yaml"; fi
+  if grep -q '^bodies:' "$f"; then
+    # Scenes name the seed superelement, whose interfaces are A and B.
+    sed 's/superelement: [^,}]*/superelement: seg.h5/' "$f" > "$work/corpus_scene_fuzz/$i.yaml"
+  fi
+done
+printf '\x00\x01\x02\x03' > "$work/corpus_superelement_fuzz/seed"
+
+export FEMB_FUZZ_DIR=$work FEMB_FUZZ_SEED_H5=$work/seg.h5 OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1
+export ASAN_OPTIONS=detect_leaks=0 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
+status=0
+for t in "${targets[@]}"; do
+  if build-fuzz/fuzz/$t "$work/corpus_$t" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=4096 \
+       -artifact_prefix="build-fuzz/artifacts/$t-" -print_final_stats=1 > "build-fuzz/$t.log" 2>&1; then
+    echo "fuzz: $t: $(grep -m1 'stat::number_of_executed_units' "build-fuzz/$t.log" | awk '{print $2}') inputs in ${seconds} s, no failure"
+  else
+    echo "fuzz: $t FAILED (input in build-fuzz/artifacts/):"; tail -40 "build-fuzz/$t.log"; status=1
+  fi
+done
+exit $status
