@@ -92,6 +92,10 @@ void Writer::IntMatrix(const std::string& name, const Eigen::MatrixXi& value) {
   WriteData(name, {hsize_t(value.rows()), hsize_t(value.cols())}, H5T_STD_I32LE, H5T_NATIVE_INT, row_major.data());
 }
 
+void Writer::IntVector(const std::string& name, const std::vector<int>& value) {
+  WriteData(name, {hsize_t(value.size())}, H5T_STD_I32LE, H5T_NATIVE_INT, value.data());
+}
+
 void Writer::Strings(const std::string& name, const std::vector<std::string>& value) {
   Handle type = Own(H5Tcopy(H5T_C_S1));
   H5Tset_size(type.id(), H5T_VARIABLE);

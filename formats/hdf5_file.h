@@ -37,6 +37,7 @@ class Writer {
   void Matrix(const std::string& name, const Eigen::MatrixXd& value);
   void Vector(const std::string& name, const Eigen::VectorXd& value);
   void IntMatrix(const std::string& name, const Eigen::MatrixXi& value);
+  void IntVector(const std::string& name, const std::vector<int>& value);
   /// Single precision (animation frames: half the size, 1e-7 relative resolution).
   void FloatMatrix(const std::string& name, const Eigen::MatrixXf& value);
   void Scalar(const std::string& name, double value);

@@ -22,6 +22,15 @@ std::string XdmfTopology(const std::string& t) {
   throw InputError("cell type '" + t + "' has no XDMF equivalent");
 }
 
+int XdmfMixedCode(const std::string& t) {
+  if (t == "line2") return 2;
+  if (t == "tet4") return 6;
+  if (t == "hex8") return 9;
+  if (t == "tet10") return 38;
+  if (t == "hex20") return 48;
+  throw InputError("cell type '" + t + "' has no XDMF equivalent");
+}
+
 Eigen::MatrixXi ToVtkOrder(const std::string& t, const Eigen::MatrixXi& cells) {
   std::vector<int> order;
   // gmsh tet10 edges (01, 12, 02, 03, 23, 13); VTK (01, 12, 02, 03, 13, 23).

@@ -13,6 +13,10 @@ int VtkCellType(const std::string& cell_type);
 /// XDMF topology name: Polyline, Tetrahedron, Hexahedron, Tetrahedron_10, Hexahedron_20.
 std::string XdmfTopology(const std::string& cell_type);
 
+/// XDMF Mixed-topology cell code: line2 2 (polyline, followed by its node count), tet4 6,
+/// hex8 9, tet10 38, hex20 48.
+int XdmfMixedCode(const std::string& cell_type);
+
 /// cells (gmsh order) -> cells in VTK/XDMF node order (they differ for tet10 and hex20).
 Eigen::MatrixXi ToVtkOrder(const std::string& cell_type, const Eigen::MatrixXi& cells);
 

@@ -268,6 +268,7 @@ SystemForces AssembleStatic(const SystemModel& model, const DofMap& dofs, System
   out.residual = Eigen::VectorXd::Zero(n);
   Triplets tangent;
   NodeForces node_forces = ZeroNodeForces(model);
+  Eigen::VectorXd gravity = Eigen::VectorXd::Zero(n);
   for (size_t b = 0; b < model.bodies.size(); ++b) {
     const SuperelementBody& body = model.bodies[b];
     const BodyConfiguration c = BodyConfigurationOf(model, state, int(b));
@@ -289,9 +290,18 @@ SystemForces AssembleStatic(const SystemModel& model, const DofMap& dofs, System
     ScatterBody(BodyMap(model, dofs, state, int(b)), &minus_f, with_tangent ? &K : nullptr, &out.residual,
                 with_tangent ? &tangent : nullptr);
     AddBodyNodeForces(model, int(b), minus_f, node_forces);
+    if (model.static_gravity_end > 0 && model.gravity.squaredNorm() > 0) {
+      // Gravity in a static analysis, ramped to full at pseudo-time static_gravity_end (its
+      // configuration derivative is left out of the tangent, as in the dynamic iteration matrix).
+      const double ramp = std::min(lambda / model.static_gravity_end, 1.0);
+      const Eigen::VectorXd f_grav = body.GravityForce(c, frame, ramp * model.gravity);
+      ScatterBody(BodyMap(model, dofs, state, int(b)), &f_grav, nullptr, &gravity, nullptr);
+      AddBodyNodeForces(model, int(b), f_grav, node_forces);
+    }
   }
   Eigen::VectorXd loads = Eigen::VectorXd::Zero(n);
   AddNodeLoads(model, state, lambda, loads, with_tangent ? &tangent : nullptr, &node_forces);
+  loads += gravity;
   out.loads = loads;
   AddSpringDampers(model, state, Eigen::VectorXd(), loads, with_tangent ? &tangent : nullptr, nullptr,
                    &out.elastic_energy, &node_forces);

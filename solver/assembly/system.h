@@ -61,7 +61,10 @@ struct SystemModel {
   std::vector<std::string> body_names;       ///< for messages (may be empty)
   std::vector<NodeLoad> loads;
   std::vector<SpringDamper> springs;
-  Eigen::Vector3d gravity = Eigen::Vector3d::Zero();  ///< uniform acceleration field (dynamic analyses)
+  Eigen::Vector3d gravity = Eigen::Vector3d::Zero();  ///< uniform acceleration field
+  /// Static analyses: gravity grows linearly with the pseudo-time to full at this value (the
+  /// analysis' end_time); 0: no gravity in AssembleStatic (dynamic analyses add it themselves).
+  double static_gravity_end = 0.0;
 
   int n_nodes() const { return int(node_names.size()); }
 };

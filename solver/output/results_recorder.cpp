@@ -52,11 +52,17 @@ ResultsRecorder::ResultsRecorder(const Scene& scene, const std::string& director
         for (const char* c : wxyz) csv_ << "," << p.name << "." << q << "." << c;
       } else if (q == "joint") {
         // The node's joint coordinates (revolute: angle; prismatic: travel; cylindrical: both).
+        // To the ground: the node's motion basis; between nodes: the joint's coordinates
+        // (a revolute joint's angle between two bodies, ...). Spherical joints have rotation
+        // increments, not coordinates a probe could show.
         const int k = scene.node_index.at(p.node);
-        const int d = int(scene.model.motion[k].cols());
+        int d = int(scene.model.motion[k].cols());
+        for (const NodeJoint& j : scene.model.joints) {
+          if (j.child == k) d = j.type == JointType::kSpherical ? 0 : j.n_coordinates();
+        }
         if (d == 0 || d >= 3) {
           throw InputError(p.where + ": probe '" + p.name + "': node '" + p.node +
-                           "' has no revolute, prismatic or cylindrical joint coordinate");
+                           "' has no revolute, prismatic, cylindrical or universal joint coordinate");
         }
         for (int i = 0; i < d; ++i) csv_ << "," << p.name << ".joint." << i;
       } else {
@@ -114,7 +120,11 @@ void ResultsRecorder::Record(double t, const SystemState& state, const Eigen::Ve
     for (size_t b = 0; b < model.bodies.size(); ++b) {
       const auto& mesh = scene_.meshes[b];
       if (!mesh) {
-        meshes.emplace_back();
+        // Stick figure: the positions of its nodes.
+        const std::vector<int>& sticks = scene_.stick_nodes[b];
+        Eigen::MatrixXf x(long(sticks.size()), 3);
+        for (size_t i = 0; i < sticks.size(); ++i) x.row(long(i)) = (scene_.origin + state.x[sticks[i]]).transpose().cast<float>();
+        meshes.push_back(x);
         continue;
       }
       const BodyConfiguration c = BodyConfigurationOf(model, state, int(b));
@@ -219,43 +229,75 @@ void ResultsRecorder::Finish(const std::string& status) {
 }
 
 void ResultsRecorder::WriteAnimation() {
-  // One unstructured grid per output step holding every body's mesh (nodes concatenated, cells
-  // offset; cell data 'body' = body index): a temporal collection that ParaView and meshio read.
-  std::vector<int> with_mesh;
-  long n_nodes = 0, n_cells = 0;
-  std::string cell_type;
+  // One unstructured grid per output step holding every body (nodes concatenated, cell data
+  // 'body' = body index): a temporal collection that ParaView and meshio read. Bodies with a
+  // mesh show it; the others (rigid bodies, superelements reduced without their mesh) a stick
+  // figure of lines from their first node to the others. One cell type: a uniform topology;
+  // several (beams and solids, sticks): XDMF's Mixed topology.
+  if (!scene_.spec.animation || frame_time_.empty()) return;
+  struct Block {
+    std::string cell_type;  // "line2", "tet10", ...
+    Eigen::MatrixXi cells;  // VTK/XDMF node order, body-local node indices
+  };
+  std::vector<Block> blocks;
+  std::vector<long> body_nodes(scene_.meshes.size(), 0);
   for (size_t b = 0; b < scene_.meshes.size(); ++b) {
-    if (!scene_.meshes[b]) continue;
-    if (!cell_type.empty() && scene_.meshes[b]->cell_type != cell_type) continue;  // one cell type per grid
-    cell_type = scene_.meshes[b]->cell_type;
-    with_mesh.push_back(int(b));
-    n_nodes += scene_.meshes[b]->nodes.rows();
-    n_cells += scene_.meshes[b]->cells.rows();
+    if (scene_.meshes[b]) {
+      blocks.push_back({scene_.meshes[b]->cell_type, ToVtkOrder(scene_.meshes[b]->cell_type, scene_.meshes[b]->cells)});
+      body_nodes[b] = scene_.meshes[b]->nodes.rows();
+    } else {
+      // Lines from the first node to the others; a body of one node: a line of length zero.
+      const long m = long(scene_.stick_nodes[b].size());
+      Eigen::MatrixXi lines = Eigen::MatrixXi::Zero(std::max(m - 1, 1L), 2);
+      for (long i = 1; i < m; ++i) lines.row(i - 1) << 0, int(i);
+      blocks.push_back({"line2", lines});
+      body_nodes[b] = m;
+    }
   }
-  if (!scene_.spec.animation || with_mesh.empty() || frame_time_.empty()) return;
-  const int per_cell = int(scene_.meshes[with_mesh[0]]->cells.cols());
-  Eigen::MatrixXi cells(n_cells, per_cell);
+  bool uniform = true;
+  for (const Block& block : blocks) uniform &= block.cell_type == blocks.front().cell_type;
+  long n_nodes = 0, n_cells = 0;
+  for (size_t b = 0; b < blocks.size(); ++b) n_nodes += body_nodes[b], n_cells += blocks[b].cells.rows();
+  if (n_nodes == 0 || n_cells == 0) return;
+  // Topology: uniform, n_cells x per_cell; mixed, one flat list of (XDMF type, [count,] nodes...).
+  const int per_cell = uniform ? int(blocks.front().cells.cols()) : 0;
+  std::vector<int> flat;
   Eigen::MatrixXd body(n_cells, 1);
   long node_offset = 0, cell_offset = 0;
-  for (int b : with_mesh) {
-    const Visualization& v = *scene_.meshes[b];
-    cells.middleRows(cell_offset, v.cells.rows()) = ToVtkOrder(v.cell_type, v.cells).array() + int(node_offset);
-    body.middleRows(cell_offset, v.cells.rows()).setConstant(b);
-    node_offset += v.nodes.rows();
-    cell_offset += v.cells.rows();
+  for (size_t b = 0; b < blocks.size(); ++b) {
+    const Block& block = blocks[b];
+    const int code = XdmfMixedCode(block.cell_type);
+    for (long c = 0; c < block.cells.rows(); ++c) {
+      if (!uniform) {
+        flat.push_back(code);
+        if (code == 2) flat.push_back(int(block.cells.cols()));  // polyline: its node count
+      }
+      for (long i = 0; i < block.cells.cols(); ++i) flat.push_back(block.cells(c, i) + int(node_offset));
+    }
+    body.middleRows(cell_offset, block.cells.rows()).setConstant(double(b));
+    node_offset += body_nodes[b];
+    cell_offset += block.cells.rows();
   }
+  const Eigen::MatrixXi cells = uniform ? Eigen::MatrixXi(Eigen::Map<Eigen::Matrix<int, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(
+                                              flat.data(), n_cells, per_cell))
+                                        : Eigen::MatrixXi();
+  const std::string cell_type = uniform ? blocks.front().cell_type : "mixed";
   const std::filesystem::path dir(directory_);
   const std::string h5 = (dir / "animation.h5").string(), xdmf = (dir / "animation.xdmf").string();
   const std::string pid = std::to_string(::getpid());
   {
     h5::Writer w(h5 + ".tmp." + pid);
     Eigen::MatrixXf x0;
-    w.IntMatrix("/cells", cells);
+    if (uniform) {
+      w.IntMatrix("/cells", cells);
+    } else {
+      w.IntVector("/cells", flat);
+    }
     w.Matrix("/body", body);
     for (size_t s = 0; s < frame_time_.size(); ++s) {
       Eigen::MatrixXf x(n_nodes, 3);
       long offset = 0;
-      for (int b : with_mesh) {
+      for (size_t b = 0; b < blocks.size(); ++b) {
         x.middleRows(offset, mesh_positions_[s][b].rows()) = mesh_positions_[s][b];
         offset += mesh_positions_[s][b].rows();
       }
@@ -265,7 +307,7 @@ void ResultsRecorder::WriteAnimation() {
     }
     w.Close();
   }
-  const std::string topology = XdmfTopology(cell_type);
+  const std::string topology = uniform ? XdmfTopology(cell_type) : "Mixed";
   std::ofstream out(xdmf + ".tmp." + pid);
   out << "<?xml version=\"1.0\" ?>\n<Xdmf Version=\"3.0\">\n <Domain>\n"
       << "  <Grid Name=\"" << scene_.spec.name << "\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
@@ -274,7 +316,8 @@ void ResultsRecorder::WriteAnimation() {
         << "    <Time Value=\"" << Num(frame_time_[s]) << "\"/>\n"
         << "    <Topology TopologyType=\"" << topology << "\" NumberOfElements=\"" << n_cells << "\"";
     if (cell_type == "line2") out << " NodesPerElement=\"2\"";
-    out << ">\n     <DataItem Dimensions=\"" << n_cells << " " << per_cell
+    out << ">\n     <DataItem Dimensions=\"" << (uniform ? std::to_string(n_cells) + " " + std::to_string(per_cell)
+                                                  : std::to_string(flat.size()))
         << "\" NumberType=\"Int\" Precision=\"4\" Format=\"HDF\">animation.h5:/cells</DataItem>\n    </Topology>\n"
         << "    <Geometry GeometryType=\"XYZ\">\n     <DataItem Dimensions=\"" << n_nodes
         << " 3\" NumberType=\"Float\" Precision=\"4\" Format=\"HDF\">animation.h5:/x_" << s

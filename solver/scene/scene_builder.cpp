@@ -99,6 +99,7 @@ Scene BuildScene(const SceneSpec& spec) {
       model.body_names.push_back(b.name);
       scene.meshes.emplace_back();
       scene.mesh_origin.push_back(b.center_of_mass);
+      scene.stick_nodes.push_back({com});
       for (const auto& [point, node] : b.nodes) {
         if (point == "com") continue;
         const Eigen::Vector3d x = b.position + R * b.points.at(point);
@@ -116,6 +117,7 @@ Scene BuildScene(const SceneSpec& spec) {
           }
         }
         rigid_attachments.emplace_back(k, com);
+        scene.stick_nodes.back().push_back(k);
       }
       continue;
     }
@@ -183,6 +185,7 @@ Scene BuildScene(const SceneSpec& spec) {
     model.body_names.push_back(b.name);
     scene.meshes.push_back(se.visualization);
     scene.mesh_origin.push_back(se.floating_frame.origin);
+    scene.stick_nodes.push_back(se.visualization ? std::vector<int>() : nodes);
   }
   // Rigid offsets: a rigid body's tree is rooted at its centre-of-mass node, or at the one point
   // that carries a joint (a pendulum's pivot), so that the joint acts on the root.
@@ -252,6 +255,7 @@ Scene BuildScene(const SceneSpec& spec) {
   for (const SceneLoadSpec& l : spec.loads) {
     if (l.type == "gravity") {
       model.gravity += l.g;
+      if (spec.analysis.type != "dynamic") model.static_gravity_end = spec.analysis.end_time;
       continue;
     }
     if (l.type == "spring") {

@@ -27,6 +27,10 @@ struct Scene {
   /// floating frame origin they refer to (part axes).
   std::vector<std::optional<Visualization>> meshes;
   std::vector<Eigen::Vector3d> mesh_origin;
+  /// Per body without a mesh (rigid bodies, superelements reduced without keeping theirs): the
+  /// scene nodes the animation joins by lines from the first one (a rigid body: its centre of
+  /// mass to each of its points; a superelement: its first interface to the others).
+  std::vector<std::vector<int>> stick_nodes;
 };
 
 /// Throws InputError for: a missing or wrong-version superelement file, an interface name the

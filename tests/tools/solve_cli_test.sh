@@ -204,6 +204,51 @@ t, pd, cd = reader.read_data(reader.num_steps - 1)
 sag = pd["displacement"][:, 1].min()
 assert -1e-3 < sag < 0, sag   # sags: static tip sag q L^4 / 8 EI = 0.22 mm, dynamically up to twice
 PY
+# Every body is in the animation (it once held only the first body's kind): the solid bar,
+# a beam rod on a revolute hinge at its tip and a rigid block (a stick figure): XDMF Mixed
+# topology (quadratic tetrahedra and lines); counted from the file itself.
+cp "$work/pend/rod.h5" "$work/solid/rod.h5"
+cat > "$work/solid/mixed.yaml" <<'YAML'
+name: mixed
+units: SI
+bodies:
+  - {name: bar, superelement: bar.h5, nodes: {root: r, tip: t}}
+  - {name: rod, superelement: rod.h5, placement: {position: [1, 0.025, 0.025]}, nodes: {A: t2, B: t3}}
+  - {name: block, type: rigid, mass: 1, center_of_mass: [0, 0, 0], inertia: [1e-3, 1e-3, 1e-3], points: {P: [0, 0, 0]}, placement: {position: [1.3, 0.025, 0.025]}, nodes: {P: t3}}
+joints:
+  - {type: clamp, node: r}
+  - {type: revolute, node: t2, parent: t, axis: [0, 0, 1]}
+loads:
+  - {type: gravity, g: [0, -9.81, 0]}
+analysis: {type: dynamic, end_time: 0.003, step: 1e-3}
+outputs:
+  animation: true
+  probes:
+    - {name: hinge, node: t2, quantities: [joint]}
+YAML
+"$bin/femb-solve" -q "$work/solid/mixed.yaml" -o "$work/solid/mixed" && ok || fail "mixed scene"
+$py - "$work/solid/mixed" <<'PY' && ok || fail "mixed animation / hinge probe"
+import sys, csv, h5py, numpy as np
+f = h5py.File(sys.argv[1] + "/animation.h5")
+flat, body = f["cells"][...], f["body"][...].ravel()
+xml = open(sys.argv[1] + "/animation.xdmf").read()
+assert 'TopologyType="Mixed"' in xml
+counts, r = {}, 0
+while r < len(flat):
+    code = flat[r]
+    n = {38: 10, 2: None}[code]
+    if code == 2:
+        n = flat[r + 1]; r += 1
+    counts[code] = counts.get(code, 0) + 1
+    r += 1 + n
+assert counts[2] == 6 + 1, counts                 # rod: 6 beam elements; block: one (zero-length) line
+assert counts[38] == (body == 0).sum(), counts    # the bar's tetrahedra
+assert set(np.unique(body)) == {0, 1, 2}
+assert f["x_0"].shape[0] == f["x_3"].shape[0] > 0
+# A joint probe on a revolute joint between two nodes (it was refused: exit 2).
+rows = list(csv.DictReader(open(sys.argv[1] + "/probes.csv")))
+assert "hinge.joint.0" in rows[0] and len(rows) == 4, rows[0].keys()
+PY
 
 expect() {  # name, exit code, expected text, scene text transformation (sed)
   local name=$1 code=$2 text=$3 script=$4
