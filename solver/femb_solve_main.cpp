@@ -1,5 +1,6 @@
 // femb-solve: simulate a scene of superelements (static or dynamic).
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <string>
@@ -27,6 +28,30 @@ femb::StaticOptions StaticOptionsOf(const femb::SceneAnalysisSpec& a) {
 
 double Seconds(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+// The mode shapes as output steps 1..n after the state (step 0): each the state moved along the
+// mode by an amplitude that displaces its largest-moving node by 5% of the scene's size (the
+// time value of step k is the mode number k). Shown by the animation and kept in results.h5.
+void RecordModeShapes(const femb::Scene& scene, const femb::SystemState& state, const femb::ModalResult& modes,
+                      double load_time, femb::ResultsRecorder& recorder) {
+  const femb::SystemModel& model = scene.model;
+  const femb::DofMap dofs(model);
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(HUGE_VAL), hi = -lo;
+  for (const Eigen::Vector3d& x : state.x) lo = lo.cwiseMin(x), hi = hi.cwiseMax(x);
+  const double size = model.n_nodes() > 1 ? (hi - lo).norm() : 1.0;
+  for (int k = 0; k < modes.shapes.cols(); ++k) {
+    const Eigen::VectorXd v = modes.shapes.col(k);
+    double largest = 0.0;
+    for (int n = 0; n < model.n_nodes(); ++n) largest = std::max(largest, femb::NodeMotion(state, n, v).head<3>().norm());
+    if (!(largest > 0)) continue;  // a mode of modal coordinates or rotations only: no motion to show
+    femb::SystemState moved = state;
+    femb::ApplyIncrement(model, dofs, (0.05 * size / largest) * v, moved);
+    femb::UpdateKinematics(model, dofs, moved);
+    const femb::SystemForces f = femb::AssembleStatic(model, dofs, moved, load_time, false);  // solves the frames
+    if (!f.ok) continue;
+    recorder.Record(double(k + 1), moved, Eigen::VectorXd(), 0.0, 0.0, 0.0);
+  }
 }
 
 constexpr const char* kUsage = R"(usage: femb-solve SCENE.yaml [-o OUTDIR] [--set key=value]... [--quiet]
@@ -97,6 +122,7 @@ int main(int argc, char** argv) {
       }
       recorder.Record(load_time, state, Eigen::VectorXd(), 0.0, 0.0, 0.0);
       const femb::ModalResult modes = femb::LinearizedModes(scene.model, state, load_time, spec.analysis.mode_count);
+      if (modes.ok) RecordModeShapes(scene, state, modes, load_time, recorder);
       recorder.Finish(modes.ok ? "completed" : modes.message);
       if (!modes.ok) {
         std::fprintf(stderr, "femb-solve: %s: numerical failure: %s\n", scene_path.c_str(), modes.message.c_str());

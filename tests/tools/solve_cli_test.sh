@@ -250,6 +250,22 @@ rows = list(csv.DictReader(open(sys.argv[1] + "/probes.csv")))
 assert "hinge.joint.0" in rows[0] and len(rows) == 4, rows[0].keys()
 PY
 
+# A modes analysis writes its mode shapes: animation steps 1..3 are the state moved along each
+# mode (its largest node motion 5% of the scene's 1 m).
+"$bin/femb-solve" -q "$work/scene.yaml" -o "$work/modes_out" --set analysis.type=modes --set analysis.count=3 \
+  --set outputs.animation=true && ok || fail "modes run"
+$py - "$work/modes_out" <<'PY' && ok || fail "mode shapes in the animation"
+import sys, meshio, numpy as np
+r = meshio.xdmf.TimeSeriesReader(sys.argv[1] + "/animation.xdmf")
+r.read_points_cells()
+assert r.num_steps == 4, r.num_steps
+for s in range(1, 4):
+    t, pd, cd = r.read_data(s)
+    assert t == s
+    d = np.linalg.norm(pd["displacement"], axis=1).max()
+    assert abs(d - 0.05) < 1e-3, (s, d)
+PY
+
 expect() {  # name, exit code, expected text, scene text transformation (sed)
   local name=$1 code=$2 text=$3 script=$4
   sed "$script" "$work/scene.yaml" > "$work/bad.yaml"
