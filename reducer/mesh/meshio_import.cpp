@@ -1,11 +1,17 @@
 #include "reducer/mesh/meshio_import.h"
 
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/wait.h>
 #include <unistd.h>
+
+#include <cerrno>
 
 #include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 
 #include "formats/input_error.h"
@@ -13,6 +19,8 @@
 #ifndef FEMB_MESHIO_BRIDGE
 #define FEMB_MESHIO_BRIDGE "formats/meshio_bridge.py"
 #endif
+
+extern char** environ;
 
 namespace femb {
 
@@ -22,6 +30,46 @@ bool IsGmshFile(const std::string& path) {
   return ext == ".msh" || ext == ".geo" || ext == ".step" || ext == ".stp" || ext == ".brep";
 }
 
+namespace {
+
+// The bridge script: $FEMB_MESHIO_BRIDGE, else beside the running program (the build and the
+// install put it there), else ../share/femb/ from it, else the source tree this was built from.
+std::string BridgePath() {
+  const char* env = std::getenv("FEMB_MESHIO_BRIDGE");
+  if (env && *env) return env;
+  std::error_code ec;
+  const std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", ec);
+  if (!ec) {
+    for (const auto& candidate : {exe.parent_path() / "meshio_bridge.py",
+                                  exe.parent_path().parent_path() / "share" / "femb" / "meshio_bridge.py"}) {
+      if (std::filesystem::exists(candidate)) return candidate.string();
+    }
+  }
+  return FEMB_MESHIO_BRIDGE;
+}
+
+// Runs argv[0] with `args` (no shell: any character in a file name is safe), its stderr into
+// `err_path`; returns the exit status (-1 when it could not start).
+int Run(const std::vector<std::string>& args, const std::string& err_path) {
+  std::vector<char*> argv;
+  for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+  argv.push_back(nullptr);
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, 2, err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);
+  pid_t pid = 0;
+  const int started = posix_spawn(&pid, argv[0], &actions, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  if (started != 0) return -1;
+  int status = 0;
+  while (waitpid(pid, &status, 0) < 0) {
+    if (errno != EINTR) return -1;
+  }
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+}  // namespace
+
 SolidMesh ImportWithMeshio(const std::string& path, const std::string& where) {
   // Debian's python3 sees python3-meshio; FEMB_PYTHON names another interpreter that has meshio.
   const char* env = std::getenv("FEMB_PYTHON");
@@ -29,10 +77,17 @@ SolidMesh ImportWithMeshio(const std::string& path, const std::string& where) {
   if (!std::filesystem::exists(python)) {
     throw InputError(where + ": reading " + path + " needs Debian's python3 and meshio: apt-get install python3-meshio");
   }
-  const std::string tmp = (std::filesystem::temp_directory_path() / ("femb_mesh_" + std::to_string(::getpid()))).string();
+  const std::string bridge = BridgePath();
+  if (!std::filesystem::exists(bridge)) {
+    throw InputError(where + ": reading " + path + " needs the meshio bridge, not found at " + bridge +
+                     " (install it beside femb-reduce or set FEMB_MESHIO_BRIDGE)");
+  }
+  static int counter = 0;
+  const std::string tmp = (std::filesystem::temp_directory_path() /
+                           ("femb_mesh_" + std::to_string(::getpid()) + "_" + std::to_string(counter++)))
+                              .string();
   const std::string err = tmp + ".err";
-  const std::string command = python + " '" + FEMB_MESHIO_BRIDGE + "' '" + path + "' '" + tmp + "' 2> '" + err + "'";
-  const int status = std::system(command.c_str());
+  const int status = Run({python, bridge, path, tmp}, err);
   std::string message;
   {
     // The bridge's own one-line message comes last (meshio may print before it).
@@ -44,35 +99,47 @@ SolidMesh ImportWithMeshio(const std::string& path, const std::string& where) {
   std::filesystem::remove(err);
   if (status != 0) {
     std::filesystem::remove(tmp);
-    if (message.empty()) message = "the meshio bridge failed";
+    if (message.empty()) message = status < 0 ? "could not run " + python : "the meshio bridge failed";
     throw InputError(where + ": " + message);
   }
   std::ifstream in(tmp);
   SolidMesh mesh;
+  auto fail = [&](const std::string& what) {
+    std::filesystem::remove(tmp);
+    throw InputError(where + ": the meshio bridge wrote an unreadable mesh for " + path + " (" + what + ")");
+  };
   std::string word, type;
-  long n = 0, m = 0, k = 0;
-  in >> word >> n;  // femb-mesh 1
-  in >> word >> n;
+  long version = 0, n = 0, m = 0, k = 0;
+  if (!(in >> word >> version) || word != "femb-mesh" || version != 1) fail("not a femb-mesh 1 file");
+  if (!(in >> word >> n) || word != "nodes" || n <= 0) fail("no node count");
   mesh.nodes.resize(n, 3);
-  for (long i = 0; i < n; ++i) in >> mesh.nodes(i, 0) >> mesh.nodes(i, 1) >> mesh.nodes(i, 2);
-  in >> word >> type >> m >> k;
-  if (type == "tet4") mesh.type = SolidType::kTet4;
-  else if (type == "tet10") mesh.type = SolidType::kTet10;
-  else if (type == "hex8") mesh.type = SolidType::kHex8;
-  else mesh.type = SolidType::kHex20;
+  for (long i = 0; i < n; ++i)
+    if (!(in >> mesh.nodes(i, 0) >> mesh.nodes(i, 1) >> mesh.nodes(i, 2))) fail("node " + std::to_string(i));
+  if (!(in >> word >> type >> m >> k) || word != "cells") fail("no cell block");
+  const std::map<std::string, std::pair<SolidType, long>> types = {{"tet4", {SolidType::kTet4, 4}},
+                                                                   {"tet10", {SolidType::kTet10, 10}},
+                                                                   {"hex8", {SolidType::kHex8, 8}},
+                                                                   {"hex20", {SolidType::kHex20, 20}}};
+  const auto found = types.find(type);
+  if (found == types.end()) fail("cell type '" + type + "'");  // it once fell back to hex20 silently
+  if (m <= 0 || k != found->second.second) fail(type + " cells with " + std::to_string(k) + " nodes");
+  mesh.type = found->second.first;
   mesh.cells.resize(m, k);
   for (long e = 0; e < m; ++e)
-    for (long a = 0; a < k; ++a) in >> mesh.cells(e, a);
+    for (long a = 0; a < k; ++a)
+      if (!(in >> mesh.cells(e, a)) || mesh.cells(e, a) < 0 || mesh.cells(e, a) >= n) fail("cell " + std::to_string(e));
   std::string name;
   long count;
   while (in >> word >> name >> count) {
+    if (word != "set" || count < 0) fail("set '" + name + "'");
     std::vector<int>& set = mesh.node_sets[name];
     set.resize(count);
-    for (long i = 0; i < count; ++i) in >> set[i];
+    for (long i = 0; i < count; ++i)
+      if (!(in >> set[i]) || set[i] < 0 || set[i] >= n) fail("set '" + name + "'");
     std::sort(set.begin(), set.end());
   }
+  if (!in.eof()) fail("trailing data");
   std::filesystem::remove(tmp);
-  if (!in.eof() && in.fail()) throw InputError(where + ": the meshio bridge wrote an unreadable mesh for " + path);
   return mesh;
 }
 

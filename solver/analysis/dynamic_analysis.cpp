@@ -65,7 +65,8 @@ void FinishAssembly(const SystemModel& model, const DofMap& dofs, const SystemSt
     out.C = ToMatrix(n, parts.C);
     out.M = ToMatrix(n, parts.M);
   }
-  out.scale = std::max({out.scale, springs.norm(), loads.norm(), 1e-300});
+  const Eigen::VectorXd w = ResidualWeights(model, dofs);
+  out.scale = std::max({out.scale, (w.asDiagonal() * springs).norm(), (w.asDiagonal() * loads).norm(), 1e-300});
 }
 
 Assembly AssembleDynamic(const SystemModel& model, const DofMap& dofs, DynamicState& s, double t, bool matrices,
@@ -95,11 +96,11 @@ Assembly AssembleDynamic(const SystemModel& model, const DofMap& dofs, DynamicSt
     if (model.gravity.squaredNorm() > 0) f_grav = body.GravityForce(c, frame, model.gravity);
     // Scale of the forces in balance, each term on its own (for a torque-free body M_g wdot and
     // the gyroscopic terms cancel: their sum is no scale).
-    out.scale = std::max({out.scale, f_int.norm(), f_in.norm(), f_grav.norm(), body.force_floor()});
+    out.scale = std::max({out.scale, body.ForceNorm(f_int), body.ForceNorm(f_in), body.ForceNorm(f_grav), body.force_floor()});
     out.roundoff += body.RoundOffForce(c);
     if (matrices) {
       const Eigen::VectorXd f_acc = Mb * wdot;
-      out.scale = std::max({out.scale, f_acc.norm(), (f_in - f_acc).norm()});
+      out.scale = std::max({out.scale, body.ForceNorm(f_acc), body.ForceNorm(f_in - f_acc)});
     }
     const std::vector<MapEntry> map = BodyMap(model, dofs, s.config, int(b));
     const Eigen::VectorXd r_b = f_grav - f_int - f_in;
@@ -232,10 +233,11 @@ StepOutcome GeneralizedAlphaStep(const SystemModel& model, const DofMap& dofs, c
   const double t_new = state.t + h;
   StepOutcome out;
   const double tolerance = std::max(options.tolerance, kRoundOffTolerance);
+  const Eigen::VectorXd weights = ResidualWeights(model, dofs);
   for (; out.iterations < options.max_iterations; ++out.iterations) {
     const Assembly a = AssembleDynamic(model, dofs, next, t_new, true, options.full_inertia_tangent);
     if (!a.ok || !a.residual.allFinite()) return out;
-    if (FreeNorm(dofs, a.residual) <= std::max(tolerance * a.scale, a.roundoff) && out.iterations > 0) {
+    if (FreeNorm(dofs, a.residual, weights) <= std::max(tolerance * a.scale, a.roundoff) && out.iterations > 0) {
       out.converged = true;
       next.a += (1 - alpha_f) / (1 - alpha_m) * next.Wdot;
       next.t = t_new;
@@ -466,7 +468,8 @@ Assembly AssembleMidpoint(const SystemModel& model, const DofMap& dofs, const Dy
     if (model.gravity.squaredNorm() > 0) f_grav = body.GravityForce(cm, fm, model.gravity);
     // Scale: each term on its own (for a torque-free body the momentum change and the source
     // cancel; M_g (w_n+1 - w_n) / h is the size of the inertia force).
-    out.scale = std::max({out.scale, f_int.norm(), f_in.norm(), f_grav.norm(), body.force_floor(), f_acc.norm()});
+    out.scale = std::max({out.scale, body.ForceNorm(f_int), body.ForceNorm(f_in), body.ForceNorm(f_grav), body.force_floor(),
+                          body.ForceNorm(f_acc)});
     out.roundoff += body.RoundOffForce(c1);
     const std::vector<MapEntry> map = BodyMap(model, dofs, k.mid, int(b));
     const Eigen::VectorXd r_b = f_grav - f_int - f_in;
@@ -497,12 +500,13 @@ StepOutcome MidpointStep(const SystemModel& model, const DofMap& dofs, const Dyn
   ApplyPrescribed(model, dofs, state.t + h, next.config, &next.W, &next.Wdot);
   StepOutcome out;
   const double tolerance = std::max(options.tolerance, kRoundOffTolerance);
+  const Eigen::VectorXd weights = ResidualWeights(model, dofs);
   for (; out.iterations < options.max_iterations; ++out.iterations) {
     MidpointKinematics k = Midpoint(model, dofs, triples, state, h, next);
     double work = 0.0;
     const Assembly a = AssembleMidpoint(model, dofs, state, p0, h, k, next, work);
     if (!a.ok || !a.residual.allFinite()) return out;
-    if (FreeNorm(dofs, a.residual) <= std::max(tolerance * a.scale, a.roundoff) && out.iterations > 0) {
+    if (FreeNorm(dofs, a.residual, weights) <= std::max(tolerance * a.scale, a.roundoff) && out.iterations > 0) {
       out.converged = true;
       next.t = state.t + h;
       // a: the mean acceleration over the step (t_n+1/2); Wdot: extrapolated to t_n+1 from

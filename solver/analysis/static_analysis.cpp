@@ -44,6 +44,7 @@ StaticResult SolveStatic(const SystemModel& model, SystemState& state, const Sta
   Eigen::VectorXd loads_before = Eigen::VectorXd::Zero(dofs.n_dofs());
   int cuts = 0;
   const double tolerance = std::max(options.tolerance, kRoundOffTolerance);
+  const Eigen::VectorXd weights = ResidualWeights(model, dofs);
   if (options.tolerance < kRoundOffTolerance) {
     char buffer[200];
     std::snprintf(buffer, sizeof buffer,
@@ -65,7 +66,7 @@ StaticResult SolveStatic(const SystemModel& model, SystemState& state, const Sta
     for (; it < options.max_iterations; ++it) {
       const SystemForces f = AssembleStatic(model, dofs, trial, target, true);
       if (!f.ok) break;
-      r_norm = FreeNorm(dofs, f.residual);
+      r_norm = FreeNorm(dofs, f.residual, weights);
       energy = f.elastic_energy;
       loads_after = f.loads;
       if (!std::isfinite(r_norm)) break;

@@ -284,7 +284,7 @@ SystemForces AssembleStatic(const SystemModel& model, const DofMap& dofs, System
     Eigen::MatrixXd K;
     body.ElasticForce(c, frame, &f, with_tangent ? &K : nullptr);
     out.elastic_energy += body.ElasticEnergy(c, frame);
-    out.force_scale = std::max({out.force_scale, f.norm(), body.force_floor()});
+    out.force_scale = std::max({out.force_scale, body.ForceNorm(f), body.force_floor()});
     out.roundoff += body.RoundOffForce(c);
     const Eigen::VectorXd minus_f = -f;
     ScatterBody(BodyMap(model, dofs, state, int(b)), &minus_f, with_tangent ? &K : nullptr, &out.residual,
@@ -306,7 +306,7 @@ SystemForces AssembleStatic(const SystemModel& model, const DofMap& dofs, System
   AddSpringDampers(model, state, Eigen::VectorXd(), loads, with_tangent ? &tangent : nullptr, nullptr,
                    &out.elastic_energy, &node_forces);
   out.residual += loads;
-  out.force_scale = std::max(out.force_scale, loads.norm());
+  out.force_scale = std::max(out.force_scale, (ResidualWeights(model, dofs).asDiagonal() * loads).norm());
   if (with_tangent) {
     AddJointGeometricStiffness(model, dofs, state, node_forces, tangent);
     out.tangent = ToMatrix(n, tangent);
@@ -466,9 +466,36 @@ Eigen::VectorXd SolveFree(const DofMap& dofs, const SystemMatrix& S, const Eigen
   return solver.Solve(r);
 }
 
-double FreeNorm(const DofMap& dofs, const Eigen::VectorXd& r) {
+Eigen::VectorXd ResidualWeights(const SystemModel& model, const DofMap& dofs) {
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(HUGE_VAL), hi = -lo;
+  for (const Eigen::Vector3d& x : model.node_x0) lo = lo.cwiseMin(x), hi = hi.cwiseMax(x);
+  double L = model.n_nodes() > 1 ? (hi - lo).norm() : 0.0;
+  if (!(L > 0)) L = 1.0;
+  Eigen::VectorXd w = Eigen::VectorXd::Ones(dofs.n_dofs());
+  for (int k = 0; k < model.n_nodes(); ++k) {
+    const int first = dofs.node_first(k), j = dofs.joint_of(k);
+    if (j < 0) {
+      const Eigen::MatrixXd& S = dofs.S(k);
+      for (int c = 0; c < S.cols(); ++c) {
+        if (S.col(c).tail<3>().norm() > 0) w[first + c] = 1.0 / L;
+      }
+      continue;
+    }
+    const NodeJoint& joint = model.joints[j];
+    for (int c = 0; c < joint.n_coordinates(); ++c) {
+      if (c != joint.s_index()) w[first + c] = 1.0 / L;  // every joint coordinate but a travel is an angle
+    }
+  }
+  for (size_t b = 0; b < model.bodies.size(); ++b) {
+    const int m = model.bodies[b].n_modes();
+    if (m > 0) w.segment(dofs.mode_dof(int(b)), m).setConstant(model.bodies[b].ModalForceWeight());
+  }
+  return w;
+}
+
+double FreeNorm(const DofMap& dofs, const Eigen::VectorXd& r, const Eigen::VectorXd& weights) {
   double s = 0;
-  for (int j : dofs.solved()) s += r[j] * r[j];
+  for (int j : dofs.solved()) s += weights[j] * weights[j] * r[j] * r[j];
   return std::sqrt(s);
 }
 

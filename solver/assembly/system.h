@@ -244,8 +244,14 @@ class FreeSolver {
   std::shared_ptr<Eigen::SparseLU<SystemMatrix, Eigen::COLAMDOrdering<int>>> sparse_lu_;
   bool valid_ = false, sparse_ = false;
 };
-/// Norm of r over the coordinates solved for.
-double FreeNorm(const DofMap& dofs, const Eigen::VectorXd& r);
+/// Weights that make a vector over the coordinates (a residual) a vector of forces whatever the
+/// unit system: 1 for translation coordinates, 1/L for rotation coordinates (moments over the
+/// model's size L: the diagonal of its nodes' bounding box), sqrt(m_b) for body b's modal
+/// coordinates (mass-normalized: their forces are force / sqrt(mass)). Newton's convergence test
+/// on the weighted norm gives the same answer in SI and in mm-t-s.
+Eigen::VectorXd ResidualWeights(const SystemModel& model, const DofMap& dofs);
+/// Weighted norm of r over the coordinates solved for.
+double FreeNorm(const DofMap& dofs, const Eigen::VectorXd& r, const Eigen::VectorXd& weights);
 
 /// Applies an increment of the unknowns: x += dx, R <- exp(dpi~) R, eta += d eta.
 void ApplyIncrement(const SystemModel& model, const DofMap& dofs, const Eigen::VectorXd& delta, SystemState& state);

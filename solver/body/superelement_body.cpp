@@ -43,8 +43,18 @@ SuperelementBody::SuperelementBody(const Superelement& se, const SuperelementOpt
   T0_ = Eigen::MatrixXd::Identity(n_coordinates(), n_coordinates()) - Phi_rig0_ * Phi_CB_;
   double size = 0.0;
   for (const Eigen::Vector3d& X : X_) size = std::max(size, X.norm());
-  k_max_ = K_.cwiseAbs().maxCoeff();
-  force_floor_ = 1e-4 * k_max_ * std::max(size, 1e-300);
+  // Force units in any unit system (ForceNorm): moments over a length of the body (its size, or
+  // for a one-node body its radius of gyration), modal forces times sqrt(mass).
+  const double mass = (Phi_rig0_.col(0).transpose() * M_ * Phi_rig0_.col(0))(0, 0);
+  const Eigen::Matrix<double, 6, 6> M_rig = Phi_rig0_.transpose() * M_ * Phi_rig0_;
+  const double gyration = mass > 0 ? std::sqrt(M_rig.bottomRightCorner<3, 3>().diagonal().maxCoeff() / mass) : 0.0;
+  const double length = size > 0 ? size : (gyration > 0 ? gyration : 1.0);
+  force_weights_ = Eigen::VectorXd::Ones(n_coordinates());
+  for (int k = 0; k < n_nodes_; ++k) force_weights_.segment<3>(6 * k + 3).setConstant(1.0 / length);
+  modal_weight_ = std::sqrt(std::max(mass, 0.0));
+  force_weights_.tail(n_modes_).setConstant(modal_weight_);
+  k_max_ = (force_weights_.asDiagonal() * K_ * force_weights_.asDiagonal()).cwiseAbs().maxCoeff();
+  force_floor_ = 1e-4 * k_max_ * length;
   if (options_.polynomial_force && se.polynomial) polynomial_ = se.polynomial;
   initial_frame_.x = placement_x_ + placement_R_ * origin_part_;
   initial_frame_.R = placement_R_;

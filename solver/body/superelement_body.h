@@ -84,11 +84,18 @@ class SuperelementBody {
   const Eigen::MatrixXd& K() const { return K_; }
   const Eigen::MatrixXd& M() const { return M_; }
   const SuperelementOptions& options() const { return options_; }
-  /// Force of round-off size for this body: 1e-4 max|K| times its size. Newton tolerances are
-  /// relative to force scales floored by this, so that nearly unloaded states converge.
+  /// Force of round-off size for this body (ForceNorm units): 1e-4 max|D K D| times its size.
+  /// Newton tolerances are relative to force scales floored by this, so that nearly unloaded
+  /// states converge.
   double force_floor() const { return force_floor_; }
+  /// |f| of a body vector (per node force then moment, then modal forces) in force units in any
+  /// unit system: moments divided by the body's size, modal forces (force / sqrt(mass): the
+  /// modes are mass-normalized) times sqrt of its mass.
+  double ForceNorm(const Eigen::VectorXd& f) const { return (force_weights_.asDiagonal() * f).norm(); }
+  /// The weight of the modal forces in ForceNorm: sqrt of the body's mass.
+  double ModalForceWeight() const { return modal_weight_; }
   /// The residual noise that the round-off of absolute node positions of magnitude |x| causes
-  /// in the elastic force: 16 sqrt(n) eps max|K| |x|. Far from the origin (1e4 m) it exceeds a
+  /// in the elastic force (ForceNorm units): 16 sqrt(n) eps max|D K D| |x|. Far from the origin (1e4 m) it exceeds a
   /// relative Newton tolerance; the analyses accept a residual below it.
   double RoundOffForce(const BodyConfiguration& c) const;
 
@@ -198,7 +205,9 @@ class SuperelementBody {
   Eigen::Vector3d origin_part_;
   FrameSolution initial_frame_;
   double force_floor_ = 0.0;
-  double k_max_ = 0.0;  ///< max|K|
+  double k_max_ = 0.0;  ///< max|D K D|, D = diag(force_weights_): force per length
+  Eigen::VectorXd force_weights_;  ///< see ForceNorm
+  double modal_weight_ = 1.0;
 };
 
 }  // namespace femb

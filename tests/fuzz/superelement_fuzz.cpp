@@ -28,8 +28,6 @@ Eigen::MatrixXd& Pick(femb::Superelement& se, unsigned which, Eigen::MatrixXd& s
     case 0: return se.K;
     case 1: return se.M;
     case 2: return se.floating_frame.Phi_CB;
-    case 3: return se.mass_properties.inertia_com;
-    case 4: return se.floating_frame.orientation;
     default: return scratch;
   }
 }
@@ -42,15 +40,19 @@ double Special(unsigned k, double old) {
 void Mutate(femb::Superelement& se, femb::fuzz::Input& in) {
   Eigen::MatrixXd scratch;
   switch (in.Below(8)) {
-    case 0: {  // one value of a matrix
-      Eigen::MatrixXd& A = Pick(se, in.Below(5), scratch);
-      if (A.size() == 0) return;
-      const unsigned i = in.Below(unsigned(A.size()));
-      A.data()[i] = Special(in.Byte(), A.data()[i]);
+    case 0: {  // one value of a matrix (K, M, Phi_CB, the inertia, the frame orientation)
+      const unsigned which = in.Below(5);
+      double* data = which == 3 ? se.mass_properties.inertia_com.data()
+                     : which == 4 ? se.floating_frame.orientation.data()
+                                  : Pick(se, which, scratch).data();
+      const long size = which >= 3 ? 9 : long(Pick(se, which, scratch).size());
+      if (size == 0) return;
+      const unsigned i = in.Below(unsigned(size));
+      data[i] = Special(in.Byte(), data[i]);
       return;
     }
     case 1: {  // a matrix grown or shrunk by a row or a column
-      Eigen::MatrixXd& A = Pick(se, in.Below(5), scratch);
+      Eigen::MatrixXd& A = Pick(se, in.Below(3), scratch);
       const long dr = long(in.Below(3)) - 1, dc = long(in.Below(3)) - 1;
       A.conservativeResize(std::max(0L, A.rows() + dr), std::max(0L, A.cols() + dc));
       return;

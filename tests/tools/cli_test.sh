@@ -83,6 +83,15 @@ YAML
 "$bin/femb-reduce" -q "$work/inp/part.yaml" -o "$work/inp/block.h5" && "$bin/femb-inspect" "$work/inp/block.h5" --check --json > "$work/inp/j.json" \
   && $py -c "import json; j = json.load(open('$work/inp/j.json')); assert abs(j['mass'] - 78.5) < 1e-9 and j['n_full_dofs'] == 276" \
   && ok || fail "meshio .inp import"
+# A file name with a quote and a space (the bridge once ran through a shell), and femb-reduce
+# copied away from the build tree: it finds the bridge beside itself.
+cp "$work/inp/block.inp" "$work/inp/it's a block.inp"
+mkdir -p "$work/inst" && cp "$bin/femb-reduce" "$bin/meshio_bridge.py" "$work/inst/"
+sed "s/block.inp/\"it's a block.inp\"/" "$work/inp/part.yaml" > "$work/inp/quoted.yaml"
+"$work/inst/femb-reduce" -q "$work/inp/quoted.yaml" -o "$work/inp/quoted.h5" 2> "$work/err.txt" \
+  && "$bin/femb-inspect" "$work/inp/quoted.h5" --check > /dev/null && ok || fail "quoted mesh name / installed bridge: $(cat "$work/err.txt")"
+FEMB_MESHIO_BRIDGE=/nonexistent/bridge.py "$bin/femb-reduce" -q "$work/inp/part.yaml" -o "$work/inp/nob.h5" 2> "$work/err.txt"; code=$?
+[ $code = 2 ] && grep -q "needs the meshio bridge, not found at /nonexistent/bridge.py" "$work/err.txt" && ok || fail "missing bridge: $code $(cat "$work/err.txt")"
 echo "not a mesh" > "$work/inp/junk.vtu"
 sed 's/block.inp/junk.vtu/' "$work/inp/part.yaml" > "$work/inp/junk.yaml"
 "$bin/femb-reduce" -q "$work/inp/junk.yaml" -o "$work/inp/junk.h5" 2> "$work/err.txt"; code=$?
