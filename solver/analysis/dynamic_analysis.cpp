@@ -560,13 +560,7 @@ DynamicResult SolveDynamic(const SystemModel& model, DynamicState& state, const 
   const double E0 = start.kinetic_energy + start.elastic_energy;
   double energy_scale = std::abs(E0);
   bool warned = false;
-  if (options.tolerance < kRoundOffTolerance) {
-    char buffer[200];
-    std::snprintf(buffer, sizeof buffer,
-                  "analysis.tolerance %.3g is below the round-off floor of the residual; using %.0e", options.tolerance,
-                  kRoundOffTolerance);
-    result.warnings.push_back(buffer);
-  }
+  if (const std::string w = RoundOffToleranceWarning(options.tolerance); !w.empty()) result.warnings.push_back(w);
   while (state.t < options.end_time - 1e-12 * std::max(std::abs(options.end_time), options.step)) {
     const double remaining = options.end_time - state.t;
     if (remaining <= 1.01 * h) h = remaining;

@@ -33,12 +33,7 @@ std::string DescribeSingular(const SystemModel& model, const DofMap& dofs, const
     return "the system matrix (" + std::to_string(n) +
            " free coordinates) is singular; too large to name the free motion (look for a missing joint or support)";
   }
-  std::vector<int> position(S.rows(), -1);
-  for (int i = 0; i < n; ++i) position[free[i]] = i;
-  Eigen::MatrixXd A = Eigen::MatrixXd::Zero(n, n);
-  for (int col = 0; col < S.outerSize(); ++col)
-    for (SystemMatrix::InnerIterator it(S, col); it; ++it)
-      if (position[it.row()] >= 0 && position[col] >= 0) A(position[it.row()], position[col]) += it.value();
+  Eigen::MatrixXd A = DenseFreeMatrix(dofs, S);
   Eigen::VectorXd d(n);
   for (int i = 0; i < n; ++i) d[i] = std::abs(A(i, i)) > 0 ? 1.0 / std::sqrt(std::abs(A(i, i))) : 1.0;
   A = d.asDiagonal() * A * d.asDiagonal();

@@ -12,15 +12,9 @@ namespace {
 // Negative eigenvalues of the symmetric part of S on the free coordinates (inertia of a pivoted
 // LDL^T), or -1 above the dense limit.
 int NegativeEigenvalues(const DofMap& dofs, const SystemMatrix& S) {
-  const std::vector<int>& free = dofs.solved();
-  const int n = int(free.size());
+  const int n = int(dofs.solved().size());
   if (n == 0 || n > kDenseLimit) return -1;
-  std::vector<int> position(S.rows(), -1);
-  for (int i = 0; i < n; ++i) position[free[i]] = i;
-  Eigen::MatrixXd A = Eigen::MatrixXd::Zero(n, n);
-  for (int col = 0; col < S.outerSize(); ++col)
-    for (SystemMatrix::InnerIterator it(S, col); it; ++it)
-      if (position[it.row()] >= 0 && position[col] >= 0) A(position[it.row()], position[col]) += it.value();
+  const Eigen::MatrixXd A = DenseFreeMatrix(dofs, S);
   const Eigen::MatrixXd sym = 0.5 * (A + A.transpose());
   const Eigen::LDLT<Eigen::MatrixXd> ldlt(sym);
   int negative = 0;
@@ -45,13 +39,7 @@ StaticResult SolveStatic(const SystemModel& model, SystemState& state, const Sta
   int cuts = 0;
   const double tolerance = std::max(options.tolerance, kRoundOffTolerance);
   const Eigen::VectorXd weights = ResidualWeights(model, dofs);
-  if (options.tolerance < kRoundOffTolerance) {
-    char buffer[200];
-    std::snprintf(buffer, sizeof buffer,
-                  "analysis.tolerance %.3g is below the round-off floor of the residual; using %.0e", options.tolerance,
-                  kRoundOffTolerance);
-    result.warnings.push_back(buffer);
-  }
+  if (const std::string w = RoundOffToleranceWarning(options.tolerance); !w.empty()) result.warnings.push_back(w);
   int last_negative = -1;
   double last_sign_lambda = 0.0;
   int sign_reports = 0;

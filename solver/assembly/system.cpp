@@ -2,6 +2,7 @@
 
 #include <Eigen/Dense>
 #include <cmath>
+#include <cstdio>
 
 #include "formats/input_error.h"
 #include "solver/rotation.h"
@@ -464,6 +465,26 @@ Eigen::VectorXd SolveFree(const DofMap& dofs, const SystemMatrix& S, const Eigen
   FreeSolver solver;
   if (!solver.Factor(dofs, S)) return Eigen::VectorXd::Constant(r.size(), std::nan(""));
   return solver.Solve(r);
+}
+
+Eigen::MatrixXd DenseFreeMatrix(const DofMap& dofs, const SystemMatrix& S) {
+  const std::vector<int>& free = dofs.solved();
+  const int n = int(free.size());
+  std::vector<int> position(S.rows(), -1);
+  for (int i = 0; i < n; ++i) position[free[i]] = i;
+  Eigen::MatrixXd A = Eigen::MatrixXd::Zero(n, n);
+  for (int col = 0; col < S.outerSize(); ++col)
+    for (SystemMatrix::InnerIterator it(S, col); it; ++it)
+      if (position[it.row()] >= 0 && position[col] >= 0) A(position[it.row()], position[col]) += it.value();
+  return A;
+}
+
+std::string RoundOffToleranceWarning(double tolerance) {
+  if (tolerance >= kRoundOffTolerance) return "";
+  char buffer[200];
+  std::snprintf(buffer, sizeof buffer, "analysis.tolerance %.3g is below the round-off floor of the residual; using %.0e",
+                tolerance, kRoundOffTolerance);
+  return buffer;
 }
 
 Eigen::VectorXd ResidualWeights(const SystemModel& model, const DofMap& dofs) {

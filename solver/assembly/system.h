@@ -244,6 +244,13 @@ class FreeSolver {
   std::shared_ptr<Eigen::SparseLU<SystemMatrix, Eigen::COLAMDOrdering<int>>> sparse_lu_;
   bool valid_ = false, sparse_ = false;
 };
+/// S restricted to the coordinates solved for, dense (n_free x n_free).
+Eigen::MatrixXd DenseFreeMatrix(const DofMap& dofs, const SystemMatrix& S);
+
+/// The message an analysis gives once when asked for a Newton tolerance below kRoundOffTolerance
+/// (empty when the tolerance is fine).
+std::string RoundOffToleranceWarning(double tolerance);
+
 /// Weights that make a vector over the coordinates (a residual) a vector of forces whatever the
 /// unit system: 1 for translation coordinates, 1/L for rotation coordinates (moments over the
 /// model's size L: the diagonal of its nodes' bounding box), sqrt(m_b) for body b's modal

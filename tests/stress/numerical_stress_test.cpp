@@ -116,6 +116,19 @@ std::string Pendulum(bool mm, const Eigen::Vector3d& origin, const std::string& 
   return text;
 }
 
+// A straight chain of n bodies of `seg.h5` (length `segment` each) along x, nodes n0..n<n>,
+// clamped at n0.
+std::string ClampedChain(const std::string& name, int n, double segment) {
+  std::string scene = "name: " + name + "\nunits: SI\nbodies:\n";
+  for (int b = 0; b < n; ++b) {
+    char line[200];
+    std::snprintf(line, sizeof line, "  - {name: b%d, superelement: seg.h5, placement: {position: [%g, 0, 0]}, nodes: {A: n%d, B: n%d}}\n",
+                  b, segment * b, b, b + 1);
+    scene += line;
+  }
+  return scene + "joints:\n  - {type: clamp, node: n0}\n";
+}
+
 double Amplitude(const Outcome& r, const Eigen::Vector3d& centre) {
   double a = 0.0;
   for (const Eigen::Vector3d& x : r.tip) a = std::max(a, (x - centre).norm());
@@ -284,14 +297,7 @@ TEST(NumericalStress, ColumnPastItsEulerLoad) {
     (std::pow(2 * K(mid) / M_PI, 2) < 1.5 ? lo : hi) = mid;
   }
   const double elastica = 2 * lo / K(lo) * L;
-  std::string scene = "name: column\nunits: SI\nbodies:\n";
-  for (int b = 0; b < 4; ++b) {
-    char line[200];
-    std::snprintf(line, sizeof line, "  - {name: b%d, superelement: seg.h5, placement: {position: [%g, 0, 0]}, nodes: {A: n%d, B: n%d}}\n",
-                  b, 0.25 * b, b, b + 1);
-    scene += line;
-  }
-  scene += "joints:\n  - {type: clamp, node: n0}\nfunctions:\n  ramp: {type: linear}\n";
+  const std::string scene = ClampedChain("column", 4, 0.25) + "functions:\n  ramp: {type: linear}\n";
   char loads[400];
   std::snprintf(loads, sizeof loads,
                 "loads:\n  - {type: force, node: n4, force: [%.17g, %.17g, 0], function: ramp}\n"
@@ -330,15 +336,8 @@ TEST(NumericalStress, ColumnPastItsEulerLoad) {
 // the 2% sag's geometric nonlinearity are below 0.1%).
 TEST(NumericalStress, StaticEquilibriumUnderGravity) {
   const Superelement seg = test::Reduce(RodYaml(0.25, 2, false));
-  std::string scene = "name: sag\nunits: SI\nbodies:\n";
-  for (int b = 0; b < 4; ++b) {
-    char line[200];
-    std::snprintf(line, sizeof line, "  - {name: b%d, superelement: seg.h5, placement: {position: [%g, 0, 0]}, nodes: {A: n%d, B: n%d}}\n",
-                  b, 0.25 * b, b, b + 1);
-    scene += line;
-  }
-  scene += "joints:\n  - {type: clamp, node: n0}\nloads:\n  - {type: gravity, g: [0, -9.81, 0]}\n"
-           "analysis: {type: static, end_time: 1.0, steps: 2}\n";
+  const std::string scene = ClampedChain("sag", 4, 0.25) + "loads:\n  - {type: gravity, g: [0, -9.81, 0]}\n"
+                                                          "analysis: {type: static, end_time: 1.0, steps: 2}\n";
   const Outcome r = Simulate("sag", scene, {{"seg.h5", seg}}, "n4");
   ASSERT_TRUE(r.ok) << r.message;
   const double EI = 2e11 * M_PI * std::pow(0.006, 4) / 64, q = 7870 * M_PI * 0.006 * 0.006 / 4 * 9.81;
