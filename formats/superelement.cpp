@@ -6,6 +6,9 @@ namespace femb {
 
 std::string ReducedCoordinateLabel(const Superelement& se, int i) {
   static const char* kComponents[6] = {"u_x", "u_y", "u_z", "theta_x", "theta_y", "theta_z"};
+  if (i < 0 || i >= se.n_interface_dofs() + se.n_internal_modes() + int(se.n_modal_derivatives)) {
+    return "coordinate " + std::to_string(i) + " (out of range)";  // a corrupt pair of a file
+  }
   if (i < se.n_interface_dofs()) {
     return se.interfaces[i / 6].name + "." + kComponents[i % 6];
   }
@@ -16,7 +19,8 @@ std::string ReducedCoordinateLabel(const Superelement& se, int i) {
     if (d < int(se.modal_derivative_pairs.size())) {
       const auto [a, b] = se.modal_derivative_pairs[size_t(d)];
       const auto base = [&](int k) {
-        return k < se.n_interface_dofs() + se.n_internal_modes() ? ReducedCoordinateLabel(se, k) : std::to_string(k);
+        return k >= 0 && k < se.n_interface_dofs() + se.n_internal_modes() ? ReducedCoordinateLabel(se, k)
+                                                                          : std::to_string(k);
       };
       std::string la = base(a), lb = base(b);
       for (std::string* l : {&la, &lb})

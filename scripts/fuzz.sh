@@ -36,6 +36,10 @@ for f in $(git ls-files 'examples/*.yaml'); do
   fi
 done
 printf '\x00\x01\x02\x03' > "$work/corpus_superelement_fuzz/seed"
+# Every input that once failed stays in the corpus (tests/fuzz/regressions/TARGET/).
+for t in "${targets[@]}"; do
+  if [ -d "tests/fuzz/regressions/$t" ]; then cp "tests/fuzz/regressions/$t"/* "$work/corpus_$t/"; fi
+done
 
 export FEMB_FUZZ_DIR=$work FEMB_FUZZ_SEED_H5=$work/seg.h5 OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1
 export ASAN_OPTIONS=detect_leaks=0 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1

@@ -79,6 +79,13 @@ TEST(SuperelementChecks, EachDefectIsCaught) {
     se.n_modal_derivatives = 1;
     se.modal_derivative_pairs = {{0, 99}};
     EXPECT_FALSE(Passed(AnalyzeSuperelement(se), "modal_derivative_pairs"));
+    // Labels of out-of-range coordinates and pairs are said, not indexed (found by
+    // tests/fuzz/superelement_fuzz: a pair (-5, ...) indexed kComponents[-5]).
+    se.modal_derivative_pairs = {{-5, 99}};
+    EXPECT_EQ(ReducedCoordinateLabel(se, -5), "coordinate -5 (out of range)");
+    EXPECT_EQ(ReducedCoordinateLabel(se, se.n_reduced_dofs() + 3),
+              "coordinate " + std::to_string(se.n_reduced_dofs() + 3) + " (out of range)");
+    EXPECT_NE(ReducedCoordinateLabel(se, se.n_interface_dofs() + se.n_internal_modes()).find("(-5 x 99)"), std::string::npos);
   }
 }
 
