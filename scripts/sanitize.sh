@@ -8,7 +8,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=Sanitize -DCMAKE_CXX_FLAGS_SANITIZE="-O1 -g" -DCMAKE_C_FLAGS_SANITIZE="-O1 -g" \
   -DFEMB_SANITIZE=ON >/dev/null
-targets=$(grep -o 'femb_add_test([^)]*)' tests/CMakeLists.txt | sed 's|.*/||; s|\.cpp)||')
+targets=$(grep -o '^femb_add_test([^)]*)' tests/CMakeLists.txt | sed 's|.*/||; s|\.cpp)||')
 # shellcheck disable=SC2086
 cmake --build build-asan -j "$(nproc)" --target $targets -- --no-print-directory -s 2>&1 | grep -v "^\[" || true
 for t in $targets; do test -x "build-asan/tests/$t" || { echo "sanitize: $t did not build"; exit 1; }; done
