@@ -361,6 +361,7 @@ SceneSpec ParseScene(const std::string& text, const std::string& name, const std
     YamlMap m = outputs.value().Map();
     if (auto v = m.Optional("animation")) scene.animation = v->Bool();
     if (auto v = m.Optional("animation_every")) scene.animation_every = std::max(1, int(v->NonNegativeInteger()));
+    if (auto v = m.Optional("reactions")) scene.reactions = scene.reactions || v->Bool();
     if (auto probes = m.Optional("probes")) {
       for (const YamlValue& item : probes->List()) {
         YamlMap pm = item.Map();
@@ -371,9 +372,12 @@ SceneSpec ParseScene(const std::string& text, const std::string& name, const std
         YamlValue q = pm.Required("quantities");
         for (const YamlValue& qi : q.List()) {
           const std::string s = qi.String();
-          if (s != "position" && s != "rotation" && s != "velocity" && s != "angular_velocity" && s != "joint") {
-            qi.Fail("unknown probe quantity '" + s + "' (known: position, rotation, velocity, angular_velocity, joint)");
+          if (s != "position" && s != "rotation" && s != "velocity" && s != "angular_velocity" && s != "joint" &&
+              s != "reaction") {
+            qi.Fail("unknown probe quantity '" + s +
+                    "' (known: position, rotation, velocity, angular_velocity, joint, reaction)");
           }
+          if (s == "reaction") scene.reactions = true;
           p.quantities.push_back(s);
         }
         pm.CheckNoUnknownKeys();

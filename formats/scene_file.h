@@ -67,7 +67,7 @@ struct SceneLoadSpec {
 struct SceneProbeSpec {
   std::string name;
   std::string node;
-  std::vector<std::string> quantities;  ///< position, rotation, velocity, angular_velocity, joint
+  std::vector<std::string> quantities;  ///< position, rotation, velocity, angular_velocity, joint, reaction
   std::string where;
 };
 
@@ -101,6 +101,9 @@ struct SceneSpec {
   std::vector<SceneProbeSpec> probes;
   bool animation = true;  ///< write animation.xdmf/.h5 when the superelement files hold meshes
   int animation_every = 1;  ///< one animation frame per this many output steps
+  /// Compute the support and joint reactions at every output step (outputs.reactions, or a probe
+  /// asking for `reaction`): /nodes/reaction in results.h5.
+  bool reactions = false;
   /// Initial velocity (spatial) of named nodes: (linear, angular).
   std::map<std::string, std::pair<Eigen::Vector3d, Eigen::Vector3d>> initial_velocities;
   /// Initial joint rates of named nodes that have a joint (revolute: angular rate, ...).

@@ -143,12 +143,26 @@ int main(int argc, char** argv) {
     }
     if (spec.analysis.type == "static") {
       femb::SystemState state = femb::InitialState(scene.model);
-      recorder.Record(0.0, state, Eigen::VectorXd(), 0.0, 0.0, 0.0);
+      // Reactions only when the scene asks (an assembly per output step).
+      auto static_reactions = [&](double lambda, const femb::SystemState& st) {
+        std::vector<Eigen::Matrix<double, 6, 1>> out;
+        if (!spec.reactions) return out;
+        femb::SystemState copy = st;
+        const femb::SystemForces f = femb::AssembleStatic(scene.model, dofs, copy, lambda, false);
+        return femb::JointReactions(scene.model, dofs, copy, f.node_forces);
+      };
+      auto reactions0 = static_reactions(0.0, state);
+      recorder.Record(0.0, state, Eigen::VectorXd(), 0.0, 0.0, 0.0, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(),
+                      spec.reactions ? &reactions0 : nullptr);
       const femb::StaticResult r = femb::SolveStatic(
           scene.model, state, StaticOptionsOf(spec.analysis), [&](const femb::StaticStepReport& s, const femb::SystemState& st) {
             ++step_count;
             total_iterations += s.iterations;
-            if (step_count % spec.analysis.output_every == 0) recorder.Record(s.lambda, st, Eigen::VectorXd(), 0.0, s.elastic_energy, s.external_work);
+            if (step_count % spec.analysis.output_every == 0) {
+              const auto reactions = static_reactions(s.lambda, st);
+              recorder.Record(s.lambda, st, Eigen::VectorXd(), 0.0, s.elastic_energy, s.external_work, Eigen::Vector3d::Zero(),
+                              Eigen::Vector3d::Zero(), spec.reactions ? &reactions : nullptr);
+            }
             progress(s.lambda, false);
           });
       ok = r.ok;
@@ -157,8 +171,10 @@ int main(int argc, char** argv) {
     } else {
       femb::DynamicState state = femb::InitialDynamicState(scene.model, femb::InitialState(scene.model), scene.initial_velocity);
       const femb::DynamicStepReport r0 = femb::Measure(scene.model, state);
+      const auto reactions0 = spec.reactions ? femb::DynamicReactions(scene.model, state)
+                                             : std::vector<Eigen::Matrix<double, 6, 1>>();
       recorder.Record(0.0, state.config, state.W, r0.kinetic_energy, r0.elastic_energy, 0.0, r0.linear_momentum,
-                      r0.angular_momentum);
+                      r0.angular_momentum, spec.reactions ? &reactions0 : nullptr);
       femb::DynamicOptions options;
       options.step = spec.analysis.step;
       options.end_time = spec.analysis.end_time;
@@ -173,8 +189,10 @@ int main(int argc, char** argv) {
             ++step_count;
             total_iterations += s.iterations;
             if (step_count % spec.analysis.output_every == 0) {
+              const auto reactions = spec.reactions ? femb::DynamicReactions(scene.model, st)
+                                                    : std::vector<Eigen::Matrix<double, 6, 1>>();
               recorder.Record(s.t, st.config, st.W, s.kinetic_energy, s.elastic_energy, s.external_work,
-                              s.linear_momentum, s.angular_momentum);
+                              s.linear_momentum, s.angular_momentum, spec.reactions ? &reactions : nullptr);
             }
             progress(s.t, false);
           });

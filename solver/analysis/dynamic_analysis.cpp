@@ -18,6 +18,7 @@ struct Assembly {
   SystemMatrix K, C, M;
   double scale = 0.0;
   double roundoff = 0.0;  // residual noise from the round-off of absolute positions
+  NodeForces node_forces;  // per node, residual sense (for the reactions)
 };
 
 // The triplets of an assembly in progress and the node forces for the joints' stiffness.
@@ -67,6 +68,7 @@ void FinishAssembly(const SystemModel& model, const DofMap& dofs, const SystemSt
   }
   const Eigen::VectorXd w = ResidualWeights(model, dofs);
   out.scale = std::max({out.scale, (w.asDiagonal() * springs).norm(), (w.asDiagonal() * loads).norm(), 1e-300});
+  out.node_forces = parts.node_forces;
 }
 
 Assembly AssembleDynamic(const SystemModel& model, const DofMap& dofs, DynamicState& s, double t, bool matrices,
@@ -118,6 +120,14 @@ Assembly AssembleDynamic(const SystemModel& model, const DofMap& dofs, DynamicSt
 }
 
 }  // namespace
+
+std::vector<Eigen::Matrix<double, 6, 1>> DynamicReactions(const SystemModel& model, const DynamicState& state) {
+  const DofMap dofs(model);
+  DynamicState s = state;
+  const Assembly a = AssembleDynamic(model, dofs, s, s.t, false);
+  if (!a.ok) return std::vector<Eigen::Matrix<double, 6, 1>>(model.n_nodes(), Eigen::Matrix<double, 6, 1>::Zero());
+  return JointReactions(model, dofs, s.config, a.node_forces);
+}
 
 // The generalized forces the prescribed motions exert: minus the residual on the prescribed
 // coordinates (zero elsewhere).

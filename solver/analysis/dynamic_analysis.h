@@ -85,6 +85,11 @@ DynamicState InitialDynamicState(const SystemModel& model, const SystemState& co
 /// Energies and momenta of a state.
 DynamicStepReport Measure(const SystemModel& model, DynamicState& state);
 
+/// Support and joint reactions (JointReactions, system.h) at a state: the inertia forces with its
+/// accelerations (generalized-alpha: the equilibrium at t_n+1; midpoint: with the extrapolated
+/// accelerations, an O(h) approximation).
+std::vector<Eigen::Matrix<double, 6, 1>> DynamicReactions(const SystemModel& model, const DynamicState& state);
+
 /// Integrates from state.t to options.end_time; `on_step` after every converged step.
 DynamicResult SolveDynamic(const SystemModel& model, DynamicState& state, const DynamicOptions& options,
                            const std::function<void(const DynamicStepReport&, const DynamicState&)>& on_step = nullptr);

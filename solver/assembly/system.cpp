@@ -308,6 +308,7 @@ SystemForces AssembleStatic(const SystemModel& model, const DofMap& dofs, System
                    &out.elastic_energy, &node_forces);
   out.residual += loads;
   out.force_scale = std::max(out.force_scale, (ResidualWeights(model, dofs).asDiagonal() * loads).norm());
+  out.node_forces = node_forces;
   if (with_tangent) {
     AddJointGeometricStiffness(model, dofs, state, node_forces, tangent);
     out.tangent = ToMatrix(n, tangent);
@@ -465,6 +466,25 @@ Eigen::VectorXd SolveFree(const DofMap& dofs, const SystemMatrix& S, const Eigen
   FreeSolver solver;
   if (!solver.Factor(dofs, S)) return Eigen::VectorXd::Constant(r.size(), std::nan(""));
   return solver.Solve(r);
+}
+
+std::vector<Eigen::Matrix<double, 6, 1>> JointReactions(const SystemModel& model, const DofMap& dofs,
+                                                        const SystemState& state, const NodeForces& forces) {
+  std::vector<Eigen::Matrix<double, 6, 1>> t = forces.f;  // transmitted, children first
+  const std::vector<int>& order = dofs.order();
+  for (auto it = order.rbegin(); it != order.rend(); ++it) {
+    const int c = *it, j = dofs.joint_of(c);
+    if (j < 0) continue;
+    const NodeJoint& joint = model.joints[j];
+    const JointMaps maps = ComputeJointMaps(joint, state.x[joint.parent], state.R[joint.parent], state.x[c], state.z[c]);
+    t[joint.parent] += maps.A.transpose() * t[c];
+  }
+  std::vector<Eigen::Matrix<double, 6, 1>> reactions(model.n_nodes(), Eigen::Matrix<double, 6, 1>::Zero());
+  for (int k = 0; k < model.n_nodes(); ++k) {
+    const bool held = dofs.joint_of(k) >= 0 || dofs.S(k).cols() < 6;
+    if (held) reactions[k] = -t[k];
+  }
+  return reactions;
 }
 
 Eigen::MatrixXd DenseFreeMatrix(const DofMap& dofs, const SystemMatrix& S) {

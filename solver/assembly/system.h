@@ -154,6 +154,16 @@ NodeForces ZeroNodeForces(const SystemModel& model);
 void AddJointGeometricStiffness(const SystemModel& model, const DofMap& dofs, const SystemState& state,
                                 const NodeForces& forces, Triplets& tangent);
 
+/// Support and joint reactions at a converged state: for every node held by something (a
+/// support: a motion basis of fewer than 6 columns; or a parent node through a joint), the force
+/// and moment (global axes, moment about the node) that the support or the parent exerts on the
+/// node and all that hangs from it: R_k = -t_k, t_k = f_k + sum over child joints A_c^T t_c, f
+/// the node forces of the assembly (applied minus internal and inertia forces). For a prescribed
+/// joint coordinate the reaction includes the drive: e.g. a driven revolute's moment about its
+/// axis is the driving torque. Other nodes: zero.
+std::vector<Eigen::Matrix<double, 6, 1>> JointReactions(const SystemModel& model, const DofMap& dofs,
+                                                        const SystemState& state, const NodeForces& forces);
+
 /// Adds an interface node to `model` at a position and returns its index.
 int AddNode(SystemModel& model, const std::string& name, const Eigen::Vector3d& x,
             const Eigen::Matrix3d& R = Eigen::Matrix3d::Identity());
@@ -171,6 +181,7 @@ struct SystemForces {
   double elastic_energy = 0.0;
   double force_scale = 0.0;       ///< largest norm of the internal or external force terms
   double roundoff = 0.0;          ///< residual noise from the round-off of absolute positions
+  NodeForces node_forces;         ///< per node, residual sense (applied minus internal)
   Eigen::VectorXd loads;          ///< the nodal loads alone, over the coordinates (for their work)
 };
 

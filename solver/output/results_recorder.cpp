@@ -50,6 +50,9 @@ ResultsRecorder::ResultsRecorder(const Scene& scene, const std::string& director
     for (const std::string& q : p.quantities) {
       if (q == "rotation") {
         for (const char* c : wxyz) csv_ << "," << p.name << "." << q << "." << c;
+      } else if (q == "reaction") {
+        static const char* components[6] = {"fx", "fy", "fz", "mx", "my", "mz"};
+        for (const char* c : components) csv_ << "," << p.name << ".reaction." << c;
       } else if (q == "joint") {
         // The node's joint coordinates (revolute: angle; prismatic: travel; cylindrical: both).
         // To the ground: the node's motion basis; between nodes: the joint's coordinates
@@ -75,7 +78,8 @@ ResultsRecorder::ResultsRecorder(const Scene& scene, const std::string& director
 
 void ResultsRecorder::Record(double t, const SystemState& state, const Eigen::VectorXd& W, double kinetic,
                              double elastic, double external_work, const Eigen::Vector3d& linear_momentum,
-                             const Eigen::Vector3d& angular_momentum) {
+                             const Eigen::Vector3d& angular_momentum,
+                             const std::vector<Eigen::Matrix<double, 6, 1>>* reactions) {
   const SystemModel& model = scene_.model;
   const DofMap dofs(model);
   const int n = model.n_nodes();
@@ -95,6 +99,11 @@ void ResultsRecorder::Record(double t, const SystemState& state, const Eigen::Ve
   momentum << linear_momentum, angular_momentum + scene_.origin.cross(linear_momentum);  // about the global origin
   momentum_.push_back(momentum);
   positions_.push_back(pos);
+  Eigen::VectorXd reaction = Eigen::VectorXd::Zero(6 * n);
+  if (reactions) {
+    for (int k = 0; k < n; ++k) reaction.segment<6>(6 * k) = (*reactions)[k];
+  }
+  if (scene_.spec.reactions) reactions_.push_back(reaction);
   quaternions_.push_back(quat);
   velocities_.push_back(vel);
   angular_velocities_.push_back(ang);
@@ -151,6 +160,7 @@ void ResultsRecorder::Record(double t, const SystemState& state, const Eigen::Ve
       if (q == "velocity") for (int i = 0; i < 3; ++i) csv_ << "," << Num(vel[3 * k + i]);
       if (q == "angular_velocity") for (int i = 0; i < 3; ++i) csv_ << "," << Num(ang[3 * k + i]);
       if (q == "joint") for (int i = 0; i < state.z[k].size(); ++i) csv_ << "," << Num(state.z[k][i]);
+      if (q == "reaction") for (int i = 0; i < 6; ++i) csv_ << "," << Num(reaction[6 * k + i]);
     }
   }
   csv_ << "," << Num(kinetic) << "," << Num(elastic) << "," << Num(external_work) << "\n";
@@ -191,6 +201,7 @@ void ResultsRecorder::Finish(const std::string& status) {
     w.Matrix("/nodes/quaternion", Stack(quaternions_, 4 * n));
     w.Matrix("/nodes/velocity", Stack(velocities_, 3 * n));
     w.Matrix("/nodes/angular_velocity", Stack(angular_velocities_, 3 * n));
+    if (!reactions_.empty()) w.Matrix("/nodes/reaction", Stack(reactions_, 6 * n));
     std::vector<std::string> labels;
     const DofMap dofs(model);
     for (int k = 0; k < n; ++k) {

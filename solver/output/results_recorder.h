@@ -21,9 +21,11 @@ class ResultsRecorder {
   ResultsRecorder(const Scene& scene, const std::string& directory);
   /// Records one output step. W: velocities over the unknowns (zero for static analyses);
   /// momentum: linear and angular (about the origin) momentum of all bodies (dynamic analyses).
+  /// `reactions`: per node (force, moment; JointReactions), recorded when the scene asks for them.
   void Record(double t, const SystemState& state, const Eigen::VectorXd& W, double kinetic, double elastic,
               double external_work, const Eigen::Vector3d& linear_momentum = Eigen::Vector3d::Zero(),
-              const Eigen::Vector3d& angular_momentum = Eigen::Vector3d::Zero());
+              const Eigen::Vector3d& angular_momentum = Eigen::Vector3d::Zero(),
+              const std::vector<Eigen::Matrix<double, 6, 1>>* reactions = nullptr);
   /// Writes results.h5 and renames both files into place. `status` is stored ("completed" or the
   /// failure message).
   void Finish(const std::string& status);
@@ -37,7 +39,7 @@ class ResultsRecorder {
   std::ofstream csv_;
   std::vector<double> time_, kinetic_, elastic_, work_;
   std::vector<Eigen::VectorXd> momentum_;  // per step: linear (3), angular (3)
-  std::vector<Eigen::VectorXd> positions_, quaternions_, velocities_, angular_velocities_, joints_;
+  std::vector<Eigen::VectorXd> positions_, quaternions_, velocities_, angular_velocities_, joints_, reactions_;
   std::vector<std::vector<Eigen::VectorXd>> modal_;     // per step, per body
   std::vector<std::vector<Eigen::VectorXd>> frames_;    // per step, per body: x (3), quaternion (4)
   // Per animation frame (every animation_every-th output step): its time, and per body with a

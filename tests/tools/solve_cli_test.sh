@@ -171,6 +171,39 @@ import h5py; f = h5py.File('$work/solid/mid/results.h5')
 assert f['energy/angular_momentum'].shape == (f['time'].shape[0], 3), f['energy/angular_momentum'].shape
 assert f['energy/linear_momentum'][-1, 1] != 0  # gravity pulls, the clamp holds: momentum changes" \
   && ok || fail "momentum in results.h5"
+# Reactions: the pivots' reactions close the momentum balance of both pendulums in impulse
+# form, L(t) = int_0^t (m g + R_rod + R_block) dt (trapezoidal rule on the recorded steps; the
+# stiff rod's pivot force carries its unresolved high modes, which the integral averages out):
+# within 1e-3 of the largest momentum (measured 2e-4).
+"$bin/femb-solve" -q "$work/pend/scene.yaml" -o "$work/pend_react" --set analysis.end_time=0.5 --set outputs.reactions=true \
+  && ok || fail "pendulum with reactions"
+$py - "$work/pend_react" <<'PY' && ok || fail "pivot reactions vs momentum balance"
+import sys, h5py, numpy as np
+f = h5py.File(sys.argv[1] + "/results.h5")
+names = [n.decode() if isinstance(n, bytes) else n for n in f["nodes/names"][:]]
+R = f["nodes/reaction"][:].reshape(len(f["time"]), len(names), 6)
+t, L = f["time"][:], f["energy/linear_momentum"][:]
+m = 2 * 0.0667557023            # the rod and the block have the same mass
+F = m * np.array([0, -9.81, 0]) + R[:, names.index("pivot_rod"), :3] + R[:, names.index("pivot_block"), :3]
+impulse = np.concatenate([[np.zeros(3)], np.cumsum(0.5 * (F[1:] + F[:-1]) * np.diff(t)[:, None], axis=0)])
+err = np.abs(L - impulse).max() / np.abs(L).max()
+print("momentum balance with the reactions:", err)
+assert err < 1e-3, err
+assert np.abs(R[:, names.index("tip_rod")]).max() == 0  # a free node has no reaction
+PY
+# Static: the clamp's reaction balances the tip load, moment about the clamp of the deformed tip.
+"$bin/femb-solve" -q "$work/scene.yaml" -o "$work/react_static" --set outputs.reactions=true && ok || fail "static reactions"
+$py - "$work/react_static" <<'PY' && ok || fail "clamp reaction"
+import sys, h5py, numpy as np
+f = h5py.File(sys.argv[1] + "/results.h5")
+names = [n.decode() if isinstance(n, bytes) else n for n in f["nodes/names"][:]]
+pos = f["nodes/position"][-1].reshape(-1, 3)
+R = f["nodes/reaction"][-1].reshape(-1, 6)[names.index("n0")]
+F = np.array([0, -100.0 * f["time"][-1], 0])
+r = pos[names.index("n10")] - pos[names.index("n0")]
+assert np.abs(R[:3] + F).max() < 1e-6 * 1e4, R
+assert np.abs(R[3:] + np.cross(r, F)).max() < 1e-6 * 1e4, (R[3:], -np.cross(r, F))
+PY
 # Initial joint rates: the pendulums started with 2 rad/s at their pivot joints have kinetic
 # energy from the first output; a wrong number of rates is an input error.
 cat "$work/pend/scene.yaml" > "$work/pend/rate.yaml"
