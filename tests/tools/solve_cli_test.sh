@@ -204,6 +204,26 @@ r = pos[names.index("n10")] - pos[names.index("n0")]
 assert np.abs(R[:3] + F).max() < 1e-6 * 1e4, R
 assert np.abs(R[3:] + np.cross(r, F)).max() < 1e-6 * 1e4, (R[3:], -np.cross(r, F))
 PY
+# The energy watchdog (issue 12's case): the stiff rod with 40 modes (30 elements) at h = 5 ms
+# gains energy with rho_inf 0.8-1.0 and once ended "completed" with 4x the kinetic energy; now
+# it stops with exit 3 and says why, results kept. rho_inf 0.5 damps the unresolved modes.
+sed 's/internal_modes: 2/internal_modes: 40/; s/elements: 6/elements: 30/' "$work/pend/rod.yaml" > "$work/pend/rod40.yaml"
+"$bin/femb-reduce" -q "$work/pend/rod40.yaml" -o "$work/pend/rod40.h5" || fail "reduce rod40"
+cat > "$work/pend/blow.yaml" <<'YAML'
+name: blow
+units: SI
+bodies:
+  - {name: rod, superelement: rod40.h5, placement: {rotation: [0, 0, -1.5207963267948966]}, nodes: {A: pivot_rod, B: tip_rod}}
+joints:
+  - {type: revolute, node: pivot_rod, axis: [0, 0, 1]}
+loads:
+  - {type: gravity, g: [0, -9.81, 0]}
+analysis: {type: dynamic, end_time: 3.0, step: 5e-3, rho_inf: 0.9}
+YAML
+"$bin/femb-solve" -q "$work/pend/blow.yaml" -o "$work/blow" 2> "$work/err.txt" > /dev/null; code=$?
+[ $code = 3 ] && grep -q "numerical failure: the energy grew by .* numerically unstable at step 0.005; reduce analysis.step or analysis.rho_inf" "$work/err.txt" \
+  && [ -s "$work/blow/results.h5" ] && ok || fail "energy watchdog: exit $code $(cat "$work/err.txt")"
+"$bin/femb-solve" -q "$work/pend/blow.yaml" -o "$work/blow5" --set analysis.rho_inf=0.5 > /dev/null && ok || fail "rho_inf 0.5 should run"
 # Initial joint rates: the pendulums started with 2 rad/s at their pivot joints have kinetic
 # energy from the first output; a wrong number of rates is an input error.
 cat "$work/pend/scene.yaml" > "$work/pend/rate.yaml"
