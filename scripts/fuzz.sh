@@ -1,12 +1,19 @@
 #!/usr/bin/env bash
 # Third CI stage: libFuzzer targets (tests/fuzz) built with clang, AddressSanitizer and
-# UndefinedBehaviorSanitizer in build-fuzz/, each run for FEMB_FUZZ_SECONDS (default 60) from a
-# seed corpus made of the examples' files. A crash, a hang (10 s per input) or an exception that
+# UndefinedBehaviorSanitizer in build-fuzz/, each run from a seed corpus made of the examples'
+# files for a fixed number of inputs with a fixed random seed (about 30 s each here), so that a
+# run is reproducible: the same commit explores the same inputs on every machine, and a failure
+# in CI is one that `bash scripts/fuzz.sh` shows locally. FEMB_FUZZ_SCALE multiplies the input
+# counts (a longer exploratory run: FEMB_FUZZ_SCALE=20 FEMB_FUZZ_SEED=$RANDOM); FEMB_FUZZ_SECONDS
+# (default 120) caps each target's time on a slow machine. A crash, a hang (10 s per input) or an exception that
 # is not an InputError stops the run; the input is kept in build-fuzz/artifacts/ and becomes a
 # regression test. Needs build/bin/femb-reduce (scripts/build.sh) for the seed superelement.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-seconds=${FEMB_FUZZ_SECONDS:-60}
+seconds=${FEMB_FUZZ_SECONDS:-120}
+scale=${FEMB_FUZZ_SCALE:-1}
+fuzz_seed=${FEMB_FUZZ_SEED:-1}
+declare -A runs=([yaml_fuzz]=30000 [part_fuzz]=150000 [scene_fuzz]=60000 [superelement_fuzz]=4000)
 missing=()
 for p in clang libclang-rt-14-dev; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
@@ -45,9 +52,12 @@ export FEMB_FUZZ_DIR=$work FEMB_FUZZ_SEED_H5=$work/seg.h5 OMP_NUM_THREADS=1 OPEN
 export ASAN_OPTIONS=detect_leaks=0 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 status=0
 for t in "${targets[@]}"; do
-  if build-fuzz/fuzz/$t "$work/corpus_$t" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=4096 \
+  start=$(date +%s)
+  if build-fuzz/fuzz/$t "$work/corpus_$t" -seed="$fuzz_seed" -runs=$((runs[$t] * scale)) \
+       -max_total_time="$seconds" -timeout=10 -rss_limit_mb=4096 \
        -artifact_prefix="build-fuzz/artifacts/$t-" -print_final_stats=1 > "build-fuzz/$t.log" 2>&1; then
-    echo "fuzz: $t: $(grep -m1 'stat::number_of_executed_units' "build-fuzz/$t.log" | awk '{print $2}') inputs in ${seconds} s, no failure"
+    echo "fuzz: $t: $(grep -m1 'stat::number_of_executed_units' "build-fuzz/$t.log" | awk '{print $2}') inputs" \
+         "(seed $fuzz_seed) in $(($(date +%s) - start)) s, no failure"
   else
     echo "fuzz: $t FAILED (input in build-fuzz/artifacts/):"; tail -40 "build-fuzz/$t.log"; status=1
   fi

@@ -44,8 +44,13 @@ std::string DescribeSingular(const SystemModel& model, const DofMap& dofs, const
   Eigen::VectorXd null = Eigen::VectorXd::Zero(dofs.n_dofs());
   const Eigen::VectorXd v = d.asDiagonal() * svd.matrixV().col(n - 1);
   for (int i = 0; i < n; ++i) null[free[i]] = v[i];
+  // Counting the free motions: the matrix is singular (a singular value below 1e-13 of the
+  // largest); the other free motions of the same model come out of the SVD at round-off of the
+  // loaded tangent, which a body under load puts anywhere up to ~1e-10 (a free beam's sixth
+  // rigid motion measured 7e-11 with OpenBLAS): count every singular value below 1e-9, well
+  // apart from physical stiffness in this unit-diagonal scaling.
   int rank_deficiency = 0;
-  for (int i = 0; i < n; ++i) rank_deficiency += sigma[i] <= 1e-13 * sigma[0];
+  for (int i = 0; i < n; ++i) rank_deficiency += sigma[i] <= 1e-9 * sigma[0];
 
   // The model's size: rotations times it compare with translations.
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(HUGE_VAL), hi = -lo;

@@ -65,6 +65,18 @@ TEST(SuperelementChecks, EachDefectIsCaught) {
     EXPECT_FALSE(Passed(AnalyzeSuperelement(se), "floating_frame"));
   }
   {
+    // Found by fuzzing (tests/fuzz/regressions/superelement_fuzz/phi_cb_mode_column_1e308): a
+    // huge entry in an internal mode's column of Phi_CB, which Phi_CB Phi_rig0 = 1 does not see
+    // (Phi_rig0 is zero on the modal rows), made the elastic force Inf.
+    Superelement se = Good();
+    ASSERT_GT(se.floating_frame.Phi_CB.cols(), se.n_interface_dofs());
+    se.floating_frame.Phi_CB(5, se.floating_frame.Phi_CB.cols() - 1) = 1e308;
+    EXPECT_TRUE(Passed(AnalyzeSuperelement(se), "finite"));
+    EXPECT_FALSE(Passed(AnalyzeSuperelement(se), "floating_frame"));
+    se.floating_frame.Phi_CB(5, se.floating_frame.Phi_CB.cols() - 1) = 1e12;
+    EXPECT_FALSE(Passed(AnalyzeSuperelement(se), "floating_frame"));
+  }
+  {
     Superelement se = Good();
     se.interfaces[1].orientation(0, 1) += 1e-3;
     EXPECT_FALSE(Passed(AnalyzeSuperelement(se), "interface_orientations"));
