@@ -339,6 +339,7 @@ PartSpec ParsePart(const std::string& text, const std::string& name,
       }
     }
     if (auto v = m.Optional("keep_mesh")) part.reduction.keep_mesh = v->Bool();
+    if (auto v = m.Optional("geometric_stiffening")) part.reduction.geometric_stiffening = v->Bool();
     if (auto v = m.Optional("full_modes")) part.reduction.full_modes = int(v->NonNegativeInteger());
     if (auto v = m.Optional("memory_limit_gb")) part.reduction.memory_limit_gb = v->PositiveNumber();
     if (auto v = m.Optional("modal_derivatives")) {

@@ -49,12 +49,13 @@ Eigen::VectorXd PairProducts(const Eigen::VectorXd& q) {
 
 double PolynomialEnergy(const Eigen::MatrixXd& K, const PolynomialStiffness& p, const Eigen::VectorXd& q) {
   const Eigen::VectorXd z = PairProducts(q);
-  return 0.5 * q.dot(K * q) + q.dot(p.A * z) + z.dot(p.B * z);
+  return 0.5 * q.dot(K * q) + q.dot(p.A * z) + (p.cubic() ? z.dot(p.B * z) : 0.0);
 }
 
 Eigen::VectorXd PolynomialForce(const Eigen::MatrixXd& K, const PolynomialStiffness& p, const Eigen::VectorXd& q) {
   const Eigen::VectorXd z = PairProducts(q);
   const Eigen::SparseMatrix<double> J = PairJacobian(q);
+  if (!p.cubic()) return K * q + J.transpose() * (p.A.transpose() * q);  // geometric stiffness form
   const Eigen::VectorXd w = p.A.transpose() * q + 2 * (p.B * z);
   return K * q + p.A * z + J.transpose() * w;
 }
@@ -63,6 +64,12 @@ Eigen::MatrixXd PolynomialTangent(const Eigen::MatrixXd& K, const PolynomialStif
   const Eigen::VectorXd z = PairProducts(q);
   const Eigen::SparseMatrix<double> J = PairJacobian(q);
   const Eigen::MatrixXd AJ = p.A * J;
+  if (!p.cubic()) {
+    // d/dq [J^T (A^T q)] = (A J)^T + sum_p (A^T q)_p d2 z_p / dq2 (not symmetric).
+    Eigen::MatrixXd T = K + AJ.transpose();
+    AddPairHessian(p.A.transpose() * q, &T);
+    return T;
+  }
   const Eigen::MatrixXd BJ = p.B * J;
   Eigen::MatrixXd T = K + AJ + AJ.transpose();
   T.noalias() += 2 * (J.transpose() * BJ);

@@ -36,6 +36,8 @@ struct SceneBodySpec {
   std::map<std::string, std::string> nodes;  ///< interface name -> scene node name
   bool approximated = false, full_tangent = true, quadratic_velocity_terms = true, option_b = false;
   bool polynomial_force = true;  ///< use the file's polynomial internal force when it has one
+  /// options.geometric_stiffening: unset = use what the file has; true = require it; false = off.
+  std::optional<bool> geometric_stiffening;
   double modal_damping = 0.0;    ///< damping ratio of the internal modes
   std::string where;
 };

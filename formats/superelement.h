@@ -70,6 +70,14 @@ struct Provenance {
   std::vector<std::pair<std::string, double>> stage_seconds;
 };
 
+/// The unit inertia load cases of the inertia stiffening, in the order stored: the acceleration
+/// fields (frame axes, positions x from the floating frame origin) a, alpha x x and the
+/// centrifugal omega x (omega x x) split into the products of omega's components:
+///   a_x a_y a_z | alpha_x alpha_y alpha_z | w_x^2 w_y^2 w_z^2 w_x w_y w_x w_z w_y w_z.
+inline constexpr int kInertiaLoadCaseCount = 12;
+inline constexpr const char* kInertiaLoadCases[kInertiaLoadCaseCount] = {
+    "a_x", "a_y", "a_z", "alpha_x", "alpha_y", "alpha_z", "wx_wx", "wy_wy", "wz_wz", "wx_wy", "wx_wz", "wy_wz"};
+
 struct Superelement {
   std::string name;
   Units units;
@@ -90,6 +98,10 @@ struct Superelement {
   /// With modal derivatives: the quadratic and cubic coefficients of the reduced Green-Lagrange
   /// internal force (reduced_polynomial.h); the solver then uses it in place of K q.
   std::optional<PolynomialStiffness> polynomial;
+  /// Geometric stiffening from rigid-body inertia loads (issue 13; solver/body/inertia_stiffening.h):
+  /// K_sigma,k = Phi^T G(sigma_k) Phi (n x n, symmetric) of the stress sigma_k of unit inertia
+  /// load case k (kInertiaLoadCases) with the interfaces held; empty when not computed.
+  std::vector<Eigen::MatrixXd> inertia_stiffness;
   std::optional<Visualization> visualization;
   Provenance provenance;
 

@@ -52,6 +52,9 @@ Check Finite(const Superelement& se) {
     datasets.emplace_back("/reduced/polynomial/A", se.polynomial->A);
     datasets.emplace_back("/reduced/polynomial/B", se.polynomial->B);
   }
+  for (const Eigen::MatrixXd& K_sigma : se.inertia_stiffness) {
+    datasets.emplace_back("/reduced/geometric_stiffness/inertia", K_sigma);
+  }
   if (se.visualization) {
     datasets.emplace_back("/visualization/nodes", se.visualization->nodes);
     datasets.emplace_back("/visualization/shapes", se.visualization->shapes);
@@ -86,6 +89,16 @@ SuperelementChecks CheckSuperelement(const Superelement& se) {
   if (!a.checks.back().ok) return a;  // the other figures would be meaningless
   a.checks.push_back(Symmetric("K_symmetric", "/reduced/K", se.K));
   a.checks.push_back(Symmetric("M_symmetric", "/reduced/M", se.M));
+  if (!se.inertia_stiffness.empty()) {
+    double worst = 0.0;
+    for (const Eigen::MatrixXd& K_sigma : se.inertia_stiffness) {
+      const double scale = K_sigma.cwiseAbs().maxCoeff();
+      if (scale > 0) worst = std::max(worst, (K_sigma - K_sigma.transpose()).cwiseAbs().maxCoeff() / scale);
+    }
+    a.checks.push_back({"inertia_stiffness_symmetric", worst <= 1e-10,
+                        Sci("max|A - A^T| / max|A| = %.3g over the 12 load cases", worst),
+                        "/reduced/geometric_stiffness/inertia"});
+  }
   const Eigen::MatrixXd Ms = 0.5 * (se.M + se.M.transpose());
   const Eigen::MatrixXd Ks = 0.5 * (se.K + se.K.transpose());
 

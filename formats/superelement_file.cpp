@@ -61,7 +61,29 @@ void WriteContent(const Superelement& se, h5::Writer& w) {
   if (se.polynomial) {
     w.CreateGroup("/reduced/polynomial");
     w.Matrix("/reduced/polynomial/A", se.polynomial->A);
-    w.Matrix("/reduced/polynomial/B", se.polynomial->B);
+    if (se.polynomial->cubic()) w.Matrix("/reduced/polynomial/B", se.polynomial->B);
+  }
+  if (!se.inertia_stiffness.empty()) {
+    // The 12 reduced geometric stiffness matrices of the unit inertia load cases, stacked
+    // (12 n x n; case k in rows k n .. k n + n - 1), in the order of kInertiaLoadCases.
+    const long n = se.n_reduced_dofs();
+    if (se.inertia_stiffness.size() != size_t(kInertiaLoadCaseCount)) {
+      throw InputError(std::to_string(se.inertia_stiffness.size()) + " inertia stiffness matrices (need " +
+                       std::to_string(kInertiaLoadCaseCount) + ")");
+    }
+    for (const Eigen::MatrixXd& K_sigma : se.inertia_stiffness) {
+      if (K_sigma.rows() != n || K_sigma.cols() != n) {
+        throw InputError("an inertia stiffness matrix is " + std::to_string(K_sigma.rows()) + " x " +
+                         std::to_string(K_sigma.cols()) + ", the reduced K " + std::to_string(n) + " x " + std::to_string(n));
+      }
+    }
+    Eigen::MatrixXd stacked(kInertiaLoadCaseCount * n, n);
+    for (int k = 0; k < kInertiaLoadCaseCount; ++k) stacked.middleRows(k * n, n) = se.inertia_stiffness[size_t(k)];
+    w.CreateGroup("/reduced/geometric_stiffness");
+    w.Matrix("/reduced/geometric_stiffness/inertia", stacked);
+    std::string cases;
+    for (int k = 0; k < kInertiaLoadCaseCount; ++k) cases += std::string(k ? " " : "") + kInertiaLoadCases[k];
+    w.Attribute("/reduced/geometric_stiffness/inertia", "load_cases", cases);
   }
 
   w.CreateGroup("/floating_frame");
@@ -204,8 +226,17 @@ Superelement ReadSuperelementFile(const std::string& path, const SuperelementRea
   if (r.Exists("/reduced/polynomial")) {
     const long P = n * (n + 1) / 2;
     RequireShape(r, "/reduced/polynomial/A", n, P);
-    RequireShape(r, "/reduced/polynomial/B", P, P);
-    se.polynomial = PolynomialStiffness{r.Matrix("/reduced/polynomial/A"), r.Matrix("/reduced/polynomial/B")};
+    se.polynomial = PolynomialStiffness{r.Matrix("/reduced/polynomial/A"), Eigen::MatrixXd()};
+    // B is absent when the file holds the quadratic part only (geometric stiffening, issue 13).
+    if (r.Exists("/reduced/polynomial/B")) {
+      RequireShape(r, "/reduced/polynomial/B", P, P);
+      se.polynomial->B = r.Matrix("/reduced/polynomial/B");
+    }
+  }
+  if (r.Exists("/reduced/geometric_stiffness/inertia")) {
+    RequireShape(r, "/reduced/geometric_stiffness/inertia", kInertiaLoadCaseCount * n, n);
+    const Eigen::MatrixXd stacked = r.Matrix("/reduced/geometric_stiffness/inertia");
+    for (int k = 0; k < kInertiaLoadCaseCount; ++k) se.inertia_stiffness.push_back(stacked.middleRows(k * n, n));
   }
 
   se.floating_frame.type = r.StringAttribute("/floating_frame", "type");

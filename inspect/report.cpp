@@ -51,11 +51,19 @@ std::string TextSummary(const Superelement& se, const SuperelementAnalysis& a, c
   s += F("  %ld full DOFs -> %d reduced: %d interface DOFs (%d nodes) + %d internal modes + %ld modal derivatives\n",
          se.n_full_dofs, se.n_reduced_dofs(), se.n_interface_dofs(), se.n_interface_nodes(),
          se.n_internal_modes(), se.n_modal_derivatives);
-  if (se.polynomial) {
+  if (se.polynomial && se.polynomial->cubic()) {
     const long n = se.n_reduced_dofs(), P = n * (n + 1) / 2;
     s += F("  nonlinear internal force: cubic in the reduced coordinates (Green-Lagrange), quadratic coefficients A "
            "%ld x %ld, cubic B %ld x %ld (%.3g MB)\n",
            n, P, P, P, 8.0 * double(n * P + P * P) / 1e6);
+  } else if (se.polynomial) {
+    const long n = se.n_reduced_dofs(), P = n * (n + 1) / 2;
+    s += F("  geometric stiffening: the basis vectors' stress geometric stiffness (A %ld x %ld, %.3g MB)\n", n, P,
+           8.0 * double(n * P) / 1e6);
+  }
+  if (!se.inertia_stiffness.empty()) {
+    s += F("  geometric stiffening: 12 inertia load cases (a, alpha, omega products), %d x %d each\n",
+           se.n_reduced_dofs(), se.n_reduced_dofs());
   }
   if (!p.stage_seconds.empty()) {
     s += "  reduction time:";
@@ -139,7 +147,8 @@ nlohmann::json JsonSummary(const Superelement& se, const SuperelementAnalysis& a
   j["interface_positions"] = positions;
   j["n_internal_modes"] = se.n_internal_modes();
   j["n_modal_derivatives"] = se.n_modal_derivatives;
-  j["polynomial_internal_force"] = se.polynomial.has_value();
+  j["polynomial_internal_force"] = se.polynomial.has_value() && se.polynomial->cubic();
+  j["geometric_stiffening"] = !se.inertia_stiffness.empty();
   j["n_reduced_dofs"] = se.n_reduced_dofs();
   j["n_full_dofs"] = se.n_full_dofs;
   j["mass"] = se.mass_properties.mass;

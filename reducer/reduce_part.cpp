@@ -118,8 +118,12 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
       return out;
     };
   }
+  // Geometric stiffening (issue 13): the unit inertia load cases are solved on the same factor.
+  const bool stiffening = part.reduction.geometric_stiffening;
+  const Eigen::MatrixXd inertia_fields = stiffening ? InertiaFields(model) : Eigen::MatrixXd();
   const CraigBamptonResult cb = CraigBamptonReduce(model, part.reduction.internal_modes, report, 200, factor_budget,
-                                                   request.pairs.empty() ? nullptr : &request);
+                                                   request.pairs.empty() ? nullptr : &request,
+                                                   stiffening ? &inertia_fields : nullptr);
   if (!cb.ok) {
     result.too_big = cb.factorization.too_big;
     result.message = cb.message;
@@ -165,16 +169,40 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
     se.K = T0.transpose() * K_T0;
     se.K = 0.5 * (se.K + se.K.transpose()).eval();
   }
-  if (nonlinear && se.n_modal_derivatives > 0) {
-    // The reduced internal force on the whole basis (static and internal modes, derivatives)
-    // is the cubic polynomial of reduced_polynomial.h; its linear part equals K_r.
+  const bool derivatives = se.n_modal_derivatives > 0;
+  if (stiffening && !nonlinear) {
+    if (part.type == "solid") {
+      nonlinear = std::make_unique<SvkSolidMesh>(SolidTypeOf(model.cell_type), model.nodes, model.cells, part.material);
+    } else {
+      nonlinear = std::make_unique<VonKarmanBeams>(part);
+      to_model_dofs.resize(model.n_dofs(), model.n_dofs());
+      to_model_dofs.setIdentity();
+    }
+  }
+  if (nonlinear && (derivatives || stiffening)) {
+    // The reduced internal force on the whole basis (static and internal modes, derivatives):
+    // with modal derivatives the cubic polynomial of reduced_polynomial.h; for the geometric
+    // stiffening alone its quadratic part (the geometric stiffness of the stress of each basis
+    // vector). Its linear part equals K_r. With stiffening also the geometric stiffness of the
+    // inertia load cases' stresses (solver/body/inertia_stiffening.h), about the frame origin o:
+    // a field about o is the one about the part origin minus the translation it has at o.
     Stopwatch tensors;
     const Eigen::MatrixXd mesh_shapes = to_model_dofs * cb.shapes;
     const auto completion = InterfaceRotationCompletion(model.nodes, mesh_shapes, model.interface_positions,
                                                         se.floating_frame.origin, part.type == "solid" ? 3 : 6);
+    PolynomialRequest poly_request;
+    poly_request.cubic = derivatives;
+    Eigen::MatrixXd stress_fields;
+    if (stiffening) {
+      Eigen::MatrixXd u = cb.inertia_displacements;
+      const Eigen::Matrix<double, 3, 12> at_origin = InertiaFieldAt(se.floating_frame.origin);
+      for (int k = 3; k < kInertiaLoadCaseCount; ++k) u.col(k) -= u.leftCols(3) * at_origin.col(k);
+      stress_fields = to_model_dofs * u;
+      poly_request.stress_fields = &stress_fields;
+    }
     ReducedPolynomial poly = part.type == "solid"
-                                 ? ReduceSvk(static_cast<const SvkSolidMesh&>(*nonlinear), mesh_shapes, completion)
-                                 : ReduceVonKarman(static_cast<const VonKarmanBeams&>(*nonlinear), mesh_shapes, completion);
+                                 ? ReduceSvk(static_cast<const SvkSolidMesh&>(*nonlinear), mesh_shapes, completion, poly_request)
+                                 : ReduceVonKarman(static_cast<const VonKarmanBeams&>(*nonlinear), mesh_shapes, completion, poly_request);
     const double mismatch = (poly.K - cb.K).norm() / cb.K.norm();
     if (mismatch > 1e-8) {
       result.message = "the polynomial internal force's linear part differs from K_r by " + std::to_string(mismatch);
@@ -182,12 +210,30 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
     }
     se.polynomial = PolynomialStiffness{std::move(poly.A), std::move(poly.B)};
     const long nr = se.K.rows(), P = nr * (nr + 1) / 2;
-    std::snprintf(detail, sizeof detail,
-                  "quadratic %ld x %ld + cubic %ld x %ld coefficients (%.3g MB; symmetric pairs: %.0fx smaller than "
-                  "n^3 + n^4), linear part = K_r to %.1e",
-                  nr, P, P, P, 8.0 * (nr * P + P * P) / 1e6,
-                  double(nr * nr * nr + nr * nr * nr * nr) / double(nr * P + P * P), mismatch);
-    report("nonlinear force", tensors.Seconds(), detail);
+    if (stiffening) {
+      for (int k = 0; k < kInertiaLoadCaseCount; ++k) {
+        Eigen::MatrixXd K_sigma(nr, nr);
+        int p = 0;
+        for (int i = 0; i < nr; ++i)
+          for (int j = i; j < nr; ++j, ++p) K_sigma(i, j) = K_sigma(j, i) = poly.S(k, p);
+        se.inertia_stiffness.push_back(std::move(K_sigma));
+      }
+    }
+    if (derivatives) {
+      std::snprintf(detail, sizeof detail,
+                    "quadratic %ld x %ld + cubic %ld x %ld coefficients (%.3g MB; symmetric pairs: %.0fx smaller than "
+                    "n^3 + n^4), linear part = K_r to %.1e%s",
+                    nr, P, P, P, 8.0 * (nr * P + P * P) / 1e6,
+                    double(nr * nr * nr + nr * nr * nr * nr) / double(nr * P + P * P), mismatch,
+                    stiffening ? "; 12 inertia load case geometric stiffnesses" : "");
+      report("nonlinear force", tensors.Seconds(), detail);
+    } else {
+      std::snprintf(detail, sizeof detail,
+                    "quadratic %ld x %ld coefficients (Green-Lagrange over the Craig-Bampton basis) + 12 inertia load "
+                    "case geometric stiffnesses %ld x %ld (%.3g MB), linear part = K_r to %.1e",
+                    nr, P, nr, nr, 8.0 * (nr * P + 12 * nr * nr) / 1e6, mismatch);
+      report("stiffening", tensors.Seconds(), detail);
+    }
     clock.Restart();
   }
   const bool keep_mesh = part.reduction.keep_mesh.value_or(model.n_dofs() <= ReductionSpec::kKeepMeshMaxDofs);

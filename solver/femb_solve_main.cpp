@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -93,6 +94,12 @@ int main(int argc, char** argv) {
     if (!quiet) {
       std::printf("femb-solve: %s: %zu bodies, %d nodes, %d unknowns, %s analysis\n", scene_path.c_str(),
                   scene.model.bodies.size(), scene.model.n_nodes(), dofs.n_dofs(), spec.analysis.type.c_str());
+      // One note per file, not per body.
+      std::set<std::string> said;
+      for (const std::string& note : scene.notes) {
+        const std::string file = note.substr(note.find(": ") + 2);
+        if (said.insert(file).second) std::printf("femb-solve: note: %s\n", note.c_str());
+      }
     }
     std::string status = "completed";
     bool ok = true;

@@ -32,7 +32,8 @@ class VonKarmanBeams : public NonlinearModel {
   SparseMatrix Tangent(const Eigen::VectorXd& u) const override;
   const std::vector<Eigen::Vector3d>& nodes() const { return nodes_; }
   friend ReducedPolynomial ReduceVonKarman(const VonKarmanBeams& beams, const Eigen::MatrixXd& shapes,
-                                           const std::vector<std::pair<int, Eigen::VectorXd>>& pair_fields);
+                                           const std::vector<std::pair<int, Eigen::VectorXd>>& pair_fields,
+                                           const PolynomialRequest& request);
 
  private:
   struct Element {
@@ -52,6 +53,7 @@ class VonKarmanBeams : public NonlinearModel {
 /// The reduced polynomial (ReducedPolynomial) of the basis `shapes` (n_dofs x n) on this model,
 /// with optional second-order pair fields (Q_p += 2 E_lin(W_p)).
 ReducedPolynomial ReduceVonKarman(const VonKarmanBeams& beams, const Eigen::MatrixXd& shapes,
-                                  const std::vector<std::pair<int, Eigen::VectorXd>>& pair_fields = {});
+                                  const std::vector<std::pair<int, Eigen::VectorXd>>& pair_fields = {},
+                                  const PolynomialRequest& request = {});
 
 }  // namespace femb

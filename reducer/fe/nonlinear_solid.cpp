@@ -180,9 +180,12 @@ std::vector<std::pair<int, Eigen::VectorXd>> InterfaceRotationCompletion(const E
 }
 
 ReducedPolynomial ReduceSvk(const SvkSolidMesh& solid, const Eigen::MatrixXd& mesh_shapes,
-                            const std::vector<std::pair<int, Eigen::VectorXd>>& pair_fields) {
+                            const std::vector<std::pair<int, Eigen::VectorXd>>& pair_fields,
+                            const PolynomialRequest& request) {
   const int n = int(mesh_shapes.cols()), P = n * (n + 1) / 2, ne = solid.n_per_cell_;
-  PolynomialAccumulator accumulator(n);
+  const int n_stress = request.stress_fields ? int(request.stress_fields->cols()) : 0;
+  PolynomialAccumulator accumulator(n, request.cubic, n_stress);
+  Eigen::MatrixXd stress_element(3 * ne, n_stress), L_stress(6, n_stress);
   const Eigen::Matrix<double, 6, 6> C = solid.D_.llt().matrixU();  // D = C^T C
   std::vector<Eigen::Matrix3d> G(static_cast<size_t>(n));
   Eigen::MatrixXd L(6, n), Q(6, P), U(ne, 3);
@@ -194,6 +197,8 @@ ReducedPolynomial ReduceSvk(const SvkSolidMesh& solid, const Eigen::MatrixXd& me
     for (int f = 0; f < n_fields; ++f)
       for (int a = 0; a < ne; ++a)
         field_element.block(3 * a, f, 3, 1) = pair_fields[size_t(f)].second.segment<3>(3 * long(solid.cells_(c, a)));
+    for (int a = 0; a < ne && n_stress > 0; ++a)
+      stress_element.middleRows(3 * a, 3) = request.stress_fields->middleRows(3 * long(solid.cells_(c, a)), 3);
     for (int q = 0; q < solid.points_per_cell_; ++q) {
       const size_t point = size_t(c) * solid.points_per_cell_ + q;
       const Eigen::MatrixXd& g = solid.dNdX_[point];
@@ -217,27 +222,37 @@ ReducedPolynomial ReduceSvk(const SvkSolidMesh& solid, const Eigen::MatrixXd& me
         e << Gw(0, 0), Gw(1, 1), Gw(2, 2), Gw(1, 2) + Gw(2, 1), Gw(0, 2) + Gw(2, 0), Gw(0, 1) + Gw(1, 0);
         Q.col(pair_fields[size_t(f)].first) += 2 * e;
       }
-      accumulator.Add(dV, C, L, Q);
+      for (int f = 0; f < n_stress; ++f) {
+        for (int a = 0; a < ne; ++a) U.row(a) = stress_element.block(3 * a, f, 3, 1).transpose();
+        const Eigen::Matrix3d Gs = U.transpose() * g;
+        L_stress.col(f) << Gs(0, 0), Gs(1, 1), Gs(2, 2), Gs(1, 2) + Gs(2, 1), Gs(0, 2) + Gs(2, 0), Gs(0, 1) + Gs(1, 0);
+      }
+      accumulator.Add(dV, C, L, Q, n_stress > 0 ? &L_stress : nullptr);
     }
   }
   return accumulator.Finish();
 }
 
-PolynomialAccumulator::PolynomialAccumulator(int n) {
+PolynomialAccumulator::PolynomialAccumulator(int n, bool cubic, int n_fields) : cubic_(cubic) {
   const int P = n * (n + 1) / 2;
   r_.K = Eigen::MatrixXd::Zero(n, n);
   r_.A = Eigen::MatrixXd::Zero(n, P);
-  r_.B = Eigen::MatrixXd::Zero(P, P);
-  stack_.resize(6 * kPointsPerBlock, P);
+  r_.S = Eigen::MatrixXd::Zero(n_fields, P);
+  if (cubic_) {
+    r_.B = Eigen::MatrixXd::Zero(P, P);
+    stack_.resize(6 * kPointsPerBlock, P);
+  }
 }
 
 void PolynomialAccumulator::Add(double dV, const Eigen::Matrix<double, 6, 6>& C, const Eigen::MatrixXd& L,
-                                const Eigen::MatrixXd& Q) {
-  const Eigen::MatrixXd CL = C * L;
+                                const Eigen::MatrixXd& Q, const Eigen::MatrixXd* L_fields) {
+  const Eigen::MatrixXd CL = C * L, CQ = C * Q;
   r_.K.noalias() += dV * CL.transpose() * CL;
-  r_.A.noalias() += (0.5 * dV) * CL.transpose() * (C * Q);
+  r_.A.noalias() += (0.5 * dV) * CL.transpose() * CQ;
+  if (L_fields && r_.S.rows() > 0) r_.S.noalias() += dV * (C * *L_fields).transpose() * CQ;
+  if (!cubic_) return;
   // B gathers (C Q)^T (C Q) dV / 8, stacked into blocks of rows (one BLAS product each).
-  stack_.middleRows(6 * stacked_, 6) = std::sqrt(dV / 8) * (C * Q);
+  stack_.middleRows(6 * stacked_, 6) = std::sqrt(dV / 8) * CQ;
   if (++stacked_ == kPointsPerBlock) Flush();
 }
 
@@ -249,9 +264,9 @@ void PolynomialAccumulator::Flush() {
 }
 
 ReducedPolynomial PolynomialAccumulator::Finish() {
-  Flush();
+  if (cubic_) Flush();
   r_.K = 0.5 * (r_.K + r_.K.transpose()).eval();
-  r_.B = 0.5 * (r_.B + r_.B.transpose()).eval();
+  if (cubic_) r_.B = 0.5 * (r_.B + r_.B.transpose()).eval();
   return std::move(r_);
 }
 

@@ -33,7 +33,18 @@ struct NonlinearElementState {
 ///   B = int Q^T D Q / 8   (n x n, n x P, P x P; P = n (n + 1) / 2),
 /// and f(q) = dW/dq, K_t(q) = d2W/dq2 (reduced_polynomial.h evaluates them).
 struct ReducedPolynomial {
-  Eigen::MatrixXd K, A, B;
+  Eigen::MatrixXd K, A, B;  ///< B is 0 x 0 when the cubic part was not asked for
+  /// With stress fields u_f (PolynomialRequest): S(f, p) = int sigma(u_f) . Q_p dV, the reduced
+  /// geometric stiffness of the stress sigma(u_f) = D E_lin(u_f): K_sigma,f = Phi^T G(sigma_f) Phi
+  /// has entries (j, k) and (k, j) equal to S(f, p(j, k)) (sigma . Q_p = sigma : G_j^T G_k).
+  Eigen::MatrixXd S;
+};
+
+/// What to accumulate besides K and A: the cubic part B (P x P: the costly one, P = n (n + 1) / 2)
+/// and the geometric stiffness of given displacement fields' stresses (ReducedPolynomial::S).
+struct PolynomialRequest {
+  bool cubic = true;
+  const Eigen::MatrixXd* stress_fields = nullptr;  ///< n_dofs x n_fields on the model's DOF vector
 };
 
 /// One element: `X` n x 3 node coordinates, `u` its 3 n displacements (node-major).
@@ -54,15 +65,18 @@ class NonlinearModel {
 /// Accumulates the reduced polynomial (ReducedPolynomial) over quadrature points: at each, the
 /// weight dV, a factor C of the 6 x 6 stiffness D = C^T C (Cholesky, or the square root of a
 /// diagonal D, zeros allowed), the linear strain rows L (6 x n) and the quadratic ones Q (6 x P).
+/// `L_fields` (6 x n_fields): the linear strains of the stress fields at the point.
 class PolynomialAccumulator {
  public:
-  explicit PolynomialAccumulator(int n);
-  void Add(double dV, const Eigen::Matrix<double, 6, 6>& C, const Eigen::MatrixXd& L, const Eigen::MatrixXd& Q);
+  PolynomialAccumulator(int n, bool cubic = true, int n_fields = 0);
+  void Add(double dV, const Eigen::Matrix<double, 6, 6>& C, const Eigen::MatrixXd& L, const Eigen::MatrixXd& Q,
+           const Eigen::MatrixXd* L_fields = nullptr);
   ReducedPolynomial Finish();
 
  private:
   void Flush();
   static constexpr int kPointsPerBlock = 64;
+  bool cubic_;
   ReducedPolynomial r_;
   Eigen::MatrixXd stack_;
   int stacked_ = 0;
@@ -78,7 +92,8 @@ class SvkSolidMesh : public NonlinearModel {
   Eigen::VectorXd Force(const Eigen::VectorXd& u) const override;
   SparseMatrix Tangent(const Eigen::VectorXd& u) const override;
   friend ReducedPolynomial ReduceSvk(const SvkSolidMesh& solid, const Eigen::MatrixXd& mesh_shapes,
-                                     const std::vector<std::pair<int, Eigen::VectorXd>>& pair_fields);
+                                     const std::vector<std::pair<int, Eigen::VectorXd>>& pair_fields,
+                                     const PolynomialRequest& request);
 
  private:
   // Per quadrature point: dN/dX (n x 3) and the volume weight; per element, its points.
@@ -98,7 +113,8 @@ class SvkSolidMesh : public NonlinearModel {
 /// strain joins the quadratic strain, Q_p += 2 E_lin(W_p) (their higher-order terms are dropped:
 /// the strain stays quadratic in q). Used for the second-order rotation of interface faces.
 ReducedPolynomial ReduceSvk(const SvkSolidMesh& solid, const Eigen::MatrixXd& mesh_shapes,
-                            const std::vector<std::pair<int, Eigen::VectorXd>>& pair_fields = {});
+                            const std::vector<std::pair<int, Eigen::VectorXd>>& pair_fields = {},
+                            const PolynomialRequest& request = {});
 
 /// The second-order completion of the interface rotations of a solid part (RBE2 faces): with
 /// linear static modes a local rotation theta of interface k moves its face by theta x r only,

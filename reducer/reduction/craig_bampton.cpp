@@ -1,6 +1,7 @@
 #include "reducer/reduction/craig_bampton.h"
 
 #include <Eigen/Cholesky>
+#include <Eigen/Geometry>
 #include <Eigen/SparseCholesky>
 #include <algorithm>
 #include <cmath>
@@ -93,6 +94,39 @@ Eigen::MatrixXd RigidFields(const FeModel& model) {
   return normal.solve(Eigen::MatrixXd(T.transpose() * R_mesh));
 }
 
+Eigen::Matrix<double, 3, 12> InertiaFieldAt(const Eigen::Vector3d& x) {
+  Eigen::Matrix<double, 3, 12> f = Eigen::Matrix<double, 3, 12>::Zero();
+  f.leftCols<3>().setIdentity();
+  for (int i = 0; i < 3; ++i) {
+    f.col(3 + i) = Eigen::Vector3d(Eigen::Vector3d::Unit(i)).cross(x);  // alpha_i e_i x x
+    f.col(6 + i) = x[i] * Eigen::Vector3d::Unit(i) - x;                 // (e_i e_i^T - 1) x
+  }
+  f.col(9) << x.y(), x.x(), 0.0;   // (e_x e_y^T + e_y e_x^T) x
+  f.col(10) << x.z(), 0.0, x.x();  // (e_x e_z^T + e_z e_x^T) x
+  f.col(11) << 0.0, x.z(), x.y();  // (e_y e_z^T + e_z e_y^T) x
+  return f;
+}
+
+Eigen::MatrixXd InertiaFields(const FeModel& model) {
+  const long n = model.n_dofs();
+  if (model.mesh_map.size() == 0) {  // beams: 6 DOFs per node; rotations follow alpha
+    Eigen::MatrixXd A = Eigen::MatrixXd::Zero(n, 12);
+    for (long k = 0; k < model.n_nodes(); ++k) {
+      A.middleRows(6 * k, 3) = InertiaFieldAt(model.nodes.row(k).transpose());
+      A.block(6 * k + 3, 3, 3, 3).setIdentity();
+    }
+    return A;
+  }
+  // Solids: the model field T maps closest to the mesh field (exact on the free mesh nodes; a
+  // least-squares rigid fit on an RBE2 face, whose DOFs the load cases hold anyway).
+  const SparseMatrix& T = model.mesh_map;
+  Eigen::MatrixXd A_mesh(T.rows(), 12);
+  for (long k = 0; k < model.n_nodes(); ++k) A_mesh.middleRows(3 * k, 3) = InertiaFieldAt(model.nodes.row(k).transpose());
+  const SparseMatrix TtT = SparseMatrix(T.transpose() * T);
+  Eigen::SimplicialLDLT<SparseMatrix> normal(TtT);
+  return normal.solve(Eigen::MatrixXd(T.transpose() * A_mesh));
+}
+
 std::vector<int> InteriorDofs(const FeModel& model) {
   std::vector<char> is_boundary(model.n_dofs(), 0);
   for (const auto& dofs : model.interface_dofs) {
@@ -107,7 +141,7 @@ std::vector<int> InteriorDofs(const FeModel& model) {
 
 CraigBamptonResult CraigBamptonReduce(const FeModel& model, int internal_modes,
                                       const ProgressFn& progress, long dense_limit, double memory_limit_bytes,
-                                      const DerivativeRequest* derivatives) {
+                                      const DerivativeRequest* derivatives, const Eigen::MatrixXd* inertia_fields) {
   CraigBamptonResult r;
   Stopwatch clock;
   const int n = int(model.n_dofs());
@@ -323,6 +357,26 @@ CraigBamptonResult CraigBamptonReduce(const FeModel& model, int internal_modes,
       progress("modal derivatives", clock.Seconds(),
                Format("%.0f of %.0f kept (deflation tolerance ", double(kept), double(raw.cols())) +
                    Format("%.1e), %.0f linear solves", derivatives->tolerance, double(raw.cols())));
+    }
+    clock.Restart();
+  }
+  if (inertia_fields && inertia_fields->cols() > 0) {
+    // Inertia load cases (issue 13): D'Alembert loads -M A_k on the interior, interfaces held;
+    // the part in the span of the internal modes and derivatives is removed (M_ii inner
+    // product), since the basis carries it through its own coordinates.
+    const Eigen::MatrixXd MA = model.M * *inertia_fields;
+    Eigen::MatrixXd z(n_i, MA.cols());
+    for (int k = 0; k < n_i; ++k) z.row(k) = -MA.row(interior[k]);
+    Eigen::MatrixXd u = stiffness_solve(z);
+    for (int pass = 0; pass < 2; ++pass) {
+      if (m > 0) u -= Phi_i * (Phi_i.transpose() * (M.ii * u));
+      if (Theta.cols() > 0) u -= Theta * (Theta.transpose() * (M.ii * u));
+    }
+    r.inertia_displacements = Eigen::MatrixXd::Zero(n, u.cols());
+    for (int k = 0; k < n_i; ++k) r.inertia_displacements.row(interior[k]) = u.row(k);
+    if (progress) {
+      progress("inertia loads", clock.Seconds(),
+               Format("%.0f static solves with the interfaces held", double(u.cols())));
     }
     clock.Restart();
   }

@@ -45,6 +45,11 @@ struct CraigBamptonResult {
   long eigen_linear_solves = 0;
   bool dense_eigen = false;
   std::vector<std::pair<int, int>> derivative_pairs;  ///< of the derivatives kept, in order
+  /// With `inertia_fields`: the static response to each field's inertia load with the
+  /// interfaces held, u_k = -K_ii^-1 (M A_k)_i (zero on the interface DOFs, W u = 0 at RBE3
+  /// interfaces), minus its part in the span of the internal modes and modal derivatives
+  /// (M_ii-orthogonal projection: that part is the basis's own, dynamic, response), n_full x k.
+  Eigen::MatrixXd inertia_displacements;
 };
 
 /// `internal_modes` fixed-interface modes are kept. Reports stages through `progress`. With
@@ -52,11 +57,20 @@ struct CraigBamptonResult {
 /// `derivatives` (optional) appends modal derivatives to the basis.
 CraigBamptonResult CraigBamptonReduce(const FeModel& model, int internal_modes,
                                       const ProgressFn& progress, long dense_limit = 200,
-                                      double memory_limit_bytes = 0, const DerivativeRequest* derivatives = nullptr);
+                                      double memory_limit_bytes = 0, const DerivativeRequest* derivatives = nullptr,
+                                      const Eigen::MatrixXd* inertia_fields = nullptr);
 
 /// The six rigid-body motions (translations, rotations about the part origin) as fields on the
 /// model DOFs, n_dofs x 6.
 Eigen::MatrixXd RigidFields(const FeModel& model);
+
+/// The 12 unit inertia acceleration fields (formats/superelement.h kInertiaLoadCases) at a point
+/// x measured from the origin they refer to: e_i, e_i x x, (e_i e_i^T - 1) x, (e_i e_j^T + e_j e_i^T) x.
+Eigen::Matrix<double, 3, 12> InertiaFieldAt(const Eigen::Vector3d& x);
+
+/// The 12 fields on the model DOFs about the part origin (beams: the rotation DOFs follow the
+/// angular accelerations), n_dofs x 12.
+Eigen::MatrixXd InertiaFields(const FeModel& model);
 
 /// The interior DOFs (all DOFs not used by an interface), ascending.
 std::vector<int> InteriorDofs(const FeModel& model);

@@ -87,9 +87,18 @@ Assembly AssembleDynamic(const SystemModel& model, const DofMap& dofs, DynamicSt
     const Eigen::VectorXd w = GatherBody(model, dofs, s.config, int(b), s.W);
     const Eigen::VectorXd wdot = GatherBodyAcceleration(model, dofs, int(b), node_acc, s.Wdot);
     Eigen::VectorXd f_int, f_in;
-    Eigen::MatrixXd Kb, Mb, Cb;
-    body.ElasticForce(c, frame, &f_int, matrices ? &Kb : nullptr);
+    Eigen::MatrixXd Kb, Mb, Cb, d_load;
+    // Inertia stiffening (issue 13): K + K_sigma(a), a from this iterate's frame motion; its
+    // velocity and acceleration derivatives go into C and M of the iteration matrix.
+    const bool stiffening = body.has_inertia_stiffening();
+    const InertiaLoadFactors load = stiffening ? body.InertiaLoads(c, frame, w, wdot, model.gravity) : InertiaLoadFactors{};
+    body.ElasticForce(c, frame, &f_int, matrices ? &Kb : nullptr, stiffening ? &load : nullptr,
+                      stiffening && matrices ? &d_load : nullptr);
     body.InertiaForce(c, frame, w, wdot, &f_in, matrices ? &Mb : nullptr, matrices ? &Cb : nullptr);
+    if (stiffening && matrices) {
+      Mb += d_load * load.d_wdot;
+      Cb += d_load * load.d_w;
+    }
     // Configuration derivative of the inertia force: d(M_g wdot)/dq exactly; that of the
     // quadratic velocity terms by central differences with options.full_inertia_tangent.
     if (matrices) Kb += body.InertiaConfigurationTangent(c, frame, w, wdot, full_inertia_tangent);
@@ -473,7 +482,17 @@ Assembly AssembleMidpoint(const SystemModel& model, const DofMap& dofs, const Dy
       f_in = f_acc;
     }
     body.AddModalDamping(wm, f_in, &Cb);
-    body.ElasticForce(cm, fm, &f_int, &Kb);
+    if (body.has_inertia_stiffening()) {
+      // Inertia stiffening (issue 13) at the mid configuration with the step's mean velocity and
+      // acceleration; d wm = delta / h (C / h) and d (w1 - w0) / h = V delta / h (M V / h).
+      const InertiaLoadFactors load = body.InertiaLoads(cm, fm, wm, (w1 - w0) / h, model.gravity);
+      Eigen::MatrixXd d_load;
+      body.ElasticForce(cm, fm, &f_int, &Kb, &load, &d_load);
+      Cb += d_load * load.d_w;
+      Mb += d_load * load.d_wdot;
+    } else {
+      body.ElasticForce(cm, fm, &f_int, &Kb);
+    }
     Eigen::VectorXd f_grav = Eigen::VectorXd::Zero(body.n_coordinates());
     if (model.gravity.squaredNorm() > 0) f_grav = body.GravityForce(cm, fm, model.gravity);
     // Scale: each term on its own (for a torque-free body the momentum change and the source

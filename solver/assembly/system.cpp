@@ -283,7 +283,16 @@ SystemForces AssembleStatic(const SystemModel& model, const DofMap& dofs, System
     state.frames[b] = frame;
     Eigen::VectorXd f;
     Eigen::MatrixXd K;
-    body.ElasticForce(c, frame, &f, with_tangent ? &K : nullptr);
+    const bool gravity_on = model.static_gravity_end > 0 && model.gravity.squaredNorm() > 0;
+    if (gravity_on && body.has_inertia_stiffening()) {
+      // The stress of the body's own weight stiffens it (issue 13: load factors -R_j^T g at rest).
+      const double ramp = std::min(lambda / model.static_gravity_end, 1.0);
+      const Eigen::VectorXd zero = Eigen::VectorXd::Zero(body.n_coordinates());
+      const InertiaLoadFactors load = body.InertiaLoads(c, frame, zero, zero, ramp * model.gravity);
+      body.ElasticForce(c, frame, &f, with_tangent ? &K : nullptr, &load);
+    } else {
+      body.ElasticForce(c, frame, &f, with_tangent ? &K : nullptr);
+    }
     out.elastic_energy += body.ElasticEnergy(c, frame);
     out.force_scale = std::max({out.force_scale, body.ForceNorm(f), body.force_floor()});
     out.roundoff += body.RoundOffForce(c);

@@ -55,7 +55,12 @@ SuperelementBody::SuperelementBody(const Superelement& se, const SuperelementOpt
   force_weights_.tail(n_modes_).setConstant(modal_weight_);
   k_max_ = (force_weights_.asDiagonal() * K_ * force_weights_.asDiagonal()).cwiseAbs().maxCoeff();
   force_floor_ = 1e-4 * k_max_ * length;
-  if (options_.polynomial_force && se.polynomial) polynomial_ = se.polynomial;
+  // A file's polynomial is the modal derivatives' cubic force (option polynomial_force) or,
+  // without derivatives, the geometric stiffening's quadratic force (option geometric_stiffening).
+  if (se.polynomial && (se.polynomial->cubic() ? options_.polynomial_force : options_.geometric_stiffening)) {
+    polynomial_ = se.polynomial;
+  }
+  if (options_.geometric_stiffening) K_sigma_ = se.inertia_stiffness;
   initial_frame_.x = placement_x_ + placement_R_ * origin_part_;
   initial_frame_.R = placement_R_;
   initial_frame_.ok = true;
@@ -144,12 +149,61 @@ FrameSolution SuperelementBody::SolveFrame(const BodyConfiguration& c, const Fra
   return frame;
 }
 
-Eigen::VectorXd SuperelementBody::LocalForce(const Eigen::VectorXd& q) const {
-  return polynomial_ ? PolynomialForce(K_, *polynomial_, q) : Eigen::VectorXd(K_ * q);
+Eigen::VectorXd SuperelementBody::LocalForce(const Eigen::VectorXd& q, const InertiaLoadFactors* load) const {
+  Eigen::VectorXd f = polynomial_ ? PolynomialForce(K_, *polynomial_, q) : Eigen::VectorXd(K_ * q);
+  if (load && !K_sigma_.empty()) {
+    for (int k = 0; k < kInertiaLoadCaseCount; ++k)
+      if (load->a[k] != 0.0) f.noalias() += load->a[k] * (K_sigma_[size_t(k)] * q);
+  }
+  return f;
 }
 
-Eigen::MatrixXd SuperelementBody::LocalTangent(const Eigen::VectorXd& q) const {
-  return polynomial_ ? PolynomialTangent(K_, *polynomial_, q) : K_;
+Eigen::MatrixXd SuperelementBody::LocalTangent(const Eigen::VectorXd& q, const InertiaLoadFactors* load) const {
+  Eigen::MatrixXd K = polynomial_ ? PolynomialTangent(K_, *polynomial_, q) : K_;
+  if (load && !K_sigma_.empty()) {
+    for (int k = 0; k < kInertiaLoadCaseCount; ++k)
+      if (load->a[k] != 0.0) K += load->a[k] * K_sigma_[size_t(k)];
+  }
+  return K;
+}
+
+InertiaLoadFactors SuperelementBody::InertiaLoads(const BodyConfiguration& c, const FrameSolution& frame,
+                                                   const BodyVelocity& w, const BodyVelocity& wdot,
+                                                   const Eigen::Vector3d& gravity) const {
+  const int n = n_coordinates();
+  InertiaLoadFactors out;
+  out.d_w = Eigen::MatrixXd::Zero(12, n);
+  out.d_wdot = Eigen::MatrixXd::Zero(12, n);
+  const Eigen::VectorXd q = LocalCoordinates(c, frame);
+  const Kinematics kin = ComputeKinematics(q);
+  // Z Rbar^T: node vectors to frame axes, then the frame's part.
+  Eigen::MatrixXd ZR = kin.Z;
+  for (int a = 0; a < 2 * n_nodes_; ++a) ZR.middleCols<3>(3 * a) = kin.Z.middleCols<3>(3 * a) * frame.R.transpose();
+  const Eigen::Vector3d omega = ZR.bottomRows<3>() * w;
+  const Eigen::MatrixXd d_omega = ZR.bottomRows<3>();  // 3 x n
+  // Node accelerations in frame axes minus the centrifugal part of the rigid motion.
+  Eigen::Matrix<double, 6, 1> acc = ZR * wdot;
+  Eigen::Matrix<double, 6, 3> d_acc_d_omega = Eigen::Matrix<double, 6, 3>::Zero();
+  for (int a = 0; a < n_nodes_; ++a) {
+    const Eigen::Vector3d r = X_[a] + q.segment<3>(6 * a);
+    const Eigen::Vector3d centrifugal = omega * omega.dot(r) - omega.squaredNorm() * r;
+    // d/d omega [omega (omega . r) - |omega|^2 r] = (omega . r) 1 + omega r^T - 2 r omega^T.
+    const Eigen::Matrix3d d_centrifugal =
+        omega.dot(r) * Eigen::Matrix3d::Identity() + omega * r.transpose() - 2.0 * r * omega.transpose();
+    acc -= kin.Z.middleCols<3>(6 * a) * centrifugal;
+    d_acc_d_omega -= kin.Z.middleCols<3>(6 * a) * d_centrifugal;
+  }
+  out.a.head<3>() = acc.head<3>() - frame.R.transpose() * gravity;
+  out.a.segment<3>(3) = acc.tail<3>();
+  out.a.tail<6>() << omega.x() * omega.x(), omega.y() * omega.y(), omega.z() * omega.z(), omega.x() * omega.y(),
+      omega.x() * omega.z(), omega.y() * omega.z();
+  out.d_wdot.topRows<6>() = ZR;
+  Eigen::Matrix<double, 6, 3> d_products;
+  d_products << 2 * omega.x(), 0, 0, 0, 2 * omega.y(), 0, 0, 0, 2 * omega.z(), omega.y(), omega.x(), 0, omega.z(), 0,
+      omega.x(), 0, omega.z(), omega.y();
+  out.d_w.topRows<6>() = d_acc_d_omega * d_omega;
+  out.d_w.bottomRows<6>() = d_products * d_omega;
+  return out;
 }
 
 double SuperelementBody::ElasticEnergy(const BodyConfiguration& c, const FrameSolution& frame) const {
@@ -158,11 +212,13 @@ double SuperelementBody::ElasticEnergy(const BodyConfiguration& c, const FrameSo
 }
 
 void SuperelementBody::ElasticForce(const BodyConfiguration& c, const FrameSolution& frame, Eigen::VectorXd* f,
-                                    Eigen::MatrixXd* tangent) const {
+                                    Eigen::MatrixXd* tangent, const InertiaLoadFactors* load,
+                                    Eigen::MatrixXd* d_load) const {
   const int n = n_coordinates();
   const Eigen::VectorXd q = LocalCoordinates(c, frame);
   const Kinematics kin = ComputeKinematics(q);
-  const Eigen::VectorXd Q = LocalForce(q);
+  if (!load || K_sigma_.empty()) load = nullptr;
+  const Eigen::VectorXd Q = LocalForce(q, load);
   const Eigen::VectorXd Qhat = options_.approximated ? Eigen::VectorXd(T0_.transpose() * Q)
                                                      : Eigen::VectorXd(kin.B.transpose() * Q);
   // Rbar: R_j on every node's force and moment, identity on modal rows.
@@ -172,10 +228,18 @@ void SuperelementBody::ElasticForce(const BodyConfiguration& c, const FrameSolut
     return global;
   };
   if (f) *f = rotate(Qhat);
+  if (d_load) {
+    d_load->setZero(n, kInertiaLoadCaseCount);
+    for (int k = 0; load && k < kInertiaLoadCaseCount; ++k) {
+      const Eigen::VectorXd Kq_k = K_sigma_[size_t(k)] * q;
+      d_load->col(k) = rotate(options_.approximated ? Eigen::VectorXd(T0_.transpose() * Kq_k)
+                                                    : Eigen::VectorXd(kin.B.transpose() * Kq_k));
+    }
+  }
   if (!tangent) return;
 
   Eigen::MatrixXd Kt;
-  const Eigen::MatrixXd Kq = LocalTangent(q);
+  const Eigen::MatrixXd Kq = LocalTangent(q, load);
   if (options_.approximated) {
     Kt = T0_.transpose() * Kq * kin.B;
   } else {

@@ -43,6 +43,17 @@ struct SuperelementOptions {
   /// With modal derivatives in the file: the local internal force is its cubic polynomial
   /// (formats/reduced_polynomial.h, Green-Lagrange inside the body) instead of K q_loc.
   bool polynomial_force = true;
+  /// Geometric stiffening from the file (issue 13): the quadratic Green-Lagrange force of a file
+  /// without modal derivatives and the inertia load cases' geometric stiffness. false: ignored.
+  bool geometric_stiffening = true;
+};
+
+/// The 12 inertia load factors of a body's floating frame (formats/superelement.h
+/// kInertiaLoadCases) and their derivatives with respect to the body's velocities and
+/// accelerations (12 x n each). See SuperelementBody::InertiaLoads.
+struct InertiaLoadFactors {
+  Eigen::Matrix<double, 12, 1> a = Eigen::Matrix<double, 12, 1>::Zero();
+  Eigen::MatrixXd d_w, d_wdot;
 };
 
 /// Velocities of one body's system coordinates: per node xdot_k, omega_k (spatial), then etadot.
@@ -116,8 +127,31 @@ class SuperelementBody {
 
   /// Elastic force f (6N + m; per node force then moment, global axes; then modal forces) and,
   /// if `tangent` is not null, its derivative with respect to (dx_k, dpi_k, d eta).
+  /// With `load` (and a file with inertia stiffening) the local stiffness is K + K_sigma(a)
+  /// (InertiaLoads); `d_load` (n x 12) then receives df/da at fixed configuration.
   void ElasticForce(const BodyConfiguration& c, const FrameSolution& frame, Eigen::VectorXd* f,
-                    Eigen::MatrixXd* tangent) const;
+                    Eigen::MatrixXd* tangent, const InertiaLoadFactors* load = nullptr,
+                    Eigen::MatrixXd* d_load = nullptr) const;
+
+  /// True when the body uses the geometric stiffness of inertia load cases (file and option).
+  bool has_inertia_stiffening() const { return !K_sigma_.empty(); }
+
+  /// Stiffening from rigid-body inertia loads (issue 13; Wallrapp's standard input data, the SID
+  /// of Simpack; Cardona 2000 for the superelement setting). The reducer stored
+  /// K_sigma,k = Phi^T G(sigma_k) Phi for the stress sigma_k of the k-th unit inertia field with
+  /// the interfaces held; the body's local stiffness is K + sum_k a_k K_sigma,k with a_k the
+  /// floating frame's current values, in frame axes:
+  ///   a_0..2  = R_j^T (xddot_j - g)          (frame origin acceleration, gravity: d'Alembert)
+  ///   a_3..5  = alpha                        (angular acceleration)
+  ///   a_6..11 = w_x^2, w_y^2, w_z^2, w_x w_y, w_x w_z, w_y w_z   (omega x (omega x r) field)
+  /// The frame's velocity [v_j; omega] = Z Rbar^T w (thesis 3.17); its acceleration from the
+  /// nodes' accelerations with the centrifugal part of a rigid motion taken out, which Z maps
+  /// exactly (Z Phi_rig = 1): for a rigid motion R_j^T xddot_k = a_j + alpha x r_k + omega x (omega x r_k)
+  /// and R_j^T omegadot_k = alpha, so [a_j; alpha] = Z (Rbar^T wdot - c(omega)),
+  /// c_k = omega x (omega x r_k) on node k's translation rows. d_w and d_wdot are exact at fixed
+  /// configuration (the configuration dependence of R_j and Z is left out of the tangent).
+  InertiaLoadFactors InertiaLoads(const BodyConfiguration& c, const FrameSolution& frame, const BodyVelocity& w,
+                                  const BodyVelocity& wdot, const Eigen::Vector3d& gravity) const;
 
   /// Strain energy q_loc^T K q_loc / 2.
   double ElasticEnergy(const BodyConfiguration& c, const FrameSolution& frame) const;
@@ -195,8 +229,9 @@ class SuperelementBody {
   Eigen::MatrixXd K_, M_, Phi_CB_;
   std::optional<PolynomialStiffness> polynomial_;  ///< set when the file has it and the option is on
   // Local internal force and its tangent: K q or the polynomial's.
-  Eigen::VectorXd LocalForce(const Eigen::VectorXd& q) const;
-  Eigen::MatrixXd LocalTangent(const Eigen::VectorXd& q) const;
+  Eigen::VectorXd LocalForce(const Eigen::VectorXd& q, const InertiaLoadFactors* load = nullptr) const;
+  Eigen::MatrixXd LocalTangent(const Eigen::VectorXd& q, const InertiaLoadFactors* load = nullptr) const;
+  std::vector<Eigen::MatrixXd> K_sigma_;  ///< the 12 inertia load case geometric stiffnesses, or none
   std::vector<Eigen::Vector3d> X_;    ///< node positions relative to the frame origin, frame axes
   std::vector<Eigen::Matrix3d> R0_;   ///< node orientations relative to the frame
   Eigen::MatrixXd T0_;                ///< 1 - Phi_rig0 Phi_CB (approximated option)

@@ -144,6 +144,18 @@ Scene BuildScene(const SceneSpec& spec) {
     options.cardona_option_b = b.option_b;
     options.polynomial_force = b.polynomial_force;
     options.modal_damping = b.modal_damping;
+    // Geometric stiffening (issue 13): what the file has, unless switched off; asked for
+    // explicitly from a file without it is an error, otherwise a note.
+    options.geometric_stiffening = b.geometric_stiffening.value_or(true);
+    const bool file_has_stiffening = !se.inertia_stiffness.empty();
+    if (b.geometric_stiffening.value_or(false) && !file_has_stiffening) {
+      throw InputError(b.where + ": body '" + b.name + "': options.geometric_stiffening is true but " + file.string() +
+                       " has no geometric stiffening (reduce it with reduction.geometric_stiffening: true)");
+    }
+    if (!b.geometric_stiffening.has_value() && !file_has_stiffening) {
+      scene.notes.push_back("body '" + b.name + "': " + file.string() +
+                            " has no geometric stiffening; the body is linear inside (re-reduce it to add it)");
+    }
     std::vector<int> nodes;
     for (const auto& [iname, _] : b.nodes) {
       bool found = false;

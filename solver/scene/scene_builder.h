@@ -31,6 +31,8 @@ struct Scene {
   /// scene nodes the animation joins by lines from the first one (a rigid body: its centre of
   /// mass to each of its points; a superelement: its first interface to the others).
   std::vector<std::vector<int>> stick_nodes;
+  /// Lines for the log (e.g. a body whose file has no geometric stiffening).
+  std::vector<std::string> notes;
 };
 
 /// Throws InputError for: a missing or wrong-version superelement file, an interface name the

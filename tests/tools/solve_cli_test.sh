@@ -344,6 +344,12 @@ expect "node placed twice" 2 "node 'n1' is placed at" 's/position: \[0.1, 0, 0\]
 # Wrong version superelement file.
 cp "$work/segment.h5" "$work/v2.h5"
 $py -c "import h5py; f=h5py.File('$work/v2.h5','r+'); f.attrs['format_version_major']=2" 
+# Geometric stiffening asked for explicitly from a file without it (issue 13): one line, exit 2.
+expect "stiffening not in the file" 2 "options.geometric_stiffening is true but" 's/{name: b3, superelement: segment.h5/{name: b3, options: {geometric_stiffening: true}, superelement: segment.h5/'
+"$bin/femb-reduce" -q "$work/segment.yaml" -o "$work/segment_gs.h5" --set reduction.geometric_stiffening=true || fail "reduce with stiffening"
+sed 's/{name: b3, superelement: segment.h5/{name: b3, options: {geometric_stiffening: true}, superelement: segment_gs.h5/' "$work/scene.yaml" > "$work/gs.yaml"
+"$bin/femb-solve" "$work/gs.yaml" -o "$work/gs_out" > "$work/gs_log.txt" 2>&1 && grep -q "note: body 'b0': .*has no geometric stiffening" "$work/gs_log.txt" \
+  && ! grep -q "note: body 'b3'" "$work/gs_log.txt" && ok || fail "stiffening file used, note for the others: $(cat "$work/gs_log.txt")"
 expect "wrong version" 2 "is not supported by this femb" 's/{name: b3, superelement: segment.h5/{name: b3, superelement: v2.h5/'
 # Corrupt superelement files: one line naming the file, the dataset and the check (a NaN in
 # Phi_CB, the origin or the interface frames once crashed femb-solve; an indefinite M ran to the end).
