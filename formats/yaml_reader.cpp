@@ -210,6 +210,12 @@ void YamlDocument::Set(const std::string& assignment) {
       chain.push_back(list[std::size_t(index)]);
       continue;
     }
+    // A key below a list item or a scalar (found by fuzzing: 'points.R[0].element' on a
+    // coordinate list made yaml-cpp throw BadSubscript).
+    if (chain.back().IsDefined() && !chain.back().IsNull() && !chain.back().IsMap()) {
+      throw InputError("--set " + assignment + ": '" + walked + "' is not a mapping in " + file() + " (it has no key '" +
+                       name + "')");
+    }
     walked += (walked.empty() ? "" : ".") + name;
     YAML::Node next = chain.back()[name];
     const bool indexed = steps[i + 1].second >= 0;

@@ -103,6 +103,10 @@ TEST(PartFile, BadOverridesAreNamed) {
   EXPECT_NE(Error(kGood, {"reduction.modes=3"}).find("--set reduction.modes: unknown key 'modes'"), std::string::npos)
       << Error(kGood, {"reduction.modes=3"});
   EXPECT_NE(Error(kGood, {"novalue"}).find("expected key.path=value"), std::string::npos);
+  // Found by fuzzing (tests/fuzz/regressions/yaml_fuzz/set_key_below_list_item): a key below a
+  // list item that is a number threw yaml-cpp's BadSubscript instead of an InputError.
+  const std::string below = Error(kGood, {"beam.points.B[0].x.y=3"});
+  EXPECT_NE(below.find("--set beam.points.B[0].x.y=3: 'beam.points.B[0]' is not a mapping"), std::string::npos) << below;
 }
 
 // Mixed units: a value plausible only in another unit system names that system; check_units:
