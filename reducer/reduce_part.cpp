@@ -59,7 +59,7 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
   };
 
   Stopwatch clock;
-  char detail[200];
+  char detail[640];
   FeModel model;
   if (part.type == "solid") {
     model = BuildSolidModel(part, report);
@@ -91,9 +91,10 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
   DerivativeRequest request;
   std::unique_ptr<NonlinearModel> nonlinear;
   SparseMatrix to_model_dofs = model.mesh_map;  // the nonlinear model's DOFs = this x model DOFs
-  if (part.reduction.modal_derivatives.enabled) {
-    request.pairs = DerivativePairs(part, n_b, n_b + m);
-    request.tolerance = part.reduction.modal_derivatives.tolerance;
+  // The Green-Lagrange (solids) or von Karman (beams) model, built once for the derivatives
+  // and the geometric stiffening.
+  auto make_nonlinear = [&] {
+    if (nonlinear) return;
     if (part.type == "solid") {
       nonlinear = std::make_unique<SvkSolidMesh>(SolidTypeOf(model.cell_type), model.nodes, model.cells, part.material);
     } else {
@@ -101,6 +102,11 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
       to_model_dofs.resize(model.n_dofs(), model.n_dofs());
       to_model_dofs.setIdentity();
     }
+  };
+  if (part.reduction.modal_derivatives.enabled) {
+    request.pairs = DerivativePairs(part, n_b, n_b + m);
+    request.tolerance = part.reduction.modal_derivatives.tolerance;
+    make_nonlinear();
     const double size = (model.nodes.colwise().maxCoeff() - model.nodes.colwise().minCoeff()).norm();
     request.stiffness_derivative = [&, size](const Eigen::MatrixXd& shapes, const std::vector<std::pair<int, int>>& pairs) {
       const SparseMatrix& T = to_model_dofs;
@@ -170,15 +176,7 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
     se.K = 0.5 * (se.K + se.K.transpose()).eval();
   }
   const bool derivatives = se.n_modal_derivatives > 0;
-  if (stiffening && !nonlinear) {
-    if (part.type == "solid") {
-      nonlinear = std::make_unique<SvkSolidMesh>(SolidTypeOf(model.cell_type), model.nodes, model.cells, part.material);
-    } else {
-      nonlinear = std::make_unique<VonKarmanBeams>(part);
-      to_model_dofs.resize(model.n_dofs(), model.n_dofs());
-      to_model_dofs.setIdentity();
-    }
-  }
+  if (stiffening) make_nonlinear();
   if (nonlinear && (derivatives || stiffening)) {
     // The reduced internal force on the whole basis (static and internal modes, derivatives):
     // with modal derivatives the cubic polynomial of reduced_polynomial.h; for the geometric

@@ -75,6 +75,19 @@ TEST(SuperelementChecks, EachDefectIsCaught) {
     EXPECT_FALSE(Passed(AnalyzeSuperelement(se), "floating_frame"));
     se.floating_frame.Phi_CB(5, se.floating_frame.Phi_CB.cols() - 1) = 1e12;
     EXPECT_FALSE(Passed(AnalyzeSuperelement(se), "floating_frame"));
+    // Where K Phi_rig0 is exactly zero in that rigid direction the residual stays 0; the
+    // projector's M-norm still catches it (phi_cb_mode_column_1e308_zero_residual).
+    se = Good();
+    const Eigen::MatrixXd Phi_rig0 = RigidBodyModes(se, se.floating_frame.origin);
+    se.K -= se.K * Phi_rig0 * se.floating_frame.Phi_CB;  // K Phi_rig0 = 0 to round-off
+    se.K = 0.5 * (se.K + se.K.transpose()).eval();
+    se.floating_frame.Phi_CB(2, se.floating_frame.Phi_CB.cols() - 1) = 1e308;
+    EXPECT_FALSE(Passed(AnalyzeSuperelement(se), "floating_frame"));
+  }
+  {
+    // A valid file's projector is moderate: the check passes with its norm printed.
+    const SuperelementAnalysis a = AnalyzeSuperelement(Good());
+    EXPECT_TRUE(Passed(a, "floating_frame"));
   }
   {
     Superelement se = Good();
