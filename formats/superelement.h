@@ -98,7 +98,7 @@ struct Superelement {
   /// With modal derivatives: the quadratic and cubic coefficients of the reduced Green-Lagrange
   /// internal force (reduced_polynomial.h); the solver then uses it in place of K q.
   std::optional<PolynomialStiffness> polynomial;
-  /// Geometric stiffening from rigid-body inertia loads (issue 13; solver/body/inertia_stiffening.h):
+  /// Geometric stiffening from rigid-body inertia loads (issue 13; SuperelementBody::InertiaLoads):
   /// K_sigma,k = Phi^T G(sigma_k) Phi (n x n, symmetric) of the stress sigma_k of unit inertia
   /// load case k (kInertiaLoadCases) with the interfaces held; empty when not computed.
   std::vector<Eigen::MatrixXd> inertia_stiffness;

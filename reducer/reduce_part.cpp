@@ -182,7 +182,7 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
     // with modal derivatives the cubic polynomial of reduced_polynomial.h; for the geometric
     // stiffening alone its quadratic part (the geometric stiffness of the stress of each basis
     // vector). Its linear part equals K_r. With stiffening also the geometric stiffness of the
-    // inertia load cases' stresses (solver/body/inertia_stiffening.h), about the frame origin o:
+    // inertia load cases' stresses (SuperelementBody::InertiaLoads, solver/body/superelement_body.h), about the frame origin o:
     // a field about o is the one about the part origin minus the translation it has at o.
     Stopwatch tensors;
     const Eigen::MatrixXd mesh_shapes = to_model_dofs * cb.shapes;

@@ -12,6 +12,13 @@ namespace {
 
 using Vector6 = Eigen::Matrix<double, 6, 1>;
 
+// The linear (engineering) Voigt strain of a displacement gradient G_ij = d u_i / d X_j.
+Vector6 LinearStrain(const Eigen::Matrix3d& G) {
+  Vector6 e;
+  e << G(0, 0), G(1, 1), G(2, 2), G(1, 2) + G(2, 1), G(0, 2) + G(2, 0), G(0, 1) + G(1, 0);
+  return e;
+}
+
 // dN/dX (n x 3) and dV at every quadrature point of one element (solid_element.h); throws for
 // inverted elements.
 void ElementPoints(SolidType type, const Eigen::MatrixXd& X, long element_id, std::vector<Eigen::MatrixXd>* dNdX,
@@ -207,7 +214,7 @@ ReducedPolynomial ReduceSvk(const SvkSolidMesh& solid, const Eigen::MatrixXd& me
         for (int a = 0; a < ne; ++a) U.row(a) = element.block(3 * a, j, 3, 1).transpose();
         G[size_t(j)] = U.transpose() * g;
         const Eigen::Matrix3d& Gj = G[size_t(j)];
-        L.col(j) << Gj(0, 0), Gj(1, 1), Gj(2, 2), Gj(1, 2) + Gj(2, 1), Gj(0, 2) + Gj(2, 0), Gj(0, 1) + Gj(1, 0);
+        L.col(j) = LinearStrain(Gj);
       }
       int p = 0;
       for (int j = 0; j < n; ++j)
@@ -217,15 +224,11 @@ ReducedPolynomial ReduceSvk(const SvkSolidMesh& solid, const Eigen::MatrixXd& me
         }
       for (int f = 0; f < n_fields; ++f) {
         for (int a = 0; a < ne; ++a) U.row(a) = field_element.block(3 * a, f, 3, 1).transpose();
-        const Eigen::Matrix3d Gw = U.transpose() * g;
-        Eigen::Matrix<double, 6, 1> e;
-        e << Gw(0, 0), Gw(1, 1), Gw(2, 2), Gw(1, 2) + Gw(2, 1), Gw(0, 2) + Gw(2, 0), Gw(0, 1) + Gw(1, 0);
-        Q.col(pair_fields[size_t(f)].first) += 2 * e;
+        Q.col(pair_fields[size_t(f)].first) += 2 * LinearStrain(U.transpose() * g);
       }
       for (int f = 0; f < n_stress; ++f) {
         for (int a = 0; a < ne; ++a) U.row(a) = stress_element.block(3 * a, f, 3, 1).transpose();
-        const Eigen::Matrix3d Gs = U.transpose() * g;
-        L_stress.col(f) << Gs(0, 0), Gs(1, 1), Gs(2, 2), Gs(1, 2) + Gs(2, 1), Gs(0, 2) + Gs(2, 0), Gs(0, 1) + Gs(1, 0);
+        L_stress.col(f) = LinearStrain(U.transpose() * g);
       }
       accumulator.Add(dV, C, L, Q, n_stress > 0 ? &L_stress : nullptr);
     }

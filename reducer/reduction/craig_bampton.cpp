@@ -70,6 +70,19 @@ Blocks Partition(const SparseMatrix& A, const std::vector<int>& interior_index,
 
 }  // namespace
 
+namespace {
+
+// Solids: the model DOF fields that the mesh map T sends closest to the given mesh fields
+// (3 rows per mesh node): least squares, (T^T T) x = T^T f.
+Eigen::MatrixXd ModelFieldsFromMesh(const FeModel& model, const Eigen::MatrixXd& mesh_fields) {
+  const SparseMatrix& T = model.mesh_map;
+  const SparseMatrix TtT = SparseMatrix(T.transpose() * T);
+  Eigen::SimplicialLDLT<SparseMatrix> normal(TtT);
+  return normal.solve(Eigen::MatrixXd(T.transpose() * mesh_fields));
+}
+
+}  // namespace
+
 Eigen::MatrixXd RigidFields(const FeModel& model) {
   const long n = model.n_dofs();
   auto rigid = [](const Eigen::Vector3d& x, bool with_rotation) {
@@ -84,14 +97,11 @@ Eigen::MatrixXd RigidFields(const FeModel& model) {
     for (long k = 0; k < model.n_nodes(); ++k) R.middleRows(6 * k, 6) = rigid(model.nodes.row(k).transpose(), true);
     return R;
   }
-  // Solids: the mesh field is rigid; the model field is the one T maps onto it (least squares,
-  // exact: T maps rigid model motions, RBE2 nodes included, to rigid mesh motions).
-  const SparseMatrix& T = model.mesh_map;
-  Eigen::MatrixXd R_mesh(T.rows(), 6);
+  // Solids: the mesh field is rigid; the model field is the one T maps onto it (exact: T maps
+  // rigid model motions, RBE2 nodes included, to rigid mesh motions).
+  Eigen::MatrixXd R_mesh(model.mesh_map.rows(), 6);
   for (long k = 0; k < model.n_nodes(); ++k) R_mesh.middleRows(3 * k, 3) = rigid(model.nodes.row(k).transpose(), false);
-  const SparseMatrix TtT = SparseMatrix(T.transpose() * T);
-  Eigen::SimplicialLDLT<SparseMatrix> normal(TtT);
-  return normal.solve(Eigen::MatrixXd(T.transpose() * R_mesh));
+  return ModelFieldsFromMesh(model, R_mesh);
 }
 
 Eigen::Matrix<double, 3, 12> InertiaFieldAt(const Eigen::Vector3d& x) {
@@ -117,14 +127,11 @@ Eigen::MatrixXd InertiaFields(const FeModel& model) {
     }
     return A;
   }
-  // Solids: the model field T maps closest to the mesh field (exact on the free mesh nodes; a
-  // least-squares rigid fit on an RBE2 face, whose DOFs the load cases hold anyway).
-  const SparseMatrix& T = model.mesh_map;
-  Eigen::MatrixXd A_mesh(T.rows(), 12);
+  // Solids: exact on the free mesh nodes; a least-squares rigid fit on an RBE2 face, whose DOFs
+  // the load cases hold anyway.
+  Eigen::MatrixXd A_mesh(model.mesh_map.rows(), 12);
   for (long k = 0; k < model.n_nodes(); ++k) A_mesh.middleRows(3 * k, 3) = InertiaFieldAt(model.nodes.row(k).transpose());
-  const SparseMatrix TtT = SparseMatrix(T.transpose() * T);
-  Eigen::SimplicialLDLT<SparseMatrix> normal(TtT);
-  return normal.solve(Eigen::MatrixXd(T.transpose() * A_mesh));
+  return ModelFieldsFromMesh(model, A_mesh);
 }
 
 std::vector<int> InteriorDofs(const FeModel& model) {
