@@ -196,6 +196,9 @@ SceneSpec ParseScene(const std::string& text, const std::string& name, const std
         b.polynomial_force = v->OneOf({"polynomial", "linear"}, "(polynomial: the file's Green-Lagrange force when it has modal derivatives)") == "polynomial";
       }
       if (auto v = om.Optional("geometric_stiffening")) b.geometric_stiffening = v->Bool();
+      if (auto v = om.Optional("inertia")) {
+        b.exact_inertia = v->OneOf({"exact", "corotational"}, "(exact: the file's inertia invariants)") == "exact";
+      }
       if (auto v = om.Optional("inertia_option")) b.option_b = v->OneOf({"A", "B"}, "(Cardona's options)") == "B";
       if (auto v = om.Optional("modal_damping")) {
         b.modal_damping = v->Number();

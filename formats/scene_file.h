@@ -38,6 +38,9 @@ struct SceneBodySpec {
   bool polynomial_force = true;  ///< use the file's polynomial internal force when it has one
   /// options.geometric_stiffening: unset = use what the file has; true = require it; false = off.
   std::optional<bool> geometric_stiffening;
+  /// options.inertia: unset = exact when the file has the inertia invariants; exact = require
+  /// them; corotational = the thesis' kinetic energy (SuperelementOptions::exact_inertia).
+  std::optional<bool> exact_inertia;
   double modal_damping = 0.0;    ///< damping ratio of the internal modes
   std::string where;
 };

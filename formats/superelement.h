@@ -102,6 +102,14 @@ struct Superelement {
   /// K_sigma,k = Phi^T G(sigma_k) Phi (n x n, symmetric) of the stress sigma_k of unit inertia
   /// load case k (kInertiaLoadCases) with the interfaces held; empty when not computed.
   std::vector<Eigen::MatrixXd> inertia_stiffness;
+  /// Inertia invariants of the floating frame formulation (issue 13; the SID of Wallrapp): with
+  /// S_a the skew matrix of e_a on every translation and rotation triple of the full model (it
+  /// turns a displacement field with the frame), Phi the full basis and M the full mass matrix,
+  ///   inertia_gamma[a] = Gamma_a  = Phi^T M S_a Phi          (a = x, y, z)
+  ///   inertia_xi[k]    = Xi_ab    = (S_a Phi)^T M (S_b Phi)  (ab = xx yy zz xy xz yz; Xi_ba = Xi_ab^T)
+  /// (n x n each); empty when not computed. SuperelementBody uses them for the exact kinetic
+  /// energy of the reduced field in the floating frame.
+  std::vector<Eigen::MatrixXd> inertia_gamma, inertia_xi;
   std::optional<Visualization> visualization;
   Provenance provenance;
 

@@ -56,6 +56,8 @@ Check Finite(const Superelement& se) {
   for (const Eigen::MatrixXd& K_sigma : se.inertia_stiffness) {
     datasets.emplace_back("/reduced/geometric_stiffness/inertia", K_sigma);
   }
+  for (const Eigen::MatrixXd& G : se.inertia_gamma) datasets.emplace_back("/reduced/inertia_invariants/Gamma", G);
+  for (const Eigen::MatrixXd& X : se.inertia_xi) datasets.emplace_back("/reduced/inertia_invariants/Xi", X);
   if (se.visualization) {
     datasets.emplace_back("/visualization/nodes", se.visualization->nodes);
     datasets.emplace_back("/visualization/shapes", se.visualization->shapes);
@@ -186,6 +188,29 @@ SuperelementChecks CheckSuperelement(const Superelement& se) {
   a.checks.push_back({"mass", mass_error <= 1e-6,
                       Sci("stored mass %.9g", se.mass_properties.mass) + Sci(", from the reduced M %.9g", m_reduced),
                       "/mass_properties/mass"});
+
+  if (!se.inertia_gamma.empty()) {
+    // The frame's rotation turns a rigid translation e_b into the translation e_a x e_b:
+    // Gamma_a Phi_rig0 e_b = M Phi_rig0 (e_a x e_b) (b = translations), and Xi_aa is symmetric.
+    double error = 0.0, scale = se.M.norm() * Phi_rig0.norm();
+    bool shapes_ok = se.inertia_gamma.size() == 3 && se.inertia_xi.size() == 6;
+    for (const Eigen::MatrixXd& X : se.inertia_gamma) shapes_ok &= X.rows() == n && X.cols() == n;
+    for (const Eigen::MatrixXd& X : se.inertia_xi) shapes_ok &= X.rows() == n && X.cols() == n;
+    for (int i = 0; shapes_ok && i < 3; ++i) {
+      for (int b = 0; b < 3; ++b) {
+        const Eigen::Vector3d turned = Eigen::Vector3d::Unit(i).cross(Eigen::Vector3d::Unit(b));
+        const Eigen::VectorXd expected = se.M * (Phi_rig0.leftCols<3>() * turned);
+        error = std::max(error, (se.inertia_gamma[size_t(i)] * Phi_rig0.col(b) - expected).norm());
+      }
+      error = std::max(error, (se.inertia_xi[size_t(i)] - se.inertia_xi[size_t(i)].transpose()).norm());
+    }
+    const double relative = scale > 0 ? error / scale : error;
+    a.checks.push_back({"inertia_invariants", shapes_ok && relative <= 1e-8,
+                        shapes_ok ? Sci("||Gamma_a Phi_rig0 e_b - M Phi_rig0 (e_a x e_b)||, ||Xi_aa - Xi_aa^T|| = %.3g "
+                                        "of ||M|| ||Phi_rig0||", relative)
+                                  : std::string("need 3 Gamma and 6 Xi blocks of the reduced size"),
+                        "/reduced/inertia_invariants"});
+  }
   return a;
 }
 

@@ -85,6 +85,31 @@ void WriteContent(const Superelement& se, h5::Writer& w) {
     for (int k = 0; k < kInertiaLoadCaseCount; ++k) cases += std::string(k ? " " : "") + kInertiaLoadCases[k];
     w.Attribute("/reduced/geometric_stiffness/inertia", "load_cases", cases);
   }
+  if (!se.inertia_gamma.empty()) {
+    // The inertia invariants (superelement.h), stacked: Gamma 3n x n (x, y, z), Xi 6n x n.
+    const long n = se.n_reduced_dofs();
+    if (se.inertia_gamma.size() != 3 || se.inertia_xi.size() != 6) {
+      throw InputError("inertia invariants: " + std::to_string(se.inertia_gamma.size()) + " Gamma and " +
+                       std::to_string(se.inertia_xi.size()) + " Xi matrices (need 3 and 6)");
+    }
+    auto stack = [n](const std::vector<Eigen::MatrixXd>& blocks) {
+      Eigen::MatrixXd stacked(long(blocks.size()) * n, n);
+      for (size_t k = 0; k < blocks.size(); ++k) {
+        if (blocks[k].rows() != n || blocks[k].cols() != n) {
+          throw InputError("an inertia invariant is " + std::to_string(blocks[k].rows()) + " x " +
+                           std::to_string(blocks[k].cols()) + ", the reduced K " + std::to_string(n) + " x " +
+                           std::to_string(n));
+        }
+        stacked.middleRows(long(k) * n, n) = blocks[k];
+      }
+      return stacked;
+    };
+    w.CreateGroup("/reduced/inertia_invariants");
+    w.Matrix("/reduced/inertia_invariants/Gamma", stack(se.inertia_gamma));
+    w.Attribute("/reduced/inertia_invariants/Gamma", "blocks", std::string("x y z"));
+    w.Matrix("/reduced/inertia_invariants/Xi", stack(se.inertia_xi));
+    w.Attribute("/reduced/inertia_invariants/Xi", "blocks", std::string("xx yy zz xy xz yz"));
+  }
 
   w.CreateGroup("/floating_frame");
   w.Attribute("/floating_frame", "type", se.floating_frame.type);
@@ -237,6 +262,14 @@ Superelement ReadSuperelementFile(const std::string& path, const SuperelementRea
     RequireShape(r, "/reduced/geometric_stiffness/inertia", kInertiaLoadCaseCount * n, n);
     const Eigen::MatrixXd stacked = r.Matrix("/reduced/geometric_stiffness/inertia");
     for (int k = 0; k < kInertiaLoadCaseCount; ++k) se.inertia_stiffness.push_back(stacked.middleRows(k * n, n));
+  }
+  if (r.Exists("/reduced/inertia_invariants")) {
+    RequireShape(r, "/reduced/inertia_invariants/Gamma", 3 * n, n);
+    RequireShape(r, "/reduced/inertia_invariants/Xi", 6 * n, n);
+    const Eigen::MatrixXd gamma = r.Matrix("/reduced/inertia_invariants/Gamma");
+    const Eigen::MatrixXd xi = r.Matrix("/reduced/inertia_invariants/Xi");
+    for (int k = 0; k < 3; ++k) se.inertia_gamma.push_back(gamma.middleRows(k * n, n));
+    for (int k = 0; k < 6; ++k) se.inertia_xi.push_back(xi.middleRows(k * n, n));
   }
 
   se.floating_frame.type = r.StringAttribute("/floating_frame", "type");

@@ -209,6 +209,8 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
     se.polynomial = PolynomialStiffness{std::move(poly.A), std::move(poly.B)};
     const long nr = se.K.rows(), P = nr * (nr + 1) / 2;
     if (stiffening) {
+      // The inertia invariants for the exact kinetic energy of the reduced field in the frame.
+      InertiaInvariants(model, cb.shapes, &se.inertia_gamma, &se.inertia_xi);
       for (int k = 0; k < kInertiaLoadCaseCount; ++k) {
         Eigen::MatrixXd K_sigma(nr, nr);
         int p = 0;

@@ -46,4 +46,16 @@ Eigen::Matrix3d LeftJacobianInverseTransposeDerivative(const Eigen::Vector3d& th
   return G;
 }
 
+Eigen::Vector3d LeftJacobianRate(const Eigen::Vector3d& theta, const Eigen::Vector3d& theta_dot) {
+  using AD = Eigen::AutoDiffScalar<Eigen::Matrix<double, 1, 1>>;
+  Eigen::Matrix<AD, 3, 1> t;
+  for (int i = 0; i < 3; ++i) t[i] = AD(theta[i], Eigen::Matrix<double, 1, 1>(theta_dot[i]));
+  const Eigen::Matrix<AD, 3, 3> Jinv = LeftJacobianInverse<AD>(t);
+  Eigen::Matrix3d value, rate;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) value(i, j) = Jinv(i, j).value(), rate(i, j) = Jinv(i, j).derivatives()[0];
+  const Eigen::Matrix3d J = value.inverse();
+  return -J * (rate * (J * theta_dot));
+}
+
 }  // namespace femb

@@ -43,6 +43,10 @@ Eigen::Matrix<S, 3, 3> LeftJacobianInverse(const Eigen::Matrix<S, 3, 1>& theta) 
   return Eigen::Matrix<S, 3, 3>::Identity() - S(0.5) * W + c * W * W;
 }
 
+/// The rate (d/dt J_l(theta)) thetadot of the left Jacobian J_l = (J_l^-1)^-1 along
+/// thetadot, applied to thetadot: -J_l (d/dt J_l^-1) J_l thetadot, exact (forward mode).
+Eigen::Vector3d LeftJacobianRate(const Eigen::Vector3d& theta, const Eigen::Vector3d& theta_dot);
+
 /// d/dtheta [J_l^-1(theta)^T v] (3 x 3), exact (forward-mode automatic differentiation).
 Eigen::Matrix3d LeftJacobianInverseTransposeDerivative(const Eigen::Vector3d& theta, const Eigen::Vector3d& v);
 

@@ -1,6 +1,9 @@
 #!/usr/bin/python3
 """Tip deflection of the rotating beam relative to the line through the hinge and the beam's
-current centre of mass (the mean of its equal bodies' centre-of-mass floating frames), positive
+current centre of mass (the mean of its equal bodies' centres of mass, results.h5
+bodies/<name>/center_of_mass; files written before it existed: the mean of the bodies'
+centre-of-mass floating frames, i.e. of their midpoints, which for one body deflects 0.31 of the
+tip where the centre of mass deflects 0.375), positive
 ahead in the direction of rotation; runs against a reference (RMS over time, relative to the
 reference's largest deflection); exit 1 above a run's tolerance; optional PNG.
 
@@ -24,7 +27,8 @@ def load(run):
     pos = f["nodes/position"][:].reshape(len(t), len(names), 3)
     tip = max((n for n in names if n.startswith("n")), key=lambda n: int(n[1:]))
     hinge, end = pos[:, names.index("n0")], pos[:, names.index(tip)]
-    com = np.mean([f[f"bodies/{b}/floating_frame"][:, :3] for b in f["bodies"]], axis=0)
+    key = "center_of_mass" if all("center_of_mass" in f[f"bodies/{b}"] for b in f["bodies"]) else "floating_frame"
+    com = np.mean([f[f"bodies/{b}/{key}"][:, :3] for b in f["bodies"]], axis=0)
     u = com - hinge
     u /= np.linalg.norm(u, axis=1)[:, None]
     r = end - hinge

@@ -122,6 +122,9 @@ ReducedPolynomial ReduceVonKarman(const VonKarmanBeams& beams, const Eigen::Matr
     Eigen::Matrix<double, 6, 6> C_axial = Eigen::Matrix<double, 6, 6>::Zero();
     C_axial(0, 0) = std::sqrt(e.D[0]);
     Eigen::MatrixXd L_mean = Eigen::MatrixXd::Zero(6, n), Q_mean = Eigen::MatrixXd::Zero(6, P);
+    // The stress fields' geometric stiffness without the rotation completion (PolynomialAccumulator).
+    const bool separate = n_stress > 0 && !pair_fields.empty();
+    Eigen::MatrixXd Q_plain, Q_plain_mean = separate ? Eigen::MatrixXd::Zero(6, P) : Eigen::MatrixXd();
     Eigen::MatrixXd L_stress_mean = Eigen::MatrixXd::Zero(6, n_stress);
     double length = 0.0;
     for (const TimoshenkoBeam::QuadraturePoint& p : e.points) {
@@ -132,8 +135,10 @@ ReducedPolynomial ReduceVonKarman(const VonKarmanBeams& beams, const Eigen::Matr
       int k = 0;
       for (int i = 0; i < n; ++i)
         for (int j = i; j < n; ++j, ++k) Q(0, k) = G.col(i).dot(G.col(j));
+      if (separate) Q_plain = Q;
       for (size_t f = 0; f < pair_fields.size(); ++f) Q.col(pair_fields[f].first) += 2 * (p.B * fields.col(long(f)));
-      accumulator.Add(p.weight, C_points, L, Q, n_stress > 0 ? &L_stress : nullptr);
+      accumulator.Add(p.weight, C_points, L, Q, n_stress > 0 ? &L_stress : nullptr, separate ? &Q_plain : nullptr);
+      if (separate) Q_plain_mean.row(0) += p.weight * Q_plain.row(0);
       length += p.weight;
       L_mean.row(0) += p.weight * L.row(0);
       Q_mean.row(0) += p.weight * Q.row(0);
@@ -141,7 +146,9 @@ ReducedPolynomial ReduceVonKarman(const VonKarmanBeams& beams, const Eigen::Matr
     }
     // The geometric stiffness of beams is the axial force's (von Karman): N = EA (mean strain).
     const Eigen::MatrixXd L_stress_axial = L_stress_mean / length;
-    accumulator.Add(length, C_axial, L_mean / length, Q_mean / length, n_stress > 0 ? &L_stress_axial : nullptr);
+    const Eigen::MatrixXd Q_plain_axial = separate ? Eigen::MatrixXd(Q_plain_mean / length) : Eigen::MatrixXd();
+    accumulator.Add(length, C_axial, L_mean / length, Q_mean / length, n_stress > 0 ? &L_stress_axial : nullptr,
+                    separate ? &Q_plain_axial : nullptr);
   }
   return accumulator.Finish();
 }

@@ -195,7 +195,7 @@ ReducedPolynomial ReduceSvk(const SvkSolidMesh& solid, const Eigen::MatrixXd& me
   Eigen::MatrixXd stress_element(3 * ne, n_stress), L_stress(6, n_stress);
   const Eigen::Matrix<double, 6, 6> C = solid.D_.llt().matrixU();  // D = C^T C
   std::vector<Eigen::Matrix3d> G(static_cast<size_t>(n));
-  Eigen::MatrixXd L(6, n), Q(6, P), U(ne, 3);
+  Eigen::MatrixXd L(6, n), Q(6, P), Q_plain, U(ne, 3);
   Eigen::MatrixXd element(3 * ne, n);
   const int n_fields = int(pair_fields.size());
   Eigen::MatrixXd field_element(3 * ne, n_fields);
@@ -222,6 +222,8 @@ ReducedPolynomial ReduceSvk(const SvkSolidMesh& solid, const Eigen::MatrixXd& me
           const Eigen::Matrix3d S = 0.5 * (G[size_t(j)].transpose() * G[size_t(k)] + G[size_t(k)].transpose() * G[size_t(j)]);
           Q.col(p) << S(0, 0), S(1, 1), S(2, 2), 2 * S(1, 2), 2 * S(0, 2), 2 * S(0, 1);
         }
+      const bool separate = n_stress > 0 && n_fields > 0;
+      if (separate) Q_plain = Q;
       for (int f = 0; f < n_fields; ++f) {
         for (int a = 0; a < ne; ++a) U.row(a) = field_element.block(3 * a, f, 3, 1).transpose();
         Q.col(pair_fields[size_t(f)].first) += 2 * LinearStrain(U.transpose() * g);
@@ -230,7 +232,7 @@ ReducedPolynomial ReduceSvk(const SvkSolidMesh& solid, const Eigen::MatrixXd& me
         for (int a = 0; a < ne; ++a) U.row(a) = stress_element.block(3 * a, f, 3, 1).transpose();
         L_stress.col(f) = LinearStrain(U.transpose() * g);
       }
-      accumulator.Add(dV, C, L, Q, n_stress > 0 ? &L_stress : nullptr);
+      accumulator.Add(dV, C, L, Q, n_stress > 0 ? &L_stress : nullptr, separate ? &Q_plain : nullptr);
     }
   }
   return accumulator.Finish();
@@ -248,11 +250,14 @@ PolynomialAccumulator::PolynomialAccumulator(int n, bool cubic, int n_fields) : 
 }
 
 void PolynomialAccumulator::Add(double dV, const Eigen::Matrix<double, 6, 6>& C, const Eigen::MatrixXd& L,
-                                const Eigen::MatrixXd& Q, const Eigen::MatrixXd* L_fields) {
+                                const Eigen::MatrixXd& Q, const Eigen::MatrixXd* L_fields,
+                                const Eigen::MatrixXd* Q_fields) {
   const Eigen::MatrixXd CL = C * L, CQ = C * Q;
   r_.K.noalias() += dV * CL.transpose() * CL;
   r_.A.noalias() += (0.5 * dV) * CL.transpose() * CQ;
-  if (L_fields && r_.S.rows() > 0) r_.S.noalias() += dV * (C * *L_fields).transpose() * CQ;
+  if (L_fields && r_.S.rows() > 0) {
+    r_.S.noalias() += dV * (C * *L_fields).transpose() * (Q_fields ? Eigen::MatrixXd(C * *Q_fields) : CQ);
+  }
   if (!cubic_) return;
   // B gathers (C Q)^T (C Q) dV / 8, stacked into blocks of rows (one BLAS product each).
   stack_.middleRows(6 * stacked_, 6) = std::sqrt(dV / 8) * CQ;

@@ -65,12 +65,16 @@ class NonlinearModel {
 /// Accumulates the reduced polynomial (ReducedPolynomial) over quadrature points: at each, the
 /// weight dV, a factor C of the 6 x 6 stiffness D = C^T C (Cholesky, or the square root of a
 /// diagonal D, zeros allowed), the linear strain rows L (6 x n) and the quadratic ones Q (6 x P).
-/// `L_fields` (6 x n_fields): the linear strains of the stress fields at the point.
+/// `L_fields` (6 x n_fields): the linear strains of the stress fields at the point; `Q_fields`
+/// (default Q): the quadratic strains their geometric stiffness uses (without the interface
+/// rotation completion: SuperelementBody's exact inertia does not see that second-order field,
+/// and the inertia load's stress does work on it that nothing balances; on a rotating cantilever
+/// the completion added rho A Omega^2 L^2 / 12 to the tip slope's geometric stiffness).
 class PolynomialAccumulator {
  public:
   PolynomialAccumulator(int n, bool cubic = true, int n_fields = 0);
   void Add(double dV, const Eigen::Matrix<double, 6, 6>& C, const Eigen::MatrixXd& L, const Eigen::MatrixXd& Q,
-           const Eigen::MatrixXd* L_fields = nullptr);
+           const Eigen::MatrixXd* L_fields = nullptr, const Eigen::MatrixXd* Q_fields = nullptr);
   ReducedPolynomial Finish();
 
  private:

@@ -1,9 +1,11 @@
 #include "reducer/reduction/craig_bampton.h"
 
+
 #include <Eigen/Cholesky>
 #include <Eigen/Geometry>
 #include <Eigen/SparseCholesky>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 
@@ -132,6 +134,34 @@ Eigen::MatrixXd InertiaFields(const FeModel& model) {
   Eigen::MatrixXd A_mesh(model.mesh_map.rows(), 12);
   for (long k = 0; k < model.n_nodes(); ++k) A_mesh.middleRows(3 * k, 3) = InertiaFieldAt(model.nodes.row(k).transpose());
   return ModelFieldsFromMesh(model, A_mesh);
+}
+
+void InertiaInvariants(const FeModel& model, const Eigen::MatrixXd& shapes, std::vector<Eigen::MatrixXd>* gamma,
+                       std::vector<Eigen::MatrixXd>* xi) {
+  const long n = shapes.rows();
+  // Every model DOF belongs to a triple of vector components in part axes (beams: 6 per node;
+  // solids: 3 per free mesh node, then 6 per RBE2 interface), so S_a acts triple by triple.
+  std::array<Eigen::MatrixXd, 3> turned;
+  for (int a = 0; a < 3; ++a) {
+    const Eigen::Vector3d e = Eigen::Vector3d::Unit(a);
+    Eigen::Matrix3d S;  // S v = e x v
+    S << 0, -e.z(), e.y(), e.z(), 0, -e.x(), -e.y(), e.x(), 0;
+    turned[size_t(a)].resize(n, shapes.cols());
+    for (long t = 0; t + 2 < n; t += 3) turned[size_t(a)].middleRows(t, 3) = S * shapes.middleRows(t, 3);
+  }
+  gamma->clear();
+  xi->clear();
+  std::array<Eigen::MatrixXd, 3> M_turned;
+  for (int a = 0; a < 3; ++a) {
+    M_turned[size_t(a)] = model.M * turned[size_t(a)];
+    gamma->push_back(shapes.transpose() * M_turned[size_t(a)]);
+  }
+  const int pairs[6][2] = {{0, 0}, {1, 1}, {2, 2}, {0, 1}, {0, 2}, {1, 2}};
+  for (const auto& ab : pairs) {
+    Eigen::MatrixXd X = turned[size_t(ab[0])].transpose() * M_turned[size_t(ab[1])];
+    if (ab[0] == ab[1]) X = 0.5 * (X + X.transpose()).eval();
+    xi->push_back(std::move(X));
+  }
 }
 
 std::vector<int> InteriorDofs(const FeModel& model) {

@@ -72,6 +72,14 @@ Eigen::Matrix<double, 3, 12> InertiaFieldAt(const Eigen::Vector3d& x);
 /// angular accelerations), n_dofs x 12.
 Eigen::MatrixXd InertiaFields(const FeModel& model);
 
+/// The inertia invariants of a basis (formats/superelement.h: inertia_gamma, inertia_xi):
+/// Gamma_a = Phi^T M S_a Phi and Xi_ab = (S_a Phi)^T M (S_b Phi), S_a the skew matrix of e_a on
+/// every DOF triple (beams: u and theta of each node; solids: each mesh node's u, and u and theta
+/// of each RBE2 interface node, whose turned field is then the rigid face's nearest: the face
+/// rotates with its centre).
+void InertiaInvariants(const FeModel& model, const Eigen::MatrixXd& shapes, std::vector<Eigen::MatrixXd>* gamma,
+                       std::vector<Eigen::MatrixXd>* xi);
+
 /// The interior DOFs (all DOFs not used by an interface), ascending.
 std::vector<int> InteriorDofs(const FeModel& model);
 

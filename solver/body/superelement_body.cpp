@@ -1,6 +1,7 @@
 #include "solver/body/superelement_body.h"
 
 #include <Eigen/Dense>
+#include <array>
 #include <limits>
 
 #include "formats/input_error.h"
@@ -10,6 +11,13 @@ namespace femb {
 namespace {
 // Local (elastic) rotations are small in this theory; beyond 2 rad a frame is rejected.
 constexpr double kMaxLocalRotation = 2.0;
+
+// R applied to the first `blocks` 3-vectors of v (node forces and moments; modal rows as they are).
+Eigen::VectorXd TurnBlocks(const Eigen::Matrix3d& R, const Eigen::VectorXd& v, int blocks) {
+  Eigen::VectorXd out = v;
+  for (int a = 0; a < blocks; ++a) out.segment<3>(3 * a) = R * v.segment<3>(3 * a);
+  return out;
+}
 }  // namespace
 
 struct SuperelementBody::Kinematics {
@@ -19,6 +27,16 @@ struct SuperelementBody::Kinematics {
   Eigen::MatrixXd Z;        // 6 x n
   Eigen::MatrixXd T;        // n x n
   Eigen::MatrixXd B;        // n x n
+};
+
+struct SuperelementBody::ExactData {
+  Eigen::Matrix3d R;
+  Eigen::VectorXd q;
+  Kinematics kin;
+  Eigen::MatrixXd Y;                  // Phi_rig0 Z + B
+  Eigen::MatrixXd H;                  // n x 3: Gamma_a q
+  std::array<Eigen::VectorXd, 9> XQ;  // Xi_ab q at 3 a + b (Xi_ba = Xi_ab^T)
+  Eigen::Matrix3d Xq;                 // q^T Xi_ab q
 };
 
 SuperelementBody::SuperelementBody(const Superelement& se, const SuperelementOptions& options,
@@ -61,6 +79,10 @@ SuperelementBody::SuperelementBody(const Superelement& se, const SuperelementOpt
     polynomial_ = se.polynomial;
   }
   if (options_.geometric_stiffening) K_sigma_ = se.inertia_stiffness;
+  if (options_.exact_inertia && se.inertia_gamma.size() == 3 && se.inertia_xi.size() == 6) {
+    Gamma_ = se.inertia_gamma;
+    Xi_ = se.inertia_xi;
+  }
   initial_frame_.x = placement_x_ + placement_R_ * origin_part_;
   initial_frame_.R = placement_R_;
   initial_frame_.ok = true;
@@ -274,6 +296,78 @@ void SuperelementBody::ElasticForce(const BodyConfiguration& c, const FrameSolut
   *tangent = Rbar * Kt * Rbar.transpose();
 }
 
+SuperelementBody::ExactData SuperelementBody::Exact(const BodyConfiguration& c, const FrameSolution& frame) const {
+  ExactData d;
+  d.R = frame.R;
+  d.q = LocalCoordinates(c, frame);
+  d.kin = ComputeKinematics(d.q);
+  d.Y = Phi_rig0_ * d.kin.Z + d.kin.B;
+  d.H.resize(n_coordinates(), 3);
+  for (int a = 0; a < 3; ++a) d.H.col(a) = Gamma_[size_t(a)] * d.q;
+  const int stored[3][3] = {{0, 3, 4}, {3, 1, 5}, {4, 5, 2}};  // xx yy zz xy xz yz
+  for (int a = 0; a < 3; ++a)
+    for (int b = 0; b < 3; ++b) {
+      const Eigen::MatrixXd& X = Xi_[size_t(stored[a][b])];
+      d.XQ[size_t(3 * a + b)] = a <= b ? Eigen::VectorXd(X * d.q) : Eigen::VectorXd(X.transpose() * d.q);
+    }
+  for (int a = 0; a < 3; ++a)
+    for (int b = 0; b < 3; ++b) d.Xq(a, b) = d.q.dot(d.XQ[size_t(3 * a + b)]);
+  return d;
+}
+
+Eigen::VectorXd SuperelementBody::ExactInertiaForce(const ExactData& d, const BodyVelocity& w,
+                                                    const BodyVelocity& wdot) const {
+  const int n = n_coordinates(), blocks = 2 * n_nodes_;
+  const Eigen::MatrixXd& Z = d.kin.Z;
+  const Eigen::MatrixXd& B = d.kin.B;
+  const Eigen::VectorXd Rw = TurnBlocks(d.R.transpose(), w, blocks);
+  const Eigen::Matrix<double, 6, 1> xi = Z * Rw;
+  const Eigen::Vector3d v = xi.head<3>(), Om = xi.tail<3>();
+  const Eigen::VectorXd qd = B * Rw;
+  // r = Rbar^T wdot - c (header): xidot = Z r, qddot_loc = B r, ydot = Y r.
+  Eigen::VectorXd r = TurnBlocks(d.R.transpose(), wdot, blocks);
+  for (int a = 0; a < blocks; ++a) r.segment<3>(3 * a) -= Om.cross(Eigen::Vector3d(Rw.segment<3>(3 * a)));
+  for (int k = 0; k < n_nodes_; ++k) {
+    r.segment<3>(6 * k) -= Om.cross(Eigen::Vector3d(qd.segment<3>(6 * k)));
+    r.segment<3>(6 * k + 3) -=
+        LeftJacobianRate(Eigen::Vector3d(d.q.segment<3>(6 * k + 3)), Eigen::Vector3d(qd.segment<3>(6 * k + 3)));
+  }
+  const Eigen::Vector3d Omd = Z.bottomRows<3>() * r;
+  const Eigen::VectorXd y = Phi_rig0_ * xi + qd, yd = d.Y * r;
+  Eigen::MatrixXd Hd(n, 3);
+  for (int a = 0; a < 3; ++a) Hd.col(a) = Gamma_[size_t(a)] * qd;
+  const Eigen::VectorXd pi_q = M_ * y + d.H * Om;
+  const Eigen::VectorXd pi_q_dot = M_ * yd + d.H * Omd + Hd * Om;
+  Eigen::VectorXd f_q = pi_q_dot;  // minus dT/dq below
+  Eigen::Vector3d h = d.H.transpose() * y + d.Xq * Om, hd = d.H.transpose() * yd + Hd.transpose() * y + d.Xq * Omd;
+  for (int a = 0; a < 3; ++a) {
+    f_q -= Om[a] * (Gamma_[size_t(a)].transpose() * y);
+    for (int b = 0; b < 3; ++b) {
+      f_q -= Om[a] * Om[b] * d.XQ[size_t(3 * a + b)];
+      hd[a] += Om[b] * qd.dot(d.XQ[size_t(3 * a + b)] + d.XQ[size_t(3 * b + a)]);
+    }
+  }
+  // pi_xi = Phi_rig0^T pi_q + [0; h]; f_xi = d/dt pi_xi + Kirchhoff's terms.
+  Eigen::Matrix<double, 6, 1> pi_xi = Phi_rig0_.transpose() * pi_q;
+  Eigen::Matrix<double, 6, 1> f_xi = Phi_rig0_.transpose() * pi_q_dot;
+  pi_xi.tail<3>() += h;
+  f_xi.tail<3>() += hd;
+  const Eigen::Vector3d pi_v = pi_xi.head<3>(), pi_w = pi_xi.tail<3>();
+  f_xi.head<3>() += Om.cross(pi_v);
+  f_xi.tail<3>() += Om.cross(pi_w) + v.cross(pi_v);
+  return TurnBlocks(d.R, Eigen::VectorXd(Z.transpose() * f_xi + B.transpose() * f_q), blocks);
+}
+
+Eigen::MatrixXd SuperelementBody::ExactMass(const ExactData& d) const {
+  const int n = n_coordinates();
+  const Eigen::MatrixXd Zr = d.kin.Z.bottomRows<3>();
+  const Eigen::MatrixXd YHZ = d.Y.transpose() * d.H * Zr;
+  Eigen::MatrixXd Mbar = d.Y.transpose() * M_ * d.Y + YHZ + YHZ.transpose() + Zr.transpose() * d.Xq * Zr;
+  Eigen::MatrixXd Rbar = Eigen::MatrixXd::Identity(n, n);
+  for (int a = 0; a < 2 * n_nodes_; ++a) Rbar.block<3, 3>(3 * a, 3 * a) = d.R;
+  return Rbar * Mbar * Rbar.transpose();
+}
+
 void SuperelementBody::VelocityMaps(const BodyConfiguration& c, const FrameSolution& frame, Eigen::MatrixXd* P,
                                     Eigen::MatrixXd* U) const {
   const int n = n_coordinates();
@@ -327,6 +421,24 @@ void SuperelementBody::InertiaForce(const BodyConfiguration& c, const FrameSolut
                                     const BodyVelocity& wdot, Eigen::VectorXd* f_in, Eigen::MatrixXd* mass,
                                     Eigen::MatrixXd* gyroscopic) const {
   const int n = n_coordinates();
+  if (has_exact_inertia()) {
+    const ExactData d = Exact(c, frame);
+    const Eigen::VectorXd zero = Eigen::VectorXd::Zero(n);
+    if (f_in) *f_in = ExactInertiaForce(d, options_.quadratic_velocity_terms ? w : zero, wdot);
+    if (mass) *mass = ExactMass(d);
+    if (gyroscopic) {
+      gyroscopic->setZero(n, n);
+      if (!options_.quadratic_velocity_terms) return;
+      // Quadratic in w (as below): Dg(w) e = [g(w + s e) - g(w) - g(s e)] / s exactly.
+      const double s = std::max(w.norm(), 1.0);
+      const Eigen::VectorXd g0 = ExactInertiaForce(d, w, zero);
+      for (int i = 0; i < n; ++i) {
+        const Eigen::VectorXd e = s * Eigen::VectorXd::Unit(n, i);
+        gyroscopic->col(i) = (ExactInertiaForce(d, w + e, zero) - g0 - ExactInertiaForce(d, e, zero)) / s;
+      }
+    }
+    return;
+  }
   Eigen::MatrixXd P, U;
   VelocityMaps(c, frame, &P, &U);
   const Eigen::MatrixXd Mg = P.transpose() * M_ * P;
@@ -351,35 +463,61 @@ void SuperelementBody::InertiaForce(const BodyConfiguration& c, const FrameSolut
 Eigen::MatrixXd SuperelementBody::InertiaConfigurationTangent(const BodyConfiguration& c, const FrameSolution& frame,
                                                               const BodyVelocity& w, const BodyVelocity& wdot,
                                                               bool quadratic) const {
+  if (has_exact_inertia()) return ExactInertiaConfigurationTangent(c, frame, w, wdot, quadratic);
   Eigen::MatrixXd tangent = MomentumDerivative(Maps(c, frame), wdot);
   if (!quadratic || !options_.quadratic_velocity_terms) return tangent;
-  double size = 0.0;
-  for (const Eigen::Vector3d& X : X_) size = std::max(size, X.norm());
   const int n = n_coordinates();
   for (int i = 0; i < n; ++i) {
     Eigen::VectorXd g[2];
     double step = 1e-7;
     for (int side = 0; side < 2; ++side) {
-      BodyConfiguration p = c;
-      const double e = side == 0 ? 1.0 : -1.0;
-      if (i < 6 * n_nodes_) {
-        const int a = i / 6, k = i % 6;
-        if (k < 3) {
-          step = 1e-7 * std::max(size, 1e-3);
-          p.x[a][k] += e * step;
-        } else {
-          p.R[a] = ExpSO3(e * step * Eigen::Vector3d::Unit(k - 3)) * p.R[a];
-        }
-      } else {
-        // Mass-normalized modal coordinates: scale by the body's mass (eta ~ sqrt(m) x length).
-        step = 1e-7 * std::max(size, 1e-3) * std::sqrt(std::max(M_(0, 0), 1e-300));
-        p.eta[i - 6 * n_nodes_] += e * step;
-      }
+      const BodyConfiguration p = Perturbed(c, i, side == 0 ? 1.0 : -1.0, &step);
       Eigen::MatrixXd P, U;
       VelocityMaps(p, SolveFrame(p, frame), &P, &U);
       g[side] = QuadraticInertia(U, P.transpose() * M_ * P, w);
     }
     tangent.col(i) += (g[0] - g[1]) / (2 * step);
+  }
+  return tangent;
+}
+
+// Perturbed configuration for the central differences of the inertia force: coordinate i by
+// +-step (positions 1e-7 of the body size, rotations 1e-7 rad, modal coordinates 1e-7 of the
+// body size times sqrt of a mass).
+BodyConfiguration SuperelementBody::Perturbed(const BodyConfiguration& c, int i, double sign, double* step) const {
+  double size = 0.0;
+  for (const Eigen::Vector3d& X : X_) size = std::max(size, X.norm());
+  BodyConfiguration p = c;
+  *step = 1e-7;
+  if (i < 6 * n_nodes_) {
+    const int a = i / 6, k = i % 6;
+    if (k < 3) {
+      *step = 1e-7 * std::max(size, 1e-3);
+      p.x[a][k] += sign * *step;
+    } else {
+      p.R[a] = ExpSO3(sign * *step * Eigen::Vector3d::Unit(k - 3)) * p.R[a];
+    }
+  } else {
+    *step = 1e-7 * std::max(size, 1e-3) * std::sqrt(std::max(M_(0, 0), 1e-300));
+    p.eta[i - 6 * n_nodes_] += sign * *step;
+  }
+  return p;
+}
+
+Eigen::MatrixXd SuperelementBody::ExactInertiaConfigurationTangent(const BodyConfiguration& c,
+                                                                   const FrameSolution& frame, const BodyVelocity& w,
+                                                                   const BodyVelocity& wdot, bool quadratic) const {
+  // Central differences of the whole force at fixed (w, wdot), the frame re-solved (without
+  // `quadratic`: of M_g wdot only).
+  const int n = n_coordinates();
+  const Eigen::VectorXd w_used = quadratic && options_.quadratic_velocity_terms ? w : Eigen::VectorXd::Zero(n);
+  Eigen::MatrixXd tangent(n, n);
+  for (int i = 0; i < n; ++i) {
+    double step = 0.0;
+    const BodyConfiguration plus = Perturbed(c, i, 1.0, &step), minus = Perturbed(c, i, -1.0, &step);
+    const Eigen::VectorXd f_plus = ExactInertiaForce(Exact(plus, SolveFrame(plus, frame)), w_used, wdot);
+    const Eigen::VectorXd f_minus = ExactInertiaForce(Exact(minus, SolveFrame(minus, frame)), w_used, wdot);
+    tangent.col(i) = (f_plus - f_minus) / (2 * step);
   }
   return tangent;
 }
@@ -397,6 +535,7 @@ void SuperelementBody::AddModalDamping(const BodyVelocity& w, Eigen::VectorXd& f
 
 double SuperelementBody::KineticEnergy(const BodyConfiguration& c, const FrameSolution& frame,
                                        const BodyVelocity& w) const {
+  if (has_exact_inertia()) return 0.5 * w.dot(ExactMass(Exact(c, frame)) * w);
   Eigen::MatrixXd P, U;
   VelocityMaps(c, frame, &P, &U);
   const Eigen::VectorXd v = P * w;
@@ -465,7 +604,8 @@ Eigen::VectorXd SuperelementBody::MomentumSource(const BodyVelocityMaps& maps, c
 
 void SuperelementBody::Momentum(const BodyConfiguration& c, const FrameSolution& frame, const BodyVelocity& w,
                                 Eigen::Vector3d* linear, Eigen::Vector3d* angular) const {
-  const Eigen::VectorXd p = GeneralizedMomentum(Maps(c, frame), w);
+  const Eigen::VectorXd p =
+      has_exact_inertia() ? Eigen::VectorXd(ExactMass(Exact(c, frame)) * w) : GeneralizedMomentum(Maps(c, frame), w);
   linear->setZero();
   angular->setZero();
   for (int a = 0; a < n_nodes_; ++a) {
@@ -474,8 +614,29 @@ void SuperelementBody::Momentum(const BodyConfiguration& c, const FrameSolution&
   }
 }
 
+Eigen::Vector3d SuperelementBody::CenterOfMass(const BodyConfiguration& c, const FrameSolution& frame) const {
+  const Eigen::MatrixXd MPhi = M_ * Phi_rig0_;
+  // Phi_rig0^T M Phi_rig0 = [m 1, -s~; s~, J]: the first moment s from its (translation,
+  // rotation) block -s~ (entry (b, 3 + a) = e_b . (e_a x s)).
+  const Eigen::Matrix<double, 6, 6> M_rig = Phi_rig0_.transpose() * MPhi;
+  const double mass = M_rig(0, 0);
+  const Eigen::Vector3d s0(-M_rig(2, 4), -M_rig(0, 5), -M_rig(1, 3));
+  const Eigen::Vector3d moment = s0 + MPhi.leftCols<3>().transpose() * LocalCoordinates(c, frame);
+  return frame.x + frame.R * (mass > 0 ? Eigen::Vector3d(moment / mass) : Eigen::Vector3d::Zero());
+}
+
 Eigen::VectorXd SuperelementBody::GravityForce(const BodyConfiguration& c, const FrameSolution& frame,
                                                const Eigen::Vector3d& g) const {
+  if (has_exact_inertia()) {
+    // Virtual work of g on the field: y_g = Phi_rig0 [R_j^T g; 0] (a uniform field), delta of the
+    // field = Phi (Phi_rig0 delta xi + delta q_loc) + delta theta_j x (Phi q):
+    // f = Rbar (Y^T M y_g + Z_r^T H^T y_g).
+    const ExactData d = Exact(c, frame);
+    const Eigen::VectorXd yg = Phi_rig0_.leftCols<3>() * (frame.R.transpose() * g);
+    const Eigen::VectorXd local =
+        d.Y.transpose() * (M_ * yg) + d.kin.Z.bottomRows<3>().transpose() * (d.H.transpose() * yg);
+    return TurnBlocks(frame.R, local, 2 * n_nodes_);
+  }
   Eigen::MatrixXd P, U;
   VelocityMaps(c, frame, &P, &U);
   Eigen::Matrix<double, 6, 1> rigid;

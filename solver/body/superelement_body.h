@@ -46,6 +46,11 @@ struct SuperelementOptions {
   /// Geometric stiffening from the file (issue 13): the quadratic Green-Lagrange force of a file
   /// without modal derivatives and the inertia load cases' geometric stiffness. false: ignored.
   bool geometric_stiffening = true;
+  /// With the file's inertia invariants (formats/superelement.h inertia_gamma, inertia_xi): the
+  /// exact kinetic energy of the reduced field in the floating frame (SuperelementBody, "Exact
+  /// inertia") in the generalized-alpha and static analyses. false, or a file without them: the
+  /// corotational kinetic energy of the thesis (3.22). The midpoint scheme always uses the latter.
+  bool exact_inertia = true;
 };
 
 /// The 12 inertia load factors of a body's floating frame (formats/superelement.h
@@ -156,6 +161,33 @@ class SuperelementBody {
   /// Strain energy q_loc^T K q_loc / 2.
   double ElasticEnergy(const BodyConfiguration& c, const FrameSolution& frame) const;
 
+  /// True when the body uses the exact kinetic energy (file invariants and option exact_inertia).
+  ///
+  /// Exact inertia. The reduced field in frame axes is X + Phi q_loc, its velocity
+  /// v_j + Omega x (X + Phi q_loc) + Phi qdot_loc, so with y = Phi_rig0 xi + qdot_loc,
+  /// xi = (v_j, Omega) = Z Rbar^T w and qdot_loc = B Rbar^T w (thesis 3.17), the kinetic energy of
+  /// the full model's mass is (Wallrapp's floating frame of reference form, the invariants
+  /// Gamma_a, Xi_ab of formats/superelement.h)
+  ///   T = y^T M y / 2 + y^T Gamma(Omega) q + q^T Xi(Omega) q / 2,
+  ///   Gamma(Omega) = sum_a Omega_a Gamma_a,  Xi(Omega) = sum_ab Omega_a Omega_b Xi_ab.
+  /// The thesis' T = (Rbar^T w)^T M (Rbar^T w) / 2 differs from it at the order of q Omega: it
+  /// turns the interface displacements with the frame but interpolates them with the modes
+  /// (Omega x u_k at the nodes in place of Omega x (Phi q) in the body; the internal modes not at
+  /// all), and it takes the interface angular velocities for the rates of the local rotations
+  /// (J_l(theta) thetadot for thetadot); for a rotating cantilever that gave in-plane softening
+  /// -1.34 Omega^2 instead of -Omega^2 and a flapwise softening -0.3 Omega^2 that has no physical
+  /// cause (a gyroscopic coupling of tip torsion and tip slope through the momentum of the
+  /// rotating body). The equations of motion: Kirchhoff's for the frame,
+  ///   f_xi = d/dt dT/dxi + [Omega x pi_v; Omega x pi_Omega + v x pi_v],
+  /// Lagrange's for the local coordinates, f_q = d/dt dT/dqdot - dT/dq, and by virtual work
+  /// (delta xi = Z Rbar^T dq, delta q_loc = B Rbar^T dq) f_in = Rbar (Z^T f_xi + B^T f_q). The
+  /// accelerations: differentiating Rbar^T w = Phi_rig xi + D^-1 qdot_loc (with Phi_CB qdot_loc
+  /// = 0) gives xidot = Z r, qddot_loc = B r, r = Rbar^T wdot - c, c = Omega^ Rbar^T w
+  /// + [Omega x udot_k; (d/dt J_l(theta_k)) thetadot_k] on the node rows. T = w^T M_g w / 2 with
+  /// M_g = Rbar (Y^T M Y + Y^T H Z_r + Z_r^T H^T Y + Z_r^T X_q Z_r) Rbar^T, Y = Phi_rig0 Z + B,
+  /// Z_r the rotation rows of Z, H = [Gamma_a q], (X_q)_ab = q^T Xi_ab q.
+  bool has_exact_inertia() const { return !Gamma_.empty(); }
+
   /// Inertia force from the corotational kinetic energy T = v^T M v / 2, v = P w (thesis 3.22,
   /// 4.9; DESIGN.md "Inertia"), P = blockdiag(R_j^T ... , 1) (option A) or with R_k^T on the
   /// angular rows (option B). With G defined by d(P w) = P G dq and Omega_P, Omega_hat the
@@ -210,6 +242,11 @@ class SuperelementBody {
   void Momentum(const BodyConfiguration& c, const FrameSolution& frame, const BodyVelocity& w,
                 Eigen::Vector3d* linear, Eigen::Vector3d* angular) const;
 
+  /// The deformed body's centre of mass (global): x_j + R_j (s_0 + C q_loc) / m, s_0 the first
+  /// moment of the undeformed body about the frame origin, C = int rho Phi (the translation rows
+  /// of Phi_rig0^T M), m the mass.
+  Eigen::Vector3d CenterOfMass(const BodyConfiguration& c, const FrameSolution& frame) const;
+
   /// Generalized force of a uniform acceleration field g (gravity): P^T M Phi_rig0 [R_j^T g; 0].
   Eigen::VectorXd GravityForce(const BodyConfiguration& c, const FrameSolution& frame, const Eigen::Vector3d& g) const;
 
@@ -223,6 +260,15 @@ class SuperelementBody {
   // The quadratic part of f_in: M_g G w + (Omega_P - Omega_hat) p - G^T p.
   Eigen::VectorXd QuadraticInertia(const Eigen::MatrixXd& U, const Eigen::MatrixXd& Mg, const BodyVelocity& w) const;
   Eigen::MatrixXd Phi_rig0_;
+  // Exact inertia (has_exact_inertia): per-configuration data, the force, the mass matrix M_g.
+  struct ExactData;
+  ExactData Exact(const BodyConfiguration& c, const FrameSolution& frame) const;
+  Eigen::VectorXd ExactInertiaForce(const ExactData& d, const BodyVelocity& w, const BodyVelocity& wdot) const;
+  Eigen::MatrixXd ExactMass(const ExactData& d) const;
+  Eigen::MatrixXd ExactInertiaConfigurationTangent(const BodyConfiguration& c, const FrameSolution& frame,
+                                                   const BodyVelocity& w, const BodyVelocity& wdot, bool quadratic) const;
+  BodyConfiguration Perturbed(const BodyConfiguration& c, int i, double sign, double* step) const;
+  std::vector<Eigen::MatrixXd> Gamma_, Xi_;  ///< the file's inertia invariants (3, 6), or none
 
   int n_nodes_ = 0, n_modes_ = 0;
   SuperelementOptions options_;

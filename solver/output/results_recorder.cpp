@@ -110,8 +110,9 @@ void ResultsRecorder::Record(double t, const SystemState& state, const Eigen::Ve
   std::vector<Eigen::VectorXd> modal, frames;
   for (size_t b = 0; b < model.bodies.size(); ++b) {
     modal.push_back(state.eta[b]);
-    Eigen::VectorXd f(7);
-    f << state.frames[b].x + scene_.origin, Quaternion(state.frames[b].R);
+    Eigen::VectorXd f(10);
+    const Eigen::Vector3d com = model.bodies[b].CenterOfMass(BodyConfigurationOf(model, state, int(b)), state.frames[b]);
+    f << state.frames[b].x + scene_.origin, Quaternion(state.frames[b].R), com + scene_.origin;
     frames.push_back(f);
   }
   modal_.push_back(modal);
@@ -227,7 +228,9 @@ void ResultsRecorder::Finish(const std::string& status) {
         frames.push_back(frames_[s][b]);
       }
       w.Matrix(g + "/modal_coordinates", Stack(modal, model.bodies[b].n_modes()));
-      w.Matrix(g + "/floating_frame", Stack(frames, 7));
+      const Eigen::MatrixXd frame_and_com = Stack(frames, 10);
+      w.Matrix(g + "/floating_frame", frame_and_com.leftCols(7));
+      w.Matrix(g + "/center_of_mass", frame_and_com.rightCols(3));
       std::vector<std::string> nodes;
       for (int k : model.body_nodes[b]) nodes.push_back(model.node_names[k]);
       w.Strings(g + "/nodes", nodes);

@@ -41,7 +41,7 @@ class ResultsRecorder {
   std::vector<Eigen::VectorXd> momentum_;  // per step: linear (3), angular (3)
   std::vector<Eigen::VectorXd> positions_, quaternions_, velocities_, angular_velocities_, joints_, reactions_;
   std::vector<std::vector<Eigen::VectorXd>> modal_;     // per step, per body
-  std::vector<std::vector<Eigen::VectorXd>> frames_;    // per step, per body: x (3), quaternion (4)
+  std::vector<std::vector<Eigen::VectorXd>> frames_;    // per step, per body: x (3), quaternion (4), centre of mass (3)
   // Per animation frame (every animation_every-th output step): its time, and per body with a
   // mesh the deformed node positions (single precision: a solid part's mesh is large).
   std::vector<double> frame_time_;

@@ -156,6 +156,12 @@ Scene BuildScene(const SceneSpec& spec) {
       scene.notes.push_back("body '" + b.name + "': " + file.string() +
                             " has no geometric stiffening; the body is linear inside (re-reduce it to add it)");
     }
+    // The exact kinetic energy (issue 13) likewise: the file's inertia invariants unless switched off.
+    options.exact_inertia = b.exact_inertia.value_or(true);
+    if (b.exact_inertia.value_or(false) && se.inertia_gamma.empty()) {
+      throw InputError(b.where + ": body '" + b.name + "': options.inertia is exact but " + file.string() +
+                       " has no inertia invariants (reduce it with reduction.geometric_stiffening: true)");
+    }
     std::vector<int> nodes;
     for (const auto& [iname, _] : b.nodes) {
       bool found = false;
