@@ -359,13 +359,13 @@ Eigen::VectorXd SuperelementBody::ExactInertiaForce(const ExactData& d, const Bo
 }
 
 Eigen::MatrixXd SuperelementBody::ExactMass(const ExactData& d) const {
-  const int n = n_coordinates();
   const Eigen::MatrixXd Zr = d.kin.Z.bottomRows<3>();
   const Eigen::MatrixXd YHZ = d.Y.transpose() * d.H * Zr;
-  Eigen::MatrixXd Mbar = d.Y.transpose() * M_ * d.Y + YHZ + YHZ.transpose() + Zr.transpose() * d.Xq * Zr;
-  Eigen::MatrixXd Rbar = Eigen::MatrixXd::Identity(n, n);
-  for (int a = 0; a < 2 * n_nodes_; ++a) Rbar.block<3, 3>(3 * a, 3 * a) = d.R;
-  return Rbar * Mbar * Rbar.transpose();
+  Eigen::MatrixXd Mg = d.Y.transpose() * (M_ * d.Y) + YHZ + YHZ.transpose() + Zr.transpose() * d.Xq * Zr;
+  // Rbar Mbar Rbar^T block by block.
+  for (int a = 0; a < 2 * n_nodes_; ++a) Mg.middleRows<3>(3 * a) = d.R * Mg.middleRows<3>(3 * a);
+  for (int a = 0; a < 2 * n_nodes_; ++a) Mg.middleCols<3>(3 * a) = Mg.middleCols<3>(3 * a) * d.R.transpose();
+  return Mg;
 }
 
 void SuperelementBody::VelocityMaps(const BodyConfiguration& c, const FrameSolution& frame, Eigen::MatrixXd* P,
@@ -463,7 +463,12 @@ void SuperelementBody::InertiaForce(const BodyConfiguration& c, const FrameSolut
 Eigen::MatrixXd SuperelementBody::InertiaConfigurationTangent(const BodyConfiguration& c, const FrameSolution& frame,
                                                               const BodyVelocity& w, const BodyVelocity& wdot,
                                                               bool quadratic) const {
-  if (has_exact_inertia()) return ExactInertiaConfigurationTangent(c, frame, w, wdot, quadratic);
+  // Exact inertia: the whole force by central differences with `quadratic`; without, the
+  // corotational d(M_g wdot)/dq, which has its leading part (the turning of the frame; the exact
+  // mass differs from it at the order of q_loc Omega) for a fraction of the cost.
+  if (has_exact_inertia() && quadratic && options_.quadratic_velocity_terms) {
+    return ExactInertiaConfigurationTangent(c, frame, w, wdot);
+  }
   Eigen::MatrixXd tangent = MomentumDerivative(Maps(c, frame), wdot);
   if (!quadratic || !options_.quadratic_velocity_terms) return tangent;
   const int n = n_coordinates();
@@ -506,11 +511,10 @@ BodyConfiguration SuperelementBody::Perturbed(const BodyConfiguration& c, int i,
 
 Eigen::MatrixXd SuperelementBody::ExactInertiaConfigurationTangent(const BodyConfiguration& c,
                                                                    const FrameSolution& frame, const BodyVelocity& w,
-                                                                   const BodyVelocity& wdot, bool quadratic) const {
-  // Central differences of the whole force at fixed (w, wdot), the frame re-solved (without
-  // `quadratic`: of M_g wdot only).
+                                                                   const BodyVelocity& wdot) const {
+  // Central differences of the whole force at fixed (w, wdot), the frame re-solved.
   const int n = n_coordinates();
-  const Eigen::VectorXd w_used = quadratic && options_.quadratic_velocity_terms ? w : Eigen::VectorXd::Zero(n);
+  const Eigen::VectorXd& w_used = w;
   Eigen::MatrixXd tangent(n, n);
   for (int i = 0; i < n; ++i) {
     double step = 0.0;

@@ -266,7 +266,7 @@ class SuperelementBody {
   Eigen::VectorXd ExactInertiaForce(const ExactData& d, const BodyVelocity& w, const BodyVelocity& wdot) const;
   Eigen::MatrixXd ExactMass(const ExactData& d) const;
   Eigen::MatrixXd ExactInertiaConfigurationTangent(const BodyConfiguration& c, const FrameSolution& frame,
-                                                   const BodyVelocity& w, const BodyVelocity& wdot, bool quadratic) const;
+                                                   const BodyVelocity& w, const BodyVelocity& wdot) const;
   BodyConfiguration Perturbed(const BodyConfiguration& c, int i, double sign, double* step) const;
   std::vector<Eigen::MatrixXd> Gamma_, Xi_;  ///< the file's inertia invariants (3, 6), or none
 
