@@ -1,8 +1,10 @@
 // Rotating clamped cantilever in ONE body (issue 13 study): the first flapwise and in-plane
 // frequency about the steadily rotating state, measured from a free vibration, against an
 // independent converged 1-D rotating-beam model and Southwell's closed form, with and without
-// geometric stiffening, for an interface frame (at the hub) and a centre-of-mass frame. Prints
-// the table; no pass/fail (see tests/solver/analysis/geometric_stiffening_test.cpp for those).
+// geometric stiffening, for an interface frame (at the hub) and a centre-of-mass frame. "1 body":
+// a file with the stiffening (and so the exact inertia); "no stiff.": without either (the
+// thesis' corotational inertia). Prints the table; no pass/fail (the linearized check is
+// tests/solver/analysis/exact_inertia_test.cpp).
 // Usage: build/bin/rotating_cantilever_frequency
 #include <Eigen/Dense>
 #include <cmath>
@@ -13,6 +15,7 @@
 #include "formats/part_file.h"
 #include "reducer/reduce_part.h"
 #include "solver/analysis/dynamic_analysis.h"
+#include "tests/rotating_beam_reference.h"
 
 namespace femb {
 namespace {
@@ -35,43 +38,9 @@ Superelement Tube(bool stiffening, const std::string& frame) {
   return r.superelement;
 }
 
-// Lowest eigenvalue omega^2 of the rotating clamped Euler-Bernoulli beam (hub radius 0): K_b +
-// K_G(N) + in_plane * (-Omega^2 M), N = rho A Omega^2 (L^2 - x^2) / 2, Hermite cubics, n elements.
-double ReferenceOmega2(double Omega, bool in_plane, int n = 200) {
-  const double h = kL / n, EI = kE * kI, m = kRho * kA;
-  const int dofs = 2 * n;  // (w, w') per node, node 0 clamped
-  Eigen::MatrixXd K = Eigen::MatrixXd::Zero(dofs, dofs), M = K;
-  Eigen::Matrix4d ke, me;
-  ke << 12, 6 * h, -12, 6 * h, 6 * h, 4 * h * h, -6 * h, 2 * h * h, -12, -6 * h, 12, -6 * h, 6 * h, 2 * h * h, -6 * h,
-      4 * h * h;
-  ke *= EI / (h * h * h);
-  me << 156, 22 * h, 54, -13 * h, 22 * h, 4 * h * h, 13 * h, -3 * h * h, 54, 13 * h, 156, -22 * h, -13 * h, -3 * h * h,
-      -22 * h, 4 * h * h;
-  me *= m * h / 420;
-  const double gp[4] = {-0.8611363115940526, -0.3399810435848563, 0.3399810435848563, 0.8611363115940526};
-  const double gw[4] = {0.3478548451374538, 0.6521451548625461, 0.6521451548625461, 0.3478548451374538};
-  for (int e = 0; e < n; ++e) {
-    // Geometric stiffness int N N_i' N_j' dx by 4-point Gauss (exact: N is quadratic).
-    Eigen::Matrix4d kg = Eigen::Matrix4d::Zero();
-    for (int g = 0; g < 4; ++g) {
-      const double s = 0.5 * (gp[g] + 1), x = (e + s) * h;
-      const double N = m * Omega * Omega * (kL * kL - x * x) / 2;
-      Eigen::Vector4d dN;  // d/dx of the Hermite shape functions
-      dN << (-6 * s + 6 * s * s) / h, 1 - 4 * s + 3 * s * s, (6 * s - 6 * s * s) / h, -2 * s + 3 * s * s;
-      kg += 0.5 * gw[g] * h * N * dN * dN.transpose();
-    }
-    Eigen::Matrix4d k = ke + kg;
-    if (in_plane) k -= Omega * Omega * me;
-    for (int i = 0; i < 4; ++i)
-      for (int j = 0; j < 4; ++j) {
-        const int I = 2 * e + i - 2, J = 2 * e + j - 2;
-        if (I < 0 || J < 0) continue;
-        K(I, J) += k(i, j);
-        M(I, J) += me(i, j);
-      }
-  }
-  Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> eig(K, M, Eigen::EigenvaluesOnly);
-  return eig.eigenvalues()[0];
+// The converged 1-D rotating-beam model (tests/rotating_beam_reference.h).
+double ReferenceOmega2(double Omega, bool in_plane) {
+  return reference::RotatingBeamOmega2(kE * kI, kRho * kA, kL, Omega, in_plane);
 }
 
 // The first bending frequency of ONE body rotating steadily about z at Omega (hub clamped to a

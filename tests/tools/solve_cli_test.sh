@@ -350,6 +350,13 @@ expect "stiffening not in the file" 2 "options.geometric_stiffening is true but"
 sed 's/{name: b3, superelement: segment.h5/{name: b3, options: {geometric_stiffening: true}, superelement: segment_gs.h5/' "$work/scene.yaml" > "$work/gs.yaml"
 "$bin/femb-solve" "$work/gs.yaml" -o "$work/gs_out" > "$work/gs_log.txt" 2>&1 && grep -q "note: body 'b0': .*has no geometric stiffening" "$work/gs_log.txt" \
   && ! grep -q "note: body 'b3'" "$work/gs_log.txt" && ok || fail "stiffening file used, note for the others: $(cat "$work/gs_log.txt")"
+# The exact inertia asked for from a file without the invariants: one line, exit 2; a corrupted
+# invariant: the load gate names the dataset and the check.
+expect "inertia invariants not in the file" 2 "options.inertia is exact but" 's/{name: b3, superelement: segment.h5/{name: b3, options: {inertia: exact}, superelement: segment.h5/'
+expect "bad inertia option" 2 "options.inertia: expected exact or corotational (exact: the file's inertia invariants), got 'lumped'" 's/{name: b3, superelement: segment.h5/{name: b3, options: {inertia: lumped}, superelement: segment.h5/'
+cp "$work/segment_gs.h5" "$work/bad_gamma.h5"
+$py -c "import h5py; f=h5py.File('$work/bad_gamma.h5','r+'); a=f['/reduced/inertia_invariants/Gamma'][...]; a[0,1]+=1.0; f['/reduced/inertia_invariants/Gamma'][...]=a"
+expect "corrupt Gamma" 2 "bad_gamma.h5: /reduced/inertia_invariants: check inertia_invariants failed" 's/{name: b3, superelement: segment.h5/{name: b3, superelement: bad_gamma.h5/'
 expect "wrong version" 2 "is not supported by this femb" 's/{name: b3, superelement: segment.h5/{name: b3, superelement: v2.h5/'
 # Corrupt superelement files: one line naming the file, the dataset and the check (a NaN in
 # Phi_CB, the origin or the interface frames once crashed femb-solve; an indefinite M ran to the end).
