@@ -1,6 +1,8 @@
 // Solver scaling: a chain of N flexible bodies (tube segments, 2 internal modes each) clamped
 // at one end and falling under gravity; time per dynamic step and Newton iterations per step
-// for N = 1, 10, 100, 1000. Prints what it measured on this run.
+// for N = 1, 10, 100, 1000, linear bodies and bodies with the geometric stiffening and exact
+// inertia (reduction.geometric_stiffening, issue 13: the cost ratio per body-step). Prints
+// what it measured on this run.
 #include <chrono>
 #include <cstdio>
 #include <string>
@@ -11,16 +13,19 @@
 
 int main() {
   std::printf("Solver scaling: chain of N tube superelements (2 modes each), clamped, gravity, generalized-alpha\n\n");
-  std::printf("%6s %12s %10s %14s %16s %18s\n", "bodies", "coordinates", "steps", "s per step", "Newton its/step",
-              "ms per step/body");
+  std::printf("%6s %-11s %12s %10s %14s %16s %18s %8s\n", "bodies", "bodies are", "coordinates", "steps", "s per step",
+              "Newton its/step", "ms per step/body", "ratio");
   for (int n_bodies : {1, 10, 100, 1000}) {
+   double linear_ms = 0.0;
+   for (bool stiffening : {false, true}) {
     const double Lb = 1.0 / n_bodies;
     const femb::PartSpec part = femb::ParsePart(
         "name: seg\ntype: beam\nmaterial: {E: 70.0e9, nu: 0.3, rho: 2700}\n"
         "section: {shape: tube, outer_radius: 0.01, wall: 0.001}\n"
         "beam:\n  points: {A: [0, 0, 0], B: [" + std::to_string(Lb) + ", 0, 0]}\n"
         "  segments: [{from: A, to: B, elements: 2}]\n"
-        "interfaces: [{name: A}, {name: B}]\nreduction: {internal_modes: 2, keep_mesh: false}\n",
+        "interfaces: [{name: A}, {name: B}]\nreduction: {internal_modes: 2, keep_mesh: false, geometric_stiffening: " +
+            std::string(stiffening ? "true" : "false") + "}\n",
         "bench.yaml");
     const femb::ReduceResult reduced = femb::ReducePart(part, nullptr);
     if (!reduced.ok) return 3;
@@ -45,12 +50,16 @@ int main() {
     const femb::DynamicResult r = femb::SolveDynamic(model, s, options);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (!r.ok) {
-      std::printf("%6d failed: %s\n", n_bodies, r.message.c_str());
+      std::printf("%6d %-11s failed: %s\n", n_bodies, stiffening ? "stiffened" : "linear", r.message.c_str());
       continue;
     }
-    std::printf("%6d %12d %10ld %14.4f %16.2f %18.3f\n", n_bodies, dofs.n_dofs(), r.steps, seconds / r.steps,
-                double(r.newton_iterations) / r.steps, 1e3 * seconds / r.steps / n_bodies);
+    const double ms = 1e3 * seconds / r.steps / n_bodies;
+    if (!stiffening) linear_ms = ms;
+    std::printf("%6d %-11s %12d %10ld %14.4f %16.2f %18.3f %8.2f\n", n_bodies, stiffening ? "stiffened" : "linear",
+                dofs.n_dofs(), r.steps, seconds / r.steps, double(r.newton_iterations) / r.steps, ms,
+                linear_ms > 0 ? ms / linear_ms : 1.0);
     std::fflush(stdout);
+   }
   }
   return 0;
 }

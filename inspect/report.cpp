@@ -65,6 +65,10 @@ std::string TextSummary(const Superelement& se, const SuperelementAnalysis& a, c
     s += F("  geometric stiffening: 12 inertia load cases (a, alpha, omega products), %d x %d each\n",
            se.n_reduced_dofs(), se.n_reduced_dofs());
   }
+  if (!se.inertia_gamma.empty()) {
+    s += F("  inertia invariants: Gamma (3) and Xi (6), %d x %d each (exact kinetic energy in the floating frame)\n",
+           se.n_reduced_dofs(), se.n_reduced_dofs());
+  }
   if (!p.stage_seconds.empty()) {
     s += "  reduction time:";
     for (const auto& [stage, sec] : p.stage_seconds) s += F(" %s %.3g s;", stage.c_str(), sec);
@@ -149,6 +153,7 @@ nlohmann::json JsonSummary(const Superelement& se, const SuperelementAnalysis& a
   j["n_modal_derivatives"] = se.n_modal_derivatives;
   j["polynomial_internal_force"] = se.polynomial.has_value() && se.polynomial->cubic();
   j["geometric_stiffening"] = !se.inertia_stiffness.empty();
+  j["inertia_invariants"] = !se.inertia_gamma.empty();
   j["n_reduced_dofs"] = se.n_reduced_dofs();
   j["n_full_dofs"] = se.n_full_dofs;
   j["mass"] = se.mass_properties.mass;

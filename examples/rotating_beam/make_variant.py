@@ -2,13 +2,17 @@
 """The seeds' rotating beam with the tube in N equal bodies (floating frames at the centres of
 mass): OUTDIR/seg.yaml and OUTDIR/scene.yaml. Probes `hinge` (joint angle and rate) and `tip`.
 
-usage: make_variant.py OUTDIR N [STEP] [END_TIME]
+usage: make_variant.py OUTDIR N [STEP] [END_TIME] [--stiffening]
+--stiffening: the segment with reduction.geometric_stiffening (issue 13).
 """
 import os
 import sys
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+import stiffening  # noqa: E402
 import tube  # noqa: E402
+
+stiffened = stiffening.take_flag(sys.argv)
 
 out, n = sys.argv[1], int(sys.argv[2])
 step = float(sys.argv[3]) if len(sys.argv) > 3 else 1e-4
@@ -16,6 +20,8 @@ end = float(sys.argv[4]) if len(sys.argv) > 4 else 0.1
 w = 100.0
 os.makedirs(out, exist_ok=True)
 L = tube.write_segment(out, n)
+if stiffened:
+    stiffening.apply(os.path.join(out, "seg.yaml"))
 bodies = "\n".join(f"  - {{name: b{k}, superelement: seg.h5, placement: {{position: [{k * L!r}, 0, 0]}}, "
                    f"nodes: {{A: n{k}, B: n{k + 1}}}}}" for k in range(n))
 velocities = "\n".join(f"  n{k}: {{linear: [0, {w * k * L!r}, 0], angular: [0, 0, {w}]}}" for k in range(1, n + 1))

@@ -2,10 +2,16 @@
 """The spin-up beam with N equal bodies: OUTDIR/seg.yaml and OUTDIR/scene.yaml (hub angle
 prescribed by spin_up with final speed OMEGA, Ts = 15 s; probes `hub` and `tip`).
 
-usage: make_variant.py OUTDIR N [STEP] [OMEGA]
+usage: make_variant.py OUTDIR N [STEP] [OMEGA] [--stiffening]
+--stiffening: the segment with reduction.geometric_stiffening (issue 13).
 """
 import os
 import sys
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+import stiffening  # noqa: E402
+
+stiffened = stiffening.take_flag(sys.argv)
 
 out, n = sys.argv[1], int(sys.argv[2])
 step = float(sys.argv[3]) if len(sys.argv) > 3 else 0.01
@@ -25,6 +31,8 @@ beam:
 interfaces: [{{name: A}}, {{name: B}}]
 reduction: {{internal_modes: 2, floating_frame: center_of_mass}}
 """)
+if stiffened:
+    stiffening.apply(os.path.join(out, "seg.yaml"))
 bodies = "\n".join(f"  - {{name: b{k}, superelement: seg.h5, placement: {{position: [{k * L!r}, 0, 0]}}, "
                    f"nodes: {{A: n{k}, B: n{k + 1}}}}}" for k in range(n))
 with open(os.path.join(out, "scene.yaml"), "w") as g:

@@ -162,6 +162,10 @@ Scene BuildScene(const SceneSpec& spec) {
       throw InputError(b.where + ": body '" + b.name + "': options.inertia is exact but " + file.string() +
                        " has no inertia invariants (reduce it with reduction.geometric_stiffening: true)");
     }
+    if (spec.analysis.integrator == "midpoint" && options.exact_inertia && !se.inertia_gamma.empty()) {
+      scene.notes.push_back("body '" + b.name + "': the midpoint integrator uses the corotational inertia (thesis "
+                            "3.22), not the file's exact one (generalized_alpha does)");
+    }
     std::vector<int> nodes;
     for (const auto& [iname, _] : b.nodes) {
       bool found = false;
