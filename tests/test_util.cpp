@@ -59,6 +59,20 @@ std::string StraightBeamYaml(double L, int elements, const std::string& section,
   return s.str();
 }
 
+SystemModel ClampedOneBodyModel(const Superelement& se, double L, const Eigen::Vector3d& tip_force) {
+  SystemModel model;
+  AddNode(model, "n0", Eigen::Vector3d::Zero());
+  AddNode(model, "n1", Eigen::Vector3d(L, 0, 0));
+  model.bodies.emplace_back(se, SuperelementOptions{}, Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero());
+  model.body_nodes.push_back({0, 1});
+  Clamp(model, 0);
+  NodeLoad load;
+  load.node = 1;
+  load.force = tip_force;
+  model.loads.push_back(load);
+  return model;
+}
+
 Superelement Reduce(const std::string& yaml, const std::vector<std::string>& overrides) {
   PartSpec part = ParsePart(yaml, "test.yaml", overrides);
   ReduceResult r = ReducePart(part, nullptr);

@@ -6,6 +6,7 @@
 
 #include "formats/part_file.h"
 #include "formats/superelement.h"
+#include "solver/assembly/system.h"
 
 namespace femb::test {
 
@@ -19,6 +20,10 @@ std::string StraightBeamYaml(double L, int elements, const std::string& section,
 /// L) under a tip force P that stays perpendicular to the undeformed axis, by shooting with RK4
 /// (4000 steps) on the tip angle: the tip's (horizontal shortening, deflection).
 Eigen::Vector2d ElasticaTip(double P, double EI, double L);
+
+/// One body on nodes n0 at the origin (clamped) and n1 at (L, 0, 0), default options, a dead
+/// force on n1.
+SystemModel ClampedOneBodyModel(const Superelement& se, double L, const Eigen::Vector3d& tip_force);
 
 /// Parses and reduces; fails the calling test on error.
 Superelement Reduce(const std::string& yaml, const std::vector<std::string>& overrides = {});

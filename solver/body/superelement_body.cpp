@@ -12,6 +12,21 @@ namespace {
 // Local (elastic) rotations are small in this theory; beyond 2 rad a frame is rejected.
 constexpr double kMaxLocalRotation = 2.0;
 
+// The derivative of a quadratic vector function g at w, exactly (no truncation):
+// Dg(w) e = [g(w + s e) - g(w) - g(s e)] / s for any s > 0.
+template <class Quadratic>
+Eigen::MatrixXd QuadraticDerivative(const Eigen::VectorXd& w, const Quadratic& g) {
+  const long n = w.size();
+  const double s = std::max(w.norm(), 1.0);
+  const Eigen::VectorXd g0 = g(w);
+  Eigen::MatrixXd D(n, n);
+  for (long i = 0; i < n; ++i) {
+    const Eigen::VectorXd e = s * Eigen::VectorXd::Unit(n, i);
+    D.col(i) = (g(w + e) - g0 - g(e)) / s;
+  }
+  return D;
+}
+
 // R applied to the first `blocks` 3-vectors of v (node forces and moments; modal rows as they are).
 Eigen::VectorXd TurnBlocks(const Eigen::Matrix3d& R, const Eigen::VectorXd& v, int blocks) {
   Eigen::VectorXd out = v;
@@ -429,13 +444,7 @@ void SuperelementBody::InertiaForce(const BodyConfiguration& c, const FrameSolut
     if (gyroscopic) {
       gyroscopic->setZero(n, n);
       if (!options_.quadratic_velocity_terms) return;
-      // Quadratic in w (as below): Dg(w) e = [g(w + s e) - g(w) - g(s e)] / s exactly.
-      const double s = std::max(w.norm(), 1.0);
-      const Eigen::VectorXd g0 = ExactInertiaForce(d, w, zero);
-      for (int i = 0; i < n; ++i) {
-        const Eigen::VectorXd e = s * Eigen::VectorXd::Unit(n, i);
-        gyroscopic->col(i) = (ExactInertiaForce(d, w + e, zero) - g0 - ExactInertiaForce(d, e, zero)) / s;
-      }
+      *gyroscopic = QuadraticDerivative(w, [&](const Eigen::VectorXd& v) { return ExactInertiaForce(d, v, zero); });
     }
     return;
   }
@@ -450,13 +459,7 @@ void SuperelementBody::InertiaForce(const BodyConfiguration& c, const FrameSolut
   if (gyroscopic) {
     gyroscopic->setZero(n, n);
     if (!options_.quadratic_velocity_terms) return;
-    // g(w) is quadratic: Dg(w) e = [g(w + s e) - g(w) - g(s e)] / s exactly, for any s > 0.
-    const double s = std::max(w.norm(), 1.0);
-    const Eigen::VectorXd g0 = QuadraticInertia(U, Mg, w);
-    for (int i = 0; i < n; ++i) {
-      const Eigen::VectorXd e = s * Eigen::VectorXd::Unit(n, i);
-      gyroscopic->col(i) = (QuadraticInertia(U, Mg, w + e) - g0 - QuadraticInertia(U, Mg, e)) / s;
-    }
+    *gyroscopic = QuadraticDerivative(w, [&](const Eigen::VectorXd& v) { return QuadraticInertia(U, Mg, v); });
   }
 }
 

@@ -233,16 +233,7 @@ TEST(ExactInertia, CompressedCantileverInOneBodyMatchesTheOneDimensionalModel) {
   const double P_cr = M_PI * M_PI * kEI / (4 * kL * kL);
   const Superelement se = Tube("center_of_mass");
   for (double fraction : {0.0, 0.3, 0.6}) {
-    SystemModel model;
-    AddNode(model, "n0", Eigen::Vector3d::Zero());
-    AddNode(model, "n1", Eigen::Vector3d(kL, 0, 0));
-    model.bodies.emplace_back(se, SuperelementOptions{}, Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero());
-    model.body_nodes.push_back({0, 1});
-    Clamp(model, 0);
-    NodeLoad load;
-    load.node = 1;
-    load.force = Eigen::Vector3d(-fraction * P_cr, 0, 0);
-    model.loads.push_back(load);
+    SystemModel model = test::ClampedOneBodyModel(se, kL, Eigen::Vector3d(-fraction * P_cr, 0, 0));
     StaticOptions options;
     options.steps = 3;
     SystemState state = InitialState(model);

@@ -173,17 +173,7 @@ TEST(GeometricStiffening, TensionedCantileverInOneBodyMatchesTheClosedForm) {
     const double F = 10.0, k = std::sqrt(T / EI);
     const double expected = F / T * (kL - std::tanh(k * kL) / k);
     for (bool stiffening : {true, false}) {
-      SystemModel model;
-      AddNode(model, "n0", Eigen::Vector3d::Zero());
-      AddNode(model, "n1", Eigen::Vector3d(kL, 0, 0));
-      model.bodies.emplace_back(Tube(4, stiffening), SuperelementOptions{}, Eigen::Matrix3d::Identity(),
-                                Eigen::Vector3d::Zero());
-      model.body_nodes.push_back({0, 1});
-      Clamp(model, 0);
-      NodeLoad load;
-      load.node = 1;
-      load.force = Eigen::Vector3d(T, F, 0);
-      model.loads.push_back(load);
+      SystemModel model = test::ClampedOneBodyModel(Tube(4, stiffening), kL, Eigen::Vector3d(T, F, 0));
       StaticOptions options;
       options.steps = 5;
       SystemState state = InitialState(model);
