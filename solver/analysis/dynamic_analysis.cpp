@@ -71,12 +71,22 @@ void FinishAssembly(const SystemModel& model, const DofMap& dofs, const SystemSt
   out.node_forces = parts.node_forces;
 }
 
-Assembly AssembleDynamic(const SystemModel& model, const DofMap& dofs, DynamicState& s, double t, bool matrices,
-                         bool full_inertia_tangent = false) {
+// What the residual pass keeps of one body for the iteration matrix (AddDynamicMatrices).
+struct BodyPass {
+  SuperelementBody::Data data;
+  Eigen::VectorXd w, wdot;
+  InertiaLoadFactors load;
+};
+
+// The generalized-alpha residual at state s and time t: frames solved (s.config.frames
+// updated), each body's kinematics evaluated once and kept in `passes` for the matrices, which
+// an iteration builds only when it needs them (not on the converged one, not with a kept
+// factorization).
+Assembly AssembleDynamicResidual(const SystemModel& model, const DofMap& dofs, DynamicState& s, double t,
+                                 std::vector<BodyPass>& passes) {
   AssemblyParts parts;
   Assembly out = StartAssembly(model, dofs, parts);
-  Triplets &K = parts.K, &C = parts.C, &M = parts.M;
-  NodeForces& node_forces = parts.node_forces;
+  passes.resize(model.bodies.size());
   const std::vector<Eigen::Matrix<double, 6, 1>> node_acc = NodeAccelerations(model, dofs, s.config, s.W, s.Wdot);
   for (size_t b = 0; b < model.bodies.size(); ++b) {
     const SuperelementBody& body = model.bodies[b];
@@ -84,47 +94,75 @@ Assembly AssembleDynamic(const SystemModel& model, const DofMap& dofs, DynamicSt
     FrameSolution frame;
     if (!SolveBodyFrame(body, int(b), c, s.config.frames[b], &frame, out)) return out;
     s.config.frames[b] = frame;
-    const Eigen::VectorXd w = GatherBody(model, dofs, s.config, int(b), s.W);
-    const Eigen::VectorXd wdot = GatherBodyAcceleration(model, dofs, int(b), node_acc, s.Wdot);
-    Eigen::VectorXd f_int, f_in;
-    Eigen::MatrixXd Kb, Mb, Cb, d_load;
+    BodyPass& pass = passes[b];
+    pass.data = body.Evaluate(c, frame);
+    pass.w = GatherBody(model, dofs, s.config, int(b), s.W);
+    pass.wdot = GatherBodyAcceleration(model, dofs, int(b), node_acc, s.Wdot);
     // Inertia stiffening (issue 13): K + K_sigma(a), a from this iterate's frame motion; its
     // velocity and acceleration derivatives go into C and M of the iteration matrix.
     const bool stiffening = body.has_inertia_stiffening();
-    const InertiaLoadFactors load = stiffening ? body.InertiaLoads(c, frame, w, wdot, model.gravity) : InertiaLoadFactors{};
-    body.ElasticForce(c, frame, &f_int, matrices ? &Kb : nullptr, stiffening ? &load : nullptr,
-                      stiffening && matrices ? &d_load : nullptr);
-    body.InertiaForce(c, frame, w, wdot, &f_in, matrices ? &Mb : nullptr, matrices ? &Cb : nullptr);
-    if (stiffening && matrices) {
-      Mb += d_load * load.d_wdot;
-      Cb += d_load * load.d_w;
+    pass.load = stiffening ? body.InertiaLoads(pass.data, pass.w, pass.wdot, model.gravity) : InertiaLoadFactors{};
+    Eigen::VectorXd f_int, f_in, f_acc;
+    body.ElasticForce(pass.data, &f_int, nullptr, stiffening ? &pass.load : nullptr);
+    body.InertiaForce(pass.data, pass.w, pass.wdot, &f_in, nullptr, nullptr, &f_acc);
+    body.AddModalDamping(pass.w, f_in, nullptr);
+    Eigen::VectorXd f_grav = Eigen::VectorXd::Zero(body.n_coordinates());
+    if (model.gravity.squaredNorm() > 0) f_grav = body.GravityForce(pass.data, model.gravity);
+    // Scale of the forces in balance, each term on its own (for a torque-free body M_g wdot and
+    // the gyroscopic terms cancel: their sum is no scale).
+    out.scale = std::max({out.scale, body.ForceNorm(f_int), body.ForceNorm(f_in), body.ForceNorm(f_grav),
+                          body.force_floor(), body.ForceNorm(f_acc), body.ForceNorm(f_in - f_acc)});
+    out.roundoff += body.RoundOffForce(c);
+    const std::vector<MapEntry> map = BodyMap(model, dofs, s.config, int(b));
+    const Eigen::VectorXd r_b = f_grav - f_int - f_in;
+    AddBodyNodeForces(model, int(b), r_b, parts.node_forces);
+    ScatterBody(map, &r_b, nullptr, &out.residual, nullptr);
+    ScatterBody(map, &f_grav, nullptr, &out.f_ext, nullptr);
+  }
+  FinishAssembly(model, dofs, s.config, t, s.W, false, parts, out);
+  return out;
+}
+
+// The matrices K, C, M of the residual pass `out` (same state s and time t).
+void AddDynamicMatrices(const SystemModel& model, const DofMap& dofs, const DynamicState& s, double t,
+                        const std::vector<BodyPass>& passes, bool full_inertia_tangent, Assembly& out) {
+  Triplets K, C, M;
+  for (size_t b = 0; b < model.bodies.size(); ++b) {
+    const SuperelementBody& body = model.bodies[b];
+    const BodyPass& pass = passes[b];
+    const bool stiffening = body.has_inertia_stiffening();
+    Eigen::MatrixXd Kb, Mb, Cb, d_load;
+    body.ElasticForce(pass.data, nullptr, &Kb, stiffening ? &pass.load : nullptr, stiffening ? &d_load : nullptr);
+    body.InertiaForce(pass.data, pass.w, pass.wdot, nullptr, &Mb, &Cb);
+    if (stiffening) {
+      Mb += d_load * pass.load.d_wdot;
+      Cb += d_load * pass.load.d_w;
     }
     // Configuration derivative of the inertia force: d(M_g wdot)/dq exactly; that of the
     // quadratic velocity terms by central differences with options.full_inertia_tangent.
-    if (matrices) Kb += body.InertiaConfigurationTangent(c, frame, w, wdot, full_inertia_tangent);
-    body.AddModalDamping(w, f_in, matrices ? &Cb : nullptr);
-    Eigen::VectorXd f_grav = Eigen::VectorXd::Zero(body.n_coordinates());
-    if (model.gravity.squaredNorm() > 0) f_grav = body.GravityForce(c, frame, model.gravity);
-    // Scale of the forces in balance, each term on its own (for a torque-free body M_g wdot and
-    // the gyroscopic terms cancel: their sum is no scale).
-    out.scale = std::max({out.scale, body.ForceNorm(f_int), body.ForceNorm(f_in), body.ForceNorm(f_grav), body.force_floor()});
-    out.roundoff += body.RoundOffForce(c);
-    if (matrices) {
-      const Eigen::VectorXd f_acc = Mb * wdot;
-      out.scale = std::max({out.scale, body.ForceNorm(f_acc), body.ForceNorm(f_in - f_acc)});
-    }
+    Kb += body.InertiaConfigurationTangent(pass.data, pass.w, pass.wdot, full_inertia_tangent);
+    Eigen::VectorXd unused = Eigen::VectorXd::Zero(body.n_coordinates());
+    body.AddModalDamping(pass.w, unused, &Cb);
     const std::vector<MapEntry> map = BodyMap(model, dofs, s.config, int(b));
-    const Eigen::VectorXd r_b = f_grav - f_int - f_in;
-    AddBodyNodeForces(model, int(b), r_b, node_forces);
-    ScatterBody(map, &r_b, nullptr, &out.residual, nullptr);
-    ScatterBody(map, &f_grav, nullptr, &out.f_ext, nullptr);
-    if (matrices) {
-      ScatterBody(map, nullptr, &Kb, nullptr, &K);
-      ScatterBody(map, nullptr, &Cb, nullptr, &C);
-      ScatterBody(map, nullptr, &Mb, nullptr, &M);
-    }
+    ScatterBody(map, nullptr, &Kb, nullptr, &K);
+    ScatterBody(map, nullptr, &Cb, nullptr, &C);
+    ScatterBody(map, nullptr, &Mb, nullptr, &M);
   }
-  FinishAssembly(model, dofs, s.config, t, s.W, matrices, parts, out);
+  const int n = dofs.n_dofs();
+  Eigen::VectorXd unused = Eigen::VectorXd::Zero(n);
+  AddNodeLoads(model, s.config, t, unused, &K);
+  AddSpringDampers(model, s.config, s.W, unused, &K, &C, nullptr);
+  AddJointGeometricStiffness(model, dofs, s.config, out.node_forces, K);
+  out.K = ToMatrix(n, K);
+  out.C = ToMatrix(n, C);
+  out.M = ToMatrix(n, M);
+}
+
+Assembly AssembleDynamic(const SystemModel& model, const DofMap& dofs, DynamicState& s, double t, bool matrices,
+                         bool full_inertia_tangent = false) {
+  std::vector<BodyPass> passes;
+  Assembly out = AssembleDynamicResidual(model, dofs, s, t, passes);
+  if (out.ok && matrices) AddDynamicMatrices(model, dofs, s, t, passes, full_inertia_tangent, out);
   return out;
 }
 
@@ -195,10 +233,11 @@ DynamicStepReport Measure(const SystemModel& model, DynamicState& s) {
     const BodyConfiguration c = BodyConfigurationOf(model, s.config, int(b));
     const FrameSolution& frame = s.config.frames[b];
     const Eigen::VectorXd w = GatherBody(model, dofs, s.config, int(b), s.W);
-    r.kinetic_energy += body.KineticEnergy(c, frame, w);
-    r.elastic_energy += body.ElasticEnergy(c, frame);
+    const SuperelementBody::Data data = body.Evaluate(c, frame);
+    r.kinetic_energy += body.KineticEnergy(data, w);
+    r.elastic_energy += body.ElasticEnergy(data);
     Eigen::Vector3d L, H;
-    body.Momentum(c, frame, w, &L, &H);
+    body.Momentum(data, w, &L, &H);
     r.linear_momentum += L;
     r.angular_momentum += H;
   }
@@ -253,8 +292,9 @@ StepOutcome GeneralizedAlphaStep(const SystemModel& model, const DofMap& dofs, c
   StepOutcome out;
   const double tolerance = std::max(options.tolerance, kRoundOffTolerance);
   const Eigen::VectorXd weights = ResidualWeights(model, dofs);
+  std::vector<BodyPass> passes;
   for (; out.iterations < options.max_iterations; ++out.iterations) {
-    const Assembly a = AssembleDynamic(model, dofs, next, t_new, true, options.full_inertia_tangent);
+    Assembly a = AssembleDynamicResidual(model, dofs, next, t_new, passes);
     if (!a.ok || !a.residual.allFinite()) return out;
     if (FreeNorm(dofs, a.residual, weights) <= std::max(tolerance * a.scale, a.roundoff) && out.iterations > 0) {
       out.converged = true;
@@ -267,7 +307,12 @@ StepOutcome GeneralizedAlphaStep(const SystemModel& model, const DofMap& dofs, c
       next.drive_work += 0.5 * (state.f_drive + next.f_drive).dot(h * 0.5 * (state.W + next.W));
       return out;
     }
-    const auto S = [&] { return SystemMatrix(a.K + gamma_p * a.C + beta_p * a.M); };
+    bool built = false;
+    const auto S = [&] {
+      if (!built) AddDynamicMatrices(model, dofs, next, t_new, passes, options.full_inertia_tangent, a);
+      built = true;
+      return SystemMatrix(a.K + gamma_p * a.C + beta_p * a.M);
+    };
     if (!matrix.Update(dofs, options, h, S)) {
       out.singular_matrix = S();
       return out;
@@ -440,7 +485,8 @@ Assembly AssembleMidpoint(const SystemModel& model, const DofMap& dofs, const Dy
     k.mid.frames[b] = fm;
     const Eigen::VectorXd w1 = GatherBody(model, dofs, s1.config, int(b), s1.W);
     // Velocity maps at the end and at the mid configuration, shared by the momentum terms.
-    const BodyVelocityMaps maps1 = body.Maps(c1, f1), maps_m = body.Maps(cm, fm);
+    const SuperelementBody::Data d1 = body.Evaluate(c1, f1), dm = body.Evaluate(cm, fm);
+    const BodyVelocityMaps &maps1 = body.MapsOf(d1), &maps_m = body.MapsOf(dm);
     const Eigen::VectorXd p1 = body.GeneralizedMomentum(maps1, w1);
     // Node motion over the step.
     Eigen::VectorXd wm(body.n_coordinates());
@@ -485,16 +531,16 @@ Assembly AssembleMidpoint(const SystemModel& model, const DofMap& dofs, const Dy
     if (body.has_inertia_stiffening()) {
       // Inertia stiffening (issue 13) at the mid configuration with the step's mean velocity and
       // acceleration; d wm = delta / h (C / h) and d (w1 - w0) / h = V delta / h (M V / h).
-      const InertiaLoadFactors load = body.InertiaLoads(cm, fm, wm, (w1 - w0) / h, model.gravity);
+      const InertiaLoadFactors load = body.InertiaLoads(dm, wm, (w1 - w0) / h, model.gravity);
       Eigen::MatrixXd d_load;
-      body.ElasticForce(cm, fm, &f_int, &Kb, &load, &d_load);
+      body.ElasticForce(dm, &f_int, &Kb, &load, &d_load);
       Cb += d_load * load.d_w;
       Mb += d_load * load.d_wdot;
     } else {
-      body.ElasticForce(cm, fm, &f_int, &Kb);
+      body.ElasticForce(dm, &f_int, &Kb);
     }
     Eigen::VectorXd f_grav = Eigen::VectorXd::Zero(body.n_coordinates());
-    if (model.gravity.squaredNorm() > 0) f_grav = body.GravityForce(cm, fm, model.gravity);
+    if (model.gravity.squaredNorm() > 0) f_grav = body.GravityForce(dm, model.gravity);
     // Scale: each term on its own (for a torque-free body the momentum change and the source
     // cancel; M_g (w_n+1 - w_n) / h is the size of the inertia force).
     out.scale = std::max({out.scale, body.ForceNorm(f_int), body.ForceNorm(f_in), body.ForceNorm(f_grav), body.force_floor(),

@@ -281,6 +281,7 @@ SystemForces AssembleStatic(const SystemModel& model, const DofMap& dofs, System
       return out;
     }
     state.frames[b] = frame;
+    const SuperelementBody::Data data = body.Evaluate(c, frame);
     Eigen::VectorXd f;
     Eigen::MatrixXd K;
     const bool gravity_on = model.static_gravity_end > 0 && model.gravity.squaredNorm() > 0;
@@ -288,12 +289,12 @@ SystemForces AssembleStatic(const SystemModel& model, const DofMap& dofs, System
       // The stress of the body's own weight stiffens it (issue 13: load factors -R_j^T g at rest).
       const double ramp = std::min(lambda / model.static_gravity_end, 1.0);
       const Eigen::VectorXd zero = Eigen::VectorXd::Zero(body.n_coordinates());
-      const InertiaLoadFactors load = body.InertiaLoads(c, frame, zero, zero, ramp * model.gravity);
-      body.ElasticForce(c, frame, &f, with_tangent ? &K : nullptr, &load);
+      const InertiaLoadFactors load = body.InertiaLoads(data, zero, zero, ramp * model.gravity);
+      body.ElasticForce(data, &f, with_tangent ? &K : nullptr, &load);
     } else {
-      body.ElasticForce(c, frame, &f, with_tangent ? &K : nullptr);
+      body.ElasticForce(data, &f, with_tangent ? &K : nullptr);
     }
-    out.elastic_energy += body.ElasticEnergy(c, frame);
+    out.elastic_energy += body.ElasticEnergy(data);
     out.force_scale = std::max({out.force_scale, body.ForceNorm(f), body.force_floor()});
     out.roundoff += body.RoundOffForce(c);
     const Eigen::VectorXd minus_f = -f;
@@ -304,7 +305,7 @@ SystemForces AssembleStatic(const SystemModel& model, const DofMap& dofs, System
       // Gravity in a static analysis, ramped to full at pseudo-time static_gravity_end (its
       // configuration derivative is left out of the tangent, as in the dynamic iteration matrix).
       const double ramp = std::min(lambda / model.static_gravity_end, 1.0);
-      const Eigen::VectorXd f_grav = body.GravityForce(c, frame, ramp * model.gravity);
+      const Eigen::VectorXd f_grav = body.GravityForce(data, ramp * model.gravity);
       ScatterBody(BodyMap(model, dofs, state, int(b)), &f_grav, nullptr, &gravity, nullptr);
       AddBodyNodeForces(model, int(b), f_grav, node_forces);
     }

@@ -35,25 +35,6 @@ Eigen::VectorXd TurnBlocks(const Eigen::Matrix3d& R, const Eigen::VectorXd& v, i
 }
 }  // namespace
 
-struct SuperelementBody::Kinematics {
-  Eigen::MatrixXd Phi_rig;  // n x 6
-  Eigen::MatrixXd D;        // n x n (block diagonal)
-  Eigen::Matrix<double, 6, 6> S;
-  Eigen::MatrixXd Z;        // 6 x n
-  Eigen::MatrixXd T;        // n x n
-  Eigen::MatrixXd B;        // n x n
-};
-
-struct SuperelementBody::ExactData {
-  Eigen::Matrix3d R;
-  Eigen::VectorXd q;
-  Kinematics kin;
-  Eigen::MatrixXd Y;                  // Phi_rig0 Z + B
-  Eigen::MatrixXd H;                  // n x 3: Gamma_a q
-  std::array<Eigen::VectorXd, 9> XQ;  // Xi_ab q at 3 a + b (Xi_ba = Xi_ab^T)
-  Eigen::Matrix3d Xq;                 // q^T Xi_ab q
-};
-
 SuperelementBody::SuperelementBody(const Superelement& se, const SuperelementOptions& options,
                                    const Eigen::Matrix3d& placement_R, const Eigen::Vector3d& placement_x)
     : n_nodes_(se.n_interface_nodes()),
@@ -144,6 +125,26 @@ SuperelementBody::Kinematics SuperelementBody::ComputeKinematics(const Eigen::Ve
   return k;
 }
 
+SuperelementBody::Data SuperelementBody::Evaluate(const BodyConfiguration& c, const FrameSolution& frame) const {
+  Data d;
+  d.c = c;
+  d.frame = frame;
+  d.q = LocalCoordinates(c, frame);
+  d.kin = ComputeKinematics(d.q);
+  if (has_exact_inertia()) d.exact = Exact(d.q, d.kin);
+  return d;
+}
+
+const BodyVelocityMaps& SuperelementBody::MapsOf(const Data& d) const {
+  if (!d.maps) {
+    BodyVelocityMaps maps;
+    VelocityMaps(d, &maps.P, &maps.U);
+    maps.Mg = maps.P.transpose() * M_ * maps.P;
+    d.maps = std::move(maps);
+  }
+  return *d.maps;
+}
+
 FrameSolution SuperelementBody::GuessFrame(const BodyConfiguration& c) const {
   FrameSolution frame;
   frame.R = c.R[0] * R0_[0].transpose();
@@ -204,15 +205,15 @@ Eigen::MatrixXd SuperelementBody::LocalTangent(const Eigen::VectorXd& q, const I
   return K;
 }
 
-InertiaLoadFactors SuperelementBody::InertiaLoads(const BodyConfiguration& c, const FrameSolution& frame,
-                                                   const BodyVelocity& w, const BodyVelocity& wdot,
+InertiaLoadFactors SuperelementBody::InertiaLoads(const Data& d, const BodyVelocity& w, const BodyVelocity& wdot,
                                                    const Eigen::Vector3d& gravity) const {
   const int n = n_coordinates();
   InertiaLoadFactors out;
   out.d_w = Eigen::MatrixXd::Zero(12, n);
   out.d_wdot = Eigen::MatrixXd::Zero(12, n);
-  const Eigen::VectorXd q = LocalCoordinates(c, frame);
-  const Kinematics kin = ComputeKinematics(q);
+  const Eigen::VectorXd& q = d.q;
+  const Kinematics& kin = d.kin;
+  const FrameSolution& frame = d.frame;
   // Z Rbar^T: node vectors to frame axes, then the frame's part.
   Eigen::MatrixXd ZR = kin.Z;
   for (int a = 0; a < 2 * n_nodes_; ++a) ZR.middleCols<3>(3 * a) = kin.Z.middleCols<3>(3 * a) * frame.R.transpose();
@@ -243,17 +244,17 @@ InertiaLoadFactors SuperelementBody::InertiaLoads(const BodyConfiguration& c, co
   return out;
 }
 
-double SuperelementBody::ElasticEnergy(const BodyConfiguration& c, const FrameSolution& frame) const {
-  const Eigen::VectorXd q = LocalCoordinates(c, frame);
+double SuperelementBody::ElasticEnergy(const Data& d) const {
+  const Eigen::VectorXd& q = d.q;
   return polynomial_ ? PolynomialEnergy(K_, *polynomial_, q) : 0.5 * q.dot(K_ * q);
 }
 
-void SuperelementBody::ElasticForce(const BodyConfiguration& c, const FrameSolution& frame, Eigen::VectorXd* f,
-                                    Eigen::MatrixXd* tangent, const InertiaLoadFactors* load,
-                                    Eigen::MatrixXd* d_load) const {
+void SuperelementBody::ElasticForce(const Data& d, Eigen::VectorXd* f, Eigen::MatrixXd* tangent,
+                                    const InertiaLoadFactors* load, Eigen::MatrixXd* d_load) const {
   const int n = n_coordinates();
-  const Eigen::VectorXd q = LocalCoordinates(c, frame);
-  const Kinematics kin = ComputeKinematics(q);
+  const Eigen::VectorXd& q = d.q;
+  const Kinematics& kin = d.kin;
+  const FrameSolution& frame = d.frame;
   if (!load || K_sigma_.empty()) load = nullptr;
   const Eigen::VectorXd Q = LocalForce(q, load);
   const Eigen::VectorXd Qhat = options_.approximated ? Eigen::VectorXd(T0_.transpose() * Q)
@@ -311,41 +312,40 @@ void SuperelementBody::ElasticForce(const BodyConfiguration& c, const FrameSolut
   *tangent = Rbar * Kt * Rbar.transpose();
 }
 
-SuperelementBody::ExactData SuperelementBody::Exact(const BodyConfiguration& c, const FrameSolution& frame) const {
+SuperelementBody::ExactData SuperelementBody::Exact(const Eigen::VectorXd& q, const Kinematics& kin) const {
   ExactData d;
-  d.R = frame.R;
-  d.q = LocalCoordinates(c, frame);
-  d.kin = ComputeKinematics(d.q);
-  d.Y = Phi_rig0_ * d.kin.Z + d.kin.B;
+  d.Y = Phi_rig0_ * kin.Z + kin.B;
   d.H.resize(n_coordinates(), 3);
-  for (int a = 0; a < 3; ++a) d.H.col(a) = Gamma_[size_t(a)] * d.q;
+  for (int a = 0; a < 3; ++a) d.H.col(a) = Gamma_[size_t(a)] * q;
   const int stored[3][3] = {{0, 3, 4}, {3, 1, 5}, {4, 5, 2}};  // xx yy zz xy xz yz
   for (int a = 0; a < 3; ++a)
     for (int b = 0; b < 3; ++b) {
       const Eigen::MatrixXd& X = Xi_[size_t(stored[a][b])];
-      d.XQ[size_t(3 * a + b)] = a <= b ? Eigen::VectorXd(X * d.q) : Eigen::VectorXd(X.transpose() * d.q);
+      d.XQ[size_t(3 * a + b)] = a <= b ? Eigen::VectorXd(X * q) : Eigen::VectorXd(X.transpose() * q);
     }
   for (int a = 0; a < 3; ++a)
-    for (int b = 0; b < 3; ++b) d.Xq(a, b) = d.q.dot(d.XQ[size_t(3 * a + b)]);
+    for (int b = 0; b < 3; ++b) d.Xq(a, b) = q.dot(d.XQ[size_t(3 * a + b)]);
   return d;
 }
 
-Eigen::VectorXd SuperelementBody::ExactInertiaForce(const ExactData& d, const BodyVelocity& w,
+Eigen::VectorXd SuperelementBody::ExactInertiaForce(const Data& data, const BodyVelocity& w,
                                                     const BodyVelocity& wdot) const {
   const int n = n_coordinates(), blocks = 2 * n_nodes_;
-  const Eigen::MatrixXd& Z = d.kin.Z;
-  const Eigen::MatrixXd& B = d.kin.B;
-  const Eigen::VectorXd Rw = TurnBlocks(d.R.transpose(), w, blocks);
+  const ExactData& d = *data.exact;
+  const Eigen::Matrix3d& R = data.frame.R;
+  const Eigen::MatrixXd& Z = data.kin.Z;
+  const Eigen::MatrixXd& B = data.kin.B;
+  const Eigen::VectorXd Rw = TurnBlocks(R.transpose(), w, blocks);
   const Eigen::Matrix<double, 6, 1> xi = Z * Rw;
   const Eigen::Vector3d v = xi.head<3>(), Om = xi.tail<3>();
   const Eigen::VectorXd qd = B * Rw;
   // r = Rbar^T wdot - c (header): xidot = Z r, qddot_loc = B r, ydot = Y r.
-  Eigen::VectorXd r = TurnBlocks(d.R.transpose(), wdot, blocks);
+  Eigen::VectorXd r = TurnBlocks(R.transpose(), wdot, blocks);
   for (int a = 0; a < blocks; ++a) r.segment<3>(3 * a) -= Om.cross(Eigen::Vector3d(Rw.segment<3>(3 * a)));
   for (int k = 0; k < n_nodes_; ++k) {
     r.segment<3>(6 * k) -= Om.cross(Eigen::Vector3d(qd.segment<3>(6 * k)));
     r.segment<3>(6 * k + 3) -=
-        LeftJacobianRate(Eigen::Vector3d(d.q.segment<3>(6 * k + 3)), Eigen::Vector3d(qd.segment<3>(6 * k + 3)));
+        LeftJacobianRate(Eigen::Vector3d(data.q.segment<3>(6 * k + 3)), Eigen::Vector3d(qd.segment<3>(6 * k + 3)));
   }
   const Eigen::Vector3d Omd = Z.bottomRows<3>() * r;
   const Eigen::VectorXd y = Phi_rig0_ * xi + qd, yd = d.Y * r;
@@ -370,24 +370,113 @@ Eigen::VectorXd SuperelementBody::ExactInertiaForce(const ExactData& d, const Bo
   const Eigen::Vector3d pi_v = pi_xi.head<3>(), pi_w = pi_xi.tail<3>();
   f_xi.head<3>() += Om.cross(pi_v);
   f_xi.tail<3>() += Om.cross(pi_w) + v.cross(pi_v);
-  return TurnBlocks(d.R, Eigen::VectorXd(Z.transpose() * f_xi + B.transpose() * f_q), blocks);
+  return TurnBlocks(R, Eigen::VectorXd(Z.transpose() * f_xi + B.transpose() * f_q), blocks);
 }
 
-Eigen::MatrixXd SuperelementBody::ExactMass(const ExactData& d) const {
-  const Eigen::MatrixXd Zr = d.kin.Z.bottomRows<3>();
+Eigen::MatrixXd SuperelementBody::ExactGyroscopic(const Data& data, const BodyVelocity& w) const {
+  // ExactInertiaForce is A(q) wdot + g(q, w), g quadratic in w with no wdot: its derivative by
+  // w is that of g. Forward mode by hand: every quantity of the force that depends on w carries
+  // its n columns d/dw (prefix d), in the order of ExactInertiaForce.
+  const int n = n_coordinates(), blocks = 2 * n_nodes_;
+  const ExactData& d = *data.exact;
+  const Eigen::Matrix3d& R = data.frame.R;
+  const Eigen::MatrixXd& Z = data.kin.Z;
+  const Eigen::MatrixXd& B = data.kin.B;
+  const auto times_Rbar_t = [&](Eigen::MatrixXd X) {  // X Rbar^T
+    for (int a = 0; a < blocks; ++a) X.middleCols<3>(3 * a) = X.middleCols<3>(3 * a) * R.transpose();
+    return X;
+  };
+  const Eigen::VectorXd Rw = TurnBlocks(R.transpose(), w, blocks);
+  const Eigen::MatrixXd dRw = times_Rbar_t(Eigen::MatrixXd::Identity(n, n));
+  const Eigen::Matrix<double, 6, 1> xi = Z * Rw;
+  const Eigen::Vector3d v = xi.head<3>(), Om = xi.tail<3>();
+  const Eigen::MatrixXd dxi = times_Rbar_t(Z);
+  const Eigen::MatrixXd dv = dxi.topRows<3>(), dOm = dxi.bottomRows<3>();
+  const Eigen::VectorXd qd = B * Rw;
+  const Eigen::MatrixXd dqd = times_Rbar_t(B);
+  // r = Rbar^T wdot - c(w): dr = -dc.
+  Eigen::MatrixXd dr = Eigen::MatrixXd::Zero(n, n);
+  const Eigen::Matrix3d Om_x = Skew<double>(Om);
+  for (int a = 0; a < blocks; ++a) {
+    dr.middleRows<3>(3 * a) -= -Skew<double>(Eigen::Vector3d(Rw.segment<3>(3 * a))) * dOm + Om_x * dRw.middleRows<3>(3 * a);
+  }
+  for (int k = 0; k < n_nodes_; ++k) {
+    dr.middleRows<3>(6 * k) -= -Skew<double>(Eigen::Vector3d(qd.segment<3>(6 * k))) * dOm + Om_x * dqd.middleRows<3>(6 * k);
+    // LeftJacobianRate is quadratic in thetadot: its derivative by polarization, exactly.
+    const Eigen::Vector3d theta = data.q.segment<3>(6 * k + 3), thetadot = qd.segment<3>(6 * k + 3);
+    const Eigen::Matrix3d DL = [&] {
+      const double s = std::max(thetadot.norm(), 1.0);
+      const Eigen::Vector3d L0 = LeftJacobianRate(theta, thetadot);
+      Eigen::Matrix3d out;
+      for (int i = 0; i < 3; ++i) {
+        const Eigen::Vector3d e = s * Eigen::Vector3d::Unit(i);
+        out.col(i) = (LeftJacobianRate(theta, thetadot + e) - L0 - LeftJacobianRate(theta, e)) / s;
+      }
+      return out;
+    }();
+    dr.middleRows<3>(6 * k + 3) -= DL * dqd.middleRows<3>(6 * k + 3);
+  }
+  const Eigen::MatrixXd dOmd = Z.bottomRows<3>() * dr;
+  const Eigen::VectorXd y = Phi_rig0_ * xi + qd;
+  const Eigen::MatrixXd dy = Phi_rig0_ * dxi + dqd;
+  const Eigen::MatrixXd dyd = d.Y * dr;
+  Eigen::MatrixXd Hd(n, 3);
+  std::array<Eigen::MatrixXd, 3> dHd;  // Gamma_a dqd
+  for (int a = 0; a < 3; ++a) {
+    Hd.col(a) = Gamma_[size_t(a)] * qd;
+    dHd[size_t(a)] = Gamma_[size_t(a)] * dqd;
+  }
+  const Eigen::VectorXd pi_q = M_ * y + d.H * Om;
+  const Eigen::MatrixXd dpi_q = M_ * dy + d.H * dOm;
+  Eigen::MatrixXd dpi_q_dot = M_ * dyd + d.H * dOmd + Hd * dOm;
+  for (int a = 0; a < 3; ++a) dpi_q_dot += Om[a] * dHd[size_t(a)];
+  Eigen::MatrixXd df_q = dpi_q_dot;
+  const Eigen::Vector3d h = d.H.transpose() * y + d.Xq * Om;
+  const Eigen::MatrixXd dh = d.H.transpose() * dy + d.Xq * dOm;
+  Eigen::MatrixXd dhd = d.H.transpose() * dyd + d.Xq * dOmd;
+  for (int a = 0; a < 3; ++a) {
+    const Eigen::MatrixXd& Ga = Gamma_[size_t(a)];
+    df_q -= (Ga.transpose() * y) * dOm.row(a) + Om[a] * (Ga.transpose() * dy);
+    dhd.row(a) += y.transpose() * dHd[size_t(a)] + Hd.col(a).transpose() * dy;
+    for (int b = 0; b < 3; ++b) {
+      const Eigen::VectorXd& XQab = d.XQ[size_t(3 * a + b)];
+      df_q -= XQab * (Om[b] * dOm.row(a) + Om[a] * dOm.row(b));
+      const Eigen::VectorXd S_ab = XQab + d.XQ[size_t(3 * b + a)];
+      dhd.row(a) += qd.dot(S_ab) * dOm.row(b) + Om[b] * (S_ab.transpose() * dqd);
+    }
+  }
+  Eigen::Matrix<double, 6, 1> pi_xi = Phi_rig0_.transpose() * pi_q;
+  pi_xi.tail<3>() += h;
+  const Eigen::Vector3d pi_v = pi_xi.head<3>(), pi_w = pi_xi.tail<3>();
+  Eigen::MatrixXd dpi_xi = Phi_rig0_.transpose() * dpi_q;
+  dpi_xi.bottomRows<3>() += dh;
+  Eigen::MatrixXd df_xi = Phi_rig0_.transpose() * dpi_q_dot;
+  df_xi.bottomRows<3>() += dhd;
+  const Eigen::MatrixXd dpi_v = dpi_xi.topRows<3>(), dpi_w = dpi_xi.bottomRows<3>();
+  df_xi.topRows<3>() += -Skew<double>(pi_v) * dOm + Om_x * dpi_v;
+  df_xi.bottomRows<3>() += -Skew<double>(pi_w) * dOm + Om_x * dpi_w - Skew<double>(pi_v) * dv + Skew<double>(v) * dpi_v;
+  Eigen::MatrixXd G = Z.transpose() * df_xi + B.transpose() * df_q;
+  for (int a = 0; a < blocks; ++a) G.middleRows<3>(3 * a) = R * G.middleRows<3>(3 * a);
+  return G;
+}
+
+Eigen::MatrixXd SuperelementBody::ExactMass(const Data& data) const {
+  const ExactData& d = *data.exact;
+  const Eigen::Matrix3d& R = data.frame.R;
+  const Eigen::MatrixXd Zr = data.kin.Z.bottomRows<3>();
   const Eigen::MatrixXd YHZ = d.Y.transpose() * d.H * Zr;
   Eigen::MatrixXd Mg = d.Y.transpose() * (M_ * d.Y) + YHZ + YHZ.transpose() + Zr.transpose() * d.Xq * Zr;
   // Rbar Mbar Rbar^T block by block.
-  for (int a = 0; a < 2 * n_nodes_; ++a) Mg.middleRows<3>(3 * a) = d.R * Mg.middleRows<3>(3 * a);
-  for (int a = 0; a < 2 * n_nodes_; ++a) Mg.middleCols<3>(3 * a) = Mg.middleCols<3>(3 * a) * d.R.transpose();
+  for (int a = 0; a < 2 * n_nodes_; ++a) Mg.middleRows<3>(3 * a) = R * Mg.middleRows<3>(3 * a);
+  for (int a = 0; a < 2 * n_nodes_; ++a) Mg.middleCols<3>(3 * a) = Mg.middleCols<3>(3 * a) * R.transpose();
   return Mg;
 }
 
-void SuperelementBody::VelocityMaps(const BodyConfiguration& c, const FrameSolution& frame, Eigen::MatrixXd* P,
-                                    Eigen::MatrixXd* U) const {
+void SuperelementBody::VelocityMaps(const Data& d, Eigen::MatrixXd* P, Eigen::MatrixXd* U) const {
   const int n = n_coordinates();
-  const Eigen::VectorXd q = LocalCoordinates(c, frame);
-  const Kinematics kin = ComputeKinematics(q);
+  const BodyConfiguration& c = d.c;
+  const FrameSolution& frame = d.frame;
+  const Kinematics& kin = d.kin;
   Eigen::MatrixXd Rbar_t = Eigen::MatrixXd::Identity(n, n);
   *P = Eigen::MatrixXd::Identity(n, n);
   for (int a = 0; a < n_nodes_; ++a) {
@@ -432,25 +521,26 @@ Eigen::VectorXd SuperelementBody::QuadraticInertia(const Eigen::MatrixXd& U, con
   return out;
 }
 
-void SuperelementBody::InertiaForce(const BodyConfiguration& c, const FrameSolution& frame, const BodyVelocity& w,
-                                    const BodyVelocity& wdot, Eigen::VectorXd* f_in, Eigen::MatrixXd* mass,
-                                    Eigen::MatrixXd* gyroscopic) const {
+void SuperelementBody::InertiaForce(const Data& d, const BodyVelocity& w, const BodyVelocity& wdot,
+                                    Eigen::VectorXd* f_in, Eigen::MatrixXd* mass, Eigen::MatrixXd* gyroscopic,
+                                    Eigen::VectorXd* f_acc) const {
   const int n = n_coordinates();
   if (has_exact_inertia()) {
-    const ExactData d = Exact(c, frame);
     const Eigen::VectorXd zero = Eigen::VectorXd::Zero(n);
     if (f_in) *f_in = ExactInertiaForce(d, options_.quadratic_velocity_terms ? w : zero, wdot);
+    if (f_acc) *f_acc = ExactInertiaForce(d, zero, wdot);
     if (mass) *mass = ExactMass(d);
     if (gyroscopic) {
       gyroscopic->setZero(n, n);
       if (!options_.quadratic_velocity_terms) return;
-      *gyroscopic = QuadraticDerivative(w, [&](const Eigen::VectorXd& v) { return ExactInertiaForce(d, v, zero); });
+      *gyroscopic = ExactGyroscopic(d, w);
     }
     return;
   }
-  Eigen::MatrixXd P, U;
-  VelocityMaps(c, frame, &P, &U);
-  const Eigen::MatrixXd Mg = P.transpose() * M_ * P;
+  const BodyVelocityMaps& maps = MapsOf(d);
+  const Eigen::MatrixXd& U = maps.U;
+  const Eigen::MatrixXd& Mg = maps.Mg;
+  if (f_acc) *f_acc = Mg * wdot;
   if (f_in) {
     *f_in = Mg * wdot;
     if (options_.quadratic_velocity_terms) *f_in += QuadraticInertia(U, Mg, w);
@@ -463,26 +553,25 @@ void SuperelementBody::InertiaForce(const BodyConfiguration& c, const FrameSolut
   }
 }
 
-Eigen::MatrixXd SuperelementBody::InertiaConfigurationTangent(const BodyConfiguration& c, const FrameSolution& frame,
-                                                              const BodyVelocity& w, const BodyVelocity& wdot,
-                                                              bool quadratic) const {
+Eigen::MatrixXd SuperelementBody::InertiaConfigurationTangent(const Data& d, const BodyVelocity& w,
+                                                              const BodyVelocity& wdot, bool quadratic) const {
   // Exact inertia: the whole force by central differences with `quadratic`; without, the
   // corotational d(M_g wdot)/dq, which has its leading part (the turning of the frame; the exact
   // mass differs from it at the order of q_loc Omega) for a fraction of the cost.
   if (has_exact_inertia() && quadratic && options_.quadratic_velocity_terms) {
-    return ExactInertiaConfigurationTangent(c, frame, w, wdot);
+    return ExactInertiaConfigurationTangent(d, w, wdot);
   }
-  Eigen::MatrixXd tangent = MomentumDerivative(Maps(c, frame), wdot);
+  Eigen::MatrixXd tangent = MomentumDerivative(MapsOf(d), wdot);
   if (!quadratic || !options_.quadratic_velocity_terms) return tangent;
   const int n = n_coordinates();
   for (int i = 0; i < n; ++i) {
     Eigen::VectorXd g[2];
     double step = 1e-7;
     for (int side = 0; side < 2; ++side) {
-      const BodyConfiguration p = Perturbed(c, i, side == 0 ? 1.0 : -1.0, &step);
-      Eigen::MatrixXd P, U;
-      VelocityMaps(p, SolveFrame(p, frame), &P, &U);
-      g[side] = QuadraticInertia(U, P.transpose() * M_ * P, w);
+      const BodyConfiguration p = Perturbed(d.c, i, side == 0 ? 1.0 : -1.0, &step);
+      const Data dp = Evaluate(p, SolveFrame(p, d.frame));
+      const BodyVelocityMaps& maps = MapsOf(dp);
+      g[side] = QuadraticInertia(maps.U, maps.Mg, w);
     }
     tangent.col(i) += (g[0] - g[1]) / (2 * step);
   }
@@ -512,8 +601,7 @@ BodyConfiguration SuperelementBody::Perturbed(const BodyConfiguration& c, int i,
   return p;
 }
 
-Eigen::MatrixXd SuperelementBody::ExactInertiaConfigurationTangent(const BodyConfiguration& c,
-                                                                   const FrameSolution& frame, const BodyVelocity& w,
+Eigen::MatrixXd SuperelementBody::ExactInertiaConfigurationTangent(const Data& d, const BodyVelocity& w,
                                                                    const BodyVelocity& wdot) const {
   // Central differences of the whole force at fixed (w, wdot), the frame re-solved.
   const int n = n_coordinates();
@@ -521,9 +609,9 @@ Eigen::MatrixXd SuperelementBody::ExactInertiaConfigurationTangent(const BodyCon
   Eigen::MatrixXd tangent(n, n);
   for (int i = 0; i < n; ++i) {
     double step = 0.0;
-    const BodyConfiguration plus = Perturbed(c, i, 1.0, &step), minus = Perturbed(c, i, -1.0, &step);
-    const Eigen::VectorXd f_plus = ExactInertiaForce(Exact(plus, SolveFrame(plus, frame)), w_used, wdot);
-    const Eigen::VectorXd f_minus = ExactInertiaForce(Exact(minus, SolveFrame(minus, frame)), w_used, wdot);
+    const BodyConfiguration plus = Perturbed(d.c, i, 1.0, &step), minus = Perturbed(d.c, i, -1.0, &step);
+    const Eigen::VectorXd f_plus = ExactInertiaForce(Evaluate(plus, SolveFrame(plus, d.frame)), w_used, wdot);
+    const Eigen::VectorXd f_minus = ExactInertiaForce(Evaluate(minus, SolveFrame(minus, d.frame)), w_used, wdot);
     tangent.col(i) = (f_plus - f_minus) / (2 * step);
   }
   return tangent;
@@ -540,20 +628,14 @@ void SuperelementBody::AddModalDamping(const BodyVelocity& w, Eigen::VectorXd& f
   }
 }
 
-double SuperelementBody::KineticEnergy(const BodyConfiguration& c, const FrameSolution& frame,
-                                       const BodyVelocity& w) const {
-  if (has_exact_inertia()) return 0.5 * w.dot(ExactMass(Exact(c, frame)) * w);
-  Eigen::MatrixXd P, U;
-  VelocityMaps(c, frame, &P, &U);
-  const Eigen::VectorXd v = P * w;
+double SuperelementBody::KineticEnergy(const Data& d, const BodyVelocity& w) const {
+  if (has_exact_inertia()) return 0.5 * w.dot(ExactMass(d) * w);
+  const Eigen::VectorXd v = MapsOf(d).P * w;
   return 0.5 * v.dot(M_ * v);
 }
 
 BodyVelocityMaps SuperelementBody::Maps(const BodyConfiguration& c, const FrameSolution& frame) const {
-  BodyVelocityMaps maps;
-  VelocityMaps(c, frame, &maps.P, &maps.U);
-  maps.Mg = maps.P.transpose() * M_ * maps.P;
-  return maps;
+  return MapsOf(Evaluate(c, frame));
 }
 
 Eigen::VectorXd SuperelementBody::GeneralizedMomentum(const BodyVelocityMaps& maps, const BodyVelocity& w) const {
@@ -609,10 +691,10 @@ Eigen::VectorXd SuperelementBody::MomentumSource(const BodyVelocityMaps& maps, c
   return out;
 }
 
-void SuperelementBody::Momentum(const BodyConfiguration& c, const FrameSolution& frame, const BodyVelocity& w,
-                                Eigen::Vector3d* linear, Eigen::Vector3d* angular) const {
-  const Eigen::VectorXd p =
-      has_exact_inertia() ? Eigen::VectorXd(ExactMass(Exact(c, frame)) * w) : GeneralizedMomentum(Maps(c, frame), w);
+void SuperelementBody::Momentum(const Data& d, const BodyVelocity& w, Eigen::Vector3d* linear,
+                                Eigen::Vector3d* angular) const {
+  const BodyConfiguration& c = d.c;
+  const Eigen::VectorXd p = has_exact_inertia() ? Eigen::VectorXd(ExactMass(d) * w) : GeneralizedMomentum(MapsOf(d), w);
   linear->setZero();
   angular->setZero();
   for (int a = 0; a < n_nodes_; ++a) {
@@ -632,20 +714,19 @@ Eigen::Vector3d SuperelementBody::CenterOfMass(const BodyConfiguration& c, const
   return frame.x + frame.R * (mass > 0 ? Eigen::Vector3d(moment / mass) : Eigen::Vector3d::Zero());
 }
 
-Eigen::VectorXd SuperelementBody::GravityForce(const BodyConfiguration& c, const FrameSolution& frame,
-                                               const Eigen::Vector3d& g) const {
+Eigen::VectorXd SuperelementBody::GravityForce(const Data& data, const Eigen::Vector3d& g) const {
+  const FrameSolution& frame = data.frame;
   if (has_exact_inertia()) {
     // Virtual work of g on the field: y_g = Phi_rig0 [R_j^T g; 0] (a uniform field), delta of the
     // field = Phi (Phi_rig0 delta xi + delta q_loc) + delta theta_j x (Phi q):
     // f = Rbar (Y^T M y_g + Z_r^T H^T y_g).
-    const ExactData d = Exact(c, frame);
+    const ExactData& d = *data.exact;
     const Eigen::VectorXd yg = Phi_rig0_.leftCols<3>() * (frame.R.transpose() * g);
     const Eigen::VectorXd local =
-        d.Y.transpose() * (M_ * yg) + d.kin.Z.bottomRows<3>().transpose() * (d.H.transpose() * yg);
+        d.Y.transpose() * (M_ * yg) + data.kin.Z.bottomRows<3>().transpose() * (d.H.transpose() * yg);
     return TurnBlocks(frame.R, local, 2 * n_nodes_);
   }
-  Eigen::MatrixXd P, U;
-  VelocityMaps(c, frame, &P, &U);
+  const Eigen::MatrixXd& P = MapsOf(data).P;
   Eigen::Matrix<double, 6, 1> rigid;
   rigid << frame.R.transpose() * g, Eigen::Vector3d::Zero();
   return P.transpose() * (M_ * (Phi_rig0_ * rigid));

@@ -27,6 +27,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <array>
 #include <optional>
 #include <vector>
 
@@ -94,6 +95,39 @@ class SuperelementBody {
                    const Eigen::Matrix3d& placement_R = Eigen::Matrix3d::Identity(),
                    const Eigen::Vector3d& placement_x = Eigen::Vector3d::Zero());
 
+  /// The configuration-dependent quantities of the kinematics (thesis 3.14-3.18; see the file
+  /// comment): Phi_rig, D, S = Phi_CB D Phi_rig, Z = S^-1 Phi_CB D, T = 1 - Phi_rig Z, B = D T.
+  struct Kinematics {
+    Eigen::MatrixXd Phi_rig;  ///< n x 6
+    Eigen::MatrixXd D;        ///< n x n (block diagonal)
+    Eigen::Matrix<double, 6, 6> S;
+    Eigen::MatrixXd Z;        ///< 6 x n
+    Eigen::MatrixXd T;        ///< n x n
+    Eigen::MatrixXd B;        ///< n x n
+  };
+  /// The exact inertia's configuration-dependent products (has_exact_inertia).
+  struct ExactData {
+    Eigen::MatrixXd Y;                  ///< Phi_rig0 Z + B
+    Eigen::MatrixXd H;                  ///< n x 3: Gamma_a q
+    std::array<Eigen::VectorXd, 9> XQ;  ///< Xi_ab q at 3 a + b (Xi_ba = Xi_ab^T)
+    Eigen::Matrix3d Xq;                 ///< q^T Xi_ab q
+  };
+  /// Everything one configuration of the body determines, computed once (Evaluate) and passed to
+  /// every force, matrix and energy evaluated there: an assembly pass evaluates each body's
+  /// kinematics once instead of once per term (issue 14: the model / data split).
+  struct Data {
+    BodyConfiguration c;
+    FrameSolution frame;
+    Eigen::VectorXd q;  ///< q_loc
+    Kinematics kin;
+    std::optional<ExactData> exact;                 ///< with the exact inertia
+    mutable std::optional<BodyVelocityMaps> maps;   ///< the corotational maps, made when first asked
+  };
+  /// The body's quantities at configuration `c` with its solved floating frame.
+  Data Evaluate(const BodyConfiguration& c, const FrameSolution& frame) const;
+  /// The velocity maps of `d` (computed on the first call).
+  const BodyVelocityMaps& MapsOf(const Data& d) const;
+
   int n_nodes() const { return n_nodes_; }
   int n_modes() const { return n_modes_; }
   int n_coordinates() const { return 6 * n_nodes_ + n_modes_; }
@@ -134,9 +168,13 @@ class SuperelementBody {
   /// if `tangent` is not null, its derivative with respect to (dx_k, dpi_k, d eta).
   /// With `load` (and a file with inertia stiffening) the local stiffness is K + K_sigma(a)
   /// (InertiaLoads); `d_load` (n x 12) then receives df/da at fixed configuration.
+  void ElasticForce(const Data& d, Eigen::VectorXd* f, Eigen::MatrixXd* tangent,
+                    const InertiaLoadFactors* load = nullptr, Eigen::MatrixXd* d_load = nullptr) const;
   void ElasticForce(const BodyConfiguration& c, const FrameSolution& frame, Eigen::VectorXd* f,
                     Eigen::MatrixXd* tangent, const InertiaLoadFactors* load = nullptr,
-                    Eigen::MatrixXd* d_load = nullptr) const;
+                    Eigen::MatrixXd* d_load = nullptr) const {
+    ElasticForce(Evaluate(c, frame), f, tangent, load, d_load);
+  }
 
   /// True when the body uses the geometric stiffness of inertia load cases (file and option).
   bool has_inertia_stiffening() const { return !K_sigma_.empty(); }
@@ -155,11 +193,18 @@ class SuperelementBody {
   /// and R_j^T omegadot_k = alpha, so [a_j; alpha] = Z (Rbar^T wdot - c(omega)),
   /// c_k = omega x (omega x r_k) on node k's translation rows. d_w and d_wdot are exact at fixed
   /// configuration (the configuration dependence of R_j and Z is left out of the tangent).
+  InertiaLoadFactors InertiaLoads(const Data& d, const BodyVelocity& w, const BodyVelocity& wdot,
+                                  const Eigen::Vector3d& gravity) const;
   InertiaLoadFactors InertiaLoads(const BodyConfiguration& c, const FrameSolution& frame, const BodyVelocity& w,
-                                  const BodyVelocity& wdot, const Eigen::Vector3d& gravity) const;
+                                  const BodyVelocity& wdot, const Eigen::Vector3d& gravity) const {
+    return InertiaLoads(Evaluate(c, frame), w, wdot, gravity);
+  }
 
   /// Strain energy q_loc^T K q_loc / 2.
-  double ElasticEnergy(const BodyConfiguration& c, const FrameSolution& frame) const;
+  double ElasticEnergy(const Data& d) const;
+  double ElasticEnergy(const BodyConfiguration& c, const FrameSolution& frame) const {
+    return ElasticEnergy(Evaluate(c, frame));
+  }
 
   /// True when the body uses the exact kinetic energy (file invariants and option exact_inertia).
   ///
@@ -194,23 +239,35 @@ class SuperelementBody {
   /// block-diagonal skew matrices of Pdot^T = Omega_P P^T and of the node angular velocities:
   ///   f_in = M_g wdot + M_g G w + (Omega_P - Omega_hat) p - G^T p,  M_g = P^T M P, p = M_g w.
   /// `mass` receives M_g, `gyroscopic` d f_in / d w (exact: f_in is quadratic in w).
+  /// `f_acc` (optional) receives the part linear in wdot, M_g wdot.
+  void InertiaForce(const Data& d, const BodyVelocity& w, const BodyVelocity& wdot, Eigen::VectorXd* f_in,
+                    Eigen::MatrixXd* mass, Eigen::MatrixXd* gyroscopic, Eigen::VectorXd* f_acc = nullptr) const;
   void InertiaForce(const BodyConfiguration& c, const FrameSolution& frame, const BodyVelocity& w,
                     const BodyVelocity& wdot, Eigen::VectorXd* f_in, Eigen::MatrixXd* mass,
-                    Eigen::MatrixXd* gyroscopic) const;
+                    Eigen::MatrixXd* gyroscopic) const {
+    InertiaForce(Evaluate(c, frame), w, wdot, f_in, mass, gyroscopic);
+  }
 
   /// d f_in / dq at fixed (w, wdot): d(M_g wdot)/dq = MomentumDerivative(c, frame, wdot)
   /// (exact), plus with `quadratic` the configuration derivative of the quadratic velocity terms
   /// by central differences (2n evaluations with the frame re-solved; steps 1e-7 of the body
   /// size, 1e-7 rad, 1e-7 of the modal scale).
+  Eigen::MatrixXd InertiaConfigurationTangent(const Data& d, const BodyVelocity& w, const BodyVelocity& wdot,
+                                              bool quadratic) const;
   Eigen::MatrixXd InertiaConfigurationTangent(const BodyConfiguration& c, const FrameSolution& frame,
-                                              const BodyVelocity& w, const BodyVelocity& wdot, bool quadratic) const;
+                                              const BodyVelocity& w, const BodyVelocity& wdot, bool quadratic) const {
+    return InertiaConfigurationTangent(Evaluate(c, frame), w, wdot, quadratic);
+  }
 
   /// Modal damping force 2 zeta omega_i etadot_i on the internal-mode rows and its derivative
   /// with respect to w (added to `f` and `C`).
   void AddModalDamping(const BodyVelocity& w, Eigen::VectorXd& f, Eigen::MatrixXd* C) const;
 
   /// Kinetic energy v^T M v / 2.
-  double KineticEnergy(const BodyConfiguration& c, const FrameSolution& frame, const BodyVelocity& w) const;
+  double KineticEnergy(const Data& d, const BodyVelocity& w) const;
+  double KineticEnergy(const BodyConfiguration& c, const FrameSolution& frame, const BodyVelocity& w) const {
+    return KineticEnergy(Evaluate(c, frame), w);
+  }
 
   /// Velocity maps at a configuration (BodyVelocityMaps), shared by the momentum terms below.
   BodyVelocityMaps Maps(const BodyConfiguration& c, const FrameSolution& frame) const;
@@ -239,8 +296,11 @@ class SuperelementBody {
 
   /// Linear momentum and angular momentum about the global origin (Noether: sums of the
   /// generalized momenta p = M_g w of the nodes).
+  void Momentum(const Data& d, const BodyVelocity& w, Eigen::Vector3d* linear, Eigen::Vector3d* angular) const;
   void Momentum(const BodyConfiguration& c, const FrameSolution& frame, const BodyVelocity& w,
-                Eigen::Vector3d* linear, Eigen::Vector3d* angular) const;
+                Eigen::Vector3d* linear, Eigen::Vector3d* angular) const {
+    Momentum(Evaluate(c, frame), w, linear, angular);
+  }
 
   /// The deformed body's centre of mass (global): x_j + R_j (s_0 + C q_loc) / m, s_0 the first
   /// moment of the undeformed body about the frame origin, C = int rho Phi (the translation rows
@@ -248,25 +308,28 @@ class SuperelementBody {
   Eigen::Vector3d CenterOfMass(const BodyConfiguration& c, const FrameSolution& frame) const;
 
   /// Generalized force of a uniform acceleration field g (gravity): P^T M Phi_rig0 [R_j^T g; 0].
-  Eigen::VectorXd GravityForce(const BodyConfiguration& c, const FrameSolution& frame, const Eigen::Vector3d& g) const;
+  Eigen::VectorXd GravityForce(const Data& d, const Eigen::Vector3d& g) const;
+  Eigen::VectorXd GravityForce(const BodyConfiguration& c, const FrameSolution& frame, const Eigen::Vector3d& g) const {
+    return GravityForce(Evaluate(c, frame), g);
+  }
 
  private:
-  struct Kinematics;  // Phi_rig, D, S, Z, T, B at a configuration
   Kinematics ComputeKinematics(const Eigen::VectorXd& q_loc) const;
   // P (system velocities -> local velocities) and the frame's angular velocity map U (3 x n).
-  void VelocityMaps(const BodyConfiguration& c, const FrameSolution& frame, Eigen::MatrixXd* P, Eigen::MatrixXd* U) const;
+  void VelocityMaps(const Data& d, Eigen::MatrixXd* P, Eigen::MatrixXd* U) const;
   // G of d(P w) = P G dq at fixed w (n x n), from U and the velocities.
   Eigen::MatrixXd VelocityMapRate(const Eigen::MatrixXd& U, const BodyVelocity& w) const;
   // The quadratic part of f_in: M_g G w + (Omega_P - Omega_hat) p - G^T p.
   Eigen::VectorXd QuadraticInertia(const Eigen::MatrixXd& U, const Eigen::MatrixXd& Mg, const BodyVelocity& w) const;
   Eigen::MatrixXd Phi_rig0_;
   // Exact inertia (has_exact_inertia): per-configuration data, the force, the mass matrix M_g.
-  struct ExactData;
-  ExactData Exact(const BodyConfiguration& c, const FrameSolution& frame) const;
-  Eigen::VectorXd ExactInertiaForce(const ExactData& d, const BodyVelocity& w, const BodyVelocity& wdot) const;
-  Eigen::MatrixXd ExactMass(const ExactData& d) const;
-  Eigen::MatrixXd ExactInertiaConfigurationTangent(const BodyConfiguration& c, const FrameSolution& frame,
-                                                   const BodyVelocity& w, const BodyVelocity& wdot) const;
+  ExactData Exact(const Eigen::VectorXd& q, const Kinematics& kin) const;
+  Eigen::VectorXd ExactInertiaForce(const Data& d, const BodyVelocity& w, const BodyVelocity& wdot) const;
+  Eigen::MatrixXd ExactMass(const Data& d) const;
+  // d f_in / d w of the exact inertia force (forward mode, exact).
+  Eigen::MatrixXd ExactGyroscopic(const Data& d, const BodyVelocity& w) const;
+  Eigen::MatrixXd ExactInertiaConfigurationTangent(const Data& d, const BodyVelocity& w,
+                                                   const BodyVelocity& wdot) const;
   BodyConfiguration Perturbed(const BodyConfiguration& c, int i, double sign, double* step) const;
   std::vector<Eigen::MatrixXd> Gamma_, Xi_;  ///< the file's inertia invariants (3, 6), or none
 
