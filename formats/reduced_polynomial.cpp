@@ -24,6 +24,38 @@ Eigen::SparseMatrix<double> PairJacobian(const Eigen::VectorXd& q) {
   return J;
 }
 
+// J^T v without forming J (no allocation but the result): per pair p = (j, k), m_p q_k v_p to
+// entry j and m_p q_j v_p to entry k (2 q_j v_p once for a diagonal pair).
+Eigen::VectorXd PairJacobianTransposeTimes(const Eigen::VectorXd& q, const Eigen::VectorXd& v) {
+  const int n = int(q.size());
+  Eigen::VectorXd out = Eigen::VectorXd::Zero(n);
+  int p = 0;
+  for (int j = 0; j < n; ++j) {
+    out[j] += 2.0 * q[j] * v[p++];
+    for (int k = j + 1; k < n; ++k, ++p) {
+      out[j] += 2.0 * q[k] * v[p];
+      out[k] += 2.0 * q[j] * v[p];
+    }
+  }
+  return out;
+}
+
+// A J (rows of A times J) without forming J: column j of A J gathers m_p q_k A_p over the pairs
+// p = (j, k) and (k, j).
+Eigen::MatrixXd TimesPairJacobian(const Eigen::MatrixXd& A, const Eigen::VectorXd& q) {
+  const int n = int(q.size());
+  Eigen::MatrixXd out = Eigen::MatrixXd::Zero(A.rows(), n);
+  int p = 0;
+  for (int j = 0; j < n; ++j) {
+    out.col(j) += (2.0 * q[j]) * A.col(p++);
+    for (int k = j + 1; k < n; ++k, ++p) {
+      out.col(j) += (2.0 * q[k]) * A.col(p);
+      out.col(k) += (2.0 * q[j]) * A.col(p);
+    }
+  }
+  return out;
+}
+
 // Adds sum_p w_p d2 z_p / dq2 to T: m_p at (j, k) and (k, j).
 void AddPairHessian(const Eigen::VectorXd& w, Eigen::MatrixXd* T) {
   const int n = int(T->rows());
@@ -53,23 +85,22 @@ double PolynomialEnergy(const Eigen::MatrixXd& K, const PolynomialStiffness& p, 
 }
 
 Eigen::VectorXd PolynomialForce(const Eigen::MatrixXd& K, const PolynomialStiffness& p, const Eigen::VectorXd& q) {
+  if (!p.cubic()) return K * q + PairJacobianTransposeTimes(q, p.A.transpose() * q);  // geometric stiffness form
   const Eigen::VectorXd z = PairProducts(q);
-  const Eigen::SparseMatrix<double> J = PairJacobian(q);
-  if (!p.cubic()) return K * q + J.transpose() * (p.A.transpose() * q);  // geometric stiffness form
   const Eigen::VectorXd w = p.A.transpose() * q + 2 * (p.B * z);
-  return K * q + p.A * z + J.transpose() * w;
+  return K * q + p.A * z + PairJacobianTransposeTimes(q, w);
 }
 
 Eigen::MatrixXd PolynomialTangent(const Eigen::MatrixXd& K, const PolynomialStiffness& p, const Eigen::VectorXd& q) {
-  const Eigen::VectorXd z = PairProducts(q);
-  const Eigen::SparseMatrix<double> J = PairJacobian(q);
-  const Eigen::MatrixXd AJ = p.A * J;
+  const Eigen::MatrixXd AJ = TimesPairJacobian(p.A, q);
   if (!p.cubic()) {
     // d/dq [J^T (A^T q)] = (A J)^T + sum_p (A^T q)_p d2 z_p / dq2 (not symmetric).
     Eigen::MatrixXd T = K + AJ.transpose();
     AddPairHessian(p.A.transpose() * q, &T);
     return T;
   }
+  const Eigen::VectorXd z = PairProducts(q);
+  const Eigen::SparseMatrix<double> J = PairJacobian(q);
   const Eigen::MatrixXd BJ = p.B * J;
   Eigen::MatrixXd T = K + AJ + AJ.transpose();
   T.noalias() += 2 * (J.transpose() * BJ);

@@ -105,23 +105,29 @@ Eigen::VectorXd SuperelementBody::LocalCoordinates(const BodyConfiguration& c, c
   return q;
 }
 
-SuperelementBody::Kinematics SuperelementBody::ComputeKinematics(const Eigen::VectorXd& q) const {
+SuperelementBody::Kinematics SuperelementBody::ComputeKinematics(const Eigen::VectorXd& q, bool frame_only) const {
   const int n = n_coordinates();
   Kinematics k;
   k.Phi_rig = Eigen::MatrixXd::Zero(n, 6);
-  k.D = Eigen::MatrixXd::Identity(n, n);
+  // D is block diagonal: its products below act on the rotation blocks only (no n^3 products).
+  std::vector<Eigen::Matrix3d> Jinv(static_cast<size_t>(n_nodes_));
+  Eigen::MatrixXd W = Phi_CB_;  // Phi_CB D
   for (int a = 0; a < n_nodes_; ++a) {
     const Eigen::Vector3d r = X_[a] + q.segment<3>(6 * a);
     auto block = k.Phi_rig.block<6, 6>(6 * a, 0);
     block.setIdentity();
     block.block<3, 3>(0, 3) = -Skew<double>(r);
-    k.D.block<3, 3>(6 * a + 3, 6 * a + 3) = LeftJacobianInverse<double>(Eigen::Vector3d(q.segment<3>(6 * a + 3)));
+    Jinv[size_t(a)] = LeftJacobianInverse<double>(Eigen::Vector3d(q.segment<3>(6 * a + 3)));
+    W.middleCols<3>(6 * a + 3) = Phi_CB_.middleCols<3>(6 * a + 3) * Jinv[size_t(a)];
   }
-  const Eigen::MatrixXd W = Phi_CB_ * k.D;
   k.S = W * k.Phi_rig;
+  if (frame_only) return k;
+  k.D = Eigen::MatrixXd::Identity(n, n);
+  for (int a = 0; a < n_nodes_; ++a) k.D.block<3, 3>(6 * a + 3, 6 * a + 3) = Jinv[size_t(a)];
   k.Z = k.S.lu().solve(W);
   k.T = Eigen::MatrixXd::Identity(n, n) - k.Phi_rig * k.Z;
-  k.B = k.D * k.T;
+  k.B = k.T;
+  for (int a = 0; a < n_nodes_; ++a) k.B.middleRows<3>(6 * a + 3) = Jinv[size_t(a)] * k.T.middleRows<3>(6 * a + 3);
   return k;
 }
 
@@ -179,7 +185,7 @@ FrameSolution SuperelementBody::SolveFrame(const BodyConfiguration& c, const Fra
       return frame;
     }
     // d q_loc = -D Phi_rig zeta for a frame variation zeta (frame axes): zeta = S^-1 g.
-    const Kinematics kin = ComputeKinematics(q);
+    const Kinematics kin = ComputeKinematics(q, /*frame_only=*/true);
     const Eigen::Matrix<double, 6, 1> zeta = kin.S.lu().solve(g);
     frame.x += frame.R * zeta.head<3>();
     frame.R = frame.R * ExpSO3(zeta.tail<3>());

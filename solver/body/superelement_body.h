@@ -314,7 +314,8 @@ class SuperelementBody {
   }
 
  private:
-  Kinematics ComputeKinematics(const Eigen::VectorXd& q_loc) const;
+  // frame_only: Phi_rig and S only (the floating frame's Newton iteration).
+  Kinematics ComputeKinematics(const Eigen::VectorXd& q_loc, bool frame_only = false) const;
   // P (system velocities -> local velocities) and the frame's angular velocity map U (3 x n).
   void VelocityMaps(const Data& d, Eigen::MatrixXd* P, Eigen::MatrixXd* U) const;
   // G of d(P w) = P G dq at fixed w (n x n), from U and the velocities.
