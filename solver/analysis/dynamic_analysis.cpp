@@ -221,8 +221,11 @@ DynamicState InitialDynamicState(const SystemModel& model, const SystemState& co
   return s;
 }
 
-DynamicStepReport Measure(const SystemModel& model, DynamicState& s) {
-  const DofMap dofs(model);
+namespace {
+// Measure with the bodies' data of the converged iteration at this state (`passes`, one per
+// body) or, when empty, evaluated here.
+DynamicStepReport MeasureWith(const SystemModel& model, const DofMap& dofs, const DynamicState& s,
+                              const std::vector<BodyPass>& passes) {
   DynamicStepReport r;
   r.t = s.t;
   r.external_work = s.external_work;
@@ -230,10 +233,11 @@ DynamicStepReport Measure(const SystemModel& model, DynamicState& s) {
   AddSpringDampers(model, s.config, s.W, unused, nullptr, nullptr, &r.elastic_energy);  // spring energy
   for (size_t b = 0; b < model.bodies.size(); ++b) {
     const SuperelementBody& body = model.bodies[b];
-    const BodyConfiguration c = BodyConfigurationOf(model, s.config, int(b));
-    const FrameSolution& frame = s.config.frames[b];
-    const Eigen::VectorXd w = GatherBody(model, dofs, s.config, int(b), s.W);
-    const SuperelementBody::Data data = body.Evaluate(c, frame);
+    const bool kept = passes.size() == model.bodies.size();
+    const SuperelementBody::Data evaluated =
+        kept ? SuperelementBody::Data{} : body.Evaluate(BodyConfigurationOf(model, s.config, int(b)), s.config.frames[b]);
+    const SuperelementBody::Data& data = kept ? passes[b].data : evaluated;
+    const Eigen::VectorXd w = kept ? passes[b].w : GatherBody(model, dofs, s.config, int(b), s.W);
     r.kinetic_energy += body.KineticEnergy(data, w);
     r.elastic_energy += body.ElasticEnergy(data);
     Eigen::Vector3d L, H;
@@ -242,6 +246,11 @@ DynamicStepReport Measure(const SystemModel& model, DynamicState& s) {
     r.angular_momentum += H;
   }
   return r;
+}
+}  // namespace
+
+DynamicStepReport Measure(const SystemModel& model, DynamicState& s) {
+  return MeasureWith(model, DofMap(model), s, {});
 }
 
 namespace {
@@ -271,6 +280,7 @@ struct StepOutcome {
   bool converged = false;
   int iterations = 0;
   SystemMatrix singular_matrix;  ///< the iteration matrix when its factorization failed
+  std::vector<BodyPass> passes;  ///< the bodies' data at the converged state (generalized-alpha)
 };
 
 // One generalized-alpha step of size h from `state` into `next` (Arnold & Bruls 2007).
@@ -305,6 +315,7 @@ StepOutcome GeneralizedAlphaStep(const SystemModel& model, const DofMap& dofs, c
       next.f_ext = a.f_ext;
       next.f_drive = DriveForces(dofs, a.residual);
       next.drive_work += 0.5 * (state.f_drive + next.f_drive).dot(h * 0.5 * (state.W + next.W));
+      out.passes = std::move(passes);
       return out;
     }
     bool built = false;
@@ -676,7 +687,7 @@ DynamicResult SolveDynamic(const SystemModel& model, DynamicState& state, const 
     state = next;
     result.steps += 1;
     result.newton_iterations += step.iterations;
-    DynamicStepReport r = Measure(model, state);
+    DynamicStepReport r = MeasureWith(model, dofs, state, step.passes);
     r.h = h;
     r.iterations = step.iterations;
     if (on_step) on_step(r, state);

@@ -434,8 +434,17 @@ bool FreeSolver::Factor(const DofMap& dofs, const SystemMatrix& S) {
   const SystemMatrix Sf = ToMatrix(n, entries);
   sparse_ = n > kDenseLimit;
   if (sparse_) {
-    sparse_lu_ = std::make_shared<Eigen::SparseLU<SystemMatrix, Eigen::COLAMDOrdering<int>>>();
-    sparse_lu_->compute(Sf);
+    // The symbolic analysis (COLAMD ordering, elimination tree) is kept while the pattern stays
+    // (an assembly's pattern is fixed by the model's structure): numeric refactorization only.
+    const std::vector<int> outer(Sf.outerIndexPtr(), Sf.outerIndexPtr() + Sf.outerSize() + 1);
+    const std::vector<int> inner(Sf.innerIndexPtr(), Sf.innerIndexPtr() + Sf.nonZeros());
+    if (!sparse_lu_ || sparse_lu_.use_count() > 1 || outer != pattern_outer_ || inner != pattern_inner_) {
+      sparse_lu_ = std::make_shared<Eigen::SparseLU<SystemMatrix, Eigen::COLAMDOrdering<int>>>();
+      sparse_lu_->analyzePattern(Sf);
+      pattern_outer_ = outer;
+      pattern_inner_ = inner;
+    }
+    sparse_lu_->factorize(Sf);
     valid_ = sparse_lu_->info() == Eigen::Success;
     return valid_;
   }

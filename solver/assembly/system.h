@@ -253,6 +253,7 @@ class FreeSolver {
   std::vector<int> free_;
   Eigen::PartialPivLU<Eigen::MatrixXd> dense_;
   std::shared_ptr<Eigen::SparseLU<SystemMatrix, Eigen::COLAMDOrdering<int>>> sparse_lu_;
+  std::vector<int> pattern_outer_, pattern_inner_;  ///< the pattern sparse_lu_ was analysed for
   bool valid_ = false, sparse_ = false;
 };
 /// S restricted to the coordinates solved for, dense (n_free x n_free).
