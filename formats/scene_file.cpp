@@ -364,7 +364,7 @@ SceneSpec ParseScene(const std::string& text, const std::string& name, const std
   if (auto outputs = root.Optional("outputs")) {
     YamlMap m = outputs.value().Map();
     if (auto v = m.Optional("animation")) scene.animation = v->Bool();
-    if (auto v = m.Optional("animation_every")) scene.animation_every = std::max(1, int(v->NonNegativeInteger()));
+    if (auto v = m.Optional("animation_every")) scene.animation_every = int(v->NonNegativeInteger());
     if (auto v = m.Optional("reactions")) scene.reactions = scene.reactions || v->Bool();
     if (auto probes = m.Optional("probes")) {
       for (const YamlValue& item : probes->List()) {

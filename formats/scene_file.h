@@ -105,7 +105,9 @@ struct SceneSpec {
   SceneAnalysisSpec analysis;
   std::vector<SceneProbeSpec> probes;
   bool animation = true;  ///< write animation.xdmf/.h5 when the superelement files hold meshes
-  int animation_every = 1;  ///< one animation frame per this many output steps
+  /// One animation frame per this many output steps; 0 (default): about 500 frames per run
+  /// (ResultsRecorder; every output step up to 500 of them).
+  int animation_every = 0;
   /// Compute the support and joint reactions at every output step (outputs.reactions, or a probe
   /// asking for `reaction`): /nodes/reaction in results.h5.
   bool reactions = false;

@@ -322,6 +322,9 @@ class SuperelementBody {
   Eigen::MatrixXd VelocityMapRate(const Eigen::MatrixXd& U, const BodyVelocity& w) const;
   // The quadratic part of f_in: M_g G w + (Omega_P - Omega_hat) p - G^T p.
   Eigen::VectorXd QuadraticInertia(const Eigen::MatrixXd& U, const Eigen::MatrixXd& Mg, const BodyVelocity& w) const;
+  // Its derivative by w (exact, O(n^2) products).
+  Eigen::MatrixXd QuadraticInertiaDerivative(const Eigen::MatrixXd& U, const Eigen::MatrixXd& Mg,
+                                             const BodyVelocity& w) const;
   Eigen::MatrixXd Phi_rig0_;
   // Exact inertia (has_exact_inertia): per-configuration data, the force, the mass matrix M_g.
   ExactData Exact(const Eigen::VectorXd& q, const Kinematics& kin) const;

@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <Eigen/Geometry>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 
@@ -35,6 +36,13 @@ Eigen::MatrixXd Stack(const std::vector<Eigen::VectorXd>& rows, int cols) {
 
 ResultsRecorder::ResultsRecorder(const Scene& scene, const std::string& directory)
     : scene_(scene), directory_(directory) {
+  // Animation frames: as asked, or about kAutoFrames per run (the output steps the analysis will
+  // take: load steps, or time steps over output_every).
+  constexpr double kAutoFrames = 500;
+  const SceneAnalysisSpec& a = scene.spec.analysis;
+  const double outputs = a.type == "dynamic" ? a.end_time / (a.step * std::max(a.output_every, 1)) : double(a.steps);
+  animation_every_ = scene.spec.animation_every > 0 ? scene.spec.animation_every
+                                                    : std::max(1, int(std::ceil(outputs / kAutoFrames)));
   std::error_code ec;
   std::filesystem::create_directories(directory, ec);
   if (ec) throw InputError(directory + ": cannot create output folder (" + ec.message() + ")");
@@ -125,7 +133,7 @@ void ResultsRecorder::Record(double t, const SystemState& state, const Eigen::Ve
   }
   joints_.push_back(Eigen::Map<Eigen::VectorXd>(joint_values.data(), long(joint_values.size())));
   frames_.push_back(frames);
-  if (scene_.spec.animation && (time_.size() - 1) % size_t(scene_.spec.animation_every) == 0) {
+  if (scene_.spec.animation && (time_.size() - 1) % size_t(animation_every_) == 0) {
     std::vector<Eigen::MatrixXf> meshes;
     for (size_t b = 0; b < model.bodies.size(); ++b) {
       const auto& mesh = scene_.meshes[b];

@@ -35,6 +35,7 @@ class ResultsRecorder {
 
  private:
   const Scene& scene_;
+  int animation_every_ = 1;  ///< one animation frame per this many output steps (spec, or auto)
   std::string directory_, csv_path_, h5_path_, csv_tmp_;
   std::ofstream csv_;
   std::vector<double> time_, kinetic_, elastic_, work_;

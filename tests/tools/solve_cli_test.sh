@@ -74,6 +74,15 @@ reader.read_points_cells()
 assert reader.num_steps == 11, reader.num_steps
 assert [reader.read_data(k)[0] for k in (0, 1, 10)] == [0.0, 10.0, 100.0]
 PY
+# By default a long run gets about 500 frames: 1200 load steps -> every 3rd (401 frames).
+"$bin/femb-solve" -q "$work/scene.yaml" -o "$work/long" --set analysis.steps=1200 && $py - "$work/long" <<'PY' \
+  && ok || fail "automatic animation_every"
+import sys, meshio
+reader = meshio.xdmf.TimeSeriesReader(sys.argv[1] + "/animation.xdmf")
+reader.read_points_cells()
+assert reader.num_steps == 401, reader.num_steps
+assert [reader.read_data(k)[0] for k in (0, 1, 400)] == [0.0, 0.25, 100.0], [reader.read_data(k)[0] for k in (0, 1, 400)]
+PY
 
 # Linearized modes of the clamped 10-body tube: the first bending pair equals the ringing
 # frequency of one clamped tube body (19.16 Hz, tests/solver/analysis/flexible_dynamics_test).
