@@ -134,30 +134,36 @@ void ResultsRecorder::Record(double t, const SystemState& state, const Eigen::Ve
   joints_.push_back(Eigen::Map<Eigen::VectorXd>(joint_values.data(), long(joint_values.size())));
   frames_.push_back(frames);
   if (scene_.spec.animation && (time_.size() - 1) % size_t(animation_every_) == 0) {
-    std::vector<Eigen::MatrixXf> meshes;
+    std::vector<Eigen::MatrixXf> meshes, deformations;
     for (size_t b = 0; b < model.bodies.size(); ++b) {
       const auto& mesh = scene_.meshes[b];
       if (!mesh) {
-        // Stick figure: the positions of its nodes.
+        // Stick figure: the positions of its nodes (no deformation field: zero).
         const std::vector<int>& sticks = scene_.stick_nodes[b];
         Eigen::MatrixXf x(long(sticks.size()), 3);
         for (size_t i = 0; i < sticks.size(); ++i) x.row(long(i)) = (scene_.origin + state.x[sticks[i]]).transpose().cast<float>();
         meshes.push_back(x);
+        deformations.push_back(Eigen::MatrixXf::Zero(x.rows(), 3));
         continue;
       }
       const BodyConfiguration c = BodyConfigurationOf(model, state, int(b));
       const Eigen::VectorXd q = model.bodies[b].LocalCoordinates(c, state.frames[b]);
       const Eigen::VectorXd u = mesh->shapes * q;
-      Eigen::MatrixXf x(mesh->nodes.rows(), 3);
+      // x = x_j + R_j (X - X_j + Phi q_loc); the deformation field is the elastic part R_j Phi q_loc
+      // in global axes (what ParaView should colour by: no rigid motion of the body in it).
+      Eigen::MatrixXf x(mesh->nodes.rows(), 3), d(mesh->nodes.rows(), 3);
       for (int i = 0; i < mesh->nodes.rows(); ++i) {
         const Eigen::Vector3d X = mesh->nodes.row(i).transpose() - scene_.mesh_origin[b];
-        const Eigen::Vector3d ui = u.segment<3>(mesh->dofs_per_node * i);
-        x.row(i) = (scene_.origin + state.frames[b].x + state.frames[b].R * (X + ui)).transpose().cast<float>();
+        const Eigen::Vector3d ui = state.frames[b].R * u.segment<3>(mesh->dofs_per_node * i);
+        x.row(i) = (scene_.origin + state.frames[b].x + state.frames[b].R * X + ui).transpose().cast<float>();
+        d.row(i) = ui.transpose().cast<float>();
       }
       meshes.push_back(x);
+      deformations.push_back(d);
     }
     frame_time_.push_back(time_.back());
     mesh_positions_.push_back(meshes);
+    mesh_deformations_.push_back(deformations);
   }
 
   csv_ << Num(t);
@@ -317,14 +323,16 @@ void ResultsRecorder::WriteAnimation() {
     }
     w.Matrix("/body", body);
     for (size_t s = 0; s < frame_time_.size(); ++s) {
-      Eigen::MatrixXf x(n_nodes, 3);
+      Eigen::MatrixXf x(n_nodes, 3), d(n_nodes, 3);
       long offset = 0;
       for (size_t b = 0; b < blocks.size(); ++b) {
         x.middleRows(offset, mesh_positions_[s][b].rows()) = mesh_positions_[s][b];
+        d.middleRows(offset, mesh_deformations_[s][b].rows()) = mesh_deformations_[s][b];
         offset += mesh_positions_[s][b].rows();
       }
       w.FloatMatrix("/x_" + std::to_string(s), x);
       if (s == 0) x0 = x;
+      w.FloatMatrix("/deformation_" + std::to_string(s), d);
       w.FloatMatrix("/displacement_" + std::to_string(s), x - x0);
     }
     w.Close();
@@ -347,6 +355,9 @@ void ResultsRecorder::WriteAnimation() {
         << "    <Attribute Name=\"body\" AttributeType=\"Scalar\" Center=\"Cell\">\n     <DataItem Dimensions=\""
         << n_cells << " 1\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">animation.h5:/body</DataItem>\n"
         << "    </Attribute>\n"
+        << "    <Attribute Name=\"deformation\" AttributeType=\"Vector\" Center=\"Node\">\n     <DataItem Dimensions=\""
+        << n_nodes << " 3\" NumberType=\"Float\" Precision=\"4\" Format=\"HDF\">animation.h5:/deformation_" << s
+        << "</DataItem>\n    </Attribute>\n"
         << "    <Attribute Name=\"displacement\" AttributeType=\"Vector\" Center=\"Node\">\n     <DataItem Dimensions=\""
         << n_nodes << " 3\" NumberType=\"Float\" Precision=\"4\" Format=\"HDF\">animation.h5:/displacement_" << s
         << "</DataItem>\n    </Attribute>\n   </Grid>\n";

@@ -47,6 +47,7 @@ class ResultsRecorder {
   // mesh the deformed node positions (single precision: a solid part's mesh is large).
   std::vector<double> frame_time_;
   std::vector<std::vector<Eigen::MatrixXf>> mesh_positions_;
+  std::vector<std::vector<Eigen::MatrixXf>> mesh_deformations_;  ///< R_j Phi q_loc per frame and body
   void WriteAnimation();
   bool JointNode(int k) const;
 };

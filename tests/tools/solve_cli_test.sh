@@ -64,6 +64,19 @@ nodes = h5py.File(sys.argv[1] + "/results.h5", "r")["nodes/position"][100].resha
 # frames are single precision (24-bit mantissa): 1 m positions to 1e-7 m; 1e-6 m is the bound
 for i in range(10):
     assert np.abs(deformed[5 * i] - nodes[i]).max() < 1e-6, i   # 5 mesh nodes per body
+# The node vector 'deformation' is the elastic part R_j Phi q_loc alone: zero in the unloaded
+# first frame, and the deformed mesh less it is each body's undeformed mesh moved rigidly (the
+# node-to-node distances within a body are those of the first frame, to single precision).
+_, d0, _ = reader.read_data(0)
+assert np.abs(d0["deformation"]).max() < 1e-12
+d = point_data["deformation"]
+assert 1e-4 < np.abs(d).max() < 0.2 * np.abs(point_data["displacement"]).max(), (np.abs(d).max())
+rigid = deformed - d
+for i in range(10):
+    a, b = rigid[5 * i:5 * i + 5], points[5 * i:5 * i + 5]
+    da = np.linalg.norm(a[:, None] - a[None], axis=2)
+    db = np.linalg.norm(b[:, None] - b[None], axis=2)
+    assert np.abs(da - db).max() < 2e-6, (i, np.abs(da - db).max())
 PY
 # outputs.animation_every thins the frames (every 10th of the 101 output steps) and keeps the times.
 "$bin/femb-solve" -q "$work/scene.yaml" -o "$work/thin" --set outputs.animation_every=10 && $py - "$work/thin" <<'PY' \
