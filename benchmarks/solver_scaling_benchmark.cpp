@@ -1,8 +1,9 @@
 // Solver scaling: a chain of N flexible bodies (tube segments, 2 internal modes each) clamped
 // at one end and falling under gravity; time per dynamic step and Newton iterations per step
 // for N = 1, 10, 100, 1000, linear bodies and bodies with the geometric stiffening and exact
-// inertia (reduction.geometric_stiffening, issue 13: the cost ratio per body-step). Prints
-// what it measured on this run.
+// inertia (reduction.geometric_stiffening, issue 13: the cost ratio per body-step), on one
+// thread and on all the processors (bodies in parallel, issue 14: the speed-up, same bits).
+// Prints what it measured on this run.
 #include <chrono>
 #include <cstdio>
 #include <string>
@@ -10,11 +11,13 @@
 #include "formats/part_file.h"
 #include "reducer/reduce_part.h"
 #include "solver/analysis/dynamic_analysis.h"
+#include "solver/parallel.h"
 
 int main() {
   std::printf("Solver scaling: chain of N tube superelements (2 modes each), clamped, gravity, generalized-alpha\n\n");
-  std::printf("%6s %-11s %12s %10s %14s %16s %18s %8s\n", "bodies", "bodies are", "coordinates", "steps", "s per step",
-              "Newton its/step", "ms per step/body", "ratio");
+  const int threads = femb::DefaultThreads();
+  std::printf("%6s %-11s %12s %10s %14s %16s %18s %8s %18s\n", "bodies", "bodies are", "coordinates", "steps", "s per step",
+              "Newton its/step", "ms per step/body", "ratio", "speed-up, threads");
   for (int n_bodies : {1, 10, 100, 1000}) {
    double linear_ms = 0.0;
    for (bool stiffening : {false, true}) {
@@ -39,25 +42,33 @@ int main() {
     }
     model.gravity = Eigen::Vector3d(0, -9.81, 0);
     const femb::DofMap dofs(model);
-    femb::DynamicState s =
-        femb::InitialDynamicState(model, femb::InitialState(model), Eigen::VectorXd::Zero(dofs.n_dofs()));
-    femb::DynamicOptions options;
-    options.step = 1e-3;
     const int steps = n_bodies >= 1000 ? 5 : 20;
-    options.end_time = steps * options.step;
-    options.rho_inf = 0.8;
-    const auto start = std::chrono::steady_clock::now();
-    const femb::DynamicResult r = femb::SolveDynamic(model, s, options);
-    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    // One run on `t` threads: seconds, the result.
+    auto run = [&](int t, femb::DynamicResult* r) {
+      femb::DynamicState s =
+          femb::InitialDynamicState(model, femb::InitialState(model), Eigen::VectorXd::Zero(dofs.n_dofs()));
+      femb::DynamicOptions options;
+      options.step = 1e-3;
+      options.end_time = steps * options.step;
+      options.rho_inf = 0.8;
+      options.threads = t;
+      const auto start = std::chrono::steady_clock::now();
+      *r = femb::SolveDynamic(model, s, options);
+      return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    };
+    femb::DynamicResult r, r_many;
+    const double seconds = run(1, &r);
     if (!r.ok) {
       std::printf("%6d %-11s failed: %s\n", n_bodies, stiffening ? "stiffened" : "linear", r.message.c_str());
       continue;
     }
+    const double seconds_many = threads > 1 ? run(threads, &r_many) : seconds;
     const double ms = 1e3 * seconds / r.steps / n_bodies;
     if (!stiffening) linear_ms = ms;
-    std::printf("%6d %-11s %12d %10ld %14.4f %16.2f %18.3f %8.2f\n", n_bodies, stiffening ? "stiffened" : "linear",
-                dofs.n_dofs(), r.steps, seconds / r.steps, double(r.newton_iterations) / r.steps, ms,
-                linear_ms > 0 ? ms / linear_ms : 1.0);
+    std::printf("%6d %-11s %12d %10ld %14.4f %16.2f %18.3f %8.2f %14.2f, %d\n", n_bodies,
+                stiffening ? "stiffened" : "linear", dofs.n_dofs(), r.steps, seconds / r.steps,
+                double(r.newton_iterations) / r.steps, ms, linear_ms > 0 ? ms / linear_ms : 1.0, seconds / seconds_many,
+                threads);
     std::fflush(stdout);
    }
   }

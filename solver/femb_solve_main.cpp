@@ -2,6 +2,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <set>
 #include <string>
@@ -14,6 +15,7 @@
 #include "solver/analysis/modal_analysis.h"
 #include "solver/analysis/static_analysis.h"
 #include "solver/output/results_recorder.h"
+#include "solver/parallel.h"
 #include "solver/scene/scene_builder.h"
 
 namespace {
@@ -55,7 +57,7 @@ void RecordModeShapes(const femb::Scene& scene, const femb::SystemState& state, 
   }
 }
 
-constexpr const char* kUsage = R"(usage: femb-solve SCENE.yaml [-o OUTDIR] [--set key=value]... [--quiet]
+constexpr const char* kUsage = R"(usage: femb-solve SCENE.yaml [-o OUTDIR] [--set key=value]... [--threads N] [--quiet]
 
 Simulates a scene of superelements in absolute interface coordinates (see formats/SCENE_FORMAT.md):
 static (load stepping in pseudo-time, Newton with the full tangent, step cutting) or dynamic
@@ -65,6 +67,9 @@ options:
   -o, --output OUTDIR   output folder (default: out/<scene name>): results.h5 and probes.csv
   --set key=value       override a scene key, e.g. --set analysis.step=5e-4
                         --set analysis.end_time=0.5 (repeatable)
+  --threads N           threads for the bodies' forces and matrices in dynamic analysis
+                        (default: the processors available; the results are the same bits
+                        for any N)
   -q, --quiet           no progress lines
   -h, --help            this text
 
@@ -82,8 +87,20 @@ int main(int argc, char** argv) {
   cli.Value({"-o", "--output"}, [&](const std::string& v) { output = v; });
   cli.Value({"--set"}, [&](const std::string& v) { overrides.push_back(v); });
   cli.Switch({"-q", "--quiet"}, [&] { quiet = true; });
+  int threads = femb::DefaultThreads();
+  std::string threads_text;
+  cli.Value({"--threads"}, [&](const std::string& v) { threads_text = v; });
   if (!cli.Parse(argc, argv)) return cli.exit_code();
   const std::string scene_path = cli.input();
+  if (!threads_text.empty()) {
+    char* end = nullptr;
+    const long t = std::strtol(threads_text.c_str(), &end, 10);
+    if (*end != '\0' || t < 1 || t > 1024) {
+      std::fprintf(stderr, "femb-solve: --threads %s: expected a whole number from 1 to 1024\n", threads_text.c_str());
+      return 2;
+    }
+    threads = int(t);
+  }
   try {
     const auto wall = std::chrono::steady_clock::now();
     const femb::SceneSpec spec = femb::ReadSceneFile(scene_path, overrides);
@@ -92,8 +109,11 @@ int main(int argc, char** argv) {
     femb::ResultsRecorder recorder(scene, output);
     const femb::DofMap dofs(scene.model);
     if (!quiet) {
-      std::printf("femb-solve: %s: %zu bodies, %d nodes, %d unknowns, %s analysis\n", scene_path.c_str(),
-                  scene.model.bodies.size(), scene.model.n_nodes(), dofs.n_dofs(), spec.analysis.type.c_str());
+      std::printf("femb-solve: %s: %zu bodies, %d nodes, %d unknowns, %s analysis%s\n", scene_path.c_str(),
+                  scene.model.bodies.size(), scene.model.n_nodes(), dofs.n_dofs(), spec.analysis.type.c_str(),
+                  spec.analysis.type == "dynamic" && spec.analysis.integrator != "midpoint"
+                      ? (", " + std::to_string(threads) + (threads == 1 ? " thread" : " threads")).c_str()
+                      : "");
       // One note per file, not per body.
       std::set<std::string> said;
       for (const std::string& note : scene.notes) {
@@ -191,6 +211,7 @@ int main(int argc, char** argv) {
       options.max_iterations = spec.analysis.max_iterations;
       options.reuse_jacobian = spec.analysis.reuse_jacobian;
       options.full_inertia_tangent = spec.analysis.gyroscopic_tangent;
+      options.threads = threads;
       const femb::DynamicResult r = femb::SolveDynamic(
           scene.model, state, options, [&](const femb::DynamicStepReport& s, const femb::DynamicState& st) {
             ++step_count;

@@ -3,8 +3,10 @@
 #include <Eigen/Dense>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 
 #include "solver/analysis/singularity.h"
+#include "solver/parallel.h"
 #include "solver/rotation.h"
 
 namespace femb {
@@ -71,6 +73,15 @@ void FinishAssembly(const SystemModel& model, const DofMap& dofs, const SystemSt
   out.node_forces = parts.node_forces;
 }
 
+// f(b) for every body, on the pool when there is one.
+void ForEachBody(BodyThreads* threads, int n, const std::function<void(int)>& f) {
+  if (threads) {
+    threads->ForEach(n, f);
+  } else {
+    for (int b = 0; b < n; ++b) f(b);
+  }
+}
+
 // What the residual pass keeps of one body for the iteration matrix (AddDynamicMatrices).
 struct BodyPass {
   SuperelementBody::Data data;
@@ -78,26 +89,42 @@ struct BodyPass {
   InertiaLoadFactors load;
 };
 
+// One body's share of the residual pass, computed on its own (in parallel with the others) and
+// added into the system in body order.
+struct BodyResidual {
+  bool frame_ok = true;
+  Eigen::VectorXd r_b, f_grav;  // f_grav - f_int - f_in, and f_grav
+  double scale = 0.0, roundoff = 0.0;
+  std::vector<MapEntry> map;
+};
+
 // The generalized-alpha residual at state s and time t: frames solved (s.config.frames
 // updated), each body's kinematics evaluated once and kept in `passes` for the matrices, which
 // an iteration builds only when it needs them (not on the converged one, not with a kept
-// factorization).
+// factorization). Bodies on `threads` threads; the result does not depend on their number.
 Assembly AssembleDynamicResidual(const SystemModel& model, const DofMap& dofs, DynamicState& s, double t,
-                                 std::vector<BodyPass>& passes) {
+                                 std::vector<BodyPass>& passes, BodyThreads* threads = nullptr) {
   AssemblyParts parts;
   Assembly out = StartAssembly(model, dofs, parts);
-  passes.resize(model.bodies.size());
+  const int n_bodies = int(model.bodies.size());
+  passes.resize(static_cast<size_t>(n_bodies));
+  std::vector<BodyResidual> results(static_cast<size_t>(n_bodies));
   const std::vector<Eigen::Matrix<double, 6, 1>> node_acc = NodeAccelerations(model, dofs, s.config, s.W, s.Wdot);
-  for (size_t b = 0; b < model.bodies.size(); ++b) {
+  ForEachBody(threads, n_bodies, [&](int b) {
     const SuperelementBody& body = model.bodies[b];
-    const BodyConfiguration c = BodyConfigurationOf(model, s.config, int(b));
-    FrameSolution frame;
-    if (!SolveBodyFrame(body, int(b), c, s.config.frames[b], &frame, out)) return out;
+    BodyResidual& r = results[size_t(b)];
+    const BodyConfiguration c = BodyConfigurationOf(model, s.config, b);
+    FrameSolution frame = body.SolveFrame(c, s.config.frames[b]);
+    if (!frame.ok) frame = body.SolveFrame(c, body.GuessFrame(c));
+    if (!frame.ok) {
+      r.frame_ok = false;
+      return;
+    }
     s.config.frames[b] = frame;
-    BodyPass& pass = passes[b];
+    BodyPass& pass = passes[size_t(b)];
     pass.data = body.Evaluate(c, frame);
-    pass.w = GatherBody(model, dofs, s.config, int(b), s.W);
-    pass.wdot = GatherBodyAcceleration(model, dofs, int(b), node_acc, s.Wdot);
+    pass.w = GatherBody(model, dofs, s.config, b, s.W);
+    pass.wdot = GatherBodyAcceleration(model, dofs, b, node_acc, s.Wdot);
     // Inertia stiffening (issue 13): K + K_sigma(a), a from this iterate's frame motion; its
     // velocity and acceleration derivatives go into C and M of the iteration matrix.
     const bool stiffening = body.has_inertia_stiffening();
@@ -106,47 +133,68 @@ Assembly AssembleDynamicResidual(const SystemModel& model, const DofMap& dofs, D
     body.ElasticForce(pass.data, &f_int, nullptr, stiffening ? &pass.load : nullptr);
     body.InertiaForce(pass.data, pass.w, pass.wdot, &f_in, nullptr, nullptr, &f_acc);
     body.AddModalDamping(pass.w, f_in, nullptr);
-    Eigen::VectorXd f_grav = Eigen::VectorXd::Zero(body.n_coordinates());
-    if (model.gravity.squaredNorm() > 0) f_grav = body.GravityForce(pass.data, model.gravity);
+    r.f_grav = Eigen::VectorXd::Zero(body.n_coordinates());
+    if (model.gravity.squaredNorm() > 0) r.f_grav = body.GravityForce(pass.data, model.gravity);
     // Scale of the forces in balance, each term on its own (for a torque-free body M_g wdot and
     // the gyroscopic terms cancel: their sum is no scale).
-    out.scale = std::max({out.scale, body.ForceNorm(f_int), body.ForceNorm(f_in), body.ForceNorm(f_grav),
-                          body.force_floor(), body.ForceNorm(f_acc), body.ForceNorm(f_in - f_acc)});
-    out.roundoff += body.RoundOffForce(c);
-    const std::vector<MapEntry> map = BodyMap(model, dofs, s.config, int(b));
-    const Eigen::VectorXd r_b = f_grav - f_int - f_in;
-    AddBodyNodeForces(model, int(b), r_b, parts.node_forces);
-    ScatterBody(map, &r_b, nullptr, &out.residual, nullptr);
-    ScatterBody(map, &f_grav, nullptr, &out.f_ext, nullptr);
+    r.scale = std::max({body.ForceNorm(f_int), body.ForceNorm(f_in), body.ForceNorm(r.f_grav), body.force_floor(),
+                        body.ForceNorm(f_acc), body.ForceNorm(f_in - f_acc)});
+    r.roundoff = body.RoundOffForce(c);
+    r.map = BodyMap(model, dofs, s.config, b);
+    r.r_b = r.f_grav - f_int - f_in;
+  });
+  for (int b = 0; b < n_bodies; ++b) {
+    const BodyResidual& r = results[size_t(b)];
+    if (!r.frame_ok) {
+      out.ok = false;
+      out.message = "floating frame of body " + std::to_string(b) + " did not converge";
+      return out;
+    }
+    out.scale = std::max(out.scale, r.scale);
+    out.roundoff += r.roundoff;
+    AddBodyNodeForces(model, b, r.r_b, parts.node_forces);
+    ScatterBody(r.map, &r.r_b, nullptr, &out.residual, nullptr);
+    ScatterBody(r.map, &r.f_grav, nullptr, &out.f_ext, nullptr);
   }
   FinishAssembly(model, dofs, s.config, t, s.W, false, parts, out);
   return out;
 }
 
-// The matrices K, C, M of the residual pass `out` (same state s and time t).
+// The matrices K, C, M of the residual pass `out` (same state s and time t); bodies on
+// `threads` threads, added in body order.
 void AddDynamicMatrices(const SystemModel& model, const DofMap& dofs, const DynamicState& s, double t,
-                        const std::vector<BodyPass>& passes, bool full_inertia_tangent, Assembly& out) {
-  Triplets K, C, M;
-  for (size_t b = 0; b < model.bodies.size(); ++b) {
+                        const std::vector<BodyPass>& passes, bool full_inertia_tangent, Assembly& out,
+                        BodyThreads* threads = nullptr) {
+  struct BodyMatrices {
+    Eigen::MatrixXd K, C, M;
+    std::vector<MapEntry> map;
+  };
+  const int n_bodies = int(model.bodies.size());
+  std::vector<BodyMatrices> results(static_cast<size_t>(n_bodies));
+  ForEachBody(threads, n_bodies, [&](int b) {
     const SuperelementBody& body = model.bodies[b];
-    const BodyPass& pass = passes[b];
+    const BodyPass& pass = passes[size_t(b)];
+    BodyMatrices& r = results[size_t(b)];
     const bool stiffening = body.has_inertia_stiffening();
-    Eigen::MatrixXd Kb, Mb, Cb, d_load;
-    body.ElasticForce(pass.data, nullptr, &Kb, stiffening ? &pass.load : nullptr, stiffening ? &d_load : nullptr);
-    body.InertiaForce(pass.data, pass.w, pass.wdot, nullptr, &Mb, &Cb);
+    Eigen::MatrixXd d_load;
+    body.ElasticForce(pass.data, nullptr, &r.K, stiffening ? &pass.load : nullptr, stiffening ? &d_load : nullptr);
+    body.InertiaForce(pass.data, pass.w, pass.wdot, nullptr, &r.M, &r.C);
     if (stiffening) {
-      Mb += d_load * pass.load.d_wdot;
-      Cb += d_load * pass.load.d_w;
+      r.M += d_load * pass.load.d_wdot;
+      r.C += d_load * pass.load.d_w;
     }
     // Configuration derivative of the inertia force: d(M_g wdot)/dq exactly; that of the
     // quadratic velocity terms by central differences with options.full_inertia_tangent.
-    Kb += body.InertiaConfigurationTangent(pass.data, pass.w, pass.wdot, full_inertia_tangent);
+    r.K += body.InertiaConfigurationTangent(pass.data, pass.w, pass.wdot, full_inertia_tangent);
     Eigen::VectorXd unused = Eigen::VectorXd::Zero(body.n_coordinates());
-    body.AddModalDamping(pass.w, unused, &Cb);
-    const std::vector<MapEntry> map = BodyMap(model, dofs, s.config, int(b));
-    ScatterBody(map, nullptr, &Kb, nullptr, &K);
-    ScatterBody(map, nullptr, &Cb, nullptr, &C);
-    ScatterBody(map, nullptr, &Mb, nullptr, &M);
+    body.AddModalDamping(pass.w, unused, &r.C);
+    r.map = BodyMap(model, dofs, s.config, b);
+  });
+  Triplets K, C, M;
+  for (const BodyMatrices& r : results) {
+    ScatterBody(r.map, nullptr, &r.K, nullptr, &K);
+    ScatterBody(r.map, nullptr, &r.C, nullptr, &C);
+    ScatterBody(r.map, nullptr, &r.M, nullptr, &M);
   }
   const int n = dofs.n_dofs();
   Eigen::VectorXd unused = Eigen::VectorXd::Zero(n);
@@ -285,7 +333,8 @@ struct StepOutcome {
 
 // One generalized-alpha step of size h from `state` into `next` (Arnold & Bruls 2007).
 StepOutcome GeneralizedAlphaStep(const SystemModel& model, const DofMap& dofs, const DynamicOptions& options,
-                                 const DynamicState& state, double h, IterationMatrix& matrix, DynamicState& next) {
+                                 const DynamicState& state, double h, IterationMatrix& matrix, BodyThreads& threads,
+                                 DynamicState& next) {
   const double rho = std::clamp(options.rho_inf, 0.0, 1.0);
   const double alpha_m = (2 * rho - 1) / (rho + 1), alpha_f = rho / (rho + 1);
   const double gamma = 0.5 + alpha_f - alpha_m, beta = 0.25 * (gamma + 0.5) * (gamma + 0.5);
@@ -304,7 +353,7 @@ StepOutcome GeneralizedAlphaStep(const SystemModel& model, const DofMap& dofs, c
   const Eigen::VectorXd weights = ResidualWeights(model, dofs);
   std::vector<BodyPass> passes;
   for (; out.iterations < options.max_iterations; ++out.iterations) {
-    Assembly a = AssembleDynamicResidual(model, dofs, next, t_new, passes);
+    Assembly a = AssembleDynamicResidual(model, dofs, next, t_new, passes, &threads);
     if (!a.ok || !a.residual.allFinite()) return out;
     if (FreeNorm(dofs, a.residual, weights) <= std::max(tolerance * a.scale, a.roundoff) && out.iterations > 0) {
       out.converged = true;
@@ -320,7 +369,7 @@ StepOutcome GeneralizedAlphaStep(const SystemModel& model, const DofMap& dofs, c
     }
     bool built = false;
     const auto S = [&] {
-      if (!built) AddDynamicMatrices(model, dofs, next, t_new, passes, options.full_inertia_tangent, a);
+      if (!built) AddDynamicMatrices(model, dofs, next, t_new, passes, options.full_inertia_tangent, a, &threads);
       built = true;
       return SystemMatrix(a.K + gamma_p * a.C + beta_p * a.M);
     };
@@ -631,6 +680,7 @@ DynamicResult SolveDynamic(const SystemModel& model, DynamicState& state, const 
   double h = options.step;
   int cuts = 0;
   IterationMatrix matrix;
+  BodyThreads threads(options.threads);
   // Time is counted in steps: t = t_base + n h while the step stays nominal (summing h over 1e6
   // steps drifted by 1e-8 s and left a last step of 1e-8 s that Newton could not take), and a
   // remainder below 1% of a step is merged into the last one.
@@ -654,7 +704,7 @@ DynamicResult SolveDynamic(const SystemModel& model, DynamicState& state, const 
     matrix.with_this_factor = 0;  // a step may use the kept factor for reuse_max_iterations iterations
     const StepOutcome step = options.integrator == Integrator::kMidpoint
                                  ? MidpointStep(model, dofs, options, triples, state, h, matrix, next)
-                                 : GeneralizedAlphaStep(model, dofs, options, state, h, matrix, next);
+                                 : GeneralizedAlphaStep(model, dofs, options, state, h, matrix, threads, next);
     if (!step.converged && result.steps == 0 && cuts == 0 && step.singular_matrix.size() > 0) {
       // The first iteration matrix is singular: the model's, not the step's.
       const std::string why = DescribeSingular(model, dofs, state.config, step.singular_matrix);

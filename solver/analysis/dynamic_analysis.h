@@ -41,6 +41,9 @@ struct DynamicOptions {
   /// body at omega h = 0.04, at ~4x the assembly time; off by default.
   bool full_inertia_tangent = false;
   int reuse_max_iterations = 6;
+  /// Threads for the bodies' forces and matrices (generalized-alpha; solver/parallel.h). The
+  /// results are the same bits for any number.
+  int threads = 1;
 };
 
 struct DynamicState {

@@ -254,6 +254,13 @@ printf 'initial_velocity:\n  pivot_rod: {joint: [2.0]}\n  pivot_block: {joint: [
 $py -c "
 import csv; rows = list(csv.DictReader(open('$work/pend_rate/probes.csv')))
 assert float(rows[0]['kinetic_energy']) > 0, rows[0]['kinetic_energy']" && ok || fail "joint rates: no initial kinetic energy"
+# --threads: the bodies on 1 or 2 threads give the same numbers to the last digit; a bad count is
+# an input error.
+"$bin/femb-solve" -q "$work/pend/rate.yaml" -o "$work/pend_t1" --set analysis.end_time=0.02 --threads 1 \
+  && "$bin/femb-solve" -q "$work/pend/rate.yaml" -o "$work/pend_t2" --set analysis.end_time=0.02 --threads 2 \
+  && cmp -s "$work/pend_t1/probes.csv" "$work/pend_t2/probes.csv" && ok || fail "--threads 1 and 2 differ"
+"$bin/femb-solve" -q "$work/pend/rate.yaml" -o "$work/pend_t0" --threads 0 2> "$work/err.txt"; [ $? = 2 ] \
+  && grep -q "^femb-solve: --threads 0: expected a whole number from 1 to 1024$" "$work/err.txt" && ok || fail "--threads 0: $(cat "$work/err.txt")"
 printf 'initial_velocity:\n  pivot_rod: {joint: [2.0, 1.0]}\n' | cat "$work/pend/scene.yaml" - > "$work/pend/bad_rate.yaml"
 "$bin/femb-solve" -q "$work/pend/bad_rate.yaml" -o "$work/pend_bad" 2> "$work/err.txt"; [ $? = 2 ] && grep -q "has 1 joint coordinates, got 2 joint rates" "$work/err.txt" && ok || fail "bad joint rates: $(cat "$work/err.txt")"
 # Mode shapes as VTU: one file per reduced coordinate; quadratic tetrahedra in VTK node order
