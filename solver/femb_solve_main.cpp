@@ -111,7 +111,7 @@ int main(int argc, char** argv) {
     if (!quiet) {
       std::printf("femb-solve: %s: %zu bodies, %d nodes, %d unknowns, %s analysis%s\n", scene_path.c_str(),
                   scene.model.bodies.size(), scene.model.n_nodes(), dofs.n_dofs(), spec.analysis.type.c_str(),
-                  spec.analysis.type == "dynamic" && spec.analysis.integrator != "midpoint"
+                  spec.analysis.type == "dynamic"
                       ? (", " + std::to_string(threads) + (threads == 1 ? " thread" : " threads")).c_str()
                       : "");
       // One note per file, not per body.

@@ -55,8 +55,10 @@ void BodyThreads::Helper() {
   for (;;) {
     // Passes come every few hundred microseconds in a time step: look for the next one for a
     // while before sleeping (a sleeping helper wakes 10-50 us late and finds the bodies taken).
-    const auto until = std::chrono::steady_clock::now() + std::chrono::microseconds(kSpinMicroseconds);
-    while (published_.load(std::memory_order_acquire) == seen && std::chrono::steady_clock::now() < until) {
+    const auto until =
+        std::chrono::steady_clock::now() + std::chrono::microseconds(kSpinMicroseconds);
+    while (published_.load(std::memory_order_acquire) == seen &&
+           std::chrono::steady_clock::now() < until) {
       for (int k = 0; k < 64; ++k) Pause();
     }
     Pass* pass = nullptr;

@@ -51,8 +51,8 @@ class BodyThreads {
   std::vector<std::thread> helpers_;
   std::mutex mutex_;
   std::condition_variable wake_;
-  Pass* pass_ = nullptr;  ///< the pass in progress (under mutex_), nullptr between passes
-  long generation_ = 0;   ///< counts passes (under mutex_)
+  Pass* pass_ = nullptr;            ///< the pass in progress (under mutex_), nullptr between passes
+  long generation_ = 0;             ///< counts passes (under mutex_)
   std::atomic<long> published_{0};  ///< generation_, for helpers looking without the lock
   bool stop_ = false;
 };

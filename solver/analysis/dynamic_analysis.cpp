@@ -37,18 +37,6 @@ Assembly StartAssembly(const SystemModel& model, const DofMap& dofs, AssemblyPar
   return out;
 }
 
-// Solves body b's floating frame from `guess` (or, failing that, from node 0); false with the
-// message in `out` when it does not converge.
-bool SolveBodyFrame(const SuperelementBody& body, int b, const BodyConfiguration& c, const FrameSolution& guess,
-                    FrameSolution* frame, Assembly& out) {
-  *frame = body.SolveFrame(c, guess);
-  if (!frame->ok) *frame = body.SolveFrame(c, body.GuessFrame(c));
-  if (frame->ok) return true;
-  out.ok = false;
-  out.message = "floating frame of body " + std::to_string(b) + " did not converge";
-  return false;
-}
-
 // Nodal loads at t, spring-dampers at velocities W (both on `config`), the joints' geometric
 // stiffness, and the matrices built (when `matrices`).
 void FinishAssembly(const SystemModel& model, const DofMap& dofs, const SystemState& config, double t,
@@ -531,16 +519,32 @@ MidpointKinematics Midpoint(const SystemModel& model, const DofMap& dofs, const 
 // balance and the matrices at the mid configuration.
 Assembly AssembleMidpoint(const SystemModel& model, const DofMap& dofs, const DynamicState& s0,
                           const std::vector<Eigen::VectorXd>& p0, double h, MidpointKinematics& k, DynamicState& s1,
-                          double& f_ext_work) {
+                          double& f_ext_work, BodyThreads* threads = nullptr) {
   AssemblyParts parts;
   Assembly out = StartAssembly(model, dofs, parts);
-  for (size_t b = 0; b < model.bodies.size(); ++b) {
+  // Each body into its slot (on the threads), then added in body order.
+  struct BodyTerms {
+    bool frame_ok = true;
+    Eigen::VectorXd r_b, f_grav;
+    Eigen::MatrixXd K, C, M;
+    double scale = 0.0, roundoff = 0.0;
+    std::vector<MapEntry> map;
+  };
+  const int n_bodies = int(model.bodies.size());
+  std::vector<BodyTerms> terms(static_cast<size_t>(n_bodies));
+  ForEachBody(threads, n_bodies, [&](int b) {
     const SuperelementBody& body = model.bodies[b];
+    BodyTerms& r = terms[size_t(b)];
     const BodyConfiguration c1 = BodyConfigurationOf(model, s1.config, int(b));
     const BodyConfiguration cm = BodyConfigurationOf(model, k.mid, int(b));
-    FrameSolution f1, fm;
-    if (!SolveBodyFrame(body, int(b), c1, s1.config.frames[b], &f1, out)) return out;
-    if (!SolveBodyFrame(body, int(b), cm, s0.config.frames[b], &fm, out)) return out;
+    FrameSolution f1 = body.SolveFrame(c1, s1.config.frames[b]);
+    if (!f1.ok) f1 = body.SolveFrame(c1, body.GuessFrame(c1));
+    FrameSolution fm = f1.ok ? body.SolveFrame(cm, s0.config.frames[b]) : FrameSolution{};
+    if (f1.ok && !fm.ok) fm = body.SolveFrame(cm, body.GuessFrame(cm));
+    if (!f1.ok || !fm.ok) {
+      r.frame_ok = false;
+      return;
+    }
     s1.config.frames[b] = f1;
     k.mid.frames[b] = fm;
     const Eigen::VectorXd w1 = GatherBody(model, dofs, s1.config, int(b), s1.W);
@@ -557,7 +561,7 @@ Assembly AssembleMidpoint(const SystemModel& model, const DofMap& dofs, const Dy
     }
     wm.tail(body.n_modes()) = (s1.config.eta[b] - s0.config.eta[b]) / h;
     Eigen::VectorXd f_in, f_int;
-    Eigen::MatrixXd Kb, Mb, Cb;
+    Eigen::MatrixXd &Kb = r.K, &Mb = r.M, &Cb = r.C;
     // M_g at the end of the step: the 2/h^2 term of the iteration matrix is d p_n+1 / h; at
     // the mid configuration it would be off by O(omega h) and leave a 1/h error.
     Mb = maps1.Mg;
@@ -599,19 +603,30 @@ Assembly AssembleMidpoint(const SystemModel& model, const DofMap& dofs, const Dy
     } else {
       body.ElasticForce(dm, &f_int, &Kb);
     }
-    Eigen::VectorXd f_grav = Eigen::VectorXd::Zero(body.n_coordinates());
+    Eigen::VectorXd& f_grav = r.f_grav;
+    f_grav = Eigen::VectorXd::Zero(body.n_coordinates());
     if (model.gravity.squaredNorm() > 0) f_grav = body.GravityForce(dm, model.gravity);
     // Scale: each term on its own (for a torque-free body the momentum change and the source
     // cancel; M_g (w_n+1 - w_n) / h is the size of the inertia force).
-    out.scale = std::max({out.scale, body.ForceNorm(f_int), body.ForceNorm(f_in), body.ForceNorm(f_grav), body.force_floor(),
-                          body.ForceNorm(f_acc)});
-    out.roundoff += body.RoundOffForce(c1);
-    const std::vector<MapEntry> map = BodyMap(model, dofs, k.mid, int(b));
-    const Eigen::VectorXd r_b = f_grav - f_int - f_in;
-    AddBodyNodeForces(model, int(b), r_b, parts.node_forces);
-    ScatterBody(map, &r_b, &Kb, &out.residual, &parts.K);
-    ScatterBody(map, &f_grav, &Cb, &out.f_ext, &parts.C);
-    ScatterBody(map, nullptr, &Mb, nullptr, &parts.M);
+    r.scale = std::max({body.ForceNorm(f_int), body.ForceNorm(f_in), body.ForceNorm(f_grav), body.force_floor(),
+                        body.ForceNorm(f_acc)});
+    r.roundoff = body.RoundOffForce(c1);
+    r.map = BodyMap(model, dofs, k.mid, int(b));
+    r.r_b = f_grav - f_int - f_in;
+  });
+  for (int b = 0; b < n_bodies; ++b) {
+    const BodyTerms& r = terms[size_t(b)];
+    if (!r.frame_ok) {
+      out.ok = false;
+      out.message = "floating frame of body " + std::to_string(b) + " did not converge";
+      return out;
+    }
+    out.scale = std::max(out.scale, r.scale);
+    out.roundoff += r.roundoff;
+    AddBodyNodeForces(model, b, r.r_b, parts.node_forces);
+    ScatterBody(r.map, &r.r_b, &r.K, &out.residual, &parts.K);
+    ScatterBody(r.map, &r.f_grav, &r.C, &out.f_ext, &parts.C);
+    ScatterBody(r.map, nullptr, &r.M, nullptr, &parts.M);
   }
   // Loads at the mid time and configuration, spring-dampers at the mean rates Delta / h.
   FinishAssembly(model, dofs, k.mid, s0.t + 0.5 * h, k.delta / h, true, parts, out);
@@ -621,7 +636,7 @@ Assembly AssembleMidpoint(const SystemModel& model, const DofMap& dofs, const Dy
 
 StepOutcome MidpointStep(const SystemModel& model, const DofMap& dofs, const DynamicOptions& options,
                          const std::vector<RotationNode>& triples, const DynamicState& state, double h,
-                         IterationMatrix& matrix, DynamicState& next) {
+                         IterationMatrix& matrix, BodyThreads& threads, DynamicState& next) {
   next = state;
   // Momenta at the start of the step.
   std::vector<Eigen::VectorXd> p0;
@@ -639,7 +654,7 @@ StepOutcome MidpointStep(const SystemModel& model, const DofMap& dofs, const Dyn
   for (; out.iterations < options.max_iterations; ++out.iterations) {
     MidpointKinematics k = Midpoint(model, dofs, triples, state, h, next);
     double work = 0.0;
-    const Assembly a = AssembleMidpoint(model, dofs, state, p0, h, k, next, work);
+    const Assembly a = AssembleMidpoint(model, dofs, state, p0, h, k, next, work, &threads);
     if (!a.ok || !a.residual.allFinite()) return out;
     if (FreeNorm(dofs, a.residual, weights) <= std::max(tolerance * a.scale, a.roundoff) && out.iterations > 0) {
       out.converged = true;
@@ -703,7 +718,7 @@ DynamicResult SolveDynamic(const SystemModel& model, DynamicState& state, const 
     DynamicState next;
     matrix.with_this_factor = 0;  // a step may use the kept factor for reuse_max_iterations iterations
     const StepOutcome step = options.integrator == Integrator::kMidpoint
-                                 ? MidpointStep(model, dofs, options, triples, state, h, matrix, next)
+                                 ? MidpointStep(model, dofs, options, triples, state, h, matrix, threads, next)
                                  : GeneralizedAlphaStep(model, dofs, options, state, h, matrix, threads, next);
     if (!step.converged && result.steps == 0 && cuts == 0 && step.singular_matrix.size() > 0) {
       // The first iteration matrix is singular: the model's, not the step's.

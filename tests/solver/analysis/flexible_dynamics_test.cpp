@@ -166,7 +166,8 @@ TEST(FlexibleDynamics, BodiesOnSeveralThreadsGiveTheSameBits) {
   // A chain of 6 segments of 0.25 m, linear and stiffened ones alternating (bodies of different
   // cost, so the dynamic schedule hands them out in a different order each pass), clamped at
   // one end by a hinge turning at 2 rad/s, swinging under gravity: 1, 2 and 3 threads
-  // must give the same bits (per-body slots added in body order, solver/parallel.h).
+  // must give the same bits (per-body slots added in body order, solver/parallel.h), with
+  // either integrator.
   const std::string part =
       "name: seg\ntype: beam\nmaterial: {E: 70.0e9, nu: 0.3, rho: 2700}\n"
       "section: {shape: tube, outer_radius: 0.01, wall: 0.001}\n"
@@ -183,7 +184,7 @@ TEST(FlexibleDynamics, BodiesOnSeveralThreadsGiveTheSameBits) {
     model.body_nodes.push_back({i, i + 1});
   }
   model.gravity = Eigen::Vector3d(0, -9.81, 0);
-  auto run = [&](int threads) {
+  auto run = [&](Integrator integrator, int threads) {
     const DofMap dofs(model);
     Eigen::VectorXd W = Eigen::VectorXd::Zero(dofs.n_dofs());
     W[0] = 2.0;  // the hinge turns at 2 rad/s
@@ -192,20 +193,23 @@ TEST(FlexibleDynamics, BodiesOnSeveralThreadsGiveTheSameBits) {
     options.step = 1e-3;
     options.end_time = 0.05;
     options.threads = threads;
+    options.integrator = integrator;
     const DynamicResult r = SolveDynamic(model, s, options);
     EXPECT_TRUE(r.ok) << r.message;
     return s;
   };
-  const DynamicState one = run(1);
-  EXPECT_GT(one.config.x[6].norm(), 1.0);
-  for (int threads : {2, 3}) {
-    const DynamicState many = run(threads);
-    for (int k = 0; k < model.n_nodes(); ++k) {
-      EXPECT_TRUE(one.config.x[k] == many.config.x[k]) << threads << " threads, node " << k;
-      EXPECT_TRUE(one.config.R[k] == many.config.R[k]) << threads << " threads, node " << k;
+  for (Integrator integrator : {Integrator::kGeneralizedAlpha, Integrator::kMidpoint}) {
+    const DynamicState one = run(integrator, 1);
+    EXPECT_GT(one.config.x[6].norm(), 1.0);
+    for (int threads : {2, 3}) {
+      const DynamicState many = run(integrator, threads);
+      for (int k = 0; k < model.n_nodes(); ++k) {
+        EXPECT_TRUE(one.config.x[k] == many.config.x[k]) << threads << " threads, node " << k;
+        EXPECT_TRUE(one.config.R[k] == many.config.R[k]) << threads << " threads, node " << k;
+      }
+      for (size_t b = 0; b < model.bodies.size(); ++b) EXPECT_TRUE(one.config.eta[b] == many.config.eta[b]);
+      EXPECT_TRUE(one.W == many.W) << threads << " threads";
     }
-    for (size_t b = 0; b < model.bodies.size(); ++b) EXPECT_TRUE(one.config.eta[b] == many.config.eta[b]);
-    EXPECT_TRUE(one.W == many.W) << threads << " threads";
   }
 }
 
