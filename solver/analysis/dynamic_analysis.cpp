@@ -77,14 +77,36 @@ struct BodyPass {
   InertiaLoadFactors load;
 };
 
-// One body's share of the residual pass, computed on its own (in parallel with the others) and
-// added into the system in body order.
-struct BodyResidual {
+// One body's share of an assembly pass, computed on its own (in parallel with the others) and
+// added into the system in body order (AddBodyTerms).
+struct BodyTerms {
   bool frame_ok = true;
   Eigen::VectorXd r_b, f_grav;  // f_grav - f_int - f_in, and f_grav
+  Eigen::MatrixXd K, C, M;      // empty in a residual-only pass
   double scale = 0.0, roundoff = 0.0;
   std::vector<MapEntry> map;
 };
+
+// Adds the bodies' terms in body order: the same sums whatever thread computed them. False (the
+// message in `out`) when a body's floating frame did not converge.
+bool AddBodyTerms(const SystemModel& model, const std::vector<BodyTerms>& terms, AssemblyParts& parts, Assembly& out) {
+  for (size_t b = 0; b < terms.size(); ++b) {
+    const BodyTerms& r = terms[b];
+    if (!r.frame_ok) {
+      out.ok = false;
+      out.message = "floating frame of body " + std::to_string(b) + " did not converge";
+      return false;
+    }
+    out.scale = std::max(out.scale, r.scale);
+    out.roundoff += r.roundoff;
+    AddBodyNodeForces(model, int(b), r.r_b, parts.node_forces);
+    const bool matrices = r.K.size() > 0;
+    ScatterBody(r.map, &r.r_b, matrices ? &r.K : nullptr, &out.residual, matrices ? &parts.K : nullptr);
+    ScatterBody(r.map, &r.f_grav, matrices ? &r.C : nullptr, &out.f_ext, matrices ? &parts.C : nullptr);
+    if (matrices) ScatterBody(r.map, nullptr, &r.M, nullptr, &parts.M);
+  }
+  return true;
+}
 
 // The generalized-alpha residual at state s and time t: frames solved (s.config.frames
 // updated), each body's kinematics evaluated once and kept in `passes` for the matrices, which
@@ -96,11 +118,11 @@ Assembly AssembleDynamicResidual(const SystemModel& model, const DofMap& dofs, D
   Assembly out = StartAssembly(model, dofs, parts);
   const int n_bodies = int(model.bodies.size());
   passes.resize(static_cast<size_t>(n_bodies));
-  std::vector<BodyResidual> results(static_cast<size_t>(n_bodies));
+  std::vector<BodyTerms> results(static_cast<size_t>(n_bodies));
   const std::vector<Eigen::Matrix<double, 6, 1>> node_acc = NodeAccelerations(model, dofs, s.config, s.W, s.Wdot);
   ForEachBody(threads, n_bodies, [&](int b) {
     const SuperelementBody& body = model.bodies[b];
-    BodyResidual& r = results[size_t(b)];
+    BodyTerms& r = results[size_t(b)];
     const BodyConfiguration c = BodyConfigurationOf(model, s.config, b);
     FrameSolution frame = body.SolveFrame(c, s.config.frames[b]);
     if (!frame.ok) frame = body.SolveFrame(c, body.GuessFrame(c));
@@ -131,19 +153,7 @@ Assembly AssembleDynamicResidual(const SystemModel& model, const DofMap& dofs, D
     r.map = BodyMap(model, dofs, s.config, b);
     r.r_b = r.f_grav - f_int - f_in;
   });
-  for (int b = 0; b < n_bodies; ++b) {
-    const BodyResidual& r = results[size_t(b)];
-    if (!r.frame_ok) {
-      out.ok = false;
-      out.message = "floating frame of body " + std::to_string(b) + " did not converge";
-      return out;
-    }
-    out.scale = std::max(out.scale, r.scale);
-    out.roundoff += r.roundoff;
-    AddBodyNodeForces(model, b, r.r_b, parts.node_forces);
-    ScatterBody(r.map, &r.r_b, nullptr, &out.residual, nullptr);
-    ScatterBody(r.map, &r.f_grav, nullptr, &out.f_ext, nullptr);
-  }
+  if (!AddBodyTerms(model, results, parts, out)) return out;
   FinishAssembly(model, dofs, s.config, t, s.W, false, parts, out);
   return out;
 }
@@ -523,13 +533,6 @@ Assembly AssembleMidpoint(const SystemModel& model, const DofMap& dofs, const Dy
   AssemblyParts parts;
   Assembly out = StartAssembly(model, dofs, parts);
   // Each body into its slot (on the threads), then added in body order.
-  struct BodyTerms {
-    bool frame_ok = true;
-    Eigen::VectorXd r_b, f_grav;
-    Eigen::MatrixXd K, C, M;
-    double scale = 0.0, roundoff = 0.0;
-    std::vector<MapEntry> map;
-  };
   const int n_bodies = int(model.bodies.size());
   std::vector<BodyTerms> terms(static_cast<size_t>(n_bodies));
   ForEachBody(threads, n_bodies, [&](int b) {
@@ -614,20 +617,7 @@ Assembly AssembleMidpoint(const SystemModel& model, const DofMap& dofs, const Dy
     r.map = BodyMap(model, dofs, k.mid, int(b));
     r.r_b = f_grav - f_int - f_in;
   });
-  for (int b = 0; b < n_bodies; ++b) {
-    const BodyTerms& r = terms[size_t(b)];
-    if (!r.frame_ok) {
-      out.ok = false;
-      out.message = "floating frame of body " + std::to_string(b) + " did not converge";
-      return out;
-    }
-    out.scale = std::max(out.scale, r.scale);
-    out.roundoff += r.roundoff;
-    AddBodyNodeForces(model, b, r.r_b, parts.node_forces);
-    ScatterBody(r.map, &r.r_b, &r.K, &out.residual, &parts.K);
-    ScatterBody(r.map, &r.f_grav, &r.C, &out.f_ext, &parts.C);
-    ScatterBody(r.map, nullptr, &r.M, nullptr, &parts.M);
-  }
+  if (!AddBodyTerms(model, terms, parts, out)) return out;
   // Loads at the mid time and configuration, spring-dampers at the mean rates Delta / h.
   FinishAssembly(model, dofs, k.mid, s0.t + 0.5 * h, k.delta / h, true, parts, out);
   f_ext_work = out.f_ext.dot(k.delta);
