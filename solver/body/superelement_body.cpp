@@ -426,24 +426,22 @@ Eigen::MatrixXd SuperelementBody::ExactGyroscopic(const Data& data, const BodyVe
   const Eigen::VectorXd y = Phi_rig0_ * xi + qd;
   const Eigen::MatrixXd dy = Phi_rig0_ * dxi + dqd;
   const Eigen::MatrixXd dyd = d.Y * dr;
-  Eigen::MatrixXd Hd(n, 3);
-  std::array<Eigen::MatrixXd, 3> dHd;  // Gamma_a dqd
+  // Gamma(Om) = sum_a Om_a Gamma_a: the three Gamma_a dqd and Gamma_a^T dy products in one each;
+  // the rows y^T Gamma_a dqd as (Gamma_a^T y)^T dqd.
+  Eigen::MatrixXd G_Om = Om[0] * Gamma_[0];
+  for (int a = 1; a < 3; ++a) G_Om += Om[a] * Gamma_[size_t(a)];
+  Eigen::MatrixXd Hd(n, 3), Gty(n, 3);  // Gamma_a qd, Gamma_a^T y
   for (int a = 0; a < 3; ++a) {
     Hd.col(a) = Gamma_[size_t(a)] * qd;
-    dHd[size_t(a)] = Gamma_[size_t(a)] * dqd;
+    Gty.col(a) = Gamma_[size_t(a)].transpose() * y;
   }
   const Eigen::VectorXd pi_q = M_ * y + d.H * Om;
-  const Eigen::MatrixXd dpi_q = M_ * dy + d.H * dOm;
-  Eigen::MatrixXd dpi_q_dot = M_ * dyd + d.H * dOmd + Hd * dOm;
-  for (int a = 0; a < 3; ++a) dpi_q_dot += Om[a] * dHd[size_t(a)];
-  Eigen::MatrixXd df_q = dpi_q_dot;
+  Eigen::MatrixXd dpi_q_dot = M_ * dyd + d.H * dOmd + Hd * dOm + G_Om * dqd;
+  Eigen::MatrixXd df_q = dpi_q_dot - G_Om.transpose() * dy - Gty * dOm;
   const Eigen::Vector3d h = d.H.transpose() * y + d.Xq * Om;
   const Eigen::MatrixXd dh = d.H.transpose() * dy + d.Xq * dOm;
-  Eigen::MatrixXd dhd = d.H.transpose() * dyd + d.Xq * dOmd;
+  Eigen::MatrixXd dhd = d.H.transpose() * dyd + d.Xq * dOmd + Gty.transpose() * dqd + Hd.transpose() * dy;
   for (int a = 0; a < 3; ++a) {
-    const Eigen::MatrixXd& Ga = Gamma_[size_t(a)];
-    df_q -= (Ga.transpose() * y) * dOm.row(a) + Om[a] * (Ga.transpose() * dy);
-    dhd.row(a) += y.transpose() * dHd[size_t(a)] + Hd.col(a).transpose() * dy;
     for (int b = 0; b < 3; ++b) {
       const Eigen::VectorXd& XQab = d.XQ[size_t(3 * a + b)];
       df_q -= XQab * (Om[b] * dOm.row(a) + Om[a] * dOm.row(b));
@@ -454,7 +452,8 @@ Eigen::MatrixXd SuperelementBody::ExactGyroscopic(const Data& data, const BodyVe
   Eigen::Matrix<double, 6, 1> pi_xi = Phi_rig0_.transpose() * pi_q;
   pi_xi.tail<3>() += h;
   const Eigen::Vector3d pi_v = pi_xi.head<3>(), pi_w = pi_xi.tail<3>();
-  Eigen::MatrixXd dpi_xi = Phi_rig0_.transpose() * dpi_q;
+  // d pi_q = M dy + H dOm enters only through Phi_rig0^T: 6 rows.
+  Eigen::MatrixXd dpi_xi = (Phi_rig0_.transpose() * M_) * dy + (Phi_rig0_.transpose() * d.H) * dOm;
   dpi_xi.bottomRows<3>() += dh;
   Eigen::MatrixXd df_xi = Phi_rig0_.transpose() * dpi_q_dot;
   df_xi.bottomRows<3>() += dhd;
