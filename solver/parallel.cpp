@@ -11,12 +11,6 @@ namespace {
 // How long a helper looks for the next pass before it sleeps.
 constexpr int kSpinMicroseconds = 200;
 
-inline void Pause() {
-#if defined(__x86_64__) || defined(__i386__)
-  __builtin_ia32_pause();
-#endif
-}
-
 }  // namespace
 
 int DefaultThreads() {
@@ -59,7 +53,7 @@ void BodyThreads::Helper() {
         std::chrono::steady_clock::now() + std::chrono::microseconds(kSpinMicroseconds);
     while (published_.load(std::memory_order_acquire) == seen &&
            std::chrono::steady_clock::now() < until) {
-      for (int k = 0; k < 64; ++k) Pause();
+      std::this_thread::yield();  // a process that shares the core runs meanwhile
     }
     Pass* pass = nullptr;
     {
