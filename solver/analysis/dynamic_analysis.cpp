@@ -124,8 +124,7 @@ Assembly AssembleDynamicResidual(const SystemModel& model, const DofMap& dofs, D
     const SuperelementBody& body = model.bodies[b];
     BodyTerms& r = results[size_t(b)];
     const BodyConfiguration c = BodyConfigurationOf(model, s.config, b);
-    FrameSolution frame = body.SolveFrame(c, s.config.frames[b]);
-    if (!frame.ok) frame = body.SolveFrame(c, body.GuessFrame(c));
+    const FrameSolution frame = body.SolveFrameFrom(c, s.config.frames[b]);
     if (!frame.ok) {
       r.frame_ok = false;
       return;
@@ -540,10 +539,8 @@ Assembly AssembleMidpoint(const SystemModel& model, const DofMap& dofs, const Dy
     BodyTerms& r = terms[size_t(b)];
     const BodyConfiguration c1 = BodyConfigurationOf(model, s1.config, int(b));
     const BodyConfiguration cm = BodyConfigurationOf(model, k.mid, int(b));
-    FrameSolution f1 = body.SolveFrame(c1, s1.config.frames[b]);
-    if (!f1.ok) f1 = body.SolveFrame(c1, body.GuessFrame(c1));
-    FrameSolution fm = f1.ok ? body.SolveFrame(cm, s0.config.frames[b]) : FrameSolution{};
-    if (f1.ok && !fm.ok) fm = body.SolveFrame(cm, body.GuessFrame(cm));
+    const FrameSolution f1 = body.SolveFrameFrom(c1, s1.config.frames[b]);
+    const FrameSolution fm = f1.ok ? body.SolveFrameFrom(cm, s0.config.frames[b]) : FrameSolution{};
     if (!f1.ok || !fm.ok) {
       r.frame_ok = false;
       return;

@@ -273,8 +273,7 @@ SystemForces AssembleStatic(const SystemModel& model, const DofMap& dofs, System
   for (size_t b = 0; b < model.bodies.size(); ++b) {
     const SuperelementBody& body = model.bodies[b];
     const BodyConfiguration c = BodyConfigurationOf(model, state, int(b));
-    FrameSolution frame = body.SolveFrame(c, state.frames[b]);
-    if (!frame.ok) frame = body.SolveFrame(c, body.GuessFrame(c));
+    const FrameSolution frame = body.SolveFrameFrom(c, state.frames[b]);
     if (!frame.ok) {
       out.ok = false;
       out.message = "floating frame of body " + std::to_string(b) + " did not converge";

@@ -164,6 +164,11 @@ double SuperelementBody::RoundOffForce(const BodyConfiguration& c) const {
   return 16.0 * std::sqrt(double(n_coordinates())) * std::numeric_limits<double>::epsilon() * k_max_ * x;
 }
 
+FrameSolution SuperelementBody::SolveFrameFrom(const BodyConfiguration& c, const FrameSolution& last) const {
+  const FrameSolution frame = SolveFrame(c, last);
+  return frame.ok ? frame : SolveFrame(c, GuessFrame(c));
+}
+
 FrameSolution SuperelementBody::SolveFrame(const BodyConfiguration& c, const FrameSolution& guess) const {
   FrameSolution frame = guess;
   frame.ok = false;
@@ -410,16 +415,8 @@ Eigen::MatrixXd SuperelementBody::ExactGyroscopic(const Data& data, const BodyVe
     dr.middleRows<3>(6 * k) -= -Skew<double>(Eigen::Vector3d(qd.segment<3>(6 * k))) * dOm + Om_x * dqd.middleRows<3>(6 * k);
     // LeftJacobianRate is quadratic in thetadot: its derivative by polarization, exactly.
     const Eigen::Vector3d theta = data.q.segment<3>(6 * k + 3), thetadot = qd.segment<3>(6 * k + 3);
-    const Eigen::Matrix3d DL = [&] {
-      const double s = std::max(thetadot.norm(), 1.0);
-      const Eigen::Vector3d L0 = LeftJacobianRate(theta, thetadot);
-      Eigen::Matrix3d out;
-      for (int i = 0; i < 3; ++i) {
-        const Eigen::Vector3d e = s * Eigen::Vector3d::Unit(i);
-        out.col(i) = (LeftJacobianRate(theta, thetadot + e) - L0 - LeftJacobianRate(theta, e)) / s;
-      }
-      return out;
-    }();
+    const Eigen::Matrix3d DL = QuadraticDerivative(
+        thetadot, [&](const Eigen::VectorXd& e) { return Eigen::VectorXd(LeftJacobianRate(theta, Eigen::Vector3d(e))); });
     dr.middleRows<3>(6 * k + 3) -= DL * dqd.middleRows<3>(6 * k + 3);
   }
   const Eigen::MatrixXd dOmd = Z.bottomRows<3>() * dr;

@@ -160,6 +160,8 @@ class SuperelementBody {
   /// Newton on Phi_CB q_loc(x_j, R_j) = 0 from `guess` (thesis 4.2). ok = false when the
   /// residual does not fall below 1e-12 (relative) in 30 iterations.
   FrameSolution SolveFrame(const BodyConfiguration& c, const FrameSolution& guess) const;
+  /// SolveFrame from the last frame, and failing that from GuessFrame (ok = false if both fail).
+  FrameSolution SolveFrameFrom(const BodyConfiguration& c, const FrameSolution& last) const;
 
   /// Local coordinates q_loc (6N + m).
   Eigen::VectorXd LocalCoordinates(const BodyConfiguration& c, const FrameSolution& frame) const;
