@@ -38,6 +38,18 @@ double TimeFunctionSpec::Evaluate(double t) const {
   return a.second + (b.second - a.second) * (t - a.first) / (b.first - a.first);
 }
 
+std::vector<double> TimeFunctionSpec::Breakpoints() const {
+  if (type == "ramp" || type == "pulse") return {t_start, t_end};
+  if (type == "step") return {t_start};
+  if (type == "spin_up") return {t_end};
+  if (type == "table") {
+    std::vector<double> out;
+    for (const auto& p : table) out.push_back(p.first);
+    return out;
+  }
+  return {};  // linear, constant, sine: smooth
+}
+
 double TimeFunctionSpec::Rate(double t) const {
   if (type == "linear") return value;
   if (type == "ramp") return (t >= t_start && t < t_end) ? value / (t_end - t_start) : 0.0;
@@ -347,7 +359,21 @@ SceneSpec ParseScene(const std::string& text, const std::string& name, const std
       a.steps = int(v->Integer());
       if (a.steps < 1) v->Fail("needs at least 1 step");
     }
-    if (auto v = m.Optional("step")) a.step = v->PositiveNumber();
+    if (auto v = m.Optional("step")) {
+      if (v->IsScalar() && v->String() == "auto") {
+        a.adaptive_step = true;
+      } else {
+        a.step = v->PositiveNumber();
+      }
+    }
+    if (auto v = m.Optional("step_tolerance")) a.step_tolerance = v->PositiveNumber();
+    std::optional<YamlValue> min_step = m.Optional("min_step"), max_step = m.Optional("max_step");
+    if (min_step) a.min_step = min_step->PositiveNumber();
+    if (max_step) a.max_step = max_step->PositiveNumber();
+    if (min_step && max_step && a.min_step > a.max_step) {
+      min_step->Fail("min_step " + min_step->String() + " is above max_step " + max_step->String());
+    }
+    if (auto v = m.Optional("output_step")) a.output_step = v->PositiveNumber();
     if (auto v = m.Optional("rho_inf")) {
       a.rho_inf = v->Number();
       if (a.rho_inf < 0 || a.rho_inf > 1) v->Fail("rho_inf must be in [0, 1]");

@@ -20,6 +20,9 @@ struct TimeFunctionSpec {
   double Evaluate(double t) const;
   double Rate(double t) const;          ///< f'(t) (piecewise: the right derivative)
   double Acceleration(double t) const;  ///< f''(t) (kinks: 0)
+  /// Times where f or its rate jumps (step, pulse, ramp ends, table points, end of a spin-up):
+  /// step boundaries for error-controlled steps.
+  std::vector<double> Breakpoints() const;
 };
 
 struct SceneBodySpec {
@@ -82,7 +85,14 @@ struct SceneAnalysisSpec {
   bool modes_about_static = false;  ///< modes: about the static state under the loads at end_time
   double end_time = 1.0;
   int steps = 10;               ///< static: load steps over [0, end_time]
-  double step = 1e-3;           ///< dynamic: time step
+  double step = 1e-3;           ///< dynamic: time step (the first one with step: auto)
+  /// dynamic, `step: auto`: error-controlled steps (solver/analysis/dynamic_analysis.h,
+  /// DynamicOptions): the local error of positions and velocities relative to the model's motion
+  /// below step_tolerance, steps within [min_step, max_step] (0: defaults from end_time), results
+  /// at every output_step (0: at every step taken).
+  bool adaptive_step = false;
+  double step_tolerance = 3e-4;
+  double min_step = 0.0, max_step = 0.0, output_step = 0.0;
   double rho_inf = 0.9;
   /// dynamic: generalized_alpha (numerical damping by rho_inf) or midpoint (momentum-conserving,
   /// no damping; solver/analysis/dynamic_analysis.h)

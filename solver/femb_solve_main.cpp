@@ -40,9 +40,7 @@ void RecordModeShapes(const femb::Scene& scene, const femb::SystemState& state, 
                       double load_time, femb::ResultsRecorder& recorder) {
   const femb::SystemModel& model = scene.model;
   const femb::DofMap dofs(model);
-  Eigen::Vector3d lo = Eigen::Vector3d::Constant(HUGE_VAL), hi = -lo;
-  for (const Eigen::Vector3d& x : state.x) lo = lo.cwiseMin(x), hi = hi.cwiseMax(x);
-  const double size = model.n_nodes() > 1 ? (hi - lo).norm() : 1.0;
+  const double size = model.n_nodes() > 1 ? femb::BoundingDiagonal(state.x) : 1.0;
   for (int k = 0; k < modes.shapes.cols(); ++k) {
     const Eigen::VectorXd v = modes.shapes.col(k);
     double largest = 0.0;
@@ -125,13 +123,19 @@ int main(int argc, char** argv) {
     bool ok = true;
     long total_iterations = 0;
     long step_count = 0;
+    long rejected = 0;  // steps rejected so far (step: auto)
     double last_print = -1.0;
     auto progress = [&](double t, bool force) {
       if (quiet) return;
       if (!force && Seconds(wall) - last_print < 1.0) return;
       last_print = Seconds(wall);
-      std::printf("femb-solve: t = %-10.6g steps %-7ld Newton iterations %-8ld wall %.2f s\n", t, step_count,
-                  total_iterations, Seconds(wall));
+      if (spec.analysis.adaptive_step) {
+        std::printf("femb-solve: t = %-10.6g steps %-7ld rejected %-5ld Newton iterations %-8ld wall %.2f s\n", t,
+                    step_count, rejected, total_iterations, Seconds(wall));
+      } else {
+        std::printf("femb-solve: t = %-10.6g steps %-7ld Newton iterations %-8ld wall %.2f s\n", t, step_count,
+                    total_iterations, Seconds(wall));
+      }
       std::fflush(stdout);
     };
     if (spec.analysis.type == "modes") {
@@ -212,15 +216,28 @@ int main(int argc, char** argv) {
       options.reuse_jacobian = spec.analysis.reuse_jacobian;
       options.full_inertia_tangent = spec.analysis.gyroscopic_tangent;
       options.threads = threads;
+      options.adaptive = spec.analysis.adaptive_step;
+      options.step_tolerance = spec.analysis.step_tolerance;
+      options.min_step = spec.analysis.min_step;
+      options.max_step = spec.analysis.max_step;
+      options.output_step = spec.analysis.output_step;
+      for (const auto& [name, f] : spec.functions) {
+        for (double t : f.Breakpoints()) options.breakpoints.push_back(t);
+      }
+      recorder.RecordStepSize(0.0);
       const femb::DynamicResult r = femb::SolveDynamic(
           scene.model, state, options, [&](const femb::DynamicStepReport& s, const femb::DynamicState& st) {
             ++step_count;
             total_iterations += s.iterations;
-            if (step_count % spec.analysis.output_every == 0) {
+            rejected = s.rejected;
+            // output_step picks the output steps (adaptive steps land on its times); else every
+            // output_every-th step.
+            if (spec.analysis.output_step > 0 ? s.output : step_count % spec.analysis.output_every == 0) {
               const auto reactions = spec.reactions ? femb::DynamicReactions(scene.model, st)
                                                     : std::vector<Eigen::Matrix<double, 6, 1>>();
               recorder.Record(s.t, st.config, st.W, s.kinetic_energy, s.elastic_energy, s.external_work,
                               s.linear_momentum, s.angular_momentum, spec.reactions ? &reactions : nullptr);
+              recorder.RecordStepSize(s.h);
             }
             progress(s.t, false);
           });
@@ -228,6 +245,11 @@ int main(int argc, char** argv) {
       if (!ok) status = r.message;
       for (const std::string& w : r.warnings) std::printf("femb-solve: warning: %s\n", w.c_str());
       if (!quiet) std::printf("femb-solve: %ld factorizations of the iteration matrix\n", r.factorizations);
+      if (!quiet && spec.analysis.adaptive_step) {
+        std::printf("femb-solve: %ld steps rejected (%ld by the error test, %ld by Newton)\n",
+                    r.rejected_by_error + r.newton_cuts, r.rejected_by_error, r.newton_cuts);
+      }
+      recorder.StepCounts(r.steps, r.rejected_by_error, r.newton_cuts);
     }
     recorder.Finish(status);
     progress(spec.analysis.end_time, true);

@@ -230,6 +230,24 @@ Eigen::VectorXd DriveForces(const DofMap& dofs, const Eigen::VectorXd& residual)
   return f;
 }
 
+namespace {
+
+// The free accelerations from M_g Wdot = f_ext - f_int - f_gyro at s (prescribed ones as set),
+// a = Wdot, and the external and drive forces there: the start of an integration.
+void ConsistentAccelerations(const SystemModel& model, const DofMap& dofs, DynamicState& s) {
+  const Assembly b = AssembleDynamic(model, dofs, s, s.t, true);
+  for (int j : dofs.solved()) s.Wdot[j] = 0.0;
+  const Eigen::VectorXd free_acc = SolveFree(dofs, b.M, b.residual - b.M * s.Wdot);
+  for (int j : dofs.solved()) s.Wdot[j] = free_acc[j];
+  s.a = s.Wdot;
+  s.f_ext = b.f_ext;
+  Eigen::VectorXd added = Eigen::VectorXd::Zero(dofs.n_dofs());
+  for (int j : dofs.solved()) added[j] = s.Wdot[j];
+  s.f_drive = DriveForces(dofs, b.residual - b.M * added);
+}
+
+}  // namespace
+
 DynamicState InitialDynamicState(const SystemModel& model, const SystemState& config, const Eigen::VectorXd& W,
                                  double t0) {
   const DofMap dofs(model);
@@ -255,14 +273,7 @@ DynamicState InitialDynamicState(const SystemModel& model, const SystemState& co
     const Eigen::VectorXd W_free = SolveFree(dofs, f.tangent, rhs);
     for (int j : dofs.solved()) s.W[j] = W_free[j];
   }
-  const Assembly b = AssembleDynamic(model, dofs, s, t0, true);
-  const Eigen::VectorXd free_acc = SolveFree(dofs, b.M, b.residual - b.M * s.Wdot);
-  for (int j : dofs.solved()) s.Wdot[j] = free_acc[j];
-  s.a = s.Wdot;
-  s.f_ext = b.f_ext;
-  Eigen::VectorXd added = Eigen::VectorXd::Zero(dofs.n_dofs());
-  for (int j : dofs.solved()) added[j] = s.Wdot[j];
-  s.f_drive = DriveForces(dofs, b.residual - b.M * added);
+  ConsistentAccelerations(model, dofs, s);
   return s;
 }
 
@@ -329,9 +340,11 @@ struct StepOutcome {
 };
 
 // One generalized-alpha step of size h from `state` into `next` (Arnold & Bruls 2007).
+// t_new: the time reached, state.t + h, or just below a breakpoint the step lands on (the loads
+// and drives there are their left limits).
 StepOutcome GeneralizedAlphaStep(const SystemModel& model, const DofMap& dofs, const DynamicOptions& options,
-                                 const DynamicState& state, double h, IterationMatrix& matrix, BodyThreads& threads,
-                                 DynamicState& next) {
+                                 const DynamicState& state, double h, double t_new, IterationMatrix& matrix,
+                                 BodyThreads& threads, DynamicState& next) {
   const double rho = std::clamp(options.rho_inf, 0.0, 1.0);
   const double alpha_m = (2 * rho - 1) / (rho + 1), alpha_f = rho / (rho + 1);
   const double gamma = 0.5 + alpha_f - alpha_m, beta = 0.25 * (gamma + 0.5) * (gamma + 0.5);
@@ -342,9 +355,8 @@ StepOutcome GeneralizedAlphaStep(const SystemModel& model, const DofMap& dofs, c
   next.W = state.W + h * (1 - gamma) * state.a + h * gamma * a_pred;
   const Eigen::VectorXd dq = state.W + h * (0.5 - beta) * state.a + h * beta * a_pred;
   ApplyIncrement(model, dofs, h * dq, next.config);
-  ApplyPrescribed(model, dofs, state.t + h, next.config, &next.W, &next.Wdot);
+  ApplyPrescribed(model, dofs, t_new, next.config, &next.W, &next.Wdot);
   const double gamma_p = gamma / (beta * h), beta_p = (1 - alpha_m) / (beta * h * h * (1 - alpha_f));
-  const double t_new = state.t + h;
   StepOutcome out;
   const double tolerance = std::max(options.tolerance, kRoundOffTolerance);
   const Eigen::VectorXd weights = ResidualWeights(model, dofs);
@@ -622,7 +634,7 @@ Assembly AssembleMidpoint(const SystemModel& model, const DofMap& dofs, const Dy
 }
 
 StepOutcome MidpointStep(const SystemModel& model, const DofMap& dofs, const DynamicOptions& options,
-                         const std::vector<RotationNode>& triples, const DynamicState& state, double h,
+                         const std::vector<RotationNode>& triples, const DynamicState& state, double h, double t_new,
                          IterationMatrix& matrix, BodyThreads& threads, DynamicState& next) {
   next = state;
   // Momenta at the start of the step.
@@ -634,7 +646,7 @@ StepOutcome MidpointStep(const SystemModel& model, const DofMap& dofs, const Dyn
   }
   // Predictor: the configuration reached with the current velocity and acceleration.
   ApplyIncrement(model, dofs, h * state.W + 0.5 * h * h * state.Wdot, next.config);
-  ApplyPrescribed(model, dofs, state.t + h, next.config, &next.W, &next.Wdot);
+  ApplyPrescribed(model, dofs, t_new, next.config, &next.W, &next.Wdot);
   StepOutcome out;
   const double tolerance = std::max(options.tolerance, kRoundOffTolerance);
   const Eigen::VectorXd weights = ResidualWeights(model, dofs);
@@ -645,11 +657,16 @@ StepOutcome MidpointStep(const SystemModel& model, const DofMap& dofs, const Dyn
     if (!a.ok || !a.residual.allFinite()) return out;
     if (FreeNorm(dofs, a.residual, weights) <= std::max(tolerance * a.scale, a.roundoff) && out.iterations > 0) {
       out.converged = true;
-      next.t = state.t + h;
+      next.t = t_new;
       // a: the mean acceleration over the step (t_n+1/2); Wdot: extrapolated to t_n+1 from
       // the last two means (the predictor's acceleration; also what the output reports).
       next.a = (next.W - state.W) / h;
-      next.Wdot = 1.5 * next.a - 0.5 * state.a;
+      if (state.h_last > 0 && h != state.h_last) {
+        // Steps of different length: the means sit at t_n - h_last / 2 and t_n + h / 2.
+        next.Wdot = next.a + (h / (h + state.h_last)) * (next.a - state.a);
+      } else {
+        next.Wdot = 1.5 * next.a - 0.5 * state.a;
+      }
       next.external_work += work;
       next.f_ext = a.f_ext;
       next.f_drive = DriveForces(dofs, a.residual);
@@ -672,6 +689,122 @@ StepOutcome MidpointStep(const SystemModel& model, const DofMap& dofs, const Dyn
   return out;
 }
 
+
+// ---- Error-controlled steps ------------------------------------------------------------------
+//
+// Local error estimate from the accelerations of the steps taken (Zienkiewicz & Xie 1991 for
+// Newmark's method, here for both integrators): a jerk estimate per coordinate,
+//   j_n+1 = (A_n+1 - A_n) / dt_A
+// with A the accelerations (generalized-alpha: Wdot at t_n and t_n+1, dt_A = h; midpoint: the
+// mean acceleration of each step, at t_n+1/2 and t_n-1/2, dt_A = (h + h_last) / 2), gives the
+// local error of the positions over a step of h
+//   e_q = C_q h^3 j,   C_q = 1/6 - beta - (alpha_m - alpha_f) / 2 (generalized-alpha), 1/12 (midpoint).
+// Generalized-alpha: q_n+1 = q_n + h W_n + h^2 ((1/2 - beta) a_n + beta a_n+1) with the
+// acceleration-like a_n = Wdot(t_n + (alpha_m - alpha_f) h) + O(h^2) (from (1 - alpha_m) a_n+1 +
+// alpha_m a_n = (1 - alpha_f) Wdot_n+1 + alpha_f Wdot_n); Taylor's expansion of q(t_n + h) leaves
+// C_q h^3 q'''. rho_inf = 1 gives -1/12, the trapezoidal rule's constant, which is also the
+// midpoint scheme's (its positions advance by h (W_n + W_n+1) / 2). Velocities are second order
+// (gamma = 1/2 + alpha_f - alpha_m): their local error is third order too, estimated from the
+// change of the jerk,
+//   e_v = C_v h^3 (j_n+1 - j_n) / ((h + h_last) / 2),   C_v = 1/12 (trapezoidal), 1/24 (midpoint rule).
+// The estimates are compared coordinate by coordinate as lengths (e_i / w_i, w the residual
+// weights: rotations times the model's size, modal coordinates over sqrt(mass)) with
+//   step_tolerance * D (positions) and step_tolerance * V (velocities),
+// D the largest node travel so far (at least 1e-3 of the model's size), V the largest velocity so
+// far (at least D / time span): a relative error of the motion, so a cantilever that deflects a
+// millimetre is judged against that millimetre, a crank against its stroke. The largest ratio E
+// decides: E <= 1 accepts, and the next step is h * clamp(0.9 E^(-1/3), 0.2, 2) (the error goes
+// with h^3; no growth right after a rejection). Prescribed coordinates are exact and not judged.
+// Steps land on breakpoints (kinks and jumps of loads and drives), so a jump never falls inside a
+// step; the jerk history restarts after one.
+class StepController {
+ public:
+  StepController(const SystemModel& model, const DofMap& dofs, const DynamicOptions& options, double t0)
+      : options_(options), dofs_(dofs), weights_(ResidualWeights(model, dofs)), x0_(model.node_x0), t0_(t0) {
+    const double span = options.end_time - t0;
+    min_step_ = options.min_step > 0 ? options.min_step : 1e-8 * span;
+    max_step_ = options.max_step > 0 ? options.max_step : 0.01 * span;
+    D_ = 1e-3 * std::max(BoundingDiagonal(model.node_x0), 1e-300);
+    V_ = D_ / span;
+    if (options.integrator == Integrator::kMidpoint) {
+      c_q_ = 1.0 / 12, c_v_ = 1.0 / 24;
+    } else {
+      const double rho = std::clamp(options.rho_inf, 0.0, 1.0);
+      const double alpha_m = (2 * rho - 1) / (rho + 1), alpha_f = rho / (rho + 1);
+      const double gamma = 0.5 + alpha_f - alpha_m, beta = 0.25 * (gamma + 0.5) * (gamma + 0.5);
+      c_q_ = std::abs(1.0 / 6 - beta - 0.5 * (alpha_m - alpha_f)), c_v_ = 1.0 / 12;
+    }
+    breakpoints_ = options.breakpoints;
+    std::sort(breakpoints_.begin(), breakpoints_.end());
+  }
+  double min_step() const { return min_step_; }
+  double FirstStep() const { return std::clamp(options_.step, min_step_, max_step_); }
+
+  // The step to try from t: h within [min_step, max_step], shortened to land on the next
+  // boundary (end time, breakpoint, output time) or to reach it in two equal steps.
+  double Fit(double t, double h) {
+    h = std::clamp(h, min_step_, max_step_);
+    const double eps = 1e-12 * (options_.end_time - t0_);
+    boundary_ = options_.end_time;
+    bool breakpoint = false;
+    auto after = std::upper_bound(breakpoints_.begin(), breakpoints_.end(), t + eps);
+    if (after != breakpoints_.end() && *after < boundary_ - eps) boundary_ = *after, breakpoint = true;
+    output_ = true;
+    if (options_.output_step > 0) {
+      const double k = std::floor((t + eps - t0_) / options_.output_step) + 1;
+      const double next_output = t0_ + k * options_.output_step;
+      if (next_output < boundary_ - eps) boundary_ = next_output, breakpoint = false;
+      output_ = std::abs(next_output - boundary_) <= eps || boundary_ == options_.end_time;
+    }
+    at_breakpoint_ = breakpoint;
+    lands_ = t + 1.01 * h >= boundary_;
+    if (lands_) return boundary_ - t;
+    if (t + 2 * h > boundary_) return 0.5 * (boundary_ - t);
+    return h;
+  }
+  bool lands() const { return lands_; }
+  bool at_breakpoint() const { return lands_ && at_breakpoint_; }
+  double boundary() const { return boundary_; }
+  bool output() const { return lands_ && output_; }
+
+  // The error ratio E of the step from s0 to s1 (<= 1: accept); keeps the jerk for Accept.
+  double Error(const DynamicState& s0, const DynamicState& s1, double h) {
+    const bool midpoint = options_.integrator == Integrator::kMidpoint;
+    const double dt_A = midpoint ? 0.5 * (h + s0.h_last) : h;
+    jerk_ = midpoint ? Eigen::VectorXd((s1.a - s0.a) / dt_A) : Eigen::VectorXd((s1.Wdot - s0.Wdot) / dt_A);
+    const bool with_velocity = jerk_prev_.size() == jerk_.size();
+    const double h3 = h * h * h, tol_q = options_.step_tolerance * D_, tol_v = options_.step_tolerance * V_;
+    double E = 0.0;
+    for (int i : dofs_.solved()) {
+      E = std::max(E, c_q_ * h3 * std::abs(jerk_[i]) / weights_[i] / tol_q);
+      if (with_velocity) {
+        const double snap = (jerk_[i] - jerk_prev_[i]) / (0.5 * (h + s0.h_last));
+        E = std::max(E, c_v_ * h3 * std::abs(snap) / weights_[i] / tol_v);
+      }
+    }
+    return std::isfinite(E) ? E : HUGE_VAL;
+  }
+
+  // The next step after an accepted one with error ratio E; updates the motion scales.
+  double Accept(const DynamicState& s1, double h, double E, bool after_rejection) {
+    jerk_prev_ = at_breakpoint() ? Eigen::VectorXd() : jerk_;
+    for (size_t k = 0; k < x0_.size(); ++k) D_ = std::max(D_, (s1.config.x[k] - x0_[k]).norm());
+    for (int i : dofs_.solved()) V_ = std::max(V_, std::abs(s1.W[i]) / weights_[i]);
+    return h * std::min(after_rejection ? 1.0 : 2.0, Factor(E));
+  }
+  static double Factor(double E) { return E > 0 ? std::clamp(0.9 * std::cbrt(1.0 / E), 0.2, 2.0) : 2.0; }
+
+ private:
+  const DynamicOptions& options_;
+  const DofMap& dofs_;
+  Eigen::VectorXd weights_, jerk_, jerk_prev_;
+  std::vector<Eigen::Vector3d> x0_;
+  double t0_ = 0;
+  std::vector<double> breakpoints_;
+  double min_step_ = 0, max_step_ = 0, D_ = 0, V_ = 0, c_q_ = 0, c_v_ = 0, boundary_ = 0;
+  bool lands_ = false, output_ = true, at_breakpoint_ = false;
+};
+
 }  // namespace
 
 DynamicResult SolveDynamic(const SystemModel& model, DynamicState& state, const DynamicOptions& options,
@@ -679,8 +812,10 @@ DynamicResult SolveDynamic(const SystemModel& model, DynamicState& state, const 
   DynamicResult result;
   const DofMap dofs(model);
   const std::vector<RotationNode> triples = RotationNodes(model, dofs);
-  double h = options.step;
+  StepController control(model, dofs, options, state.t);
+  double h = options.adaptive ? control.FirstStep() : options.step;
   int cuts = 0;
+  bool after_rejection = false;
   IterationMatrix matrix;
   BodyThreads threads(options.threads);
   // Time is counted in steps: t = t_base + n h while the step stays nominal (summing h over 1e6
@@ -688,6 +823,8 @@ DynamicResult SolveDynamic(const SystemModel& model, DynamicState& state, const 
   // remainder below 1% of a step is merged into the last one.
   double t_base = state.t;
   long n_nominal = 0;
+  const double t_output0 = state.t;
+  double last_output = 0;
   // Energy balance E = T + U - W_loads - W_drives: constant for a conservative system, falling
   // with damping (modal, dampers, generalized-alpha's rho_inf < 1). Growth is numerical: a step
   // too long for the stiffest modes (generalized-alpha with rho_inf near 1 on stiff modes; the
@@ -699,15 +836,27 @@ DynamicResult SolveDynamic(const SystemModel& model, DynamicState& state, const 
   double energy_scale = std::abs(E0);
   bool warned = false;
   if (const std::string w = RoundOffToleranceWarning(options.tolerance); !w.empty()) result.warnings.push_back(w);
+  auto fail = [&](const std::string& message) {
+    result.message = message;
+    result.factorizations = matrix.factorizations;
+    return result;
+  };
   while (state.t < options.end_time - 1e-12 * std::max(std::abs(options.end_time), options.step)) {
-    const double remaining = options.end_time - state.t;
-    if (remaining <= 1.01 * h) h = remaining;
+    if (options.adaptive) {
+      h = control.Fit(state.t, h);
+    } else {
+      const double remaining = options.end_time - state.t;
+      if (remaining <= 1.01 * h) h = remaining;
+    }
     DynamicState next;
     matrix.with_this_factor = 0;  // a step may use the kept factor for reuse_max_iterations iterations
-    const StepOutcome step = options.integrator == Integrator::kMidpoint
-                                 ? MidpointStep(model, dofs, options, triples, state, h, matrix, threads, next)
-                                 : GeneralizedAlphaStep(model, dofs, options, state, h, matrix, threads, next);
-    if (!step.converged && result.steps == 0 && cuts == 0 && step.singular_matrix.size() > 0) {
+    const double t_new =
+        options.adaptive && control.at_breakpoint() ? std::nextafter(control.boundary(), -HUGE_VAL) : state.t + h;
+    const StepOutcome step =
+        options.integrator == Integrator::kMidpoint
+            ? MidpointStep(model, dofs, options, triples, state, h, t_new, matrix, threads, next)
+            : GeneralizedAlphaStep(model, dofs, options, state, h, t_new, matrix, threads, next);
+    if (!step.converged && result.steps == 0 && result.newton_cuts == 0 && step.singular_matrix.size() > 0) {
       // The first iteration matrix is singular: the model's, not the step's.
       const std::string why = DescribeSingular(model, dofs, state.config, step.singular_matrix);
       if (!why.empty()) {
@@ -715,8 +864,42 @@ DynamicResult SolveDynamic(const SystemModel& model, DynamicState& state, const 
         return result;
       }
     }
+    if (!step.converged && options.adaptive) {
+      matrix.solver.Invalidate();
+      ++result.newton_cuts;
+      after_rejection = true;
+      if (0.5 * h < control.min_step()) {
+        char buffer[200];
+        std::snprintf(buffer, sizeof buffer, "Newton diverged at t = %.6g with step %.3g (min_step %.3g)", state.t, h,
+                      control.min_step());
+        return fail(buffer);
+      }
+      h *= 0.5;
+      continue;
+    }
+    double error = 0.0;
+    if (options.adaptive) {
+      error = control.Error(state, next, h);
+      if (error > 1.0) {
+        ++result.rejected_by_error;
+        after_rejection = true;
+        const double h_new = h * StepController::Factor(error);
+        if (h_new < control.min_step()) {
+          char buffer[300];
+          std::snprintf(buffer, sizeof buffer,
+                        "the step fell below min_step %.3g at t = %.6g (estimated local error %.3g times "
+                        "step_tolerance with step %.3g)",
+                        control.min_step(), state.t, error, h);
+          return fail(buffer);
+        }
+        h = h_new;
+        continue;
+      }
+      next.t = control.lands() ? control.boundary() : state.t + h;
+    }
     if (!step.converged) {
       matrix.solver.Invalidate();
+      ++result.newton_cuts;
       if (cuts >= options.max_cuts) {
         char buffer[200];
         std::snprintf(buffer, sizeof buffer, "Newton diverged at t = %.6g after %d step cuts (step %.3g)",
@@ -729,19 +912,40 @@ DynamicResult SolveDynamic(const SystemModel& model, DynamicState& state, const 
       ++cuts;
       continue;
     }
-    if (h == options.step) {
-      next.t = t_base + double(++n_nominal) * options.step;
+    bool output = true;
+    if (options.adaptive) {
+      output = control.output();
     } else {
-      t_base = next.t;
-      n_nominal = 0;
+      if (h == options.step) {
+        next.t = t_base + double(++n_nominal) * options.step;
+      } else {
+        t_base = next.t;
+        n_nominal = 0;
+      }
+      if (options.end_time - next.t < 1e-9 * h) next.t = options.end_time;
+      if (options.output_step > 0) {
+        // The first step at or after each output time.
+        const double k = std::floor((next.t - t_output0) / options.output_step + 1e-9);
+        output = k > last_output || next.t >= options.end_time;
+        if (output) last_output = k;
+      }
     }
-    if (options.end_time - next.t < 1e-9 * h) next.t = options.end_time;
+    next.h_last = h;
     state = next;
+    if (options.adaptive && control.at_breakpoint()) {
+      // A load or drive jumps or kinks here: restart from the state with the accelerations of the
+      // right limit (as at the start), so no step sees the jump inside it.
+      ApplyPrescribed(model, dofs, state.t, state.config, &state.W, &state.Wdot);
+      ConsistentAccelerations(model, dofs, state);
+      state.h_last = 0.0;
+    }
     result.steps += 1;
     result.newton_iterations += step.iterations;
     DynamicStepReport r = MeasureWith(model, dofs, state, step.passes);
     r.h = h;
     r.iterations = step.iterations;
+    r.rejected = result.rejected_by_error + result.newton_cuts;
+    r.output = output;
     if (on_step) on_step(r, state);
     const double energy = r.kinetic_energy + r.elastic_energy;
     energy_scale = std::max({energy_scale, std::abs(energy), std::abs(state.external_work), std::abs(state.drive_work)});
@@ -765,7 +969,10 @@ DynamicResult SolveDynamic(const SystemModel& model, DynamicState& state, const 
       if (!warned) result.warnings.push_back(buffer);
       warned = true;
     }
-    if (cuts > 0 && step.iterations <= 4) {
+    if (options.adaptive) {
+      h = control.Accept(state, h, error, after_rejection);
+      after_rejection = false;
+    } else if (cuts > 0 && step.iterations <= 4) {
       h = std::min(options.step, 2 * h);
       --cuts;
     }

@@ -8,7 +8,10 @@
 //   the momentum balance over the step at the mid configuration, node rotations advanced by the
 //   mean convected angular velocity. Conserves linear and angular momentum exactly for free
 //   systems (flexible ones too) and, for rigid bodies, the kinetic energy; no numerical damping.
-// Both cut the step when Newton diverges.
+// Both cut the step when Newton diverges. Steps are fixed, or error-controlled (`adaptive`):
+// the local error of positions and velocities is estimated from the accelerations of the steps
+// taken (dynamic_analysis.cpp, "Error-controlled steps") and kept below step_tolerance of the
+// model's motion; steps land on the kinks and jumps of the loads and drives and on output times.
 #pragma once
 
 #include <functional>
@@ -41,6 +44,17 @@ struct DynamicOptions {
   /// body at omega h = 0.04, at ~4x the assembly time; off by default.
   bool full_inertia_tangent = false;
   int reuse_max_iterations = 6;
+  /// Error-controlled steps: `step` is the first step; each later one is chosen so that the
+  /// estimated local error stays below step_tolerance times the motion scale (positions: the
+  /// largest node travel so far, at least 1e-3 of the model's size; velocities: the largest
+  /// velocity so far), within [min_step, max_step]. A step below min_step is a failure.
+  bool adaptive = false;
+  double step_tolerance = 3e-4;
+  double min_step = 0.0;     ///< 0: 1e-8 of the analysed time span
+  double max_step = 0.0;     ///< 0: 1/100 of the analysed time span
+  double output_step = 0.0;  ///< > 0: DynamicStepReport::output marks the steps at its multiples
+                             ///< (adaptive steps land on them; fixed steps: the first at or after)
+  std::vector<double> breakpoints;  ///< adaptive steps land on these times (kinks and jumps of loads, drives)
   /// Threads for the bodies' forces and matrices (generalized-alpha; solver/parallel.h). The
   /// results are the same bits for any number.
   int threads = 1;
@@ -58,12 +72,15 @@ struct DynamicState {
   /// (the residual on the prescribed coordinates at convergence) times their increments.
   double drive_work = 0.0;
   Eigen::VectorXd f_drive;
+  double h_last = 0.0;  ///< the step that reached this state (0 at the start)
 };
 
 struct DynamicStepReport {
   double t = 0.0;
   double h = 0.0;
   int iterations = 0;
+  long rejected = 0;    ///< steps rejected so far (error test and Newton failures)
+  bool output = true;   ///< at an output time (DynamicOptions::output_step)
   double kinetic_energy = 0.0, elastic_energy = 0.0, external_work = 0.0;
   Eigen::Vector3d linear_momentum = Eigen::Vector3d::Zero();
   Eigen::Vector3d angular_momentum = Eigen::Vector3d::Zero();
@@ -74,6 +91,8 @@ struct DynamicResult {
   std::string message;
   std::vector<std::string> warnings;  ///< said once each (energy growth below the stop limit)
   long steps = 0;
+  long rejected_by_error = 0;  ///< adaptive steps: tried and rejected by the error test
+  long newton_cuts = 0;        ///< steps cut because Newton diverged
   long newton_iterations = 0;
   long factorizations = 0;  ///< of the iteration matrix
 };

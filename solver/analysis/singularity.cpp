@@ -53,9 +53,8 @@ std::string DescribeSingular(const SystemModel& model, const DofMap& dofs, const
   for (int i = 0; i < n; ++i) rank_deficiency += sigma[i] <= 1e-9 * sigma[0];
 
   // The model's size: rotations times it compare with translations.
-  Eigen::Vector3d lo = Eigen::Vector3d::Constant(HUGE_VAL), hi = -lo;
-  for (const Eigen::Vector3d& x : state.x) lo = lo.cwiseMin(x), hi = hi.cwiseMax(x);
-  const double size = model.n_nodes() > 1 && (hi - lo).norm() > 0 ? (hi - lo).norm() : 1.0;
+  const double diagonal = BoundingDiagonal(state.x);
+  const double size = diagonal > 0 ? diagonal : 1.0;
   struct Part {
     double weight;
     std::string text;

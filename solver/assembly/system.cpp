@@ -525,10 +525,15 @@ std::string RoundOffToleranceWarning(double tolerance) {
   return buffer;
 }
 
-Eigen::VectorXd ResidualWeights(const SystemModel& model, const DofMap& dofs) {
+double BoundingDiagonal(const std::vector<Eigen::Vector3d>& points) {
+  if (points.size() < 2) return 0.0;
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(HUGE_VAL), hi = -lo;
-  for (const Eigen::Vector3d& x : model.node_x0) lo = lo.cwiseMin(x), hi = hi.cwiseMax(x);
-  double L = model.n_nodes() > 1 ? (hi - lo).norm() : 0.0;
+  for (const Eigen::Vector3d& x : points) lo = lo.cwiseMin(x), hi = hi.cwiseMax(x);
+  return (hi - lo).norm();
+}
+
+Eigen::VectorXd ResidualWeights(const SystemModel& model, const DofMap& dofs) {
+  double L = BoundingDiagonal(model.node_x0);
   if (!(L > 0)) L = 1.0;
   Eigen::VectorXd w = Eigen::VectorXd::Ones(dofs.n_dofs());
   for (int k = 0; k < model.n_nodes(); ++k) {

@@ -263,6 +263,10 @@ Eigen::MatrixXd DenseFreeMatrix(const DofMap& dofs, const SystemMatrix& S);
 /// (empty when the tolerance is fine).
 std::string RoundOffToleranceWarning(double tolerance);
 
+/// The diagonal of the bounding box of points (node positions): the model's size; 0 for fewer
+/// than two points.
+double BoundingDiagonal(const std::vector<Eigen::Vector3d>& points);
+
 /// Weights that make a vector over the coordinates (a residual) a vector of forces whatever the
 /// unit system: 1 for translation coordinates, 1/L for rotation coordinates (moments over the
 /// model's size L: the diagonal of its nodes' bounding box), sqrt(m_b) for body b's modal

@@ -43,6 +43,13 @@ ResultsRecorder::ResultsRecorder(const Scene& scene, const std::string& director
   const double outputs = a.type == "dynamic" ? a.end_time / (a.step * std::max(a.output_every, 1)) : double(a.steps);
   animation_every_ = scene.spec.animation_every > 0 ? scene.spec.animation_every
                                                     : std::max(1, int(std::ceil(outputs / kAutoFrames)));
+  // Error-controlled steps: how many there will be is not known; a frame per end_time / 500
+  // (the first output at or after each such time), or every output step of output_step.
+  if (a.type == "dynamic" && a.adaptive_step && scene.spec.animation_every == 0) {
+    animation_every_ = 1;
+    frame_interval_ = a.end_time / kAutoFrames;
+    if (a.output_step > 0) frame_interval_ = std::max(frame_interval_, a.output_step);
+  }
   std::error_code ec;
   std::filesystem::create_directories(directory, ec);
   if (ec) throw InputError(directory + ": cannot create output folder (" + ec.message() + ")");
@@ -133,7 +140,12 @@ void ResultsRecorder::Record(double t, const SystemState& state, const Eigen::Ve
   }
   joints_.push_back(Eigen::Map<Eigen::VectorXd>(joint_values.data(), long(joint_values.size())));
   frames_.push_back(frames);
-  if (scene_.spec.animation && (time_.size() - 1) % size_t(animation_every_) == 0) {
+  bool frame = (time_.size() - 1) % size_t(animation_every_) == 0;
+  if (frame_interval_ > 0) {
+    frame = t >= next_frame_time_ - 1e-9 * frame_interval_;
+    if (frame) next_frame_time_ = (std::floor(t / frame_interval_ + 1e-9) + 1) * frame_interval_;
+  }
+  if (scene_.spec.animation && frame) {
     std::vector<Eigen::MatrixXf> meshes, deformations;
     for (size_t b = 0; b < model.bodies.size(); ++b) {
       const auto& mesh = scene_.meshes[b];
@@ -210,6 +222,14 @@ void ResultsRecorder::Finish(const std::string& status) {
     w.Attribute("/", "status", status);
     w.Attribute("/", "units", scene_.spec.units);
     w.Vector("/time", Eigen::Map<const Eigen::VectorXd>(time_.data(), long(time_.size())));
+    if (steps_taken_ >= 0) {
+      w.Attribute("/", "steps", steps_taken_);
+      w.Attribute("/", "rejected_steps_error", rejected_by_error_);
+      w.Attribute("/", "rejected_steps_newton", newton_cuts_);
+    }
+    if (step_size_.size() == time_.size()) {
+      w.Vector("/step_size", Eigen::Map<const Eigen::VectorXd>(step_size_.data(), long(step_size_.size())));
+    }
     w.CreateGroup("/nodes");
     w.Strings("/nodes/names", model.node_names);
     w.Matrix("/nodes/position", Stack(positions_, 3 * n));

@@ -26,6 +26,13 @@ class ResultsRecorder {
               double external_work, const Eigen::Vector3d& linear_momentum = Eigen::Vector3d::Zero(),
               const Eigen::Vector3d& angular_momentum = Eigen::Vector3d::Zero(),
               const std::vector<Eigen::Matrix<double, 6, 1>>* reactions = nullptr);
+  /// The step that reached the last recorded state (dynamic analyses; 0 for the initial state):
+  /// /step_size in results.h5.
+  void RecordStepSize(double h) { step_size_.push_back(h); }
+  /// Steps taken and rejected over the run: attributes of results.h5.
+  void StepCounts(long taken, long rejected_by_error, long newton_cuts) {
+    steps_taken_ = taken, rejected_by_error_ = rejected_by_error, newton_cuts_ = newton_cuts;
+  }
   /// Writes results.h5 and renames both files into place. `status` is stored ("completed" or the
   /// failure message).
   void Finish(const std::string& status);
@@ -36,6 +43,10 @@ class ResultsRecorder {
  private:
   const Scene& scene_;
   int animation_every_ = 1;  ///< one animation frame per this many output steps (spec, or auto)
+  double frame_interval_ = 0;  ///< > 0: one animation frame per this much time (auto, with step: auto)
+  double next_frame_time_ = 0;
+  std::vector<double> step_size_;
+  long steps_taken_ = -1, rejected_by_error_ = 0, newton_cuts_ = 0;
   std::string directory_, csv_path_, h5_path_, csv_tmp_;
   std::ofstream csv_;
   std::vector<double> time_, kinetic_, elastic_, work_;

@@ -234,12 +234,8 @@ Scene BuildScene(const SceneSpec& spec) {
                                          model.node_R0[parent], model.node_x0[child], model.node_R0[child]));
     model.motion[child] = Eigen::MatrixXd(6, 0);
   }
-  double scene_length = 0.0;  // the bounding box diagonal of the nodes: the scale of position tolerances
-  {
-    Eigen::Vector3d lo = Eigen::Vector3d::Constant(HUGE_VAL), hi = -lo;
-    for (const Eigen::Vector3d& x : model.node_x0) lo = lo.cwiseMin(x), hi = hi.cwiseMax(x);
-    if (model.n_nodes() > 1) scene_length = (hi - lo).norm();
-  }
+  // The bounding box diagonal of the nodes: the scale of position tolerances.
+  const double scene_length = BoundingDiagonal(model.node_x0);
   for (const SceneJointSpec& j : spec.joints) {
     const int k = scene.node_index.at(j.node);
     if (!j.parent.empty()) {

@@ -1,0 +1,152 @@
+// Error-controlled time steps (DynamicOptions::adaptive): the error against a converged
+// fixed-step run falls with the tolerance, with fewer steps than that run; steps land on load
+// breakpoints and output times; a step that would fall below min_step stops the run.
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+#include <cmath>
+#include <cstdio>
+
+#include "solver/analysis/dynamic_analysis.h"
+#include "test_util.h"
+
+namespace femb {
+namespace {
+
+Superelement Tube() {
+  return test::Reduce(
+      "name: tube\ntype: beam\nmaterial: {E: 70.0e9, nu: 0.3, rho: 2700}\n"
+      "section: {shape: tube, outer_radius: 0.01, wall: 0.001}\n"
+      "beam:\n  points: {A: [0, 0, 0], B: [1, 0, 0]}\n  segments: [{from: A, to: B, elements: 10}]\n"
+      "interfaces: [{name: A}, {name: B}]\nreduction: {internal_modes: 2}\n");
+}
+
+// A tube clamped at A, its tip B pushed sideways by 10 N from t = 2 ms to 6 ms (a pulse: two
+// breakpoints), ringing at about 8 Hz (period 0.12 s) for 0.1 s.
+constexpr double kPulseOn = 2e-3, kPulseOff = 6e-3, kEnd = 0.1;
+SystemModel PushedTube(const Superelement& se) {
+  SystemModel model;
+  AddNode(model, "A", Eigen::Vector3d::Zero());
+  AddNode(model, "B", Eigen::Vector3d(1, 0, 0));
+  Clamp(model, 0);
+  model.bodies.emplace_back(se, SuperelementOptions{});
+  model.body_nodes.push_back({0, 1});
+  NodeLoad pulse;
+  pulse.node = 1;
+  pulse.force = Eigen::Vector3d(0, 10.0, 0);
+  pulse.scale = [](double t) { return t >= kPulseOn && t < kPulseOff ? 1.0 : 0.0; };
+  model.loads.push_back(pulse);
+  return model;
+}
+
+struct History {
+  std::vector<double> t, y;
+  DynamicResult result;
+  double Interpolate(double at) const {
+    auto it = std::lower_bound(t.begin(), t.end(), at);
+    if (it == t.begin()) return y.front();
+    if (it == t.end()) return y.back();
+    const size_t i = size_t(it - t.begin());
+    return y[i - 1] + (y[i] - y[i - 1]) * (at - t[i - 1]) / (t[i] - t[i - 1]);
+  }
+};
+
+History Simulate(const SystemModel& model, DynamicOptions options) {
+  options.end_time = kEnd;
+  options.breakpoints = {kPulseOn, kPulseOff};
+  History h;
+  h.t.push_back(0.0);
+  h.y.push_back(0.0);
+  DynamicState s = InitialDynamicState(model, InitialState(model), Eigen::VectorXd::Zero(DofMap(model).n_dofs()));
+  h.result = SolveDynamic(model, s, options, [&](const DynamicStepReport& r, const DynamicState& st) {
+    h.t.push_back(r.t);
+    h.y.push_back(st.config.x[1].y());
+  });
+  return h;
+}
+
+// RMS of the tip deflection's difference from the reference over the run, over the reference's peak.
+double RelativeError(const History& run, const History& reference) {
+  double sum = 0, peak = 0;
+  for (double y : reference.y) peak = std::max(peak, std::abs(y));
+  for (size_t i = 0; i < run.t.size(); ++i) sum += std::pow(run.y[i] - reference.Interpolate(run.t[i]), 2);
+  return std::sqrt(sum / double(run.t.size())) / peak;
+}
+
+void ErrorFallsWithTheTolerance(Integrator integrator) {
+  const Superelement se = Tube();
+  const SystemModel model = PushedTube(se);
+  DynamicOptions fixed;
+  fixed.integrator = integrator;
+  fixed.rho_inf = 0.9;
+  fixed.step = 2.5e-6;  // reference: 40 000 fixed steps, landing on both breakpoints
+  const History reference = Simulate(model, fixed);
+  ASSERT_TRUE(reference.result.ok) << reference.result.message;
+  double last_error = HUGE_VAL;
+  for (double tolerance : {1e-2, 1e-3, 1e-4}) {
+    DynamicOptions options = fixed;
+    options.adaptive = true;
+    options.step = 1e-5;
+    options.step_tolerance = tolerance;
+    const History run = Simulate(model, options);
+    ASSERT_TRUE(run.result.ok) << run.result.message;
+    const double error = RelativeError(run, reference);
+    std::printf("[ info ] %s, step_tolerance %g: %ld steps (%ld rejected), RMS error %.3g of the peak\n",
+                integrator == Integrator::kMidpoint ? "midpoint" : "generalized-alpha", tolerance, run.result.steps,
+                run.result.rejected_by_error, error);
+    EXPECT_LT(error, last_error);  // converges with the tolerance
+    last_error = error;
+    // Every breakpoint is a step boundary (to round-off).
+    for (double b : {kPulseOn, kPulseOff}) {
+      double nearest = HUGE_VAL;
+      for (double t : run.t) nearest = std::min(nearest, std::abs(t - b));
+      EXPECT_LT(nearest, 1e-15) << "breakpoint " << b;
+    }
+    EXPECT_DOUBLE_EQ(run.t.back(), kEnd);
+    EXPECT_LT(run.result.steps, reference.result.steps / 4);
+  }
+  // The tightest tolerance: the ringing within 0.5% of its peak, RMS over the run.
+  EXPECT_LT(last_error, 5e-3);
+}
+
+TEST(AdaptiveSteps, GeneralizedAlphaErrorFallsWithTheTolerance) { ErrorFallsWithTheTolerance(Integrator::kGeneralizedAlpha); }
+
+TEST(AdaptiveSteps, MidpointErrorFallsWithTheTolerance) { ErrorFallsWithTheTolerance(Integrator::kMidpoint); }
+
+TEST(AdaptiveSteps, OutputTimesAreStepBoundaries) {
+  const Superelement se = Tube();
+  const SystemModel model = PushedTube(se);
+  DynamicOptions options;
+  options.adaptive = true;
+  options.step = 1e-5;
+  options.output_step = 2e-3;
+  options.end_time = kEnd;
+  std::vector<double> outputs;
+  long steps = 0;
+  DynamicState s = InitialDynamicState(model, InitialState(model), Eigen::VectorXd::Zero(DofMap(model).n_dofs()));
+  const DynamicResult r = SolveDynamic(model, s, options, [&](const DynamicStepReport& report, const DynamicState&) {
+    ++steps;
+    if (report.output) outputs.push_back(report.t);
+  });
+  ASSERT_TRUE(r.ok) << r.message;
+  ASSERT_EQ(outputs.size(), 50u);
+  for (size_t k = 0; k < outputs.size(); ++k) EXPECT_NEAR(outputs[k], double(k + 1) * 2e-3, 1e-15);
+  EXPECT_GT(steps, 50);  // the error, not the output grid, sets the steps
+}
+
+TEST(AdaptiveSteps, StepBelowMinStepStopsWithTheTimeAndTheError) {
+  const Superelement se = Tube();
+  const SystemModel model = PushedTube(se);
+  DynamicOptions options;
+  options.adaptive = true;
+  options.step = 1e-3;
+  options.min_step = 5e-4;  // the pulse needs far shorter steps at 1e-6
+  options.step_tolerance = 1e-6;
+  const History run = Simulate(model, options);
+  ASSERT_FALSE(run.result.ok);
+  EXPECT_NE(run.result.message.find("below min_step"), std::string::npos) << run.result.message;
+  EXPECT_GT(run.t.size(), 1u);  // the steps before it were kept (reported)
+}
+
+}  // namespace
+}  // namespace femb
