@@ -261,6 +261,28 @@ assert float(rows[0]['kinetic_energy']) > 0, rows[0]['kinetic_energy']" && ok ||
   && cmp -s "$work/pend_t1/probes.csv" "$work/pend_t2/probes.csv" && ok || fail "--threads 1 and 2 differ"
 "$bin/femb-solve" -q "$work/pend/rate.yaml" -o "$work/pend_t0" --threads 0 2> "$work/err.txt"; [ $? = 2 ] \
   && grep -q "^femb-solve: --threads 0: expected a whole number from 1 to 1024$" "$work/err.txt" && ok || fail "--threads 0: $(cat "$work/err.txt")"
+# Error-controlled steps (step: auto): results at every output_step exactly, the step sizes and
+# the rejected steps in results.h5 and in the log; bad settings are one line, exit 2; a step that
+# must fall below min_step stops with exit 3, results kept.
+"$bin/femb-solve" "$work/pend/rate.yaml" -o "$work/pend_auto" --set analysis.end_time=0.2 --set analysis.step=auto \
+  --set analysis.output_step=0.01 --threads 1 > "$work/auto.txt" && grep -q "steps rejected (.* by the error test" "$work/auto.txt" \
+  && ok || fail "step: auto: $(tail -3 "$work/auto.txt")"
+$py - "$work/pend_auto" <<'PY' && ok || fail "step: auto: results.h5"
+import sys, h5py, numpy as np
+f = h5py.File(sys.argv[1] + "/results.h5")
+t, h = f["time"][:], f["step_size"][:]
+assert len(t) == 21 and np.abs(t - 0.01 * np.arange(21)).max() < 1e-15, t
+assert f.attrs["steps"] > 20 and f.attrs["rejected_steps_error"] >= 0 and f.attrs["rejected_steps_newton"] >= 0
+assert h[0] == 0 and (h[1:] > 0).all() and (h[1:] <= 0.01 + 1e-15).all(), h
+PY
+"$bin/femb-solve" -q "$work/pend/rate.yaml" -o "$work/pend_auto_bad" --set analysis.step=auto --set analysis.min_step=0.1 \
+  --set analysis.max_step=0.01 2> "$work/err.txt"; [ $? = 2 ] && grep -q "analysis.min_step.*min_step 0.1 is above max_step 0.01" "$work/err.txt" \
+  && [ $(wc -l < "$work/err.txt") = 1 ] && ok || fail "min_step > max_step: $(cat "$work/err.txt")"
+"$bin/femb-solve" -q "$work/pend/rate.yaml" -o "$work/pend_auto_bad" --set analysis.step=auto --set analysis.step_tolerance=0 \
+  2> "$work/err.txt"; [ $? = 2 ] && grep -q "step_tolerance" "$work/err.txt" && ok || fail "step_tolerance 0: $(cat "$work/err.txt")"
+"$bin/femb-solve" -q "$work/pend/rate.yaml" -o "$work/pend_auto_min" --set analysis.step=auto --set analysis.min_step=0.005 \
+  --set analysis.step_tolerance=1e-9 2> "$work/err.txt"; [ $? = 3 ] && grep -q "the step fell below min_step 0.005 at t = " "$work/err.txt" \
+  && [ -s "$work/pend_auto_min/results.h5" ] && ok || fail "below min_step: $(cat "$work/err.txt")"
 printf 'initial_velocity:\n  pivot_rod: {joint: [2.0, 1.0]}\n' | cat "$work/pend/scene.yaml" - > "$work/pend/bad_rate.yaml"
 "$bin/femb-solve" -q "$work/pend/bad_rate.yaml" -o "$work/pend_bad" 2> "$work/err.txt"; [ $? = 2 ] && grep -q "has 1 joint coordinates, got 2 joint rates" "$work/err.txt" && ok || fail "bad joint rates: $(cat "$work/err.txt")"
 # Mode shapes as VTU: one file per reduced coordinate; quadratic tetrahedra in VTK node order
