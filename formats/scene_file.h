@@ -87,11 +87,11 @@ struct SceneAnalysisSpec {
   int steps = 10;               ///< static: load steps over [0, end_time]
   double step = 1e-3;           ///< dynamic: time step (the first one with step: auto)
   /// dynamic, `step: auto`: error-controlled steps (solver/analysis/dynamic_analysis.h,
-  /// DynamicOptions): the local error of positions and velocities relative to the model's motion
-  /// below step_tolerance, steps within [min_step, max_step] (0: defaults from end_time), results
+  /// DynamicOptions): the local error of the positions relative to the model's motion below
+  /// step_tolerance, steps within [min_step, max_step] (0: defaults from end_time), results
   /// at every output_step (0: at every step taken).
   bool adaptive_step = false;
-  double step_tolerance = 3e-4;
+  double step_tolerance = 1e-5;
   double min_step = 0.0, max_step = 0.0, output_step = 0.0;
   double rho_inf = 0.9;
   /// dynamic: generalized_alpha (numerical damping by rho_inf) or midpoint (momentum-conserving,

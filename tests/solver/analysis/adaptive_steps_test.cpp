@@ -83,7 +83,7 @@ void ErrorFallsWithTheTolerance(Integrator integrator) {
   const History reference = Simulate(model, fixed);
   ASSERT_TRUE(reference.result.ok) << reference.result.message;
   double last_error = HUGE_VAL;
-  for (double tolerance : {1e-2, 1e-3, 1e-4}) {
+  for (double tolerance : {1e-3, 1e-4, 1e-5}) {
     DynamicOptions options = fixed;
     options.adaptive = true;
     options.step = 1e-5;
@@ -105,8 +105,9 @@ void ErrorFallsWithTheTolerance(Integrator integrator) {
     EXPECT_DOUBLE_EQ(run.t.back(), kEnd);
     EXPECT_LT(run.result.steps, reference.result.steps / 4);
   }
-  // The tightest tolerance: the ringing within 0.5% of its peak, RMS over the run.
-  EXPECT_LT(last_error, 5e-3);
+  // The tightest tolerance (1e-5, the default): the ringing within 0.2% of its peak, RMS over the
+  // run (measured 0.105% generalized-alpha, 0.094% midpoint, with 13% of the reference's steps).
+  EXPECT_LT(last_error, 2e-3);
 }
 
 TEST(AdaptiveSteps, GeneralizedAlphaErrorFallsWithTheTolerance) { ErrorFallsWithTheTolerance(Integrator::kGeneralizedAlpha); }
