@@ -19,3 +19,7 @@ mkdir -p out
 echo
 # Modal derivatives: error vs run time on the cross-flexure pivot (about 2 minutes).
 /usr/bin/python3 benchmarks/flexure_error_vs_time.py build/bin --png out/flexure_error_vs_time.png
+echo
+# Fixed vs error-controlled steps (step: auto) on every dynamic seed case (about 10 minutes once
+# the examples' references exist in build/example_out, e.g. after ctest; else they are run first).
+/usr/bin/python3 benchmarks/step_control.py build/bin
