@@ -13,67 +13,88 @@
 namespace femb {
 
 double TimeFunctionSpec::Evaluate(double t) const {
-  if (type == "linear") return value * t;
-  if (type == "constant") return value;
-  if (type == "ramp") {
-    if (t <= t_start) return 0.0;
-    if (t >= t_end) return value;
-    return value * (t - t_start) / (t_end - t_start);
+  switch (type) {
+    case TimeFunctionType::kLinear:
+      return value * t;
+    case TimeFunctionType::kConstant:
+      return value;
+    case TimeFunctionType::kRamp:
+      if (t <= t_start) return 0.0;
+      if (t >= t_end) return value;
+      return value * (t - t_start) / (t_end - t_start);
+    case TimeFunctionType::kStep:
+      return t >= t_start ? value : 0.0;
+    case TimeFunctionType::kPulse:
+      return (t >= t_start && t < t_end) ? value : 0.0;
+    case TimeFunctionType::kSine:
+      return offset + amplitude * std::sin(2 * M_PI * frequency * t + phase);
+    case TimeFunctionType::kSpinUp: {
+      // theta = (w/Ts)(t^2/2 + (Ts/2pi)^2 (cos(2 pi t/Ts) - 1)) for t < Ts, then w (t - Ts/2).
+      const double Ts = t_end, w = value, c = Ts / (2 * M_PI);
+      if (t >= Ts) return w * (t - 0.5 * Ts);
+      return w / Ts * (0.5 * t * t + c * c * (std::cos(t / c) - 1));
+    }
+    case TimeFunctionType::kTable: {
+      if (t <= table.front().first) return table.front().second;
+      if (t >= table.back().first) return table.back().second;
+      auto it = std::upper_bound(table.begin(), table.end(), t, [](double v, const auto& p) { return v < p.first; });
+      const auto& b = *it;
+      const auto& a = *(it - 1);
+      return a.second + (b.second - a.second) * (t - a.first) / (b.first - a.first);
+    }
   }
-  if (type == "step") return t >= t_start ? value : 0.0;
-  if (type == "pulse") return (t >= t_start && t < t_end) ? value : 0.0;
-  if (type == "sine") return offset + amplitude * std::sin(2 * M_PI * frequency * t + phase);
-  if (type == "spin_up") {
-    // theta = (w/Ts)(t^2/2 + (Ts/2pi)^2 (cos(2 pi t/Ts) - 1)) for t < Ts, then w (t - Ts/2).
-    const double Ts = t_end, w = value, c = Ts / (2 * M_PI);
-    if (t >= Ts) return w * (t - 0.5 * Ts);
-    return w / Ts * (0.5 * t * t + c * c * (std::cos(t / c) - 1));
-  }
-  // table
-  if (t <= table.front().first) return table.front().second;
-  if (t >= table.back().first) return table.back().second;
-  auto it = std::upper_bound(table.begin(), table.end(), t, [](double v, const auto& p) { return v < p.first; });
-  const auto& b = *it;
-  const auto& a = *(it - 1);
-  return a.second + (b.second - a.second) * (t - a.first) / (b.first - a.first);
+  return 0.0;
 }
 
 std::vector<double> TimeFunctionSpec::Breakpoints() const {
-  if (type == "ramp" || type == "pulse") return {t_start, t_end};
-  if (type == "step") return {t_start};
-  if (type == "spin_up") return {t_end};
-  if (type == "table") {
-    std::vector<double> out;
-    for (const auto& p : table) out.push_back(p.first);
-    return out;
+  switch (type) {
+    case TimeFunctionType::kRamp:
+    case TimeFunctionType::kPulse:
+      return {t_start, t_end};
+    case TimeFunctionType::kStep:
+      return {t_start};
+    case TimeFunctionType::kSpinUp:
+      return {t_end};
+    case TimeFunctionType::kTable: {
+      std::vector<double> out;
+      for (const auto& p : table) out.push_back(p.first);
+      return out;
+    }
+    default:
+      return {};  // linear, constant, sine: smooth
   }
-  return {};  // linear, constant, sine: smooth
 }
 
 double TimeFunctionSpec::Rate(double t) const {
-  if (type == "linear") return value;
-  if (type == "ramp") return (t >= t_start && t < t_end) ? value / (t_end - t_start) : 0.0;
-  if (type == "sine") return amplitude * 2 * M_PI * frequency * std::cos(2 * M_PI * frequency * t + phase);
-  if (type == "spin_up") {
-    const double Ts = t_end, w = value, c = Ts / (2 * M_PI);
-    return t >= Ts ? w : w / Ts * (t - c * std::sin(t / c));
-  }
-  if (type == "table") {
-    for (size_t i = 1; i < table.size(); ++i) {
-      if (t >= table[i - 1].first && t < table[i].first) {
-        return (table[i].second - table[i - 1].second) / (table[i].first - table[i - 1].first);
-      }
+  switch (type) {
+    case TimeFunctionType::kLinear:
+      return value;
+    case TimeFunctionType::kRamp:
+      return (t >= t_start && t < t_end) ? value / (t_end - t_start) : 0.0;
+    case TimeFunctionType::kSine:
+      return amplitude * 2 * M_PI * frequency * std::cos(2 * M_PI * frequency * t + phase);
+    case TimeFunctionType::kSpinUp: {
+      const double Ts = t_end, w = value, c = Ts / (2 * M_PI);
+      return t >= Ts ? w : w / Ts * (t - c * std::sin(t / c));
     }
+    case TimeFunctionType::kTable:
+      for (size_t i = 1; i < table.size(); ++i) {
+        if (t >= table[i - 1].first && t < table[i].first) {
+          return (table[i].second - table[i - 1].second) / (table[i].first - table[i - 1].first);
+        }
+      }
+      return 0.0;  // outside its range
+    default:
+      return 0.0;  // constant, step, pulse
   }
-  return 0.0;  // constant, step, pulse; table outside its range
 }
 
 double TimeFunctionSpec::Acceleration(double t) const {
-  if (type == "sine") {
+  if (type == TimeFunctionType::kSine) {
     const double w = 2 * M_PI * frequency;
     return -amplitude * w * w * std::sin(w * t + phase);
   }
-  if (type == "spin_up") {
+  if (type == TimeFunctionType::kSpinUp) {
     const double Ts = t_end, w = value, c = Ts / (2 * M_PI);
     return t >= Ts ? 0.0 : w / Ts * (1 - std::cos(t / c));
   }
@@ -86,28 +107,34 @@ TimeFunctionSpec ParseFunction(const YamlValue& value) {
   YamlMap m = value.Map();
   TimeFunctionSpec f;
   YamlValue type = m.Required("type");
-  f.type = type.String();
-  if (f.type == "constant") {
+  const std::string name = type.String();
+  if (name == "constant") {
+    f.type = TimeFunctionType::kConstant;
     f.value = m.Required("value").Number();
-  } else if (f.type == "ramp" || f.type == "pulse") {
+  } else if (name == "ramp" || name == "pulse") {
+    f.type = name == "ramp" ? TimeFunctionType::kRamp : TimeFunctionType::kPulse;
     f.value = m.Required("value").Number();
     f.t_start = m.Required("t_start").Number();
     YamlValue t_end = m.Required("t_end");
     f.t_end = t_end.Number();
     if (!(f.t_end > f.t_start)) t_end.Fail("t_end must be after t_start");
-  } else if (f.type == "step") {
+  } else if (name == "step") {
+    f.type = TimeFunctionType::kStep;
     f.value = m.Required("value").Number();
     f.t_start = m.Required("t_start").Number();
-  } else if (f.type == "sine") {
+  } else if (name == "sine") {
+    f.type = TimeFunctionType::kSine;
     f.amplitude = m.Required("amplitude").Number();
     f.frequency = m.Required("frequency").Number();
     if (auto v = m.Optional("phase")) f.phase = v->Number();
     if (auto v = m.Optional("offset")) f.offset = v->Number();
-  } else if (f.type == "spin_up") {
+  } else if (name == "spin_up") {
+    f.type = TimeFunctionType::kSpinUp;
     f.value = m.Required("omega").Number();
     YamlValue ts = m.Required("t_spin");
     f.t_end = ts.PositiveNumber();
-  } else if (f.type == "table") {
+  } else if (name == "table") {
+    f.type = TimeFunctionType::kTable;
     YamlValue points = m.Required("points");
     for (const YamlValue& p : points.List()) {
       auto pair = p.List();
@@ -118,10 +145,11 @@ TimeFunctionSpec ParseFunction(const YamlValue& value) {
       }
     }
     if (f.table.empty()) points.Fail("a table needs at least one point");
-  } else if (f.type == "linear") {
+  } else if (name == "linear") {
+    f.type = TimeFunctionType::kLinear;
     if (auto v = m.Optional("slope")) f.value = v->Number();
   } else {
-    type.Fail("unknown time function type '" + f.type + "' (known: linear, constant, ramp, step, pulse, sine, table, spin_up)");
+    type.Fail("unknown time function type '" + name + "' (known: linear, constant, ramp, step, pulse, sine, table, spin_up)");
   }
   m.CheckNoUnknownKeys();
   return f;

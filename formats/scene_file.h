@@ -11,8 +11,20 @@
 namespace femb {
 
 /// A scalar function of time (or of the pseudo-time of a static analysis).
+/// The time functions of a scene (SCENE_FORMAT.md `functions`).
+enum class TimeFunctionType {
+  kLinear,    ///< f = slope t
+  kConstant,  ///< f = value
+  kRamp,      ///< 0 before t_start, value after t_end, linear between
+  kStep,      ///< value from t_start on
+  kPulse,     ///< value on [t_start, t_end)
+  kSine,      ///< offset + amplitude sin(2 pi frequency t + phase)
+  kTable,     ///< linear between (t, f) points, constant outside
+  kSpinUp,    ///< smooth spin-up to the rate `value` over t_end, then constant rate
+};
+
 struct TimeFunctionSpec {
-  std::string type = "linear";  ///< linear (f = slope t), constant, ramp, step, pulse, sine, table, spin_up
+  TimeFunctionType type = TimeFunctionType::kLinear;
   double value = 1.0;           ///< constant value; final value of ramp and step
   double t_start = 0.0, t_end = 1.0;  ///< ramp from 0 at t_start to value at t_end; step at t_start
   double amplitude = 0.0, frequency = 0.0, phase = 0.0, offset = 0.0;  ///< sine [Hz]

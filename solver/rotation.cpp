@@ -25,14 +25,16 @@ Eigen::Vector3d LogSO3(const Eigen::Matrix3d& R) {
   const Eigen::Vector3d w(R(2, 1) - R(1, 2), R(0, 2) - R(2, 0), R(1, 0) - R(0, 1));
   if (t < 1e-6) return 0.5 * (1.0 + t * t / 6.0) * w;
   if (M_PI - t > 1e-6) return t / (2.0 * std::sin(t)) * w;
-  // Near pi: axis from the symmetric part, sign from w.
-  const Eigen::Matrix3d B = 0.5 * (R + Eigen::Matrix3d::Identity());
+  // Near pi: axis from the symmetric part (R's antisymmetric part sin(t) a~ would tilt it by
+  // ~(pi - t)), sign from w.
+  const Eigen::Matrix3d B = 0.5 * (0.5 * (R + R.transpose()) + Eigen::Matrix3d::Identity());
   int k;
   B.diagonal().maxCoeff(&k);
   Eigen::Vector3d axis = B.col(k) / std::sqrt(std::max(B(k, k), 1e-300));
   axis.normalize();
   if (axis.dot(w) < 0) axis = -axis;
-  return t * axis;
+  // The angle from atan2(sin, cos): acos of c = -1 + (pi - t)^2 / 2 keeps only sqrt(eps) of it.
+  return std::atan2(0.5 * w.norm(), c) * axis;
 }
 
 Eigen::Matrix3d LeftJacobianInverseTransposeDerivative(const Eigen::Vector3d& theta, const Eigen::Vector3d& v) {

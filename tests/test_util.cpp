@@ -81,3 +81,10 @@ Superelement Reduce(const std::string& yaml, const std::vector<std::string>& ove
 }
 
 }  // namespace femb::test
+
+std::string femb::test::Replace(std::string text, const std::string& from, const std::string& to) {
+  const size_t at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  if (at == std::string::npos) return text;
+  return text.replace(at, from.size(), to);
+}

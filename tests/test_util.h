@@ -25,6 +25,9 @@ Eigen::Vector2d ElasticaTip(double P, double EI, double L);
 /// force on n1.
 SystemModel ClampedOneBodyModel(const Superelement& se, double L, const Eigen::Vector3d& tip_force);
 
+/// `text` with its first `from` replaced by `to`; fails the calling test when `from` is missing.
+std::string Replace(std::string text, const std::string& from, const std::string& to);
+
 /// Parses and reduces; fails the calling test on error.
 Superelement Reduce(const std::string& yaml, const std::vector<std::string>& overrides = {});
 

@@ -25,11 +25,7 @@ const std::string kGood =
     "reduction:\n"                                       // 14
     "  internal_modes: 4\n";                             // 15
 
-std::string Replace(std::string text, const std::string& from, const std::string& to) {
-  const size_t at = text.find(from);
-  EXPECT_NE(at, std::string::npos) << from;
-  return text.replace(at, from.size(), to);
-}
+using test::Replace;
 
 std::string Error(const std::string& text, const std::vector<std::string>& overrides = {}) {
   return test::ThrownMessage([&] { ParsePart(text, "part.yaml", overrides); });

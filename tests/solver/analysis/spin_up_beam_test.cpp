@@ -41,7 +41,7 @@ SpinUpResult SpinUp(double ws, int n_bodies, double end_time) {
   }
   RevoluteToGround(model, 0, Eigen::Vector3d::UnitZ());
   TimeFunctionSpec theta;
-  theta.type = "spin_up";
+  theta.type = TimeFunctionType::kSpinUp;
   theta.value = ws;
   theta.t_end = 15.0;
   SystemModel::Prescribed p;
