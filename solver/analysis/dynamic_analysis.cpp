@@ -6,6 +6,7 @@
 #include <functional>
 
 #include "solver/analysis/singularity.h"
+#include "solver/analysis/step_control.h"
 #include "solver/parallel.h"
 #include "solver/rotation.h"
 
@@ -689,134 +690,6 @@ StepOutcome MidpointStep(const SystemModel& model, const DofMap& dofs, const Dyn
   return out;
 }
 
-
-// ---- Error-controlled steps ------------------------------------------------------------------
-//
-// Local error estimate from the accelerations of the steps taken (Zienkiewicz & Xie 1991 for
-// Newmark's method, here for both integrators): a jerk estimate per coordinate,
-//   j_n+1 = (A_n+1 - A_n) / dt_A
-// with A the accelerations (generalized-alpha: Wdot at t_n and t_n+1, dt_A = h; midpoint: the
-// mean acceleration of each step, at t_n+1/2 and t_n-1/2, dt_A = (h + h_last) / 2), gives the
-// local error of the positions over a step of h
-//   e_q = C_q h^3 j,   C_q = 1/6 - beta - (alpha_m - alpha_f) / 2 (generalized-alpha), 1/12 (midpoint).
-// Generalized-alpha: q_n+1 = q_n + h W_n + h^2 ((1/2 - beta) a_n + beta a_n+1) with the
-// acceleration-like a_n = Wdot(t_n + (alpha_m - alpha_f) h) + O(h^2) (from (1 - alpha_m) a_n+1 +
-// alpha_m a_n = (1 - alpha_f) Wdot_n+1 + alpha_f Wdot_n); Taylor's expansion of q(t_n + h) leaves
-// C_q h^3 q'''. rho_inf = 1 gives -1/12, the trapezoidal rule's constant, which is also the
-// midpoint scheme's (its positions advance by h (W_n + W_n+1) / 2). Velocities are second order
-// (gamma = 1/2 + alpha_f - alpha_m): their local error is third order too, estimated from the
-// change of the jerk,
-//   e_v = C_v h^3 (j_n+1 - j_n) / ((h + h_last) / 2),   C_v = 1/12 (trapezoidal), 1/24 (midpoint rule).
-// The estimates are compared coordinate by coordinate as lengths (e_i / w_i, w the residual
-// weights: rotations times the model's size, modal coordinates over sqrt(mass)) with
-//   step_tolerance * D,
-// D the largest node travel so far (at least 1e-3 of the model's size): a relative error of the
-// motion, so a cantilever that deflects a millimetre is judged against that millimetre, a crank
-// against its stroke. The velocity error enters as what it moves the positions over the next
-// step, h e_v. Judged against a velocity scale of its own (the largest velocity so far), the
-// velocity estimate, a second difference of the accelerations, follows the high modes that the
-// integrator is meant to damp: the rotating beam (seed 5.4, 10 bodies) took 51 018 steps at a
-// tolerance of 1e-3 instead of 576 with positions only, for an error of 0.36% where 8 047 steps
-// give 0.27% this way (benchmarks/step_control.py). The largest ratio E decides: E <= 1 accepts;
-// the next step follows by PI control (Accept; the error goes with h^3; no growth right after a
-// rejection, a rejected step is retried at h clamp(0.9 E^(-1/3), 0.2, 1)). Prescribed
-// coordinates are exact and not judged.
-// Steps land on breakpoints (kinks and jumps of loads and drives), so a jump never falls inside a
-// step; the jerk history restarts after one.
-class StepController {
- public:
-  StepController(const SystemModel& model, const DofMap& dofs, const DynamicOptions& options, double t0)
-      : options_(options), dofs_(dofs), weights_(ResidualWeights(model, dofs)), x0_(model.node_x0), t0_(t0) {
-    const double span = options.end_time - t0;
-    min_step_ = options.min_step > 0 ? options.min_step : 1e-8 * span;
-    max_step_ = options.max_step > 0 ? options.max_step : 0.01 * span;
-    D_ = 1e-3 * std::max(BoundingDiagonal(model.node_x0), 1e-300);
-    if (options.integrator == Integrator::kMidpoint) {
-      c_q_ = 1.0 / 12, c_v_ = 1.0 / 24;
-    } else {
-      const double rho = std::clamp(options.rho_inf, 0.0, 1.0);
-      const double alpha_m = (2 * rho - 1) / (rho + 1), alpha_f = rho / (rho + 1);
-      const double gamma = 0.5 + alpha_f - alpha_m, beta = 0.25 * (gamma + 0.5) * (gamma + 0.5);
-      c_q_ = std::abs(1.0 / 6 - beta - 0.5 * (alpha_m - alpha_f)), c_v_ = 1.0 / 12;
-    }
-    breakpoints_ = options.breakpoints;
-    std::sort(breakpoints_.begin(), breakpoints_.end());
-  }
-  double min_step() const { return min_step_; }
-  double FirstStep() const { return std::clamp(options_.step, min_step_, max_step_); }
-
-  // The step to try from t: h within [min_step, max_step], shortened to land on the next
-  // boundary (end time, breakpoint, output time) or to reach it in two equal steps.
-  double Fit(double t, double h) {
-    h = std::clamp(h, min_step_, max_step_);
-    const double eps = 1e-12 * (options_.end_time - t0_);
-    boundary_ = options_.end_time;
-    bool breakpoint = false;
-    auto after = std::upper_bound(breakpoints_.begin(), breakpoints_.end(), t + eps);
-    if (after != breakpoints_.end() && *after < boundary_ - eps) boundary_ = *after, breakpoint = true;
-    output_ = true;
-    if (options_.output_step > 0) {
-      const double k = std::floor((t + eps - t0_) / options_.output_step) + 1;
-      const double next_output = t0_ + k * options_.output_step;
-      if (next_output < boundary_ - eps) boundary_ = next_output, breakpoint = false;
-      output_ = std::abs(next_output - boundary_) <= eps || boundary_ == options_.end_time;
-    }
-    at_breakpoint_ = breakpoint;
-    lands_ = t + 1.01 * h >= boundary_;
-    if (lands_) return boundary_ - t;
-    if (t + 2 * h > boundary_) return 0.5 * (boundary_ - t);
-    return h;
-  }
-  bool lands() const { return lands_; }
-  bool at_breakpoint() const { return lands_ && at_breakpoint_; }
-  double boundary() const { return boundary_; }
-  bool output() const { return lands_ && output_; }
-
-  // The error ratio E of the step from s0 to s1 (<= 1: accept); keeps the jerk for Accept.
-  double Error(const DynamicState& s0, const DynamicState& s1, double h) {
-    const bool midpoint = options_.integrator == Integrator::kMidpoint;
-    const double dt_A = midpoint ? 0.5 * (h + s0.h_last) : h;
-    jerk_ = midpoint ? Eigen::VectorXd((s1.a - s0.a) / dt_A) : Eigen::VectorXd((s1.Wdot - s0.Wdot) / dt_A);
-    const bool with_velocity = jerk_prev_.size() == jerk_.size();
-    const double h3 = h * h * h, tol_q = options_.step_tolerance * D_;
-    double E = 0.0;
-    for (int i : dofs_.solved()) {
-      E = std::max(E, c_q_ * h3 * std::abs(jerk_[i]) / weights_[i] / tol_q);
-      if (with_velocity) {
-        const double snap = (jerk_[i] - jerk_prev_[i]) / (0.5 * (h + s0.h_last));
-        E = std::max(E, c_v_ * h3 * h * std::abs(snap) / weights_[i] / tol_q);
-      }
-    }
-    return std::isfinite(E) ? E : HUGE_VAL;
-  }
-
-  // The next step after an accepted one with error ratio E; updates the motion scales.
-  double Accept(const DynamicState& s1, double h, double E, bool after_rejection) {
-    jerk_prev_ = at_breakpoint() ? Eigen::VectorXd() : jerk_;
-    for (size_t k = 0; k < x0_.size(); ++k) D_ = std::max(D_, (s1.config.x[k] - x0_[k]).norm());
-    // PI control (Gustafsson 1991; Hairer & Wanner II, IV.2): the exponents 0.7/3 and 0.4/3 of
-    // this and the last accepted error ratio damp the step's oscillation that pure
-    // E^(-1/3) control shows on the estimate's step-to-step scatter. Measured on the 2D
-    // slider-crank (4 bodies): 30% of the steps tried were rejected with E^(-1/3), 2.5% with PI,
-    // at the same error per step tried.
-    const double f = E_prev_ > 0 && E > 0 ? std::clamp(0.9 * std::pow(E, -0.7 / 3) * std::pow(E_prev_, 0.4 / 3), 0.2, 2.0)
-                                          : Factor(E);
-    E_prev_ = std::max(E, 1e-4);
-    return h * std::min(after_rejection ? 1.0 : 2.0, f);
-  }
-  static double Factor(double E) { return E > 0 ? std::clamp(0.9 * std::cbrt(1.0 / E), 0.2, 2.0) : 2.0; }
-
- private:
-  const DynamicOptions& options_;
-  const DofMap& dofs_;
-  Eigen::VectorXd weights_, jerk_, jerk_prev_;
-  std::vector<Eigen::Vector3d> x0_;
-  double t0_ = 0;
-  std::vector<double> breakpoints_;
-  double min_step_ = 0, max_step_ = 0, D_ = 0, c_q_ = 0, c_v_ = 0, boundary_ = 0;
-  bool lands_ = false, output_ = true, at_breakpoint_ = false;
-  double E_prev_ = 0;
-};
 
 }  // namespace
 
