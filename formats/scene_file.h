@@ -97,7 +97,7 @@ struct SceneAnalysisSpec {
   bool modes_about_static = false;  ///< modes: about the static state under the loads at end_time
   double end_time = 1.0;
   int steps = 10;               ///< static: load steps over [0, end_time]
-  double step = 1e-3;           ///< dynamic: time step (the first one with step: auto)
+  double step = 1e-3;           ///< dynamic: time step (unused with step: auto)
   /// dynamic, `step: auto`: error-controlled steps (solver/analysis/dynamic_analysis.h,
   /// DynamicOptions): the local error of the positions relative to the model's motion below
   /// step_tolerance, steps within [min_step, max_step] (0: defaults from end_time), results

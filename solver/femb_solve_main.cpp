@@ -217,6 +217,7 @@ int main(int argc, char** argv) {
       options.full_inertia_tangent = spec.analysis.gyroscopic_tangent;
       options.threads = threads;
       options.adaptive = spec.analysis.adaptive_step;
+      if (options.adaptive) options.step = 1e-4 * spec.analysis.end_time;  // the first step tried
       options.step_tolerance = spec.analysis.step_tolerance;
       options.min_step = spec.analysis.min_step;
       options.max_step = spec.analysis.max_step;
