@@ -844,9 +844,9 @@ DynamicResult SolveDynamic(const SystemModel& model, DynamicState& state, const 
       char buffer[400];
       std::snprintf(buffer, sizeof buffer,
                     "the energy grew by %.3g (%.1f%% of %.3g) at t = %.6g beyond the work of the loads and drives: "
-                    "numerically unstable at step %.3g; reduce analysis.step%s",
+                    "numerically unstable at step %.3g; reduce analysis.%s%s",
                     growth, 100 * growth / energy_scale, energy_scale, state.t, h,
-                    options.integrator == Integrator::kGeneralizedAlpha ? " or analysis.rho_inf" : "");
+                    options.adaptive ? "step_tolerance" : "step", options.integrator == Integrator::kGeneralizedAlpha ? " or analysis.rho_inf" : "");
       if (growth > kEnergyStop * energy_scale) {
         result.message = buffer;
         result.factorizations = matrix.factorizations;

@@ -81,7 +81,7 @@ void ErrorFallsWithTheTolerance(Integrator integrator) {
   DynamicOptions fixed;
   fixed.integrator = integrator;
   fixed.rho_inf = 0.9;
-  fixed.step = 2.5e-6;  // reference: 40 000 fixed steps, landing on both breakpoints
+  fixed.step = 5e-6;  // reference: 20 000 fixed steps, landing on both breakpoints
   const History reference = Simulate(model, fixed);
   ASSERT_TRUE(reference.result.ok) << reference.result.message;
   double last_error = HUGE_VAL;
@@ -105,10 +105,10 @@ void ErrorFallsWithTheTolerance(Integrator integrator) {
       EXPECT_LT(nearest, 1e-15) << "breakpoint " << b;
     }
     EXPECT_DOUBLE_EQ(run.t.back(), kEnd);
-    EXPECT_LT(run.result.steps, reference.result.steps / 4);
+    EXPECT_LT(run.result.steps, reference.result.steps / 3);
   }
   // The tightest tolerance (1e-5, the default): the ringing within 0.2% of its peak, RMS over the
-  // run (measured 0.105% generalized-alpha, 0.094% midpoint, with 13% of the reference's steps).
+  // run (measured 0.106% generalized-alpha, 0.089% midpoint, with 26% of the reference's steps).
   EXPECT_LT(last_error, 2e-3);
 }
 
