@@ -690,7 +690,6 @@ StepOutcome MidpointStep(const SystemModel& model, const DofMap& dofs, const Dyn
   return out;
 }
 
-
 }  // namespace
 
 DynamicResult SolveDynamic(const SystemModel& model, DynamicState& state, const DynamicOptions& options,
@@ -790,9 +789,7 @@ DynamicResult SolveDynamic(const SystemModel& model, DynamicState& state, const 
         char buffer[200];
         std::snprintf(buffer, sizeof buffer, "Newton diverged at t = %.6g after %d step cuts (step %.3g)",
                       state.t, cuts, h);
-        result.message = buffer;
-        result.factorizations = matrix.factorizations;
-        return result;
+        return fail(buffer);
       }
       h *= 0.5;
       ++cuts;
@@ -846,12 +843,9 @@ DynamicResult SolveDynamic(const SystemModel& model, DynamicState& state, const 
                     "the energy grew by %.3g (%.1f%% of %.3g) at t = %.6g beyond the work of the loads and drives: "
                     "numerically unstable at step %.3g; reduce analysis.%s%s",
                     growth, 100 * growth / energy_scale, energy_scale, state.t, h,
-                    options.adaptive ? "step_tolerance" : "step", options.integrator == Integrator::kGeneralizedAlpha ? " or analysis.rho_inf" : "");
-      if (growth > kEnergyStop * energy_scale) {
-        result.message = buffer;
-        result.factorizations = matrix.factorizations;
-        return result;
-      }
+                    options.adaptive ? "step_tolerance" : "step",
+                    options.integrator == Integrator::kGeneralizedAlpha ? " or analysis.rho_inf" : "");
+      if (growth > kEnergyStop * energy_scale) return fail(buffer);
       if (!warned) result.warnings.push_back(buffer);
       warned = true;
     }
