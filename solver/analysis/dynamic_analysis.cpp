@@ -158,11 +158,18 @@ Assembly AssembleDynamicResidual(const SystemModel& model, const DofMap& dofs, D
   return out;
 }
 
+// Coefficients of an iteration matrix K + c_C C + c_M M (generalized-alpha: gamma', beta').
+struct MatrixCombination {
+  double c_C = 0.0, c_M = 0.0;
+};
+
 // The matrices K, C, M of the residual pass `out` (same state s and time t); bodies on
-// `threads` threads, added in body order.
+// `threads` threads, added in body order. With `combine`, out.K receives the iteration matrix
+// K + c_C C + c_M M alone, combined body by body before the scatter (one sparse matrix built
+// instead of three and their sum), and out.C, out.M stay empty.
 void AddDynamicMatrices(const SystemModel& model, const DofMap& dofs, const DynamicState& s, double t,
                         const std::vector<BodyPass>& passes, bool full_inertia_tangent, Assembly& out,
-                        BodyThreads* threads = nullptr) {
+                        BodyThreads* threads = nullptr, const MatrixCombination* combine = nullptr) {
   struct BodyMatrices {
     Eigen::MatrixXd K, C, M;
     std::vector<MapEntry> map;
@@ -178,19 +185,25 @@ void AddDynamicMatrices(const SystemModel& model, const DofMap& dofs, const Dyna
     body.ElasticForce(pass.data, nullptr, &r.K, stiffening ? &pass.load : nullptr, stiffening ? &d_load : nullptr);
     body.InertiaForce(pass.data, pass.w, pass.wdot, nullptr, &r.M, &r.C);
     if (stiffening) {
-      r.M += d_load * pass.load.d_wdot;
-      r.C += d_load * pass.load.d_w;
+      r.M.noalias() += d_load * pass.load.d_wdot;
+      r.C.noalias() += d_load * pass.load.d_w;
     }
     // Configuration derivative of the inertia force: d(M_g wdot)/dq exactly; that of the
     // quadratic velocity terms by central differences with options.full_inertia_tangent.
     r.K += body.InertiaConfigurationTangent(pass.data, pass.w, pass.wdot, full_inertia_tangent);
     Eigen::VectorXd unused = Eigen::VectorXd::Zero(body.n_coordinates());
     body.AddModalDamping(pass.w, unused, &r.C);
+    if (combine) {
+      r.K += combine->c_C * r.C + combine->c_M * r.M;
+      r.C.resize(0, 0);
+      r.M.resize(0, 0);
+    }
     r.map = BodyMap(model, dofs, s.config, b);
   });
   Triplets K, C, M;
   for (const BodyMatrices& r : results) {
     ScatterBody(r.map, nullptr, &r.K, nullptr, &K);
+    if (combine) continue;
     ScatterBody(r.map, nullptr, &r.C, nullptr, &C);
     ScatterBody(r.map, nullptr, &r.M, nullptr, &M);
   }
@@ -199,6 +212,11 @@ void AddDynamicMatrices(const SystemModel& model, const DofMap& dofs, const Dyna
   AddNodeLoads(model, s.config, t, unused, &K);
   AddSpringDampers(model, s.config, s.W, unused, &K, &C, nullptr);
   AddJointGeometricStiffness(model, dofs, s.config, out.node_forces, K);
+  if (combine) {
+    for (const Eigen::Triplet<double>& e : C) K.emplace_back(e.row(), e.col(), combine->c_C * e.value());
+    out.K = ToMatrix(n, K);
+    return;
+  }
   out.K = ToMatrix(n, K);
   out.C = ToMatrix(n, C);
   out.M = ToMatrix(n, M);
@@ -379,9 +397,10 @@ StepOutcome GeneralizedAlphaStep(const SystemModel& model, const DofMap& dofs, c
     }
     bool built = false;
     const auto S = [&] {
-      if (!built) AddDynamicMatrices(model, dofs, next, t_new, passes, options.full_inertia_tangent, a, &threads);
+      const MatrixCombination combine{gamma_p, beta_p};
+      if (!built) AddDynamicMatrices(model, dofs, next, t_new, passes, options.full_inertia_tangent, a, &threads, &combine);
       built = true;
-      return SystemMatrix(a.K + gamma_p * a.C + beta_p * a.M);
+      return a.K;  // K + gamma' C + beta' M
     };
     if (!matrix.Update(dofs, options, h, S)) {
       out.singular_matrix = S();

@@ -423,16 +423,16 @@ bool FreeSolver::Factor(const DofMap& dofs, const SystemMatrix& S) {
   const int n = int(free_.size());
   std::vector<int> position(S.rows(), -1);
   for (int i = 0; i < n; ++i) position[free_[i]] = i;
-  Triplets entries;
-  entries.reserve(S.nonZeros());
-  for (int col = 0; col < S.outerSize(); ++col) {
-    for (SystemMatrix::InnerIterator it(S, col); it; ++it) {
-      if (position[it.row()] >= 0 && position[col] >= 0) entries.emplace_back(position[it.row()], position[col], it.value());
-    }
-  }
-  const SystemMatrix Sf = ToMatrix(n, entries);
   sparse_ = n > kDenseLimit;
   if (sparse_) {
+    Triplets entries;
+    entries.reserve(S.nonZeros());
+    for (int col = 0; col < S.outerSize(); ++col) {
+      for (SystemMatrix::InnerIterator it(S, col); it; ++it) {
+        if (position[it.row()] >= 0 && position[col] >= 0) entries.emplace_back(position[it.row()], position[col], it.value());
+      }
+    }
+    const SystemMatrix Sf = ToMatrix(n, entries);
     // The symbolic analysis (COLAMD ordering, elimination tree) is kept while the pattern stays
     // (an assembly's pattern is fixed by the model's structure): numeric refactorization only.
     const std::vector<int> outer(Sf.outerIndexPtr(), Sf.outerIndexPtr() + Sf.outerSize() + 1);
@@ -447,7 +447,7 @@ bool FreeSolver::Factor(const DofMap& dofs, const SystemMatrix& S) {
     valid_ = sparse_lu_->info() == Eigen::Success;
     return valid_;
   }
-  const Eigen::MatrixXd A(Sf);
+  const Eigen::MatrixXd A = DenseFreeMatrix(dofs, S);  // straight from S, no triplets
   dense_.compute(A);
   valid_ = A.allFinite();
   if (!valid_ || n == 0) return valid_;

@@ -33,6 +33,32 @@ Eigen::VectorXd TurnBlocks(const Eigen::Matrix3d& R, const Eigen::VectorXd& v, i
   for (int a = 0; a < blocks; ++a) out.segment<3>(3 * a) = R * v.segment<3>(3 * a);
   return out;
 }
+
+// X <- blockdiag(A(0), ..., A(blocks - 1), 1) X in place: the first `blocks` row triples each
+// turned by its 3 x 3 matrix A(a), column by column (fixed-size products, no temporaries; a
+// dense n x n product with the block-diagonal Rbar would cost n / 3 times more).
+template <class Blocks>
+void TurnRowBlocks(Eigen::MatrixXd& X, int blocks, const Blocks& A) {
+  for (int a = 0; a < blocks; ++a) {
+    const Eigen::Matrix3d Aa = A(a);
+    for (Eigen::Index j = 0; j < X.cols(); ++j) {
+      const Eigen::Vector3d x = X.block<3, 1>(3 * a, j);
+      X.block<3, 1>(3 * a, j) = Aa * x;
+    }
+  }
+}
+
+// X <- X blockdiag(A(0), ..., A(blocks - 1), 1) in place, row by row.
+template <class Blocks>
+void TurnColBlocks(Eigen::MatrixXd& X, int blocks, const Blocks& A) {
+  for (int a = 0; a < blocks; ++a) {
+    const Eigen::Matrix3d Aa = A(a);
+    for (Eigen::Index i = 0; i < X.rows(); ++i) {
+      const Eigen::RowVector3d x = X.block<1, 3>(i, 3 * a);
+      X.block<1, 3>(i, 3 * a) = x * Aa;
+    }
+  }
+}
 }  // namespace
 
 SuperelementBody::SuperelementBody(const Superelement& se, const SuperelementOptions& options,
@@ -105,7 +131,20 @@ Eigen::VectorXd SuperelementBody::LocalCoordinates(const BodyConfiguration& c, c
   return q;
 }
 
-SuperelementBody::Kinematics SuperelementBody::ComputeKinematics(const Eigen::VectorXd& q, bool frame_only) const {
+Eigen::Matrix<double, 6, 6> SuperelementBody::FrameMatrix(const Eigen::VectorXd& q) const {
+  // S = Phi_CB D Phi_rig node by node: node a's rows of D Phi_rig are [1, -r_a~] (translations)
+  // and [0, J_l^-1(theta_a)] (rotations); the modal rows are zero.
+  Eigen::Matrix<double, 6, 6> S = Eigen::Matrix<double, 6, 6>::Zero();
+  for (int a = 0; a < n_nodes_; ++a) {
+    const Eigen::Vector3d r = X_[a] + q.segment<3>(6 * a);
+    const Eigen::Matrix<double, 6, 3> Pt = Phi_CB_.middleCols<3>(6 * a), Pr = Phi_CB_.middleCols<3>(6 * a + 3);
+    S.leftCols<3>() += Pt;
+    S.rightCols<3>() += Pr * LeftJacobianInverse<double>(Eigen::Vector3d(q.segment<3>(6 * a + 3))) - Pt * Skew<double>(r);
+  }
+  return S;
+}
+
+SuperelementBody::Kinematics SuperelementBody::ComputeKinematics(const Eigen::VectorXd& q) const {
   const int n = n_coordinates();
   Kinematics k;
   k.Phi_rig = Eigen::MatrixXd::Zero(n, 6);
@@ -120,14 +159,19 @@ SuperelementBody::Kinematics SuperelementBody::ComputeKinematics(const Eigen::Ve
     Jinv[size_t(a)] = LeftJacobianInverse<double>(Eigen::Vector3d(q.segment<3>(6 * a + 3)));
     W.middleCols<3>(6 * a + 3) = Phi_CB_.middleCols<3>(6 * a + 3) * Jinv[size_t(a)];
   }
-  k.S = W * k.Phi_rig;
-  if (frame_only) return k;
+  k.S = FrameMatrix(q);
   k.D = Eigen::MatrixXd::Identity(n, n);
   for (int a = 0; a < n_nodes_; ++a) k.D.block<3, 3>(6 * a + 3, 6 * a + 3) = Jinv[size_t(a)];
   k.Z = k.S.lu().solve(W);
-  k.T = Eigen::MatrixXd::Identity(n, n) - k.Phi_rig * k.Z;
+  k.T = Eigen::MatrixXd::Identity(n, n);
+  k.T.noalias() -= k.Phi_rig * k.Z;
   k.B = k.T;
-  for (int a = 0; a < n_nodes_; ++a) k.B.middleRows<3>(6 * a + 3) = Jinv[size_t(a)] * k.T.middleRows<3>(6 * a + 3);
+  for (int a = 0; a < n_nodes_; ++a) {
+    for (int j = 0; j < n; ++j) {
+      const Eigen::Vector3d t = k.T.block<3, 1>(6 * a + 3, j);
+      k.B.block<3, 1>(6 * a + 3, j) = Jinv[size_t(a)] * t;
+    }
+  }
   return k;
 }
 
@@ -145,7 +189,10 @@ const BodyVelocityMaps& SuperelementBody::MapsOf(const Data& d) const {
   if (!d.maps) {
     BodyVelocityMaps maps;
     VelocityMaps(d, &maps.P, &maps.U);
-    maps.Mg = maps.P.transpose() * M_ * maps.P;
+    // M_g = P^T M P with P block diagonal (3 x 3 blocks, then 1 on the modal rows).
+    maps.Mg = M_;
+    TurnRowBlocks(maps.Mg, 2 * n_nodes_, [&](int a) { return Eigen::Matrix3d(maps.P.block<3, 3>(3 * a, 3 * a).transpose()); });
+    TurnColBlocks(maps.Mg, 2 * n_nodes_, [&](int a) { return Eigen::Matrix3d(maps.P.block<3, 3>(3 * a, 3 * a)); });
     d.maps = std::move(maps);
   }
   return *d.maps;
@@ -190,8 +237,7 @@ FrameSolution SuperelementBody::SolveFrame(const BodyConfiguration& c, const Fra
       return frame;
     }
     // d q_loc = -D Phi_rig zeta for a frame variation zeta (frame axes): zeta = S^-1 g.
-    const Kinematics kin = ComputeKinematics(q, /*frame_only=*/true);
-    const Eigen::Matrix<double, 6, 1> zeta = kin.S.lu().solve(g);
+    const Eigen::Matrix<double, 6, 1> zeta = FrameMatrix(q).lu().solve(g);
     frame.x += frame.R * zeta.head<3>();
     frame.R = frame.R * ExpSO3(zeta.tail<3>());
   }
@@ -309,18 +355,22 @@ void SuperelementBody::ElasticForce(const Data& d, Eigen::VectorXd* f, Eigen::Ma
       // K4: variation of D (exact rotation kinematics), v = P^T Q, P = 1 - D Phi_rig S^-1 Phi_CB.
       const Eigen::VectorXd v =
           Q - Phi_CB_.transpose() * kin.S.transpose().lu().solve(kin.Phi_rig.transpose() * (kin.D.transpose() * Q));
-      Eigen::MatrixXd G = Eigen::MatrixXd::Zero(n, n);
+      // G is block diagonal (a 3 x 3 block per node rotation): T^T G B = sum_a T_a^T (G_a B_a)
+      // with T_a, B_a node a's rotation rows.
+      Eigen::Matrix<double, 3, Eigen::Dynamic> GB(3, n);
       for (int a = 0; a < n_nodes_; ++a) {
-        G.block<3, 3>(6 * a + 3, 6 * a + 3) = LeftJacobianInverseTransposeDerivative(
-            Eigen::Vector3d(q.segment<3>(6 * a + 3)), Eigen::Vector3d(v.segment<3>(6 * a + 3)));
+        const Eigen::Matrix3d G = LeftJacobianInverseTransposeDerivative(Eigen::Vector3d(q.segment<3>(6 * a + 3)),
+                                                                         Eigen::Vector3d(v.segment<3>(6 * a + 3)));
+        GB.noalias() = G * kin.B.middleRows<3>(6 * a + 3);
+        Kt.noalias() += kin.T.middleRows<3>(6 * a + 3).transpose() * GB;
       }
-      Kt += kin.T.transpose() * G * kin.B;
     }
   }
-  // Rbar Kt Rbar^T.
-  Eigen::MatrixXd Rbar = Eigen::MatrixXd::Identity(n, n);
-  for (int a = 0; a < 2 * n_nodes_; ++a) Rbar.block<3, 3>(3 * a, 3 * a) = frame.R;
-  *tangent = Rbar * Kt * Rbar.transpose();
+  // Rbar Kt Rbar^T, block by block.
+  const Eigen::Matrix3d R = frame.R, Rt = frame.R.transpose();
+  TurnRowBlocks(Kt, 2 * n_nodes_, [&](int) { return R; });
+  TurnColBlocks(Kt, 2 * n_nodes_, [&](int) { return Rt; });
+  *tangent = std::move(Kt);
 }
 
 SuperelementBody::ExactData SuperelementBody::Exact(const Eigen::VectorXd& q, const Kinematics& kin) const {
@@ -479,16 +529,16 @@ void SuperelementBody::VelocityMaps(const Data& d, Eigen::MatrixXd* P, Eigen::Ma
   const BodyConfiguration& c = d.c;
   const FrameSolution& frame = d.frame;
   const Kinematics& kin = d.kin;
-  Eigen::MatrixXd Rbar_t = Eigen::MatrixXd::Identity(n, n);
   *P = Eigen::MatrixXd::Identity(n, n);
   for (int a = 0; a < n_nodes_; ++a) {
-    Rbar_t.block<3, 3>(6 * a, 6 * a) = frame.R.transpose();
-    Rbar_t.block<3, 3>(6 * a + 3, 6 * a + 3) = frame.R.transpose();
     P->block<3, 3>(6 * a, 6 * a) = frame.R.transpose();
     P->block<3, 3>(6 * a + 3, 6 * a + 3) = options_.cardona_option_b ? c.R[a].transpose() : frame.R.transpose();
   }
   // Spatial variation of the frame rotation: d pi_j = R_j (Z Rbar^T dq)_rot (thesis 3.17).
-  *U = frame.R * (kin.Z * Rbar_t).bottomRows(3);
+  Eigen::MatrixXd Zr = kin.Z.bottomRows<3>();
+  const Eigen::Matrix3d Rt = frame.R.transpose();
+  TurnColBlocks(Zr, 2 * n_nodes_, [&](int) { return Rt; });
+  *U = frame.R * Zr;
 }
 
 Eigen::MatrixXd SuperelementBody::VelocityMapRate(const Eigen::MatrixXd& U, const BodyVelocity& w) const {

@@ -316,8 +316,9 @@ class SuperelementBody {
   }
 
  private:
-  // frame_only: Phi_rig and S only (the floating frame's Newton iteration).
-  Kinematics ComputeKinematics(const Eigen::VectorXd& q_loc, bool frame_only = false) const;
+  Kinematics ComputeKinematics(const Eigen::VectorXd& q_loc) const;
+  // S = Phi_CB D Phi_rig alone (the floating frame's Newton iteration), node block by node block.
+  Eigen::Matrix<double, 6, 6> FrameMatrix(const Eigen::VectorXd& q_loc) const;
   // P (system velocities -> local velocities) and the frame's angular velocity map U (3 x n).
   void VelocityMaps(const Data& d, Eigen::MatrixXd* P, Eigen::MatrixXd* U) const;
   // G of d(P w) = P G dq at fixed w (n x n), from U and the velocities.
