@@ -149,7 +149,8 @@ SuperelementBody::Kinematics SuperelementBody::ComputeKinematics(const Eigen::Ve
   Kinematics k;
   k.Phi_rig = Eigen::MatrixXd::Zero(n, 6);
   // D is block diagonal: its products below act on the rotation blocks only (no n^3 products).
-  std::vector<Eigen::Matrix3d> Jinv(static_cast<size_t>(n_nodes_));
+  std::vector<Eigen::Matrix3d>& Jinv = k.Jinv;
+  Jinv.resize(static_cast<size_t>(n_nodes_));
   Eigen::MatrixXd W = Phi_CB_;  // Phi_CB D
   for (int a = 0; a < n_nodes_; ++a) {
     const Eigen::Vector3d r = X_[a] + q.segment<3>(6 * a);
@@ -160,8 +161,6 @@ SuperelementBody::Kinematics SuperelementBody::ComputeKinematics(const Eigen::Ve
     W.middleCols<3>(6 * a + 3) = Phi_CB_.middleCols<3>(6 * a + 3) * Jinv[size_t(a)];
   }
   k.S = FrameMatrix(q);
-  k.D = Eigen::MatrixXd::Identity(n, n);
-  for (int a = 0; a < n_nodes_; ++a) k.D.block<3, 3>(6 * a + 3, 6 * a + 3) = Jinv[size_t(a)];
   k.Z = k.S.lu().solve(W);
   k.T = Eigen::MatrixXd::Identity(n, n);
   k.T.noalias() -= k.Phi_rig * k.Z;
@@ -353,8 +352,9 @@ void SuperelementBody::ElasticForce(const Data& d, Eigen::VectorXd* f, Eigen::Ma
     if (!options_.approximated) {
       Kt -= kin.Z.transpose() * Fhat.transpose() * kin.B;  // K2: variation of Phi_rig in T
       // K4: variation of D (exact rotation kinematics), v = P^T Q, P = 1 - D Phi_rig S^-1 Phi_CB.
-      const Eigen::VectorXd v =
-          Q - Phi_CB_.transpose() * kin.S.transpose().lu().solve(kin.Phi_rig.transpose() * (kin.D.transpose() * Q));
+      Eigen::VectorXd DtQ = Q;  // D^T Q
+      for (int a = 0; a < n_nodes_; ++a) DtQ.segment<3>(6 * a + 3) = kin.Jinv[size_t(a)].transpose() * Q.segment<3>(6 * a + 3);
+      const Eigen::VectorXd v = Q - Phi_CB_.transpose() * kin.S.transpose().lu().solve(kin.Phi_rig.transpose() * DtQ);
       // G is block diagonal (a 3 x 3 block per node rotation): T^T G B = sum_a T_a^T (G_a B_a)
       // with T_a, B_a node a's rotation rows.
       Eigen::Matrix<double, 3, Eigen::Dynamic> GB(3, n);
@@ -749,7 +749,20 @@ Eigen::MatrixXd SuperelementBody::MomentumDerivative(const BodyVelocityMaps& map
   const Eigen::MatrixXd& U = maps.U;
   const Eigen::VectorXd p = maps.Mg * w;
   // dp = dP^T mu + M_g G dq, mu = M P w; P^T turns each node block with R_j (or R_k).
-  Eigen::MatrixXd D = maps.Mg * VelocityMapRate(U, w);
+  // M_g G = (M_g L) U (+ option B: M_g's rotation columns times omega_a~), L the stacked
+  // xdot_a~ (and omega_a~, option A) of VelocityMapRate: O(n^2) instead of an n x n product.
+  const int n = n_coordinates();
+  Eigen::MatrixXd L = Eigen::MatrixXd::Zero(n, 3);
+  for (int a = 0; a < n_nodes_; ++a) {
+    L.middleRows<3>(6 * a) = Skew<double>(Eigen::Vector3d(w.segment<3>(6 * a)));
+    if (!options_.cardona_option_b) L.middleRows<3>(6 * a + 3) = Skew<double>(Eigen::Vector3d(w.segment<3>(6 * a + 3)));
+  }
+  const Eigen::MatrixXd MgL = maps.Mg * L;
+  Eigen::MatrixXd D = MgL * U;
+  if (options_.cardona_option_b) {
+    for (int a = 0; a < n_nodes_; ++a)
+      D.middleCols<3>(6 * a + 3) += maps.Mg.middleCols<3>(6 * a + 3) * Skew<double>(Eigen::Vector3d(w.segment<3>(6 * a + 3)));
+  }
   for (int a = 0; a < n_nodes_; ++a) {
     D.middleRows<3>(6 * a) -= Skew<double>(Eigen::Vector3d(p.segment<3>(6 * a))) * U;
     const Eigen::Matrix3d p_rot = Skew<double>(Eigen::Vector3d(p.segment<3>(6 * a + 3)));

@@ -99,7 +99,7 @@ class SuperelementBody {
   /// comment): Phi_rig, D, S = Phi_CB D Phi_rig, Z = S^-1 Phi_CB D, T = 1 - Phi_rig Z, B = D T.
   struct Kinematics {
     Eigen::MatrixXd Phi_rig;  ///< n x 6
-    Eigen::MatrixXd D;        ///< n x n (block diagonal)
+    std::vector<Eigen::Matrix3d> Jinv;  ///< D's rotation blocks J_l^-1(theta_k) (D is 1 elsewhere)
     Eigen::Matrix<double, 6, 6> S;
     Eigen::MatrixXd Z;        ///< 6 x n
     Eigen::MatrixXd T;        ///< n x n
