@@ -5,30 +5,15 @@
 #include <cstdio>
 #include <functional>
 
+#include "solver/analysis/dynamic_step.h"
 #include "solver/analysis/singularity.h"
 #include "solver/analysis/step_control.h"
 #include "solver/parallel.h"
 #include "solver/rotation.h"
 
 namespace femb {
-namespace {
 
-struct Assembly {
-  bool ok = true;
-  std::string message;
-  Eigen::VectorXd residual;  // f_ext + f_grav - f_int - f_in
-  Eigen::VectorXd f_ext;     // nodal loads and gravity, for the work
-  SystemMatrix K, C, M;
-  double scale = 0.0;
-  double roundoff = 0.0;  // residual noise from the round-off of absolute positions
-  NodeForces node_forces;  // per node, residual sense (for the reactions)
-};
-
-// The triplets of an assembly in progress and the node forces for the joints' stiffness.
-struct AssemblyParts {
-  Triplets K, C, M;
-  NodeForces node_forces;
-};
+namespace dynamic_internal {
 
 Assembly StartAssembly(const SystemModel& model, const DofMap& dofs, AssemblyParts& parts) {
   Assembly out;
@@ -38,8 +23,6 @@ Assembly StartAssembly(const SystemModel& model, const DofMap& dofs, AssemblyPar
   return out;
 }
 
-// Nodal loads at t, spring-dampers at velocities W (both on `config`), the joints' geometric
-// stiffness, and the matrices built (when `matrices`).
 void FinishAssembly(const SystemModel& model, const DofMap& dofs, const SystemState& config, double t,
                     const Eigen::VectorXd& W, bool matrices, AssemblyParts& parts, Assembly& out) {
   const int n = dofs.n_dofs();
@@ -62,7 +45,6 @@ void FinishAssembly(const SystemModel& model, const DofMap& dofs, const SystemSt
   out.node_forces = parts.node_forces;
 }
 
-// f(b) for every body, on the pool when there is one.
 void ForEachBody(BodyThreads* threads, int n, const std::function<void(int)>& f) {
   if (threads) {
     threads->ForEach(n, f);
@@ -71,25 +53,6 @@ void ForEachBody(BodyThreads* threads, int n, const std::function<void(int)>& f)
   }
 }
 
-// What the residual pass keeps of one body for the iteration matrix (AddDynamicMatrices).
-struct BodyPass {
-  SuperelementBody::Data data;
-  Eigen::VectorXd w, wdot;
-  InertiaLoadFactors load;
-};
-
-// One body's share of an assembly pass, computed on its own (in parallel with the others) and
-// added into the system in body order (AddBodyTerms).
-struct BodyTerms {
-  bool frame_ok = true;
-  Eigen::VectorXd r_b, f_grav;  // f_grav - f_int - f_in, and f_grav
-  Eigen::MatrixXd K, C, M;      // empty in a residual-only pass
-  double scale = 0.0, roundoff = 0.0;
-  std::vector<MapEntry> map;
-};
-
-// Adds the bodies' terms in body order: the same sums whatever thread computed them. False (the
-// message in `out`) when a body's floating frame did not converge.
 bool AddBodyTerms(const SystemModel& model, const std::vector<BodyTerms>& terms, AssemblyParts& parts, Assembly& out) {
   for (size_t b = 0; b < terms.size(); ++b) {
     const BodyTerms& r = terms[b];
@@ -108,6 +71,19 @@ bool AddBodyTerms(const SystemModel& model, const std::vector<BodyTerms>& terms,
   }
   return true;
 }
+
+Eigen::VectorXd DriveForces(const DofMap& dofs, const Eigen::VectorXd& residual) {
+  Eigen::VectorXd f = Eigen::VectorXd::Zero(residual.size());
+  for (int j = 0; j < dofs.n_dofs(); ++j)
+    if (dofs.prescribed(j)) f[j] = -residual[j];
+  return f;
+}
+
+}  // namespace dynamic_internal
+
+using namespace dynamic_internal;
+
+namespace {
 
 // The generalized-alpha residual at state s and time t: frames solved (s.config.frames
 // updated), each body's kinematics evaluated once and kept in `passes` for the matrices, which
@@ -240,15 +216,6 @@ std::vector<Eigen::Matrix<double, 6, 1>> DynamicReactions(const SystemModel& mod
   return JointReactions(model, dofs, s.config, a.node_forces);
 }
 
-// The generalized forces the prescribed motions exert: minus the residual on the prescribed
-// coordinates (zero elsewhere).
-Eigen::VectorXd DriveForces(const DofMap& dofs, const Eigen::VectorXd& residual) {
-  Eigen::VectorXd f = Eigen::VectorXd::Zero(residual.size());
-  for (int j = 0; j < dofs.n_dofs(); ++j)
-    if (dofs.prescribed(j)) f[j] = -residual[j];
-  return f;
-}
-
 namespace {
 
 // The free accelerations from M_g Wdot = f_ext - f_int - f_gyro at s (prescribed ones as set),
@@ -330,34 +297,6 @@ DynamicStepReport Measure(const SystemModel& model, DynamicState& s) {
 
 namespace {
 
-// The factorized iteration matrix, kept across iterations and steps with Jacobian reuse.
-struct IterationMatrix {
-  FreeSolver solver;
-  double factored_h = -1.0;
-  int with_this_factor = 0;
-  long factorizations = 0;
-
-  // Factors S unless the kept factor may be reused; false when S is singular.
-  bool Update(const DofMap& dofs, const DynamicOptions& options, double h, const std::function<SystemMatrix()>& S) {
-    if (options.reuse_jacobian && solver.valid() && factored_h == h && with_this_factor < options.reuse_max_iterations) {
-      ++with_this_factor;
-      return true;
-    }
-    if (!solver.Factor(dofs, S())) return false;
-    factored_h = h;
-    with_this_factor = 1;
-    ++factorizations;
-    return true;
-  }
-};
-
-struct StepOutcome {
-  bool converged = false;
-  int iterations = 0;
-  SystemMatrix singular_matrix;  ///< the iteration matrix when its factorization failed
-  std::vector<BodyPass> passes;  ///< the bodies' data at the converged state (generalized-alpha)
-};
-
 // One generalized-alpha step of size h from `state` into `next` (Arnold & Bruls 2007).
 // t_new: the time reached, state.t + h, or just below a breakpoint the step lands on (the loads
 // and drives there are their left limits).
@@ -414,297 +353,6 @@ StepOutcome GeneralizedAlphaStep(const SystemModel& model, const DofMap& dofs, c
     ApplyIncrement(model, dofs, delta, next.config);
     next.W += gamma_p * delta;
     next.Wdot += beta_p * delta;
-  }
-  return out;
-}
-
-// ---- Momentum-conserving midpoint scheme ---------------------------------------------------
-//
-// Per step (Simo & Wong 1991 for the rigid body; free nodes move as on SE(3)):
-//   kinematics   node rotations: R_n+1 = R_n exp(h Omega_m~), Omega_m = (Omega_n + Omega_n+1) / 2
-//                (Omega = R^T omega, convected); free nodes also x_n+1 = x_n + R_n J_l(h Omega_m)
-//                h V_m, V_m = (V_n + V_n+1) / 2, V = R^T xdot (a rigid motion of constant twist is
-//                then exact for every node of a body); every other coordinate
-//                z_n+1 - z_n = h (W_n + W_n+1) / 2.
-//   mid config   q_m: half the step on the same curves (SE(3) geodesic midpoint for free nodes,
-//                rotations exp(Delta_pi / 2) R_n, z_n + Delta / 2). The chord midpoint would make
-//                a spinning body look compressed by (omega h)^2 / 8 of its radius: 500 N of
-//                spurious axial force in a 1 m tube at 20 rad/s and 200 steps per turn.
-//   balance      per body, mapped by the node Jacobians at q_m:
-//                (p_n+1 - p_n) / h - [s(q_m, w_b, p_n) + s(q_m, w_a, p_n+1)] / 2
-//                    = f_ext(q_m, t_m) - f_int(q_m),
-//                p = M_g w (generalized momentum), s = MomentumSource (superelement_body.h), w_b,
-//                w_a the node motion of the two half steps: translations 2 (x_m - x_n) / h and
-//                2 (x_n+1 - x_m) / h, rotations log(R_n+1 R_n^T) / h.
-// s has no resultant and its moment about the origin is sum_k p_x,k x xdot_k, so the source's
-// moment equals minus the change of sum_k x_k x p_x,k over the two half steps, and the forces at
-// q_m have no moment: the linear and angular momentum of a free system are conserved exactly,
-// flexible bodies included. For a rigid body this is Simo & Wong's scheme and the kinetic energy
-// is conserved too; for flexible bodies the energy error is second order and small (free
-// spinning tube: 6e-6 against generalized-alpha's 2e-3). No numerical damping.
-
-// Nodes whose coordinates include their own spatial rotation increment (free node, spherical
-// joint to ground, spherical child): the first index of the rotation triple, and of the
-// translation triple when the node is free (-1 otherwise).
-struct RotationNode {
-  int node, rotation, translation;
-};
-
-std::vector<RotationNode> RotationNodes(const SystemModel& model, const DofMap& dofs) {
-  std::vector<RotationNode> nodes;
-  for (int k = 0; k < model.n_nodes(); ++k) {
-    const int j = dofs.joint_of(k);
-    if (j >= 0) {
-      if (model.joints[j].type == JointType::kSpherical) nodes.push_back({k, dofs.node_first(k), -1});
-      continue;
-    }
-    const Eigen::MatrixXd& S = dofs.S(k);
-    if (S.cols() == 6 && S.isIdentity()) {
-      nodes.push_back({k, dofs.node_first(k) + 3, dofs.node_first(k)});
-    } else if (S.cols() == 3 && S.topRows(3).isZero() && S.bottomRows(3).isIdentity()) {
-      nodes.push_back({k, dofs.node_first(k), -1});
-    }
-  }
-  return nodes;
-}
-
-// The step's increment Delta of the coordinates (spatial rotation vectors log(R_n+1 R_n^T) on
-// the rotation triples), the end velocities it implies, the mid configuration, and the first-
-// order maps of the end coordinates' increments (delta, as Newton applies them at n+1) to the
-// mid configuration and to the end velocities.
-struct MidpointKinematics {
-  Eigen::VectorXd delta;  // Delta
-  SystemState mid;        // q_m
-  SystemMatrix T;         // d q_m / d delta: 1/2 off the rotation nodes
-  SystemMatrix V;         // d W_n+1 / d delta: 2/h off the rotation nodes
-};
-
-MidpointKinematics Midpoint(const SystemModel& model, const DofMap& dofs, const std::vector<RotationNode>& nodes,
-                            const DynamicState& s0, double h, DynamicState& s1) {
-  MidpointKinematics k;
-  const int n = dofs.n_dofs();
-  k.delta = Eigen::VectorXd::Zero(n);
-  for (int node = 0; node < model.n_nodes(); ++node) {
-    if (dofs.node_count(node) > 0) {
-      k.delta.segment(dofs.node_first(node), dofs.node_count(node)) = s1.config.z[node] - s0.config.z[node];
-    }
-  }
-  for (size_t b = 0; b < model.bodies.size(); ++b) {
-    k.delta.segment(dofs.mode_dof(int(b)), model.bodies[b].n_modes()) = s1.config.eta[b] - s0.config.eta[b];
-  }
-  // Every other coordinate: z_n+1 - z_n = h (W_n + W_n+1) / 2, z_m = z_n + Delta / 2.
-  Eigen::VectorXd W1 = 2.0 / h * k.delta - s0.W;
-  Eigen::VectorXd half = 0.5 * k.delta;
-  std::vector<bool> in_block(n, false);
-  Triplets T, V;
-  auto add_block = [](Triplets& t, int row, int col, const Eigen::Matrix3d& block) {
-    for (int i = 0; i < 3; ++i) {
-      for (int j = 0; j < 3; ++j) t.emplace_back(row + i, col + j, block(i, j));
-    }
-  };
-  for (const RotationNode& r : nodes) {
-    const Eigen::Matrix3d& R0 = s0.config.R[r.node];
-    const Eigen::Matrix3d& R1 = s1.config.R[r.node];
-    const Eigen::Vector3d dpi = LogSO3(R1 * R0.transpose());
-    k.delta.segment<3>(r.rotation) = dpi;
-    half.segment<3>(r.rotation) = 0.5 * dpi;
-    const Eigen::Vector3d Omega_m = R0.transpose() * dpi / h;
-    const Eigen::Vector3d omega1 = R1 * (2.0 * Omega_m - R0.transpose() * s0.W.segment<3>(r.rotation));
-    W1.segment<3>(r.rotation) = omega1;
-    for (int i = 0; i < 3; ++i) in_block[r.rotation + i] = true;
-    // An end increment delta (R_n+1 <- exp(delta~) R_n+1) changes Delta_pi by J_l^-1(Delta_pi)
-    // delta: the mid rotation exp(Delta_pi~ / 2) R_n by A delta / 2, A = J_l(Delta_pi / 2)
-    // J_l^-1(Delta_pi), and omega_n+1 by [2/h R_n+1 R_n^T J_l^-1(Delta_pi) - omega_n+1~] delta.
-    const Eigen::Matrix3d Jinv = LeftJacobianInverse<double>(dpi);
-    const Eigen::Matrix3d A = LeftJacobianInverse<double>(Eigen::Vector3d(0.5 * dpi)).inverse() * Jinv;
-    add_block(T, r.rotation, r.rotation, 0.5 * A);
-    add_block(V, r.rotation, r.rotation, 2.0 / h * R1 * R0.transpose() * Jinv - Skew<double>(omega1));
-    if (r.translation < 0) continue;
-    // Free node: the step is the SE(3) exponential of the mean convected twist (V, Omega),
-    // V = R^T xdot: x_n+1 = x_n + R_n J_l(h Omega_m) h V_m. A rigid motion of constant twist is
-    // then exact for every node of a body (chords and rotations agree).
-    const Eigen::Vector3d dx = k.delta.segment<3>(r.translation);
-    const Eigen::Matrix3d Jinv_step = LeftJacobianInverse<double>(Eigen::Vector3d(h * Omega_m));
-    const Eigen::Vector3d V_m = Jinv_step * (R0.transpose() * dx) / h;
-    const Eigen::Vector3d xdot1 = R1 * (2.0 * V_m - R0.transpose() * s0.W.segment<3>(r.translation));
-    W1.segment<3>(r.translation) = xdot1;
-    // Mid configuration on the same SE(3) geodesic (not the chord midpoint: at the chord
-    // midpoint a spinning body would look compressed, by (omega h)^2 / 8 of its radius). In
-    // spatial form x_m - x_n = A Delta_x / 2; its change with the end rotation is Delta_x~ / 8
-    // to first order.
-    const Eigen::Matrix3d J_half = LeftJacobianInverse<double>(Eigen::Vector3d(0.5 * h * Omega_m)).inverse();
-    half.segment<3>(r.translation) = R0 * (J_half * (0.5 * h * V_m));
-    for (int i = 0; i < 3; ++i) in_block[r.translation + i] = true;
-    add_block(T, r.translation, r.translation, 0.5 * A);
-    add_block(T, r.translation, r.rotation, Skew<double>(dx) / 8.0);
-    // xdot_n+1: 2/h R_n+1 J_l^-1(h Omega_m) R_n^T per end translation; per end rotation
-    // -xdot_n+1~ (turning R_n+1) + R_n+1 V_m~ R_n^T (through Omega_m), to first order.
-    add_block(V, r.translation, r.translation, 2.0 / h * R1 * Jinv_step * R0.transpose());
-    add_block(V, r.translation, r.rotation, -Skew<double>(xdot1) + R1 * Skew<double>(V_m) * R0.transpose());
-  }
-  for (int j = 0; j < n; ++j) {
-    if (in_block[j]) continue;
-    T.emplace_back(j, j, 0.5);
-    V.emplace_back(j, j, 2.0 / h);
-  }
-  k.T = ToMatrix(n, T);
-  k.V = ToMatrix(n, V);
-  // End velocities from the kinematics (prescribed coordinates keep their given rates).
-  for (int j : dofs.solved()) s1.W[j] = W1[j];
-  k.mid = s0.config;
-  ApplyIncrement(model, dofs, half, k.mid);
-  return k;
-}
-
-// Residual (applied minus inertia and internal forces, over the coordinates) of the midpoint
-// balance and the matrices at the mid configuration.
-Assembly AssembleMidpoint(const SystemModel& model, const DofMap& dofs, const DynamicState& s0,
-                          const std::vector<Eigen::VectorXd>& p0, double h, MidpointKinematics& k, DynamicState& s1,
-                          double& f_ext_work, BodyThreads* threads = nullptr) {
-  AssemblyParts parts;
-  Assembly out = StartAssembly(model, dofs, parts);
-  // Each body into its slot (on the threads), then added in body order.
-  const int n_bodies = int(model.bodies.size());
-  std::vector<BodyTerms> terms(static_cast<size_t>(n_bodies));
-  ForEachBody(threads, n_bodies, [&](int b) {
-    const SuperelementBody& body = model.bodies[b];
-    BodyTerms& r = terms[size_t(b)];
-    const BodyConfiguration c1 = BodyConfigurationOf(model, s1.config, int(b));
-    const BodyConfiguration cm = BodyConfigurationOf(model, k.mid, int(b));
-    const FrameSolution f1 = body.SolveFrameFrom(c1, s1.config.frames[b]);
-    const FrameSolution fm = f1.ok ? body.SolveFrameFrom(cm, s0.config.frames[b]) : FrameSolution{};
-    if (!f1.ok || !fm.ok) {
-      r.frame_ok = false;
-      return;
-    }
-    s1.config.frames[b] = f1;
-    k.mid.frames[b] = fm;
-    const Eigen::VectorXd w1 = GatherBody(model, dofs, s1.config, int(b), s1.W);
-    // Velocity maps at the end and at the mid configuration, shared by the momentum terms.
-    const SuperelementBody::Data d1 = body.Evaluate(c1, f1), dm = body.Evaluate(cm, fm);
-    const BodyVelocityMaps &maps1 = body.MapsOf(d1), &maps_m = body.MapsOf(dm);
-    const Eigen::VectorXd p1 = body.GeneralizedMomentum(maps1, w1);
-    // Node motion over the step.
-    Eigen::VectorXd wm(body.n_coordinates());
-    for (int a = 0; a < body.n_nodes(); ++a) {
-      const int node = model.body_nodes[b][a];
-      wm.segment<3>(6 * a) = (s1.config.x[node] - s0.config.x[node]) / h;
-      wm.segment<3>(6 * a + 3) = LogSO3(s1.config.R[node] * s0.config.R[node].transpose()) / h;
-    }
-    wm.tail(body.n_modes()) = (s1.config.eta[b] - s0.config.eta[b]) / h;
-    Eigen::VectorXd f_in, f_int;
-    Eigen::MatrixXd &Kb = r.K, &Mb = r.M, &Cb = r.C;
-    // M_g at the end of the step: the 2/h^2 term of the iteration matrix is d p_n+1 / h; at
-    // the mid configuration it would be off by O(omega h) and leave a 1/h error.
-    Mb = maps1.Mg;
-    const Eigen::VectorXd w0 = GatherBody(model, dofs, s0.config, int(b), s0.W);
-    const Eigen::VectorXd f_acc = Mb * (w1 - w0) / h;
-    Cb.setZero(body.n_coordinates(), body.n_coordinates());
-    if (body.options().quadratic_velocity_terms) {
-      // Source terms with the node motion of each half step, so that their moment matches the
-      // change of sum x_k x p_k exactly: x_m is not the mean of x_n and x_n+1.
-      Eigen::VectorXd w_second = wm, w_first = wm;
-      for (int a = 0; a < body.n_nodes(); ++a) {
-        const int node = model.body_nodes[b][a];
-        w_second.segment<3>(6 * a) = 2.0 * (s1.config.x[node] - k.mid.x[node]) / h;
-        w_first.segment<3>(6 * a) = 2.0 * (k.mid.x[node] - s0.config.x[node]) / h;
-      }
-      f_in = (p1 - p0[b]) / h -
-             0.5 * (body.MomentumSource(maps_m, w_second, p1) + body.MomentumSource(maps_m, w_first, p0[b]));
-      // Iteration matrix: with dp_n+1 = (M_g V + D) delta (V = d W_n+1 / d delta ~ 2/h,
-      // D = d p / dq at fixed w) and dw_a ~ delta / h,
-      //   d f_in / d delta = [M_g V + D - d_w s(p_mean) - (d_p s) M_g] / h + O(1).
-      // All the 1/h terms are needed (and M_g at n+1, V with its O(omega) part): each is
-      // O(omega h) of the leading one, and without them Newton contracts only by ~omega h per
-      // iteration, or worse on stiff, lightly inertial directions such as a tube's torsion.
-      Eigen::MatrixXd d_w, d_p;
-      body.MomentumSourceDerivatives(maps_m, wm, 0.5 * (p0[b] + p1), &d_w, &d_p);
-      Cb = body.MomentumDerivative(maps1, w1) - d_w - d_p * Mb;
-    } else {
-      f_in = f_acc;
-    }
-    body.AddModalDamping(wm, f_in, &Cb);
-    if (body.has_inertia_stiffening()) {
-      // Inertia stiffening (issue 13) at the mid configuration with the step's mean velocity and
-      // acceleration; d wm = delta / h (C / h) and d (w1 - w0) / h = V delta / h (M V / h).
-      const InertiaLoadFactors load = body.InertiaLoads(dm, wm, (w1 - w0) / h, model.gravity);
-      Eigen::MatrixXd d_load;
-      body.ElasticForce(dm, &f_int, &Kb, &load, &d_load);
-      Cb += d_load * load.d_w;
-      Mb += d_load * load.d_wdot;
-    } else {
-      body.ElasticForce(dm, &f_int, &Kb);
-    }
-    Eigen::VectorXd& f_grav = r.f_grav;
-    f_grav = Eigen::VectorXd::Zero(body.n_coordinates());
-    if (model.gravity.squaredNorm() > 0) f_grav = body.GravityForce(dm, model.gravity);
-    // Scale: each term on its own (for a torque-free body the momentum change and the source
-    // cancel; M_g (w_n+1 - w_n) / h is the size of the inertia force).
-    r.scale = std::max({body.ForceNorm(f_int), body.ForceNorm(f_in), body.ForceNorm(f_grav), body.force_floor(),
-                        body.ForceNorm(f_acc)});
-    r.roundoff = body.RoundOffForce(c1);
-    r.map = BodyMap(model, dofs, k.mid, int(b));
-    r.r_b = f_grav - f_int - f_in;
-  });
-  if (!AddBodyTerms(model, terms, parts, out)) return out;
-  // Loads at the mid time and configuration, spring-dampers at the mean rates Delta / h.
-  FinishAssembly(model, dofs, k.mid, s0.t + 0.5 * h, k.delta / h, true, parts, out);
-  f_ext_work = out.f_ext.dot(k.delta);
-  return out;
-}
-
-StepOutcome MidpointStep(const SystemModel& model, const DofMap& dofs, const DynamicOptions& options,
-                         const std::vector<RotationNode>& triples, const DynamicState& state, double h, double t_new,
-                         IterationMatrix& matrix, BodyThreads& threads, DynamicState& next) {
-  next = state;
-  // Momenta at the start of the step.
-  std::vector<Eigen::VectorXd> p0;
-  for (size_t b = 0; b < model.bodies.size(); ++b) {
-    const BodyConfiguration c = BodyConfigurationOf(model, state.config, int(b));
-    p0.push_back(model.bodies[b].GeneralizedMomentum(model.bodies[b].Maps(c, state.config.frames[b]),
-                                                     GatherBody(model, dofs, state.config, int(b), state.W)));
-  }
-  // Predictor: the configuration reached with the current velocity and acceleration.
-  ApplyIncrement(model, dofs, h * state.W + 0.5 * h * h * state.Wdot, next.config);
-  ApplyPrescribed(model, dofs, t_new, next.config, &next.W, &next.Wdot);
-  StepOutcome out;
-  const double tolerance = std::max(options.tolerance, kRoundOffTolerance);
-  const Eigen::VectorXd weights = ResidualWeights(model, dofs);
-  for (; out.iterations < options.max_iterations; ++out.iterations) {
-    MidpointKinematics k = Midpoint(model, dofs, triples, state, h, next);
-    double work = 0.0;
-    const Assembly a = AssembleMidpoint(model, dofs, state, p0, h, k, next, work, &threads);
-    if (!a.ok || !a.residual.allFinite()) return out;
-    if (FreeNorm(dofs, a.residual, weights) <= std::max(tolerance * a.scale, a.roundoff) && out.iterations > 0) {
-      out.converged = true;
-      next.t = t_new;
-      // a: the mean acceleration over the step (t_n+1/2); Wdot: extrapolated to t_n+1 from
-      // the last two means (the predictor's acceleration; also what the output reports).
-      next.a = (next.W - state.W) / h;
-      if (state.h_last > 0 && h != state.h_last) {
-        // Steps of different length: the means sit at t_n - h_last / 2 and t_n + h / 2.
-        next.Wdot = next.a + (h / (h + state.h_last)) * (next.a - state.a);
-      } else {
-        next.Wdot = 1.5 * next.a - 0.5 * state.a;
-      }
-      next.external_work += work;
-      next.f_ext = a.f_ext;
-      next.f_drive = DriveForces(dofs, a.residual);
-      next.drive_work += next.f_drive.dot(k.delta);
-      return out;
-    }
-    // Newton's increment delta at n+1: dW_n+1 = V delta, dq_m = T delta, dw_m ~ delta / h.
-    const auto S = [&] { return SystemMatrix(a.K * k.T + (1.0 / h) * (a.C + a.M * k.V)); };
-    if (!matrix.Update(dofs, options, h, S)) {
-      out.singular_matrix = S();
-      return out;
-    }
-    const Eigen::VectorXd delta = matrix.solver.Solve(a.residual);
-    if (!delta.allFinite()) {
-      out.singular_matrix = S();
-      return out;
-    }
-    ApplyIncrement(model, dofs, delta, next.config);
   }
   return out;
 }

@@ -1,0 +1,112 @@
+// Internal to the dynamic analysis: what the generalized-alpha step (dynamic_analysis.cpp) and
+// the momentum-conserving midpoint step (midpoint_step.cpp) share, the assembly of one pass
+// over the bodies and the kept iteration matrix. Not an interface for other code.
+#pragma once
+
+#include <Eigen/Core>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "solver/analysis/dynamic_analysis.h"
+#include "solver/assembly/system.h"
+#include "solver/parallel.h"
+
+namespace femb::dynamic_internal {
+
+struct Assembly {
+  bool ok = true;
+  std::string message;
+  Eigen::VectorXd residual;  // f_ext + f_grav - f_int - f_in
+  Eigen::VectorXd f_ext;     // nodal loads and gravity, for the work
+  SystemMatrix K, C, M;
+  double scale = 0.0;
+  double roundoff = 0.0;  // residual noise from the round-off of absolute positions
+  NodeForces node_forces;  // per node, residual sense (for the reactions)
+};
+
+// The triplets of an assembly in progress and the node forces for the joints' stiffness.
+struct AssemblyParts {
+  Triplets K, C, M;
+  NodeForces node_forces;
+};
+
+Assembly StartAssembly(const SystemModel& model, const DofMap& dofs, AssemblyParts& parts);
+
+// Nodal loads at t, spring-dampers at velocities W (both on `config`), the joints' geometric
+// stiffness, and the matrices built (when `matrices`).
+void FinishAssembly(const SystemModel& model, const DofMap& dofs, const SystemState& config, double t,
+                    const Eigen::VectorXd& W, bool matrices, AssemblyParts& parts, Assembly& out);
+
+// f(b) for every body, on the pool when there is one.
+void ForEachBody(BodyThreads* threads, int n, const std::function<void(int)>& f);
+
+// What the residual pass keeps of one body for the iteration matrix (AddDynamicMatrices).
+struct BodyPass {
+  SuperelementBody::Data data;
+  Eigen::VectorXd w, wdot;
+  InertiaLoadFactors load;
+};
+
+// One body's share of an assembly pass, computed on its own (in parallel with the others) and
+// added into the system in body order (AddBodyTerms).
+struct BodyTerms {
+  bool frame_ok = true;
+  Eigen::VectorXd r_b, f_grav;  // f_grav - f_int - f_in, and f_grav
+  Eigen::MatrixXd K, C, M;      // empty in a residual-only pass
+  double scale = 0.0, roundoff = 0.0;
+  std::vector<MapEntry> map;
+};
+
+// Adds the bodies' terms in body order: the same sums whatever thread computed them. False (the
+// message in `out`) when a body's floating frame did not converge.
+bool AddBodyTerms(const SystemModel& model, const std::vector<BodyTerms>& terms, AssemblyParts& parts, Assembly& out);
+
+// The generalized forces the prescribed motions exert: minus the residual on the prescribed
+// coordinates (zero elsewhere).
+Eigen::VectorXd DriveForces(const DofMap& dofs, const Eigen::VectorXd& residual);
+
+// The factorized iteration matrix, kept across iterations and steps with Jacobian reuse.
+struct IterationMatrix {
+  FreeSolver solver;
+  double factored_h = -1.0;
+  int with_this_factor = 0;
+  long factorizations = 0;
+
+  // Factors S unless the kept factor may be reused; false when S is singular.
+  bool Update(const DofMap& dofs, const DynamicOptions& options, double h, const std::function<SystemMatrix()>& S) {
+    if (options.reuse_jacobian && solver.valid() && factored_h == h && with_this_factor < options.reuse_max_iterations) {
+      ++with_this_factor;
+      return true;
+    }
+    if (!solver.Factor(dofs, S())) return false;
+    factored_h = h;
+    with_this_factor = 1;
+    ++factorizations;
+    return true;
+  }
+};
+
+struct StepOutcome {
+  bool converged = false;
+  int iterations = 0;
+  SystemMatrix singular_matrix;  ///< the iteration matrix when its factorization failed
+  std::vector<BodyPass> passes;  ///< the bodies' data at the converged state (generalized-alpha)
+};
+
+// Nodes whose coordinates include their own spatial rotation increment (free node, spherical
+// joint to ground, spherical child): the first index of the rotation triple, and of the
+// translation triple when the node is free (-1 otherwise).
+struct RotationNode {
+  int node, rotation, translation;
+};
+
+std::vector<RotationNode> RotationNodes(const SystemModel& model, const DofMap& dofs);
+
+// One step of the momentum-conserving midpoint scheme (midpoint_step.cpp) of size h from `state`
+// into `next`; t_new as for the generalized-alpha step.
+StepOutcome MidpointStep(const SystemModel& model, const DofMap& dofs, const DynamicOptions& options,
+                         const std::vector<RotationNode>& triples, const DynamicState& state, double h, double t_new,
+                         IterationMatrix& matrix, BodyThreads& threads, DynamicState& next);
+
+}  // namespace femb::dynamic_internal
