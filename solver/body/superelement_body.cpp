@@ -376,6 +376,7 @@ void SuperelementBody::ElasticForce(const Data& d, Eigen::VectorXd* f, Eigen::Ma
 SuperelementBody::ExactData SuperelementBody::Exact(const Eigen::VectorXd& q, const Kinematics& kin) const {
   ExactData d;
   d.Y = Phi_rig0_ * kin.Z + kin.B;
+  d.MY.noalias() = M_ * d.Y;
   d.H.resize(n_coordinates(), 3);
   for (int a = 0; a < 3; ++a) d.H.col(a) = Gamma_[size_t(a)] * q;
   const int stored[3][3] = {{0, 3, 4}, {3, 1, 5}, {4, 5, 2}};  // xx yy zz xy xz yz
@@ -386,6 +387,7 @@ SuperelementBody::ExactData SuperelementBody::Exact(const Eigen::VectorXd& q, co
     }
   for (int a = 0; a < 3; ++a)
     for (int b = 0; b < 3; ++b) d.Xq(a, b) = q.dot(d.XQ[size_t(3 * a + b)]);
+  d.HtY.noalias() = d.H.transpose() * d.Y;
   return d;
 }
 
@@ -472,7 +474,6 @@ Eigen::MatrixXd SuperelementBody::ExactGyroscopic(const Data& data, const BodyVe
   const Eigen::MatrixXd dOmd = Z.bottomRows<3>() * dr;
   const Eigen::VectorXd y = Phi_rig0_ * xi + qd;
   const Eigen::MatrixXd dy = Phi_rig0_ * dxi + dqd;
-  const Eigen::MatrixXd dyd = d.Y * dr;
   // Gamma(Om) = sum_a Om_a Gamma_a: the three Gamma_a dqd and Gamma_a^T dy products in one each;
   // the rows y^T Gamma_a dqd as (Gamma_a^T y)^T dqd.
   Eigen::MatrixXd G_Om = Om[0] * Gamma_[0];
@@ -483,11 +484,12 @@ Eigen::MatrixXd SuperelementBody::ExactGyroscopic(const Data& data, const BodyVe
     Gty.col(a) = Gamma_[size_t(a)].transpose() * y;
   }
   const Eigen::VectorXd pi_q = M_ * y + d.H * Om;
-  Eigen::MatrixXd dpi_q_dot = M_ * dyd + d.H * dOmd + Hd * dOm + G_Om * dqd;
+  // M dyd and H^T dyd with dyd = Y dr: (M Y) dr and (H^T Y) dr, M Y and H^T Y kept per configuration.
+  Eigen::MatrixXd dpi_q_dot = d.MY * dr + d.H * dOmd + Hd * dOm + G_Om * dqd;
   Eigen::MatrixXd df_q = dpi_q_dot - G_Om.transpose() * dy - Gty * dOm;
   const Eigen::Vector3d h = d.H.transpose() * y + d.Xq * Om;
   const Eigen::MatrixXd dh = d.H.transpose() * dy + d.Xq * dOm;
-  Eigen::MatrixXd dhd = d.H.transpose() * dyd + d.Xq * dOmd + Gty.transpose() * dqd + Hd.transpose() * dy;
+  Eigen::MatrixXd dhd = d.HtY * dr + d.Xq * dOmd + Gty.transpose() * dqd + Hd.transpose() * dy;
   for (int a = 0; a < 3; ++a) {
     for (int b = 0; b < 3; ++b) {
       const Eigen::VectorXd& XQab = d.XQ[size_t(3 * a + b)];
@@ -512,16 +514,18 @@ Eigen::MatrixXd SuperelementBody::ExactGyroscopic(const Data& data, const BodyVe
   return G;
 }
 
-Eigen::MatrixXd SuperelementBody::ExactMass(const Data& data) const {
+const Eigen::MatrixXd& SuperelementBody::ExactMass(const Data& data) const {
+  if (data.exact_mass) return *data.exact_mass;
   const ExactData& d = *data.exact;
   const Eigen::Matrix3d& R = data.frame.R;
   const Eigen::MatrixXd Zr = data.kin.Z.bottomRows<3>();
   const Eigen::MatrixXd YHZ = d.Y.transpose() * d.H * Zr;
-  Eigen::MatrixXd Mg = d.Y.transpose() * (M_ * d.Y) + YHZ + YHZ.transpose() + Zr.transpose() * d.Xq * Zr;
+  Eigen::MatrixXd Mg = d.Y.transpose() * d.MY + YHZ + YHZ.transpose() + Zr.transpose() * d.Xq * Zr;
   // Rbar Mbar Rbar^T block by block.
   for (int a = 0; a < 2 * n_nodes_; ++a) Mg.middleRows<3>(3 * a) = R * Mg.middleRows<3>(3 * a);
   for (int a = 0; a < 2 * n_nodes_; ++a) Mg.middleCols<3>(3 * a) = Mg.middleCols<3>(3 * a) * R.transpose();
-  return Mg;
+  data.exact_mass = std::move(Mg);
+  return *data.exact_mass;
 }
 
 void SuperelementBody::VelocityMaps(const Data& d, Eigen::MatrixXd* P, Eigen::MatrixXd* U) const {

@@ -108,6 +108,8 @@ class SuperelementBody {
   /// The exact inertia's configuration-dependent products (has_exact_inertia).
   struct ExactData {
     Eigen::MatrixXd Y;                  ///< Phi_rig0 Z + B
+    Eigen::MatrixXd MY;                 ///< M Y
+    Eigen::MatrixXd HtY;                ///< H^T Y (3 x n)
     Eigen::MatrixXd H;                  ///< n x 3: Gamma_a q
     std::array<Eigen::VectorXd, 9> XQ;  ///< Xi_ab q at 3 a + b (Xi_ba = Xi_ab^T)
     Eigen::Matrix3d Xq;                 ///< q^T Xi_ab q
@@ -122,6 +124,7 @@ class SuperelementBody {
     Kinematics kin;
     std::optional<ExactData> exact;                 ///< with the exact inertia
     mutable std::optional<BodyVelocityMaps> maps;   ///< the corotational maps, made when first asked
+    mutable std::optional<Eigen::MatrixXd> exact_mass;  ///< M_g of the exact inertia, made when first asked
   };
   /// The body's quantities at configuration `c` with its solved floating frame.
   Data Evaluate(const BodyConfiguration& c, const FrameSolution& frame) const;
@@ -332,7 +335,7 @@ class SuperelementBody {
   // Exact inertia (has_exact_inertia): per-configuration data, the force, the mass matrix M_g.
   ExactData Exact(const Eigen::VectorXd& q, const Kinematics& kin) const;
   Eigen::VectorXd ExactInertiaForce(const Data& d, const BodyVelocity& w, const BodyVelocity& wdot) const;
-  Eigen::MatrixXd ExactMass(const Data& d) const;
+  const Eigen::MatrixXd& ExactMass(const Data& d) const;  // computed once per Data
   // d f_in / d w of the exact inertia force (forward mode, exact).
   Eigen::MatrixXd ExactGyroscopic(const Data& d, const BodyVelocity& w) const;
   Eigen::MatrixXd ExactInertiaConfigurationTangent(const Data& d, const BodyVelocity& w,
