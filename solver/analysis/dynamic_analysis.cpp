@@ -341,15 +341,8 @@ StepOutcome GeneralizedAlphaStep(const SystemModel& model, const DofMap& dofs, c
       built = true;
       return a.K;  // K + gamma' C + beta' M
     };
-    if (!matrix.Update(dofs, options, h, S)) {
-      out.singular_matrix = S();
-      return out;
-    }
-    const Eigen::VectorXd delta = matrix.solver.Solve(a.residual);
-    if (!delta.allFinite()) {
-      out.singular_matrix = S();
-      return out;
-    }
+    Eigen::VectorXd delta;
+    if (!matrix.Increment(dofs, options, h, S, a.residual, delta, out.singular_matrix)) return out;
     ApplyIncrement(model, dofs, delta, next.config);
     next.W += gamma_p * delta;
     next.Wdot += beta_p * delta;

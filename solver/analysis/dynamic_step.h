@@ -85,6 +85,18 @@ struct IterationMatrix {
     ++factorizations;
     return true;
   }
+
+  // Newton's increment S^-1 r with the kept or a new factor. False when S is singular or the
+  // increment is not finite; S is then in `singular`.
+  bool Increment(const DofMap& dofs, const DynamicOptions& options, double h, const std::function<SystemMatrix()>& S,
+                 const Eigen::VectorXd& r, Eigen::VectorXd& delta, SystemMatrix& singular) {
+    if (Update(dofs, options, h, S)) {
+      delta = solver.Solve(r);
+      if (delta.allFinite()) return true;
+    }
+    singular = S();
+    return false;
+  }
 };
 
 struct StepOutcome {

@@ -281,15 +281,8 @@ StepOutcome MidpointStep(const SystemModel& model, const DofMap& dofs, const Dyn
     }
     // Newton's increment delta at n+1: dW_n+1 = V delta, dq_m = T delta, dw_m ~ delta / h.
     const auto S = [&] { return SystemMatrix(a.K * k.T + (1.0 / h) * (a.C + a.M * k.V)); };
-    if (!matrix.Update(dofs, options, h, S)) {
-      out.singular_matrix = S();
-      return out;
-    }
-    const Eigen::VectorXd delta = matrix.solver.Solve(a.residual);
-    if (!delta.allFinite()) {
-      out.singular_matrix = S();
-      return out;
-    }
+    Eigen::VectorXd delta;
+    if (!matrix.Increment(dofs, options, h, S, a.residual, delta, out.singular_matrix)) return out;
     ApplyIncrement(model, dofs, delta, next.config);
   }
   return out;
