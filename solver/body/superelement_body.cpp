@@ -80,6 +80,15 @@ SuperelementBody::SuperelementBody(const Superelement& se, const SuperelementOpt
     R0_.push_back(node.orientation);
   }
   Phi_rig0_ = RigidBodyModes(se, se.floating_frame.origin);
+  {
+    // CenterOfMass's constants. Phi_rig0^T M Phi_rig0 = [m 1, -s~; s~, J]: the first moment s
+    // from its (translation, rotation) block -s~ (entry (b, 3 + a) = e_b . (e_a x s)).
+    const Eigen::MatrixXd MPhi = M_ * Phi_rig0_;
+    const Eigen::Matrix<double, 6, 6> M_rig = Phi_rig0_.transpose() * MPhi;
+    mass_ = M_rig(0, 0);
+    first_moment0_ = Eigen::Vector3d(-M_rig(2, 4), -M_rig(0, 5), -M_rig(1, 3));
+    first_moment_map_ = MPhi.leftCols<3>().transpose();
+  }
   T0_ = Eigen::MatrixXd::Identity(n_coordinates(), n_coordinates()) - Phi_rig0_ * Phi_CB_;
   double size = 0.0;
   for (const Eigen::Vector3d& X : X_) size = std::max(size, X.norm());
@@ -824,14 +833,8 @@ void SuperelementBody::Momentum(const Data& d, const BodyVelocity& w, Eigen::Vec
 }
 
 Eigen::Vector3d SuperelementBody::CenterOfMass(const BodyConfiguration& c, const FrameSolution& frame) const {
-  const Eigen::MatrixXd MPhi = M_ * Phi_rig0_;
-  // Phi_rig0^T M Phi_rig0 = [m 1, -s~; s~, J]: the first moment s from its (translation,
-  // rotation) block -s~ (entry (b, 3 + a) = e_b . (e_a x s)).
-  const Eigen::Matrix<double, 6, 6> M_rig = Phi_rig0_.transpose() * MPhi;
-  const double mass = M_rig(0, 0);
-  const Eigen::Vector3d s0(-M_rig(2, 4), -M_rig(0, 5), -M_rig(1, 3));
-  const Eigen::Vector3d moment = s0 + MPhi.leftCols<3>().transpose() * LocalCoordinates(c, frame);
-  return frame.x + frame.R * (mass > 0 ? Eigen::Vector3d(moment / mass) : Eigen::Vector3d::Zero());
+  const Eigen::Vector3d moment = first_moment0_ + first_moment_map_ * LocalCoordinates(c, frame);
+  return frame.x + frame.R * (mass_ > 0 ? Eigen::Vector3d(moment / mass_) : Eigen::Vector3d::Zero());
 }
 
 Eigen::VectorXd SuperelementBody::GravityForce(const Data& data, const Eigen::Vector3d& g) const {

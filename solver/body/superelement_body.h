@@ -332,6 +332,10 @@ class SuperelementBody {
   Eigen::MatrixXd QuadraticInertiaDerivative(const Eigen::MatrixXd& U, const Eigen::MatrixXd& Mg,
                                              const BodyVelocity& w) const;
   Eigen::MatrixXd Phi_rig0_;
+  // CenterOfMass: the mass m, the undeformed first moment s_0 about the frame origin, and C.
+  double mass_ = 0.0;
+  Eigen::Vector3d first_moment0_ = Eigen::Vector3d::Zero();
+  Eigen::MatrixXd first_moment_map_;  ///< 3 x n
   // Exact inertia (has_exact_inertia): per-configuration data, the force, the mass matrix M_g.
   ExactData Exact(const Eigen::VectorXd& q, const Kinematics& kin) const;
   Eigen::VectorXd ExactInertiaForce(const Data& d, const BodyVelocity& w, const BodyVelocity& wdot) const;
