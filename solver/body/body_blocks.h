@@ -1,0 +1,58 @@
+// Block helpers of the superelement body's kernels (superelement_body.cpp, exact_inertia.cpp):
+// node vectors and matrices turned by 3 x 3 blocks, the exact derivative of a quadratic function.
+// Internal to solver/body.
+#pragma once
+
+#include <Eigen/Core>
+#include <algorithm>
+
+namespace femb::body_blocks {
+
+// The derivative of a quadratic vector function g at w, exactly (no truncation):
+// Dg(w) e = [g(w + s e) - g(w) - g(s e)] / s for any s > 0.
+template <class Quadratic>
+Eigen::MatrixXd QuadraticDerivative(const Eigen::VectorXd& w, const Quadratic& g) {
+  const long n = w.size();
+  const double s = std::max(w.norm(), 1.0);
+  const Eigen::VectorXd g0 = g(w);
+  Eigen::MatrixXd D(n, n);
+  for (long i = 0; i < n; ++i) {
+    const Eigen::VectorXd e = s * Eigen::VectorXd::Unit(n, i);
+    D.col(i) = (g(w + e) - g0 - g(e)) / s;
+  }
+  return D;
+}
+
+// R applied to the first `blocks` 3-vectors of v (node forces and moments; modal rows as they are).
+inline Eigen::VectorXd TurnBlocks(const Eigen::Matrix3d& R, const Eigen::VectorXd& v, int blocks) {
+  Eigen::VectorXd out = v;
+  for (int a = 0; a < blocks; ++a) out.segment<3>(3 * a) = R * v.segment<3>(3 * a);
+  return out;
+}
+
+// X <- blockdiag(A(0), ..., A(blocks - 1), 1) X in place: the first `blocks` row triples each
+// turned by its 3 x 3 matrix A(a), column by column (fixed-size products, no temporaries; a
+// dense n x n product with the block-diagonal Rbar would cost n / 3 times more).
+template <class Blocks>
+void TurnRowBlocks(Eigen::MatrixXd& X, int blocks, const Blocks& A) {
+  for (int a = 0; a < blocks; ++a) {
+    const Eigen::Matrix3d Aa = A(a);
+    for (Eigen::Index j = 0; j < X.cols(); ++j) {
+      const Eigen::Vector3d x = X.block<3, 1>(3 * a, j);
+      X.block<3, 1>(3 * a, j) = Aa * x;
+    }
+  }
+}
+
+// X <- X blockdiag(A(0), ..., A(blocks - 1), 1) in place, row by row.
+template <class Blocks>
+void TurnColBlocks(Eigen::MatrixXd& X, int blocks, const Blocks& A) {
+  for (int a = 0; a < blocks; ++a) {
+    const Eigen::Matrix3d Aa = A(a);
+    for (Eigen::Index i = 0; i < X.rows(); ++i) {
+      const Eigen::RowVector3d x = X.block<1, 3>(i, 3 * a);
+      X.block<1, 3>(i, 3 * a) = x * Aa;
+    }
+  }
+}
+}  // namespace femb::body_blocks
