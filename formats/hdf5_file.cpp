@@ -233,6 +233,17 @@ Eigen::MatrixXi Reader::IntMatrix(const std::string& name) const {
   return m;
 }
 
+Eigen::VectorXi Reader::IntVector(const std::string& name) const {
+  std::vector<hsize_t> shape = Shape(name);
+  if (shape.size() != 1) Fail("dataset " + name + " must be 1-dimensional");
+  Eigen::VectorXi v(static_cast<Eigen::Index>(shape[0]));
+  Handle set = Own(H5Dopen2(file_.id(), name.c_str(), H5P_DEFAULT));
+  if (v.size() > 0 && H5Dread(set.id(), H5T_NATIVE_INT, H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data()) < 0) {
+    Fail("cannot read dataset " + name);
+  }
+  return v;
+}
+
 std::vector<std::string> Reader::Strings(const std::string& name) const {
   std::vector<hsize_t> shape = Shape(name);
   if (shape.size() != 1) Fail("dataset " + name + " must be a 1-dimensional list of strings");

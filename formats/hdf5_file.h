@@ -68,6 +68,7 @@ class Reader {
   Eigen::MatrixXd Matrix(const std::string& name) const;
   Eigen::VectorXd Vector(const std::string& name) const;
   Eigen::MatrixXi IntMatrix(const std::string& name) const;
+  Eigen::VectorXi IntVector(const std::string& name) const;
   double Scalar(const std::string& name) const;
   std::vector<std::string> Strings(const std::string& name) const;
   std::string StringAttribute(const std::string& object, const std::string& name) const;

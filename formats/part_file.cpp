@@ -339,6 +339,13 @@ PartSpec ParsePart(const std::string& text, const std::string& name,
       }
     }
     if (auto v = m.Optional("keep_mesh")) part.reduction.keep_mesh = v->Bool();
+    if (auto v = m.Optional("stresses")) {
+      part.reduction.stresses = v->Bool();
+      part.reduction.where_stresses = v->Where();
+      if (*part.reduction.stresses && part.reduction.keep_mesh == false) {
+        v->Fail("reduction.stresses: true needs the mesh: keep_mesh is false (the stresses live on its nodes)");
+      }
+    }
     if (auto v = m.Optional("geometric_stiffening")) part.reduction.geometric_stiffening = v->Bool();
     if (auto v = m.Optional("full_modes")) part.reduction.full_modes = int(v->NonNegativeInteger());
     if (auto v = m.Optional("memory_limit_gb")) part.reduction.memory_limit_gb = v->PositiveNumber();

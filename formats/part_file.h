@@ -92,6 +92,10 @@ struct ReductionSpec {
   /// kKeepMeshMaxDofs DOFs (the shapes take n_dofs x n_reduced doubles).
   std::optional<bool> keep_mesh;
   static constexpr long kKeepMeshMaxDofs = 200000;
+  /// Modal stresses (issue 17, reducer/reduction/modal_stress.h) beside the kept mesh; unset: on
+  /// whenever the mesh is kept. true without the mesh is an error.
+  std::optional<bool> stresses;
+  std::string where_stresses;
   int full_modes = 0;     ///< K lowest nonzero free-free frequencies of the full model
   double memory_limit_gb = 0;  ///< refuse when the Cholesky factor would exceed it (0: MemAvailable)
   std::string where_floating_frame;

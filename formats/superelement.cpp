@@ -79,9 +79,24 @@ MassProperties ComputeMassProperties(const Superelement& se) {
 
 }  // namespace femb
 
+#include <Eigen/Eigenvalues>
 #include <cmath>
 namespace femb {
 double FrequencyHz(double lambda) {
   return std::copysign(std::sqrt(std::abs(lambda)), lambda) / (2.0 * M_PI);
+}
+
+double VonMises(const Eigen::Matrix<double, 6, 1>& s) {
+  const double a = s[0] - s[1], b = s[1] - s[2], c = s[2] - s[0];
+  return std::sqrt(0.5 * (a * a + b * b + c * c) + 3.0 * (s[3] * s[3] + s[4] * s[4] + s[5] * s[5]));
+}
+
+Eigen::Vector3d PrincipalStresses(const Eigen::Matrix<double, 6, 1>& s) {
+  Eigen::Matrix3d S;
+  S << s[0], s[5], s[4], s[5], s[1], s[3], s[4], s[3], s[2];
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
+  eig.compute(S, Eigen::EigenvaluesOnly);  // iterative: computeDirect loses digits on near-equal roots
+  const Eigen::Vector3d l = eig.eigenvalues();  // ascending
+  return Eigen::Vector3d(l[2], l[1], l[0]);
 }
 }  // namespace femb

@@ -59,6 +59,30 @@ struct Visualization {
   Eigen::MatrixXd shapes;       ///< (n_nodes * dofs_per_node) x n_reduced, node-major
 };
 
+/// Optional (issue 17): the stress that each reduced coordinate causes at stress points of the
+/// kept mesh. Linear: sigma(point p) = sum_i q_i modes.block(6 p, i, 6, 1) for local coordinates
+/// q (the rigid-body modes cause none). Components (xx, yy, zz, yz, xz, xy), Cauchy = linear
+/// stress, part axes, [stress per unit of the coordinate]. Solids: one point per mesh node (the
+/// element stresses at the quadrature points projected onto each element's own shape functions
+/// (local L2 projection), averaged over the elements at the node weighted by their volume).
+/// Beams: fibre points of the section at both ends of every element (axial stress from the
+/// normal force and the bending moments, shear from torsion and transverse shear; see
+/// reducer/reduction/modal_stress.h), several per mesh node.
+struct ModalStress {
+  std::string method;            ///< "solid_nodal_l2" or "beam_fibres": how the points were made
+  Eigen::MatrixXd points;        ///< n_points x 3, part axes [length]
+  Eigen::VectorXi node;          ///< n_points: the visualization mesh node each point belongs to
+  Eigen::MatrixXf modes;         ///< (6 n_points) x n_reduced, point-major
+  /// Beams: the section forces at the element ends, (12 n_cells) x n_reduced: per element
+  /// (N, V_y, V_z, T, M_y, M_z) at its first node, then at its second, in element axes (the
+  /// force and moment that the part beyond the cut exerts, i.e. tension and sagging positive as
+  /// in beam theory); element_axes (n_cells x 9): rows e1 (along), e2, e3 of each element, part
+  /// axes. Empty for solids.
+  Eigen::MatrixXf section_forces;
+  Eigen::MatrixXd element_axes;
+  int n_points() const { return int(points.rows()); }
+};
+
 /// Where the file came from and what it cost.
 struct Provenance {
   std::string femb_version;
@@ -111,6 +135,7 @@ struct Superelement {
   /// energy of the reduced field in the floating frame.
   std::vector<Eigen::MatrixXd> inertia_gamma, inertia_xi;
   std::optional<Visualization> visualization;
+  std::optional<ModalStress> stress;  ///< only with the visualization mesh
   Provenance provenance;
 
   int n_interface_nodes() const { return int(interfaces.size()); }
@@ -142,6 +167,10 @@ MassProperties ComputeMassProperties(const Superelement& se);
 }  // namespace femb
 
 namespace femb {
+/// von Mises equivalent stress of (xx, yy, zz, yz, xz, xy).
+double VonMises(const Eigen::Matrix<double, 6, 1>& s);
+/// Principal stresses of (xx, yy, zz, yz, xz, xy), largest first.
+Eigen::Vector3d PrincipalStresses(const Eigen::Matrix<double, 6, 1>& s);
 /// Signed frequency in Hz from an eigenvalue omega^2: sign(lambda) sqrt(|lambda|) / (2 pi).
 double FrequencyHz(double lambda);
 }  // namespace femb

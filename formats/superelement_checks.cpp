@@ -62,6 +62,12 @@ Check Finite(const Superelement& se) {
     datasets.emplace_back("/visualization/nodes", se.visualization->nodes);
     datasets.emplace_back("/visualization/shapes", se.visualization->shapes);
   }
+  if (se.stress) {
+    datasets.emplace_back("/stress/modes", se.stress->modes.cast<double>());
+    if (se.stress->section_forces.size() > 0) {
+      datasets.emplace_back("/stress/section_forces", se.stress->section_forces.cast<double>());
+    }
+  }
   for (const auto& [name, A] : datasets) {
     const std::string bad = FirstNonFinite(A);
     if (!bad.empty()) return {"finite", false, name + " " + bad, name};

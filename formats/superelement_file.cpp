@@ -140,6 +140,19 @@ void WriteContent(const Superelement& se, h5::Writer& w) {
     w.IntMatrix("/visualization/cells", v.cells);
     w.Matrix("/visualization/shapes", v.shapes);
   }
+  if (se.stress) {
+    const ModalStress& st = *se.stress;
+    w.CreateGroup("/stress");
+    w.Attribute("/stress", "method", st.method);
+    w.Attribute("/stress", "components", std::string("xx yy zz yz xz xy"));
+    w.Matrix("/stress/points", st.points);
+    w.IntVector("/stress/node", std::vector<int>(st.node.data(), st.node.data() + st.node.size()));
+    w.FloatMatrix("/stress/modes", st.modes);
+    if (st.section_forces.size() > 0) {
+      w.FloatMatrix("/stress/section_forces", st.section_forces);
+      w.Matrix("/stress/element_axes", st.element_axes);
+    }
+  }
 
   const Provenance& p = se.provenance;
   w.CreateGroup("/provenance");
@@ -303,6 +316,31 @@ Superelement ReadSuperelementFile(const std::string& path, const SuperelementRea
     v.cells = r.IntMatrix("/visualization/cells");
     RequireShape(r, "/visualization/shapes", v.nodes.rows() * v.dofs_per_node, n);
     v.shapes = r.Matrix("/visualization/shapes");
+    if (options.stress && r.Exists("/stress")) {
+      ModalStress st;
+      st.method = r.StringAttribute("/stress", "method");
+      const std::vector<hsize_t> shape = r.Shape("/stress/points");
+      const long np = shape.empty() ? 0 : long(shape[0]);
+      RequireShape(r, "/stress/points", np, 3);
+      st.points = r.Matrix("/stress/points");
+      RequireShape(r, "/stress/node", np, -1);
+      st.node = r.IntVector("/stress/node");
+      for (long p = 0; p < np; ++p) {
+        if (st.node[p] < 0 || st.node[p] >= v.nodes.rows()) {
+          throw InputError(path + ": dataset /stress/node: entry " + std::to_string(p) + " = " +
+                           std::to_string(st.node[p]) + " is not a node of /visualization/nodes");
+        }
+      }
+      RequireShape(r, "/stress/modes", 6 * np, n);
+      st.modes = r.Matrix("/stress/modes").cast<float>();
+      if (r.Exists("/stress/section_forces")) {
+        RequireShape(r, "/stress/section_forces", 12 * v.cells.rows(), n);
+        RequireShape(r, "/stress/element_axes", v.cells.rows(), 9);
+        st.section_forces = r.Matrix("/stress/section_forces").cast<float>();
+        st.element_axes = r.Matrix("/stress/element_axes");
+      }
+      se.stress = std::move(st);
+    }
     se.visualization = std::move(v);
   }
 

@@ -18,6 +18,7 @@ void WriteSuperelementFile(const Superelement& se, const std::string& path);
 /// What to read besides the always-present data.
 struct SuperelementReadOptions {
   bool visualization = true;  ///< read the (possibly large) mesh and mode shapes if present
+  bool stress = true;         ///< with the mesh: read the modal stresses if present
 };
 
 /// Reads a superelement file. Throws InputError naming the file and the problem for: a missing

@@ -13,6 +13,7 @@
 #include "reducer/reduction/craig_bampton.h"
 #include "reducer/reduction/floating_frame.h"
 #include "reducer/reduction/full_modes.h"
+#include "reducer/reduction/modal_stress.h"
 
 #ifndef FEMB_VERSION
 #define FEMB_VERSION "unknown"
@@ -70,6 +71,12 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
     report("mesh+assembly", clock.Seconds(), detail);
   }
 
+  const bool keep_mesh = part.reduction.keep_mesh.value_or(model.n_dofs() <= ReductionSpec::kKeepMeshMaxDofs);
+  if (!keep_mesh && part.reduction.stresses.value_or(false)) {
+    throw InputError(part.reduction.where_stresses + ": reduction.stresses: true needs the mesh, which is not kept for "
+                     "more than " + std::to_string(ReductionSpec::kKeepMeshMaxDofs) + " DOFs (this part has " +
+                     std::to_string(model.n_dofs()) + "): set reduction.keep_mesh: true");
+  }
   const long n_interior = long(InteriorDofs(model).size());
   if (part.reduction.internal_modes > n_interior) {
     throw InputError(part.file + ": reduction.internal_modes = " +
@@ -236,7 +243,6 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
     }
     clock.Restart();
   }
-  const bool keep_mesh = part.reduction.keep_mesh.value_or(model.n_dofs() <= ReductionSpec::kKeepMeshMaxDofs);
   if (keep_mesh) {
     Visualization v;
     v.nodes = model.nodes;
@@ -254,6 +260,17 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
   prov.n_elements = model.n_elements();
   report("frame+mass", clock.Seconds(), "floating frame " + se.floating_frame.type +
                                              (keep_mesh ? ", mesh and mode shapes kept" : ", mesh and mode shapes not kept (reduction.keep_mesh)"));
+  if (keep_mesh && part.reduction.stresses.value_or(true)) {
+    Stopwatch stress_clock;
+    const Visualization& v = *se.visualization;
+    se.stress = part.type == "solid"
+                    ? SolidModalStress(SolidTypeOf(model.cell_type), model.nodes, model.cells, part.material, v.shapes)
+                    : BeamModalStress(part, v.shapes);
+    std::snprintf(detail, sizeof detail, "%d stress points x %ld coordinates (%s), %.3g MB in single precision",
+                  se.stress->n_points(), long(v.shapes.cols()), se.stress->method.c_str(),
+                  4.0 * double(se.stress->modes.size() + se.stress->section_forces.size()) / 1e6);
+    report("stresses", stress_clock.Seconds(), detail);
+  }
 
   if (part.reduction.full_modes > 0) {
     clock.Restart();

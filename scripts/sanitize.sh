@@ -6,7 +6,7 @@
 # the library code, which the other tests exercise on the same paths.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=Sanitize -DCMAKE_CXX_FLAGS_SANITIZE="-O1 -g" -DCMAKE_C_FLAGS_SANITIZE="-O1 -g" \
+cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=Sanitize -DCMAKE_CXX_FLAGS_SANITIZE="-O1 -g1" -DCMAKE_C_FLAGS_SANITIZE="-O1 -g1" \
   -DFEMB_SANITIZE=ON >/dev/null
 targets=$(grep -o '^femb_add_test([^)]*)' tests/CMakeLists.txt | sed 's|.*/||; s|\.cpp)||')
 # shellcheck disable=SC2086

@@ -1,0 +1,217 @@
+#include "reducer/reduction/modal_stress.h"
+
+#include <Eigen/Cholesky>
+#include <cmath>
+#include <vector>
+
+#include "reducer/fe/beam_model.h"
+#include "reducer/fe/timoshenko_beam.h"
+
+namespace femb {
+namespace {
+
+// Strain-displacement rows (xx, yy, zz, yz, xz, xy; engineering shear) of one quadrature point.
+Eigen::MatrixXd StrainMatrix(const Eigen::MatrixXd& dNdX) {
+  const long n = dNdX.rows();
+  Eigen::MatrixXd B = Eigen::MatrixXd::Zero(6, 3 * n);
+  for (long a = 0; a < n; ++a) {
+    const double gx = dNdX(a, 0), gy = dNdX(a, 1), gz = dNdX(a, 2);
+    B(0, 3 * a) = gx;
+    B(1, 3 * a + 1) = gy;
+    B(2, 3 * a + 2) = gz;
+    B(3, 3 * a + 1) = gz;
+    B(3, 3 * a + 2) = gy;
+    B(4, 3 * a) = gz;
+    B(4, 3 * a + 2) = gx;
+    B(5, 3 * a) = gy;
+    B(5, 3 * a + 1) = gx;
+  }
+  return B;
+}
+
+// (xx, yy, zz, yz, xz, xy) of the part-axes tensor R^T S R of a fibre's element-axes stress:
+// S = [s t_y t_z; t_y 0 0; t_z 0 0], R's rows the element axes.
+Eigen::Matrix<double, 6, 3> FibreToPart(const Eigen::Matrix3d& R) {
+  Eigen::Matrix<double, 6, 3> V;
+  const int rows[6][2] = {{0, 0}, {1, 1}, {2, 2}, {1, 2}, {0, 2}, {0, 1}};
+  for (int k = 0; k < 6; ++k) {
+    const int i = rows[k][0], j = rows[k][1];
+    // sigma_ij = sum_ab R_ai S_ab R_bj with S_00 = s, S_01 = S_10 = t_y, S_02 = S_20 = t_z.
+    V(k, 0) = R(0, i) * R(0, j);
+    V(k, 1) = R(0, i) * R(1, j) + R(1, i) * R(0, j);
+    V(k, 2) = R(0, i) * R(2, j) + R(2, i) * R(0, j);
+  }
+  return V;
+}
+
+// One fibre of a section: where it is (y, z) and the map from the section forces
+// (N, V_y, V_z, T, M_y, M_z) to its stresses (sigma_xx, tau_xy, tau_xz) in element axes.
+struct Fibre {
+  double y, z;
+  Eigen::Matrix<double, 3, 6> map;
+};
+
+// Saint-Venant torsion of a rectangle with half sides a >= b (see the header): the shear stress
+// per unit torque at the middle of the long sides and of the short sides.
+void RectangleTorsion(double a, double b, double* tau_long, double* tau_short) {
+  double s5 = 0, sech = 0, alt = 0;
+  for (int n = 1; n < 400; n += 2) {
+    const double x = n * M_PI * a / (2 * b);
+    s5 += std::tanh(x) / std::pow(n, 5);
+    sech += (x > 700 ? 0.0 : 1.0 / std::cosh(x)) / (double(n) * n);
+    alt += ((n / 2) % 2 == 0 ? 1.0 : -1.0) * std::tanh(x) / (double(n) * n);
+  }
+  const double g_theta = 1.0 / ((16.0 / 3.0) * a * b * b * b * (1 - 192 / std::pow(M_PI, 5) * (b / a) * s5));
+  *tau_long = 2 * g_theta * b - 16 * g_theta * b / (M_PI * M_PI) * sech;
+  *tau_short = 16 * g_theta * b / (M_PI * M_PI) * alt;
+}
+
+std::vector<Fibre> SectionFibres(const BeamSectionSpec& s, const SectionProperties& p) {
+  std::vector<Fibre> fibres;
+  auto axial = [&](double y, double z) {
+    Fibre f{y, z, Eigen::Matrix<double, 3, 6>::Zero()};
+    f.map(0, 0) = 1 / p.A;
+    f.map(0, 4) = z / p.Iy;
+    f.map(0, 5) = -y / p.Iz;
+    return f;
+  };
+  if (s.shape == "circle" || s.shape == "tube") {
+    const double R = s.shape == "circle" ? 0.5 * s.diameter : s.outer_radius;
+    const double r = s.shape == "circle" ? 0.0 : s.outer_radius - s.wall;
+    const double jourawski = (4.0 / 3.0) * (R * R + R * r + r * r) / (R * R + r * r) / p.A;
+    for (int k = 0; k < 8; ++k) {
+      const double phi = k * M_PI / 4, c = std::cos(phi), sn = std::sin(phi);
+      Fibre f = axial(R * c, R * sn);
+      // Torsion: tangential, e_x x rho: tau_xy = -T z / J, tau_xz = T y / J.
+      f.map(1, 3) = -R * sn / p.J;
+      f.map(2, 3) = R * c / p.J;
+      if (k % 4 == 2) f.map(1, 1) = jourawski;  // y = 0: the neutral axis of V_y
+      if (k % 4 == 0) f.map(2, 2) = jourawski;  // z = 0: the neutral axis of V_z
+      fibres.push_back(f);
+    }
+  } else if (s.shape == "rectangle") {
+    const double hy = 0.5 * s.width, hz = 0.5 * s.height;
+    double t_long = 0, t_short = 0;
+    RectangleTorsion(std::max(hy, hz), std::min(hy, hz), &t_long, &t_short);
+    // The long sides are the ones at y = +-hy when the section is taller than wide.
+    const double t_at_y_sides = hz >= hy ? t_long : t_short, t_at_z_sides = hz >= hy ? t_short : t_long;
+    for (int sy : {-1, 1})
+      for (int sz : {-1, 1}) fibres.push_back(axial(sy * hy, sz * hz));
+    for (int sy : {-1, 1}) {  // middle of the sides y = +-hy: tau_xz from torsion and from V_z
+      Fibre f = axial(sy * hy, 0);
+      f.map(2, 3) = sy * t_at_y_sides;
+      f.map(2, 2) = 1.5 / p.A;
+      fibres.push_back(f);
+    }
+    for (int sz : {-1, 1}) {  // middle of the sides z = +-hz: tau_xy from torsion and from V_y
+      Fibre f = axial(0, sz * hz);
+      f.map(1, 3) = -sz * t_at_z_sides;
+      f.map(1, 1) = 1.5 / p.A;
+      fibres.push_back(f);
+    }
+  }
+  return fibres;
+}
+
+}  // namespace
+
+ModalStress SolidModalStress(SolidType type, const Eigen::MatrixXd& nodes, const Eigen::MatrixXi& cells,
+                             const MaterialSpec& material, const Eigen::MatrixXd& mesh_shapes) {
+  const long n_nodes = nodes.rows(), m = mesh_shapes.cols();
+  const int n = SolidNodeCount(type);
+  const Eigen::Matrix<double, 6, 6> D = IsotropicElasticity(material.E, material.nu);
+  Eigen::MatrixXd sum = Eigen::MatrixXd::Zero(6 * n_nodes, m);
+  Eigen::VectorXd weight = Eigen::VectorXd::Zero(n_nodes);
+  Eigen::MatrixXd X(n, 3), U(3 * n, m);
+  for (long e = 0; e < cells.rows(); ++e) {
+    for (int a = 0; a < n; ++a) {
+      X.row(a) = nodes.row(cells(e, a));
+      U.middleRows(3 * a, 3) = mesh_shapes.middleRows(3 * long(cells(e, a)), 3);
+    }
+    // E = sum_g dV N_g (x) D B_g: (6 n) x (3 n), node-major; M_e = sum_g dV N_g N_g^T.
+    Eigen::MatrixXd E = Eigen::MatrixXd::Zero(6 * n, 3 * n), Me = Eigen::MatrixXd::Zero(n, n);
+    double volume = 0;
+    for (const SolidPoint& p : SolidElementPoints(type, X, e + 1)) {
+      const Eigen::MatrixXd DB = D * StrainMatrix(p.dNdX);
+      for (int a = 0; a < n; ++a) E.middleRows(6 * a, 6) += (p.dV * p.N[a]) * DB;
+      Me.noalias() += p.dV * p.N * p.N.transpose();
+      volume += p.dV;
+    }
+    const Eigen::MatrixXd S = E * U;  // (6 n) x m: int N_a sigma dV per node a
+    const Eigen::LLT<Eigen::MatrixXd> llt(Me);
+    for (int c = 0; c < 6; ++c) {
+      // The projection per stress component: nodal values = M_e^-1 (int N sigma_c dV).
+      Eigen::MatrixXd rhs(n, m);
+      for (int a = 0; a < n; ++a) rhs.row(a) = S.row(6 * a + c);
+      const Eigen::MatrixXd nodal = llt.solve(rhs);
+      for (int a = 0; a < n; ++a) sum.row(6 * long(cells(e, a)) + c) += volume * nodal.row(a);
+    }
+    for (int a = 0; a < n; ++a) weight[cells(e, a)] += volume;
+  }
+  ModalStress out;
+  out.method = "solid_nodal_l2";
+  out.points = nodes;
+  out.node.resize(n_nodes);
+  out.modes.resize(6 * n_nodes, m);
+  for (long i = 0; i < n_nodes; ++i) {
+    out.node[i] = int(i);
+    // Nodes of no element (none in a meshed part) keep zero stress.
+    const double w = weight[i] > 0 ? weight[i] : 1.0;
+    out.modes.middleRows(6 * i, 6) = (sum.middleRows(6 * i, 6) / w).cast<float>();
+  }
+  return out;
+}
+
+ModalStress BeamModalStress(const PartSpec& part, const Eigen::MatrixXd& shapes) {
+  std::vector<Eigen::Vector3d> nodes;
+  const std::vector<BeamElement> elements = BeamElements(part, &nodes);
+  const long m = shapes.cols(), n_cells = long(elements.size());
+  ModalStress out;
+  out.method = "beam_fibres";
+  out.section_forces.resize(12 * n_cells, m);
+  out.element_axes.resize(n_cells, 9);
+  std::vector<Eigen::Vector3d> points;
+  std::vector<int> point_node;
+  std::vector<Eigen::MatrixXd> point_modes;
+  long e = 0;
+  for (const BeamSegmentSpec& seg : part.beam.segments) {
+    const BeamSectionSpec& section = seg.section ? *seg.section : part.beam.section;
+    const SectionProperties props = ComputeSectionProperties(section, part.material.nu);
+    const std::vector<Fibre> fibres = SectionFibres(section, props);
+    for (int k = 0; k < seg.elements; ++k, ++e) {
+      const BeamElement& el = elements[size_t(e)];
+      Eigen::MatrixXd u(12, m);
+      u.topRows(6) = shapes.middleRows(6 * long(el.n1), 6);
+      u.bottomRows(6) = shapes.middleRows(6 * long(el.n2), 6);
+      // End forces on the element, local axes; the section forces: minus those at the first
+      // end (its cut face points along -x), those at the second.
+      const Eigen::MatrixXd f = el.beam->LocalStiffness() * (BeamTransformation(el.R) * u);
+      Eigen::MatrixXd ends(12, m);
+      ends.topRows(6) = -f.topRows(6);
+      ends.bottomRows(6) = f.bottomRows(6);
+      out.section_forces.middleRows(12 * e, 12) = ends.cast<float>();
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c) out.element_axes(e, 3 * r + c) = el.R(r, c);
+      const Eigen::Matrix<double, 6, 3> to_part = FibreToPart(el.R);
+      for (int end = 0; end < 2; ++end) {
+        const int node = end == 0 ? el.n1 : el.n2;
+        for (const Fibre& fb : fibres) {
+          points.push_back(nodes[size_t(node)] + fb.y * el.R.row(1).transpose() + fb.z * el.R.row(2).transpose());
+          point_node.push_back(node);
+          point_modes.push_back(to_part * fb.map * ends.middleRows(6 * end, 6));
+        }
+      }
+    }
+  }
+  out.points.resize(long(points.size()), 3);
+  out.node.resize(long(points.size()));
+  out.modes.resize(6 * long(points.size()), m);
+  for (size_t p = 0; p < points.size(); ++p) {
+    out.points.row(long(p)) = points[p].transpose();
+    out.node[long(p)] = point_node[p];
+    out.modes.middleRows(6 * long(p), 6) = point_modes[p].cast<float>();
+  }
+  return out;
+}
+
+}  // namespace femb
