@@ -420,20 +420,33 @@ SceneSpec ParseScene(const std::string& text, const std::string& name, const std
     if (auto v = m.Optional("animation")) scene.animation = v->Bool();
     if (auto v = m.Optional("animation_every")) scene.animation_every = int(v->NonNegativeInteger());
     if (auto v = m.Optional("reactions")) scene.reactions = scene.reactions || v->Bool();
+    if (auto v = m.Optional("stresses")) scene.stresses = v->Bool();
     if (auto probes = m.Optional("probes")) {
       for (const YamlValue& item : probes->List()) {
         YamlMap pm = item.Map();
         SceneProbeSpec p;
         p.where = item.Where();
         p.name = pm.Required("name").String();
-        p.node = check_node(pm.Required("node"));
+        const auto body = pm.Optional("body");
+        if (body) {
+          // A stress probe: a body and a point, quantities [stress] only.
+          p.body = body->String();
+          p.point = pm.Required("point").Vector3();
+          if (pm.Optional("node")) item.Fail("probe '" + p.name + "': give either node (node quantities) or body and point (stress), not both");
+        } else {
+          p.node = check_node(pm.Required("node"));
+        }
         YamlValue q = pm.Required("quantities");
         for (const YamlValue& qi : q.List()) {
           const std::string s = qi.String();
           if (s != "position" && s != "rotation" && s != "velocity" && s != "angular_velocity" && s != "joint" &&
-              s != "reaction") {
+              s != "reaction" && s != "stress") {
             qi.Fail("unknown probe quantity '" + s +
-                    "' (known: position, rotation, velocity, angular_velocity, joint, reaction)");
+                    "' (known: position, rotation, velocity, angular_velocity, joint, reaction; stress with body and point)");
+          }
+          if ((s == "stress") != body.has_value()) {
+            qi.Fail(s == "stress" ? "probe quantity 'stress' needs body and point (e.g. {name: s, body: rod0, point: [x, y, z], quantities: [stress]})"
+                                  : "probe quantity '" + s + "' is a node quantity: give node, not body and point");
           }
           if (s == "reaction") scene.reactions = true;
           p.quantities.push_back(s);

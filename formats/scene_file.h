@@ -87,7 +87,11 @@ struct SceneLoadSpec {
 struct SceneProbeSpec {
   std::string name;
   std::string node;
-  std::vector<std::string> quantities;  ///< position, rotation, velocity, angular_velocity, joint, reaction
+  /// A stress probe (quantity `stress`, issue 17) names a body and a point instead of a node: the
+  /// body's stress point nearest to `point` (scene coordinates at the initial placement).
+  std::string body;
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();
+  std::vector<std::string> quantities;  ///< position, rotation, velocity, angular_velocity, joint, reaction | stress
   std::string where;
 };
 
@@ -133,6 +137,11 @@ struct SceneSpec {
   /// Compute the support and joint reactions at every output step (outputs.reactions, or a probe
   /// asking for `reaction`): /nodes/reaction in results.h5.
   bool reactions = false;
+  /// Stress recovery in every body whose superelement file has modal stresses (outputs.stresses):
+  /// von Mises, principal stresses and the tensor as node fields of the animation, and each
+  /// body's largest von Mises stress and where it is per output step in results.h5. Off by
+  /// default (no cost); stress probes work without it.
+  bool stresses = false;
   /// Initial velocity (spatial) of named nodes: (linear, angular).
   std::map<std::string, std::pair<Eigen::Vector3d, Eigen::Vector3d>> initial_velocities;
   /// Initial joint rates of named nodes that have a joint (revolute: angular rate, ...).

@@ -99,4 +99,23 @@ Eigen::Vector3d PrincipalStresses(const Eigen::Matrix<double, 6, 1>& s) {
   const Eigen::Vector3d l = eig.eigenvalues();  // ascending
   return Eigen::Vector3d(l[2], l[1], l[0]);
 }
+
+void NodeStresses(const ModalStress& modal, const Eigen::VectorXd& q, long n_nodes, Eigen::MatrixXd* stress,
+                  Eigen::VectorXd* von_mises) {
+  // Column by column in double precision (no double copy of the single-precision modes).
+  Eigen::VectorXd all = Eigen::VectorXd::Zero(modal.modes.rows());
+  for (Eigen::Index i = 0; i < q.size(); ++i) all += q[i] * modal.modes.col(i).cast<double>();
+  stress->setZero(n_nodes, 6);
+  von_mises->setConstant(n_nodes, -1.0);
+  for (int p = 0; p < modal.n_points(); ++p) {
+    const Eigen::Matrix<double, 6, 1> s = all.segment<6>(6 * p);
+    const double v = VonMises(s);
+    const int k = modal.node[p];
+    if (v > (*von_mises)[k]) {
+      (*von_mises)[k] = v;
+      stress->row(k) = s.transpose();
+    }
+  }
+  *von_mises = von_mises->cwiseMax(0.0);
+}
 }  // namespace femb

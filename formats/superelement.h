@@ -171,6 +171,12 @@ namespace femb {
 double VonMises(const Eigen::Matrix<double, 6, 1>& s);
 /// Principal stresses of (xx, yy, zz, yz, xz, xy), largest first.
 Eigen::Vector3d PrincipalStresses(const Eigen::Matrix<double, 6, 1>& s);
+/// The stress field of local coordinates q at the mesh nodes: per node the 6 components (xx, yy,
+/// zz, yz, xz, xy; part axes) of its stress point with the largest von Mises stress (solids: its
+/// only point; beams: the most stressed fibre of the sections at the node) in `stress`
+/// (n_nodes x 6) and that von Mises stress in `von_mises` (n_nodes). Nodes without a point: 0.
+void NodeStresses(const ModalStress& modal, const Eigen::VectorXd& q, long n_nodes, Eigen::MatrixXd* stress,
+                  Eigen::VectorXd* von_mises);
 /// Signed frequency in Hz from an eigenvalue omega^2: sign(lambda) sqrt(|lambda|) / (2 pi).
 double FrequencyHz(double lambda);
 }  // namespace femb

@@ -58,6 +58,22 @@ int WriteModeShapesVtu(const Superelement& se, const std::string& directory) {
         }
         out << "</DataArray>\n";
       }
+      if (se.stress) {
+        // The mode's stress per unit coordinate (femb-reduce's modal stresses): von Mises and the
+        // tensor, VTK's symmetric order xx yy zz xy yz xz (ParaView shows it as a tensor).
+        Eigen::VectorXd unit = Eigen::VectorXd::Zero(se.n_reduced_dofs()), von_mises;
+        unit[i] = 1.0;
+        Eigen::MatrixXd stress;
+        NodeStresses(*se.stress, unit, n, &stress, &von_mises);
+        out << "<DataArray type=\"Float64\" Name=\"von_mises\" format=\"ascii\">\n";
+        for (long p = 0; p < n; ++p) out << von_mises[p] << "\n";
+        out << "</DataArray>\n<DataArray type=\"Float64\" Name=\"stress\" NumberOfComponents=\"6\" format=\"ascii\">\n";
+        for (long p = 0; p < n; ++p) {
+          out << stress(p, 0) << " " << stress(p, 1) << " " << stress(p, 2) << " " << stress(p, 5) << " "
+              << stress(p, 3) << " " << stress(p, 4) << "\n";
+        }
+        out << "</DataArray>\n";
+      }
       out << "</PointData>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n";
       if (!out) throw InputError(tmp + ": write failed");
     }

@@ -65,6 +65,10 @@ ResultsRecorder::ResultsRecorder(const Scene& scene, const std::string& director
     for (const std::string& q : p.quantities) {
       if (q == "rotation") {
         for (const char* c : wxyz) csv_ << "," << p.name << "." << q << "." << c;
+      } else if (q == "stress") {
+        // The stress point's von Mises stress and tensor (part axes, issue 17).
+        static const char* components[7] = {"von_mises", "xx", "yy", "zz", "yz", "xz", "xy"};
+        for (const char* c : components) csv_ << "," << p.name << ".stress." << c;
       } else if (q == "reaction") {
         static const char* components[6] = {"fx", "fy", "fz", "mx", "my", "mz"};
         for (const char* c : components) csv_ << "," << p.name << ".reaction." << c;
@@ -145,6 +149,40 @@ void ResultsRecorder::Record(double t, const SystemState& state, const Eigen::Ve
     frame = t >= next_frame_time_ - 1e-9 * frame_interval_;
     if (frame) next_frame_time_ = (std::floor(t / frame_interval_ + 1e-9) + 1) * frame_interval_;
   }
+  // Local coordinates of body b (once per output step, for the mesh, the stresses, the probes).
+  std::vector<Eigen::VectorXd> q_loc(model.bodies.size());
+  auto local = [&](size_t b) -> const Eigen::VectorXd& {
+    if (q_loc[b].size() == 0) q_loc[b] = model.bodies[b].LocalCoordinates(BodyConfigurationOf(model, state, int(b)), state.frames[b]);
+    return q_loc[b];
+  };
+  if (scene_.spec.stresses) {
+    const bool frame_fields = frame && scene_.spec.animation;  // the animation's node fields
+    max_von_mises_.resize(model.bodies.size());
+    max_von_mises_node_.resize(model.bodies.size());
+    std::vector<Eigen::MatrixXf> fields;
+    for (size_t b = 0; b < model.bodies.size(); ++b) {
+      const long n_mesh = scene_.meshes[b] ? long(scene_.meshes[b]->nodes.rows()) : long(scene_.stick_nodes[b].size());
+      if (!scene_.stresses[b]) {
+        if (frame_fields) fields.push_back(Eigen::MatrixXf::Zero(n_mesh, 4));
+        continue;
+      }
+      Eigen::MatrixXd stress;
+      Eigen::VectorXd von_mises;
+      NodeStresses(*scene_.stresses[b], local(b), n_mesh, &stress, &von_mises);
+      Eigen::Index worst = 0;
+      max_von_mises_[b].push_back(von_mises.size() ? von_mises.maxCoeff(&worst) : 0.0);
+      max_von_mises_node_[b].push_back(int(worst));
+      if (frame_fields) {
+        Eigen::MatrixXf f(n_mesh, 4);
+        for (long i = 0; i < n_mesh; ++i) {
+          f(i, 0) = float(von_mises[i]);
+          f.block<1, 3>(i, 1) = PrincipalStresses(stress.row(i).transpose()).transpose().cast<float>();
+        }
+        fields.push_back(f);
+      }
+    }
+    if (frame_fields) frame_stress_.push_back(std::move(fields));
+  }
   if (scene_.spec.animation && frame) {
     std::vector<Eigen::MatrixXf> meshes, deformations;
     for (size_t b = 0; b < model.bodies.size(); ++b) {
@@ -158,9 +196,7 @@ void ResultsRecorder::Record(double t, const SystemState& state, const Eigen::Ve
         deformations.push_back(Eigen::MatrixXf::Zero(x.rows(), 3));
         continue;
       }
-      const BodyConfiguration c = BodyConfigurationOf(model, state, int(b));
-      const Eigen::VectorXd q = model.bodies[b].LocalCoordinates(c, state.frames[b]);
-      const Eigen::VectorXd u = mesh->shapes * q;
+      const Eigen::VectorXd u = mesh->shapes * local(b);
       // x = x_j + R_j (X - X_j + Phi q_loc); the deformation field is the elastic part R_j Phi q_loc
       // in global axes (what ParaView should colour by: no rigid motion of the body in it).
       Eigen::MatrixXf x(mesh->nodes.rows(), 3), d(mesh->nodes.rows(), 3);
@@ -179,7 +215,16 @@ void ResultsRecorder::Record(double t, const SystemState& state, const Eigen::Ve
   }
 
   csv_ << Num(t);
-  for (const SceneProbeSpec& p : scene_.spec.probes) {
+  for (size_t pi = 0; pi < scene_.spec.probes.size(); ++pi) {
+    const SceneProbeSpec& p = scene_.spec.probes[pi];
+    if (!p.body.empty()) {  // a stress probe: its stress point
+      const auto [b, point] = scene_.stress_probes[pi];
+      const Eigen::Matrix<double, 6, 1> s =
+          scene_.stresses[size_t(b)]->modes.middleRows(6 * point, 6).cast<double>() * local(size_t(b));
+      csv_ << "," << Num(VonMises(s));
+      for (int i = 0; i < 6; ++i) csv_ << "," << Num(s[i]);
+      continue;
+    }
     const int k = scene_.node_index.at(p.node);
     for (const std::string& q : p.quantities) {
       if (q == "position") for (int i = 0; i < 3; ++i) csv_ << "," << Num(pos[3 * k + i]);
@@ -268,6 +313,16 @@ void ResultsRecorder::Finish(const std::string& status) {
       std::vector<std::string> nodes;
       for (int k : model.body_nodes[b]) nodes.push_back(model.node_names[k]);
       w.Strings(g + "/nodes", nodes);
+      if (b < max_von_mises_.size() && !max_von_mises_[b].empty()) {
+        // The largest von Mises stress of the body per output step, its mesh node and where that
+        // node is in part axes.
+        const std::vector<double>& v = max_von_mises_[b];
+        w.Vector(g + "/max_von_mises", Eigen::Map<const Eigen::VectorXd>(v.data(), long(v.size())));
+        w.IntVector(g + "/max_von_mises_node", max_von_mises_node_[b]);
+        Eigen::MatrixXd where(long(v.size()), 3);
+        for (size_t s = 0; s < v.size(); ++s) where.row(long(s)) = scene_.meshes[b]->nodes.row(max_von_mises_node_[b][s]);
+        w.Matrix(g + "/max_von_mises_point", where);
+      }
     }
     w.Close();
   }
@@ -354,6 +409,16 @@ void ResultsRecorder::WriteAnimation() {
       if (s == 0) x0 = x;
       w.FloatMatrix("/deformation_" + std::to_string(s), d);
       w.FloatMatrix("/displacement_" + std::to_string(s), x - x0);
+      if (s < frame_stress_.size()) {
+        Eigen::MatrixXf f(n_nodes, 4);
+        offset = 0;
+        for (size_t b = 0; b < blocks.size(); ++b) {
+          f.middleRows(offset, frame_stress_[s][b].rows()) = frame_stress_[s][b];
+          offset += frame_stress_[s][b].rows();
+        }
+        w.FloatMatrix("/von_mises_" + std::to_string(s), f.leftCols(1));
+        w.FloatMatrix("/principal_stress_" + std::to_string(s), f.rightCols(3));
+      }
     }
     w.Close();
   }
@@ -380,7 +445,16 @@ void ResultsRecorder::WriteAnimation() {
         << "</DataItem>\n    </Attribute>\n"
         << "    <Attribute Name=\"displacement\" AttributeType=\"Vector\" Center=\"Node\">\n     <DataItem Dimensions=\""
         << n_nodes << " 3\" NumberType=\"Float\" Precision=\"4\" Format=\"HDF\">animation.h5:/displacement_" << s
-        << "</DataItem>\n    </Attribute>\n   </Grid>\n";
+        << "</DataItem>\n    </Attribute>\n";
+    if (s < frame_stress_.size()) {
+      out << "    <Attribute Name=\"von_mises\" AttributeType=\"Scalar\" Center=\"Node\">\n     <DataItem Dimensions=\""
+          << n_nodes << " 1\" NumberType=\"Float\" Precision=\"4\" Format=\"HDF\">animation.h5:/von_mises_" << s
+          << "</DataItem>\n    </Attribute>\n"
+          << "    <Attribute Name=\"principal_stress\" AttributeType=\"Vector\" Center=\"Node\">\n     <DataItem Dimensions=\""
+          << n_nodes << " 3\" NumberType=\"Float\" Precision=\"4\" Format=\"HDF\">animation.h5:/principal_stress_" << s
+          << "</DataItem>\n    </Attribute>\n";
+    }
+    out << "   </Grid>\n";
   }
   out << "  </Grid>\n </Domain>\n</Xdmf>\n";
   out.close();

@@ -59,6 +59,12 @@ class ResultsRecorder {
   std::vector<double> frame_time_;
   std::vector<std::vector<Eigen::MatrixXf>> mesh_positions_;
   std::vector<std::vector<Eigen::MatrixXf>> mesh_deformations_;  ///< R_j Phi q_loc per frame and body
+  // Stress recovery (outputs.stresses): per body with modal stresses, per output step the largest
+  // von Mises stress and its mesh node; per frame and body the node fields (von Mises, the three
+  // principal stresses; zero for bodies without stresses).
+  std::vector<std::vector<double>> max_von_mises_;
+  std::vector<std::vector<int>> max_von_mises_node_;
+  std::vector<std::vector<Eigen::MatrixXf>> frame_stress_;
   void WriteAnimation();
   bool JointNode(int k) const;
 };

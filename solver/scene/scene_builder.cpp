@@ -98,6 +98,7 @@ Scene BuildScene(const SceneSpec& spec) {
       scene.body_names.push_back(b.name);
       model.body_names.push_back(b.name);
       scene.meshes.emplace_back();
+      scene.stresses.emplace_back();
       scene.mesh_origin.push_back(b.center_of_mass);
       scene.stick_nodes.push_back({com});
       for (const auto& [point, node] : b.nodes) {
@@ -126,7 +127,10 @@ Scene BuildScene(const SceneSpec& spec) {
     Superelement se;
     try {
       SuperelementReadOptions options;
-      options.visualization = spec.animation;
+      bool stress_probe = false;
+      for (const SceneProbeSpec& p : spec.probes) stress_probe |= p.body == b.name;
+      options.stress = spec.stresses || stress_probe;
+      options.visualization = spec.animation || options.stress;
       se = ReadSuperelementFile(file.string(), options);
       RequireValidSuperelement(se, file.string());
     } catch (const InputError& e) {
@@ -201,6 +205,8 @@ Scene BuildScene(const SceneSpec& spec) {
       }
       nodes.push_back(scene.node_index[node]);
     }
+    scene.stresses.push_back(std::move(se.stress));
+    se.stress.reset();
     model.bodies.emplace_back(se, options, R, b.position);
     model.body_nodes.push_back(nodes);
     scene.body_names.push_back(b.name);
@@ -328,6 +334,37 @@ Scene BuildScene(const SceneSpec& spec) {
                        ", got " + std::to_string(rates.size()) + " joint rates");
     }
     for (size_t i = 0; i < rates.size(); ++i) scene.initial_velocity[dofs.node_first(k) + int(i)] = rates[i];
+  }
+  // Stress probes: the body's stress point nearest to the given point (scene coordinates at the
+  // initial placement, i.e. part axes through the body's placement).
+  for (const SceneProbeSpec& p : spec.probes) {
+    scene.stress_probes.emplace_back(-1, -1);
+    if (p.body.empty()) continue;
+    int b = 0;
+    while (b < int(spec.bodies.size()) && spec.bodies[size_t(b)].name != p.body) ++b;
+    if (b == int(spec.bodies.size())) {
+      throw InputError(p.where + ": probe '" + p.name + "': no body '" + p.body + "' in the scene");
+    }
+    const SceneBodySpec& body = spec.bodies[size_t(b)];
+    if (!scene.stresses[size_t(b)]) {
+      throw InputError(p.where + ": probe '" + p.name + "': body '" + p.body + "' has no modal stresses" +
+                       (body.type == "rigid" ? std::string(" (a rigid body)")
+                                             : " in " + body.superelement + " (reduce it with the mesh kept: reduction.keep_mesh, reduction.stresses)"));
+    }
+    const ModalStress& st = *scene.stresses[size_t(b)];
+    if (st.n_points() == 0) {
+      throw InputError(p.where + ": probe '" + p.name + "': body '" + p.body + "' has no stress points (beams of "
+                       "'general' sections have section forces only)");
+    }
+    const Eigen::Vector3d X = ExpSO3(body.rotation).transpose() * (p.point - body.position);
+    Eigen::Index nearest = 0;
+    (st.points.rowwise() - X.transpose()).rowwise().squaredNorm().minCoeff(&nearest);
+    scene.stress_probes.back() = {b, int(nearest)};
+    char buffer[200];
+    std::snprintf(buffer, sizeof buffer, "probe '%s': stress point %ld of body '%s' at (%.6g, %.6g, %.6g) in part axes, %.3g from the given point",
+                  p.name.c_str(), long(nearest), p.body.c_str(), st.points(nearest, 0), st.points(nearest, 1),
+                  st.points(nearest, 2), (st.points.row(nearest).transpose() - X).norm());
+    scene.notes.push_back(buffer);
   }
   return scene;
 }

@@ -27,6 +27,12 @@ struct Scene {
   /// floating frame origin they refer to (part axes).
   std::vector<std::optional<Visualization>> meshes;
   std::vector<Eigen::Vector3d> mesh_origin;
+  /// Per body: its file's modal stresses (issue 17), loaded when the scene asks for stresses
+  /// (outputs.stresses or a stress probe on the body).
+  std::vector<std::optional<ModalStress>> stresses;
+  /// Per probe: for a stress probe the body and its stress point nearest to the probe's point
+  /// (-1, -1 for node probes).
+  std::vector<std::pair<int, int>> stress_probes;
   /// Per body without a mesh (rigid bodies, superelements reduced without keeping theirs): the
   /// scene nodes the animation joins by lines from the first one (a rigid body: its centre of
   /// mass to each of its points; a superelement: its first interface to the others).

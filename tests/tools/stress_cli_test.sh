@@ -1,0 +1,107 @@
+#!/usr/bin/env bash
+# Stress recovery end to end (issue 17): femb-reduce stores modal stresses, femb-inspect --vtu
+# shows them per mode, femb-solve recovers them (probe, results.h5 maximum, animation fields),
+# and bad stress requests get one line and exit 2.
+# Usage: stress_cli_test.sh BIN_DIR SOURCE_DIR
+set -u
+bin=$1
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+passed=0
+failed=0
+ok() { passed=$((passed + 1)); }
+fail() { failed=$((failed + 1)); echo "FAIL: $*"; }
+py=/usr/bin/python3
+
+# A steel cantilever 1 m x 50 mm x 50 mm in HEX20, clamped at root, 1 kN along y at the tip.
+cat > "$work/bar.yaml" <<'EOF'
+name: bar
+type: solid
+units: SI
+material: {E: 2.1e11, nu: 0.3, rho: 7850}
+geometry: {shape: box, size: [1.0, 0.05, 0.05]}
+mesh: {size: 0.025, order: 2, elements: hexahedra}
+interfaces:
+  - {name: root, group: xmin, coupling: rbe2}
+  - {name: tip, group: xmax, coupling: rbe2}
+reduction: {internal_modes: 4}
+EOF
+"$bin/femb-reduce" "$work/bar.yaml" -o "$work/bar.h5" > "$work/reduce.txt" && ok || fail "reduce: $(cat "$work/reduce.txt")"
+grep -q "stresses .* stress points x 16 coordinates (solid_nodal_l2)" "$work/reduce.txt" && ok || fail "no stresses progress line: $(cat "$work/reduce.txt")"
+"$bin/femb-inspect" "$work/bar.h5" --vtu "$work/vtu" > /dev/null && ok || fail "inspect --vtu"
+$py - "$work/vtu/bar_006.vtu" <<'PY' && ok || fail "mode VTU has no stress"
+import sys, meshio, numpy as np
+m = meshio.read(sys.argv[1])
+# Mode 6 is tip.u_x: a unit stretch of the bar, sigma_xx = E / L at mid-span; 1%: the RBE2 faces
+# stop the lateral contraction at the ends, which stiffens them, so the middle strains 0.4% more.
+vm, s = m.point_data["von_mises"], m.point_data["stress"]
+mid = np.argmin(np.linalg.norm(m.points - [0.5, 0.025, 0.025], axis=1))
+assert s.shape == (len(m.points), 6)
+assert abs(s[mid, 0] - 2.1e11) < 1e-2 * 2.1e11 and abs(vm[mid] - s[mid, 0]) < 1e-6 * 2.1e11, (s[mid], vm[mid])
+assert np.abs(s[mid, 1:]).max() < 1e-6 * 2.1e11, s[mid]
+PY
+
+cat > "$work/scene.yaml" <<'EOF'
+name: bar_static
+units: SI
+bodies:
+  - {name: bar, superelement: bar.h5, nodes: {root: r, tip: t}}
+joints:
+  - {type: clamp, node: r}
+loads:
+  - {type: force, node: t, force: [0, 1, 0]}
+analysis: {type: static, end_time: 1, steps: 2}
+outputs:
+  stresses: true
+  probes:
+    - {name: top, body: bar, point: [0.5, 0.05, 0.025], quantities: [stress]}
+    - {name: tip, node: t, quantities: [position]}
+EOF
+"$bin/femb-solve" "$work/scene.yaml" -o "$work/out" > "$work/log.txt" 2>&1 && ok || fail "solve: $(cat "$work/log.txt")"
+grep -q "probe 'top': stress point .* of body 'bar' at (0.5, 0.05, 0.025) in part axes" "$work/log.txt" && ok || fail "probe note: $(cat "$work/log.txt")"
+$py - "$work/out" <<'PY' && ok || fail "stress results"
+import csv, sys, h5py, meshio, numpy as np
+rows = list(csv.DictReader(open(sys.argv[1] + "/probes.csv")))
+# Beam theory at mid-span: sigma_xx = -M c / I on the +y face (compression), M = F L / 2.
+ref = -1.0 * 0.5 * 0.025 / (0.05 * 0.05 ** 3 / 12)
+sxx, vm = float(rows[-1]["top.stress.xx"]), float(rows[-1]["top.stress.von_mises"])
+assert abs(sxx - ref) < 0.02 * abs(ref) and abs(vm - abs(ref)) < 0.02 * abs(ref), (sxx, vm, ref)
+assert abs(float(rows[1]["top.stress.xx"]) - 0.5 * sxx) < 1e-6 * abs(sxx)   # half the load, half the stress
+f = h5py.File(sys.argv[1] + "/results.h5", "r")
+g = f["bodies/bar"]
+m = g["max_von_mises"][()]
+assert m.shape == (3,) and m[0] == 0 and abs(m[2] - 2 * m[1]) < 1e-6 * m[2], m
+# The largest von Mises stress is at the clamped end (bending moment F L there).
+assert g["max_von_mises_point"][2][0] < 0.05 and m[2] > 0.9 * abs(ref) * 2, (g["max_von_mises_point"][2], m[2])
+reader = meshio.xdmf.TimeSeriesReader(sys.argv[1] + "/animation.xdmf")
+points, cells = reader.read_points_cells()
+_, data, _ = reader.read_data(2)
+vm_field, principal = data["von_mises"].ravel(), data["principal_stress"]
+assert abs(vm_field.max() - m[2]) < 1e-6 * m[2], (vm_field.max(), m[2])
+assert (principal[:, 0] >= principal[:, 1]).all() and (principal[:, 1] >= principal[:, 2]).all()
+PY
+# Without outputs.stresses: no fields, no maxima (the probe still works).
+"$bin/femb-solve" -q "$work/scene.yaml" -o "$work/plain" --set outputs.stresses=false && $py - "$work/plain" <<'PY' \
+  && ok || fail "stresses off"
+import sys, h5py
+assert "max_von_mises" not in h5py.File(sys.argv[1] + "/results.h5", "r")["bodies/bar"]
+assert "von_mises" not in open(sys.argv[1] + "/animation.xdmf").read()
+assert "top.stress.xx" in open(sys.argv[1] + "/probes.csv").readline()
+PY
+
+# Bad input: one line, exit 2.
+expect() {  # label, expected message, sed on the scene, [part file override]
+  sed "$3" "$work/scene.yaml" > "$work/bad.yaml"
+  "$bin/femb-solve" -q "$work/bad.yaml" -o "$work/bad_out" 2> "$work/err.txt" > /dev/null
+  local code=$?
+  [ $code = 2 ] && grep -qF "$2" "$work/err.txt" && [ "$(wc -l < "$work/err.txt")" = 1 ] && ok \
+    || fail "$1: exit $code: $(cat "$work/err.txt")"
+}
+expect "unknown body" "probe 'top': no body 'nobar' in the scene" 's/body: bar, point/body: nobar, point/'
+expect "stress on a node" "probe quantity 'stress' needs body and point" 's/quantities: \[position\]/quantities: [stress]/'
+expect "node quantity on a body" "probe quantity 'position' is a node quantity" 's/quantities: \[stress\]/quantities: [position]/'
+"$bin/femb-reduce" -q "$work/bar.yaml" -o "$work/bar_plain.h5" --set reduction.stresses=false || fail "reduce without stresses"
+expect "file without stresses" "body 'bar' has no modal stresses in bar_plain.h5" 's/bar.h5/bar_plain.h5/'
+
+echo "stress cli: $passed passed, $failed failed"
+[ $failed = 0 ]
