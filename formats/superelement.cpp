@@ -100,11 +100,21 @@ Eigen::Vector3d PrincipalStresses(const Eigen::Matrix<double, 6, 1>& s) {
   return Eigen::Vector3d(l[2], l[1], l[0]);
 }
 
+Eigen::Matrix<double, 6, 1> PointStress(const ModalStress& modal, int p, const Eigen::VectorXd& q,
+                                        const Eigen::VectorXd* inertia) {
+  Eigen::Matrix<double, 6, 1> s = modal.modes.middleRows(6 * p, 6).cast<double>() * q;
+  if (inertia && modal.inertia_modes.size() > 0) s += modal.inertia_modes.middleRows(6 * p, 6).cast<double>() * *inertia;
+  return s;
+}
+
 void NodeStresses(const ModalStress& modal, const Eigen::VectorXd& q, long n_nodes, Eigen::MatrixXd* stress,
-                  Eigen::VectorXd* von_mises) {
+                  Eigen::VectorXd* von_mises, const Eigen::VectorXd* inertia) {
   // Column by column in double precision (no double copy of the single-precision modes).
   Eigen::VectorXd all = Eigen::VectorXd::Zero(modal.modes.rows());
   for (Eigen::Index i = 0; i < q.size(); ++i) all += q[i] * modal.modes.col(i).cast<double>();
+  if (inertia && modal.inertia_modes.size() > 0) {
+    for (Eigen::Index k = 0; k < inertia->size(); ++k) all += (*inertia)[k] * modal.inertia_modes.col(k).cast<double>();
+  }
   stress->setZero(n_nodes, 6);
   von_mises->setConstant(n_nodes, -1.0);
   for (int p = 0; p < modal.n_points(); ++p) {

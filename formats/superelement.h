@@ -80,6 +80,14 @@ struct ModalStress {
   /// axes. Empty for solids.
   Eigen::MatrixXf section_forces;
   Eigen::MatrixXd element_axes;
+  /// With geometric stiffening (the 12 unit inertia load cases, kInertiaLoadCases): the stress of
+  /// each case's static field with the interfaces held, less its internal-mode part, (6 n_points)
+  /// x 12, and for beams its section forces (12 n_cells) x 12. The body's stress is then
+  /// sum_i q_i modes_i + sum_k a_k inertia_modes_k with the frame's load factors a_k
+  /// (SuperelementBody::InertiaLoads): the quasi-static part of the distributed inertia load's
+  /// stress that the basis does not carry (a mode-acceleration correction); empty otherwise.
+  Eigen::MatrixXf inertia_modes;
+  Eigen::MatrixXf inertia_section_forces;
   int n_points() const { return int(points.rows()); }
 };
 
@@ -175,8 +183,13 @@ Eigen::Vector3d PrincipalStresses(const Eigen::Matrix<double, 6, 1>& s);
 /// zz, yz, xz, xy; part axes) of its stress point with the largest von Mises stress (solids: its
 /// only point; beams: the most stressed fibre of the sections at the node) in `stress`
 /// (n_nodes x 6) and that von Mises stress in `von_mises` (n_nodes). Nodes without a point: 0.
+/// `inertia`: the 12 inertia load factors of the body's frame, for the inertia load cases'
+/// stresses (ModalStress::inertia_modes; ignored when the file has none or when null).
 void NodeStresses(const ModalStress& modal, const Eigen::VectorXd& q, long n_nodes, Eigen::MatrixXd* stress,
-                  Eigen::VectorXd* von_mises);
+                  Eigen::VectorXd* von_mises, const Eigen::VectorXd* inertia = nullptr);
+/// The stress (6 components) at stress point p of local coordinates q (and inertia factors).
+Eigen::Matrix<double, 6, 1> PointStress(const ModalStress& modal, int p, const Eigen::VectorXd& q,
+                                        const Eigen::VectorXd* inertia = nullptr);
 /// Signed frequency in Hz from an eigenvalue omega^2: sign(lambda) sqrt(|lambda|) / (2 pi).
 double FrequencyHz(double lambda);
 }  // namespace femb

@@ -64,6 +64,7 @@ Check Finite(const Superelement& se) {
   }
   if (se.stress) {
     datasets.emplace_back("/stress/modes", se.stress->modes.cast<double>());
+    if (se.stress->inertia_modes.size() > 0) datasets.emplace_back("/stress/inertia_modes", se.stress->inertia_modes.cast<double>());
     if (se.stress->section_forces.size() > 0) {
       datasets.emplace_back("/stress/section_forces", se.stress->section_forces.cast<double>());
     }

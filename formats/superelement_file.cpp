@@ -152,6 +152,10 @@ void WriteContent(const Superelement& se, h5::Writer& w) {
       w.FloatMatrix("/stress/section_forces", st.section_forces);
       w.Matrix("/stress/element_axes", st.element_axes);
     }
+    if (st.inertia_modes.size() > 0) {
+      w.FloatMatrix("/stress/inertia_modes", st.inertia_modes);
+      if (st.inertia_section_forces.size() > 0) w.FloatMatrix("/stress/inertia_section_forces", st.inertia_section_forces);
+    }
   }
 
   const Provenance& p = se.provenance;
@@ -338,6 +342,14 @@ Superelement ReadSuperelementFile(const std::string& path, const SuperelementRea
         RequireShape(r, "/stress/element_axes", v.cells.rows(), 9);
         st.section_forces = r.Matrix("/stress/section_forces").cast<float>();
         st.element_axes = r.Matrix("/stress/element_axes");
+      }
+      if (r.Exists("/stress/inertia_modes")) {
+        RequireShape(r, "/stress/inertia_modes", 6 * np, kInertiaLoadCaseCount);
+        st.inertia_modes = r.Matrix("/stress/inertia_modes").cast<float>();
+        if (r.Exists("/stress/inertia_section_forces")) {
+          RequireShape(r, "/stress/inertia_section_forces", 12 * v.cells.rows(), kInertiaLoadCaseCount);
+          st.inertia_section_forces = r.Matrix("/stress/inertia_section_forces").cast<float>();
+        }
       }
       se.stress = std::move(st);
     }

@@ -183,6 +183,9 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
     se.K = 0.5 * (se.K + se.K.transpose()).eval();
   }
   const bool derivatives = se.n_modal_derivatives > 0;
+  // With stiffening: the inertia load cases' fields on the mesh (about the frame origin), for
+  // their geometric stiffness and their stresses.
+  Eigen::MatrixXd stress_fields;
   if (stiffening) make_nonlinear();
   if (nonlinear && (derivatives || stiffening)) {
     // The reduced internal force on the whole basis (static and internal modes, derivatives):
@@ -197,7 +200,6 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
                                                         se.floating_frame.origin, part.type == "solid" ? 3 : 6);
     PolynomialRequest poly_request;
     poly_request.cubic = derivatives;
-    Eigen::MatrixXd stress_fields;
     if (stiffening) {
       Eigen::MatrixXd u = cb.inertia_displacements;
       const Eigen::Matrix<double, 3, 12> at_origin = InertiaFieldAt(se.floating_frame.origin);
@@ -263,9 +265,16 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
   if (keep_mesh && part.reduction.stresses.value_or(true)) {
     Stopwatch stress_clock;
     const Visualization& v = *se.visualization;
-    se.stress = part.type == "solid"
-                    ? SolidModalStress(SolidTypeOf(model.cell_type), model.nodes, model.cells, part.material, v.shapes)
-                    : BeamModalStress(part, v.shapes);
+    auto stresses_of = [&](const Eigen::MatrixXd& fields) {
+      return part.type == "solid" ? SolidModalStress(SolidTypeOf(model.cell_type), model.nodes, model.cells, part.material, fields)
+                                  : BeamModalStress(part, fields);
+    };
+    se.stress = stresses_of(v.shapes);
+    if (stress_fields.cols() > 0) {
+      const ModalStress inertia = stresses_of(stress_fields);
+      se.stress->inertia_modes = inertia.modes;
+      se.stress->inertia_section_forces = inertia.section_forces;
+    }
     std::snprintf(detail, sizeof detail, "%d stress points x %ld coordinates (%s), %.3g MB in single precision",
                   se.stress->n_points(), long(v.shapes.cols()), se.stress->method.c_str(),
                   4.0 * double(se.stress->modes.size() + se.stress->section_forces.size()) / 1e6);

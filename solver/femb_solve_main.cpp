@@ -205,7 +205,7 @@ int main(int argc, char** argv) {
       const auto reactions0 = spec.reactions ? femb::DynamicReactions(scene.model, state)
                                              : std::vector<Eigen::Matrix<double, 6, 1>>();
       recorder.Record(0.0, state.config, state.W, r0.kinetic_energy, r0.elastic_energy, 0.0, r0.linear_momentum,
-                      r0.angular_momentum, spec.reactions ? &reactions0 : nullptr);
+                      r0.angular_momentum, spec.reactions ? &reactions0 : nullptr, &state.Wdot);
       femb::DynamicOptions options;
       options.step = spec.analysis.step;
       options.end_time = spec.analysis.end_time;
@@ -237,7 +237,7 @@ int main(int argc, char** argv) {
               const auto reactions = spec.reactions ? femb::DynamicReactions(scene.model, st)
                                                     : std::vector<Eigen::Matrix<double, 6, 1>>();
               recorder.Record(s.t, st.config, st.W, s.kinetic_energy, s.elastic_energy, s.external_work,
-                              s.linear_momentum, s.angular_momentum, spec.reactions ? &reactions : nullptr);
+                              s.linear_momentum, s.angular_momentum, spec.reactions ? &reactions : nullptr, &st.Wdot);
               recorder.RecordStepSize(s.h);
             }
             progress(s.t, false);

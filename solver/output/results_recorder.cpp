@@ -98,7 +98,8 @@ ResultsRecorder::ResultsRecorder(const Scene& scene, const std::string& director
 void ResultsRecorder::Record(double t, const SystemState& state, const Eigen::VectorXd& W, double kinetic,
                              double elastic, double external_work, const Eigen::Vector3d& linear_momentum,
                              const Eigen::Vector3d& angular_momentum,
-                             const std::vector<Eigen::Matrix<double, 6, 1>>* reactions) {
+                             const std::vector<Eigen::Matrix<double, 6, 1>>* reactions,
+                             const Eigen::VectorXd* accelerations) {
   const SystemModel& model = scene_.model;
   const DofMap dofs(model);
   const int n = model.n_nodes();
@@ -155,6 +156,27 @@ void ResultsRecorder::Record(double t, const SystemState& state, const Eigen::Ve
     if (q_loc[b].size() == 0) q_loc[b] = model.bodies[b].LocalCoordinates(BodyConfigurationOf(model, state, int(b)), state.frames[b]);
     return q_loc[b];
   };
+  // The inertia load factors of body b's frame (SuperelementBody::InertiaLoads) when its modal
+  // stresses include the inertia load cases: d'Alembert with gravity (static analyses: gravity
+  // as ramped by the analysis, no motion).
+  std::vector<Eigen::VectorXd> factors(model.bodies.size());
+  std::vector<Eigen::Matrix<double, 6, 1>> node_acc;
+  auto inertia = [&](size_t b) -> const Eigen::VectorXd* {
+    if (!scene_.stresses[b] || scene_.stresses[b]->inertia_modes.size() == 0) return nullptr;
+    if (factors[b].size() > 0) return &factors[b];
+    const bool dynamic = scene_.spec.analysis.type == "dynamic";
+    const Eigen::VectorXd zero = Eigen::VectorXd::Zero(dofs.n_dofs());
+    const Eigen::VectorXd& V = W.size() == dofs.n_dofs() ? W : zero;
+    const Eigen::VectorXd& A = accelerations && accelerations->size() == dofs.n_dofs() ? *accelerations : zero;
+    if (node_acc.empty()) node_acc = NodeAccelerations(model, dofs, state, V, A);
+    double g = dynamic ? 1.0 : 0.0;
+    if (!dynamic && model.static_gravity_end > 0) g = std::min(t / model.static_gravity_end, 1.0);
+    factors[b] = model.bodies[b]
+                     .InertiaLoads(BodyConfigurationOf(model, state, int(b)), state.frames[b], GatherBody(model, dofs, state, int(b), V),
+                                   GatherBodyAcceleration(model, dofs, int(b), node_acc, A), g * model.gravity)
+                     .a;
+    return &factors[b];
+  };
   if (scene_.spec.stresses) {
     const bool frame_fields = frame && scene_.spec.animation;  // the animation's node fields
     max_von_mises_.resize(model.bodies.size());
@@ -168,7 +190,7 @@ void ResultsRecorder::Record(double t, const SystemState& state, const Eigen::Ve
       }
       Eigen::MatrixXd stress;
       Eigen::VectorXd von_mises;
-      NodeStresses(*scene_.stresses[b], local(b), n_mesh, &stress, &von_mises);
+      NodeStresses(*scene_.stresses[b], local(b), n_mesh, &stress, &von_mises, inertia(b));
       Eigen::Index worst = 0;
       max_von_mises_[b].push_back(von_mises.size() ? von_mises.maxCoeff(&worst) : 0.0);
       max_von_mises_node_[b].push_back(int(worst));
@@ -219,8 +241,7 @@ void ResultsRecorder::Record(double t, const SystemState& state, const Eigen::Ve
     const SceneProbeSpec& p = scene_.spec.probes[pi];
     if (!p.body.empty()) {  // a stress probe: its stress point
       const auto [b, point] = scene_.stress_probes[pi];
-      const Eigen::Matrix<double, 6, 1> s =
-          scene_.stresses[size_t(b)]->modes.middleRows(6 * point, 6).cast<double>() * local(size_t(b));
+      const Eigen::Matrix<double, 6, 1> s = PointStress(*scene_.stresses[size_t(b)], point, local(size_t(b)), inertia(size_t(b)));
       csv_ << "," << Num(VonMises(s));
       for (int i = 0; i < 6; ++i) csv_ << "," << Num(s[i]);
       continue;

@@ -22,10 +22,13 @@ class ResultsRecorder {
   /// Records one output step. W: velocities over the unknowns (zero for static analyses);
   /// momentum: linear and angular (about the origin) momentum of all bodies (dynamic analyses).
   /// `reactions`: per node (force, moment; JointReactions), recorded when the scene asks for them.
+  /// `accelerations` (dynamic analyses): over the unknowns, for the inertia load cases' stresses
+  /// (static analyses: none, only gravity).
   void Record(double t, const SystemState& state, const Eigen::VectorXd& W, double kinetic, double elastic,
               double external_work, const Eigen::Vector3d& linear_momentum = Eigen::Vector3d::Zero(),
               const Eigen::Vector3d& angular_momentum = Eigen::Vector3d::Zero(),
-              const std::vector<Eigen::Matrix<double, 6, 1>>* reactions = nullptr);
+              const std::vector<Eigen::Matrix<double, 6, 1>>* reactions = nullptr,
+              const Eigen::VectorXd* accelerations = nullptr);
   /// The step that reached the last recorded state (dynamic analyses; 0 for the initial state):
   /// /step_size in results.h5.
   void RecordStepSize(double h) { step_size_.push_back(h); }
