@@ -49,12 +49,13 @@ done
 rows=$("$bin/femb-inspect" "$work/beam_rod.h5" --dump K --format csv | wc -l)
 [ "$rows" = 16 ] && ok || fail "--dump K csv rows $rows"
 "$bin/femb-inspect" "$work/beam_rod.h5" --dump PhiCB | sed -n 3p | grep -qx "6 16" && ok || fail "--dump PhiCB mtx"
-# --vtu: beam mode shapes as VTU line meshes with displacement and rotation; without a stored
+# --vtu: beam mode shapes as VTU line meshes with displacement, rotation and the modal stress
+# (von Mises, tensor; issue 17); without a stored
 # mesh it is a clear error.
 "$bin/femb-inspect" "$work/beam_rod.h5" --vtu "$work/vtu" > /dev/null && [ "$(ls "$work/vtu" | wc -l)" = 16 ] && ok || fail "--vtu beam"
 $py -c "
 import meshio; m = meshio.read('$work/vtu/beam_rod_013.vtu')
-assert m.cells[0].type == 'line' and set(m.point_data) == {'displacement', 'rotation'}" && ok || fail "vtu beam content"
+assert m.cells[0].type == 'line' and set(m.point_data) == {'displacement', 'rotation', 'von_mises', 'stress'}" && ok || fail "vtu beam content"
 "$bin/femb-reduce" -q "$src/examples/beam_rod/part.yaml" -o "$work/nomesh.h5" --set reduction.keep_mesh=false
 "$bin/femb-inspect" "$work/nomesh.h5" --vtu "$work/vtu2" 2> "$work/err.txt"; [ $? = 2 ] && grep -q "no mesh and mode shapes stored" "$work/err.txt" && ok || fail "--vtu without mesh"
 # A foreign mesh through the meshio bridge: an Abaqus .inp hex block with node sets.
