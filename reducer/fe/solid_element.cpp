@@ -191,6 +191,24 @@ std::vector<SolidPoint> SolidElementPoints(SolidType type, const Eigen::MatrixXd
   return out;
 }
 
+Eigen::MatrixXd SolidStrainMatrix(const Eigen::MatrixXd& dNdX) {
+  const long n = dNdX.rows();
+  Eigen::MatrixXd B = Eigen::MatrixXd::Zero(6, 3 * n);
+  for (long a = 0; a < n; ++a) {
+    const double gx = dNdX(a, 0), gy = dNdX(a, 1), gz = dNdX(a, 2);
+    B(0, 3 * a) = gx;
+    B(1, 3 * a + 1) = gy;
+    B(2, 3 * a + 2) = gz;
+    B(3, 3 * a + 1) = gz;
+    B(3, 3 * a + 2) = gy;
+    B(4, 3 * a) = gz;
+    B(4, 3 * a + 2) = gx;
+    B(5, 3 * a) = gy;
+    B(5, 3 * a + 1) = gx;
+  }
+  return B;
+}
+
 SolidElementMatrices ComputeSolidElement(SolidType type, const Eigen::MatrixXd& X, const MaterialSpec& material,
                                          long element_id) {
   const int n = SolidNodeCount(type);
@@ -199,21 +217,8 @@ SolidElementMatrices ComputeSolidElement(SolidType type, const Eigen::MatrixXd& 
   out.M = Eigen::MatrixXd::Zero(3 * n, 3 * n);
   const Eigen::Matrix<double, 6, 6> D = IsotropicElasticity(material.E, material.nu);
   for (const SolidPoint& p : SolidElementPoints(type, X, element_id)) {
-    const Eigen::MatrixXd& dNdx = p.dNdX;  // n x 3
     const Eigen::VectorXd& N = p.N;
-    Eigen::MatrixXd B = Eigen::MatrixXd::Zero(6, 3 * n);
-    for (int a = 0; a < n; ++a) {
-      const double gx = dNdx(a, 0), gy = dNdx(a, 1), gz = dNdx(a, 2);
-      B(0, 3 * a) = gx;
-      B(1, 3 * a + 1) = gy;
-      B(2, 3 * a + 2) = gz;
-      B(3, 3 * a + 1) = gz;
-      B(3, 3 * a + 2) = gy;
-      B(4, 3 * a) = gz;
-      B(4, 3 * a + 2) = gx;
-      B(5, 3 * a) = gy;
-      B(5, 3 * a + 1) = gx;
-    }
+    const Eigen::MatrixXd B = SolidStrainMatrix(p.dNdX);
     const double dV = p.dV;
     out.volume += dV;
     out.K.noalias() += dV * B.transpose() * D * B;

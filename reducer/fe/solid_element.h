@@ -39,6 +39,10 @@ struct SolidPoint {
 };
 std::vector<SolidPoint> SolidElementPoints(SolidType type, const Eigen::MatrixXd& X, long element_id);
 
+/// The strain-displacement matrix (6 x 3n; xx, yy, zz, yz, xz, xy with engineering shear
+/// strains) of shape-function gradients dN/dX (n x 3).
+Eigen::MatrixXd SolidStrainMatrix(const Eigen::MatrixXd& dNdX);
+
 /// Shape functions (n) and their derivatives (n x 3) at a reference point.
 void SolidShapeFunctions(SolidType type, const Eigen::Vector3d& xi, Eigen::VectorXd* N, Eigen::MatrixXd* dN);
 

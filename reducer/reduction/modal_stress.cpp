@@ -10,25 +10,6 @@
 namespace femb {
 namespace {
 
-// Strain-displacement rows (xx, yy, zz, yz, xz, xy; engineering shear) of one quadrature point.
-Eigen::MatrixXd StrainMatrix(const Eigen::MatrixXd& dNdX) {
-  const long n = dNdX.rows();
-  Eigen::MatrixXd B = Eigen::MatrixXd::Zero(6, 3 * n);
-  for (long a = 0; a < n; ++a) {
-    const double gx = dNdX(a, 0), gy = dNdX(a, 1), gz = dNdX(a, 2);
-    B(0, 3 * a) = gx;
-    B(1, 3 * a + 1) = gy;
-    B(2, 3 * a + 2) = gz;
-    B(3, 3 * a + 1) = gz;
-    B(3, 3 * a + 2) = gy;
-    B(4, 3 * a) = gz;
-    B(4, 3 * a + 2) = gx;
-    B(5, 3 * a) = gy;
-    B(5, 3 * a + 1) = gx;
-  }
-  return B;
-}
-
 // (xx, yy, zz, yz, xz, xy) of the part-axes tensor R^T S R of a fibre's element-axes stress:
 // S = [s t_y t_z; t_y 0 0; t_z 0 0], R's rows the element axes.
 Eigen::Matrix<double, 6, 3> FibreToPart(const Eigen::Matrix3d& R) {
@@ -132,7 +113,7 @@ ModalStress SolidModalStress(SolidType type, const Eigen::MatrixXd& nodes, const
     Eigen::MatrixXd E = Eigen::MatrixXd::Zero(6 * n, 3 * n), Me = Eigen::MatrixXd::Zero(n, n);
     double volume = 0;
     for (const SolidPoint& p : SolidElementPoints(type, X, e + 1)) {
-      const Eigen::MatrixXd DB = D * StrainMatrix(p.dNdX);
+      const Eigen::MatrixXd DB = D * SolidStrainMatrix(p.dNdX);
       for (int a = 0; a < n; ++a) E.middleRows(6 * a, 6) += (p.dV * p.N[a]) * DB;
       Me.noalias() += p.dV * p.N * p.N.transpose();
       volume += p.dV;

@@ -5,13 +5,7 @@
 # Usage: stress_cli_test.sh BIN_DIR SOURCE_DIR
 set -u
 bin=$1
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-passed=0
-failed=0
-ok() { passed=$((passed + 1)); }
-fail() { failed=$((failed + 1)); echo "FAIL: $*"; }
-py=/usr/bin/python3
+source "$(dirname "$0")/test_lib.sh"
 
 # A steel cantilever 1 m x 50 mm x 50 mm in HEX20, clamped at root, 1 kN along y at the tip.
 cat > "$work/bar.yaml" <<'EOF'
