@@ -100,10 +100,29 @@ Eigen::Vector3d PrincipalStresses(const Eigen::Matrix<double, 6, 1>& s) {
   return Eigen::Vector3d(l[2], l[1], l[0]);
 }
 
+namespace {
+
+// D E_quad of St. Venant-Kirchhoff at point p: E_quad = H^T H / 2 with H = sum_i q_i H_i
+// (Voigt xx, yy, zz, yz, xz, xy; engineering shear 2 E_ij).
+Eigen::Matrix<double, 6, 1> QuadraticStress(const ModalStress& modal, long p, const Eigen::VectorXd& q) {
+  const Eigen::Matrix<double, 9, 1> h = modal.gradients.middleRows(9 * p, 9).cast<double>() * q;
+  const Eigen::Matrix3d H = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(h.data());
+  const Eigen::Matrix3d Eq = 0.5 * H.transpose() * H;
+  const double lambda = modal.E * modal.nu / ((1 + modal.nu) * (1 - 2 * modal.nu)), mu = modal.E / (2 * (1 + modal.nu));
+  const double trace = Eq.trace();
+  Eigen::Matrix<double, 6, 1> s;
+  s << lambda * trace + 2 * mu * Eq(0, 0), lambda * trace + 2 * mu * Eq(1, 1), lambda * trace + 2 * mu * Eq(2, 2),
+      2 * mu * Eq(1, 2), 2 * mu * Eq(0, 2), 2 * mu * Eq(0, 1);
+  return s;
+}
+
+}  // namespace
+
 Eigen::Matrix<double, 6, 1> PointStress(const ModalStress& modal, int p, const Eigen::VectorXd& q,
                                         const Eigen::VectorXd* inertia) {
   Eigen::Matrix<double, 6, 1> s = modal.modes.middleRows(6 * p, 6).cast<double>() * q;
   if (inertia && modal.inertia_modes.size() > 0) s += modal.inertia_modes.middleRows(6 * p, 6).cast<double>() * *inertia;
+  if (modal.gradients.size() > 0) s += QuadraticStress(modal, p, q);
   return s;
 }
 
@@ -114,6 +133,9 @@ void NodeStresses(const ModalStress& modal, const Eigen::VectorXd& q, long n_nod
   for (Eigen::Index i = 0; i < q.size(); ++i) all += q[i] * modal.modes.col(i).cast<double>();
   if (inertia && modal.inertia_modes.size() > 0) {
     for (Eigen::Index k = 0; k < inertia->size(); ++k) all += (*inertia)[k] * modal.inertia_modes.col(k).cast<double>();
+  }
+  if (modal.gradients.size() > 0) {
+    for (int p = 0; p < modal.n_points(); ++p) all.segment<6>(6 * p) += QuadraticStress(modal, p, q);
   }
   stress->setZero(n_nodes, 6);
   von_mises->setConstant(n_nodes, -1.0);

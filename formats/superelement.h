@@ -88,6 +88,14 @@ struct ModalStress {
   /// stress that the basis does not carry (a mode-acceleration correction); empty otherwise.
   Eigen::MatrixXf inertia_modes;
   Eigen::MatrixXf inertia_section_forces;
+  /// Solids with modal derivatives: each basis vector's displacement gradient H = du/dX at the
+  /// points, (9 n_points) x n_reduced (row 9 p + 3 i + j: du_i/dX_j, part axes), and the
+  /// material's E and nu. The stress is then the second Piola-Kirchhoff stress of St. Venant-
+  /// Kirchhoff, S = D (E_lin + E_quad) with E_quad = H^T H / 2 (H = sum_i q_i H_i): the
+  /// Green-Lagrange strain's linear and quadratic parts, as the body's polynomial force. Empty
+  /// otherwise (linear stress).
+  Eigen::MatrixXf gradients;
+  double E = 0.0, nu = 0.0;
   int n_points() const { return int(points.rows()); }
 };
 

@@ -65,6 +65,7 @@ Check Finite(const Superelement& se) {
   if (se.stress) {
     datasets.emplace_back("/stress/modes", se.stress->modes.cast<double>());
     if (se.stress->inertia_modes.size() > 0) datasets.emplace_back("/stress/inertia_modes", se.stress->inertia_modes.cast<double>());
+    if (se.stress->gradients.size() > 0) datasets.emplace_back("/stress/gradients", se.stress->gradients.cast<double>());
     if (se.stress->section_forces.size() > 0) {
       datasets.emplace_back("/stress/section_forces", se.stress->section_forces.cast<double>());
     }
@@ -196,6 +197,15 @@ SuperelementChecks CheckSuperelement(const Superelement& se) {
                       Sci("stored mass %.9g", se.mass_properties.mass) + Sci(", from the reduced M %.9g", m_reduced),
                       "/mass_properties/mass"});
 
+  if (se.stress && se.stress->modes.rows() > 0 && se.stress->modes.cols() == n) {
+    // Rigid motions cause no stress: the modal stresses of Phi_rig0's columns vanish to the
+    // single precision they are stored in (a mutated or mismatched stress dataset shows here).
+    const Eigen::MatrixXd modes = se.stress->modes.cast<double>();
+    const double scale = modes.cwiseAbs().maxCoeff() * Phi_rig0.cwiseAbs().maxCoeff();
+    const double relative = scale > 0 ? (modes * Phi_rig0).cwiseAbs().maxCoeff() / scale : 0.0;
+    a.checks.push_back({"stress_rigid_body", relative <= 1e-4,
+                        Sci("max|sigma(Phi_rig0)| = %.3g of max|sigma_i| max|Phi_rig0|", relative), "/stress/modes"});
+  }
   if (!se.inertia_gamma.empty()) {
     // The frame's rotation turns a rigid translation e_b into the translation e_a x e_b:
     // Gamma_a Phi_rig0 e_b = M Phi_rig0 (e_a x e_b) (b = translations), and Xi_aa is symmetric.

@@ -152,6 +152,10 @@ void WriteContent(const Superelement& se, h5::Writer& w) {
       w.FloatMatrix("/stress/section_forces", st.section_forces);
       w.Matrix("/stress/element_axes", st.element_axes);
     }
+    if (st.gradients.size() > 0) {
+      w.FloatMatrix("/stress/gradients", st.gradients);
+      w.Vector("/stress/material", Eigen::Vector2d(st.E, st.nu));
+    }
     if (st.inertia_modes.size() > 0) {
       w.FloatMatrix("/stress/inertia_modes", st.inertia_modes);
       if (st.inertia_section_forces.size() > 0) w.FloatMatrix("/stress/inertia_section_forces", st.inertia_section_forces);
@@ -342,6 +346,17 @@ Superelement ReadSuperelementFile(const std::string& path, const SuperelementRea
         RequireShape(r, "/stress/element_axes", v.cells.rows(), 9);
         st.section_forces = r.Matrix("/stress/section_forces").cast<float>();
         st.element_axes = r.Matrix("/stress/element_axes");
+      }
+      if (r.Exists("/stress/gradients")) {
+        RequireShape(r, "/stress/gradients", 9 * np, n);
+        RequireShape(r, "/stress/material", 2, -1);
+        st.gradients = r.Matrix("/stress/gradients").cast<float>();
+        const Eigen::VectorXd material = r.Vector("/stress/material");
+        st.E = material[0];
+        st.nu = material[1];
+        if (!(st.E > 0) || !(st.nu > -1 && st.nu < 0.5)) {
+          throw InputError(path + ": dataset /stress/material: E and nu must be positive and in (-1, 0.5)");
+        }
       }
       if (r.Exists("/stress/inertia_modes")) {
         RequireShape(r, "/stress/inertia_modes", 6 * np, kInertiaLoadCaseCount);

@@ -265,19 +265,27 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
   if (keep_mesh && part.reduction.stresses.value_or(true)) {
     Stopwatch stress_clock;
     const Visualization& v = *se.visualization;
+    // With modal derivatives (solids) the stress keeps the Green-Lagrange strain's quadratic part.
+    bool gradients = derivatives;
     auto stresses_of = [&](const Eigen::MatrixXd& fields) {
-      return part.type == "solid" ? SolidModalStress(SolidTypeOf(model.cell_type), model.nodes, model.cells, part.material, fields)
+      return part.type == "solid" ? SolidModalStress(SolidTypeOf(model.cell_type), model.nodes, model.cells, part.material, fields,
+                                                     gradients)
                                   : BeamModalStress(part, fields);
     };
     se.stress = stresses_of(v.shapes);
+    gradients = false;  // the inertia load cases' stresses are linear
     if (stress_fields.cols() > 0) {
       const ModalStress inertia = stresses_of(stress_fields);
       se.stress->inertia_modes = inertia.modes;
       se.stress->inertia_section_forces = inertia.section_forces;
     }
-    std::snprintf(detail, sizeof detail, "%d stress points x %ld coordinates (%s), %.3g MB in single precision",
-                  se.stress->n_points(), long(v.shapes.cols()), se.stress->method.c_str(),
-                  4.0 * double(se.stress->modes.size() + se.stress->section_forces.size()) / 1e6);
+    const ModalStress& st = *se.stress;
+    std::snprintf(detail, sizeof detail, "%d stress points x %ld coordinates (%s%s%s), %.3g MB in single precision",
+                  st.n_points(), long(v.shapes.cols()), st.method.c_str(),
+                  st.gradients.size() ? "; displacement gradients for the Green-Lagrange quadratic part" : "",
+                  st.inertia_modes.size() ? "; 12 inertia load cases" : "",
+                  4.0 * double(st.modes.size() + st.section_forces.size() + st.gradients.size() + st.inertia_modes.size() +
+                               st.inertia_section_forces.size()) / 1e6);
     report("stresses", stress_clock.Seconds(), detail);
   }
 

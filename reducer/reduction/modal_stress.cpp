@@ -97,35 +97,44 @@ std::vector<Fibre> SectionFibres(const BeamSectionSpec& s, const SectionProperti
 }  // namespace
 
 ModalStress SolidModalStress(SolidType type, const Eigen::MatrixXd& nodes, const Eigen::MatrixXi& cells,
-                             const MaterialSpec& material, const Eigen::MatrixXd& mesh_shapes) {
+                             const MaterialSpec& material, const Eigen::MatrixXd& mesh_shapes, bool gradients) {
   const long n_nodes = nodes.rows(), m = mesh_shapes.cols();
   const int n = SolidNodeCount(type);
+  // Per point the rows projected: the 6 stresses D B u, then (with gradients) the 9 entries of
+  // the displacement gradient du_i/dX_j (row 3 i + j).
+  const int rows = gradients ? 15 : 6;
   const Eigen::Matrix<double, 6, 6> D = IsotropicElasticity(material.E, material.nu);
-  Eigen::MatrixXd sum = Eigen::MatrixXd::Zero(6 * n_nodes, m);
+  Eigen::MatrixXd sum = Eigen::MatrixXd::Zero(rows * n_nodes, m);
   Eigen::VectorXd weight = Eigen::VectorXd::Zero(n_nodes);
-  Eigen::MatrixXd X(n, 3), U(3 * n, m);
+  Eigen::MatrixXd X(n, 3), U(3 * n, m), op(rows, 3 * n);
   for (long e = 0; e < cells.rows(); ++e) {
     for (int a = 0; a < n; ++a) {
       X.row(a) = nodes.row(cells(e, a));
       U.middleRows(3 * a, 3) = mesh_shapes.middleRows(3 * long(cells(e, a)), 3);
     }
-    // E = sum_g dV N_g (x) D B_g: (6 n) x (3 n), node-major; M_e = sum_g dV N_g N_g^T.
-    Eigen::MatrixXd E = Eigen::MatrixXd::Zero(6 * n, 3 * n), Me = Eigen::MatrixXd::Zero(n, n);
+    // E = sum_g dV N_g (x) op_g: (rows n) x (3 n), node-major; M_e = sum_g dV N_g N_g^T.
+    Eigen::MatrixXd E = Eigen::MatrixXd::Zero(rows * n, 3 * n), Me = Eigen::MatrixXd::Zero(n, n);
     double volume = 0;
     for (const SolidPoint& p : SolidElementPoints(type, X, e + 1)) {
-      const Eigen::MatrixXd DB = D * SolidStrainMatrix(p.dNdX);
-      for (int a = 0; a < n; ++a) E.middleRows(6 * a, 6) += (p.dV * p.N[a]) * DB;
+      op.topRows(6) = D * SolidStrainMatrix(p.dNdX);
+      if (gradients) {
+        op.bottomRows(9).setZero();
+        for (int a = 0; a < n; ++a)
+          for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j) op(6 + 3 * i + j, 3 * a + i) = p.dNdX(a, j);
+      }
+      for (int a = 0; a < n; ++a) E.middleRows(rows * a, rows) += (p.dV * p.N[a]) * op;
       Me.noalias() += p.dV * p.N * p.N.transpose();
       volume += p.dV;
     }
-    const Eigen::MatrixXd S = E * U;  // (6 n) x m: int N_a sigma dV per node a
+    const Eigen::MatrixXd S = E * U;  // (rows n) x m: int N_a (op u) dV per node a
     const Eigen::LLT<Eigen::MatrixXd> llt(Me);
-    for (int c = 0; c < 6; ++c) {
-      // The projection per stress component: nodal values = M_e^-1 (int N sigma_c dV).
+    for (int c = 0; c < rows; ++c) {
+      // The projection per component: nodal values = M_e^-1 (int N f_c dV).
       Eigen::MatrixXd rhs(n, m);
-      for (int a = 0; a < n; ++a) rhs.row(a) = S.row(6 * a + c);
+      for (int a = 0; a < n; ++a) rhs.row(a) = S.row(rows * a + c);
       const Eigen::MatrixXd nodal = llt.solve(rhs);
-      for (int a = 0; a < n; ++a) sum.row(6 * long(cells(e, a)) + c) += volume * nodal.row(a);
+      for (int a = 0; a < n; ++a) sum.row(rows * long(cells(e, a)) + c) += volume * nodal.row(a);
     }
     for (int a = 0; a < n; ++a) weight[cells(e, a)] += volume;
   }
@@ -134,11 +143,17 @@ ModalStress SolidModalStress(SolidType type, const Eigen::MatrixXd& nodes, const
   out.points = nodes;
   out.node.resize(n_nodes);
   out.modes.resize(6 * n_nodes, m);
+  if (gradients) {
+    out.gradients.resize(9 * n_nodes, m);
+    out.E = material.E;
+    out.nu = material.nu;
+  }
   for (long i = 0; i < n_nodes; ++i) {
     out.node[i] = int(i);
     // Nodes of no element (none in a meshed part) keep zero stress.
     const double w = weight[i] > 0 ? weight[i] : 1.0;
-    out.modes.middleRows(6 * i, 6) = (sum.middleRows(6 * i, 6) / w).cast<float>();
+    out.modes.middleRows(6 * i, 6) = (sum.middleRows(rows * i, 6) / w).cast<float>();
+    if (gradients) out.gradients.middleRows(9 * i, 9) = (sum.middleRows(rows * i + 6, 9) / w).cast<float>();
   }
   return out;
 }

@@ -37,8 +37,11 @@ namespace femb {
 
 /// Modal stresses of a solid part: `mesh_shapes` (3 n_nodes x n, node-major) the full
 /// displacement field of each basis vector on the mesh `nodes` (n_nodes x 3), `cells` of `type`.
+/// `gradients` (parts with modal derivatives): also each basis vector's displacement gradient at
+/// the nodes, projected the same way, for the quadratic part of the Green-Lagrange strain
+/// (ModalStress::gradients).
 ModalStress SolidModalStress(SolidType type, const Eigen::MatrixXd& nodes, const Eigen::MatrixXi& cells,
-                             const MaterialSpec& material, const Eigen::MatrixXd& mesh_shapes);
+                             const MaterialSpec& material, const Eigen::MatrixXd& mesh_shapes, bool gradients = false);
 
 /// Modal stresses of a beam part: `shapes` (6 n_nodes x n) on the nodes of BeamElements(part).
 ModalStress BeamModalStress(const PartSpec& part, const Eigen::MatrixXd& shapes);

@@ -9,7 +9,9 @@
 #include <cmath>
 #include <cstdio>
 
+#include "formats/superelement_checks.h"
 #include "formats/superelement_file.h"
+#include "reducer/fe/solid_model.h"
 #include "test_util.h"
 
 namespace femb {
@@ -91,6 +93,14 @@ TEST(ModalStress, RigidBodyMotionsCauseNoStress) {
     const Eigen::MatrixXd modes = se.stress->modes.cast<double>();
     const double scale = modes.cwiseAbs().maxCoeff() * Phi_rig0.cwiseAbs().maxCoeff();
     EXPECT_LT((modes * Phi_rig0).cwiseAbs().maxCoeff(), 1e-5 * scale) << se.stress->method;
+    // The file check sees it, and a stress dataset that does not belong to the basis fails it.
+    const SuperelementChecks good = CheckSuperelement(se);
+    ASSERT_TRUE(good.all_ok()) << good.first_failure()->detail;
+    Superelement bad = se;
+    bad.stress->modes.col(0) += bad.stress->modes.col(1);
+    const SuperelementChecks checks = CheckSuperelement(bad);
+    ASSERT_NE(checks.first_failure(), nullptr);
+    EXPECT_EQ(checks.first_failure()->name, "stress_rigid_body");
   }
 }
 
@@ -140,6 +150,59 @@ TEST(ModalStress, BeamFibreStressesAreBeamTheoryExactly) {
   }
   EXPECT_NEAR(VonMises(StressAt(s, NearestPoint(s, Eigen::Vector3d(0.5, 0.01, 0.02)), q)),
               std::abs(N / A + My * 0.02 / Iy - Mz * 0.01 / Iz), 1e-6 * (N / A + My * 0.02 / Iy + Mz * 0.01 / Iz));
+}
+
+TEST(ModalStress, AffineFieldsHaveExactGradientsAndGreenLagrangeStress) {
+  // Reference: an affine displacement u = A X has the constant gradient A, which every element
+  // represents: the projected nodal gradients are A to single precision at every node, and the
+  // recovered stress at amplitude q is St. Venant-Kirchhoff's S = D E with the exact Green-Lagrange
+  // strain E = (q A + q A^T + q^2 A^T A) / 2 (linear plus quadratic part; no other term exists).
+  const PartSpec part = ParsePart(SolidBar("hexahedra", 0.025), "bar.yaml", {});
+  const FeModel model = BuildSolidModel(part);
+  Eigen::Matrix3d A;
+  A << 0.3, -0.2, 0.1, 0.5, 0.05, -0.4, 0.2, 0.1, -0.15;
+  Eigen::MatrixXd field(model.nodes.rows() * 3, 1);
+  for (long i = 0; i < model.nodes.rows(); ++i) field.block<3, 1>(3 * i, 0) = A * model.nodes.row(i).transpose();
+  const ModalStress s = SolidModalStress(SolidType::kHex20, model.nodes, model.cells, part.material, field, true);
+  ASSERT_EQ(s.gradients.rows(), 9 * model.nodes.rows());
+  double worst = 0;
+  for (long i = 0; i < model.nodes.rows(); ++i) {
+    const Eigen::Matrix<double, 9, 1> h = s.gradients.block<9, 1>(9 * i, 0).cast<double>();
+    worst = std::max(worst, (Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(h.data()) - A).cwiseAbs().maxCoeff());
+  }
+  EXPECT_LT(worst, 1e-6);
+  const double q = 0.7, E = part.material.E, nu = part.material.nu;
+  const Eigen::Matrix3d G = 0.5 * (q * A + q * A.transpose() + q * q * A.transpose() * A);
+  const double lambda = E * nu / ((1 + nu) * (1 - 2 * nu)), mu = E / (2 * (1 + nu));
+  const Eigen::Matrix3d S = lambda * G.trace() * Eigen::Matrix3d::Identity() + 2 * mu * G;
+  Eigen::Matrix<double, 6, 1> expected;
+  expected << S(0, 0), S(1, 1), S(2, 2), S(1, 2), S(0, 2), S(0, 1);
+  const Eigen::VectorXd amplitude = Eigen::VectorXd::Constant(1, q);
+  for (int p : {0, 17, int(model.nodes.rows()) - 1}) {
+    EXPECT_LT((PointStress(s, p, amplitude) - expected).cwiseAbs().maxCoeff(), 1e-6 * expected.cwiseAbs().maxCoeff()) << p;
+  }
+  // A part with modal derivatives stores the gradients of its whole basis (and the file keeps
+  // them); one without does not.
+  const Superelement se = test::Reduce(
+      test::Replace(SolidBar("hexahedra", 0.025), "internal_modes: 4}", "internal_modes: 4, modal_derivatives: {of: internal}}"));
+  ASSERT_TRUE(se.stress.has_value());
+  EXPECT_GT(se.n_modal_derivatives, 0);
+  EXPECT_EQ(se.stress->gradients.rows(), 9 * se.stress->n_points());
+  EXPECT_EQ(se.stress->gradients.cols(), se.n_reduced_dofs());
+  EXPECT_EQ(se.stress->E, part.material.E);
+  const std::string path = "/tmp/femb_modal_stress_gradients_" + std::to_string(::getpid()) + ".h5";
+  WriteSuperelementFile(se, path);
+  const Superelement back = ReadSuperelementFile(path);
+  std::remove(path.c_str());
+  ASSERT_TRUE(back.stress.has_value());
+  EXPECT_EQ(back.stress->gradients, se.stress->gradients);
+  EXPECT_EQ(back.stress->nu, se.stress->nu);
+  EXPECT_EQ(test::Reduce(SolidBar("hexahedra", 0.025)).stress->gradients.size(), 0);
+  // Without gradients the same field gives the linear stress alone.
+  const ModalStress linear = SolidModalStress(SolidType::kHex20, model.nodes, model.cells, part.material, field);
+  EXPECT_EQ(linear.gradients.size(), 0);
+  const Eigen::Matrix3d Gl = 0.5 * q * (A + A.transpose());
+  EXPECT_NEAR(PointStress(linear, 5, amplitude)[5], 2 * mu * Gl(0, 1), 1e-6 * E);
 }
 
 TEST(ModalStress, VonMisesAndPrincipalStressesOfKnownStates) {
