@@ -3,8 +3,8 @@ animation, saved as a PNG. usage: pvpython render_stress.py ANIMATION.xdmf OUT.p
 (SCALE exaggerates the deformation: the drawn mesh is x + (SCALE - 1) * deformation)."""
 import sys
 
-from paraview.simple import (ColorBy, GetActiveViewOrCreate, GetColorTransferFunction, GetScalarBar,
-                             OpenDataFile, SaveScreenshot, Show, WarpByVector)
+from paraview.simple import (ColorBy, GetActiveCamera, GetActiveViewOrCreate, GetColorTransferFunction, GetScalarBar,
+                             OpenDataFile, SaveScreenshot, Show, Text, WarpByVector)
 
 source = OpenDataFile(sys.argv[1])
 source.UpdatePipelineInformation()
@@ -35,5 +35,10 @@ view.CameraPosition = [0.075, -0.25, 0.30]
 view.CameraFocalPoint = [0.075, 0.0, 0.01]
 view.CameraViewUp = [0, 0, 1]
 view.ResetCamera()
+GetActiveCamera().Dolly(1.7)
+label = Text(Text=f"von Mises stress, deformation x {scale:g} (femb-solve, t = {view.ViewTime:g})")
+label_display = Show(label, view)
+label_display.Color = [0, 0, 0]
+label_display.FontSize = 14
 SaveScreenshot(sys.argv[2], view, ImageResolution=[1400, 800])
 print("render_stress: wrote", sys.argv[2])

@@ -10,10 +10,12 @@ here=$(cd "$(dirname "$0")" && pwd)
 bin=${1:-$here/../../build/bin}
 out=$here/out
 mkdir -p "$out"
-if ! command -v pvpython > /dev/null || ! command -v xvfb-run > /dev/null; then
+# ParaView's Python (Debian: python3-paraview).
+find_pv() { command -v pvpython; }
+if [ -z "$(find_pv)" ] || ! command -v xvfb-run > /dev/null; then
   sudo_cmd=""; [ "$(id -u)" -ne 0 ] && sudo_cmd="sudo"
   $sudo_cmd apt-get update -q
-  DEBIAN_FRONTEND=noninteractive $sudo_cmd apt-get install -y -q --no-install-recommends paraview xvfb xauth
+  DEBIAN_FRONTEND=noninteractive $sudo_cmd apt-get install -y -q --no-install-recommends paraview python3-paraview xvfb xauth
 fi
 [ -s "$out/solid_crank.h5" ] || "$bin/femb-reduce" -q "$here/part.yaml" -o "$out/solid_crank.h5"
 "$bin/femb-solve" -q "$here/stress_scene.yaml" -o "$out/stress"
@@ -24,4 +26,4 @@ sxx, ref = float(row["web_side.stress.xx"]), -1000 * 0.075 * 0.012 / (0.012 * 0.
 print(f"web side at mid-length: sigma_xx {sxx / 1e6:.2f} MPa, beam theory {ref / 1e6:.2f} MPa ({100 * (sxx / ref - 1):+.1f}%)")
 PY
 png=$here/../../docs/results/solid_crank_von_mises.png
-xvfb-run -a pvpython "$here/render_stress.py" "$out/stress/animation.xdmf" "$png" 100
+xvfb-run -a "$(find_pv)" "$here/render_stress.py" "$out/stress/animation.xdmf" "$png" 100
