@@ -13,7 +13,7 @@ cd "$(dirname "$0")/.."
 seconds=${FEMB_FUZZ_SECONDS:-120}
 scale=${FEMB_FUZZ_SCALE:-1}
 fuzz_seed=${FEMB_FUZZ_SEED:-1}
-declare -A runs=([yaml_fuzz]=30000 [part_fuzz]=150000 [scene_fuzz]=60000 [superelement_fuzz]=4000)
+declare -A runs=([yaml_fuzz]=15000 [part_fuzz]=75000 [scene_fuzz]=30000 [superelement_fuzz]=2000)
 missing=()
 for p in clang libclang-rt-14-dev; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
