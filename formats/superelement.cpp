@@ -105,6 +105,20 @@ namespace {
 // D E_quad of St. Venant-Kirchhoff at point p: E_quad = H^T H / 2 with H = sum_i q_i H_i
 // (Voigt xx, yy, zz, yz, xz, xy; engineering shear 2 E_ij).
 Eigen::Matrix<double, 6, 1> QuadraticStress(const ModalStress& modal, long p, const Eigen::VectorXd& q) {
+  if (modal.element_quadratic.size() > 0) {
+    // Beams: E q^T Q_e q / 2 along the element axis e1: (e1 e1^T) in Voigt order.
+    const int e = modal.point_element[p];
+    double c = 0;
+    long k = 0;
+    for (long i = 0; i < q.size(); ++i) {
+      c += 0.5 * modal.element_quadratic(e, k++) * q[i] * q[i];
+      for (long j = i + 1; j < q.size(); ++j) c += modal.element_quadratic(e, k++) * q[i] * q[j];
+    }
+    const Eigen::Vector3d e1 = modal.element_axes.row(e).head<3>().transpose();
+    Eigen::Matrix<double, 6, 1> s;
+    s << e1[0] * e1[0], e1[1] * e1[1], e1[2] * e1[2], e1[1] * e1[2], e1[0] * e1[2], e1[0] * e1[1];
+    return modal.E * c * s;
+  }
   const Eigen::Matrix<double, 9, 1> h = modal.gradients.middleRows(9 * p, 9).cast<double>() * q;
   const Eigen::Matrix3d H = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(h.data());
   const Eigen::Matrix3d Eq = 0.5 * H.transpose() * H;
@@ -122,7 +136,7 @@ Eigen::Matrix<double, 6, 1> PointStress(const ModalStress& modal, int p, const E
                                         const Eigen::VectorXd* inertia) {
   Eigen::Matrix<double, 6, 1> s = modal.modes.middleRows(6 * p, 6).cast<double>() * q;
   if (inertia && modal.inertia_modes.size() > 0) s += modal.inertia_modes.middleRows(6 * p, 6).cast<double>() * *inertia;
-  if (modal.gradients.size() > 0) s += QuadraticStress(modal, p, q);
+  if (modal.gradients.size() > 0 || modal.element_quadratic.size() > 0) s += QuadraticStress(modal, p, q);
   return s;
 }
 
@@ -134,7 +148,7 @@ void NodeStresses(const ModalStress& modal, const Eigen::VectorXd& q, long n_nod
   if (inertia && modal.inertia_modes.size() > 0) {
     for (Eigen::Index k = 0; k < inertia->size(); ++k) all += (*inertia)[k] * modal.inertia_modes.col(k).cast<double>();
   }
-  if (modal.gradients.size() > 0) {
+  if (modal.gradients.size() > 0 || modal.element_quadratic.size() > 0) {
     for (int p = 0; p < modal.n_points(); ++p) all.segment<6>(6 * p) += QuadraticStress(modal, p, q);
   }
   stress->setZero(n_nodes, 6);

@@ -95,6 +95,13 @@ struct ModalStress {
   /// Green-Lagrange strain's linear and quadratic parts, as the body's polynomial force. Empty
   /// otherwise (linear stress).
   Eigen::MatrixXf gradients;
+  /// Beams with modal derivatives: the von Karman part of the axial strain, element by element
+  /// as in the body's polynomial force (reducer/fe/nonlinear_beam.h: the element mean of
+  /// (v'^2 + w'^2) / 2), a quadratic form q^T Q_e q / 2 per element stored as its upper triangle
+  /// row by row (n_cells x n (n + 1) / 2), and the element of each stress point (n_points); the
+  /// stress adds E q^T Q_e q / 2 along the element axis. Empty otherwise.
+  Eigen::MatrixXf element_quadratic;
+  Eigen::VectorXi point_element;
   double E = 0.0, nu = 0.0;
   int n_points() const { return int(points.rows()); }
 };

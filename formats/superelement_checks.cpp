@@ -66,6 +66,9 @@ Check Finite(const Superelement& se) {
     datasets.emplace_back("/stress/modes", se.stress->modes.cast<double>());
     if (se.stress->inertia_modes.size() > 0) datasets.emplace_back("/stress/inertia_modes", se.stress->inertia_modes.cast<double>());
     if (se.stress->gradients.size() > 0) datasets.emplace_back("/stress/gradients", se.stress->gradients.cast<double>());
+    if (se.stress->element_quadratic.size() > 0) {
+      datasets.emplace_back("/stress/element_quadratic", se.stress->element_quadratic.cast<double>());
+    }
     if (se.stress->section_forces.size() > 0) {
       datasets.emplace_back("/stress/section_forces", se.stress->section_forces.cast<double>());
     }

@@ -152,10 +152,13 @@ void WriteContent(const Superelement& se, h5::Writer& w) {
       w.FloatMatrix("/stress/section_forces", st.section_forces);
       w.Matrix("/stress/element_axes", st.element_axes);
     }
-    if (st.gradients.size() > 0) {
-      w.FloatMatrix("/stress/gradients", st.gradients);
-      w.Vector("/stress/material", Eigen::Vector2d(st.E, st.nu));
+    if (st.gradients.size() > 0) w.FloatMatrix("/stress/gradients", st.gradients);
+    if (st.element_quadratic.size() > 0) {
+      w.FloatMatrix("/stress/element_quadratic", st.element_quadratic);
+      w.IntVector("/stress/point_element",
+                  std::vector<int>(st.point_element.data(), st.point_element.data() + st.point_element.size()));
     }
+    if (st.gradients.size() > 0 || st.element_quadratic.size() > 0) w.Vector("/stress/material", Eigen::Vector2d(st.E, st.nu));
     if (st.inertia_modes.size() > 0) {
       w.FloatMatrix("/stress/inertia_modes", st.inertia_modes);
       if (st.inertia_section_forces.size() > 0) w.FloatMatrix("/stress/inertia_section_forces", st.inertia_section_forces);
@@ -347,10 +350,26 @@ Superelement ReadSuperelementFile(const std::string& path, const SuperelementRea
         st.section_forces = r.Matrix("/stress/section_forces").cast<float>();
         st.element_axes = r.Matrix("/stress/element_axes");
       }
-      if (r.Exists("/stress/gradients")) {
-        RequireShape(r, "/stress/gradients", 9 * np, n);
+      if (r.Exists("/stress/element_quadratic")) {
+        RequireShape(r, "/stress/element_quadratic", v.cells.rows(), n * (n + 1) / 2);
+        RequireShape(r, "/stress/point_element", np, -1);
+        RequireShape(r, "/stress/element_axes", v.cells.rows(), 9);
+        st.element_quadratic = r.Matrix("/stress/element_quadratic").cast<float>();
+        st.element_axes = r.Matrix("/stress/element_axes");
+        st.point_element = r.IntVector("/stress/point_element");
+        for (long p = 0; p < np; ++p) {
+          if (st.point_element[p] < 0 || st.point_element[p] >= v.cells.rows()) {
+            throw InputError(path + ": dataset /stress/point_element: entry " + std::to_string(p) + " = " +
+                             std::to_string(st.point_element[p]) + " is not a cell of /visualization/cells");
+          }
+        }
+      }
+      if (r.Exists("/stress/gradients") || r.Exists("/stress/element_quadratic")) {
         RequireShape(r, "/stress/material", 2, -1);
-        st.gradients = r.Matrix("/stress/gradients").cast<float>();
+        if (r.Exists("/stress/gradients")) {
+          RequireShape(r, "/stress/gradients", 9 * np, n);
+          st.gradients = r.Matrix("/stress/gradients").cast<float>();
+        }
         const Eigen::VectorXd material = r.Vector("/stress/material");
         st.E = material[0];
         st.nu = material[1];

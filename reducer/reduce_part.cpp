@@ -265,12 +265,13 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
   if (keep_mesh && part.reduction.stresses.value_or(true)) {
     Stopwatch stress_clock;
     const Visualization& v = *se.visualization;
-    // With modal derivatives (solids) the stress keeps the Green-Lagrange strain's quadratic part.
+    // With modal derivatives the stress keeps the strain's quadratic part (solids: Green-Lagrange;
+    // beams: the von Karman axial term), as the body's polynomial force does.
     bool gradients = derivatives;
     auto stresses_of = [&](const Eigen::MatrixXd& fields) {
       return part.type == "solid" ? SolidModalStress(SolidTypeOf(model.cell_type), model.nodes, model.cells, part.material, fields,
                                                      gradients)
-                                  : BeamModalStress(part, fields);
+                                  : BeamModalStress(part, fields, gradients);
     };
     se.stress = stresses_of(v.shapes);
     gradients = false;  // the inertia load cases' stresses are linear
@@ -282,9 +283,10 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
     const ModalStress& st = *se.stress;
     std::snprintf(detail, sizeof detail, "%d stress points x %ld coordinates (%s%s%s), %.3g MB in single precision",
                   st.n_points(), long(v.shapes.cols()), st.method.c_str(),
-                  st.gradients.size() ? "; displacement gradients for the Green-Lagrange quadratic part" : "",
+                  st.gradients.size() ? "; displacement gradients for the Green-Lagrange quadratic part"
+                  : st.element_quadratic.size() ? "; element forms of the von Karman axial strain" : "",
                   st.inertia_modes.size() ? "; 12 inertia load cases" : "",
-                  4.0 * double(st.modes.size() + st.section_forces.size() + st.gradients.size() + st.inertia_modes.size() +
+                  4.0 * double(st.modes.size() + st.section_forces.size() + st.gradients.size() + st.element_quadratic.size() + st.inertia_modes.size() +
                                st.inertia_section_forces.size()) / 1e6);
     report("stresses", stress_clock.Seconds(), detail);
   }

@@ -158,7 +158,7 @@ ModalStress SolidModalStress(SolidType type, const Eigen::MatrixXd& nodes, const
   return out;
 }
 
-ModalStress BeamModalStress(const PartSpec& part, const Eigen::MatrixXd& shapes) {
+ModalStress BeamModalStress(const PartSpec& part, const Eigen::MatrixXd& shapes, bool quadratic) {
   std::vector<Eigen::Vector3d> nodes;
   const std::vector<BeamElement> elements = BeamElements(part, &nodes);
   const long m = shapes.cols(), n_cells = long(elements.size());
@@ -166,8 +166,13 @@ ModalStress BeamModalStress(const PartSpec& part, const Eigen::MatrixXd& shapes)
   out.method = "beam_fibres";
   out.section_forces.resize(12 * n_cells, m);
   out.element_axes.resize(n_cells, 9);
+  if (quadratic) {
+    out.element_quadratic.resize(n_cells, m * (m + 1) / 2);
+    out.E = part.material.E;
+    out.nu = part.material.nu;
+  }
   std::vector<Eigen::Vector3d> points;
-  std::vector<int> point_node;
+  std::vector<int> point_node, point_element;
   std::vector<Eigen::MatrixXd> point_modes;
   long e = 0;
   for (const BeamSegmentSpec& seg : part.beam.segments) {
@@ -181,7 +186,22 @@ ModalStress BeamModalStress(const PartSpec& part, const Eigen::MatrixXd& shapes)
       u.bottomRows(6) = shapes.middleRows(6 * long(el.n2), 6);
       // End forces on the element, local axes; the section forces: minus those at the first
       // end (its cut face points along -x), those at the second.
-      const Eigen::MatrixXd f = el.beam->LocalStiffness() * (BeamTransformation(el.R) * u);
+      const Eigen::MatrixXd local = BeamTransformation(el.R) * u;
+      const Eigen::MatrixXd f = el.beam->LocalStiffness() * local;
+      if (quadratic) {
+        // Q_e = (1 / L) sum_g w_g S_g^T S_g, S_g (2 x m) the slopes v', w' of the basis vectors.
+        Eigen::MatrixXd Q = Eigen::MatrixXd::Zero(m, m);
+        double length = 0;
+        for (const TimoshenkoBeam::QuadraturePoint& g : el.beam->QuadraturePoints()) {
+          const Eigen::MatrixXd S = g.slope * local;
+          Q.noalias() += g.weight * S.transpose() * S;
+          length += g.weight;
+        }
+        Q /= length;
+        long k = 0;
+        for (long i = 0; i < m; ++i)
+          for (long j = i; j < m; ++j) out.element_quadratic(e, k++) = float(Q(i, j));
+      }
       Eigen::MatrixXd ends(12, m);
       ends.topRows(6) = -f.topRows(6);
       ends.bottomRows(6) = f.bottomRows(6);
@@ -194,6 +214,7 @@ ModalStress BeamModalStress(const PartSpec& part, const Eigen::MatrixXd& shapes)
         for (const Fibre& fb : fibres) {
           points.push_back(nodes[size_t(node)] + fb.y * el.R.row(1).transpose() + fb.z * el.R.row(2).transpose());
           point_node.push_back(node);
+          point_element.push_back(int(e));
           point_modes.push_back(to_part * fb.map * ends.middleRows(6 * end, 6));
         }
       }
@@ -201,10 +222,12 @@ ModalStress BeamModalStress(const PartSpec& part, const Eigen::MatrixXd& shapes)
   }
   out.points.resize(long(points.size()), 3);
   out.node.resize(long(points.size()));
+  if (quadratic) out.point_element.resize(long(points.size()));
   out.modes.resize(6 * long(points.size()), m);
   for (size_t p = 0; p < points.size(); ++p) {
     out.points.row(long(p)) = points[p].transpose();
     out.node[long(p)] = point_node[p];
+    if (quadratic) out.point_element[long(p)] = point_element[p];
     out.modes.middleRows(6 * long(p), 6) = point_modes[p].cast<float>();
   }
   return out;

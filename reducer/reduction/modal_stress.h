@@ -44,6 +44,8 @@ ModalStress SolidModalStress(SolidType type, const Eigen::MatrixXd& nodes, const
                              const MaterialSpec& material, const Eigen::MatrixXd& mesh_shapes, bool gradients = false);
 
 /// Modal stresses of a beam part: `shapes` (6 n_nodes x n) on the nodes of BeamElements(part).
-ModalStress BeamModalStress(const PartSpec& part, const Eigen::MatrixXd& shapes);
+/// `quadratic` (parts with modal derivatives): also the element quadratic forms of the von Karman
+/// axial strain (ModalStress::element_quadratic).
+ModalStress BeamModalStress(const PartSpec& part, const Eigen::MatrixXd& shapes, bool quadratic = false);
 
 }  // namespace femb
