@@ -266,17 +266,16 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
     Stopwatch stress_clock;
     const Visualization& v = *se.visualization;
     // With modal derivatives the stress keeps the strain's quadratic part (solids: Green-Lagrange;
-    // beams: the von Karman axial term), as the body's polynomial force does.
-    bool gradients = derivatives;
-    auto stresses_of = [&](const Eigen::MatrixXd& fields) {
+    // beams: the von Karman axial term), as the body's polynomial force does; the inertia load
+    // cases' stresses are linear.
+    auto stresses_of = [&](const Eigen::MatrixXd& fields, bool quadratic) {
       return part.type == "solid" ? SolidModalStress(SolidTypeOf(model.cell_type), model.nodes, model.cells, part.material, fields,
-                                                     gradients)
-                                  : BeamModalStress(part, fields, gradients);
+                                                     quadratic)
+                                  : BeamModalStress(part, fields, quadratic);
     };
-    se.stress = stresses_of(v.shapes);
-    gradients = false;  // the inertia load cases' stresses are linear
+    se.stress = stresses_of(v.shapes, derivatives);
     if (stress_fields.cols() > 0) {
-      const ModalStress inertia = stresses_of(stress_fields);
+      const ModalStress inertia = stresses_of(stress_fields, false);
       se.stress->inertia_modes = inertia.modes;
       se.stress->inertia_section_forces = inertia.section_forces;
     }
