@@ -180,6 +180,60 @@ void CheckMaterialUnits(const PartSpec& part, const YamlValue& material) {
   }
 }
 
+// interfaces[k].select: {cylinder: {point, axis, radius, [length]}, tolerance} (or sphere:
+// {center, radius}, box: {min, max}, plane: {point, normal}).
+NodeSelectionSpec ParseSelection(const YamlValue& value) {
+  YamlMap m = value.Map();
+  NodeSelectionSpec s;
+  s.where = value.Where();
+  if (auto t = m.Optional("tolerance")) s.tolerance = t->PositiveNumber();
+  int shapes = 0;
+  auto unit = [](const YamlValue& v) {
+    const Eigen::Vector3d a = v.Vector3();
+    if (!(a.norm() > 0)) v.Fail("must be a nonzero vector");
+    return Eigen::Vector3d(a.normalized());
+  };
+  if (auto c = m.Optional("cylinder")) {
+    ++shapes;
+    YamlMap g = c->Map();
+    s.shape = "cylinder";
+    s.point = g.Required("point").Vector3();
+    s.axis = unit(g.Required("axis"));
+    s.radius = g.Required("radius").PositiveNumber();
+    if (auto l = g.Optional("length")) s.length = l->PositiveNumber();
+    g.CheckNoUnknownKeys();
+  }
+  if (auto c = m.Optional("sphere")) {
+    ++shapes;
+    YamlMap g = c->Map();
+    s.shape = "sphere";
+    s.point = g.Required("center").Vector3();
+    s.radius = g.Required("radius").PositiveNumber();
+    g.CheckNoUnknownKeys();
+  }
+  if (auto c = m.Optional("box")) {
+    ++shapes;
+    YamlMap g = c->Map();
+    s.shape = "box";
+    s.point = g.Required("min").Vector3();
+    YamlValue max = g.Required("max");
+    s.axis = max.Vector3();
+    if (!((s.axis - s.point).minCoeff() >= 0)) max.Fail("every coordinate of max must be at least that of min");
+    g.CheckNoUnknownKeys();
+  }
+  if (auto c = m.Optional("plane")) {
+    ++shapes;
+    YamlMap g = c->Map();
+    s.shape = "plane";
+    s.point = g.Required("point").Vector3();
+    s.axis = unit(g.Required("normal"));
+    g.CheckNoUnknownKeys();
+  }
+  if (shapes != 1) value.Fail("give exactly one of cylinder, sphere, box, plane");
+  m.CheckNoUnknownKeys();
+  return s;
+}
+
 }  // namespace
 
 void CheckPartSize(const PartSpec& part, double diagonal, const std::string& where) {
@@ -307,7 +361,14 @@ PartSpec ParsePart(const std::string& text, const std::string& name,
         if (other.point == spec.point) item.Fail("point '" + point_name + "' is already interface '" + other.name + "'");
       }
     } else {
-      spec.group = m.Required("group").String();
+      auto group = m.Optional("group");
+      auto select = m.Optional("select");
+      if (group.has_value() == select.has_value()) {
+        item.Fail("interface '" + spec.name + "': give either 'group' (a named node set of the mesh) or 'select' "
+                  "(nodes picked by geometry: cylinder, sphere, box or plane)");
+      }
+      if (group) spec.group = group->String();
+      if (select) spec.select = ParseSelection(*select);
       if (auto c = m.Optional("coupling")) {
         spec.coupling = c->String();
         if (spec.coupling != "rbe2" && spec.coupling != "rbe3") c->Fail("unknown coupling '" + spec.coupling + "' (known: rbe2, rbe3)");

@@ -46,12 +46,25 @@ struct BeamSpec {
   BeamSectionSpec section;
 };
 
+/// Nodes picked by geometry (issue 16): the mesh nodes on a surface (cylinder, sphere, plane)
+/// within `tolerance`, or inside a box. reducer/mesh/node_selection.h applies it.
+struct NodeSelectionSpec {
+  std::string shape;  ///< "cylinder", "sphere", "box" or "plane"
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();  ///< cylinder: on the axis; sphere: centre; plane: on it; box: min
+  Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();  ///< cylinder: axis; plane: normal (unit); box: max
+  double radius = 0.0;                              ///< cylinder, sphere
+  double length = 0.0;                              ///< cylinder: 0 = unbounded, else from point along axis
+  std::optional<double> tolerance;                  ///< default: 1e-4 x the mesh's bounding-box diagonal
+  std::string where;
+};
+
 struct InterfaceSpec {
   std::string name;
   int point = -1;  ///< index into BeamSpec::points (beam parts)
   // solid parts: the node set (gmsh physical surface group; box: xmin ... zmax), the coupling
   // and the interface point (default: the centroid of the node set)
   std::string group;
+  std::optional<NodeSelectionSpec> select;  ///< instead of `group`
   std::string coupling = "rbe2";
   std::optional<Eigen::Vector3d> location;
   std::string where;

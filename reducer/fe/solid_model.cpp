@@ -11,6 +11,7 @@
 #include "reducer/fe/solid_element.h"
 #include "reducer/mesh/gmsh_mesher.h"
 #include "reducer/mesh/meshio_import.h"
+#include "reducer/mesh/node_selection.h"
 
 namespace femb {
 namespace {
@@ -280,30 +281,42 @@ FeModel BuildSolidModel(const PartSpec& part, const ProgressFn& progress) {
 
   clock.Restart();
 
-  // Interface couplings (RBE2).
+  // Interface node sets: a named set of the mesh, or nodes picked by geometry.
   std::vector<int> owner(n_nodes, -1);
   FeModel model;
+  std::vector<std::vector<int>> sets(part.interfaces.size());
+  std::string selected;  // per interface, for the progress line
   for (size_t k = 0; k < part.interfaces.size(); ++k) {
     const InterfaceSpec& i = part.interfaces[k];
-    auto set = mesh->node_sets.find(i.group);
-    if (set == mesh->node_sets.end()) {
-      std::string known;
-      for (const auto& [name, _] : mesh->node_sets) known += (known.empty() ? "" : ", ") + name;
-      throw InputError(i.where + ": interface '" + i.name + "': node set '" + i.group + "' not found in the mesh (known: " +
-                       (known.empty() ? "none" : known) + ")");
+    std::string what;
+    if (i.select) {
+      sets[k] = SelectNodes(*i.select, mesh->nodes, i.name);
+      what = "by " + i.select->shape;
+    } else {
+      auto set = mesh->node_sets.find(i.group);
+      if (set == mesh->node_sets.end()) {
+        std::string known;
+        for (const auto& [name, _] : mesh->node_sets) known += (known.empty() ? "" : ", ") + name;
+        throw InputError(i.where + ": interface '" + i.name + "': node set '" + i.group + "' not found in the mesh (known: " +
+                         (known.empty() ? "none" : known) + "; or pick the nodes by geometry with 'select')");
+      }
+      if (set->second.empty()) throw InputError(i.where + ": interface '" + i.name + "': node set '" + i.group + "' is empty");
+      sets[k] = set->second;
+      what = "of set '" + i.group + "'";
     }
-    if (set->second.empty()) throw InputError(i.where + ": interface '" + i.name + "': node set '" + i.group + "' is empty");
+    selected += (k ? ", " : "") + i.name + ": " + std::to_string(sets[k].size()) + " nodes " + what;
+    const std::string source = i.select ? "the " + i.select->shape + " selection" : "node set '" + i.group + "'";
     Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-    for (int node : set->second) {
+    for (int node : sets[k]) {
       if (owner[node] >= 0) {
-        throw InputError(i.where + ": interface '" + i.name + "': node set '" + i.group + "' shares nodes with interface '" +
+        throw InputError(i.where + ": interface '" + i.name + "': " + source + " shares nodes with interface '" +
                          part.interfaces[owner[node]].name + "' (couplings must not overlap)");
       }
       owner[node] = int(k);
       centroid += mesh->nodes.row(node).transpose();
     }
-    centroid /= double(set->second.size());
-    const std::optional<Eigen::Vector3d> surface = SurfaceCentroid(*mesh, set->second);
+    centroid /= double(sets[k].size());
+    const std::optional<Eigen::Vector3d> surface = SurfaceCentroid(*mesh, sets[k]);
     if (surface) centroid = *surface;
     model.interface_names.push_back(i.name);
     model.interface_positions.push_back(i.location ? *i.location : centroid);
@@ -321,7 +334,7 @@ FeModel BuildSolidModel(const PartSpec& part, const ProgressFn& progress) {
   std::vector<Rbe3> rbe3(part.interfaces.size());
   for (size_t k = 0; k < part.interfaces.size(); ++k) {
     if (part.interfaces[k].coupling != "rbe3") continue;
-    const std::vector<int>& set = mesh->node_sets.at(part.interfaces[k].group);
+    const std::vector<int>& set = sets[k];
     const int ns = int(set.size());
     Eigen::Vector3d c = Eigen::Vector3d::Zero();
     for (int node : set) c += mesh->nodes.row(node).transpose();
@@ -388,7 +401,8 @@ FeModel BuildSolidModel(const PartSpec& part, const ProgressFn& progress) {
   T.setFromTriplets(t_entries.begin(), t_entries.end());
   if (progress) {
     progress("couplings", clock.Seconds(),
-             std::to_string(part.interfaces.size()) + " interfaces, " + std::to_string(n_model) + " model DOFs");
+             std::to_string(part.interfaces.size()) + " interfaces (" + selected + "), " + std::to_string(n_model) +
+                 " model DOFs");
   }
 
   // Element matrices straight onto the model DOFs (RBE2 folded in per element).

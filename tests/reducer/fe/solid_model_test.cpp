@@ -237,8 +237,68 @@ TEST(SolidModel, InterfacePointIsTheFaceCentroid) {
 
 TEST(SolidModel, MissingNodeSetIsNamed) {
   const std::string message = test::ThrownMessage([] { test::Reduce(Bar("[{name: root, group: xlow}]", 2)); });
-  EXPECT_NE(message.find("interface 'root': node set 'xlow' not found in the mesh (known: xmax, xmin, ymax, ymin, zmax, zmin)"),
+  EXPECT_NE(message.find("interface 'root': node set 'xlow' not found in the mesh (known: xmax, xmin, ymax, ymin, zmax, zmin; or pick the nodes by geometry with 'select')"),
             std::string::npos) << message;
+}
+
+// Interfaces picked by geometry (issue 16) take the same nodes as the named sets of the same
+// mesh: the reduced matrices agree to round-off. Tube 50/30 mm x 0.3 m: the bore (cylinder of
+// radius 30 mm, bounded to the tube's length), the bottom face (plane z = 0) and the top face
+// (a box around z = 0.3); also a sphere cap on a box's corner.
+TEST(SolidModel, GeometricSelectionsTakeTheNodesOfTheNamedSets) {
+  const std::string head = "name: t\ntype: solid\nmaterial: {E: 2.1e11, nu: 0.3, rho: 7850}\n"
+                           "geometry: {shape: tube, radius: 0.05, inner_radius: 0.03, length: 0.3}\n"
+                           "mesh: {size: 0.02, order: 2}\nreduction: {internal_modes: 3, floating_frame: mean_axes}\n";
+  // The bore shares its edge nodes with the end faces: two models.
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"[{name: bore, group: inner, coupling: rbe3}]",
+       "[{name: bore, coupling: rbe3, select: {cylinder: {point: [0, 0, 0], axis: [0, 0, 2], radius: 0.03, length: 0.3}}}]"},
+      {"[{name: bottom, group: bottom}, {name: top, group: top}]",
+       "[{name: bottom, select: {plane: {point: [0, 0, 0], normal: [0, 0, -1]}, tolerance: 1e-6}},"
+       " {name: top, select: {box: {min: [-1, -1, 0.2999], max: [1, 1, 0.31]}}}]"}};
+  for (const auto& [named, picked] : cases) {
+    const Superelement by_name = test::Reduce(head + "interfaces: " + named + "\n");
+    const Superelement by_geometry = test::Reduce(head + "interfaces: " + picked + "\n");
+    ASSERT_EQ(by_name.K.rows(), by_geometry.K.rows());
+    const double k_diff = (by_name.K - by_geometry.K).norm() / by_name.K.norm();
+    const double m_diff = (by_name.M - by_geometry.M).norm() / by_name.M.norm();
+    std::printf("[ info ] tube by name vs by geometry: K %.2e, M %.2e\n", k_diff, m_diff);
+    EXPECT_LT(k_diff, 1e-10);
+    EXPECT_LT(m_diff, 1e-10);
+    for (size_t k = 0; k < by_name.interfaces.size(); ++k)
+      EXPECT_LT((by_name.interfaces[k].position - by_geometry.interfaces[k].position).norm(), 1e-12);
+  }
+}
+
+TEST(SolidModel, SelectionSphereAndBadSelectionsAreNamed) {
+  PartSpec part = ParsePart(Bar("[{name: corner, select: {sphere: {center: [1, 0.05, 0.05], radius: 0.02}, tolerance: 0.02}}]", 2),
+                            "bar.yaml");
+  // Every node within 0.04 of the corner (the sphere's surface +- 0.02 includes the inside).
+  const FeModel model = BuildSolidModel(part);
+  int expected = 0;
+  for (Eigen::Index i = 0; i < model.nodes.rows(); ++i)
+    expected += (model.nodes.row(i) - Eigen::RowVector3d(1, 0.05, 0.05)).norm() <= 0.04;
+  EXPECT_GT(expected, 3);
+  EXPECT_EQ(model.interface_dofs.size(), 1u);
+  EXPECT_EQ(model.n_dofs(), 3 * (model.n_nodes() - expected) + 6);
+  // No node on the surface: the nearest node's distance and the tolerance are named (a part in
+  // mm-sized numbers while the mesh is in m).
+  std::string message = test::ThrownMessage([] {
+    test::Reduce(Bar("[{name: root, select: {plane: {point: [-20, 0, 0], normal: [1, 0, 0]}}}]", 2));
+  });
+  EXPECT_NE(message.find("test.yaml:6: interfaces[0].select: interface 'root': the plane through (-20, 0, 0) normal to (1, 0, 0) "
+                         "selects no node: the nearest of the"), std::string::npos) << message;
+  EXPECT_NE(message.find("is 20 from it, the tolerance is 0.0001"), std::string::npos) << message;
+  // Two selections sharing nodes.
+  message = test::ThrownMessage([] {
+    test::Reduce(Bar("[{name: a, group: xmin}, {name: b, select: {box: {min: [0, 0, 0], max: [0.1, 0.05, 0.05]}}}]", 2));
+  });
+  EXPECT_NE(message.find("interface 'b': the box selection shares nodes with interface 'a'"), std::string::npos) << message;
+  // Both or neither of group and select.
+  message = test::ThrownMessage([] { test::Reduce(Bar("[{name: a, group: xmin, select: {plane: {point: [0, 0, 0], normal: [1, 0, 0]}}}]", 2)); });
+  EXPECT_NE(message.find("give either 'group'"), std::string::npos) << message;
+  message = test::ThrownMessage([] { test::Reduce(Bar("[{name: a, select: {plane: {point: [0, 0, 0], normal: [0, 0, 0]}}}]", 2)); });
+  EXPECT_NE(message.find("normal: must be a nonzero vector"), std::string::npos) << message;
 }
 
 }  // namespace
