@@ -277,12 +277,40 @@ PartSpec ParsePart(const std::string& text, const std::string& name,
   part.name = root.Required("name").String();
   YamlValue type = root.Required("type");
   part.type = type.String();
-  if (part.type != "beam" && part.type != "solid") type.Fail("unknown part type '" + part.type + "' (known: beam, solid)");
+  if (part.type != "beam" && part.type != "solid" && part.type != "imported") {
+    type.Fail("unknown part type '" + part.type + "' (known: beam, solid, imported)");
+  }
   if (auto u = root.Optional("units")) part.units = UnitSystem(u->String(), u->Where());
   if (auto v = root.Optional("check_units")) part.check_units = v->Bool();
-  part.material = ParseMaterial(root.Required("material"));
-  if (part.check_units) CheckMaterialUnits(part, root.Required("material"));
-  if (part.type == "beam") {
+  auto resolve = [&](const YamlValue& file, const std::string& what) {
+    std::filesystem::path f(file.String());
+    if (f.is_relative()) f = std::filesystem::path(name).parent_path() / f;
+    if (!std::filesystem::exists(f)) file.Fail(what + " '" + f.string() + "' not found");
+    return f.string();
+  };
+  if (part.type != "imported") {
+    part.material = ParseMaterial(root.Required("material"));
+    if (part.check_units) CheckMaterialUnits(part, root.Required("material"));
+  }
+  if (part.type == "imported") {
+    // The matrices carry the material; the geometry file gives the node coordinates (and ids).
+    YamlValue geometry = root.Required("geometry");
+    YamlMap g = geometry.Map();
+    part.solid.where = geometry.Where();
+    part.solid.file = resolve(g.Required("file"), "geometry file");
+    g.CheckNoUnknownKeys();
+    YamlValue matrices = root.Required("matrices");
+    YamlMap m = matrices.Map();
+    MatricesSpec& x = part.matrices;
+    x.where = matrices.Where();
+    x.format = m.Required("format").OneOf({"calculix", "abaqus", "matrix_market"});
+    x.stiffness = resolve(m.Required("stiffness"), "stiffness matrix file");
+    x.mass = resolve(m.Required("mass"), "mass matrix file");
+    if (x.format != "abaqus") {
+      x.dofs = resolve(m.Required("dofs"), x.format == "calculix" ? "DOF map (job.dof)" : "DOF map (CSV: node, component)");
+    }
+    m.CheckNoUnknownKeys();
+  } else if (part.type == "beam") {
     part.beam.section = ParseSection(root.Required("section"));
     ParseBeam(root.Required("beam"), part);
     Eigen::Vector3d lo = part.beam.points[0], hi = lo;
@@ -315,11 +343,7 @@ PartSpec ParsePart(const std::string& text, const std::string& name,
         CheckPartSize(part, std::hypot(2 * part.solid.radius, part.solid.length), length.Where());
       }
     } else {
-      YamlValue file = g.Required("file");
-      std::filesystem::path f(file.String());
-      if (f.is_relative()) f = std::filesystem::path(name).parent_path() / f;
-      if (!std::filesystem::exists(f)) file.Fail("geometry file '" + f.string() + "' not found");
-      part.solid.file = f.string();
+      part.solid.file = resolve(g.Required("file"), "geometry file");
     }
     g.CheckNoUnknownKeys();
     if (auto mesh = root.Optional("mesh")) {
@@ -402,12 +426,20 @@ PartSpec ParsePart(const std::string& text, const std::string& name,
     if (auto v = m.Optional("keep_mesh")) part.reduction.keep_mesh = v->Bool();
     if (auto v = m.Optional("stresses")) {
       part.reduction.stresses = v->Bool();
+      if (*part.reduction.stresses && part.type == "imported") {
+        v->Fail("stresses need femb's own elements and material; imported matrices do not have them");
+      }
       part.reduction.where_stresses = v->Where();
       if (*part.reduction.stresses && part.reduction.keep_mesh == false) {
         v->Fail("reduction.stresses: true needs the mesh: keep_mesh is false (the stresses live on its nodes)");
       }
     }
-    if (auto v = m.Optional("geometric_stiffening")) part.reduction.geometric_stiffening = v->Bool();
+    if (auto v = m.Optional("geometric_stiffening")) {
+      part.reduction.geometric_stiffening = v->Bool();
+      if (part.reduction.geometric_stiffening && part.type == "imported") {
+        v->Fail("geometric stiffening needs femb's own elements (the stress of each field); imported matrices do not have them");
+      }
+    }
     if (auto v = m.Optional("full_modes")) part.reduction.full_modes = int(v->NonNegativeInteger());
     if (auto v = m.Optional("memory_limit_gb")) part.reduction.memory_limit_gb = v->PositiveNumber();
     if (auto v = m.Optional("modal_derivatives")) {
@@ -428,6 +460,9 @@ PartSpec ParsePart(const std::string& text, const std::string& name,
           }
         }
         dm.CheckNoUnknownKeys();
+      }
+      if (d.enabled && part.type == "imported") {
+        v->Fail("modal derivatives need femb's own elements (the nonlinear strain); imported matrices do not have them");
       }
     }
     m.CheckNoUnknownKeys();

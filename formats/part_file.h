@@ -114,15 +114,25 @@ struct ReductionSpec {
   std::string where_floating_frame;
 };
 
+/// Imported matrices (issue 16, `type: imported`): K and M of a model assembled by another FE
+/// code, with the node coordinates from `geometry.file` (SolidSpec::file).
+struct MatricesSpec {
+  std::string format;     ///< "calculix", "abaqus" or "matrix_market"
+  std::string stiffness, mass;  ///< resolved paths
+  std::string dofs;       ///< calculix: job.dof; matrix_market: the row -> (node, component) CSV
+  std::string where;
+};
+
 struct PartSpec {
   std::string file;
   std::string text_hash;  ///< FNV-1a 64-bit of the file text (after --set), hex
   std::string name;
-  std::string type;       ///< "beam" or "solid"
+  std::string type;       ///< "beam", "solid" or "imported"
   Units units;
   MaterialSpec material;
   BeamSpec beam;
-  SolidSpec solid;
+  SolidSpec solid;          ///< solid; imported: file and where only
+  MatricesSpec matrices;    ///< imported
   std::vector<InterfaceSpec> interfaces;
   ReductionSpec reduction;
   bool check_units = true;  ///< flag implausible (mixed-unit) density, modulus and part size

@@ -10,6 +10,10 @@ int VtkCellType(const std::string& t) {
   if (t == "hex8") return 12;
   if (t == "tet10") return 24;
   if (t == "hex20") return 25;
+  if (t == "tri3") return 5;
+  if (t == "quad4") return 9;
+  if (t == "tri6") return 22;
+  if (t == "quad8") return 23;
   throw InputError("cell type '" + t + "' has no VTK equivalent");
 }
 
@@ -19,6 +23,10 @@ std::string XdmfTopology(const std::string& t) {
   if (t == "hex8") return "Hexahedron";
   if (t == "tet10") return "Tetrahedron_10";
   if (t == "hex20") return "Hexahedron_20";
+  if (t == "tri3") return "Triangle";
+  if (t == "quad4") return "Quadrilateral";
+  if (t == "tri6") return "Triangle_6";
+  if (t == "quad8") return "Quadrilateral_8";
   throw InputError("cell type '" + t + "' has no XDMF equivalent");
 }
 
@@ -28,6 +36,10 @@ int XdmfMixedCode(const std::string& t) {
   if (t == "hex8") return 9;
   if (t == "tet10") return 38;
   if (t == "hex20") return 48;
+  if (t == "tri3") return 4;
+  if (t == "quad4") return 5;
+  if (t == "tri6") return 36;
+  if (t == "quad8") return 37;
   throw InputError("cell type '" + t + "' has no XDMF equivalent");
 }
 

@@ -11,15 +11,17 @@
 #include "formats/superelement_checks.h"
 #include "formats/part_file.h"
 #include "formats/superelement_file.h"
+#include "reducer/fe/imported_model.h"
 #include "reducer/linalg/sparse_cholesky.h"
 #include "reducer/reduce_part.h"
 
 namespace {
 
 constexpr const char* kUsage = R"(usage: femb-reduce PART.yaml [-o OUT.h5] [--full-modes K] [--set key=value]... [--quiet]
+       femb-reduce PART.yaml --export-matrices DIR [--matrix-format F]
 
-Reduces a part (beam polyline or solid: gmsh geometry, built-in shape or mesh file; see
-formats/PART_FORMAT.md) to a Craig-Bampton superelement file
+Reduces a part (beam polyline; solid: gmsh geometry, built-in shape or mesh file; or matrices
+imported from another FE code; see formats/PART_FORMAT.md) to a Craig-Bampton superelement file
 (HDF5; see formats/SUPERELEMENT_FORMAT.md).
 
 options:
@@ -30,6 +32,12 @@ options:
                         (same as --set reduction.full_modes=K)
   --set key=value       override a part-file key, e.g. --set reduction.internal_modes=8
                         --set reduction.floating_frame=mean_axes (repeatable)
+  --export-matrices DIR instead of reducing: write the part's assembled stiffness and mass (before
+                        any interface coupling: solids 3 DOFs per mesh node, beams 6) and its mesh
+                        (DIR/NAME.inp, node labels = matrix node numbers, named node sets), for
+                        another FE code or for a part file of type 'imported'
+  --matrix-format F     calculix (NAME.sti/.mas/.dof, default), abaqus (NAME_STIF1.mtx,
+                        NAME_MASS1.mtx) or matrix_market (NAME_K.mtx, NAME_M.mtx, NAME_dofs.csv)
   -q, --quiet           no progress lines
   -h, --help            this text
 
@@ -43,15 +51,21 @@ int main(int argc, char** argv) {
   std::string output;
   std::vector<std::string> overrides;
   bool quiet = false;
+  std::string export_dir, matrix_format = "calculix";
   femb::CommandLine cli("femb-reduce", kUsage, "part file");
   cli.Value({"-o", "--output"}, [&](const std::string& v) { output = v; });
   cli.Value({"--full-modes"}, [&](const std::string& v) { overrides.push_back("reduction.full_modes=" + v); });
   cli.Value({"--set"}, [&](const std::string& v) { overrides.push_back(v); });
+  cli.Value({"--export-matrices"}, [&](const std::string& v) { export_dir = v; });
+  cli.Value({"--matrix-format"}, [&](const std::string& v) { matrix_format = v; });
   cli.Switch({"-q", "--quiet"}, [&] { quiet = true; });
   if (!cli.Parse(argc, argv)) return cli.exit_code();
   const std::string part_path = cli.input();
   try {
     femb::Stopwatch total;
+    if (matrix_format != "calculix" && matrix_format != "abaqus" && matrix_format != "matrix_market") {
+      throw femb::InputError("--matrix-format: unknown format '" + matrix_format + "' (known: calculix, abaqus, matrix_market)");
+    }
     const femb::PartSpec part = femb::ReadPartFile(part_path, overrides);
     if (output.empty()) output = part.name + ".h5";
     auto progress = [&](const std::string& stage, double seconds, const std::string& detail) {
@@ -60,6 +74,11 @@ int main(int argc, char** argv) {
                   seconds, detail.c_str());
       std::fflush(stdout);
     };
+    if (!export_dir.empty()) {
+      const std::vector<std::string> written = femb::ExportPartMatrices(part, matrix_format, export_dir, progress);
+      if (!quiet) std::printf("femb-reduce: wrote %zu files to %s\n", written.size(), export_dir.c_str());
+      return 0;
+    }
     femb::ReduceResult result = femb::ReducePart(part, progress);
     if (!result.ok && result.too_big) {
       std::fprintf(stderr, "femb-reduce: %s: refused: %s (no output written)\n", part_path.c_str(),

@@ -6,6 +6,7 @@
 
 #include "formats/input_error.h"
 #include "reducer/fe/beam_model.h"
+#include "reducer/fe/imported_model.h"
 #include "reducer/fe/nonlinear_beam.h"
 #include "reducer/fe/nonlinear_solid.h"
 #include "reducer/fe/solid_model.h"
@@ -64,6 +65,8 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
   FeModel model;
   if (part.type == "solid") {
     model = BuildSolidModel(part, report);
+  } else if (part.type == "imported") {
+    model = BuildImportedModel(part, report);
   } else {
     model = BuildBeamModel(part);
     std::snprintf(detail, sizeof detail, "%ld nodes, %ld %s elements, %ld DOFs", model.n_nodes(),
@@ -262,7 +265,8 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
   prov.n_elements = model.n_elements();
   report("frame+mass", clock.Seconds(), "floating frame " + se.floating_frame.type +
                                              (keep_mesh ? ", mesh and mode shapes kept" : ", mesh and mode shapes not kept (reduction.keep_mesh)"));
-  if (keep_mesh && part.reduction.stresses.value_or(true)) {
+  // Imported matrices have no elements to recover stresses from (the part file refuses true).
+  if (keep_mesh && part.reduction.stresses.value_or(part.type != "imported")) {
     Stopwatch stress_clock;
     const Visualization& v = *se.visualization;
     // With modal derivatives the stress keeps the strain's quadratic part (solids: Green-Lagrange;

@@ -44,6 +44,12 @@ struct FeModel {
   /// the coupled nodes in favour of the 6-DOF interface nodes). Empty for beams (identity).
   SparseMatrix mesh_map;
 
+  /// Imported models (several DOF layouts per node: solids 3, shells and beams 6): the point
+  /// (part axes) and component (0..5: u_x, u_y, u_z, theta_x, theta_y, theta_z) of every model
+  /// DOF, for the rigid-body fields. Empty for femb's own models.
+  std::vector<Eigen::Vector3d> dof_point;
+  std::vector<int> dof_component;
+
   long n_dofs() const { return long(K.rows()); }
   long n_nodes() const { return long(nodes.rows()); }
   long n_elements() const { return long(cells.rows()); }

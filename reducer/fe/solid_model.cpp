@@ -199,8 +199,6 @@ void AssembleSolid(const SolidMesh& mesh, const MaterialSpec& material, const So
   }
 }
 
-namespace {
-
 // The area-weighted centroid of the boundary faces whose corners all lie in `set` (flat facets
 // through the corners; a face met twice is inside the part and left out): the default point of
 // a solid interface. For a bore it lies on the axis, where the plain mean of the nodes does not
@@ -249,10 +247,66 @@ std::optional<Eigen::Vector3d> SurfaceCentroid(const SolidMesh& mesh, const std:
   return moment / area;
 }
 
-}  // namespace
+Eigen::MatrixXd Rbe3Weights(const Eigen::MatrixXd& nodes, const std::vector<int>& set, const Eigen::Vector3d& point,
+                            const std::string& where, const std::string& name) {
+  const int ns = int(set.size());
+  Eigen::Vector3d c = Eigen::Vector3d::Zero();
+  for (int node : set) c += nodes.row(node).transpose();
+  c /= std::max(ns, 1);
+  Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
+  for (int node : set) {
+    const Eigen::Vector3d r = nodes.row(node).transpose() - c;
+    A += r.squaredNorm() * Eigen::Matrix3d::Identity() - r * r.transpose();
+  }
+  if (ns < 3 || std::abs(A.determinant()) < 1e-12 * std::pow(A.trace(), 3)) {
+    throw InputError(where + ": interface '" + name + "': an RBE3 coupling needs at least 3 nodes not on one line");
+  }
+  const Eigen::Matrix3d Ainv = A.inverse();
+  const Eigen::Vector3d d = point - c;
+  Eigen::MatrixXd W = Eigen::MatrixXd::Zero(6, 3 * ns);
+  for (int a = 0; a < ns; ++a) {
+    const Eigen::Vector3d r = nodes.row(set[a]).transpose() - c;
+    const Eigen::Matrix3d Wtheta = Ainv * SkewOf(r);
+    W.block<3, 3>(3, 3 * a) = Wtheta;
+    W.block<3, 3>(0, 3 * a) = Eigen::Matrix3d::Identity() / ns - SkewOf(d) * Wtheta;
+  }
+  return W;
+}
 
-FeModel BuildSolidModel(const PartSpec& part, const ProgressFn& progress) {
-  Stopwatch clock;
+std::function<std::optional<SparseMatrix>(const Eigen::Vector3d&)> SolidInterpolation(std::shared_ptr<const SolidMesh> mesh,
+                                                                                      const SparseMatrix& T) {
+  return [mesh, T](const Eigen::Vector3d& x) -> std::optional<SparseMatrix> {
+    const int per = SolidNodeCount(mesh->type);
+    for (int e = 0; e < mesh->cells.rows(); ++e) {
+      Eigen::Vector3d xi;
+      if (!Locate(*mesh, e, x, &xi)) continue;
+      Eigen::VectorXd N;
+      Eigen::MatrixXd dN;
+      SolidShapeFunctions(mesh->type, xi, &N, &dN);
+      Eigen::MatrixXd X(per, 3);
+      for (int a = 0; a < per; ++a) X.row(a) = mesh->nodes.row(mesh->cells(e, a));
+      const Eigen::MatrixXd g = dN * (X.transpose() * dN).inverse();  // dN/dx
+      std::vector<Eigen::Triplet<double>> entries;
+      for (int a = 0; a < per; ++a) {
+        const int node = mesh->cells(e, a);
+        for (int d = 0; d < 3; ++d) entries.emplace_back(d, 3 * node + d, N[a]);
+        // theta = curl(u) / 2
+        entries.emplace_back(3, 3 * node + 2, 0.5 * g(a, 1));
+        entries.emplace_back(3, 3 * node + 1, -0.5 * g(a, 2));
+        entries.emplace_back(4, 3 * node + 0, 0.5 * g(a, 2));
+        entries.emplace_back(4, 3 * node + 2, -0.5 * g(a, 0));
+        entries.emplace_back(5, 3 * node + 1, 0.5 * g(a, 0));
+        entries.emplace_back(5, 3 * node + 0, -0.5 * g(a, 1));
+      }
+      SparseMatrix S(6, mesh->nodes.rows() * 3);
+      S.setFromTriplets(entries.begin(), entries.end());
+      return SparseMatrix(S * T);
+    }
+    return std::nullopt;
+  };
+}
+
+SolidMesh MeshSolidPart(const PartSpec& part) {
   MeshRequest request;
   request.shape = part.solid.shape;
   request.size = part.solid.size;
@@ -265,18 +319,23 @@ FeModel BuildSolidModel(const PartSpec& part, const ProgressFn& progress) {
   request.order = part.solid.order;
   request.hexahedra = part.solid.hexahedra;
   request.where = part.solid.where;
-  auto mesh = std::make_shared<SolidMesh>(request.file.empty() || IsGmshFile(request.file)
-                                               ? MeshWithGmsh(request)
-                                               : ImportWithMeshio(request.file, part.solid.where));
-  const int n_nodes = int(mesh->nodes.rows());
-  if (n_nodes > 0) {
-    const Eigen::Vector3d lo = mesh->nodes.colwise().minCoeff(), hi = mesh->nodes.colwise().maxCoeff();
+  SolidMesh mesh = request.file.empty() || IsGmshFile(request.file) ? MeshWithGmsh(request)
+                                                                    : ImportWithMeshio(request.file, part.solid.where);
+  if (mesh.nodes.rows() > 0) {
+    const Eigen::Vector3d lo = mesh.nodes.colwise().minCoeff(), hi = mesh.nodes.colwise().maxCoeff();
     CheckPartSize(part, (hi - lo).norm(), part.solid.where + " (" + (request.file.empty() ? part.solid.shape : request.file) + ")");
   }
+  return mesh;
+}
+
+FeModel BuildSolidModel(const PartSpec& part, const ProgressFn& progress) {
+  Stopwatch clock;
+  auto mesh = std::make_shared<SolidMesh>(MeshSolidPart(part));
+  const int n_nodes = int(mesh->nodes.rows());
   if (progress) {
     progress("mesh", clock.Seconds(),
              std::to_string(n_nodes) + " nodes, " + std::to_string(mesh->cells.rows()) + " " +
-                 SolidTypeName(mesh->type) + " elements" + (request.file.empty() ? "" : " from " + request.file));
+                 SolidTypeName(mesh->type) + " elements" + (part.solid.file.empty() ? "" : " from " + part.solid.file));
   }
 
   clock.Restart();
@@ -335,30 +394,10 @@ FeModel BuildSolidModel(const PartSpec& part, const ProgressFn& progress) {
   for (size_t k = 0; k < part.interfaces.size(); ++k) {
     if (part.interfaces[k].coupling != "rbe3") continue;
     const std::vector<int>& set = sets[k];
-    const int ns = int(set.size());
-    Eigen::Vector3d c = Eigen::Vector3d::Zero();
-    for (int node : set) c += mesh->nodes.row(node).transpose();
-    c /= ns;
-    Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
-    for (int node : set) {
-      const Eigen::Vector3d r = mesh->nodes.row(node).transpose() - c;
-      A += r.squaredNorm() * Eigen::Matrix3d::Identity() - r * r.transpose();
-    }
-    if (ns < 3 || std::abs(A.determinant()) < 1e-12 * std::pow(A.trace(), 3)) {
-      throw InputError(part.interfaces[k].where + ": interface '" + part.interfaces[k].name +
-                       "': an RBE3 coupling needs at least 3 nodes not on one line");
-    }
-    const Eigen::Matrix3d Ainv = A.inverse();
-    const Eigen::Vector3d d = model.interface_positions[k] - c;
     Rbe3& r3 = rbe3[k];
-    r3.W = Eigen::MatrixXd::Zero(6, 3 * ns);
-    for (int a = 0; a < ns; ++a) {
-      const Eigen::Vector3d r = mesh->nodes.row(set[a]).transpose() - c;
-      const Eigen::Matrix3d Wtheta = Ainv * SkewOf(r);
-      r3.W.block<3, 3>(3, 3 * a) = Wtheta;
-      r3.W.block<3, 3>(0, 3 * a) = Eigen::Matrix3d::Identity() / ns - SkewOf(d) * Wtheta;
-      for (int i = 0; i < 3; ++i) r3.dofs.push_back(3 * set[a] + i);
-    }
+    r3.W = Rbe3Weights(mesh->nodes, set, model.interface_positions[k], part.interfaces[k].where, part.interfaces[k].name);
+    for (int node : set)
+      for (int i = 0; i < 3; ++i) r3.dofs.push_back(3 * node + i);
   }
   // Model coordinates: every mesh DOF not in an RBE2 set, then 6 per RBE2 interface.
   std::vector<int> coupled;
@@ -457,35 +496,7 @@ FeModel BuildSolidModel(const PartSpec& part, const ProgressFn& progress) {
   model.element_type = SolidTypeName(mesh->type);
 
   // Material point interpolation: displacement and small rotation (curl / 2) at x.
-  model.interpolate_at = [mesh, T](const Eigen::Vector3d& x) -> std::optional<SparseMatrix> {
-    const int per = SolidNodeCount(mesh->type);
-    for (int e = 0; e < mesh->cells.rows(); ++e) {
-      Eigen::Vector3d xi;
-      if (!Locate(*mesh, e, x, &xi)) continue;
-      Eigen::VectorXd N;
-      Eigen::MatrixXd dN;
-      SolidShapeFunctions(mesh->type, xi, &N, &dN);
-      Eigen::MatrixXd X(per, 3);
-      for (int a = 0; a < per; ++a) X.row(a) = mesh->nodes.row(mesh->cells(e, a));
-      const Eigen::MatrixXd g = dN * (X.transpose() * dN).inverse();  // dN/dx
-      std::vector<Eigen::Triplet<double>> entries;
-      for (int a = 0; a < per; ++a) {
-        const int node = mesh->cells(e, a);
-        for (int d = 0; d < 3; ++d) entries.emplace_back(d, 3 * node + d, N[a]);
-        // theta = curl(u) / 2
-        entries.emplace_back(3, 3 * node + 2, 0.5 * g(a, 1));
-        entries.emplace_back(3, 3 * node + 1, -0.5 * g(a, 2));
-        entries.emplace_back(4, 3 * node + 0, 0.5 * g(a, 2));
-        entries.emplace_back(4, 3 * node + 2, -0.5 * g(a, 0));
-        entries.emplace_back(5, 3 * node + 1, 0.5 * g(a, 0));
-        entries.emplace_back(5, 3 * node + 0, -0.5 * g(a, 1));
-      }
-      SparseMatrix S(6, mesh->nodes.rows() * 3);
-      S.setFromTriplets(entries.begin(), entries.end());
-      return SparseMatrix(S * T);
-    }
-    return std::nullopt;
-  };
+  model.interpolate_at = SolidInterpolation(mesh, T);
   return model;
 }
 

@@ -10,12 +10,20 @@
 // The interface point defaults to the centroid of the node set.
 #pragma once
 
+#include <functional>
+#include <memory>
+#include <optional>
+
 #include "formats/part_file.h"
 #include "reducer/fe/fe_model.h"
 #include "reducer/mesh/gmsh_mesher.h"
 #include "reducer/progress.h"
 
 namespace femb {
+
+/// The part's mesh: gmsh (built-in shapes, geometry and .msh files) or meshio (other mesh files),
+/// its size checked against the unit system.
+SolidMesh MeshSolidPart(const PartSpec& part);
 
 /// Throws InputError for a missing or empty node set, node sets that overlap, or an inverted
 /// element (named).
@@ -39,5 +47,20 @@ struct SolidDofMap {
 /// couples like components). No triplet lists and no sparse products: memory is the matrices.
 void AssembleSolid(const SolidMesh& mesh, const MaterialSpec& material, const SolidDofMap& map, SparseMatrix* K,
                    SparseMatrix* M);
+
+/// The area-weighted centroid of the boundary faces whose corners all lie in `set` (the default
+/// interface point: on a bore's axis, where the nodes' mean is not); none when the set has no face.
+std::optional<Eigen::Vector3d> SurfaceCentroid(const SolidMesh& mesh, const std::vector<int>& set);
+
+/// The RBE3 weights W (6 x 3 |set|, node by node): the interface's (u, theta) at `point` from the
+/// least-squares rigid fit of the set's displacements. Throws InputError (naming `where` and the
+/// interface) for fewer than 3 nodes or nodes on one line.
+Eigen::MatrixXd Rbe3Weights(const Eigen::MatrixXd& nodes, const std::vector<int>& set, const Eigen::Vector3d& point,
+                            const std::string& where, const std::string& name);
+
+/// FeModel::interpolate_at for a volume mesh whose mesh DOFs (3 per node) are T x model DOFs:
+/// displacement and small rotation (curl / 2) of the element containing x.
+std::function<std::optional<SparseMatrix>(const Eigen::Vector3d&)> SolidInterpolation(std::shared_ptr<const SolidMesh> mesh,
+                                                                                      const SparseMatrix& T);
 
 }  // namespace femb

@@ -70,7 +70,7 @@ int Run(const std::vector<std::string>& args, const std::string& err_path) {
 
 }  // namespace
 
-SolidMesh ImportWithMeshio(const std::string& path, const std::string& where) {
+ForeignMesh ReadWithMeshio(const std::string& path, const std::string& where, bool any_cells) {
   // Debian's python3 sees python3-meshio; FEMB_PYTHON names another interpreter that has meshio.
   const char* env = std::getenv("FEMB_PYTHON");
   const std::string python = env && *env ? env : "/usr/bin/python3";
@@ -87,7 +87,9 @@ SolidMesh ImportWithMeshio(const std::string& path, const std::string& where) {
                            ("femb_mesh_" + std::to_string(::getpid()) + "_" + std::to_string(counter++)))
                               .string();
   const std::string err = tmp + ".err";
-  const int status = Run({python, bridge, path, tmp}, err);
+  std::vector<std::string> command = {python, bridge, path, tmp};
+  if (any_cells) command.insert(command.begin() + 2, "--any-cells");
+  const int status = Run(command, err);
   std::string message;
   {
     // The bridge's own one-line message comes last (meshio may print before it).
@@ -103,7 +105,7 @@ SolidMesh ImportWithMeshio(const std::string& path, const std::string& where) {
     throw InputError(where + ": " + message);
   }
   std::ifstream in(tmp);
-  SolidMesh mesh;
+  ForeignMesh mesh;
   auto fail = [&](const std::string& what) {
     std::filesystem::remove(tmp);
     throw InputError(where + ": the meshio bridge wrote an unreadable mesh for " + path + " (" + what + ")");
@@ -115,15 +117,17 @@ SolidMesh ImportWithMeshio(const std::string& path, const std::string& where) {
   mesh.nodes.resize(n, 3);
   for (long i = 0; i < n; ++i)
     if (!(in >> mesh.nodes(i, 0) >> mesh.nodes(i, 1) >> mesh.nodes(i, 2))) fail("node " + std::to_string(i));
+  if (!(in >> word >> m) || word != "ids" || m != n) fail("no node ids");
+  mesh.ids.resize(size_t(n));
+  for (long i = 0; i < n; ++i)
+    if (!(in >> mesh.ids[size_t(i)])) fail("node id " + std::to_string(i));
   if (!(in >> word >> type >> m >> k) || word != "cells") fail("no cell block");
-  const std::map<std::string, std::pair<SolidType, long>> types = {{"tet4", {SolidType::kTet4, 4}},
-                                                                   {"tet10", {SolidType::kTet10, 10}},
-                                                                   {"hex8", {SolidType::kHex8, 8}},
-                                                                   {"hex20", {SolidType::kHex20, 20}}};
+  const std::map<std::string, long> types = {{"tet4", 4}, {"tet10", 10}, {"hex8", 8}, {"hex20", 20}, {"tri3", 3},
+                                             {"tri6", 6}, {"quad4", 4}, {"quad8", 8}, {"line2", 2}};
   const auto found = types.find(type);
   if (found == types.end()) fail("cell type '" + type + "'");  // it once fell back to hex20 silently
-  if (m <= 0 || k != found->second.second) fail(type + " cells with " + std::to_string(k) + " nodes");
-  mesh.type = found->second.first;
+  if (m <= 0 || k != found->second) fail(type + " cells with " + std::to_string(k) + " nodes");
+  mesh.cell_type = type;
   mesh.cells.resize(m, k);
   for (long e = 0; e < m; ++e)
     for (long a = 0; a < k; ++a)
@@ -140,6 +144,20 @@ SolidMesh ImportWithMeshio(const std::string& path, const std::string& where) {
   }
   if (!in.eof()) fail("trailing data");
   std::filesystem::remove(tmp);
+  return mesh;
+}
+
+SolidMesh ImportWithMeshio(const std::string& path, const std::string& where) {
+  ForeignMesh foreign = ReadWithMeshio(path, where, false);
+  const std::map<std::string, SolidType> types = {
+      {"tet4", SolidType::kTet4}, {"tet10", SolidType::kTet10}, {"hex8", SolidType::kHex8}, {"hex20", SolidType::kHex20}};
+  const auto found = types.find(foreign.cell_type);
+  if (found == types.end()) throw InputError(where + ": " + path + " has no volume elements");
+  SolidMesh mesh;
+  mesh.nodes = std::move(foreign.nodes);
+  mesh.type = found->second;
+  mesh.cells = std::move(foreign.cells);
+  mesh.node_sets = std::move(foreign.node_sets);
   return mesh;
 }
 

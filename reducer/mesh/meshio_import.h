@@ -13,8 +13,20 @@ namespace femb {
 /// true for extensions gmsh reads itself (.msh, .geo, .step, .stp, .brep).
 bool IsGmshFile(const std::string& path);
 
+/// A mesh as the bridge reads it: any cell type femb draws, and the file's node labels.
+struct ForeignMesh {
+  Eigen::MatrixXd nodes;      ///< n x 3
+  std::vector<long> ids;      ///< node labels of the file (.inp, .bdf), else 1..n in file order
+  std::string cell_type;      ///< tet4, tet10, hex8, hex20; with any_cells also tri3, tri6, quad4, quad8, line2
+  Eigen::MatrixXi cells;      ///< 0-based, gmsh node order
+  std::map<std::string, std::vector<int>> node_sets;
+};
+
 /// Throws InputError for: python3 or meshio missing (with the apt-get line), an unreadable
-/// file, no volume elements.
+/// file, no volume elements (with any_cells: no cells at all).
+ForeignMesh ReadWithMeshio(const std::string& path, const std::string& where, bool any_cells);
+
+/// The same for solid parts: volume elements only.
 SolidMesh ImportWithMeshio(const std::string& path, const std::string& where);
 
 }  // namespace femb

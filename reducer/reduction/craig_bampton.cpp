@@ -94,6 +94,11 @@ Eigen::MatrixXd RigidFields(const FeModel& model) {
     if (with_rotation) r.bottomRightCorner<3, 3>().setIdentity();
     return r;
   };
+  if (!model.dof_component.empty()) {  // imported: each DOF knows its point and component
+    Eigen::MatrixXd R(n, 6);
+    for (long d = 0; d < n; ++d) R.row(d) = rigid(model.dof_point[size_t(d)], true).row(model.dof_component[size_t(d)]);
+    return R;
+  }
   if (model.mesh_map.size() == 0) {  // beams: 6 DOFs per node
     Eigen::MatrixXd R(n, 6);
     for (long k = 0; k < model.n_nodes(); ++k) R.middleRows(6 * k, 6) = rigid(model.nodes.row(k).transpose(), true);

@@ -1,0 +1,666 @@
+#include "reducer/fe/imported_model.h"
+
+#include <unistd.h>
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <array>
+#include <functional>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <sstream>
+#include <unordered_map>
+
+#include "formats/input_error.h"
+#include "formats/vtk_cells.h"
+#include "reducer/fe/beam_model.h"
+#include "reducer/fe/solid_element.h"
+#include "reducer/fe/solid_model.h"
+#include "reducer/mesh/meshio_import.h"
+#include "reducer/mesh/node_selection.h"
+#include "reducer/reduction/craig_bampton.h"
+
+namespace femb {
+namespace {
+
+constexpr const char* kComponentNames[6] = {"u_x", "u_y", "u_z", "theta_x", "theta_y", "theta_z"};
+
+struct Entry {
+  long row, col;  // 0-based
+  double value;
+  long line;
+};
+
+// Lines of a text file with their numbers; comment and blank lines skipped.
+class LineReader {
+ public:
+  LineReader(const std::string& path, const std::string& what) : path_(path), in_(path) {
+    if (!in_) throw InputError(path + ": cannot open the " + what);
+  }
+  bool Next(std::string* line, const std::string& comment) {
+    while (std::getline(in_, *line)) {
+      ++number_;
+      const size_t first = line->find_first_not_of(" \t\r");
+      if (first == std::string::npos) continue;
+      if (!comment.empty() && line->compare(first, comment.size(), comment) == 0) continue;
+      return true;
+    }
+    return false;
+  }
+  [[noreturn]] void Fail(const std::string& what) const {
+    throw InputError(path_ + ":" + std::to_string(number_) + ": " + what);
+  }
+  long number() const { return number_; }
+
+ private:
+  std::string path_;
+  std::ifstream in_;
+  long number_ = 0;
+};
+
+// Whitespace- or comma-separated fields.
+std::vector<std::string> Fields(const std::string& line) {
+  std::string s = line;
+  std::replace(s.begin(), s.end(), ',', ' ');
+  std::istringstream in(s);
+  std::vector<std::string> out;
+  for (std::string f; in >> f;) out.push_back(f);
+  return out;
+}
+
+double NumberField(const LineReader& r, const std::string& text) {
+  char* end = nullptr;
+  const double v = std::strtod(text.c_str(), &end);
+  if (end == text.c_str() || *end != '\0') r.Fail("'" + text + "' is not a number");
+  if (!std::isfinite(v)) r.Fail("entry " + text + " is not finite");
+  return v;
+}
+
+long IntegerField(const LineReader& r, const std::string& text) {
+  char* end = nullptr;
+  const long v = std::strtol(text.c_str(), &end, 10);
+  if (end == text.c_str() || *end != '\0') r.Fail("'" + text + "' is not an integer");
+  return v;
+}
+
+std::string DofName(long node, int component) {
+  return "node " + std::to_string(node) + " " + kComponentNames[component];
+}
+
+// Row/column entries (0-based) -> the symmetric matrix: one triangle is mirrored; both are
+// checked to be symmetric to 1e-8 of the largest entry.
+SparseMatrix Symmetric(const std::vector<Entry>& entries, long n, const std::string& path,
+                       const std::vector<long>& node, const std::vector<int>& component, std::string* stored) {
+  std::vector<Eigen::Triplet<double>> t;
+  t.reserve(entries.size());
+  long upper = 0, lower = 0;
+  for (const Entry& e : entries) {
+    t.emplace_back(int(e.row), int(e.col), e.value);
+    upper += e.row < e.col;
+    lower += e.row > e.col;
+  }
+  SparseMatrix A(n, n);
+  A.setFromTriplets(t.begin(), t.end());
+  const SparseMatrix At = A.transpose();
+  if (upper > 0 && lower > 0) {
+    *stored = "both triangles";
+    const SparseMatrix D = A - At;
+    double max_a = 0.0;
+    for (int k = 0; k < A.outerSize(); ++k)
+      for (SparseMatrix::InnerIterator it(A, k); it; ++it) max_a = std::max(max_a, std::abs(it.value()));
+    for (int k = 0; k < D.outerSize(); ++k)
+      for (SparseMatrix::InnerIterator it(D, k); it; ++it)
+        if (std::abs(it.value()) > 1e-8 * max_a) {
+          char b[200];
+          std::snprintf(b, sizeof b, " differ by %.3g (%.2g of the largest entry): the matrix is not symmetric",
+                        std::abs(it.value()), std::abs(it.value()) / max_a);
+          throw InputError(path + ": entries (" + DofName(node[size_t(it.row())], component[size_t(it.row())]) + ", " +
+                           DofName(node[size_t(it.col())], component[size_t(it.col())]) + ") and its transpose" + b);
+        }
+    return SparseMatrix(0.5 * (A + At));
+  }
+  *stored = upper > 0 ? "upper triangle" : lower > 0 ? "lower triangle" : "diagonal";
+  SparseMatrix diagonal(n, n);
+  std::vector<Eigen::Triplet<double>> d;
+  for (long i = 0; i < n; ++i)
+    if (A.coeff(i, i) != 0.0) d.emplace_back(int(i), int(i), A.coeff(i, i));
+  diagonal.setFromTriplets(d.begin(), d.end());
+  return SparseMatrix(A + At - diagonal);
+}
+
+// CalculiX: "row col value" lines, 1-based, and the .dof file "node.component".
+void ReadCalculix(const MatricesSpec& spec, ImportedMatrices* out, std::vector<Entry>* k, std::vector<Entry>* m,
+                  long* entry_lines) {
+  LineReader dofs(spec.dofs, "DOF map");
+  std::string line;
+  while (dofs.Next(&line, "")) {
+    const std::vector<std::string> f = Fields(line);
+    const size_t dot = f.empty() ? std::string::npos : f[0].find('.');
+    if (f.size() != 1 || dot == std::string::npos) dofs.Fail("expected node.component (e.g. 12.3), got '" + line + "'");
+    const long node = IntegerField(dofs, f[0].substr(0, dot));
+    const long c = IntegerField(dofs, f[0].substr(dot + 1));
+    if (c < 1 || c > 6) dofs.Fail("component " + std::to_string(c) + " is not 1..6");
+    out->node.push_back(node);
+    out->component.push_back(int(c - 1));
+  }
+  if (out->node.empty()) throw InputError(spec.dofs + ": no DOFs");
+  const long n = long(out->node.size());
+  for (auto [path, entries] : {std::pair{&spec.stiffness, k}, std::pair{&spec.mass, m}}) {
+    LineReader r(*path, "matrix file");
+    while (r.Next(&line, "")) {
+      const std::vector<std::string> f = Fields(line);
+      if (f.size() != 3) r.Fail("expected 'row column value', got '" + line + "'");
+      const long i = IntegerField(r, f[0]), j = IntegerField(r, f[1]);
+      if (i < 1 || i > n || j < 1 || j > n) {
+        r.Fail("index (" + f[0] + ", " + f[1] + ") outside the " + std::to_string(n) + " DOFs of " + spec.dofs);
+      }
+      entries->push_back({i - 1, j - 1, NumberField(r, f[2]), r.number()});
+      ++*entry_lines;
+    }
+  }
+}
+
+// Abaqus: "row node, row dof, column node, column dof, value"; rows numbered by (node, dof).
+void ReadAbaqus(const MatricesSpec& spec, ImportedMatrices* out, std::vector<Entry>* k, std::vector<Entry>* m,
+                long* entry_lines) {
+  struct Raw {
+    long n1, d1, n2, d2;
+    double v;
+  };
+  std::map<std::pair<long, int>, long> index;
+  std::vector<Raw> raw_k, raw_m;
+  std::string line;
+  for (auto [path, raw] : {std::pair{&spec.stiffness, &raw_k}, std::pair{&spec.mass, &raw_m}}) {
+    LineReader r(*path, "matrix file");
+    while (r.Next(&line, "*")) {
+      const std::vector<std::string> f = Fields(line);
+      if (f.size() != 5) r.Fail("expected 'node, dof, node, dof, value', got '" + line + "'");
+      Raw e{IntegerField(r, f[0]), IntegerField(r, f[1]), IntegerField(r, f[2]), IntegerField(r, f[3]), NumberField(r, f[4])};
+      for (long label : {e.n1, e.n2}) {
+        if (label <= 0) {
+          r.Fail("node " + std::to_string(label) + " is an Abaqus internal node (Lagrange multipliers of hybrid elements, "
+                 "MPCs or connectors): export a model without them");
+        }
+      }
+      for (long d : {e.d1, e.d2}) {
+        if (d < 1 || d > 6) r.Fail("dof " + std::to_string(d) + " is not 1..6 (only displacements and rotations)");
+      }
+      index[{e.n1, int(e.d1 - 1)}] = 0;
+      index[{e.n2, int(e.d2 - 1)}] = 0;
+      raw->push_back(e);
+      ++*entry_lines;
+    }
+  }
+  long row = 0;
+  for (auto& [key, value] : index) {
+    value = row++;
+    out->node.push_back(key.first);
+    out->component.push_back(key.second);
+  }
+  for (auto [raw, entries] : {std::pair{&raw_k, k}, std::pair{&raw_m, m}})
+    for (const Raw& e : *raw) entries->push_back({index[{e.n1, int(e.d1 - 1)}], index[{e.n2, int(e.d2 - 1)}], e.v, 0});
+}
+
+// Matrix Market coordinate real (symmetric or general) and the CSV "node, component" map.
+void ReadMatrixMarket(const MatricesSpec& spec, ImportedMatrices* out, std::vector<Entry>* k, std::vector<Entry>* m,
+                      long* entry_lines) {
+  LineReader dofs(spec.dofs, "DOF map");
+  std::string line;
+  bool first = true;
+  while (dofs.Next(&line, "#")) {
+    const std::vector<std::string> f = Fields(line);
+    if (first && !f.empty() && !std::isdigit(static_cast<unsigned char>(f[0][0]))) {  // a header line
+      first = false;
+      continue;
+    }
+    first = false;
+    if (f.size() != 2) dofs.Fail("expected 'node, component', got '" + line + "'");
+    const long node = IntegerField(dofs, f[0]), c = IntegerField(dofs, f[1]);
+    if (c < 1 || c > 6) dofs.Fail("component " + std::to_string(c) + " is not 1..6 (u_x, u_y, u_z, theta_x, theta_y, theta_z)");
+    out->node.push_back(node);
+    out->component.push_back(int(c - 1));
+  }
+  if (out->node.empty()) throw InputError(spec.dofs + ": no DOFs");
+  const long n = long(out->node.size());
+  for (auto [path, entries] : {std::pair{&spec.stiffness, k}, std::pair{&spec.mass, m}}) {
+    LineReader r(*path, "matrix file");
+    if (!r.Next(&line, "")) r.Fail("empty file");
+    std::string lower = line;
+    std::transform(lower.begin(), lower.end(), lower.begin(), ::tolower);
+    if (lower.rfind("%%matrixmarket", 0) != 0 || lower.find("coordinate") == std::string::npos ||
+        lower.find("real") == std::string::npos ||
+        (lower.find("symmetric") == std::string::npos && lower.find("general") == std::string::npos)) {
+      r.Fail("expected '%%MatrixMarket matrix coordinate real symmetric' (or general), got '" + line + "'");
+    }
+    if (!r.Next(&line, "%")) r.Fail("no size line");
+    const std::vector<std::string> size = Fields(line);
+    if (size.size() != 3) r.Fail("expected 'rows columns entries', got '" + line + "'");
+    const long rows = IntegerField(r, size[0]), cols = IntegerField(r, size[1]), nnz = IntegerField(r, size[2]);
+    if (rows != cols) r.Fail("the matrix is " + size[0] + " x " + size[1] + ", not square");
+    if (rows != n) r.Fail("the matrix has " + size[0] + " rows but " + spec.dofs + " maps " + std::to_string(n));
+    long count = 0;
+    while (r.Next(&line, "%")) {
+      const std::vector<std::string> f = Fields(line);
+      if (f.size() != 3) r.Fail("expected 'row column value', got '" + line + "'");
+      const long i = IntegerField(r, f[0]), j = IntegerField(r, f[1]);
+      if (i < 1 || i > n || j < 1 || j > n) r.Fail("index (" + f[0] + ", " + f[1] + ") outside 1.." + std::to_string(n));
+      entries->push_back({i - 1, j - 1, NumberField(r, f[2]), r.number()});
+      ++count;
+      ++*entry_lines;
+    }
+    if (count != nnz) r.Fail("the size line announces " + std::to_string(nnz) + " entries, the file has " + std::to_string(count));
+  }
+}
+
+Eigen::Matrix3d Skew(const Eigen::Vector3d& a) {
+  Eigen::Matrix3d m;
+  m << 0, -a.z(), a.y(), a.z(), 0, -a.x(), -a.y(), a.x(), 0;
+  return m;
+}
+
+std::string Short(double v) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.3g", v);
+  return b;
+}
+
+}  // namespace
+
+ImportedMatrices ReadImportedMatrices(const MatricesSpec& spec) {
+  ImportedMatrices out;
+  std::vector<Entry> k, m;
+  long lines = 0;
+  if (spec.format == "calculix") {
+    ReadCalculix(spec, &out, &k, &m, &lines);
+  } else if (spec.format == "abaqus") {
+    ReadAbaqus(spec, &out, &k, &m, &lines);
+  } else {
+    ReadMatrixMarket(spec, &out, &k, &m, &lines);
+  }
+  const long n = long(out.node.size());
+  {
+    std::map<std::pair<long, int>, long> seen;
+    for (long r = 0; r < n; ++r) {
+      auto [it, fresh] = seen.emplace(std::pair{out.node[size_t(r)], out.component[size_t(r)]}, r);
+      if (!fresh) {
+        throw InputError(spec.dofs + ": " + DofName(out.node[size_t(r)], out.component[size_t(r)]) + " appears twice (rows " +
+                         std::to_string(it->second + 1) + " and " + std::to_string(r + 1) + ")");
+      }
+    }
+  }
+  std::string stored_m;
+  out.K = Symmetric(k, n, spec.stiffness, out.node, out.component, &out.stored);
+  out.M = Symmetric(m, n, spec.mass, out.node, out.component, &stored_m);
+  for (long r = 0; r < n; ++r) {
+    const double kd = out.K.coeff(r, r), md = out.M.coeff(r, r);
+    const std::string dof = DofName(out.node[size_t(r)], out.component[size_t(r)]);
+    if (kd < 0) throw InputError(spec.stiffness + ": the diagonal of " + dof + " is negative (" + Short(kd) + ")");
+    if (md < 0) throw InputError(spec.mass + ": the diagonal of " + dof + " is negative (" + Short(md) + ")");
+    if (kd == 0) {
+      throw InputError(spec.stiffness + ": " + dof + " has no stiffness (zero diagonal): a node of no element, or a "
+                       "shell's drilling rotation; leave it out of the export");
+    }
+  }
+  return out;
+}
+
+FeModel BuildImportedModel(const PartSpec& part, const ProgressFn& progress) {
+  Stopwatch clock;
+  const ForeignMesh geometry = ReadWithMeshio(part.solid.file, part.solid.where, true);
+  const long n_nodes = geometry.nodes.rows();
+  const Eigen::Vector3d lo = geometry.nodes.colwise().minCoeff(), hi = geometry.nodes.colwise().maxCoeff();
+  CheckPartSize(part, (hi - lo).norm(), part.solid.where + " (" + part.solid.file + ")");
+  if (progress) {
+    progress("geometry", clock.Seconds(),
+             std::to_string(n_nodes) + " nodes, " + std::to_string(geometry.cells.rows()) + " " + geometry.cell_type +
+                 " cells from " + part.solid.file);
+  }
+
+  clock.Restart();
+  const ImportedMatrices im = ReadImportedMatrices(part.matrices);
+  const long n_full = long(im.node.size());
+  std::unordered_map<long, int> index_of;
+  for (long s = 0; s < n_nodes; ++s) index_of[geometry.ids[size_t(s)]] = int(s);
+  std::vector<int> full_node(static_cast<size_t>(n_full));  // mesh node of each imported DOF
+  std::vector<std::array<int, 6>> full_dof(static_cast<size_t>(n_nodes));
+  for (auto& d : full_dof) d.fill(-1);
+  int rotational = 0;
+  for (long r = 0; r < n_full; ++r) {
+    auto it = index_of.find(im.node[size_t(r)]);
+    if (it == index_of.end()) {
+      throw InputError(part.matrices.where + ": node " + std::to_string(im.node[size_t(r)]) + " of the matrices is not in " +
+                       part.solid.file + " (its node labels run " + std::to_string(geometry.ids.front()) + " .. " +
+                       std::to_string(geometry.ids.back()) + "): the geometry file must be the mesh the matrices were exported from");
+    }
+    full_node[size_t(r)] = it->second;
+    full_dof[size_t(it->second)][size_t(im.component[size_t(r)])] = int(r);
+    rotational += im.component[size_t(r)] >= 3;
+  }
+  if (progress) {
+    progress("matrices", clock.Seconds(),
+             std::to_string(n_full) + " DOFs (" + std::to_string(rotational) + " rotational), K " +
+                 std::to_string(im.K.nonZeros()) + " entries (" + im.stored + " in the file), M " +
+                 std::to_string(im.M.nonZeros()) + " entries, " + part.matrices.format);
+  }
+
+  // Interfaces: node sets by name or by geometry.
+  clock.Restart();
+  FeModel model;
+  std::shared_ptr<SolidMesh> volume;
+  if (geometry.cell_type == "tet4" || geometry.cell_type == "tet10" || geometry.cell_type == "hex8" ||
+      geometry.cell_type == "hex20") {
+    volume = std::make_shared<SolidMesh>();
+    volume->nodes = geometry.nodes;
+    volume->cells = geometry.cells;
+    for (SolidType t : {SolidType::kTet4, SolidType::kTet10, SolidType::kHex8, SolidType::kHex20})
+      if (SolidTypeName(t) == geometry.cell_type) volume->type = t;
+  }
+  std::vector<int> owner(static_cast<size_t>(n_nodes), -1);
+  std::vector<std::vector<int>> sets(part.interfaces.size());
+  std::string selected;
+  for (size_t k = 0; k < part.interfaces.size(); ++k) {
+    const InterfaceSpec& i = part.interfaces[k];
+    if (i.select) {
+      sets[k] = SelectNodes(*i.select, geometry.nodes, i.name);
+    } else {
+      auto set = geometry.node_sets.find(i.group);
+      if (set == geometry.node_sets.end()) {
+        std::string known;
+        for (const auto& [name, _] : geometry.node_sets) known += (known.empty() ? "" : ", ") + name;
+        throw InputError(i.where + ": interface '" + i.name + "': node set '" + i.group + "' not found in " + part.solid.file +
+                         " (known: " + (known.empty() ? "none" : known) + "; or pick the nodes by geometry with 'select')");
+      }
+      sets[k] = set->second;
+    }
+    // Only nodes that carry DOFs of the matrices take part (a mesh may have unused nodes).
+    std::vector<int> used;
+    for (int s : sets[k])
+      for (int c = 0; c < 6; ++c)
+        if (full_dof[size_t(s)][size_t(c)] >= 0) {
+          used.push_back(s);
+          break;
+        }
+    if (used.empty()) {
+      throw InputError(i.where + ": interface '" + i.name + "': none of its " + std::to_string(sets[k].size()) +
+                       " nodes has a DOF in the matrices");
+    }
+    sets[k] = used;
+    selected += (k ? ", " : "") + i.name + ": " + std::to_string(used.size()) + " nodes " +
+                (i.select ? "by " + i.select->shape : "of set '" + i.group + "'");
+    Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+    for (int s : used) {
+      if (owner[size_t(s)] >= 0) {
+        throw InputError(i.where + ": interface '" + i.name + "': " +
+                         (i.select ? "the " + i.select->shape + " selection" : "node set '" + i.group + "'") +
+                         " shares nodes with interface '" + part.interfaces[size_t(owner[size_t(s)])].name +
+                         "' (couplings must not overlap)");
+      }
+      owner[size_t(s)] = int(k);
+      centroid += geometry.nodes.row(s).transpose();
+    }
+    centroid /= double(used.size());
+    if (volume) {
+      if (auto surface = SurfaceCentroid(*volume, used)) centroid = *surface;
+    }
+    model.interface_names.push_back(i.name);
+    model.interface_positions.push_back(i.location ? *i.location : centroid);
+  }
+
+  // Model DOFs: the imported DOFs of nodes in no RBE2 set (file order), then 6 per RBE2
+  // interface. T (imported -> model): u_s = u_k + theta_k x (x_s - x_k) = u_k - (x_s - x_k)~ theta_k,
+  // theta_s = theta_k.
+  auto rbe2 = [&](long s) { return owner[size_t(s)] >= 0 && part.interfaces[size_t(owner[size_t(s)])].coupling == "rbe2"; };
+  std::vector<int> model_of(static_cast<size_t>(n_full), -1);
+  int n_model = 0;
+  for (long r = 0; r < n_full; ++r) {
+    if (!rbe2(full_node[size_t(r)])) {
+      model_of[size_t(r)] = n_model++;
+      model.dof_point.push_back(geometry.nodes.row(full_node[size_t(r)]).transpose());
+      model.dof_component.push_back(im.component[size_t(r)]);
+    }
+  }
+  std::vector<int> base(part.interfaces.size(), -1);
+  for (size_t k = 0; k < part.interfaces.size(); ++k) {
+    if (part.interfaces[k].coupling != "rbe2") continue;
+    base[k] = n_model;
+    for (int c = 0; c < 6; ++c) {
+      model.dof_point.push_back(model.interface_positions[k]);
+      model.dof_component.push_back(c);
+    }
+    n_model += 6;
+  }
+  std::vector<Eigen::Triplet<double>> t;
+  for (long r = 0; r < n_full; ++r) {
+    const long s = full_node[size_t(r)];
+    const int c = im.component[size_t(r)];
+    if (!rbe2(s)) {
+      t.emplace_back(int(r), model_of[size_t(r)], 1.0);
+      continue;
+    }
+    const size_t k = size_t(owner[size_t(s)]);
+    t.emplace_back(int(r), base[k] + c, 1.0);
+    if (c < 3) {
+      const Eigen::Matrix3d arm = -Skew(geometry.nodes.row(s).transpose() - model.interface_positions[k]);
+      for (int j = 0; j < 3; ++j)
+        if (arm(c, j) != 0.0) t.emplace_back(int(r), base[k] + 3 + j, arm(c, j));
+    }
+  }
+  SparseMatrix T(n_full, n_model);
+  T.setFromTriplets(t.begin(), t.end());
+  const SparseMatrix Tt = T.transpose();
+  model.K = SparseMatrix(Tt * im.K * T);
+  model.M = SparseMatrix(Tt * im.M * T);
+  model.K.prune(0.0);
+  model.M.prune(0.0);
+  // Interfaces: RBE2 DOFs; RBE3 weights on the translations of the set's nodes.
+  for (size_t k = 0; k < part.interfaces.size(); ++k) {
+    std::vector<FullDof> dofs;
+    SparseMatrix W(0, n_model);
+    if (base[k] >= 0) {
+      for (int d = 0; d < 6; ++d) dofs.push_back({base[k] + d});
+    } else {
+      std::vector<int> nodes;
+      for (int s : sets[k]) {
+        const auto& f = full_dof[size_t(s)];
+        if (f[0] >= 0 && f[1] >= 0 && f[2] >= 0) nodes.push_back(s);
+      }
+      const Eigen::MatrixXd w = Rbe3Weights(geometry.nodes, nodes, model.interface_positions[k], part.interfaces[k].where,
+                                            part.interfaces[k].name);
+      std::vector<Eigen::Triplet<double>> entries;
+      for (size_t a = 0; a < nodes.size(); ++a)
+        for (int c = 0; c < 3; ++c)
+          for (int i = 0; i < 6; ++i)
+            entries.emplace_back(i, model_of[size_t(full_dof[size_t(nodes[a])][size_t(c)])], w(i, long(3 * a + c)));
+      W.resize(6, n_model);
+      W.setFromTriplets(entries.begin(), entries.end());
+    }
+    model.interface_dofs.push_back(dofs);
+    model.interface_weights.push_back(W);
+  }
+  // Mesh DOFs (3 per geometry node: the translations; zero for a node without them) = S T q.
+  std::vector<Eigen::Triplet<double>> pick;
+  for (long s = 0; s < n_nodes; ++s)
+    for (int c = 0; c < 3; ++c)
+      if (full_dof[size_t(s)][size_t(c)] >= 0) pick.emplace_back(int(3 * s + c), full_dof[size_t(s)][size_t(c)], 1.0);
+  SparseMatrix S(3 * n_nodes, n_full);
+  S.setFromTriplets(pick.begin(), pick.end());
+  model.mesh_map = SparseMatrix(S * T);
+  model.dofs_per_node = 3;
+  model.nodes = geometry.nodes;
+  model.cells = geometry.cells;
+  model.cell_type = geometry.cell_type;
+  model.element_type = "imported " + part.matrices.format;
+  if (volume) model.interpolate_at = SolidInterpolation(volume, model.mesh_map);
+
+  // The body must float: K R = 0 for the rigid-body fields R (to the round-off of the export).
+  const Eigen::MatrixXd R = RigidFields(model);
+  const Eigen::MatrixXd KR = model.K * R;
+  double k_scale = 0.0;
+  for (int j = 0; j < model.K.outerSize(); ++j) k_scale = std::max(k_scale, model.K.coeff(j, j));
+  double residual = 0.0;
+  for (int j = 0; j < 6; ++j) residual = std::max(residual, KR.col(j).cwiseAbs().maxCoeff() / (k_scale * R.col(j).cwiseAbs().maxCoeff()));
+  const double mass = (R.col(0).transpose() * model.M * R.col(0)).value();
+  if (residual > 1e-6) {
+    throw InputError(part.matrices.where + ": the stiffness resists a rigid-body motion (|K r| = " + Short(residual) +
+                     " of the largest diagonal): the export kept boundary conditions or grounded springs; export the "
+                     "free part");
+  }
+  if (!(mass > 0)) throw InputError(part.matrices.where + ": the mass matrix gives the part no mass (" + Short(mass) + ")");
+  if (progress) {
+    progress("couplings", clock.Seconds(),
+             std::to_string(part.interfaces.size()) + " interfaces (" + selected + "), " + std::to_string(n_model) +
+                 " model DOFs; rigid-body residual " + Short(residual) + ", mass " + Short(mass));
+  }
+  return model;
+}
+
+std::vector<std::string> WriteMatrices(const std::string& format, const SparseMatrix& K, const SparseMatrix& M,
+                                       const std::vector<long>& node, const std::vector<int>& component,
+                                       const std::string& directory, const std::string& stem) {
+  std::error_code ec;
+  std::filesystem::create_directories(directory, ec);
+  const std::filesystem::path dir(directory);
+  std::vector<std::string> written;
+  // Atomic per file: a temporary name in the same folder, renamed when complete.
+  auto write = [&](const std::string& name, const std::function<void(std::ostream&)>& body) {
+    const std::string path = (dir / name).string();
+    const std::string tmp = path + ".tmp" + std::to_string(::getpid());
+    {
+      std::ofstream out(tmp);
+      if (!out) throw InputError(directory + ": cannot write " + name);
+      out.precision(17);
+      body(out);
+      if (!out) throw InputError(directory + ": cannot write " + name);
+    }
+    std::filesystem::rename(tmp, path);
+    written.push_back(path);
+  };
+  auto upper = [](const SparseMatrix& A, const std::function<void(long, long, double)>& emit) {
+    for (int j = 0; j < A.outerSize(); ++j)
+      for (SparseMatrix::InnerIterator it(A, j); it; ++it)
+        if (it.row() <= j) emit(it.row(), j, it.value());
+  };
+  auto count_upper = [&](const SparseMatrix& A) {
+    long c = 0;
+    upper(A, [&](long, long, double) { ++c; });
+    return c;
+  };
+  if (format == "calculix") {
+    for (auto [ext, A] : {std::pair{".sti", &K}, std::pair{".mas", &M}})
+      write(stem + ext, [&, A = A](std::ostream& out) {
+        upper(*A, [&](long i, long j, double v) { out << i + 1 << ' ' << j + 1 << ' ' << v << '\n'; });
+      });
+    write(stem + ".dof", [&](std::ostream& out) {
+      for (size_t r = 0; r < node.size(); ++r) out << node[r] << '.' << component[r] + 1 << '\n';
+    });
+  } else if (format == "abaqus") {
+    for (auto [suffix, A] : {std::pair{"_STIF1.mtx", &K}, std::pair{"_MASS1.mtx", &M}})
+      write(stem + suffix, [&, A = A](std::ostream& out) {
+        upper(*A, [&](long i, long j, double v) {
+          out << node[size_t(i)] << ',' << component[size_t(i)] + 1 << ", " << node[size_t(j)] << ','
+              << component[size_t(j)] + 1 << ", " << v << '\n';
+        });
+      });
+  } else if (format == "matrix_market") {
+    // Symmetric storage is the lower triangle: entry (j, i) for each upper (i, j).
+    for (auto [suffix, A] : {std::pair{"_K.mtx", &K}, std::pair{"_M.mtx", &M}})
+      write(stem + suffix, [&, A = A](std::ostream& out) {
+        out << "%%MatrixMarket matrix coordinate real symmetric\n% written by femb-reduce --export-matrices\n";
+        out << A->rows() << ' ' << A->cols() << ' ' << count_upper(*A) << '\n';
+        upper(*A, [&](long i, long j, double v) { out << j + 1 << ' ' << i + 1 << ' ' << v << '\n'; });
+      });
+    write(stem + "_dofs.csv", [&](std::ostream& out) {
+      out << "node,component\n";
+      for (size_t r = 0; r < node.size(); ++r) out << node[r] << ',' << component[r] + 1 << '\n';
+    });
+  } else {
+    throw InputError("--matrix-format: unknown format '" + format + "' (known: calculix, abaqus, matrix_market)");
+  }
+  return written;
+}
+
+std::vector<std::string> ExportPartMatrices(const PartSpec& part, const std::string& format, const std::string& directory,
+                                            const ProgressFn& progress) {
+  if (part.type == "imported") throw InputError(part.file + ": --export-matrices: the part's matrices are imported already");
+  Stopwatch clock;
+  SparseMatrix K, M;
+  std::vector<long> node;
+  std::vector<int> component;
+  Eigen::MatrixXd nodes;
+  Eigen::MatrixXi cells;
+  std::string element;  // Abaqus element type
+  std::map<std::string, std::vector<int>> node_sets;
+  if (part.type == "solid") {
+    const SolidMesh mesh = MeshSolidPart(part);
+    SolidDofMap map;
+    const int n = int(mesh.nodes.rows());
+    map.n_dofs = 3 * n;
+    map.model_node.resize(size_t(n));
+    map.arm.assign(size_t(n), Eigen::Matrix3d::Zero());
+    for (int s = 0; s < n; ++s) {
+      map.model_node[size_t(s)] = s;
+      map.first_dof.push_back(3 * s);
+      map.dofs.push_back(3);
+    }
+    AssembleSolid(mesh, part.material, map, &K, &M);
+    for (int s = 0; s < n; ++s)
+      for (int c = 0; c < 3; ++c) {
+        node.push_back(s + 1);
+        component.push_back(c);
+      }
+    nodes = mesh.nodes;
+    cells = ToVtkOrder(SolidTypeName(mesh.type), mesh.cells);  // VTK order = Abaqus order for these
+    const std::map<SolidType, std::string> names = {
+        {SolidType::kTet4, "C3D4"}, {SolidType::kTet10, "C3D10"}, {SolidType::kHex8, "C3D8"}, {SolidType::kHex20, "C3D20"}};
+    element = names.at(mesh.type);
+    node_sets = mesh.node_sets;
+  } else {
+    const FeModel model = BuildBeamModel(part);
+    K = model.K;
+    M = model.M;
+    for (long s = 0; s < model.n_nodes(); ++s)
+      for (int c = 0; c < 6; ++c) {
+        node.push_back(s + 1);
+        component.push_back(c);
+      }
+    nodes = model.nodes;
+    cells = model.cells;
+    element = "B31";
+    for (size_t p = 0; p < part.beam.point_names.size(); ++p) node_sets[part.beam.point_names[p]] = {int(p)};
+  }
+  std::vector<std::string> written = WriteMatrices(format, K, M, node, component, directory, part.name);
+  const std::string mesh_path = (std::filesystem::path(directory) / (part.name + ".inp")).string();
+  {
+    const std::string tmp = mesh_path + ".tmp" + std::to_string(::getpid());
+    std::ofstream out(tmp);
+    out.precision(17);
+    out << "** " << part.name << ": mesh of femb-reduce --export-matrices (node labels = matrix node numbers)\n*NODE\n";
+    for (long s = 0; s < nodes.rows(); ++s) out << s + 1 << ", " << nodes(s, 0) << ", " << nodes(s, 1) << ", " << nodes(s, 2) << '\n';
+    out << "*ELEMENT, TYPE=" << element << ", ELSET=EALL\n";
+    for (long e = 0; e < cells.rows(); ++e) {
+      out << e + 1;
+      for (long a = 0; a < cells.cols(); ++a) out << ", " << cells(e, a) + 1;
+      out << '\n';
+    }
+    for (const auto& [name, set] : node_sets) {
+      out << "*NSET, NSET=" << name << '\n';
+      for (size_t i = 0; i < set.size(); ++i) out << set[i] + 1 << (i % 16 == 15 || i + 1 == set.size() ? "\n" : ", ");
+    }
+    if (!out) throw InputError(directory + ": cannot write " + mesh_path);
+    out.close();
+    std::filesystem::rename(tmp, mesh_path);
+  }
+  written.push_back(mesh_path);
+  if (progress) {
+    progress("export", clock.Seconds(),
+             std::to_string(node.size()) + " DOFs, " + std::to_string(cells.rows()) + " " + element + " elements, " + format +
+                 " matrices and " + mesh_path);
+  }
+  return written;
+}
+
+}  // namespace femb
