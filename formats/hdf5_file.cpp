@@ -265,6 +265,10 @@ std::vector<std::string> Reader::Strings(const std::string& name) const {
   return out;
 }
 
+bool Reader::HasAttribute(const std::string& object, const std::string& name) const {
+  return Exists(object) && H5Aexists_by_name(file_.id(), object.c_str(), name.c_str(), H5P_DEFAULT) > 0;
+}
+
 std::string Reader::StringAttribute(const std::string& object, const std::string& name) const {
   if (H5Aexists_by_name(file_.id(), object.c_str(), name.c_str(), H5P_DEFAULT) <= 0) {
     Fail("missing attribute " + object + "@" + name);

@@ -72,6 +72,7 @@ class Reader {
   double Scalar(const std::string& name) const;
   std::vector<std::string> Strings(const std::string& name) const;
   std::string StringAttribute(const std::string& object, const std::string& name) const;
+  bool HasAttribute(const std::string& object, const std::string& name) const;
   long IntAttribute(const std::string& object, const std::string& name) const;
   /// Shape of a dataset (empty for a scalar).
   std::vector<hsize_t> Shape(const std::string& name) const;

@@ -409,6 +409,10 @@ PartSpec ParsePart(const std::string& text, const std::string& name,
   if (auto r = root.Optional("reduction")) {
     YamlMap m = r->Map();
     if (auto v = m.Optional("internal_modes")) part.reduction.internal_modes = int(v->NonNegativeInteger());
+    if (auto v = m.Optional("method")) {
+      part.reduction.method = v->OneOf({"craig_bampton", "free_interface"});
+      part.reduction.where_method = v->Where();
+    }
     if (auto v = m.Optional("floating_frame")) {
       part.reduction.floating_frame = v->String();
       part.reduction.where_floating_frame = v->Where();
@@ -466,7 +470,13 @@ PartSpec ParsePart(const std::string& text, const std::string& name,
       }
     }
     m.CheckNoUnknownKeys();
+    if (part.reduction.method != "craig_bampton" &&
+        (part.reduction.modal_derivatives.enabled || part.reduction.geometric_stiffening)) {
+      throw InputError(part.reduction.where_method + ": modal derivatives and geometric stiffening are built on the "
+                       "Craig-Bampton basis: use reduction.method: craig_bampton with them");
+    }
   }
+  if (part.reduction.where_method.empty()) part.reduction.where_method = name;
   if (part.reduction.where_floating_frame.empty()) part.reduction.where_floating_frame = name;
   root.CheckNoUnknownKeys();
   return part;

@@ -95,6 +95,11 @@ struct ModalDerivativeSpec {
 
 struct ReductionSpec {
   int internal_modes = 10;
+  /// craig_bampton: fixed-interface modes; free_interface: the part's lowest free-free modes
+  /// with the static constraint modes, brought to interface form by the pseudo-inverse route of
+  /// thesis 8.2 (reducer/reduction/general_basis.h); internal_modes counts the free-free modes.
+  std::string method = "craig_bampton";
+  std::string where_method;
   ModalDerivativeSpec modal_derivatives;
   std::string floating_frame = "center_of_mass";
   /// Geometric stiffening (issue 13): the geometric stiffness of the basis vectors' stresses and

@@ -112,6 +112,7 @@ struct Provenance {
   std::string input_file;
   std::string input_hash;       ///< FNV-1a 64-bit of the part file text, hex
   std::string element_type;
+  std::string reduction_method;  ///< craig_bampton | free_interface ("" in files before it was stored)
   long n_nodes = 0;
   long n_elements = 0;
   std::vector<std::pair<std::string, double>> stage_seconds;

@@ -171,6 +171,7 @@ void WriteContent(const Superelement& se, h5::Writer& w) {
   w.Attribute("/provenance", "input_file", p.input_file);
   w.Attribute("/provenance", "input_hash", p.input_hash);
   w.Attribute("/provenance", "element_type", p.element_type);
+  if (!p.reduction_method.empty()) w.Attribute("/provenance", "reduction_method", p.reduction_method);
   w.Attribute("/provenance", "n_nodes", p.n_nodes);
   w.Attribute("/provenance", "n_elements", p.n_elements);
   std::vector<std::string> stages;
@@ -396,6 +397,7 @@ Superelement ReadSuperelementFile(const std::string& path, const SuperelementRea
     p.input_file = r.StringAttribute("/provenance", "input_file");
     p.input_hash = r.StringAttribute("/provenance", "input_hash");
     p.element_type = r.StringAttribute("/provenance", "element_type");
+    if (r.HasAttribute("/provenance", "reduction_method")) p.reduction_method = r.StringAttribute("/provenance", "reduction_method");
     p.n_nodes = r.IntAttribute("/provenance", "n_nodes");
     p.n_elements = r.IntAttribute("/provenance", "n_elements");
     std::vector<std::string> stages = r.Strings("/provenance/stages");

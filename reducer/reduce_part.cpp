@@ -14,6 +14,7 @@
 #include "reducer/reduction/craig_bampton.h"
 #include "reducer/reduction/floating_frame.h"
 #include "reducer/reduction/full_modes.h"
+#include "reducer/reduction/general_basis.h"
 #include "reducer/reduction/modal_stress.h"
 
 #ifndef FEMB_VERSION
@@ -137,9 +138,10 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
   // Geometric stiffening (issue 13): the unit inertia load cases are solved on the same factor.
   const bool stiffening = part.reduction.geometric_stiffening;
   const Eigen::MatrixXd inertia_fields = stiffening ? InertiaFields(model) : Eigen::MatrixXd();
-  const CraigBamptonResult cb = CraigBamptonReduce(model, part.reduction.internal_modes, report, 200, factor_budget,
-                                                   request.pairs.empty() ? nullptr : &request,
-                                                   stiffening ? &inertia_fields : nullptr);
+  const bool free_interface = part.reduction.method == "free_interface";
+  CraigBamptonResult cb = CraigBamptonReduce(model, free_interface ? 0 : part.reduction.internal_modes, report, 200,
+                                             factor_budget, request.pairs.empty() ? nullptr : &request,
+                                             stiffening ? &inertia_fields : nullptr);
   if (!cb.ok) {
     result.too_big = cb.factorization.too_big;
     result.message = cb.message;
@@ -152,6 +154,51 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
                         "machine with more memory";
     }
     return result;
+  }
+
+  if (free_interface) {
+    // Thesis 8.2: the part's lowest free-free modes with the static constraint modes (which carry
+    // the interface stiffness exactly), brought to interface form (reducer/reduction/general_basis.h).
+    Stopwatch basis_clock;
+    Eigen::MatrixXd free_modes;
+    Eigen::VectorXd free_lambda;
+    const int k = part.reduction.internal_modes;
+    if (k > 0) {
+      double max_ratio = 0.0;
+      for (int j = 0; j < model.K.outerSize(); ++j) {
+        const double mj = model.M.coeff(j, j);
+        if (mj > 0) max_ratio = std::max(max_ratio, model.K.coeff(j, j) / mj);
+      }
+      const FullModesResult full = FullFreeFreeFrequencies(model, k, 1e-8 * max_ratio, &free_modes, &free_lambda);
+      if (!full.ok) {
+        result.message = "free-free eigen solve failed: " + full.message;
+        return result;
+      }
+    }
+    Eigen::MatrixXd V(model.n_dofs(), n_b + k);
+    V << cb.shapes.leftCols(n_b), free_modes.rightCols(k);
+    const GeneralBasisResult g = ReduceOnGeneralBasis(model, V);
+    if (!g.ok) {
+      if (g.input_error) throw InputError(part.reduction.where_method + ": reduction.method free_interface: " + g.message);
+      result.message = g.message;
+      return result;
+    }
+    cb.K = g.K;
+    cb.M = g.M;
+    cb.shapes = g.shapes;
+    cb.lambda = g.lambda;
+    std::string freqs;
+    for (int j = 6; j < std::min<int>(int(free_lambda.size()), 10); ++j) {
+      char b[32];
+      std::snprintf(b, sizeof b, "%s%.4g", freqs.empty() ? "" : ", ", FrequencyHz(free_lambda[j]));
+      freqs += b;
+    }
+    std::snprintf(detail, sizeof detail,
+                  "%d free-free modes (%s%s Hz) + %d static modes: %d of %d shapes independent, interface rank %d of %d "
+                  "(thesis 8.2), %ld reduced DOFs",
+                  k, freqs.c_str(), k > 4 ? ", ..." : "", n_b, g.columns_kept, g.columns_given + 6, g.interface_rank, n_b,
+                  long(g.K.rows()));
+    report("free-interface basis", basis_clock.Seconds(), detail);
   }
 
   clock.Restart();
@@ -261,6 +308,7 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
   prov.input_file = part.file;
   prov.input_hash = part.text_hash;
   prov.element_type = model.element_type;
+  prov.reduction_method = part.reduction.method;
   prov.n_nodes = model.n_nodes();
   prov.n_elements = model.n_elements();
   report("frame+mass", clock.Seconds(), "floating frame " + se.floating_frame.type +

@@ -7,7 +7,8 @@
 
 namespace femb {
 
-FullModesResult FullFreeFreeFrequencies(const FeModel& model, int n_flexible, double s) {
+FullModesResult FullFreeFreeFrequencies(const FeModel& model, int n_flexible, double s, Eigen::MatrixXd* vectors,
+                                        Eigen::VectorXd* lambda) {
   FullModesResult r;
   const int nev = std::min<int>(n_flexible + 6, int(model.n_dofs()));
   SparseMatrix shifted = model.K + s * model.M;
@@ -25,6 +26,8 @@ FullModesResult FullFreeFreeFrequencies(const FeModel& model, int n_flexible, do
   }
   r.frequencies_hz.resize(nev);
   for (int k = 0; k < nev; ++k) r.frequencies_hz[k] = FrequencyHz(eig.lambda[k]);
+  if (vectors) *vectors = std::move(eig.vectors);
+  if (lambda) *lambda = eig.lambda;
   r.ok = true;
   return r;
 }

@@ -20,7 +20,10 @@ struct FullModesResult {
 };
 
 /// The 6 rigid-body and `n_flexible` lowest flexible frequencies. `s` > 0 is the shift size
-/// (a fraction of the lowest expected flexible eigenvalue is a good choice).
-FullModesResult FullFreeFreeFrequencies(const FeModel& model, int n_flexible, double s);
+/// (a fraction of the lowest expected flexible eigenvalue is a good choice). With `vectors`,
+/// also the M-orthonormal mode shapes (n_dofs x (6 + n_flexible), ascending) and, with
+/// `lambda`, their eigenvalues.
+FullModesResult FullFreeFreeFrequencies(const FeModel& model, int n_flexible, double s,
+                                        Eigen::MatrixXd* vectors = nullptr, Eigen::VectorXd* lambda = nullptr);
 
 }  // namespace femb

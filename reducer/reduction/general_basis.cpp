@@ -1,0 +1,105 @@
+#include "reducer/reduction/general_basis.h"
+
+#include <Eigen/Dense>
+#include <cstdio>
+
+#include "reducer/reduction/craig_bampton.h"
+
+namespace femb {
+
+SparseMatrix InterfaceRows(const FeModel& model) {
+  const int N = int(model.interface_names.size());
+  std::vector<Eigen::Triplet<double>> t;
+  for (int k = 0; k < N; ++k) {
+    const bool rbe3 = k < int(model.interface_weights.size()) && model.interface_weights[size_t(k)].rows() > 0;
+    if (rbe3) {
+      const SparseMatrix& W = model.interface_weights[size_t(k)];
+      for (int j = 0; j < W.outerSize(); ++j)
+        for (SparseMatrix::InnerIterator it(W, j); it; ++it) t.emplace_back(6 * k + int(it.row()), j, it.value());
+    } else {
+      for (int d = 0; d < 6; ++d) t.emplace_back(6 * k + d, model.interface_dofs[size_t(k)][size_t(d)].value, 1.0);
+    }
+  }
+  SparseMatrix B(6 * N, model.n_dofs());
+  B.setFromTriplets(t.begin(), t.end());
+  return B;
+}
+
+GeneralBasisResult ReduceOnGeneralBasis(const FeModel& model, const Eigen::MatrixXd& V_given) {
+  GeneralBasisResult r;
+  const int N = int(model.interface_names.size()), nb = 6 * N;
+  // 1. Rigid-body fields appended; M-orthonormal, dependent columns dropped.
+  Eigen::MatrixXd V(model.n_dofs(), 6 + V_given.cols());
+  V << RigidFields(model), V_given;
+  r.columns_given = int(V_given.cols());
+  const Eigen::MatrixXd MV = model.M * V;
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> gram(V.transpose() * MV);
+  const Eigen::VectorXd g = gram.eigenvalues();
+  const double g_max = g.maxCoeff();
+  std::vector<int> keep;
+  for (int k = 0; k < g.size(); ++k)
+    if (g[k] > 1e-10 * g_max) keep.push_back(k);
+  Eigen::MatrixXd Q(V.rows(), long(keep.size()));
+  for (size_t j = 0; j < keep.size(); ++j) Q.col(long(j)) = V * gram.eigenvectors().col(keep[j]) / std::sqrt(g[keep[j]]);
+  r.columns_kept = int(Q.cols());
+
+  // 2. The interface span (8.12) and its SVD.
+  const SparseMatrix B = InterfaceRows(model);
+  const Eigen::MatrixXd Phi_IP = B * Q;  // 6N x M
+  Eigen::JacobiSVD<Eigen::MatrixXd> svd(Phi_IP, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  const Eigen::VectorXd s = svd.singularValues();
+  const double s_max = s.size() ? s[0] : 0.0;
+  int m = 0;
+  for (int k = 0; k < s.size(); ++k) m += s[k] > 1e-8 * s_max;
+  r.interface_rank = m;
+  if (m < nb) {
+    // Case 4: name the interface coordinate that dominates the first unspanned direction.
+    const Eigen::VectorXd u = svd.matrixU().col(m);
+    Eigen::Index at = 0;
+    u.cwiseAbs().maxCoeff(&at);
+    static const char* kNames[6] = {"u_x", "u_y", "u_z", "theta_x", "theta_y", "theta_z"};
+    char b[320];
+    std::snprintf(b, sizeof b,
+                  "the deformation shapes (with the rigid-body fields) move only %d of the %d interface coordinates: "
+                  "interface '%s' %s (and %d more directions) cannot move relative to the others; add shapes that "
+                  "move it (residual attachment or static modes) - femb does not constrain interface directions inside a body",
+                  m, nb, model.interface_names[size_t(at / 6)].c_str(), kNames[at % 6], nb - m - 1);
+    r.message = b;
+    r.input_error = true;
+    return r;
+  }
+  const long n_internal = Q.cols() - nb;
+  // Phi0 = Q Phi_IP^+ = Q V_s S^-1 U^T; Psi0 = Q N (the right singular vectors past the rank).
+  const Eigen::MatrixXd pinv = svd.matrixV().leftCols(nb) * s.head(nb).cwiseInverse().asDiagonal() *
+                               svd.matrixU().transpose();
+  Eigen::MatrixXd Phi = Q * pinv;
+  Eigen::MatrixXd Psi = Q * svd.matrixV().rightCols(n_internal);
+
+  // 3. Condensation within the basis; 4. internal eigen-coordinates.
+  if (n_internal > 0) {
+    const Eigen::MatrixXd K_Psi = model.K * Psi;
+    const Eigen::MatrixXd Kpp = 0.5 * (Psi.transpose() * K_Psi + (Psi.transpose() * K_Psi).transpose());
+    const Eigen::MatrixXd Mpp = Psi.transpose() * (model.M * Psi);
+    Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> eig(Kpp, 0.5 * (Mpp + Mpp.transpose()));
+    if (eig.info() != Eigen::Success || !(eig.eigenvalues().minCoeff() > 0)) {
+      r.message = "the shapes' internal part (zero at the interfaces) has no stiffness in some direction (a mechanism "
+                  "or a dependent shape): the basis cannot carry it";
+      r.input_error = true;
+      return r;
+    }
+    Psi = Psi * eig.eigenvectors();  // K = diag(lambda), M = 1 on the internal block
+    r.lambda = eig.eigenvalues();
+    Phi -= Psi * (r.lambda.cwiseInverse().asDiagonal() * (Psi.transpose() * (model.K * Phi)));
+  }
+  r.shapes.resize(model.n_dofs(), nb + n_internal);
+  r.shapes << Phi, Psi;
+  const Eigen::MatrixXd KS = model.K * r.shapes, MS = model.M * r.shapes;
+  r.K = r.shapes.transpose() * KS;
+  r.M = r.shapes.transpose() * MS;
+  r.K = 0.5 * (r.K + r.K.transpose()).eval();
+  r.M = 0.5 * (r.M + r.M.transpose()).eval();
+  r.ok = true;
+  return r;
+}
+
+}  // namespace femb

@@ -1,0 +1,114 @@
+// General deformation bases (thesis 8.2, issue 16 item 3): the pseudo-inverse route gives back
+// Craig-Bampton when handed its basis (case m = M = 6N: Guyan; m = 6N < M: with its modes); a
+// free-interface basis reproduces the full model's free-free frequencies it contains exactly and
+// converges as modes are added; too few shapes to move every interface direction (m < 6N) is
+// refused, naming the direction.
+#include "reducer/reduction/general_basis.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+#include <cstdio>
+
+#include "formats/superelement_checks.h"
+#include "reducer/fe/beam_model.h"
+#include "reducer/reduction/craig_bampton.h"
+#include "reducer/reduction/full_modes.h"
+#include "test_util.h"
+
+namespace femb {
+namespace {
+
+const std::string kRod = test::StraightBeamYaml(0.3, 20, "{shape: circle, diameter: 0.006}", "{E: 2.0e11, nu: 0.3, rho: 7870}",
+                                                "[{name: A}, {name: B}]", "reduction: {internal_modes: 6}\n");
+
+double Relative(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) { return (a - b).norm() / b.norm(); }
+
+TEST(GeneralBasis, CraigBamptonBasisGivesCraigBamptonBack) {
+  const FeModel model = BuildBeamModel(ParsePart(kRod, "rod.yaml"));
+  const CraigBamptonResult cb = CraigBamptonReduce(model, 6, nullptr);
+  ASSERT_TRUE(cb.ok) << cb.message;
+  // Case 3 (m = 6N = 12, M = 18): static and fixed-interface modes. Case 2 (M = 12): static only.
+  for (const int modes : {6, 0}) {
+    const GeneralBasisResult g = ReduceOnGeneralBasis(model, cb.shapes.leftCols(12 + modes));
+    ASSERT_TRUE(g.ok) << g.message;
+    EXPECT_EQ(g.interface_rank, 12);
+    EXPECT_EQ(g.columns_kept, 12 + modes);  // the 6 rigid fields appended lie in the static modes' span
+    const int n = 12 + modes;
+    std::printf("[ info ] %d modes: K_r %.2e, M_r %.2e, static shapes %.2e\n", modes,
+                Relative(g.K, cb.K.topLeftCorner(n, n)), Relative(g.M.topLeftCorner(12, 12), cb.M.topLeftCorner(12, 12)),
+                Relative(g.shapes.leftCols(12), cb.shapes.leftCols(12)));
+    EXPECT_LT(Relative(g.K.topLeftCorner(12, 12), cb.K.topLeftCorner(12, 12)), 1e-9);
+    EXPECT_LT(Relative(g.M.topLeftCorner(12, 12), cb.M.topLeftCorner(12, 12)), 1e-9);
+    EXPECT_LT(Relative(g.shapes.leftCols(12), cb.shapes.leftCols(12)), 1e-9);
+    for (int k = 0; k < modes; ++k) EXPECT_NEAR(g.lambda[k], cb.lambda[k], 1e-9 * cb.lambda[k]) << k;
+  }
+}
+
+TEST(GeneralBasis, FreeInterfaceBasisHasTheFullModelsFreeFreeFrequencies) {
+  const std::string part = kRod + "";
+  const Superelement cb = test::Reduce(part, {"reduction.full_modes=12"});
+  const double f_full_7 = cb.full_free_free_frequencies_hz[6 + 6];  // the 7th flexible mode
+  double previous = 1e300;
+  for (const int k : {4, 8, 12}) {
+    const Superelement fi = test::Reduce(part, {"reduction.method=free_interface", "reduction.internal_modes=" + std::to_string(k),
+                                                "reduction.full_modes=12"});
+    EXPECT_EQ(fi.provenance.reduction_method, "free_interface");
+    EXPECT_EQ(fi.n_reduced_dofs(), 12 + k);
+    const SuperelementChecks checks = CheckSuperelement(fi);
+    EXPECT_EQ(checks.first_failure(), nullptr) << (checks.first_failure() ? checks.first_failure()->detail : "");
+    // Free-free frequencies of the reduced model (6 rigid first) against the full model's.
+    Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> eig(fi.K, fi.M, Eigen::EigenvaluesOnly);
+    double worst_included = 0.0;
+    for (int j = 0; j < k; ++j) {
+      const double f = std::sqrt(std::max(eig.eigenvalues()[6 + j], 0.0)) / (2 * M_PI);
+      worst_included = std::max(worst_included, std::abs(f / fi.full_free_free_frequencies_hz[6 + j] - 1));
+    }
+    const double f7 = std::sqrt(eig.eigenvalues()[6 + 6]) / (2 * M_PI);
+    std::printf("[ info ] free-interface, %d modes: the %d included free-free frequencies within %.2e; 7th flexible "
+                "%+.3f%% (Craig-Bampton 6 modes: %+.3f%%)\n",
+                k, k, worst_included, 100 * (f7 / f_full_7 - 1),
+                100 * (std::sqrt(CheckSuperelement(cb).lambda[12]) / (2 * M_PI) / f_full_7 - 1));
+    EXPECT_LT(worst_included, 1e-8) << k;
+    // Rayleigh-Ritz: never below the full model, and better as modes are added.
+    EXPECT_GE(f7, f_full_7 * (1 - 1e-9));
+    EXPECT_LE(f7, previous * (1 + 1e-9));
+    previous = f7;
+  }
+}
+
+TEST(GeneralBasis, TooFewShapesToMoveEveryInterfaceDirectionAreRefused) {
+  const FeModel model = BuildBeamModel(ParsePart(kRod, "rod.yaml"));
+  Eigen::MatrixXd modes;
+  Eigen::VectorXd lambda;
+  ASSERT_TRUE(FullFreeFreeFrequencies(model, 4, 1.0, &modes, &lambda).ok);
+  // 4 free-free bending modes + 6 rigid fields move at most 10 of the 12 interface coordinates
+  // (case 4 of thesis 8.2: e.g. no axial stretch, no twist).
+  const GeneralBasisResult g = ReduceOnGeneralBasis(model, modes.rightCols(4));
+  EXPECT_FALSE(g.ok);
+  EXPECT_TRUE(g.input_error);
+  EXPECT_LT(g.interface_rank, 12);
+  EXPECT_NE(g.message.find("move only " + std::to_string(g.interface_rank) + " of the 12 interface coordinates"), std::string::npos)
+      << g.message;
+  EXPECT_NE(g.message.find("cannot move relative to the others"), std::string::npos) << g.message;
+}
+
+// A solid tube with a distributing (RBE3) interface: the interface rows are the RBE3 weights,
+// and the free-interface superelement passes every file check.
+TEST(GeneralBasis, FreeInterfaceSolidWithDistributingInterface) {
+  const Superelement fi = test::Reduce(
+      "name: t\ntype: solid\nmaterial: {E: 2.1e11, nu: 0.3, rho: 7850}\n"
+      "geometry: {shape: tube, radius: 0.05, inner_radius: 0.03, length: 0.3}\nmesh: {size: 0.02, order: 2}\n"
+      "interfaces: [{name: bottom, group: bottom}, {name: top, group: top, coupling: rbe3}]\n"
+      "reduction: {method: free_interface, internal_modes: 6, floating_frame: mean_axes, full_modes: 6}\n");
+  const SuperelementChecks checks = CheckSuperelement(fi);
+  EXPECT_EQ(checks.first_failure(), nullptr) << (checks.first_failure() ? checks.first_failure()->detail : "");
+  Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> eig(fi.K, fi.M, Eigen::EigenvaluesOnly);
+  for (int j = 0; j < 6; ++j) {
+    const double f = std::sqrt(eig.eigenvalues()[6 + j]) / (2 * M_PI);
+    EXPECT_NEAR(f, fi.full_free_free_frequencies_hz[6 + j], 1e-7 * fi.full_free_free_frequencies_hz[6 + j]) << j;
+  }
+}
+
+}  // namespace
+}  // namespace femb
