@@ -410,8 +410,21 @@ PartSpec ParsePart(const std::string& text, const std::string& name,
     YamlMap m = r->Map();
     if (auto v = m.Optional("internal_modes")) part.reduction.internal_modes = int(v->NonNegativeInteger());
     if (auto v = m.Optional("method")) {
-      part.reduction.method = v->OneOf({"craig_bampton", "free_interface"});
+      part.reduction.method = v->OneOf({"craig_bampton", "free_interface", "general"});
       part.reduction.where_method = v->Where();
+      if (part.reduction.method == "general" && part.type != "imported") {
+        v->Fail("method general reads shapes on the DOFs of imported matrices: it needs type: imported (for femb's own "
+                "parts use free_interface)");
+      }
+    }
+    if (auto v = m.Optional("basis")) {
+      YamlMap b = v->Map();
+      part.reduction.where_basis = v->Where();
+      part.reduction.basis_file = resolve(b.Required("file"), "deformation shapes file");
+      b.CheckNoUnknownKeys();
+      if (part.reduction.method != "general") v->Fail("a basis file is read with reduction.method: general only");
+    } else if (part.reduction.method == "general") {
+      m.AsValue().Fail("reduction.method general needs reduction.basis: {file: shapes.mtx}");
     }
     if (auto v = m.Optional("floating_frame")) {
       part.reduction.floating_frame = v->String();

@@ -97,9 +97,14 @@ struct ReductionSpec {
   int internal_modes = 10;
   /// craig_bampton: fixed-interface modes; free_interface: the part's lowest free-free modes
   /// with the static constraint modes, brought to interface form by the pseudo-inverse route of
-  /// thesis 8.2 (reducer/reduction/general_basis.h); internal_modes counts the free-free modes.
+  /// thesis 8.2 (reducer/reduction/general_basis.h); internal_modes counts the free-free modes;
+  /// general: shapes from a file (basis_file), the same route.
   std::string method = "craig_bampton";
   std::string where_method;
+  /// method general (imported parts): the deformation shapes, a Matrix Market file (array or
+  /// coordinate, real) with one row per imported DOF in the matrices' order and one column per shape.
+  std::string basis_file;
+  std::string where_basis;
   ModalDerivativeSpec modal_derivatives;
   std::string floating_frame = "center_of_mass";
   /// Geometric stiffening (issue 13): the geometric stiffness of the basis vectors' stresses and

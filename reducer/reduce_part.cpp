@@ -4,6 +4,8 @@
 #include <cstdio>
 #include <memory>
 
+#include <Eigen/SparseCholesky>
+
 #include "formats/input_error.h"
 #include "reducer/fe/beam_model.h"
 #include "reducer/fe/imported_model.h"
@@ -139,7 +141,8 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
   const bool stiffening = part.reduction.geometric_stiffening;
   const Eigen::MatrixXd inertia_fields = stiffening ? InertiaFields(model) : Eigen::MatrixXd();
   const bool free_interface = part.reduction.method == "free_interface";
-  CraigBamptonResult cb = CraigBamptonReduce(model, free_interface ? 0 : part.reduction.internal_modes, report, 200,
+  const bool general = part.reduction.method == "general";
+  CraigBamptonResult cb = CraigBamptonReduce(model, free_interface || general ? 0 : part.reduction.internal_modes, report, 200,
                                              factor_budget, request.pairs.empty() ? nullptr : &request,
                                              stiffening ? &inertia_fields : nullptr);
   if (!cb.ok) {
@@ -199,6 +202,33 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
                   k, freqs.c_str(), k > 4 ? ", ..." : "", n_b, g.columns_kept, g.columns_given + 6, g.interface_rank, n_b,
                   long(g.K.rows()));
     report("free-interface basis", basis_clock.Seconds(), detail);
+  }
+
+  if (general) {
+    // Thesis 8.2 with the user's shapes on the imported DOFs, fitted to the model DOFs (least
+    // squares: an RBE2 face moves rigidly in the model, the shapes may not).
+    Stopwatch basis_clock;
+    const Eigen::MatrixXd V_full = ReadShapeMatrix(part.reduction.basis_file, model.full_map.rows());
+    const SparseMatrix& T = model.full_map;
+    Eigen::SimplicialLDLT<SparseMatrix> normal(SparseMatrix(T.transpose() * T));
+    const Eigen::MatrixXd V = normal.solve(Eigen::MatrixXd(T.transpose() * V_full));
+    const double off_rigid = (Eigen::MatrixXd(T * V) - V_full).norm() / std::max(V_full.norm(), 1e-300);
+    const GeneralBasisResult g = ReduceOnGeneralBasis(model, V);
+    if (!g.ok) {
+      if (g.input_error) throw InputError(part.reduction.where_basis + ": " + part.reduction.basis_file + ": " + g.message);
+      result.message = g.message;
+      return result;
+    }
+    cb.K = g.K;
+    cb.M = g.M;
+    cb.shapes = g.shapes;
+    cb.lambda = g.lambda;
+    std::snprintf(detail, sizeof detail,
+                  "%d shapes from %s (%.2g of their norm off the RBE2 faces' rigid motion): %d of %d with the rigid fields "
+                  "independent, interface rank %d of %d (thesis 8.2), %ld reduced DOFs",
+                  g.columns_given, part.reduction.basis_file.c_str(), off_rigid, g.columns_kept, g.columns_given + 6,
+                  g.interface_rank, n_b, long(g.K.rows()));
+    report("general basis", basis_clock.Seconds(), detail);
   }
 
   clock.Restart();

@@ -49,6 +49,8 @@ struct FeModel {
   /// DOF, for the rigid-body fields. Empty for femb's own models.
   std::vector<Eigen::Vector3d> dof_point;
   std::vector<int> dof_component;
+  /// Imported models: the imported DOFs (the matrices' rows) = full_map * model DOFs.
+  SparseMatrix full_map;
 
   long n_dofs() const { return long(K.rows()); }
   long n_nodes() const { return long(nodes.rows()); }

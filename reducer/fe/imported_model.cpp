@@ -308,6 +308,45 @@ ImportedMatrices ReadImportedMatrices(const MatricesSpec& spec) {
   return out;
 }
 
+Eigen::MatrixXd ReadShapeMatrix(const std::string& path, long rows) {
+  LineReader r(path, "deformation shapes file");
+  std::string line;
+  if (!r.Next(&line, "")) r.Fail("empty file");
+  std::string lower = line;
+  std::transform(lower.begin(), lower.end(), lower.begin(), ::tolower);
+  const bool array = lower.find(" array") != std::string::npos;
+  if (lower.rfind("%%matrixmarket", 0) != 0 || (!array && lower.find("coordinate") == std::string::npos) ||
+      lower.find("real") == std::string::npos || lower.find("general") == std::string::npos) {
+    r.Fail("expected '%%MatrixMarket matrix array real general' (or coordinate), got '" + line + "'");
+  }
+  if (!r.Next(&line, "%")) r.Fail("no size line");
+  const std::vector<std::string> size = Fields(line);
+  if (size.size() != (array ? 2u : 3u)) r.Fail("expected the size line 'rows columns" + std::string(array ? "'" : " entries'"));
+  const long n = IntegerField(r, size[0]), m = IntegerField(r, size[1]);
+  if (n != rows) {
+    r.Fail("the shapes have " + size[0] + " rows but the matrices have " + std::to_string(rows) +
+           " DOFs (one row per DOF, in the matrices' order)");
+  }
+  if (m <= 0) r.Fail("no shapes (columns)");
+  Eigen::MatrixXd V = Eigen::MatrixXd::Zero(n, m);
+  if (array) {
+    for (long j = 0; j < m; ++j)
+      for (long i = 0; i < n; ++i) {
+        if (!r.Next(&line, "%")) r.Fail("the file ends after " + std::to_string(j * n + i) + " of " + std::to_string(n * m) + " values");
+        V(i, j) = NumberField(r, Fields(line).empty() ? std::string() : Fields(line)[0]);
+      }
+  } else {
+    while (r.Next(&line, "%")) {
+      const std::vector<std::string> f = Fields(line);
+      if (f.size() != 3) r.Fail("expected 'row column value', got '" + line + "'");
+      const long i = IntegerField(r, f[0]), j = IntegerField(r, f[1]);
+      if (i < 1 || i > n || j < 1 || j > m) r.Fail("index (" + f[0] + ", " + f[1] + ") outside the " + size[0] + " x " + size[1] + " matrix");
+      V(i - 1, j - 1) = NumberField(r, f[2]);
+    }
+  }
+  return V;
+}
+
 FeModel BuildImportedModel(const PartSpec& part, const ProgressFn& progress) {
   Stopwatch clock;
   const ForeignMesh geometry = ReadWithMeshio(part.solid.file, part.solid.where, true);
@@ -489,6 +528,7 @@ FeModel BuildImportedModel(const PartSpec& part, const ProgressFn& progress) {
   SparseMatrix S(3 * n_nodes, n_full);
   S.setFromTriplets(pick.begin(), pick.end());
   model.mesh_map = SparseMatrix(S * T);
+  model.full_map = T;
   model.dofs_per_node = 3;
   model.nodes = geometry.nodes;
   model.cells = geometry.cells;

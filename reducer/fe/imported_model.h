@@ -46,6 +46,11 @@ ImportedMatrices ReadImportedMatrices(const MatricesSpec& spec);
 /// couplings.
 FeModel BuildImportedModel(const PartSpec& part, const ProgressFn& progress = nullptr);
 
+/// Deformation shapes on the imported DOFs (reduction.method general): a Matrix Market file,
+/// `array real general` (column by column) or `coordinate real general`, `rows` x shapes.
+/// Throws InputError naming the file and line.
+Eigen::MatrixXd ReadShapeMatrix(const std::string& path, long rows);
+
 /// Writes K and M (both triangles given; the upper one is written) in `format` for the DOFs
 /// (node label, component 0..5): calculix -> DIR/STEM.sti, .mas, .dof; abaqus ->
 /// DIR/STEM_STIF1.mtx, DIR/STEM_MASS1.mtx; matrix_market -> DIR/STEM_K.mtx, DIR/STEM_M.mtx,

@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <Eigen/Dense>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -195,6 +196,77 @@ TEST(ImportedModel, BadMatricesAreOneLineEach) {
                                   "matrices: {format: calculix, stiffness: nothere.sti, mass: bar.mas, dofs: bar.dof}\n"
                                   "interfaces: [{name: root, group: xmin}]\n");
   expect(test::ThrownMessage([&] { ReadPartFile((dir / "missing.yaml").string()); }), "nothere.sti' not found");
+  fs::remove_all(dir);
+}
+
+// Thesis 8.2 with shapes from "another code": the free-free modes and static constraint modes of
+// the exported rod, computed here densely on the imported matrices and written as a Matrix
+// Market array, span the same space as femb's free_interface reduction of the native rod: the
+// same internal frequencies. Four free-free modes alone do not move every interface direction.
+TEST(ImportedModel, GeneralBasisFromAFileMatchesFreeInterface) {
+  const fs::path dir = TempDir("general");
+  const std::string rod = test::StraightBeamYaml(0.3, 10, "{shape: circle, diameter: 0.006}", "{E: 2.1e11, nu: 0.3, rho: 7850}",
+                                                 "[{name: A}, {name: B}]",
+                                                 "reduction: {method: free_interface, internal_modes: 8, floating_frame: mean_axes}\n");
+  WriteText(dir / "rod.yaml", rod);
+  const PartSpec part = ReadPartFile((dir / "rod.yaml").string());
+  ExportPartMatrices(part, "calculix", dir.string());
+  const std::string name = part.name;
+  MatricesSpec spec;
+  spec.format = "calculix";
+  spec.stiffness = (dir / (name + ".sti")).string();
+  spec.mass = (dir / (name + ".mas")).string();
+  spec.dofs = (dir / (name + ".dof")).string();
+  const ImportedMatrices im = ReadImportedMatrices(spec);
+  const Eigen::MatrixXd K(im.K), M(im.M);
+  const long n = K.rows();
+  // Free-free modes (dense, shifted) and the static modes of the interface nodes 1 and 2 (A, B).
+  Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> eig(K + 1.0 * M, M);
+  std::vector<long> boundary, interior;
+  for (long r = 0; r < n; ++r) (im.node[size_t(r)] <= 2 ? boundary : interior).push_back(r);
+  ASSERT_EQ(boundary.size(), 12u);
+  Eigen::MatrixXd Kii(interior.size(), interior.size()), Kib(interior.size(), 12);
+  for (size_t i = 0; i < interior.size(); ++i) {
+    for (size_t j = 0; j < interior.size(); ++j) Kii(long(i), long(j)) = K(interior[i], interior[j]);
+    for (size_t j = 0; j < 12; ++j) Kib(long(i), long(j)) = K(interior[i], boundary[j]);
+  }
+  const Eigen::MatrixXd Psi_i = -Kii.ldlt().solve(Kib);
+  Eigen::MatrixXd V = Eigen::MatrixXd::Zero(n, 20);
+  for (size_t j = 0; j < 12; ++j) {
+    V(boundary[j], long(j)) = 1.0;
+    for (size_t i = 0; i < interior.size(); ++i) V(interior[i], long(j)) = Psi_i(long(i), long(j));
+  }
+  V.rightCols(8) = eig.eigenvectors().middleCols(6, 8);
+  auto write_array = [&](const fs::path& path, const Eigen::MatrixXd& A) {
+    std::ofstream out(path);
+    out.precision(17);
+    out << "%%MatrixMarket matrix array real general\n% shapes\n" << A.rows() << " " << A.cols() << "\n";
+    for (long j = 0; j < A.cols(); ++j)
+      for (long i = 0; i < A.rows(); ++i) out << A(i, j) << "\n";
+  };
+  write_array(dir / "shapes.mtx", V);
+  const std::string imported = "name: rod\ntype: imported\ngeometry: {file: " + name + ".inp}\nmatrices: {format: calculix, "
+                               "stiffness: " + name + ".sti, mass: " + name + ".mas, dofs: " + name + ".dof}\n"
+                               "interfaces: [{name: A, group: A}, {name: B, group: B}]\n";
+  WriteText(dir / "general.yaml", imported + "reduction: {method: general, basis: {file: shapes.mtx}, floating_frame: mean_axes}\n");
+  const Superelement native = ReduceFile(dir / "rod.yaml");
+  const Superelement general = ReduceFile(dir / "general.yaml");
+  ASSERT_EQ(general.internal_frequencies_hz.size(), 8);
+  const double f = ((general.internal_frequencies_hz.array() / native.internal_frequencies_hz.array()) - 1).abs().maxCoeff();
+  std::printf("[ info ] general basis from a file vs free_interface: internal frequencies within %.2e, K_r static block %.2e\n", f,
+              Relative(general.K.topLeftCorner(12, 12), native.K.topLeftCorner(12, 12)));
+  EXPECT_LT(f, 1e-8);
+  EXPECT_LT(Relative(general.K.topLeftCorner(12, 12), native.K.topLeftCorner(12, 12)), 1e-8);
+  EXPECT_EQ(general.provenance.reduction_method, "general");
+  // Case 4: four free-free modes (with the rigid fields) cannot stretch or twist the rod.
+  write_array(dir / "few.mtx", eig.eigenvectors().middleCols(6, 4));
+  WriteText(dir / "few.yaml", imported + "reduction: {method: general, basis: {file: few.mtx}, floating_frame: mean_axes}\n");
+  const std::string message = test::ThrownMessage([&] { ReduceFile(dir / "few.yaml"); });
+  EXPECT_NE(message.find("few.mtx: the deformation shapes (with the rigid-body fields) move only"), std::string::npos) << message;
+  // A shapes file with the wrong number of rows.
+  write_array(dir / "short.mtx", V.topRows(n - 1));
+  WriteText(dir / "short.yaml", imported + "reduction: {method: general, basis: {file: short.mtx}, floating_frame: mean_axes}\n");
+  EXPECT_NE(test::ThrownMessage([&] { ReduceFile(dir / "short.yaml"); }).find("short.mtx:3: the shapes have"), std::string::npos);
   fs::remove_all(dir);
 }
 
