@@ -677,7 +677,7 @@ std::vector<std::string> ExportPartMatrices(const PartSpec& part, const std::str
   {
     const std::string tmp = mesh_path + ".tmp" + std::to_string(::getpid());
     std::ofstream out(tmp);
-    out.precision(17);
+    out.precision(13);  // CalculiX reads at most 20 characters per field ("-7.347880794884e-18" is 19)
     out << "** " << part.name << ": mesh of femb-reduce --export-matrices (node labels = matrix node numbers)\n*NODE\n";
     for (long s = 0; s < nodes.rows(); ++s) out << s + 1 << ", " << nodes(s, 0) << ", " << nodes(s, 1) << ", " << nodes(s, 2) << '\n';
     out << "*ELEMENT, TYPE=" << element << ", ELSET=EALL\n";
