@@ -159,30 +159,55 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
     return result;
   }
 
-  if (free_interface) {
-    // Thesis 8.2: the part's lowest free-free modes with the static constraint modes (which carry
-    // the interface stiffness exactly), brought to interface form (reducer/reduction/general_basis.h).
+  if (free_interface || general) {
+    // Thesis 8.2 (reducer/reduction/general_basis.h). free_interface: the part's lowest free-free
+    // modes with the static constraint modes (which carry the interface stiffness exactly);
+    // general: the user's shapes on the imported DOFs, fitted to the model DOFs (least squares:
+    // an RBE2 face moves rigidly in the model, the shapes may not).
     Stopwatch basis_clock;
-    Eigen::MatrixXd free_modes;
-    Eigen::VectorXd free_lambda;
-    const int k = part.reduction.internal_modes;
-    if (k > 0) {
-      double max_ratio = 0.0;
-      for (int j = 0; j < model.K.outerSize(); ++j) {
-        const double mj = model.M.coeff(j, j);
-        if (mj > 0) max_ratio = std::max(max_ratio, model.K.coeff(j, j) / mj);
+    Eigen::MatrixXd V;
+    std::string where, source;
+    if (free_interface) {
+      Eigen::MatrixXd free_modes;
+      Eigen::VectorXd free_lambda;
+      const int k = part.reduction.internal_modes;
+      if (k > 0) {
+        double max_ratio = 0.0;
+        for (int j = 0; j < model.K.outerSize(); ++j) {
+          const double mj = model.M.coeff(j, j);
+          if (mj > 0) max_ratio = std::max(max_ratio, model.K.coeff(j, j) / mj);
+        }
+        const FullModesResult full = FullFreeFreeFrequencies(model, k, 1e-8 * max_ratio, &free_modes, &free_lambda);
+        if (!full.ok) {
+          result.message = "free-free eigen solve failed: " + full.message;
+          return result;
+        }
       }
-      const FullModesResult full = FullFreeFreeFrequencies(model, k, 1e-8 * max_ratio, &free_modes, &free_lambda);
-      if (!full.ok) {
-        result.message = "free-free eigen solve failed: " + full.message;
-        return result;
+      V.resize(model.n_dofs(), n_b + k);
+      V << cb.shapes.leftCols(n_b), free_modes.rightCols(k);
+      where = part.reduction.where_method + ": reduction.method free_interface";
+      std::string freqs;
+      for (int j = 6; j < std::min<int>(int(free_lambda.size()), 10); ++j) {
+        char b[32];
+        std::snprintf(b, sizeof b, "%s%.4g", freqs.empty() ? "" : ", ", FrequencyHz(free_lambda[j]));
+        freqs += b;
       }
+      source = std::to_string(k) + " free-free modes (" + freqs + (k > 4 ? ", ..." : "") + " Hz) + " + std::to_string(n_b) +
+               " static modes";
+    } else {
+      const Eigen::MatrixXd V_full = ReadShapeMatrix(part.reduction.basis_file, model.full_map.rows());
+      const SparseMatrix& T = model.full_map;
+      Eigen::SimplicialLDLT<SparseMatrix> normal(SparseMatrix(T.transpose() * T));
+      V = normal.solve(Eigen::MatrixXd(T.transpose() * V_full));
+      const double off_rigid = (Eigen::MatrixXd(T * V) - V_full).norm() / std::max(V_full.norm(), 1e-300);
+      where = part.reduction.where_basis + ": " + part.reduction.basis_file;
+      char b[96];
+      std::snprintf(b, sizeof b, " (%.2g of their norm off the RBE2 faces' rigid motion)", off_rigid);
+      source = std::to_string(V.cols()) + " shapes from " + part.reduction.basis_file + b;
     }
-    Eigen::MatrixXd V(model.n_dofs(), n_b + k);
-    V << cb.shapes.leftCols(n_b), free_modes.rightCols(k);
     const GeneralBasisResult g = ReduceOnGeneralBasis(model, V);
     if (!g.ok) {
-      if (g.input_error) throw InputError(part.reduction.where_method + ": reduction.method free_interface: " + g.message);
+      if (g.input_error) throw InputError(where + ": " + g.message);
       result.message = g.message;
       return result;
     }
@@ -190,45 +215,10 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
     cb.M = g.M;
     cb.shapes = g.shapes;
     cb.lambda = g.lambda;
-    std::string freqs;
-    for (int j = 6; j < std::min<int>(int(free_lambda.size()), 10); ++j) {
-      char b[32];
-      std::snprintf(b, sizeof b, "%s%.4g", freqs.empty() ? "" : ", ", FrequencyHz(free_lambda[j]));
-      freqs += b;
-    }
-    std::snprintf(detail, sizeof detail,
-                  "%d free-free modes (%s%s Hz) + %d static modes: %d of %d shapes independent, interface rank %d of %d "
+    std::snprintf(detail, sizeof detail, "%s: %d of %d shapes with the rigid fields independent, interface rank %d of %d "
                   "(thesis 8.2), %ld reduced DOFs",
-                  k, freqs.c_str(), k > 4 ? ", ..." : "", n_b, g.columns_kept, g.columns_given + 6, g.interface_rank, n_b,
-                  long(g.K.rows()));
-    report("free-interface basis", basis_clock.Seconds(), detail);
-  }
-
-  if (general) {
-    // Thesis 8.2 with the user's shapes on the imported DOFs, fitted to the model DOFs (least
-    // squares: an RBE2 face moves rigidly in the model, the shapes may not).
-    Stopwatch basis_clock;
-    const Eigen::MatrixXd V_full = ReadShapeMatrix(part.reduction.basis_file, model.full_map.rows());
-    const SparseMatrix& T = model.full_map;
-    Eigen::SimplicialLDLT<SparseMatrix> normal(SparseMatrix(T.transpose() * T));
-    const Eigen::MatrixXd V = normal.solve(Eigen::MatrixXd(T.transpose() * V_full));
-    const double off_rigid = (Eigen::MatrixXd(T * V) - V_full).norm() / std::max(V_full.norm(), 1e-300);
-    const GeneralBasisResult g = ReduceOnGeneralBasis(model, V);
-    if (!g.ok) {
-      if (g.input_error) throw InputError(part.reduction.where_basis + ": " + part.reduction.basis_file + ": " + g.message);
-      result.message = g.message;
-      return result;
-    }
-    cb.K = g.K;
-    cb.M = g.M;
-    cb.shapes = g.shapes;
-    cb.lambda = g.lambda;
-    std::snprintf(detail, sizeof detail,
-                  "%d shapes from %s (%.2g of their norm off the RBE2 faces' rigid motion): %d of %d with the rigid fields "
-                  "independent, interface rank %d of %d (thesis 8.2), %ld reduced DOFs",
-                  g.columns_given, part.reduction.basis_file.c_str(), off_rigid, g.columns_kept, g.columns_given + 6,
-                  g.interface_rank, n_b, long(g.K.rows()));
-    report("general basis", basis_clock.Seconds(), detail);
+                  source.c_str(), g.columns_kept, g.columns_given + 6, g.interface_rank, n_b, long(g.K.rows()));
+    report(free_interface ? "free-interface basis" : "general basis", basis_clock.Seconds(), detail);
   }
 
   clock.Restart();

@@ -106,6 +106,28 @@ long IntegerField(const LineReader& r, std::string_view text) {
   return v;
 }
 
+// One row of the DOF map: node label and component 1..6.
+void AddDof(const LineReader& r, long node, long c, ImportedMatrices* out) {
+  if (c < 1 || c > 6) r.Fail("component " + std::to_string(c) + " is not 1..6 (u_x, u_y, u_z, theta_x, theta_y, theta_z)");
+  out->node.push_back(node);
+  out->component.push_back(int(c - 1));
+}
+
+// "row column value" lines (1-based) up to the end of the file, into 0-based entries.
+void ReadCoordinateEntries(LineReader* r, long rows, long cols, const std::string& range, std::vector<Entry>* entries,
+                           const std::string& comment = "") {
+  std::string line;
+  while (r->Next(&line, comment)) {
+    const std::vector<std::string_view> f = Fields(line);
+    if (f.size() != 3) r->Fail("expected 'row column value', got '" + line + "'");
+    const long i = IntegerField(*r, f[0]), j = IntegerField(*r, f[1]);
+    if (i < 1 || i > rows || j < 1 || j > cols) {
+      r->Fail("index (" + std::string(f[0]) + ", " + std::string(f[1]) + ") outside " + range);
+    }
+    entries->push_back({i - 1, j - 1, NumberField(*r, f[2]), r->number()});
+  }
+}
+
 std::string DofName(long node, int component) {
   return "node " + std::to_string(node) + " " + kComponentNames[component];
 }
@@ -152,8 +174,7 @@ SparseMatrix Symmetric(const std::vector<Entry>& entries, long n, const std::str
 }
 
 // CalculiX: "row col value" lines, 1-based, and the .dof file "node.component".
-void ReadCalculix(const MatricesSpec& spec, ImportedMatrices* out, std::vector<Entry>* k, std::vector<Entry>* m,
-                  long* entry_lines) {
+void ReadCalculix(const MatricesSpec& spec, ImportedMatrices* out, std::vector<Entry>* k, std::vector<Entry>* m) {
   LineReader dofs(spec.dofs, "DOF map");
   std::string line;
   while (dofs.Next(&line, "")) {
@@ -162,30 +183,18 @@ void ReadCalculix(const MatricesSpec& spec, ImportedMatrices* out, std::vector<E
     if (f.size() != 1 || dot == std::string::npos) dofs.Fail("expected node.component (e.g. 12.3), got '" + line + "'");
     const long node = IntegerField(dofs, f[0].substr(0, dot));
     const long c = IntegerField(dofs, f[0].substr(dot + 1));
-    if (c < 1 || c > 6) dofs.Fail("component " + std::to_string(c) + " is not 1..6");
-    out->node.push_back(node);
-    out->component.push_back(int(c - 1));
+    AddDof(dofs, node, c, out);
   }
   if (out->node.empty()) throw InputError(spec.dofs + ": no DOFs");
   const long n = long(out->node.size());
   for (auto [path, entries] : {std::pair{&spec.stiffness, k}, std::pair{&spec.mass, m}}) {
     LineReader r(*path, "matrix file");
-    while (r.Next(&line, "")) {
-      const std::vector<std::string_view> f = Fields(line);
-      if (f.size() != 3) r.Fail("expected 'row column value', got '" + line + "'");
-      const long i = IntegerField(r, f[0]), j = IntegerField(r, f[1]);
-      if (i < 1 || i > n || j < 1 || j > n) {
-        r.Fail("index (" + std::string(f[0]) + ", " + std::string(f[1]) + ") outside the " + std::to_string(n) + " DOFs of " + spec.dofs);
-      }
-      entries->push_back({i - 1, j - 1, NumberField(r, f[2]), r.number()});
-      ++*entry_lines;
-    }
+    ReadCoordinateEntries(&r, n, n, "the " + std::to_string(n) + " DOFs of " + spec.dofs, entries);
   }
 }
 
 // Abaqus: "row node, row dof, column node, column dof, value"; rows numbered by (node, dof).
-void ReadAbaqus(const MatricesSpec& spec, ImportedMatrices* out, std::vector<Entry>* k, std::vector<Entry>* m,
-                long* entry_lines) {
+void ReadAbaqus(const MatricesSpec& spec, ImportedMatrices* out, std::vector<Entry>* k, std::vector<Entry>* m) {
   struct Raw {
     long n1, d1, n2, d2;
     double v;
@@ -211,7 +220,6 @@ void ReadAbaqus(const MatricesSpec& spec, ImportedMatrices* out, std::vector<Ent
       index[{e.n1, int(e.d1 - 1)}] = 0;
       index[{e.n2, int(e.d2 - 1)}] = 0;
       raw->push_back(e);
-      ++*entry_lines;
     }
   }
   long row = 0;
@@ -225,8 +233,7 @@ void ReadAbaqus(const MatricesSpec& spec, ImportedMatrices* out, std::vector<Ent
 }
 
 // Matrix Market coordinate real (symmetric or general) and the CSV "node, component" map.
-void ReadMatrixMarket(const MatricesSpec& spec, ImportedMatrices* out, std::vector<Entry>* k, std::vector<Entry>* m,
-                      long* entry_lines) {
+void ReadMatrixMarket(const MatricesSpec& spec, ImportedMatrices* out, std::vector<Entry>* k, std::vector<Entry>* m) {
   LineReader dofs(spec.dofs, "DOF map");
   std::string line;
   bool first = true;
@@ -239,9 +246,7 @@ void ReadMatrixMarket(const MatricesSpec& spec, ImportedMatrices* out, std::vect
     first = false;
     if (f.size() != 2) dofs.Fail("expected 'node, component', got '" + line + "'");
     const long node = IntegerField(dofs, f[0]), c = IntegerField(dofs, f[1]);
-    if (c < 1 || c > 6) dofs.Fail("component " + std::to_string(c) + " is not 1..6 (u_x, u_y, u_z, theta_x, theta_y, theta_z)");
-    out->node.push_back(node);
-    out->component.push_back(int(c - 1));
+    AddDof(dofs, node, c, out);
   }
   if (out->node.empty()) throw InputError(spec.dofs + ": no DOFs");
   const long n = long(out->node.size());
@@ -261,16 +266,9 @@ void ReadMatrixMarket(const MatricesSpec& spec, ImportedMatrices* out, std::vect
     const long rows = IntegerField(r, size[0]), cols = IntegerField(r, size[1]), nnz = IntegerField(r, size[2]);
     if (rows != cols) r.Fail("the matrix is " + std::string(size[0]) + " x " + std::string(size[1]) + ", not square");
     if (rows != n) r.Fail("the matrix has " + std::string(size[0]) + " rows but " + spec.dofs + " maps " + std::to_string(n));
-    long count = 0;
-    while (r.Next(&line, "%")) {
-      const std::vector<std::string_view> f = Fields(line);
-      if (f.size() != 3) r.Fail("expected 'row column value', got '" + line + "'");
-      const long i = IntegerField(r, f[0]), j = IntegerField(r, f[1]);
-      if (i < 1 || i > n || j < 1 || j > n) r.Fail("index (" + std::string(f[0]) + ", " + std::string(f[1]) + ") outside 1.." + std::to_string(n));
-      entries->push_back({i - 1, j - 1, NumberField(r, f[2]), r.number()});
-      ++count;
-      ++*entry_lines;
-    }
+    const size_t before = entries->size();
+    ReadCoordinateEntries(&r, n, n, "1.." + std::to_string(n), entries, "%");
+    const long count = long(entries->size() - before);
     if (count != nnz) r.Fail("the size line announces " + std::to_string(nnz) + " entries, the file has " + std::to_string(count));
   }
 }
@@ -292,13 +290,12 @@ std::string Short(double v) {
 ImportedMatrices ReadImportedMatrices(const MatricesSpec& spec) {
   ImportedMatrices out;
   std::vector<Entry> k, m;
-  long lines = 0;
   if (spec.format == "calculix") {
-    ReadCalculix(spec, &out, &k, &m, &lines);
+    ReadCalculix(spec, &out, &k, &m);
   } else if (spec.format == "abaqus") {
-    ReadAbaqus(spec, &out, &k, &m, &lines);
+    ReadAbaqus(spec, &out, &k, &m);
   } else {
-    ReadMatrixMarket(spec, &out, &k, &m, &lines);
+    ReadMatrixMarket(spec, &out, &k, &m);
   }
   const long n = long(out.node.size());
   {
@@ -357,13 +354,9 @@ Eigen::MatrixXd ReadShapeMatrix(const std::string& path, long rows) {
         V(i, j) = NumberField(r, f[0]);
       }
   } else {
-    while (r.Next(&line, "%")) {
-      const std::vector<std::string_view> f = Fields(line);
-      if (f.size() != 3) r.Fail("expected 'row column value', got '" + line + "'");
-      const long i = IntegerField(r, f[0]), j = IntegerField(r, f[1]);
-      if (i < 1 || i > n || j < 1 || j > m) r.Fail("index (" + std::string(f[0]) + ", " + std::string(f[1]) + ") outside the " + std::string(size[0]) + " x " + std::string(size[1]) + " matrix");
-      V(i - 1, j - 1) = NumberField(r, f[2]);
-    }
+    std::vector<Entry> entries;
+    ReadCoordinateEntries(&r, n, m, "the " + std::string(size[0]) + " x " + std::string(size[1]) + " matrix", &entries, "%");
+    for (const Entry& e : entries) V(e.row, e.col) = e.value;
   }
   return V;
 }
