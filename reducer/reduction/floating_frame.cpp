@@ -17,7 +17,12 @@ FloatingFrame ComputeFloatingFrame(const std::string& type, const std::string& w
   frame.Phi_CB = Eigen::MatrixXd::Zero(6, n_r);
 
   if (type == "center_of_mass") {
-    auto interpolation = model.interpolate_at ? model.interpolate_at(c) : std::nullopt;
+    if (!model.interpolate_at) {
+      throw InputError(where + ": floating_frame center_of_mass interpolates the field at the centre of mass, and this "
+                       "model's mesh has no volume cells to interpolate in (an imported surface or line mesh): use "
+                       "floating_frame: mean_axes");
+    }
+    auto interpolation = model.interpolate_at(c);
     if (!interpolation) {
       char buffer[160];
       std::snprintf(buffer, sizeof buffer, "(%.6g, %.6g, %.6g)", c.x(), c.y(), c.z());

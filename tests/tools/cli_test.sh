@@ -230,6 +230,65 @@ a = h5py.File(sys.argv[1])["reduced/internal_frequencies_hz"][()]
 b = h5py.File(sys.argv[2])["reduced/internal_frequencies_hz"][()]
 assert np.abs(b / a - 1).max() < 1e-8, (a, b)
 PY
+# A surface mesh for the pictures (S3 triangles on the boundary of an exported TET4 box): the
+# imported model draws triangles (VTK type 5); center_of_mass has nothing to interpolate in.
+cat > "$work/box.yaml" <<'YAML'
+name: box
+type: solid
+material: {E: 2.1e11, nu: 0.3, rho: 7850}
+geometry: {shape: box, size: [0.2, 0.02, 0.02]}
+mesh: {size: 0.01, order: 1}
+interfaces: [{name: a, group: xmin}, {name: b, group: xmax}]
+reduction: {internal_modes: 4, floating_frame: mean_axes}
+YAML
+"$bin/femb-reduce" -q "$work/box.yaml" -o "$work/box_native.h5" && "$bin/femb-reduce" -q "$work/box.yaml" --export-matrices "$work/boxm" \
+  && ok || fail "box export"
+$py - "$work/boxm/box.inp" "$work/boxm/surface.inp" <<'PY' && ok || fail "surface mesh"
+import collections, sys, meshio
+m = meshio.read(sys.argv[1])
+tets = [c.data for c in m.cells if c.type == "tetra"][0]
+count = collections.Counter()
+faces = {}
+for t in tets:
+    for f in ((0, 1, 2), (0, 1, 3), (0, 2, 3), (1, 2, 3)):
+        tri = tuple(t[list(f)])
+        count[tuple(sorted(tri))] += 1
+        faces[tuple(sorted(tri))] = tri
+with open(sys.argv[2], "w") as out:
+    out.write("*NODE\n")
+    for i, p in enumerate(m.points):
+        out.write("%d, %.13g, %.13g, %.13g\n" % (i + 1, p[0], p[1], p[2]))
+    out.write("*ELEMENT, TYPE=S3, ELSET=SKIN\n")
+    k = 0
+    for key, n in count.items():
+        if n == 1:
+            k += 1
+            a, b, c = faces[key]
+            out.write("%d, %d, %d, %d\n" % (k, a + 1, b + 1, c + 1))
+PY
+cat > "$work/boxm/surface.yaml" <<'YAML'
+name: box
+type: imported
+geometry: {file: surface.inp}
+matrices: {format: calculix, stiffness: box.sti, mass: box.mas, dofs: box.dof}
+interfaces:
+  - {name: a, select: {plane: {point: [0, 0, 0], normal: [1, 0, 0]}}}
+  - {name: b, select: {plane: {point: [0.2, 0, 0], normal: [1, 0, 0]}}}
+reduction: {internal_modes: 4, floating_frame: mean_axes}
+YAML
+"$bin/femb-reduce" -q "$work/boxm/surface.yaml" -o "$work/box_surface.h5" && ok || fail "reduce with a surface mesh"
+"$bin/femb-inspect" "$work/box_surface.h5" --vtu "$work/box_vtu" > /dev/null && ok || fail "inspect --vtu surface"
+$py - "$work/box_native.h5" "$work/box_surface.h5" "$work/box_vtu/box_000.vtu" <<'PY' && ok || fail "surface model frequencies or cells"
+import sys, h5py, meshio, numpy as np
+a = h5py.File(sys.argv[1])["reduced/internal_frequencies_hz"][()]
+b = h5py.File(sys.argv[2])["reduced/internal_frequencies_hz"][()]
+assert np.abs(b / a - 1).max() < 1e-8, (a, b)
+assert h5py.File(sys.argv[2])["visualization"].attrs["cell_type"] in (b"tri3", "tri3")
+m = meshio.read(sys.argv[3])
+assert [c.type for c in m.cells] == ["triangle"], m.cells
+PY
+expect_input_error "center of mass on a surface mesh" "has no volume cells to interpolate in" "$work/boxm/surface.yaml" \
+  --set reduction.floating_frame=center_of_mass
 expect_input_error "matrix format" "--matrix-format: unknown format 'nastran'" "$good" --export-matrices "$work/x" --matrix-format nastran
 sed 's/^1,1$/77777,1/' "$work/rod_mm/beam_rod_dofs.csv" > "$work/rod_mm/bad_dofs.csv"
 sed 's/beam_rod_dofs.csv/bad_dofs.csv/' "$work/rod_mm/imported.yaml" > "$work/rod_mm/bad.yaml"
