@@ -344,6 +344,14 @@ Eigen::MatrixXd ReadShapeMatrix(const std::string& path, long rows) {
            " DOFs (one row per DOF, in the matrices' order)");
   }
   if (m <= 0) r.Fail("no shapes (columns)");
+  // Before allocating n x m: more shapes than DOFs cannot be independent, and an array file
+  // holds at least 2 bytes per value (a digit and a newline).
+  if (m > n) r.Fail("the file announces " + std::to_string(m) + " shapes for " + std::to_string(n) + " DOFs (at most one per DOF)");
+  std::error_code ec;
+  const auto bytes = std::filesystem::file_size(path, ec);
+  if (array && !ec && double(bytes) < 2.0 * double(n) * double(m)) {
+    r.Fail("the file is too short for the " + std::to_string(n) + " x " + std::to_string(m) + " values its size line announces");
+  }
   Eigen::MatrixXd V = Eigen::MatrixXd::Zero(n, m);
   if (array) {
     for (long j = 0; j < m; ++j)

@@ -267,6 +267,13 @@ TEST(ImportedModel, GeneralBasisFromAFileMatchesFreeInterface) {
   write_array(dir / "short.mtx", V.topRows(n - 1));
   WriteText(dir / "short.yaml", imported + "reduction: {method: general, basis: {file: short.mtx}, floating_frame: mean_axes}\n");
   EXPECT_NE(test::ThrownMessage([&] { ReduceFile(dir / "short.yaml"); }).find("short.mtx:3: the shapes have"), std::string::npos);
+  // A size line announcing absurdly many shapes is refused before anything is allocated.
+  WriteText(dir / "huge.mtx", "%%MatrixMarket matrix array real general\n" + std::to_string(n) + " 1000000000000\n1.0\n");
+  WriteText(dir / "huge.yaml", imported + "reduction: {method: general, basis: {file: huge.mtx}, floating_frame: mean_axes}\n");
+  EXPECT_NE(test::ThrownMessage([&] { ReduceFile(dir / "huge.yaml"); }).find("huge.mtx:2: the file announces 1000000000000 shapes"),
+            std::string::npos);
+  WriteText(dir / "huge.mtx", "%%MatrixMarket matrix array real general\n" + std::to_string(n) + " 20\n1.0\n");
+  EXPECT_NE(test::ThrownMessage([&] { ReduceFile(dir / "huge.yaml"); }).find("the file is too short"), std::string::npos);
   fs::remove_all(dir);
 }
 
