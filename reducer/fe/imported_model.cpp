@@ -420,55 +420,22 @@ FeModel BuildImportedModel(const PartSpec& part, const ProgressFn& progress) {
     for (SolidType t : {SolidType::kTet4, SolidType::kTet10, SolidType::kHex8, SolidType::kHex20})
       if (SolidTypeName(t) == geometry.cell_type) volume->type = t;
   }
-  std::vector<int> owner(static_cast<size_t>(n_nodes), -1);
-  std::vector<std::vector<int>> sets(part.interfaces.size());
-  std::string selected;
+  // Interface node sets; only nodes that carry DOFs of the matrices take part (a mesh may have
+  // unused nodes).
+  const InterfaceNodes interface_nodes = ResolveInterfaceNodes(
+      part, geometry.nodes, geometry.node_sets, volume.get(), part.solid.file,
+      [&](int s) {
+        for (int c = 0; c < 6; ++c)
+          if (full_dof[size_t(s)][size_t(c)] >= 0) return true;
+        return false;
+      },
+      "has a DOF in the matrices");
+  const std::vector<std::vector<int>>& sets = interface_nodes.sets;
+  const std::vector<int>& owner = interface_nodes.owner;
+  const std::string& selected = interface_nodes.summary;
   for (size_t k = 0; k < part.interfaces.size(); ++k) {
-    const InterfaceSpec& i = part.interfaces[k];
-    if (i.select) {
-      sets[k] = SelectNodes(*i.select, geometry.nodes, i.name);
-    } else {
-      auto set = geometry.node_sets.find(i.group);
-      if (set == geometry.node_sets.end()) {
-        std::string known;
-        for (const auto& [name, _] : geometry.node_sets) known += (known.empty() ? "" : ", ") + name;
-        throw InputError(i.where + ": interface '" + i.name + "': node set '" + i.group + "' not found in " + part.solid.file +
-                         " (known: " + (known.empty() ? "none" : known) + "; or pick the nodes by geometry with 'select')");
-      }
-      sets[k] = set->second;
-    }
-    // Only nodes that carry DOFs of the matrices take part (a mesh may have unused nodes).
-    std::vector<int> used;
-    for (int s : sets[k])
-      for (int c = 0; c < 6; ++c)
-        if (full_dof[size_t(s)][size_t(c)] >= 0) {
-          used.push_back(s);
-          break;
-        }
-    if (used.empty()) {
-      throw InputError(i.where + ": interface '" + i.name + "': none of its " + std::to_string(sets[k].size()) +
-                       " nodes has a DOF in the matrices");
-    }
-    sets[k] = used;
-    selected += (k ? ", " : "") + i.name + ": " + std::to_string(used.size()) + " nodes " +
-                (i.select ? "by " + i.select->shape : "of set '" + i.group + "'");
-    Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-    for (int s : used) {
-      if (owner[size_t(s)] >= 0) {
-        throw InputError(i.where + ": interface '" + i.name + "': " +
-                         (i.select ? "the " + i.select->shape + " selection" : "node set '" + i.group + "'") +
-                         " shares nodes with interface '" + part.interfaces[size_t(owner[size_t(s)])].name +
-                         "' (couplings must not overlap)");
-      }
-      owner[size_t(s)] = int(k);
-      centroid += geometry.nodes.row(s).transpose();
-    }
-    centroid /= double(used.size());
-    if (volume) {
-      if (auto surface = SurfaceCentroid(*volume, used)) centroid = *surface;
-    }
-    model.interface_names.push_back(i.name);
-    model.interface_positions.push_back(i.location ? *i.location : centroid);
+    model.interface_names.push_back(part.interfaces[k].name);
+    model.interface_positions.push_back(interface_nodes.positions[k]);
   }
 
   // Model DOFs: the imported DOFs of nodes in no RBE2 set (file order), then 6 per RBE2

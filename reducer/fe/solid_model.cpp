@@ -247,6 +247,57 @@ std::optional<Eigen::Vector3d> SurfaceCentroid(const SolidMesh& mesh, const std:
   return moment / area;
 }
 
+InterfaceNodes ResolveInterfaceNodes(const PartSpec& part, const Eigen::MatrixXd& nodes,
+                                     const std::map<std::string, std::vector<int>>& node_sets, const SolidMesh* volume,
+                                     const std::string& mesh_name, const std::function<bool(int)>& keep,
+                                     const std::string& keep_reason) {
+  InterfaceNodes out;
+  out.sets.resize(part.interfaces.size());
+  out.owner.assign(static_cast<size_t>(nodes.rows()), -1);
+  for (size_t k = 0; k < part.interfaces.size(); ++k) {
+    const InterfaceSpec& i = part.interfaces[k];
+    std::vector<int> set;
+    if (i.select) {
+      set = SelectNodes(*i.select, nodes, i.name);
+    } else {
+      auto found = node_sets.find(i.group);
+      if (found == node_sets.end()) {
+        std::string known;
+        for (const auto& [name, _] : node_sets) known += (known.empty() ? "" : ", ") + name;
+        throw InputError(i.where + ": interface '" + i.name + "': node set '" + i.group + "' not found in " + mesh_name +
+                         " (known: " + (known.empty() ? "none" : known) + "; or pick the nodes by geometry with 'select')");
+      }
+      if (found->second.empty()) throw InputError(i.where + ": interface '" + i.name + "': node set '" + i.group + "' is empty");
+      set = found->second;
+    }
+    std::vector<int>& used = out.sets[k];
+    for (int s : set)
+      if (!keep || keep(s)) used.push_back(s);
+    if (used.empty()) {
+      throw InputError(i.where + ": interface '" + i.name + "': none of its " + std::to_string(set.size()) + " nodes " +
+                       keep_reason);
+    }
+    const std::string source = i.select ? "the " + i.select->shape + " selection" : "node set '" + i.group + "'";
+    out.summary += (k ? ", " : "") + i.name + ": " + std::to_string(used.size()) + " nodes " +
+                   (i.select ? "by " + i.select->shape : "of set '" + i.group + "'");
+    Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+    for (int s : used) {
+      if (out.owner[size_t(s)] >= 0) {
+        throw InputError(i.where + ": interface '" + i.name + "': " + source + " shares nodes with interface '" +
+                         part.interfaces[size_t(out.owner[size_t(s)])].name + "' (couplings must not overlap)");
+      }
+      out.owner[size_t(s)] = int(k);
+      centroid += nodes.row(s).transpose();
+    }
+    centroid /= double(used.size());
+    if (volume) {
+      if (const std::optional<Eigen::Vector3d> surface = SurfaceCentroid(*volume, used)) centroid = *surface;
+    }
+    out.positions.push_back(i.location ? *i.location : centroid);
+  }
+  return out;
+}
+
 Eigen::MatrixXd Rbe3Weights(const Eigen::MatrixXd& nodes, const std::vector<int>& set, const Eigen::Vector3d& point,
                             const std::string& where, const std::string& name) {
   const int ns = int(set.size());
@@ -341,44 +392,15 @@ FeModel BuildSolidModel(const PartSpec& part, const ProgressFn& progress) {
   clock.Restart();
 
   // Interface node sets: a named set of the mesh, or nodes picked by geometry.
-  std::vector<int> owner(n_nodes, -1);
   FeModel model;
-  std::vector<std::vector<int>> sets(part.interfaces.size());
-  std::string selected;  // per interface, for the progress line
+  const InterfaceNodes interface_nodes =
+      ResolveInterfaceNodes(part, mesh->nodes, mesh->node_sets, mesh.get(), "the mesh");
+  const std::vector<std::vector<int>>& sets = interface_nodes.sets;
+  const std::vector<int>& owner = interface_nodes.owner;
+  const std::string& selected = interface_nodes.summary;  // per interface, for the progress line
   for (size_t k = 0; k < part.interfaces.size(); ++k) {
-    const InterfaceSpec& i = part.interfaces[k];
-    std::string what;
-    if (i.select) {
-      sets[k] = SelectNodes(*i.select, mesh->nodes, i.name);
-      what = "by " + i.select->shape;
-    } else {
-      auto set = mesh->node_sets.find(i.group);
-      if (set == mesh->node_sets.end()) {
-        std::string known;
-        for (const auto& [name, _] : mesh->node_sets) known += (known.empty() ? "" : ", ") + name;
-        throw InputError(i.where + ": interface '" + i.name + "': node set '" + i.group + "' not found in the mesh (known: " +
-                         (known.empty() ? "none" : known) + "; or pick the nodes by geometry with 'select')");
-      }
-      if (set->second.empty()) throw InputError(i.where + ": interface '" + i.name + "': node set '" + i.group + "' is empty");
-      sets[k] = set->second;
-      what = "of set '" + i.group + "'";
-    }
-    selected += (k ? ", " : "") + i.name + ": " + std::to_string(sets[k].size()) + " nodes " + what;
-    const std::string source = i.select ? "the " + i.select->shape + " selection" : "node set '" + i.group + "'";
-    Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-    for (int node : sets[k]) {
-      if (owner[node] >= 0) {
-        throw InputError(i.where + ": interface '" + i.name + "': " + source + " shares nodes with interface '" +
-                         part.interfaces[owner[node]].name + "' (couplings must not overlap)");
-      }
-      owner[node] = int(k);
-      centroid += mesh->nodes.row(node).transpose();
-    }
-    centroid /= double(sets[k].size());
-    const std::optional<Eigen::Vector3d> surface = SurfaceCentroid(*mesh, sets[k]);
-    if (surface) centroid = *surface;
-    model.interface_names.push_back(i.name);
-    model.interface_positions.push_back(i.location ? *i.location : centroid);
+    model.interface_names.push_back(part.interfaces[k].name);
+    model.interface_positions.push_back(interface_nodes.positions[k]);
   }
   // RBE3 (distributing): the interface motion is the least-squares rigid fit of its node set,
   //   u_k = u_c + theta x (x_k - c),  u_c = mean(u_i),  theta = A^-1 sum r_i x u_i,

@@ -11,6 +11,7 @@
 #pragma once
 
 #include <functional>
+#include <map>
 #include <memory>
 #include <optional>
 
@@ -57,6 +58,24 @@ std::optional<Eigen::Vector3d> SurfaceCentroid(const SolidMesh& mesh, const std:
 /// interface) for fewer than 3 nodes or nodes on one line.
 Eigen::MatrixXd Rbe3Weights(const Eigen::MatrixXd& nodes, const std::vector<int>& set, const Eigen::Vector3d& point,
                             const std::string& where, const std::string& name);
+
+/// The node sets of a part's interfaces on a mesh: a named set of `node_sets` or the nodes picked
+/// by geometry (`select`), kept only where `keep` (null: all) says so, each with its reference
+/// point (the interface's `location`, else the surface centroid of the set on `volume` when it
+/// has faces there, else the mean of its nodes).
+struct InterfaceNodes {
+  std::vector<std::vector<int>> sets;      ///< per interface
+  std::vector<int> owner;                  ///< per mesh node: its interface, or -1
+  std::vector<Eigen::Vector3d> positions;  ///< per interface
+  std::string summary;                     ///< "A: 12 nodes by cylinder, B: ..." (progress line)
+};
+/// Throws InputError naming the interface for a set missing from `node_sets` (listing the known
+/// ones; `mesh_name` says where it was looked for), an empty set, a set without a kept node
+/// (`keep_reason` says why nodes are dropped) and sets that share nodes.
+InterfaceNodes ResolveInterfaceNodes(const PartSpec& part, const Eigen::MatrixXd& nodes,
+                                     const std::map<std::string, std::vector<int>>& node_sets, const SolidMesh* volume,
+                                     const std::string& mesh_name, const std::function<bool(int)>& keep = nullptr,
+                                     const std::string& keep_reason = "");
 
 /// FeModel::interpolate_at for a volume mesh whose mesh DOFs (3 per node) are T x model DOFs:
 /// displacement and small rotation (curl / 2) of the element containing x.

@@ -75,9 +75,12 @@ GeneralBasisResult ReduceOnGeneralBasis(const FeModel& model, const Eigen::Matri
   Eigen::MatrixXd Phi = Q * pinv;
   Eigen::MatrixXd Psi = Q * svd.matrixV().rightCols(n_internal);
 
-  // 3. Condensation within the basis; 4. internal eigen-coordinates.
+  // 3. Condensation within the basis; 4. internal eigen-coordinates. K enters through K Phi and
+  // K Psi alone, each product taken once and carried along the changes of basis.
+  Eigen::MatrixXd K_Phi = model.K * Phi;
+  Eigen::MatrixXd K_Psi(model.n_dofs(), 0);
   if (n_internal > 0) {
-    const Eigen::MatrixXd K_Psi = model.K * Psi;
+    K_Psi = model.K * Psi;
     const Eigen::MatrixXd Kpp = 0.5 * (Psi.transpose() * K_Psi + (Psi.transpose() * K_Psi).transpose());
     const Eigen::MatrixXd Mpp = Psi.transpose() * (model.M * Psi);
     Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> eig(Kpp, 0.5 * (Mpp + Mpp.transpose()));
@@ -88,12 +91,17 @@ GeneralBasisResult ReduceOnGeneralBasis(const FeModel& model, const Eigen::Matri
       return r;
     }
     Psi = Psi * eig.eigenvectors();  // K = diag(lambda), M = 1 on the internal block
+    K_Psi = K_Psi * eig.eigenvectors();
     r.lambda = eig.eigenvalues();
-    Phi -= Psi * (r.lambda.cwiseInverse().asDiagonal() * (Psi.transpose() * (model.K * Phi)));
+    const Eigen::MatrixXd C = r.lambda.cwiseInverse().asDiagonal() * (Psi.transpose() * K_Phi);
+    Phi -= Psi * C;
+    K_Phi -= K_Psi * C;
   }
   r.shapes.resize(model.n_dofs(), nb + n_internal);
   r.shapes << Phi, Psi;
-  const Eigen::MatrixXd KS = model.K * r.shapes, MS = model.M * r.shapes;
+  Eigen::MatrixXd KS(model.n_dofs(), nb + n_internal);
+  KS << K_Phi, K_Psi;
+  const Eigen::MatrixXd MS = model.M * r.shapes;
   r.K = r.shapes.transpose() * KS;
   r.M = r.shapes.transpose() * MS;
   r.K = 0.5 * (r.K + r.K.transpose()).eval();
