@@ -6,11 +6,14 @@
 // Prints what it measured on this run, with the heap allocations per body-step (malloc, which
 // Eigen and operator new call, wrapped in this program around glibc's: issue 14 asks for none
 // inside a step).
+// Usage: solver_scaling_benchmark [BODIES STEPS [linear|stiffened]]: one chain, for profiling.
 #include <atomic>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <string>
+#include <vector>
+#include <algorithm>
 
 #include "formats/part_file.h"
 #include "reducer/reduce_part.h"
@@ -51,14 +54,22 @@ __attribute__((visibility("default"))) void free(void* p) { __libc_free(p); }
 }
 #endif
 
-int main() {
+int main(int argc, char** argv) {
+  std::vector<int> chains = {1, 10, 100, 1000};
+  int fixed_steps = 0;
+  std::vector<bool> kinds = {false, true};
+  if (argc >= 3) {
+    chains = {std::max(1, std::atoi(argv[1]))};
+    fixed_steps = std::max(1, std::atoi(argv[2]));
+    if (argc >= 4) kinds = {std::string(argv[3]) == "stiffened"};
+  }
   std::printf("Solver scaling: chain of N tube superelements (2 modes each), clamped, gravity, generalized-alpha\n\n");
   const int threads = femb::DefaultThreads();
   std::printf("%6s %-11s %12s %10s %14s %16s %18s %8s %18s %16s\n", "bodies", "bodies are", "coordinates", "steps",
               "s per step", "Newton its/step", "ms per step/body", "ratio", "speed-up, threads", "allocs/body-step");
-  for (int n_bodies : {1, 10, 100, 1000}) {
+  for (int n_bodies : chains) {
    double linear_ms = 0.0;
-   for (bool stiffening : {false, true}) {
+   for (bool stiffening : kinds) {
     const double Lb = 1.0 / n_bodies;
     const femb::PartSpec part = femb::ParsePart(
         "name: seg\ntype: beam\nmaterial: {E: 70.0e9, nu: 0.3, rho: 2700}\n"
@@ -80,7 +91,8 @@ int main() {
     }
     model.gravity = Eigen::Vector3d(0, -9.81, 0);
     const femb::DofMap dofs(model);
-    const int steps = n_bodies >= 1000 ? 5 : n_bodies >= 100 ? 50 : 200;  // small chains: more steps, less noise
+    const int steps = fixed_steps > 0 ? fixed_steps
+                    : n_bodies >= 1000 ? 5 : n_bodies >= 100 ? 50 : 200;  // small chains: more steps, less noise
     // One run on `t` threads: seconds, the result.
     auto run = [&](int t, femb::DynamicResult* r) {
       femb::DynamicState s =

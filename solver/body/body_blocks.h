@@ -8,17 +8,16 @@
 
 namespace femb::body_blocks {
 
-// The derivative of a quadratic vector function g at w, exactly (no truncation):
+// The derivative of a quadratic function g of a 3-vector at w, exactly (no truncation):
 // Dg(w) e = [g(w + s e) - g(w) - g(s e)] / s for any s > 0.
 template <class Quadratic>
-Eigen::MatrixXd QuadraticDerivative(const Eigen::VectorXd& w, const Quadratic& g) {
-  const long n = w.size();
+Eigen::Matrix3d QuadraticDerivative(const Eigen::Vector3d& w, const Quadratic& g) {
   const double s = std::max(w.norm(), 1.0);
-  const Eigen::VectorXd g0 = g(w);
-  Eigen::MatrixXd D(n, n);
-  for (long i = 0; i < n; ++i) {
-    const Eigen::VectorXd e = s * Eigen::VectorXd::Unit(n, i);
-    D.col(i) = (g(w + e) - g0 - g(e)) / s;
+  const Eigen::Vector3d g0 = g(w);
+  Eigen::Matrix3d D;
+  for (int i = 0; i < 3; ++i) {
+    const Eigen::Vector3d e = s * Eigen::Vector3d::Unit(i);
+    D.col(i) = (g(Eigen::Vector3d(w + e)) - g0 - g(e)) / s;
   }
   return D;
 }

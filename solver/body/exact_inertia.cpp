@@ -15,25 +15,29 @@ using body_blocks::TurnColBlocks;
 using body_blocks::TurnRowBlocks;
 
 SuperelementBody::ExactData SuperelementBody::Exact(const Eigen::VectorXd& q, const Kinematics& kin) const {
+  const int n = n_coordinates();
   ExactData d;
-  d.Y = Phi_rig0_ * kin.Z + kin.B;
-  d.MY.noalias() = M_ * d.Y;
-  d.H.resize(n_coordinates(), 3);
-  for (int a = 0; a < 3; ++a) d.H.col(a) = Gamma_[size_t(a)] * q;
-  const int stored[3][3] = {{0, 3, 4}, {3, 1, 5}, {4, 5, 2}};  // xx yy zz xy xz yz
+  d.Y = kin.B;
+  d.Y.noalias() += Phi_rig0_ * kin.Z;
+  const Eigen::VectorXd gq = Gamma_stack_ * q, xq = Xi_stack_ * q;
+  d.H = Eigen::Map<const Eigen::MatrixXd>(gq.data(), n, 3);
+  d.XQ = Eigen::Map<const Eigen::MatrixXd>(xq.data(), n, 9);
   for (int a = 0; a < 3; ++a)
-    for (int b = 0; b < 3; ++b) {
-      const Eigen::MatrixXd& X = Xi_[size_t(stored[a][b])];
-      d.XQ[size_t(3 * a + b)] = a <= b ? Eigen::VectorXd(X * q) : Eigen::VectorXd(X.transpose() * q);
-    }
-  for (int a = 0; a < 3; ++a)
-    for (int b = 0; b < 3; ++b) d.Xq(a, b) = q.dot(d.XQ[size_t(3 * a + b)]);
-  d.HtY.noalias() = d.H.transpose() * d.Y;
+    for (int b = 0; b < 3; ++b) d.Xq(a, b) = q.dot(d.XQ.col(3 * a + b));
+  return d;
+}
+
+const SuperelementBody::ExactData& SuperelementBody::ExactProducts(const Data& data) const {
+  const ExactData& d = *data.exact;
+  if (d.MY.size() == 0) {
+    d.MY.noalias() = M_ * d.Y;
+    d.HtY.noalias() = d.H.transpose() * d.Y;
+  }
   return d;
 }
 
 Eigen::VectorXd SuperelementBody::ExactInertiaForce(const Data& data, const BodyVelocity& w,
-                                                    const BodyVelocity& wdot) const {
+                                                    const BodyVelocity& wdot, Eigen::VectorXd* f_acc) const {
   const int n = n_coordinates(), blocks = 2 * n_nodes_;
   const ExactData& d = *data.exact;
   const Eigen::Matrix3d& R = data.frame.R;
@@ -45,6 +49,15 @@ Eigen::VectorXd SuperelementBody::ExactInertiaForce(const Data& data, const Body
   const Eigen::VectorXd qd = B * Rw;
   // r = Rbar^T wdot - c (header): xidot = Z r, qddot_loc = B r, ydot = Y r.
   Eigen::VectorXd r = TurnBlocks(R.transpose(), wdot, blocks);
+  if (f_acc) {
+    // The same force at w = 0: r = Rbar^T wdot, xi = qd = y = 0.
+    const Eigen::Vector3d Omd0 = Z.bottomRows<3>() * r;
+    const Eigen::VectorXd yd0 = d.Y * r;
+    const Eigen::VectorXd pi_q_dot0 = M_ * yd0 + d.H * Omd0;
+    Eigen::Matrix<double, 6, 1> f_xi0 = Phi_rig0_.transpose() * pi_q_dot0;
+    f_xi0.tail<3>() += d.H.transpose() * yd0 + d.Xq * Omd0;
+    *f_acc = TurnBlocks(R, Eigen::VectorXd(Z.transpose() * f_xi0 + B.transpose() * pi_q_dot0), blocks);
+  }
   for (int a = 0; a < blocks; ++a) r.segment<3>(3 * a) -= Om.cross(Eigen::Vector3d(Rw.segment<3>(3 * a)));
   for (int k = 0; k < n_nodes_; ++k) {
     r.segment<3>(6 * k) -= Om.cross(Eigen::Vector3d(qd.segment<3>(6 * k)));
@@ -54,7 +67,10 @@ Eigen::VectorXd SuperelementBody::ExactInertiaForce(const Data& data, const Body
   const Eigen::Vector3d Omd = Z.bottomRows<3>() * r;
   const Eigen::VectorXd y = Phi_rig0_ * xi + qd, yd = d.Y * r;
   Eigen::MatrixXd Hd(n, 3);
-  for (int a = 0; a < 3; ++a) Hd.col(a) = Gamma_[size_t(a)] * qd;
+  {
+    const Eigen::VectorXd gqd = Gamma_stack_ * qd;
+    Hd = Eigen::Map<const Eigen::MatrixXd>(gqd.data(), n, 3);
+  }
   const Eigen::VectorXd pi_q = M_ * y + d.H * Om;
   const Eigen::VectorXd pi_q_dot = M_ * yd + d.H * Omd + Hd * Om;
   Eigen::VectorXd f_q = pi_q_dot;  // minus dT/dq below
@@ -62,8 +78,8 @@ Eigen::VectorXd SuperelementBody::ExactInertiaForce(const Data& data, const Body
   for (int a = 0; a < 3; ++a) {
     f_q -= Om[a] * (Gamma_[size_t(a)].transpose() * y);
     for (int b = 0; b < 3; ++b) {
-      f_q -= Om[a] * Om[b] * d.XQ[size_t(3 * a + b)];
-      hd[a] += Om[b] * qd.dot(d.XQ[size_t(3 * a + b)] + d.XQ[size_t(3 * b + a)]);
+      f_q -= Om[a] * Om[b] * d.XQ.col(3 * a + b);
+      hd[a] += Om[b] * qd.dot(d.XQ.col(3 * a + b) + d.XQ.col(3 * b + a));
     }
   }
   // pi_xi = Phi_rig0^T pi_q + [0; h]; f_xi = d/dt pi_xi + Kirchhoff's terms.
@@ -82,7 +98,7 @@ Eigen::MatrixXd SuperelementBody::ExactGyroscopic(const Data& data, const BodyVe
   // w is that of g. Forward mode by hand: every quantity of the force that depends on w carries
   // its n columns d/dw (prefix d), in the order of ExactInertiaForce.
   const int n = n_coordinates(), blocks = 2 * n_nodes_;
-  const ExactData& d = *data.exact;
+  const ExactData& d = ExactProducts(data);
   const Eigen::Matrix3d& R = data.frame.R;
   const Eigen::MatrixXd& Z = data.kin.Z;
   const Eigen::MatrixXd& B = data.kin.B;
@@ -92,25 +108,25 @@ Eigen::MatrixXd SuperelementBody::ExactGyroscopic(const Data& data, const BodyVe
     return X;
   };
   const Eigen::VectorXd Rw = TurnBlocks(R.transpose(), w, blocks);
-  const Eigen::MatrixXd dRw = times_Rbar_t(Eigen::MatrixXd::Identity(n, n));
   const Eigen::Matrix<double, 6, 1> xi = Z * Rw;
   const Eigen::Vector3d v = xi.head<3>(), Om = xi.tail<3>();
   const Eigen::MatrixXd dxi = times_Rbar_t(Z);
   const Eigen::MatrixXd dv = dxi.topRows<3>(), dOm = dxi.bottomRows<3>();
   const Eigen::VectorXd qd = B * Rw;
   const Eigen::MatrixXd dqd = times_Rbar_t(B);
-  // r = Rbar^T wdot - c(w): dr = -dc.
+  // r = Rbar^T wdot - c(w): dr = -dc. d(Rbar^T w) = Rbar^T: block a is R^T at column block a.
   Eigen::MatrixXd dr = Eigen::MatrixXd::Zero(n, n);
   const Eigen::Matrix3d Om_x = Skew<double>(Om);
   for (int a = 0; a < blocks; ++a) {
-    dr.middleRows<3>(3 * a) -= -Skew<double>(Eigen::Vector3d(Rw.segment<3>(3 * a))) * dOm + Om_x * dRw.middleRows<3>(3 * a);
+    dr.middleRows<3>(3 * a).noalias() += Skew<double>(Eigen::Vector3d(Rw.segment<3>(3 * a))) * dOm;
+    dr.block<3, 3>(3 * a, 3 * a) -= Om_x * Rt;
   }
   for (int k = 0; k < n_nodes_; ++k) {
     dr.middleRows<3>(6 * k) -= -Skew<double>(Eigen::Vector3d(qd.segment<3>(6 * k))) * dOm + Om_x * dqd.middleRows<3>(6 * k);
     // LeftJacobianRate is quadratic in thetadot: its derivative by polarization, exactly.
     const Eigen::Vector3d theta = data.q.segment<3>(6 * k + 3), thetadot = qd.segment<3>(6 * k + 3);
-    const Eigen::Matrix3d DL = QuadraticDerivative(
-        thetadot, [&](const Eigen::VectorXd& e) { return Eigen::VectorXd(LeftJacobianRate(theta, Eigen::Vector3d(e))); });
+    const Eigen::Matrix3d DL =
+        QuadraticDerivative(thetadot, [&](const Eigen::Vector3d& e) { return LeftJacobianRate(theta, e); });
     dr.middleRows<3>(6 * k + 3) -= DL * dqd.middleRows<3>(6 * k + 3);
   }
   const Eigen::MatrixXd dOmd = Z.bottomRows<3>() * dr;
@@ -121,10 +137,11 @@ Eigen::MatrixXd SuperelementBody::ExactGyroscopic(const Data& data, const BodyVe
   Eigen::MatrixXd G_Om = Om[0] * Gamma_[0];
   for (int a = 1; a < 3; ++a) G_Om += Om[a] * Gamma_[size_t(a)];
   Eigen::MatrixXd Hd(n, 3), Gty(n, 3);  // Gamma_a qd, Gamma_a^T y
-  for (int a = 0; a < 3; ++a) {
-    Hd.col(a) = Gamma_[size_t(a)] * qd;
-    Gty.col(a) = Gamma_[size_t(a)].transpose() * y;
+  {
+    const Eigen::VectorXd gqd = Gamma_stack_ * qd;
+    Hd = Eigen::Map<const Eigen::MatrixXd>(gqd.data(), n, 3);
   }
+  for (int a = 0; a < 3; ++a) Gty.col(a).noalias() = Gamma_[size_t(a)].transpose() * y;
   const Eigen::VectorXd pi_q = M_ * y + d.H * Om;
   // M dyd and H^T dyd with dyd = Y dr: (M Y) dr and (H^T Y) dr, M Y and H^T Y kept per configuration.
   Eigen::MatrixXd dpi_q_dot = d.MY * dr + d.H * dOmd + Hd * dOm + G_Om * dqd;
@@ -134,9 +151,9 @@ Eigen::MatrixXd SuperelementBody::ExactGyroscopic(const Data& data, const BodyVe
   Eigen::MatrixXd dhd = d.HtY * dr + d.Xq * dOmd + Gty.transpose() * dqd + Hd.transpose() * dy;
   for (int a = 0; a < 3; ++a) {
     for (int b = 0; b < 3; ++b) {
-      const Eigen::VectorXd& XQab = d.XQ[size_t(3 * a + b)];
+      const auto XQab = d.XQ.col(3 * a + b);
       df_q -= XQab * (Om[b] * dOm.row(a) + Om[a] * dOm.row(b));
-      const Eigen::VectorXd S_ab = XQab + d.XQ[size_t(3 * b + a)];
+      const Eigen::VectorXd S_ab = XQab + d.XQ.col(3 * b + a);
       dhd.row(a) += qd.dot(S_ab) * dOm.row(b) + Om[b] * (S_ab.transpose() * dqd);
     }
   }
@@ -144,7 +161,7 @@ Eigen::MatrixXd SuperelementBody::ExactGyroscopic(const Data& data, const BodyVe
   pi_xi.tail<3>() += h;
   const Eigen::Vector3d pi_v = pi_xi.head<3>(), pi_w = pi_xi.tail<3>();
   // d pi_q = M dy + H dOm enters only through Phi_rig0^T: 6 rows.
-  Eigen::MatrixXd dpi_xi = (Phi_rig0_.transpose() * M_) * dy + (Phi_rig0_.transpose() * d.H) * dOm;
+  Eigen::MatrixXd dpi_xi = PtM_ * dy + (Phi_rig0_.transpose() * d.H) * dOm;
   dpi_xi.bottomRows<3>() += dh;
   Eigen::MatrixXd df_xi = Phi_rig0_.transpose() * dpi_q_dot;
   df_xi.bottomRows<3>() += dhd;
@@ -158,7 +175,7 @@ Eigen::MatrixXd SuperelementBody::ExactGyroscopic(const Data& data, const BodyVe
 
 const Eigen::MatrixXd& SuperelementBody::ExactMass(const Data& data) const {
   if (data.exact_mass) return *data.exact_mass;
-  const ExactData& d = *data.exact;
+  const ExactData& d = ExactProducts(data);
   const Eigen::Matrix3d& R = data.frame.R;
   const Eigen::MatrixXd Zr = data.kin.Z.bottomRows<3>();
   const Eigen::MatrixXd YHZ = d.Y.transpose() * d.H * Zr;

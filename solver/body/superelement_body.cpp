@@ -66,10 +66,31 @@ SuperelementBody::SuperelementBody(const Superelement& se, const SuperelementOpt
   if (se.polynomial && (se.polynomial->cubic() ? options_.polynomial_force : options_.geometric_stiffening)) {
     polynomial_ = se.polynomial;
   }
-  if (options_.geometric_stiffening) K_sigma_ = se.inertia_stiffness;
+  const int n = n_coordinates();
+  if (options_.geometric_stiffening) {
+    K_sigma_ = se.inertia_stiffness;
+    if (!K_sigma_.empty()) {
+      K_sigma_stack_.resize(kInertiaLoadCaseCount * n, n);
+      for (int k = 0; k < kInertiaLoadCaseCount; ++k) K_sigma_stack_.middleRows(k * n, n) = K_sigma_[size_t(k)];
+    }
+  }
   if (options_.exact_inertia && se.inertia_gamma.size() == 3 && se.inertia_xi.size() == 6) {
     Gamma_ = se.inertia_gamma;
     Xi_ = se.inertia_xi;
+    Gamma_stack_.resize(3 * n, n);
+    for (int a = 0; a < 3; ++a) Gamma_stack_.middleRows(a * n, n) = Gamma_[size_t(a)];
+    const int stored[3][3] = {{0, 3, 4}, {3, 1, 5}, {4, 5, 2}};  // xx yy zz xy xz yz
+    Xi_stack_.resize(9 * n, n);
+    for (int a = 0; a < 3; ++a)
+      for (int b = 0; b < 3; ++b) {
+        const Eigen::MatrixXd& X = Xi_[size_t(stored[a][b])];
+        if (a <= b) {
+          Xi_stack_.middleRows((3 * a + b) * n, n) = X;
+        } else {
+          Xi_stack_.middleRows((3 * a + b) * n, n) = X.transpose();
+        }
+      }
+    PtM_ = Phi_rig0_.transpose() * M_;
   }
   initial_frame_.x = placement_x_ + placement_R_ * origin_part_;
   initial_frame_.R = placement_R_;
@@ -209,13 +230,25 @@ FrameSolution SuperelementBody::SolveFrame(const BodyConfiguration& c, const Fra
   return frame;
 }
 
-Eigen::VectorXd SuperelementBody::LocalForce(const Eigen::VectorXd& q, const InertiaLoadFactors* load) const {
-  Eigen::VectorXd f = polynomial_ ? PolynomialForce(K_, *polynomial_, q) : Eigen::VectorXd(K_ * q);
-  if (load && !K_sigma_.empty()) {
-    for (int k = 0; k < kInertiaLoadCaseCount; ++k)
-      if (load->a[k] != 0.0) f.noalias() += load->a[k] * (K_sigma_[size_t(k)] * q);
+const Eigen::MatrixXd& SuperelementBody::SigmaProducts(const Data& d) const {
+  if (!d.sigma_q) {
+    const int n = n_coordinates();
+    const Eigen::VectorXd stacked = K_sigma_stack_ * d.q;
+    d.sigma_q = Eigen::Map<const Eigen::MatrixXd>(stacked.data(), n, kInertiaLoadCaseCount);
   }
-  return f;
+  return *d.sigma_q;
+}
+
+const Eigen::VectorXd& SuperelementBody::LocalForce(const Data& d, const InertiaLoadFactors* load) const {
+  const bool loaded = load && !K_sigma_.empty();
+  if (d.local_force && d.local_force_loaded == loaded && (!loaded || d.local_force_load == load->a)) return *d.local_force;
+  const Eigen::VectorXd& q = d.q;
+  Eigen::VectorXd f = polynomial_ ? PolynomialForce(K_, *polynomial_, q) : Eigen::VectorXd(K_ * q);
+  if (loaded) f.noalias() += SigmaProducts(d) * load->a;
+  d.local_force = std::move(f);
+  d.local_force_loaded = loaded;
+  if (loaded) d.local_force_load = load->a;
+  return *d.local_force;
 }
 
 Eigen::MatrixXd SuperelementBody::LocalTangent(const Eigen::VectorXd& q, const InertiaLoadFactors* load) const {
@@ -278,7 +311,7 @@ void SuperelementBody::ElasticForce(const Data& d, Eigen::VectorXd* f, Eigen::Ma
   const Kinematics& kin = d.kin;
   const FrameSolution& frame = d.frame;
   if (!load || K_sigma_.empty()) load = nullptr;
-  const Eigen::VectorXd Q = LocalForce(q, load);
+  const Eigen::VectorXd& Q = LocalForce(d, load);
   const Eigen::VectorXd Qhat = options_.approximated ? Eigen::VectorXd(T0_.transpose() * Q)
                                                      : Eigen::VectorXd(kin.B.transpose() * Q);
   // Rbar: R_j on every node's force and moment, identity on modal rows.
@@ -289,11 +322,13 @@ void SuperelementBody::ElasticForce(const Data& d, Eigen::VectorXd* f, Eigen::Ma
   };
   if (f) *f = rotate(Qhat);
   if (d_load) {
-    d_load->setZero(n, kInertiaLoadCaseCount);
-    for (int k = 0; load && k < kInertiaLoadCaseCount; ++k) {
-      const Eigen::VectorXd Kq_k = K_sigma_[size_t(k)] * q;
-      d_load->col(k) = rotate(options_.approximated ? Eigen::VectorXd(T0_.transpose() * Kq_k)
-                                                    : Eigen::VectorXd(kin.B.transpose() * Kq_k));
+    if (load) {
+      // Rbar B^T [K_sigma,k q]: node rows turned by R_j.
+      *d_load = options_.approximated ? Eigen::MatrixXd(T0_.transpose() * SigmaProducts(d))
+                                      : Eigen::MatrixXd(kin.B.transpose() * SigmaProducts(d));
+      TurnRowBlocks(*d_load, 2 * n_nodes_, [&](int) { return frame.R; });
+    } else {
+      d_load->setZero(n, kInertiaLoadCaseCount);
     }
   }
   if (!tangent) return;
@@ -316,7 +351,7 @@ void SuperelementBody::ElasticForce(const Data& d, Eigen::VectorXd* f, Eigen::Ma
     }
     Kt -= FMhat * kin.Z;  // K3: rotation of the frame
     if (!options_.approximated) {
-      Kt -= kin.Z.transpose() * Fhat.transpose() * kin.B;  // K2: variation of Phi_rig in T
+      Kt.noalias() -= kin.Z.transpose() * (Fhat.transpose() * kin.B);  // K2: variation of Phi_rig in T (6 x n first)
       // K4: variation of D (exact rotation kinematics), v = P^T Q, P = 1 - D Phi_rig S^-1 Phi_CB.
       Eigen::VectorXd DtQ = Q;  // D^T Q
       for (int a = 0; a < n_nodes_; ++a) DtQ.segment<3>(6 * a + 3) = kin.Jinv[size_t(a)].transpose() * Q.segment<3>(6 * a + 3);
@@ -445,8 +480,11 @@ void SuperelementBody::InertiaForce(const Data& d, const BodyVelocity& w, const 
   const int n = n_coordinates();
   if (has_exact_inertia()) {
     const Eigen::VectorXd zero = Eigen::VectorXd::Zero(n);
-    if (f_in) *f_in = ExactInertiaForce(d, options_.quadratic_velocity_terms ? w : zero, wdot);
-    if (f_acc) *f_acc = ExactInertiaForce(d, zero, wdot);
+    if (f_in) {
+      *f_in = ExactInertiaForce(d, options_.quadratic_velocity_terms ? w : zero, wdot, f_acc);
+    } else if (f_acc) {
+      *f_acc = ExactInertiaForce(d, zero, wdot);
+    }
     if (mass) *mass = ExactMass(d);
     if (gyroscopic) {
       gyroscopic->setZero(n, n);

@@ -108,11 +108,11 @@ class SuperelementBody {
   /// The exact inertia's configuration-dependent products (has_exact_inertia).
   struct ExactData {
     Eigen::MatrixXd Y;                  ///< Phi_rig0 Z + B
-    Eigen::MatrixXd MY;                 ///< M Y
-    Eigen::MatrixXd HtY;                ///< H^T Y (3 x n)
     Eigen::MatrixXd H;                  ///< n x 3: Gamma_a q
-    std::array<Eigen::VectorXd, 9> XQ;  ///< Xi_ab q at 3 a + b (Xi_ba = Xi_ab^T)
+    Eigen::MatrixXd XQ;                 ///< n x 9: Xi_ab q in column 3 a + b (Xi_ba = Xi_ab^T)
     Eigen::Matrix3d Xq;                 ///< q^T Xi_ab q
+    /// For the matrices only (ExactMass, ExactGyroscopic), made when first asked: M Y and H^T Y (3 x n).
+    mutable Eigen::MatrixXd MY, HtY;
   };
   /// Everything one configuration of the body determines, computed once (Evaluate) and passed to
   /// every force, matrix and energy evaluated there: an assembly pass evaluates each body's
@@ -125,6 +125,13 @@ class SuperelementBody {
     std::optional<ExactData> exact;                 ///< with the exact inertia
     mutable std::optional<BodyVelocityMaps> maps;   ///< the corotational maps, made when first asked
     mutable std::optional<Eigen::MatrixXd> exact_mass;  ///< M_g of the exact inertia, made when first asked
+    /// The local force Q (LocalForce) of the last load factors asked for, and with inertia
+    /// stiffening the products K_sigma,k q_loc (n x 12): the residual and the matrix passes of an
+    /// iteration share them.
+    mutable std::optional<Eigen::VectorXd> local_force;
+    mutable Eigen::Matrix<double, 12, 1> local_force_load = Eigen::Matrix<double, 12, 1>::Zero();
+    mutable bool local_force_loaded = false;
+    mutable std::optional<Eigen::MatrixXd> sigma_q;
   };
   /// The body's quantities at configuration `c` with its solved floating frame.
   Data Evaluate(const BodyConfiguration& c, const FrameSolution& frame) const;
@@ -338,7 +345,11 @@ class SuperelementBody {
   Eigen::MatrixXd first_moment_map_;  ///< 3 x n
   // Exact inertia (has_exact_inertia): per-configuration data, the force, the mass matrix M_g.
   ExactData Exact(const Eigen::VectorXd& q, const Kinematics& kin) const;
-  Eigen::VectorXd ExactInertiaForce(const Data& d, const BodyVelocity& w, const BodyVelocity& wdot) const;
+  // With `f_acc`, also the part linear in wdot alone (M_g wdot) from the same products.
+  Eigen::VectorXd ExactInertiaForce(const Data& d, const BodyVelocity& w, const BodyVelocity& wdot,
+                                    Eigen::VectorXd* f_acc = nullptr) const;
+  // M Y and H^T Y of d.exact, made on the first call.
+  const ExactData& ExactProducts(const Data& d) const;
   const Eigen::MatrixXd& ExactMass(const Data& d) const;  // computed once per Data
   // d f_in / d w of the exact inertia force (forward mode, exact).
   Eigen::MatrixXd ExactGyroscopic(const Data& d, const BodyVelocity& w) const;
@@ -346,15 +357,22 @@ class SuperelementBody {
                                                    const BodyVelocity& wdot) const;
   BodyConfiguration Perturbed(const BodyConfiguration& c, int i, double sign, double* step) const;
   std::vector<Eigen::MatrixXd> Gamma_, Xi_;  ///< the file's inertia invariants (3, 6), or none
+  // The invariants stacked for one matrix-vector product each: [Gamma_0; Gamma_1; Gamma_2]
+  // (3n x n) and Xi_ab at row block 3 a + b (9n x n, Xi_ba = Xi_ab^T); Phi_rig0^T M (6 x n).
+  Eigen::MatrixXd Gamma_stack_, Xi_stack_, PtM_;
 
   int n_nodes_ = 0, n_modes_ = 0;
   SuperelementOptions options_;
   Eigen::MatrixXd K_, M_, Phi_CB_;
   std::optional<PolynomialStiffness> polynomial_;  ///< set when the file has it and the option is on
   // Local internal force and its tangent: K q or the polynomial's.
-  Eigen::VectorXd LocalForce(const Eigen::VectorXd& q, const InertiaLoadFactors* load = nullptr) const;
+  // The force is kept in d (Data::local_force) for the next call with the same load factors.
+  const Eigen::VectorXd& LocalForce(const Data& d, const InertiaLoadFactors* load = nullptr) const;
   Eigen::MatrixXd LocalTangent(const Eigen::VectorXd& q, const InertiaLoadFactors* load = nullptr) const;
+  // K_sigma,k q_loc for the 12 load cases (n x 12), kept in d.
+  const Eigen::MatrixXd& SigmaProducts(const Data& d) const;
   std::vector<Eigen::MatrixXd> K_sigma_;  ///< the 12 inertia load case geometric stiffnesses, or none
+  Eigen::MatrixXd K_sigma_stack_;         ///< the same stacked (12n x n)
   std::vector<Eigen::Vector3d> X_;    ///< node positions relative to the frame origin, frame axes
   std::vector<Eigen::Matrix3d> R0_;   ///< node orientations relative to the frame
   Eigen::MatrixXd T0_;                ///< 1 - Phi_rig0 Phi_CB (approximated option)
