@@ -8,6 +8,8 @@ build/bin/beam_reduction_benchmark
 echo
 build/bin/solver_scaling_benchmark
 echo
+build/bin/body_kernels_benchmark
+echo
 # Solid reduction vs CalculiX (calculix-ccx): about 35 minutes and 22 GB at the 1e6-DOF size;
 # SOLID_SIZES=1e5,3e5 for a quick run.
 command -v ccx > /dev/null || apt-get install -y -q calculix-ccx > /dev/null

@@ -1,0 +1,201 @@
+// One body's kernels, timed call by call: the work of a Newton iteration of generalized-alpha on
+// one superelement (a tube segment with 2 interface nodes and 2 internal modes, 14 coordinates;
+// more modes with an argument), linear and with the geometric stiffening and exact inertia
+// (issue 13's cost ratio), split into the passes femb-solve makes: the body data (Evaluate:
+// local coordinates and kinematics), the residual pass (elastic, inertia and gravity forces, the
+// inertia load factors) and the matrix pass (tangent, mass and gyroscopic matrices,
+// configuration tangent of the inertia force). Prints microseconds per call and heap
+// allocations per call measured on this run.
+// Usage: body_kernels_benchmark [INTERNAL_MODES [REPEATS]]
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "formats/part_file.h"
+#include "reducer/reduce_part.h"
+#include "solver/body/superelement_body.h"
+#include "solver/rotation.h"
+
+#if defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define FEMB_NO_MALLOC_COUNT
+#endif
+#endif
+#ifdef __SANITIZE_ADDRESS__
+#define FEMB_NO_MALLOC_COUNT
+#endif
+static std::atomic<long> g_allocations{0};
+#ifndef FEMB_NO_MALLOC_COUNT
+extern "C" {
+void* __libc_malloc(std::size_t);
+void* __libc_calloc(std::size_t, std::size_t);
+void* __libc_realloc(void*, std::size_t);
+void __libc_free(void*);
+__attribute__((visibility("default"))) void* malloc(std::size_t size) {
+  g_allocations.fetch_add(1, std::memory_order_relaxed);
+  return __libc_malloc(size);
+}
+__attribute__((visibility("default"))) void* calloc(std::size_t n, std::size_t size) {
+  g_allocations.fetch_add(1, std::memory_order_relaxed);
+  return __libc_calloc(n, size);
+}
+__attribute__((visibility("default"))) void* realloc(void* p, std::size_t size) {
+  g_allocations.fetch_add(1, std::memory_order_relaxed);
+  return __libc_realloc(p, size);
+}
+__attribute__((visibility("default"))) void free(void* p) { __libc_free(p); }
+}
+#endif
+
+namespace {
+
+struct Timing {
+  double us = 0.0;
+  double allocations = 0.0;
+};
+
+// Every work timed in rounds of `repeats` calls, the works interleaved within a round so that a
+// slow spell of the (noisy, shared) machine touches them all; the best of 9 rounds is the cost.
+std::vector<Timing> MeasureInterleaved(int repeats, const std::vector<std::function<void()>>& works) {
+  std::vector<Timing> best(works.size(), Timing{1e300, 0.0});
+  for (int round = 0; round < 9; ++round) {
+    for (size_t k = 0; k < works.size(); ++k) {
+      const long before = g_allocations.load();
+      const auto start = std::chrono::steady_clock::now();
+      for (int i = 0; i < repeats; ++i) works[k]();
+      const double us = 1e6 * std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() / repeats;
+      if (us < best[k].us) best[k] = {us, double(g_allocations.load() - before) / repeats};
+    }
+  }
+  return best;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const int modes = argc > 1 ? std::max(0, std::atoi(argv[1])) : 2;
+  const int repeats = argc > 2 ? std::max(1, std::atoi(argv[2])) : 2000;
+  std::printf("One body's kernels: tube segment, 2 interface nodes, %d internal modes; microseconds per call "
+              "(best of 9 interleaved rounds of %d), heap allocations per call\n\n",
+              modes, repeats);
+  std::printf("%-48s %10s %7s %12s %7s %12s %7s %7s %7s\n", "kernel", "linear us", "allocs", "exact in. us", "allocs",
+              "stiffened us", "allocs", "ratio", "ratio");
+  std::printf("%-48s %10s %7s %12s %7s %12s %7s %7s %7s\n", "", "", "", "", "", "", "", "st/lin", "st/ex");
+  // Kinds: a linear file; a stiffened file with the stiffening switched off (body option
+  // geometric_stiffening: false: the exact inertia alone); the stiffened file as it is.
+  // Each kind's setup, then its works: names and calls (each call on fresh body data, as an
+  // iteration has).
+  struct Setup {
+    std::unique_ptr<femb::SuperelementBody> body;
+    femb::BodyConfiguration c;
+    femb::FrameSolution frame;
+    Eigen::VectorXd w, wdot;
+  };
+  std::vector<Setup> setups(3);
+  const Eigen::Vector3d g(0, -9.81, 0);
+  const std::vector<std::string> names = {"floating frame (SolveFrame from the last)",
+                                          "body data (Evaluate)",
+                                          "  + residual pass (forces, load factors)",
+                                          "  + elastic tangent (with d_load)",
+                                          "  + mass and gyroscopic matrices",
+                                          "  + inertia configuration tangent",
+                                          "a Newton iteration (data, residual, matrices)"};
+  std::vector<std::function<void()>> works;
+  double sink = 0.0;
+  for (int kind = 0; kind < 3; ++kind) {
+    const bool stiffening = kind >= 1;
+    const femb::PartSpec part = femb::ParsePart(
+        "name: seg\ntype: beam\nmaterial: {E: 70.0e9, nu: 0.3, rho: 2700}\n"
+        "section: {shape: tube, outer_radius: 0.01, wall: 0.001}\n"
+        "beam:\n  points: {A: [0, 0, 0], B: [0.5, 0, 0]}\n"
+        "  segments: [{from: A, to: B, elements: 8}]\n"
+        "interfaces: [{name: A}, {name: B}]\nreduction: {internal_modes: " + std::to_string(modes) +
+            ", keep_mesh: false, geometric_stiffening: " + std::string(stiffening ? "true" : "false") + "}\n",
+        "bench.yaml");
+    const femb::ReduceResult reduced = femb::ReducePart(part, nullptr);
+    if (!reduced.ok) return 3;
+    femb::SuperelementOptions options;
+    options.geometric_stiffening = kind == 2;
+    Setup& u = setups[size_t(kind)];
+    u.body = std::make_unique<femb::SuperelementBody>(reduced.superelement, options);
+    const femb::SuperelementBody& body = *u.body;
+    const int n = body.n_coordinates();
+    // A deformed, turned configuration and a spinning, accelerating motion.
+    u.c = body.InitialConfiguration();
+    const Eigen::Matrix3d turn = femb::ExpSO3(Eigen::Vector3d(0.3, -0.2, 0.5));
+    for (size_t k = 0; k < u.c.x.size(); ++k) {
+      u.c.x[k] = turn * u.c.x[k] + Eigen::Vector3d(0.01 * double(k), -0.02, 0.005 * double(k));
+      u.c.R[k] = femb::ExpSO3(Eigen::Vector3d(0.02 * double(k), 0.01, -0.03 * double(k))) * turn * u.c.R[k];
+    }
+    for (int i = 0; i < u.c.eta.size(); ++i) u.c.eta[i] = 1e-3 * (i + 1);
+    u.frame = body.SolveFrame(u.c, body.GuessFrame(u.c));
+    if (!u.frame.ok) return 3;
+    u.w.resize(n);
+    u.wdot.resize(n);
+    for (int i = 0; i < n; ++i) {
+      u.w[i] = std::sin(1.0 + i);
+      u.wdot[i] = 10.0 * std::cos(2.0 + i);
+    }
+    const Setup* p = &u;
+    // Stages of an iteration, cumulative: 0 data, 1 + residual, 2 + elastic tangent,
+    // 3 + mass and gyroscopic, 4 + configuration tangent.
+    auto iteration = [p, g, &sink](int stages) {
+      const femb::SuperelementBody& b = *p->body;
+      const femb::SuperelementBody::Data d = b.Evaluate(p->c, p->frame);
+      if (stages < 1) return;
+      const bool s = b.has_inertia_stiffening();
+      femb::InertiaLoadFactors load;
+      Eigen::VectorXd f_int, f_in, f_acc;
+      if (s) load = b.InertiaLoads(d, p->w, p->wdot, g);
+      b.ElasticForce(d, &f_int, nullptr, s ? &load : nullptr);
+      b.InertiaForce(d, p->w, p->wdot, &f_in, nullptr, nullptr, &f_acc);
+      const Eigen::VectorXd f_grav = b.GravityForce(d, g);
+      sink += f_int.sum() + f_in.sum() + f_acc.sum() + f_grav.sum();
+      if (stages < 2) return;
+      Eigen::MatrixXd K, M, C, d_load;
+      b.ElasticForce(d, nullptr, &K, s ? &load : nullptr, s ? &d_load : nullptr);
+      if (stages < 3) return;
+      b.InertiaForce(d, p->w, p->wdot, nullptr, &M, &C);
+      if (s) {
+        M.noalias() += d_load * load.d_wdot;
+        C.noalias() += d_load * load.d_w;
+      }
+      if (stages < 4) return;
+      K += b.InertiaConfigurationTangent(d, p->w, p->wdot, false);
+      sink += K.sum() + M.sum() + C.sum();
+    };
+    works.push_back([p] {
+      const femb::FrameSolution f = p->body->SolveFrame(p->c, p->frame);
+      if (!f.ok) std::abort();
+    });
+    for (int stages = 0; stages <= 4; ++stages) works.push_back([iteration, stages] { iteration(stages); });
+  }
+  const std::vector<Timing> t = MeasureInterleaved(repeats, works);
+  // Per kind: frame, then the cumulative stages 0..4; rows are the frame, the data, the
+  // increments of stages 1..4 and the whole iteration.
+  std::vector<std::pair<std::string, Timing>> rows[3];
+  for (int kind = 0; kind < 3; ++kind) {
+    const Timing* k = &t[size_t(6 * kind)];
+    rows[kind].push_back({names[0], k[0]});
+    rows[kind].push_back({names[1], k[1]});
+    for (int stage = 1; stage <= 4; ++stage)
+      rows[kind].push_back({names[size_t(stage + 1)],
+                            {k[stage + 1].us - k[stage].us, k[stage + 1].allocations - k[stage].allocations}});
+    rows[kind].push_back({names[6], k[5]});
+  }
+  if (sink == 12345.678) std::printf(" ");
+  for (size_t i = 0; i < rows[0].size(); ++i) {
+    const Timing& l = rows[0][i].second;
+    const Timing& e = rows[1][i].second;
+    const Timing& s = rows[2][i].second;
+    std::printf("%-48s %10.2f %7.0f %12.2f %7.0f %12.2f %7.0f %7.2f %7.2f\n", rows[0][i].first.c_str(), l.us,
+                l.allocations, e.us, e.allocations, s.us, s.allocations, s.us / l.us, s.us / e.us);
+  }
+  return 0;
+}
