@@ -144,8 +144,19 @@ Eigen::MatrixXd SuperelementBody::ExactGyroscopic(const Data& data, const BodyVe
   for (int a = 0; a < 3; ++a) Gty.col(a).noalias() = Gamma_[size_t(a)].transpose() * y;
   const Eigen::VectorXd pi_q = M_ * y + d.H * Om;
   // M dyd and H^T dyd with dyd = Y dr: (M Y) dr and (H^T Y) dr, M Y and H^T Y kept per configuration.
-  Eigen::MatrixXd dpi_q_dot = d.MY * dr + d.H * dOmd + Hd * dOm + G_Om * dqd;
-  Eigen::MatrixXd df_q = dpi_q_dot - G_Om.transpose() * dy - Gty * dOm;
+  // d pi_qdot = base + G_Om dqd and df_q = d pi_qdot - G_Om^T dy - Gty dOm with
+  // dy = Phi_rig0 dxi + dqd: the two n x n products with G_Om as one, (G_Om - G_Om^T) dqd.
+  Eigen::MatrixXd base = d.MY * dr;
+  base.noalias() += d.H * dOmd;
+  base.noalias() += Hd * dOm;
+  Eigen::MatrixXd df_q = base;
+  {
+    const Eigen::MatrixXd G_skew = G_Om - G_Om.transpose();
+    df_q.noalias() += G_skew * dqd;
+    const Eigen::MatrixXd GtP = G_Om.transpose() * Phi_rig0_;  // n x 6
+    df_q.noalias() -= GtP * dxi;
+    df_q.noalias() -= Gty * dOm;
+  }
   const Eigen::Vector3d h = d.H.transpose() * y + d.Xq * Om;
   const Eigen::MatrixXd dh = d.H.transpose() * dy + d.Xq * dOm;
   Eigen::MatrixXd dhd = d.HtY * dr + d.Xq * dOmd + Gty.transpose() * dqd + Hd.transpose() * dy;
@@ -163,7 +174,8 @@ Eigen::MatrixXd SuperelementBody::ExactGyroscopic(const Data& data, const BodyVe
   // d pi_q = M dy + H dOm enters only through Phi_rig0^T: 6 rows.
   Eigen::MatrixXd dpi_xi = PtM_ * dy + (Phi_rig0_.transpose() * d.H) * dOm;
   dpi_xi.bottomRows<3>() += dh;
-  Eigen::MatrixXd df_xi = Phi_rig0_.transpose() * dpi_q_dot;
+  Eigen::MatrixXd df_xi = Phi_rig0_.transpose() * base;
+  df_xi.noalias() += (Phi_rig0_.transpose() * G_Om) * dqd;
   df_xi.bottomRows<3>() += dhd;
   const Eigen::MatrixXd dpi_v = dpi_xi.topRows<3>(), dpi_w = dpi_xi.bottomRows<3>();
   df_xi.topRows<3>() += -Skew<double>(pi_v) * dOm + Om_x * dpi_v;
