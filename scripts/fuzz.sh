@@ -13,7 +13,7 @@ cd "$(dirname "$0")/.."
 seconds=${FEMB_FUZZ_SECONDS:-120}
 scale=${FEMB_FUZZ_SCALE:-1}
 fuzz_seed=${FEMB_FUZZ_SEED:-1}
-declare -A runs=([yaml_fuzz]=15000 [part_fuzz]=75000 [scene_fuzz]=30000 [superelement_fuzz]=2000)
+declare -A runs=([yaml_fuzz]=15000 [part_fuzz]=75000 [scene_fuzz]=30000 [superelement_fuzz]=2000 [matrix_fuzz]=20000)
 missing=()
 for p in clang libclang-rt-14-dev; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
@@ -23,7 +23,7 @@ if [ ${#missing[@]} -gt 0 ]; then
   $sudo_cmd apt-get update -q
   DEBIAN_FRONTEND=noninteractive $sudo_cmd apt-get install -y -q --no-install-recommends "${missing[@]}"
 fi
-targets=(yaml_fuzz part_fuzz scene_fuzz superelement_fuzz)
+targets=(yaml_fuzz part_fuzz scene_fuzz superelement_fuzz matrix_fuzz)
 CC=clang CXX=clang++ cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DFEMB_FUZZ=ON \
   -DFEMB_BUILD_TESTS=OFF >/dev/null
 cmake --build build-fuzz -j "$(nproc)" --target "${targets[@]}" -- --no-print-directory -s 2>&1 | grep -v "^\[" || true
@@ -43,6 +43,19 @@ for f in $(git ls-files 'examples/*.yaml'); do
   fi
 done
 printf '\x00\x01\x02\x03' > "$work/corpus_superelement_fuzz/seed"
+# matrix_fuzz: a reader byte, then its files cut by 0x01 (tests/fuzz/matrix_fuzz.cpp), from the
+# seed part's matrices exported in every format, and a small shapes file.
+for f in calculix abaqus matrix_market; do
+  build/bin/femb-reduce -q examples/pendulum/rod.yaml --export-matrices "$work/export_$f" --matrix-format $f
+done
+m=$work/corpus_matrix_fuzz
+e=$work/export_calculix
+{ printf '\x00'; cat "$e"/*.sti; printf '\x01'; cat "$e"/*.mas; printf '\x01'; cat "$e"/*.dof; } > "$m/calculix"
+e=$work/export_abaqus
+{ printf '\x01'; cat "$e"/*_STIF1.mtx; printf '\x01'; cat "$e"/*_MASS1.mtx; } > "$m/abaqus"
+e=$work/export_matrix_market
+{ printf '\x02'; cat "$e"/*_K.mtx; printf '\x01'; cat "$e"/*_M.mtx; printf '\x01'; cat "$e"/*_dofs.csv; } > "$m/matrix_market"
+{ printf '\x03%%%%MatrixMarket matrix array real general\n3 2\n1\n2\n3\n4\n5\n6\n\x01ab'; } > "$m/shapes"
 # Every input that once failed stays in the corpus (tests/fuzz/regressions/TARGET/).
 for t in "${targets[@]}"; do
   if [ -d "tests/fuzz/regressions/$t" ]; then cp "tests/fuzz/regressions/$t"/* "$work/corpus_$t/"; fi
