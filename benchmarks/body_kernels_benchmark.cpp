@@ -5,7 +5,8 @@
 // local coordinates and kinematics), the residual pass (elastic, inertia and gravity forces, the
 // inertia load factors) and the matrix pass (tangent, mass and gyroscopic matrices,
 // configuration tangent of the inertia force). Prints microseconds per call and heap
-// allocations per call measured on this run.
+// allocations per call measured on this run. The stage rows are differences of cumulative runs
+// (best of interleaved rounds): on a shared machine they move by a few microseconds run to run.
 // Usage: body_kernels_benchmark [INTERNAL_MODES [REPEATS]]
 #include <algorithm>
 #include <atomic>
@@ -17,41 +18,12 @@
 #include <string>
 #include <vector>
 
+#include "benchmarks/allocation_count.h"
 #include "formats/part_file.h"
 #include "reducer/reduce_part.h"
 #include "solver/body/superelement_body.h"
 #include "solver/rotation.h"
 
-#if defined(__has_feature)
-#if __has_feature(address_sanitizer)
-#define FEMB_NO_MALLOC_COUNT
-#endif
-#endif
-#ifdef __SANITIZE_ADDRESS__
-#define FEMB_NO_MALLOC_COUNT
-#endif
-static std::atomic<long> g_allocations{0};
-#ifndef FEMB_NO_MALLOC_COUNT
-extern "C" {
-void* __libc_malloc(std::size_t);
-void* __libc_calloc(std::size_t, std::size_t);
-void* __libc_realloc(void*, std::size_t);
-void __libc_free(void*);
-__attribute__((visibility("default"))) void* malloc(std::size_t size) {
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
-  return __libc_malloc(size);
-}
-__attribute__((visibility("default"))) void* calloc(std::size_t n, std::size_t size) {
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
-  return __libc_calloc(n, size);
-}
-__attribute__((visibility("default"))) void* realloc(void* p, std::size_t size) {
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
-  return __libc_realloc(p, size);
-}
-__attribute__((visibility("default"))) void free(void* p) { __libc_free(p); }
-}
-#endif
 
 namespace {
 
@@ -66,11 +38,11 @@ std::vector<Timing> MeasureInterleaved(int repeats, const std::vector<std::funct
   std::vector<Timing> best(works.size(), Timing{1e300, 0.0});
   for (int round = 0; round < 9; ++round) {
     for (size_t k = 0; k < works.size(); ++k) {
-      const long before = g_allocations.load();
+      const long before = femb_allocations.load();
       const auto start = std::chrono::steady_clock::now();
       for (int i = 0; i < repeats; ++i) works[k]();
       const double us = 1e6 * std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() / repeats;
-      if (us < best[k].us) best[k] = {us, double(g_allocations.load() - before) / repeats};
+      if (us < best[k].us) best[k] = {us, double(femb_allocations.load() - before) / repeats};
     }
   }
   return best;

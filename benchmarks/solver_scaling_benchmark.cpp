@@ -15,44 +15,12 @@
 #include <vector>
 #include <algorithm>
 
+#include "benchmarks/allocation_count.h"
 #include "formats/part_file.h"
 #include "reducer/reduce_part.h"
 #include "solver/analysis/dynamic_analysis.h"
 #include "solver/parallel.h"
 
-// Every heap allocation of the program, counted: malloc, calloc and realloc replaced by
-// wrappers around glibc's own (the program's definitions interpose the library's).
-// Not under AddressSanitizer, which has malloc of its own (the column then reads 0).
-#if defined(__has_feature)
-#if __has_feature(address_sanitizer)
-#define FEMB_NO_MALLOC_COUNT
-#endif
-#endif
-#ifdef __SANITIZE_ADDRESS__
-#define FEMB_NO_MALLOC_COUNT
-#endif
-static std::atomic<long> g_allocations{0};
-#ifndef FEMB_NO_MALLOC_COUNT
-extern "C" {
-void* __libc_malloc(std::size_t);
-void* __libc_calloc(std::size_t, std::size_t);
-void* __libc_realloc(void*, std::size_t);
-void __libc_free(void*);
-__attribute__((visibility("default"))) void* malloc(std::size_t size) {
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
-  return __libc_malloc(size);
-}
-__attribute__((visibility("default"))) void* calloc(std::size_t n, std::size_t size) {
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
-  return __libc_calloc(n, size);
-}
-__attribute__((visibility("default"))) void* realloc(void* p, std::size_t size) {
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
-  return __libc_realloc(p, size);
-}
-__attribute__((visibility("default"))) void free(void* p) { __libc_free(p); }
-}
-#endif
 
 int main(int argc, char** argv) {
   std::vector<int> chains = {1, 10, 100, 1000};
@@ -107,9 +75,9 @@ int main(int argc, char** argv) {
       return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     };
     femb::DynamicResult r, r_many;
-    const long allocations_before = g_allocations.load();
+    const long allocations_before = femb_allocations.load();
     const double seconds = run(1, &r);
-    const long allocations = g_allocations.load() - allocations_before;
+    const long allocations = femb_allocations.load() - allocations_before;
     if (!r.ok) {
       std::printf("%6d %-11s failed: %s\n", n_bodies, stiffening ? "stiffened" : "linear", r.message.c_str());
       continue;
