@@ -1,7 +1,7 @@
 #include "reducer/reduction/general_basis.h"
 
 #include <Eigen/Dense>
-#include <cstdio>
+#include <string>
 
 #include "reducer/reduction/craig_bampton.h"
 
@@ -58,13 +58,11 @@ GeneralBasisResult ReduceOnGeneralBasis(const FeModel& model, const Eigen::Matri
     Eigen::Index at = 0;
     u.cwiseAbs().maxCoeff(&at);
     static const char* kNames[6] = {"u_x", "u_y", "u_z", "theta_x", "theta_y", "theta_z"};
-    char b[320];
-    std::snprintf(b, sizeof b,
-                  "the deformation shapes (with the rigid-body fields) move only %d of the %d interface coordinates: "
-                  "interface '%s' %s (and %d more directions) cannot move relative to the others; add shapes that "
-                  "move it (residual attachment or static modes) - femb does not constrain interface directions inside a body",
-                  m, nb, model.interface_names[size_t(at / 6)].c_str(), kNames[at % 6], nb - m - 1);
-    r.message = b;
+    r.message = "the deformation shapes (with the rigid-body fields) move only " + std::to_string(m) + " of the " +
+                std::to_string(nb) + " interface coordinates: interface '" + model.interface_names[size_t(at / 6)] +
+                "' " + kNames[at % 6] + " (and " + std::to_string(nb - m - 1) +
+                " more directions) cannot move relative to the others; add shapes that move it (residual attachment "
+                "or static modes) - femb does not constrain interface directions inside a body";
     r.input_error = true;
     return r;
   }
