@@ -19,12 +19,17 @@ SuperelementBody::ExactData SuperelementBody::Exact(const Eigen::VectorXd& q, co
   ExactData d;
   d.Y = kin.B;
   d.Y.noalias() += Phi_rig0_ * kin.Z;
-  const Eigen::VectorXd gq = Gamma_stack_ * q, xq = Xi_stack_ * q;
-  d.H = Eigen::Map<const Eigen::MatrixXd>(gq.data(), n, 3);
+  const Eigen::VectorXd xq = Xi_stack_ * q;
+  d.H = GammaColumns(q);
   d.XQ = Eigen::Map<const Eigen::MatrixXd>(xq.data(), n, 9);
   for (int a = 0; a < 3; ++a)
     for (int b = 0; b < 3; ++b) d.Xq(a, b) = q.dot(d.XQ.col(3 * a + b));
   return d;
+}
+
+Eigen::MatrixXd SuperelementBody::GammaColumns(const Eigen::VectorXd& v) const {
+  const Eigen::VectorXd stacked = Gamma_stack_ * v;
+  return Eigen::Map<const Eigen::MatrixXd>(stacked.data(), n_coordinates(), 3);
 }
 
 const SuperelementBody::ExactData& SuperelementBody::ExactProducts(const Data& data) const {
@@ -38,7 +43,7 @@ const SuperelementBody::ExactData& SuperelementBody::ExactProducts(const Data& d
 
 Eigen::VectorXd SuperelementBody::ExactInertiaForce(const Data& data, const BodyVelocity& w,
                                                     const BodyVelocity& wdot, Eigen::VectorXd* f_acc) const {
-  const int n = n_coordinates(), blocks = 2 * n_nodes_;
+  const int blocks = 2 * n_nodes_;
   const ExactData& d = *data.exact;
   const Eigen::Matrix3d& R = data.frame.R;
   const Eigen::MatrixXd& Z = data.kin.Z;
@@ -66,11 +71,7 @@ Eigen::VectorXd SuperelementBody::ExactInertiaForce(const Data& data, const Body
   }
   const Eigen::Vector3d Omd = Z.bottomRows<3>() * r;
   const Eigen::VectorXd y = Phi_rig0_ * xi + qd, yd = d.Y * r;
-  Eigen::MatrixXd Hd(n, 3);
-  {
-    const Eigen::VectorXd gqd = Gamma_stack_ * qd;
-    Hd = Eigen::Map<const Eigen::MatrixXd>(gqd.data(), n, 3);
-  }
+  const Eigen::MatrixXd Hd = GammaColumns(qd);
   const Eigen::VectorXd pi_q = M_ * y + d.H * Om;
   const Eigen::VectorXd pi_q_dot = M_ * yd + d.H * Omd + Hd * Om;
   Eigen::VectorXd f_q = pi_q_dot;  // minus dT/dq below
@@ -136,11 +137,8 @@ Eigen::MatrixXd SuperelementBody::ExactGyroscopic(const Data& data, const BodyVe
   // the rows y^T Gamma_a dqd as (Gamma_a^T y)^T dqd.
   Eigen::MatrixXd G_Om = Om[0] * Gamma_[0];
   for (int a = 1; a < 3; ++a) G_Om += Om[a] * Gamma_[size_t(a)];
-  Eigen::MatrixXd Hd(n, 3), Gty(n, 3);  // Gamma_a qd, Gamma_a^T y
-  {
-    const Eigen::VectorXd gqd = Gamma_stack_ * qd;
-    Hd = Eigen::Map<const Eigen::MatrixXd>(gqd.data(), n, 3);
-  }
+  const Eigen::MatrixXd Hd = GammaColumns(qd);  // Gamma_a qd
+  Eigen::MatrixXd Gty(n, 3);                     // Gamma_a^T y
   for (int a = 0; a < 3; ++a) Gty.col(a).noalias() = Gamma_[size_t(a)].transpose() * y;
   const Eigen::VectorXd pi_q = M_ * y + d.H * Om;
   // M dyd and H^T dyd with dyd = Y dr: (M Y) dr and (H^T Y) dr, M Y and H^T Y kept per configuration.

@@ -76,14 +76,13 @@ SuperelementBody::SuperelementBody(const Superelement& se, const SuperelementOpt
   }
   if (options_.exact_inertia && se.inertia_gamma.size() == 3 && se.inertia_xi.size() == 6) {
     Gamma_ = se.inertia_gamma;
-    Xi_ = se.inertia_xi;
     Gamma_stack_.resize(3 * n, n);
     for (int a = 0; a < 3; ++a) Gamma_stack_.middleRows(a * n, n) = Gamma_[size_t(a)];
     const int stored[3][3] = {{0, 3, 4}, {3, 1, 5}, {4, 5, 2}};  // xx yy zz xy xz yz
     Xi_stack_.resize(9 * n, n);
     for (int a = 0; a < 3; ++a)
       for (int b = 0; b < 3; ++b) {
-        const Eigen::MatrixXd& X = Xi_[size_t(stored[a][b])];
+        const Eigen::MatrixXd& X = se.inertia_xi[size_t(stored[a][b])];
         if (a <= b) {
           Xi_stack_.middleRows((3 * a + b) * n, n) = X;
         } else {
@@ -240,15 +239,15 @@ const Eigen::MatrixXd& SuperelementBody::SigmaProducts(const Data& d) const {
 }
 
 const Eigen::VectorXd& SuperelementBody::LocalForce(const Data& d, const InertiaLoadFactors* load) const {
-  const bool loaded = load && !K_sigma_.empty();
-  if (d.local_force && d.local_force_loaded == loaded && (!loaded || d.local_force_load == load->a)) return *d.local_force;
+  // The load factors the force is for (all zero without inertia stiffening: K q alone).
+  const Eigen::Matrix<double, 12, 1> a =
+      load && !K_sigma_.empty() ? load->a : Eigen::Matrix<double, 12, 1>::Zero().eval();
+  if (d.local_force && d.local_force->a == a) return d.local_force->Q;
   const Eigen::VectorXd& q = d.q;
   Eigen::VectorXd f = polynomial_ ? PolynomialForce(K_, *polynomial_, q) : Eigen::VectorXd(K_ * q);
-  if (loaded) f.noalias() += SigmaProducts(d) * load->a;
-  d.local_force = std::move(f);
-  d.local_force_loaded = loaded;
-  if (loaded) d.local_force_load = load->a;
-  return *d.local_force;
+  if (!a.isZero(0.0)) f.noalias() += SigmaProducts(d) * a;
+  d.local_force = Data::LocalForceOf{a, std::move(f)};
+  return d.local_force->Q;
 }
 
 Eigen::MatrixXd SuperelementBody::LocalTangent(const Eigen::VectorXd& q, const InertiaLoadFactors* load) const {
@@ -315,12 +314,7 @@ void SuperelementBody::ElasticForce(const Data& d, Eigen::VectorXd* f, Eigen::Ma
   const Eigen::VectorXd Qhat = options_.approximated ? Eigen::VectorXd(T0_.transpose() * Q)
                                                      : Eigen::VectorXd(kin.B.transpose() * Q);
   // Rbar: R_j on every node's force and moment, identity on modal rows.
-  auto rotate = [&](const Eigen::VectorXd& local) {
-    Eigen::VectorXd global = local;
-    for (int a = 0; a < 2 * n_nodes_; ++a) global.segment<3>(3 * a) = frame.R * local.segment<3>(3 * a);
-    return global;
-  };
-  if (f) *f = rotate(Qhat);
+  if (f) *f = TurnBlocks(frame.R, Qhat, 2 * n_nodes_);
   if (d_load) {
     if (load) {
       // Rbar B^T [K_sigma,k q]: node rows turned by R_j.

@@ -128,9 +128,11 @@ class SuperelementBody {
     /// The local force Q (LocalForce) of the last load factors asked for, and with inertia
     /// stiffening the products K_sigma,k q_loc (n x 12): the residual and the matrix passes of an
     /// iteration share them.
-    mutable std::optional<Eigen::VectorXd> local_force;
-    mutable Eigen::Matrix<double, 12, 1> local_force_load = Eigen::Matrix<double, 12, 1>::Zero();
-    mutable bool local_force_loaded = false;
+    struct LocalForceOf {
+      Eigen::Matrix<double, 12, 1> a;  ///< the load factors (zero: none)
+      Eigen::VectorXd Q;
+    };
+    mutable std::optional<LocalForceOf> local_force;
     mutable std::optional<Eigen::MatrixXd> sigma_q;
   };
   /// The body's quantities at configuration `c` with its solved floating frame.
@@ -356,10 +358,12 @@ class SuperelementBody {
   Eigen::MatrixXd ExactInertiaConfigurationTangent(const Data& d, const BodyVelocity& w,
                                                    const BodyVelocity& wdot) const;
   BodyConfiguration Perturbed(const BodyConfiguration& c, int i, double sign, double* step) const;
-  std::vector<Eigen::MatrixXd> Gamma_, Xi_;  ///< the file's inertia invariants (3, 6), or none
+  std::vector<Eigen::MatrixXd> Gamma_;  ///< the file's inertia invariants Gamma_a (3), or none
   // The invariants stacked for one matrix-vector product each: [Gamma_0; Gamma_1; Gamma_2]
   // (3n x n) and Xi_ab at row block 3 a + b (9n x n, Xi_ba = Xi_ab^T); Phi_rig0^T M (6 x n).
   Eigen::MatrixXd Gamma_stack_, Xi_stack_, PtM_;
+  // [Gamma_0 v, Gamma_1 v, Gamma_2 v] (n x 3) from the stack.
+  Eigen::MatrixXd GammaColumns(const Eigen::VectorXd& v) const;
 
   int n_nodes_ = 0, n_modes_ = 0;
   SuperelementOptions options_;

@@ -12,7 +12,7 @@
 
 #include "formats/input_error.h"
 #include "formats/part_file.h"
-#include "reducer/fe/imported_model.h"
+#include "reducer/fe/matrix_files.h"
 
 namespace {
 
