@@ -319,10 +319,12 @@ StepOutcome GeneralizedAlphaStep(const SystemModel& model, const DofMap& dofs, c
   const double tolerance = std::max(options.tolerance, kRoundOffTolerance);
   const Eigen::VectorXd weights = ResidualWeights(model, dofs);
   std::vector<BodyPass> passes;
+  DivergenceTest divergence;
   for (; out.iterations < options.max_iterations; ++out.iterations) {
     Assembly a = AssembleDynamicResidual(model, dofs, next, t_new, passes, &threads);
     if (!a.ok || !a.residual.allFinite()) return out;
-    if (FreeNorm(dofs, a.residual, weights) <= std::max(tolerance * a.scale, a.roundoff) && out.iterations > 0) {
+    const double r_norm = FreeNorm(dofs, a.residual, weights);
+    if (r_norm <= std::max(tolerance * a.scale, a.roundoff) && out.iterations > 0) {
       out.converged = true;
       next.a += (1 - alpha_f) / (1 - alpha_m) * next.Wdot;
       next.t = t_new;
@@ -334,6 +336,7 @@ StepOutcome GeneralizedAlphaStep(const SystemModel& model, const DofMap& dofs, c
       out.passes = std::move(passes);
       return out;
     }
+    if (divergence.Diverged(out.iterations, r_norm)) return out;
     bool built = false;
     const auto S = [&] {
       const MatrixCombination combine{gamma_p, beta_p};

@@ -256,12 +256,14 @@ StepOutcome MidpointStep(const SystemModel& model, const DofMap& dofs, const Dyn
   StepOutcome out;
   const double tolerance = std::max(options.tolerance, kRoundOffTolerance);
   const Eigen::VectorXd weights = ResidualWeights(model, dofs);
+  DivergenceTest divergence;
   for (; out.iterations < options.max_iterations; ++out.iterations) {
     MidpointKinematics k = Midpoint(model, dofs, triples, state, h, next);
     double work = 0.0;
     const Assembly a = AssembleMidpoint(model, dofs, state, p0, h, k, next, work, &threads);
     if (!a.ok || !a.residual.allFinite()) return out;
-    if (FreeNorm(dofs, a.residual, weights) <= std::max(tolerance * a.scale, a.roundoff) && out.iterations > 0) {
+    const double r_norm = FreeNorm(dofs, a.residual, weights);
+    if (r_norm <= std::max(tolerance * a.scale, a.roundoff) && out.iterations > 0) {
       out.converged = true;
       next.t = t_new;
       // a: the mean acceleration over the step (t_n+1/2); Wdot: extrapolated to t_n+1 from
@@ -279,6 +281,7 @@ StepOutcome MidpointStep(const SystemModel& model, const DofMap& dofs, const Dyn
       next.drive_work += next.f_drive.dot(k.delta);
       return out;
     }
+    if (divergence.Diverged(out.iterations, r_norm)) return out;
     // Newton's increment delta at n+1: dW_n+1 = V delta, dq_m = T delta, dw_m ~ delta / h.
     const auto S = [&] { return SystemMatrix(a.K * k.T + (1.0 / h) * (a.C + a.M * k.V)); };
     Eigen::VectorXd delta;

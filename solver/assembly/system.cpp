@@ -1,5 +1,7 @@
 #include "solver/assembly/system.h"
 
+#include <klu.h>
+
 #include <Eigen/Dense>
 #include <cmath>
 #include <cstdio>
@@ -418,53 +420,101 @@ void ApplyPrescribed(const SystemModel& model, const DofMap& dofs, double t, Sys
   ApplyIncrement(model, dofs, delta, state);
 }
 
+struct FreeSolver::Klu {
+  klu_common common;
+  klu_symbolic* symbolic = nullptr;
+  klu_numeric* numeric = nullptr;
+  // The free block of S in compressed columns; the pattern `symbolic` was analysed for.
+  std::vector<int> outer, inner, analysed_outer, analysed_inner;
+  std::vector<double> values;
+  // The pivot ratio (min / max |u_ii|) of the last full factorization.
+  double rcond = 0.0;
+  Klu() {
+    klu_defaults(&common);
+    common.halt_if_singular = 1;
+  }
+  ~Klu() { Clear(); }
+  void Clear() {
+    if (numeric) klu_free_numeric(&numeric, &common);
+    if (symbolic) klu_free_symbolic(&symbolic, &common);
+  }
+  // A full factorization (pivoting) with the kept analysis; false on a zero pivot.
+  bool FactorAnew() {
+    if (numeric) klu_free_numeric(&numeric, &common);
+    numeric = klu_factor(outer.data(), inner.data(), values.data(), symbolic, &common);
+    if (!numeric) return false;
+    klu_rcond(symbolic, numeric, &common);
+    rcond = common.rcond;
+    return rcond > 0.0;
+  }
+};
+
+FreeSolver::FreeSolver() : klu_(std::make_unique<Klu>()) {}
+FreeSolver::~FreeSolver() = default;
+
 bool FreeSolver::Factor(const DofMap& dofs, const SystemMatrix& S) {
+  valid_ = false;
+  Klu& k = *klu_;
   free_ = dofs.solved();
   const int n = int(free_.size());
-  std::vector<int> position(S.rows(), -1);
-  for (int i = 0; i < n; ++i) position[free_[i]] = i;
-  sparse_ = n > kDenseLimit;
-  if (sparse_) {
-    Triplets entries;
-    entries.reserve(S.nonZeros());
-    for (int col = 0; col < S.outerSize(); ++col) {
-      for (SystemMatrix::InnerIterator it(S, col); it; ++it) {
-        if (position[it.row()] >= 0 && position[col] >= 0) entries.emplace_back(position[it.row()], position[col], it.value());
-      }
+  position_.assign(size_t(S.rows()), -1);
+  for (int i = 0; i < n; ++i) position_[size_t(free_[size_t(i)])] = i;
+  // The free block, column by column (free_ ascending keeps the rows sorted), and the diagonal
+  // scaling d_i = 1 / sqrt|s_ii| of the singularity test below.
+  k.outer.assign(size_t(n) + 1, 0);
+  k.inner.clear();
+  k.values.clear();
+  Eigen::VectorXd d = Eigen::VectorXd::Ones(n);
+  for (int c = 0; c < n; ++c) {
+    for (SystemMatrix::InnerIterator it(S, free_[size_t(c)]); it; ++it) {
+      const int row = position_[size_t(it.row())];
+      if (row < 0) continue;
+      if (!std::isfinite(it.value())) return false;
+      k.inner.push_back(row);
+      k.values.push_back(it.value());
+      if (row == c && it.value() != 0.0) d[c] = 1.0 / std::sqrt(std::abs(it.value()));
     }
-    const SystemMatrix Sf = ToMatrix(n, entries);
-    // The symbolic analysis (COLAMD ordering, elimination tree) is kept while the pattern stays
-    // (an assembly's pattern is fixed by the model's structure): numeric refactorization only.
-    const std::vector<int> outer(Sf.outerIndexPtr(), Sf.outerIndexPtr() + Sf.outerSize() + 1);
-    const std::vector<int> inner(Sf.innerIndexPtr(), Sf.innerIndexPtr() + Sf.nonZeros());
-    if (!sparse_lu_ || sparse_lu_.use_count() > 1 || outer != pattern_outer_ || inner != pattern_inner_) {
-      sparse_lu_ = std::make_shared<Eigen::SparseLU<SystemMatrix, Eigen::COLAMDOrdering<int>>>();
-      sparse_lu_->analyzePattern(Sf);
-      pattern_outer_ = outer;
-      pattern_inner_ = inner;
-    }
-    sparse_lu_->factorize(Sf);
-    valid_ = sparse_lu_->info() == Eigen::Success;
-    return valid_;
+    k.outer[size_t(c) + 1] = int(k.inner.size());
   }
-  const Eigen::MatrixXd A = DenseFreeMatrix(dofs, S);  // straight from S, no triplets
-  dense_.compute(A);
-  valid_ = A.allFinite();
-  if (!valid_ || n == 0) return valid_;
-  // Singular or not is a property of the matrix scaled to unit diagonal, D A D with
-  // d_i = 1 / sqrt|a_ii| (translations, rotations and modal coordinates in any units alike): its
-  // inverse D^-1 A^-1 D^-1 is probed with the factor on two fixed +-1 vectors (an O(n^2) estimate
-  // of ||(D A D)^-1||); singular when ||D A D|| ||(D A D)^-1|| > 1e15. The solve itself stays
-  // unscaled, so regular systems are solved exactly as before.
-  Eigen::VectorXd d(n);
-  for (int i = 0; i < n; ++i) d[i] = std::abs(A(i, i)) > 0 ? 1.0 / std::sqrt(std::abs(A(i, i))) : 1.0;
-  const double norm = (d.asDiagonal() * A * d.asDiagonal()).cwiseAbs().colwise().sum().maxCoeff();
+  if (n == 0) return valid_ = true;
+  bool factored = false;
+  if (!k.symbolic || k.outer != k.analysed_outer || k.inner != k.analysed_inner) {
+    // A new pattern (the first factorization, or the model's structure changed).
+    k.Clear();
+    k.symbolic = klu_analyze(n, k.outer.data(), k.inner.data(), &k.common);
+    if (!k.symbolic) return false;
+    k.analysed_outer = k.outer;
+    k.analysed_inner = k.inner;
+  } else if (k.numeric && klu_refactor(k.outer.data(), k.inner.data(), k.values.data(), k.symbolic, k.numeric, &k.common)) {
+    // The kept pivot order, while its pivots stay as good as the last full factorization's (the
+    // ratio of the smallest to the largest, O(n); the pivot growth would cost a factorization).
+    klu_rcond(k.symbolic, k.numeric, &k.common);
+    factored = k.common.rcond > 1e-3 * k.rcond;
+    if (factored) ++refactored_;
+  }
+  if (!factored) {
+    if (!k.FactorAnew()) return false;
+    ++full_;
+  }
+  // Singular or not is a property of the matrix scaled to unit diagonal, D S D (translations,
+  // rotations and modal coordinates in any units alike): its inverse D^-1 S^-1 D^-1 is probed
+  // with the factor on two fixed +-1 vectors (an O(nnz) estimate of ||(D S D)^-1||_1); singular
+  // when ||D S D||_1 ||(D S D)^-1||_1 > 1e15. The solve itself stays unscaled.
+  double norm = 0.0;
+  for (int c = 0; c < n; ++c) {
+    double column = 0.0;
+    for (int p = k.outer[size_t(c)]; p < k.outer[size_t(c) + 1]; ++p)
+      column += std::abs(d[k.inner[size_t(p)]] * k.values[size_t(p)] * d[c]);
+    norm = std::max(norm, column);
+  }
   double inverse = 0.0;
   for (int probe = 0; probe < 2; ++probe) {
-    Eigen::VectorXd x(n);
+    Eigen::VectorXd x(n), y(n);
     for (int i = 0; i < n; ++i) x[i] = ((i * (probe + 3) + probe) % 5 < 2) ? -1.0 : 1.0;
-    const Eigen::VectorXd y = d.cwiseInverse().asDiagonal() * dense_.solve(Eigen::VectorXd(d.cwiseInverse().asDiagonal() * x));
-    if (!y.allFinite()) return valid_ = false;
+    y = d.cwiseInverse().asDiagonal() * x;
+    klu_solve(k.symbolic, k.numeric, n, 1, y.data(), &k.common);
+    y = d.cwiseInverse().asDiagonal() * y;
+    if (!y.allFinite()) return false;
     inverse = std::max(inverse, y.lpNorm<1>() / x.lpNorm<1>());
   }
   valid_ = norm * inverse < 1e15;
@@ -474,9 +524,9 @@ bool FreeSolver::Factor(const DofMap& dofs, const SystemMatrix& S) {
 Eigen::VectorXd FreeSolver::Solve(const Eigen::VectorXd& r) const {
   Eigen::VectorXd rf(free_.size());
   for (size_t i = 0; i < free_.size(); ++i) rf[i] = r[free_[i]];
-  const Eigen::VectorXd df = sparse_ ? Eigen::VectorXd(sparse_lu_->solve(rf)) : Eigen::VectorXd(dense_.solve(rf));
+  if (rf.size() > 0) klu_solve(klu_->symbolic, klu_->numeric, int(rf.size()), 1, rf.data(), &klu_->common);
   Eigen::VectorXd d = Eigen::VectorXd::Zero(r.size());
-  for (size_t i = 0; i < free_.size(); ++i) d[free_[i]] = df[i];
+  for (size_t i = 0; i < free_.size(); ++i) d[free_[i]] = rf[i];
   return d;
 }
 

@@ -16,7 +16,6 @@
 #include <Eigen/Core>
 #include <Eigen/LU>
 #include <Eigen/SparseCore>
-#include <Eigen/SparseLU>
 #include <memory>
 #include <array>
 #include <functional>
@@ -69,8 +68,9 @@ struct SystemModel {
   int n_nodes() const { return int(node_names.size()); }
 };
 
-/// System matrices are sparse (assembled from triplets); the solver factorizes them densely
-/// below kDenseLimit free coordinates and with SparseLU above.
+/// System matrices are sparse (assembled from triplets) and factorized sparse (FreeSolver);
+/// analyses that need a dense matrix (the tangent's inertia, singular motions) do so below
+/// kDenseLimit free coordinates.
 using SystemMatrix = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
 using Triplets = std::vector<Eigen::Triplet<double>>;
 inline constexpr int kDenseLimit = 400;
@@ -234,27 +234,39 @@ SystemMatrix ToMatrix(int n, const Triplets& triplets);
 void ApplyPrescribed(const SystemModel& model, const DofMap& dofs, double t, SystemState& state,
                      Eigen::VectorXd* W, Eigen::VectorXd* Wdot);
 
-/// Solves S d = r on the coordinates that are not prescribed (prescribed ones: d = 0);
-/// dense LU below kDenseLimit free coordinates, SparseLU (COLAMD ordering) above.
+/// Solves S d = r on the coordinates that are not prescribed (prescribed ones: d = 0) with
+/// FreeSolver.
 Eigen::VectorXd SolveFree(const DofMap& dofs, const SystemMatrix& S, const Eigen::VectorXd& r);
 
-/// The same with a kept factorization (Jacobian reuse): Factor once, Solve many times.
-/// Factor returns false when the matrix is singular: a zero pivot or, dense, a condition
-/// estimate of the matrix scaled to unit diagonal (D S D) above 1e15.
+/// The sparse LU factor of S on the coordinates solved for, kept for several solves (Jacobian
+/// reuse): Factor once, Solve many times. KLU (SuiteSparse; Davis & Palamadai Natarajan 2010,
+/// made for the repeated factorizations of one sparsity pattern in circuit simulation): its
+/// ordering (block triangular form, then AMD on each block) is computed once per pattern, and a
+/// factorization with the same pattern reuses the analysis and, while its pivots stay good
+/// (the ratio of its smallest to its largest pivot within 1e-3 of the last full factorization's), the
+/// pivot order (klu_refactor); otherwise it pivots anew (klu_factor). Factor returns false when
+/// the matrix is singular: a zero pivot or a condition estimate of the matrix scaled to unit
+/// diagonal (D S D) above 1e15.
 class FreeSolver {
  public:
+  FreeSolver();
+  ~FreeSolver();
+  FreeSolver(const FreeSolver&) = delete;
+  FreeSolver& operator=(const FreeSolver&) = delete;
   bool Factor(const DofMap& dofs, const SystemMatrix& S);
   Eigen::VectorXd Solve(const Eigen::VectorXd& r) const;
   bool valid() const { return valid_; }
   void Invalidate() { valid_ = false; }
-  bool sparse() const { return sparse_; }
+  /// Factorizations that pivoted anew (klu_factor), and those that reused the pivot order.
+  long full_factorizations() const { return full_; }
+  long refactorizations() const { return refactored_; }
 
  private:
-  std::vector<int> free_;
-  Eigen::PartialPivLU<Eigen::MatrixXd> dense_;
-  std::shared_ptr<Eigen::SparseLU<SystemMatrix, Eigen::COLAMDOrdering<int>>> sparse_lu_;
-  std::vector<int> pattern_outer_, pattern_inner_;  ///< the pattern sparse_lu_ was analysed for
-  bool valid_ = false, sparse_ = false;
+  struct Klu;
+  std::unique_ptr<Klu> klu_;
+  std::vector<int> free_, position_;
+  bool valid_ = false;
+  long full_ = 0, refactored_ = 0;
 };
 /// S restricted to the coordinates solved for, dense (n_free x n_free).
 Eigen::MatrixXd DenseFreeMatrix(const DofMap& dofs, const SystemMatrix& S);
