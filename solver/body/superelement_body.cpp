@@ -134,29 +134,36 @@ SuperelementBody::Kinematics SuperelementBody::ComputeKinematics(const Eigen::Ve
   const int n = n_coordinates();
   Kinematics k;
   k.Phi_rig = Eigen::MatrixXd::Zero(n, 6);
-  // D is block diagonal: its products below act on the rotation blocks only (no n^3 products).
+  // D is block diagonal and Phi_rig is a [1, -r_a~; 0, 1] block per node: every product below
+  // goes node block by node block (O(n) per block, no n^3 or dense n x n products).
   std::vector<Eigen::Matrix3d>& Jinv = k.Jinv;
   Jinv.resize(static_cast<size_t>(n_nodes_));
+  std::vector<Eigen::Matrix3d> r_skew(static_cast<size_t>(n_nodes_));
   Eigen::MatrixXd W = Phi_CB_;  // Phi_CB D
+  k.S.setZero();
   for (int a = 0; a < n_nodes_; ++a) {
-    const Eigen::Vector3d r = X_[a] + q.segment<3>(6 * a);
+    r_skew[size_t(a)] = Skew<double>(Eigen::Vector3d(X_[a] + q.segment<3>(6 * a)));
     auto block = k.Phi_rig.block<6, 6>(6 * a, 0);
     block.setIdentity();
-    block.block<3, 3>(0, 3) = -Skew<double>(r);
+    block.block<3, 3>(0, 3) = -r_skew[size_t(a)];
     Jinv[size_t(a)] = LeftJacobianInverse<double>(Eigen::Vector3d(q.segment<3>(6 * a + 3)));
     W.middleCols<3>(6 * a + 3) = Phi_CB_.middleCols<3>(6 * a + 3) * Jinv[size_t(a)];
+    // S = Phi_CB D Phi_rig = W Phi_rig (FrameMatrix, with D's blocks at hand).
+    k.S.leftCols<3>() += W.middleCols<3>(6 * a);
+    k.S.rightCols<3>() += W.middleCols<3>(6 * a + 3) - W.middleCols<3>(6 * a) * r_skew[size_t(a)];
   }
-  k.S = FrameMatrix(q);
   k.Z = k.S.lu().solve(W);
+  // T = 1 - Phi_rig Z: node a's translation rows minus (Z_t - r_a~ Z_r), rotation rows minus Z_r
+  // (Z_t, Z_r the frame's translation and rotation rows of Z); B = D T: the rotation rows turned.
   k.T = Eigen::MatrixXd::Identity(n, n);
-  k.T.noalias() -= k.Phi_rig * k.Z;
-  k.B = k.T;
+  const auto Zt = k.Z.topRows<3>(), Zr = k.Z.bottomRows<3>();
   for (int a = 0; a < n_nodes_; ++a) {
-    for (int j = 0; j < n; ++j) {
-      const Eigen::Vector3d t = k.T.block<3, 1>(6 * a + 3, j);
-      k.B.block<3, 1>(6 * a + 3, j) = Jinv[size_t(a)] * t;
-    }
+    k.T.middleRows<3>(6 * a) -= Zt;
+    k.T.middleRows<3>(6 * a).noalias() += r_skew[size_t(a)] * Zr;
+    k.T.middleRows<3>(6 * a + 3) -= Zr;
   }
+  k.B = k.T;
+  for (int a = 0; a < n_nodes_; ++a) k.B.middleRows<3>(6 * a + 3).noalias() = Jinv[size_t(a)] * k.T.middleRows<3>(6 * a + 3);
   return k;
 }
 
@@ -402,17 +409,34 @@ Eigen::MatrixXd SuperelementBody::VelocityMapRate(const Eigen::MatrixXd& U, cons
 
 Eigen::VectorXd SuperelementBody::QuadraticInertia(const Eigen::MatrixXd& U, const Eigen::MatrixXd& Mg,
                                                    const BodyVelocity& w) const {
+  // G = VelocityMapRate(U, w) is never formed: its rows are xdot_a~ U (and omega_a~ U, option A;
+  // the diagonal block omega_a~, option B), so G w = [xdot_a x omega_j; omega_a x omega_j (A) or
+  // 0 (B); 0] and G^T p = U^T sum_a (p_a x xdot_a + p_rot,a x omega_a (A)) (+ option B:
+  // p_rot,a x omega_a on node a's rotation rows).
+  const bool B = options_.cardona_option_b;
   const Eigen::Vector3d omega_j = U * w;
-  const Eigen::MatrixXd G = VelocityMapRate(U, w);
   const Eigen::VectorXd p = Mg * w;
-  Eigen::VectorXd out = Mg * (G * w) - G.transpose() * p;
+  Eigen::VectorXd Gw = Eigen::VectorXd::Zero(n_coordinates());
+  Eigen::Vector3d v = Eigen::Vector3d::Zero();
+  for (int a = 0; a < n_nodes_; ++a) {
+    const Eigen::Vector3d xdot = w.segment<3>(6 * a), omega = w.segment<3>(6 * a + 3);
+    const Eigen::Vector3d p_x = p.segment<3>(6 * a), p_r = p.segment<3>(6 * a + 3);
+    Gw.segment<3>(6 * a) = xdot.cross(omega_j);
+    v += p_x.cross(xdot);
+    if (!B) {
+      Gw.segment<3>(6 * a + 3) = omega.cross(omega_j);
+      v += p_r.cross(omega);
+    }
+  }
+  Eigen::VectorXd out = Mg * Gw;
+  out.noalias() -= U.transpose() * v;
   for (int a = 0; a < n_nodes_; ++a) {
     const Eigen::Vector3d omega = w.segment<3>(6 * a + 3);
+    const Eigen::Vector3d p_x = p.segment<3>(6 * a), p_r = p.segment<3>(6 * a + 3);
+    if (B) out.segment<3>(6 * a + 3) -= p_r.cross(omega);
     // (Omega_P - Omega_hat) p: translation rows omega_j~, rotation rows omega_j~ - omega_a~ (A), 0 (B).
-    out.segment<3>(6 * a) += omega_j.cross(Eigen::Vector3d(p.segment<3>(6 * a)));
-    if (!options_.cardona_option_b) {
-      out.segment<3>(6 * a + 3) += (omega_j - omega).cross(Eigen::Vector3d(p.segment<3>(6 * a + 3)));
-    }
+    out.segment<3>(6 * a) += omega_j.cross(p_x);
+    if (!B) out.segment<3>(6 * a + 3) += (omega_j - omega).cross(p_r);
   }
   return out;
 }
@@ -564,8 +588,7 @@ void SuperelementBody::AddModalDamping(const BodyVelocity& w, Eigen::VectorXd& f
 
 double SuperelementBody::KineticEnergy(const Data& d, const BodyVelocity& w) const {
   if (has_exact_inertia()) return 0.5 * w.dot(ExactMass(d) * w);
-  const Eigen::VectorXd v = MapsOf(d).P * w;
-  return 0.5 * v.dot(M_ * v);
+  return 0.5 * w.dot(MapsOf(d).Mg * w);
 }
 
 BodyVelocityMaps SuperelementBody::Maps(const BodyConfiguration& c, const FrameSolution& frame) const {
@@ -667,10 +690,11 @@ Eigen::VectorXd SuperelementBody::GravityForce(const Data& data, const Eigen::Ve
         d.Y.transpose() * (M_ * yg) + data.kin.Z.bottomRows<3>().transpose() * (d.H.transpose() * yg);
     return TurnBlocks(frame.R, local, 2 * n_nodes_);
   }
+  // P^T block by block (P is block diagonal: its 3 x 3 node blocks, then 1 on the modal rows).
   const Eigen::MatrixXd& P = MapsOf(data).P;
-  Eigen::Matrix<double, 6, 1> rigid;
-  rigid << frame.R.transpose() * g, Eigen::Vector3d::Zero();
-  return P.transpose() * (M_ * (Phi_rig0_ * rigid));
+  Eigen::VectorXd f = M_ * (Phi_rig0_.leftCols<3>() * (frame.R.transpose() * g));
+  for (int a = 0; a < 2 * n_nodes_; ++a) f.segment<3>(3 * a) = P.block<3, 3>(3 * a, 3 * a).transpose() * Eigen::Vector3d(f.segment<3>(3 * a));
+  return f;
 }
 
 }  // namespace femb
