@@ -152,7 +152,10 @@ SuperelementBody::Kinematics SuperelementBody::ComputeKinematics(const Eigen::Ve
     k.S.leftCols<3>() += W.middleCols<3>(6 * a);
     k.S.rightCols<3>() += W.middleCols<3>(6 * a + 3) - W.middleCols<3>(6 * a) * r_skew[size_t(a)];
   }
-  k.Z = k.S.lu().solve(W);
+  // S^-1 once (a 6 x 6 LU); Z and the elastic tangent's K4 take fixed-size products with it
+  // instead of a triangular solve with n right-hand sides each.
+  k.S_inv = k.S.partialPivLu().inverse();
+  k.Z.noalias() = k.S_inv * W;
   // T = 1 - Phi_rig Z: node a's translation rows minus (Z_t - r_a~ Z_r), rotation rows minus Z_r
   // (Z_t, Z_r the frame's translation and rotation rows of Z); B = D T: the rotation rows turned.
   k.T = Eigen::MatrixXd::Identity(n, n);
@@ -356,7 +359,7 @@ void SuperelementBody::ElasticForce(const Data& d, Eigen::VectorXd* f, Eigen::Ma
       // K4: variation of D (exact rotation kinematics), v = P^T Q, P = 1 - D Phi_rig S^-1 Phi_CB.
       Eigen::VectorXd DtQ = Q;  // D^T Q
       for (int a = 0; a < n_nodes_; ++a) DtQ.segment<3>(6 * a + 3) = kin.Jinv[size_t(a)].transpose() * Q.segment<3>(6 * a + 3);
-      const Eigen::VectorXd v = Q - Phi_CB_.transpose() * kin.S.transpose().lu().solve(kin.Phi_rig.transpose() * DtQ);
+      const Eigen::VectorXd v = Q - Phi_CB_.transpose() * (kin.S_inv.transpose() * (kin.Phi_rig.transpose() * DtQ));
       // G is block diagonal (a 3 x 3 block per node rotation): T^T G B = sum_a T_a^T (G_a B_a)
       // with T_a, B_a node a's rotation rows.
       Eigen::Matrix<double, 3, Eigen::Dynamic> GB(3, n);

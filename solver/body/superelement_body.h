@@ -100,7 +100,7 @@ class SuperelementBody {
   struct Kinematics {
     Eigen::MatrixXd Phi_rig;  ///< n x 6
     std::vector<Eigen::Matrix3d> Jinv;  ///< D's rotation blocks J_l^-1(theta_k) (D is 1 elsewhere)
-    Eigen::Matrix<double, 6, 6> S;
+    Eigen::Matrix<double, 6, 6> S, S_inv;
     Eigen::MatrixXd Z;        ///< 6 x n
     Eigen::MatrixXd T;        ///< n x n
     Eigen::MatrixXd B;        ///< n x n
