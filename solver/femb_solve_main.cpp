@@ -245,7 +245,12 @@ int main(int argc, char** argv) {
       ok = r.ok;
       if (!ok) status = r.message;
       for (const std::string& w : r.warnings) std::printf("femb-solve: warning: %s\n", w.c_str());
-      if (!quiet) std::printf("femb-solve: %ld factorizations of the iteration matrix\n", r.factorizations);
+      if (!quiet) {
+        const std::string analysed = r.pattern_analyses == 1 ? "once" : std::to_string(r.pattern_analyses) + " times";
+        std::printf("femb-solve: %ld factorizations of the iteration matrix; its sparsity pattern analysed %s; pivots "
+                    "chosen in %ld, reused in %ld\n", r.factorizations, analysed.c_str(), r.pivoted,
+                    r.factorizations - r.pivoted);
+      }
       if (!quiet && spec.analysis.adaptive_step) {
         std::printf("femb-solve: %ld steps rejected (%ld by the error test, %ld by Newton)\n",
                     r.rejected_by_error + r.newton_cuts, r.rejected_by_error, r.newton_cuts);

@@ -65,9 +65,10 @@ bool AddBodyTerms(const SystemModel& model, const std::vector<BodyTerms>& terms,
     out.roundoff += r.roundoff;
     AddBodyNodeForces(model, int(b), r.r_b, parts.node_forces);
     const bool matrices = r.K.size() > 0;
-    ScatterBody(r.map, &r.r_b, matrices ? &r.K : nullptr, &out.residual, matrices ? &parts.K : nullptr);
-    ScatterBody(r.map, &r.f_grav, matrices ? &r.C : nullptr, &out.f_ext, matrices ? &parts.C : nullptr);
-    if (matrices) ScatterBody(r.map, nullptr, &r.M, nullptr, &parts.M);
+    const std::vector<MapEntry>& map = r.Map();
+    ScatterBody(map, &r.r_b, matrices ? &r.K : nullptr, &out.residual, matrices ? &parts.K : nullptr);
+    ScatterBody(map, &r.f_grav, matrices ? &r.C : nullptr, &out.f_ext, matrices ? &parts.C : nullptr);
+    if (matrices) ScatterBody(map, nullptr, &r.M, nullptr, &parts.M);
   }
   return true;
 }
@@ -90,25 +91,29 @@ namespace {
 // an iteration builds only when it needs them (not on the converged one, not with a kept
 // factorization). Bodies on `threads` threads; the result does not depend on their number.
 Assembly AssembleDynamicResidual(const SystemModel& model, const DofMap& dofs, DynamicState& s, double t,
-                                 std::vector<BodyPass>& passes, BodyThreads* threads = nullptr) {
+                                 BodyWorkspace& work, BodyThreads* threads = nullptr) {
   AssemblyParts parts;
   Assembly out = StartAssembly(model, dofs, parts);
   const int n_bodies = int(model.bodies.size());
+  std::vector<BodyPass>& passes = work.passes;
+  std::vector<BodyTerms>& results = work.terms;
   passes.resize(static_cast<size_t>(n_bodies));
-  std::vector<BodyTerms> results(static_cast<size_t>(n_bodies));
+  results.resize(static_cast<size_t>(n_bodies));
   const std::vector<Eigen::Matrix<double, 6, 1>> node_acc = NodeAccelerations(model, dofs, s.config, s.W, s.Wdot);
   ForEachBody(threads, n_bodies, [&](int b) {
     const SuperelementBody& body = model.bodies[b];
     BodyTerms& r = results[size_t(b)];
-    const BodyConfiguration c = BodyConfigurationOf(model, s.config, b);
+    BodyPass& pass = passes[size_t(b)];
+    r.frame_ok = true;
+    BodyConfiguration& c = pass.data.c;  // evaluated in place: the pass's storage is reused
+    BodyConfigurationOf(model, s.config, b, c);
     const FrameSolution frame = body.SolveFrameFrom(c, s.config.frames[b]);
     if (!frame.ok) {
       r.frame_ok = false;
       return;
     }
     s.config.frames[b] = frame;
-    BodyPass& pass = passes[size_t(b)];
-    pass.data = body.Evaluate(c, frame);
+    body.Evaluate(c, frame, pass.data);
     pass.w = GatherBody(model, dofs, s.config, b, s.W);
     pass.wdot = GatherBodyAcceleration(model, dofs, b, node_acc, s.Wdot);
     // Inertia stiffening (issue 13): K + K_sigma(a), a from this iterate's frame motion; its
@@ -119,14 +124,15 @@ Assembly AssembleDynamicResidual(const SystemModel& model, const DofMap& dofs, D
     body.ElasticForce(pass.data, &f_int, nullptr, stiffening ? &pass.load : nullptr);
     body.InertiaForce(pass.data, pass.w, pass.wdot, &f_in, nullptr, nullptr, &f_acc);
     body.AddModalDamping(pass.w, f_in, nullptr);
-    r.f_grav = Eigen::VectorXd::Zero(body.n_coordinates());
+    r.f_grav.setZero(body.n_coordinates());
     if (model.gravity.squaredNorm() > 0) r.f_grav = body.GravityForce(pass.data, model.gravity);
     // Scale of the forces in balance, each term on its own (for a torque-free body M_g wdot and
     // the gyroscopic terms cancel: their sum is no scale).
     r.scale = std::max({body.ForceNorm(f_int), body.ForceNorm(f_in), body.ForceNorm(r.f_grav), body.force_floor(),
                         body.ForceNorm(f_acc), body.ForceNorm(f_in - f_acc)});
     r.roundoff = body.RoundOffForce(c);
-    r.map = BodyMap(model, dofs, s.config, b);
+    BodyMap(model, dofs, s.config, b, pass.map);
+    r.kept_map = &pass.map;
     r.r_b = r.f_grav - f_int - f_in;
   });
   if (!AddBodyTerms(model, results, parts, out)) return out;
@@ -148,7 +154,6 @@ void AddDynamicMatrices(const SystemModel& model, const DofMap& dofs, const Dyna
                         BodyThreads* threads = nullptr, const MatrixCombination* combine = nullptr) {
   struct BodyMatrices {
     Eigen::MatrixXd K, C, M;
-    std::vector<MapEntry> map;
   };
   const int n_bodies = int(model.bodies.size());
   std::vector<BodyMatrices> results(static_cast<size_t>(n_bodies));
@@ -174,14 +179,15 @@ void AddDynamicMatrices(const SystemModel& model, const DofMap& dofs, const Dyna
       r.C.resize(0, 0);
       r.M.resize(0, 0);
     }
-    r.map = BodyMap(model, dofs, s.config, b);
   });
   Triplets K, C, M;
-  for (const BodyMatrices& r : results) {
-    ScatterBody(r.map, nullptr, &r.K, nullptr, &K);
+  for (int b = 0; b < n_bodies; ++b) {
+    const BodyMatrices& r = results[size_t(b)];
+    const std::vector<MapEntry>& map = passes[size_t(b)].map;  // the residual pass's, same state
+    ScatterBody(map, nullptr, &r.K, nullptr, &K);
     if (combine) continue;
-    ScatterBody(r.map, nullptr, &r.C, nullptr, &C);
-    ScatterBody(r.map, nullptr, &r.M, nullptr, &M);
+    ScatterBody(map, nullptr, &r.C, nullptr, &C);
+    ScatterBody(map, nullptr, &r.M, nullptr, &M);
   }
   const int n = dofs.n_dofs();
   Eigen::VectorXd unused = Eigen::VectorXd::Zero(n);
@@ -200,9 +206,9 @@ void AddDynamicMatrices(const SystemModel& model, const DofMap& dofs, const Dyna
 
 Assembly AssembleDynamic(const SystemModel& model, const DofMap& dofs, DynamicState& s, double t, bool matrices,
                          bool full_inertia_tangent = false) {
-  std::vector<BodyPass> passes;
-  Assembly out = AssembleDynamicResidual(model, dofs, s, t, passes);
-  if (out.ok && matrices) AddDynamicMatrices(model, dofs, s, t, passes, full_inertia_tangent, out);
+  BodyWorkspace work;
+  Assembly out = AssembleDynamicResidual(model, dofs, s, t, work);
+  if (out.ok && matrices) AddDynamicMatrices(model, dofs, s, t, work.passes, full_inertia_tangent, out);
   return out;
 }
 
@@ -302,7 +308,7 @@ namespace {
 // and drives there are their left limits).
 StepOutcome GeneralizedAlphaStep(const SystemModel& model, const DofMap& dofs, const DynamicOptions& options,
                                  const DynamicState& state, double h, double t_new, IterationMatrix& matrix,
-                                 BodyThreads& threads, DynamicState& next) {
+                                 BodyThreads& threads, BodyWorkspace& work, DynamicState& next) {
   const double rho = std::clamp(options.rho_inf, 0.0, 1.0);
   const double alpha_m = (2 * rho - 1) / (rho + 1), alpha_f = rho / (rho + 1);
   const double gamma = 0.5 + alpha_f - alpha_m, beta = 0.25 * (gamma + 0.5) * (gamma + 0.5);
@@ -318,10 +324,9 @@ StepOutcome GeneralizedAlphaStep(const SystemModel& model, const DofMap& dofs, c
   StepOutcome out;
   const double tolerance = std::max(options.tolerance, kRoundOffTolerance);
   const Eigen::VectorXd weights = ResidualWeights(model, dofs);
-  std::vector<BodyPass> passes;
   DivergenceTest divergence;
   for (; out.iterations < options.max_iterations; ++out.iterations) {
-    Assembly a = AssembleDynamicResidual(model, dofs, next, t_new, passes, &threads);
+    Assembly a = AssembleDynamicResidual(model, dofs, next, t_new, work, &threads);
     if (!a.ok || !a.residual.allFinite()) return out;
     const double r_norm = FreeNorm(dofs, a.residual, weights);
     if (r_norm <= std::max(tolerance * a.scale, a.roundoff) && out.iterations > 0) {
@@ -333,14 +338,14 @@ StepOutcome GeneralizedAlphaStep(const SystemModel& model, const DofMap& dofs, c
       next.f_ext = a.f_ext;
       next.f_drive = DriveForces(dofs, a.residual);
       next.drive_work += 0.5 * (state.f_drive + next.f_drive).dot(h * 0.5 * (state.W + next.W));
-      out.passes = std::move(passes);
+      out.passes_kept = true;
       return out;
     }
     if (divergence.Diverged(out.iterations, r_norm)) return out;
     bool built = false;
     const auto S = [&] {
       const MatrixCombination combine{gamma_p, beta_p};
-      if (!built) AddDynamicMatrices(model, dofs, next, t_new, passes, options.full_inertia_tangent, a, &threads, &combine);
+      if (!built) AddDynamicMatrices(model, dofs, next, t_new, work.passes, options.full_inertia_tangent, a, &threads, &combine);
       built = true;
       return a.K;  // K + gamma' C + beta' M
     };
@@ -366,6 +371,7 @@ DynamicResult SolveDynamic(const SystemModel& model, DynamicState& state, const 
   bool after_rejection = false;
   IterationMatrix matrix;
   BodyThreads threads(options.threads);
+  BodyWorkspace work;
   // Time is counted in steps: t = t_base + n h while the step stays nominal (summing h over 1e6
   // steps drifted by 1e-8 s and left a last step of 1e-8 s that Newton could not take), and a
   // remainder below 1% of a step is merged into the last one.
@@ -387,6 +393,8 @@ DynamicResult SolveDynamic(const SystemModel& model, DynamicState& state, const 
   auto fail = [&](const std::string& message) {
     result.message = message;
     result.factorizations = matrix.factorizations;
+    result.pattern_analyses = matrix.solver.analyses();
+    result.pivoted = matrix.solver.full_factorizations();
     return result;
   };
   while (state.t < options.end_time - 1e-12 * std::max(std::abs(options.end_time), options.step)) {
@@ -403,7 +411,7 @@ DynamicResult SolveDynamic(const SystemModel& model, DynamicState& state, const 
     const StepOutcome step =
         options.integrator == Integrator::kMidpoint
             ? MidpointStep(model, dofs, options, triples, state, h, t_new, matrix, threads, next)
-            : GeneralizedAlphaStep(model, dofs, options, state, h, t_new, matrix, threads, next);
+            : GeneralizedAlphaStep(model, dofs, options, state, h, t_new, matrix, threads, work, next);
     if (!step.converged && result.steps == 0 && result.newton_cuts == 0 && step.singular_matrix.size() > 0) {
       // The first iteration matrix is singular: the model's, not the step's.
       const std::string why = DescribeSingular(model, dofs, state.config, step.singular_matrix);
@@ -487,7 +495,7 @@ DynamicResult SolveDynamic(const SystemModel& model, DynamicState& state, const 
     }
     result.steps += 1;
     result.newton_iterations += step.iterations;
-    DynamicStepReport r = MeasureWith(model, dofs, state, step.passes);
+    DynamicStepReport r = MeasureWith(model, dofs, state, step.passes_kept ? work.passes : std::vector<BodyPass>{});
     r.h = h;
     r.iterations = step.iterations;
     r.rejected = result.rejected_by_error + result.newton_cuts;
@@ -521,6 +529,8 @@ DynamicResult SolveDynamic(const SystemModel& model, DynamicState& state, const 
     }
   }
   result.factorizations = matrix.factorizations;
+  result.pattern_analyses = matrix.solver.analyses();
+  result.pivoted = matrix.solver.full_factorizations();
   result.ok = true;
   return result;
 }

@@ -95,6 +95,8 @@ struct DynamicResult {
   long newton_cuts = 0;        ///< steps cut because Newton diverged
   long newton_iterations = 0;
   long factorizations = 0;  ///< of the iteration matrix
+  long pattern_analyses = 0;  ///< of its sparsity pattern (once unless the pattern changes)
+  long pivoted = 0;           ///< factorizations that chose their pivots anew (the others reused them)
 };
 
 /// Initial state: configuration and velocities given; accelerations from M_g wdot = f_ext -

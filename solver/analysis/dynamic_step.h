@@ -41,11 +41,13 @@ void FinishAssembly(const SystemModel& model, const DofMap& dofs, const SystemSt
 // f(b) for every body, on the pool when there is one.
 void ForEachBody(BodyThreads* threads, int n, const std::function<void(int)>& f);
 
-// What the residual pass keeps of one body for the iteration matrix (AddDynamicMatrices).
+// What the residual pass keeps of one body for the iteration matrix (AddDynamicMatrices), and
+// the body's map to the coordinates at that state.
 struct BodyPass {
   SuperelementBody::Data data;
   Eigen::VectorXd w, wdot;
   InertiaLoadFactors load;
+  std::vector<MapEntry> map;
 };
 
 // One body's share of an assembly pass, computed on its own (in parallel with the others) and
@@ -56,6 +58,15 @@ struct BodyTerms {
   Eigen::MatrixXd K, C, M;      // empty in a residual-only pass
   double scale = 0.0, roundoff = 0.0;
   std::vector<MapEntry> map;
+  const std::vector<MapEntry>* kept_map = nullptr;  // the map when kept elsewhere (BodyPass)
+  const std::vector<MapEntry>& Map() const { return kept_map ? *kept_map : map; }
+};
+
+// The bodies' storage of a dynamic analysis, kept from one Newton iteration and one step to the
+// next so that evaluating a body reuses its matrices instead of allocating them (issue 14).
+struct BodyWorkspace {
+  std::vector<BodyPass> passes;  // the last residual pass; after a converged step, at its state
+  std::vector<BodyTerms> terms;
 };
 
 // Adds the bodies' terms in body order: the same sums whatever thread computed them. False (the
@@ -117,7 +128,7 @@ struct StepOutcome {
   bool converged = false;
   int iterations = 0;
   SystemMatrix singular_matrix;  ///< the iteration matrix when its factorization failed
-  std::vector<BodyPass> passes;  ///< the bodies' data at the converged state (generalized-alpha)
+  bool passes_kept = false;  ///< the workspace's passes hold the bodies' data at the converged state
 };
 
 // Nodes whose coordinates include their own spatial rotation increment (free node, spherical

@@ -198,17 +198,30 @@ SystemState InitialState(const SystemModel& model) {
 
 BodyConfiguration BodyConfigurationOf(const SystemModel& model, const SystemState& state, int b) {
   BodyConfiguration c;
-  for (int node : model.body_nodes[b]) {
-    c.x.push_back(state.x[node]);
-    c.R.push_back(state.R[node]);
-  }
-  c.eta = state.eta[b];
+  BodyConfigurationOf(model, state, b, c);
   return c;
 }
 
+void BodyConfigurationOf(const SystemModel& model, const SystemState& state, int b, BodyConfiguration& c) {
+  const std::vector<int>& nodes = model.body_nodes[b];
+  c.x.resize(nodes.size());
+  c.R.resize(nodes.size());
+  for (size_t a = 0; a < nodes.size(); ++a) {
+    c.x[a] = state.x[nodes[a]];
+    c.R[a] = state.R[nodes[a]];
+  }
+  c.eta = state.eta[b];
+}
+
 std::vector<MapEntry> BodyMap(const SystemModel& model, const DofMap& dofs, const SystemState& state, int b) {
-  const SuperelementBody& body = model.bodies[b];
   std::vector<MapEntry> map;
+  BodyMap(model, dofs, state, b, map);
+  return map;
+}
+
+void BodyMap(const SystemModel& model, const DofMap& dofs, const SystemState& state, int b, std::vector<MapEntry>& map) {
+  const SuperelementBody& body = model.bodies[b];
+  map.clear();
   for (int a = 0; a < body.n_nodes(); ++a) {
     const int k = model.body_nodes[b][a];
     for (const auto& [col, vec] : state.J[k]) {
@@ -218,7 +231,6 @@ std::vector<MapEntry> BodyMap(const SystemModel& model, const DofMap& dofs, cons
     }
   }
   for (int m = 0; m < body.n_modes(); ++m) map.push_back({6 * body.n_nodes() + m, dofs.mode_dof(b) + m, 1.0});
-  return map;
 }
 
 void ScatterBody(const std::vector<MapEntry>& map, const Eigen::VectorXd* f, const Eigen::MatrixXd* K,
@@ -483,6 +495,7 @@ bool FreeSolver::Factor(const DofMap& dofs, const SystemMatrix& S) {
     k.Clear();
     k.symbolic = klu_analyze(n, k.outer.data(), k.inner.data(), &k.common);
     if (!k.symbolic) return false;
+    ++analysed_;
     k.analysed_outer = k.outer;
     k.analysed_inner = k.inner;
   } else if (k.numeric && klu_refactor(k.outer.data(), k.inner.data(), k.values.data(), k.symbolic, k.numeric, &k.common)) {

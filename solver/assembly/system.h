@@ -218,6 +218,8 @@ struct MapEntry {
   double coefficient;
 };
 std::vector<MapEntry> BodyMap(const SystemModel& model, const DofMap& dofs, const SystemState& state, int b);
+/// The same into `map` (its storage reused).
+void BodyMap(const SystemModel& model, const DofMap& dofs, const SystemState& state, int b, std::vector<MapEntry>& map);
 /// Adds body b's local vector (residual sense) to the node forces.
 void AddBodyNodeForces(const SystemModel& model, int b, const Eigen::VectorXd& r_b, NodeForces& forces);
 
@@ -257,7 +259,9 @@ class FreeSolver {
   Eigen::VectorXd Solve(const Eigen::VectorXd& r) const;
   bool valid() const { return valid_; }
   void Invalidate() { valid_ = false; }
-  /// Factorizations that pivoted anew (klu_factor), and those that reused the pivot order.
+  /// Sparsity patterns analysed, factorizations that pivoted anew (klu_factor), and those that
+  /// reused the pivot order (klu_refactor).
+  long analyses() const { return analysed_; }
   long full_factorizations() const { return full_; }
   long refactorizations() const { return refactored_; }
 
@@ -266,7 +270,7 @@ class FreeSolver {
   std::unique_ptr<Klu> klu_;
   std::vector<int> free_, position_;
   bool valid_ = false;
-  long full_ = 0, refactored_ = 0;
+  long analysed_ = 0, full_ = 0, refactored_ = 0;
 };
 /// S restricted to the coordinates solved for, dense (n_free x n_free).
 Eigen::MatrixXd DenseFreeMatrix(const DofMap& dofs, const SystemMatrix& S);
@@ -291,7 +295,8 @@ double FreeNorm(const DofMap& dofs, const Eigen::VectorXd& r, const Eigen::Vecto
 /// Applies an increment of the unknowns: x += dx, R <- exp(dpi~) R, eta += d eta.
 void ApplyIncrement(const SystemModel& model, const DofMap& dofs, const Eigen::VectorXd& delta, SystemState& state);
 
-/// The body's configuration taken from the system state.
+/// The body's configuration taken from the system state (into `c`: reusing its storage).
 BodyConfiguration BodyConfigurationOf(const SystemModel& model, const SystemState& state, int body);
+void BodyConfigurationOf(const SystemModel& model, const SystemState& state, int body, BodyConfiguration& c);
 
 }  // namespace femb

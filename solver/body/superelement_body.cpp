@@ -107,14 +107,19 @@ BodyConfiguration SuperelementBody::InitialConfiguration() const {
 }
 
 Eigen::VectorXd SuperelementBody::LocalCoordinates(const BodyConfiguration& c, const FrameSolution& frame) const {
-  Eigen::VectorXd q(n_coordinates());
+  Eigen::VectorXd q;
+  LocalCoordinates(c, frame, q);
+  return q;
+}
+
+void SuperelementBody::LocalCoordinates(const BodyConfiguration& c, const FrameSolution& frame, Eigen::VectorXd& q) const {
+  q.resize(n_coordinates());
   const Eigen::Matrix3d Rt = frame.R.transpose();
   for (int k = 0; k < n_nodes_; ++k) {
     q.segment<3>(6 * k) = Rt * (c.x[k] - frame.x) - X_[k];
-    q.segment<3>(6 * k + 3) = LogSO3(Rt * c.R[k] * R0_[k].transpose());
+    q.segment<3>(6 * k + 3) = LogSO3(Eigen::Matrix3d(Rt * c.R[k] * R0_[k].transpose()));
   }
   q.tail(n_modes_) = c.eta;
-  return q;
 }
 
 Eigen::Matrix<double, 6, 6> SuperelementBody::FrameMatrix(const Eigen::VectorXd& q) const {
@@ -130,67 +135,79 @@ Eigen::Matrix<double, 6, 6> SuperelementBody::FrameMatrix(const Eigen::VectorXd&
   return S;
 }
 
-SuperelementBody::Kinematics SuperelementBody::ComputeKinematics(const Eigen::VectorXd& q) const {
+void SuperelementBody::ComputeKinematics(const Eigen::VectorXd& q, Kinematics& k) const {
   const int n = n_coordinates();
-  Kinematics k;
-  k.Phi_rig = Eigen::MatrixXd::Zero(n, 6);
+  k.Phi_rig.setZero(n, 6);
   // D is block diagonal and Phi_rig is a [1, -r_a~; 0, 1] block per node: every product below
   // goes node block by node block (O(n) per block, no n^3 or dense n x n products).
   std::vector<Eigen::Matrix3d>& Jinv = k.Jinv;
   Jinv.resize(static_cast<size_t>(n_nodes_));
-  std::vector<Eigen::Matrix3d> r_skew(static_cast<size_t>(n_nodes_));
-  Eigen::MatrixXd W = Phi_CB_;  // Phi_CB D
+  Eigen::MatrixXd& W = k.W;
+  W = Phi_CB_;  // Phi_CB D
   k.S.setZero();
   for (int a = 0; a < n_nodes_; ++a) {
-    r_skew[size_t(a)] = Skew<double>(Eigen::Vector3d(X_[a] + q.segment<3>(6 * a)));
+    const Eigen::Matrix3d r_skew = Skew<double>(Eigen::Vector3d(X_[a] + q.segment<3>(6 * a)));
     auto block = k.Phi_rig.block<6, 6>(6 * a, 0);
     block.setIdentity();
-    block.block<3, 3>(0, 3) = -r_skew[size_t(a)];
+    block.block<3, 3>(0, 3) = -r_skew;
     Jinv[size_t(a)] = LeftJacobianInverse<double>(Eigen::Vector3d(q.segment<3>(6 * a + 3)));
     W.middleCols<3>(6 * a + 3) = Phi_CB_.middleCols<3>(6 * a + 3) * Jinv[size_t(a)];
     // S = Phi_CB D Phi_rig = W Phi_rig (FrameMatrix, with D's blocks at hand).
     k.S.leftCols<3>() += W.middleCols<3>(6 * a);
-    k.S.rightCols<3>() += W.middleCols<3>(6 * a + 3) - W.middleCols<3>(6 * a) * r_skew[size_t(a)];
+    k.S.rightCols<3>() += W.middleCols<3>(6 * a + 3) - W.middleCols<3>(6 * a) * r_skew;
   }
   // S^-1 once (a 6 x 6 LU); Z and the elastic tangent's K4 take fixed-size products with it
   // instead of a triangular solve with n right-hand sides each.
   k.S_inv = k.S.partialPivLu().inverse();
+  k.Z.resize(6, n);
   k.Z.noalias() = k.S_inv * W;
   // T = 1 - Phi_rig Z: node a's translation rows minus (Z_t - r_a~ Z_r), rotation rows minus Z_r
   // (Z_t, Z_r the frame's translation and rotation rows of Z); B = D T: the rotation rows turned.
-  k.T = Eigen::MatrixXd::Identity(n, n);
+  k.T.setIdentity(n, n);
   const auto Zt = k.Z.topRows<3>(), Zr = k.Z.bottomRows<3>();
   for (int a = 0; a < n_nodes_; ++a) {
+    const Eigen::Matrix3d r_skew = Skew<double>(Eigen::Vector3d(X_[a] + q.segment<3>(6 * a)));
     k.T.middleRows<3>(6 * a) -= Zt;
-    k.T.middleRows<3>(6 * a).noalias() += r_skew[size_t(a)] * Zr;
+    k.T.middleRows<3>(6 * a).noalias() += r_skew * Zr;
     k.T.middleRows<3>(6 * a + 3) -= Zr;
   }
   k.B = k.T;
   for (int a = 0; a < n_nodes_; ++a) k.B.middleRows<3>(6 * a + 3).noalias() = Jinv[size_t(a)] * k.T.middleRows<3>(6 * a + 3);
-  return k;
 }
 
 SuperelementBody::Data SuperelementBody::Evaluate(const BodyConfiguration& c, const FrameSolution& frame) const {
   Data d;
-  d.c = c;
-  d.frame = frame;
-  d.q = LocalCoordinates(c, frame);
-  d.kin = ComputeKinematics(d.q);
-  if (has_exact_inertia()) d.exact = Exact(d.q, d.kin);
+  Evaluate(c, frame, d);
   return d;
 }
 
+void SuperelementBody::Evaluate(const BodyConfiguration& c, const FrameSolution& frame, Data& d) const {
+  if (&c != &d.c) d.c = c;
+  d.frame = frame;
+  LocalCoordinates(d.c, frame, d.q);
+  ComputeKinematics(d.q, d.kin);
+  if (has_exact_inertia()) {
+    d.exact = Exact(d.q, d.kin);
+  } else {
+    d.exact.reset();
+  }
+  d.has_maps = false;
+  d.local_force.valid = false;
+  d.exact_mass.reset();
+  d.sigma_q.reset();
+}
+
 const BodyVelocityMaps& SuperelementBody::MapsOf(const Data& d) const {
-  if (!d.maps) {
-    BodyVelocityMaps maps;
+  if (!d.has_maps) {
+    BodyVelocityMaps& maps = d.maps;
     VelocityMaps(d, &maps.P, &maps.U);
     // M_g = P^T M P with P block diagonal (3 x 3 blocks, then 1 on the modal rows).
     maps.Mg = M_;
     TurnRowBlocks(maps.Mg, 2 * n_nodes_, [&](int a) { return Eigen::Matrix3d(maps.P.block<3, 3>(3 * a, 3 * a).transpose()); });
     TurnColBlocks(maps.Mg, 2 * n_nodes_, [&](int a) { return Eigen::Matrix3d(maps.P.block<3, 3>(3 * a, 3 * a)); });
-    d.maps = std::move(maps);
+    d.has_maps = true;
   }
-  return *d.maps;
+  return d.maps;
 }
 
 FrameSolution SuperelementBody::GuessFrame(const BodyConfiguration& c) const {
@@ -220,8 +237,9 @@ FrameSolution SuperelementBody::SolveFrame(const BodyConfiguration& c, const Fra
   for (int k = 0; k < n_nodes_; ++k) size = std::max(size, X_[k].norm());
   for (const Eigen::Vector3d& x : c.x) far = std::max(far, x.norm());
   const double tolerance = 1e-13 * size + 32 * std::numeric_limits<double>::epsilon() * far;
+  Eigen::VectorXd q(n_coordinates());
   for (int it = 0; it < 30; ++it) {
-    const Eigen::VectorXd q = LocalCoordinates(c, frame);
+    LocalCoordinates(c, frame, q);
     Eigen::Matrix<double, 6, 1> g = Phi_CB_ * q;
     frame.iterations = it;
     if (g.head<3>().norm() <= std::max(tolerance, 1e-300) && g.tail<3>().norm() <= 1e-13) {
@@ -252,12 +270,19 @@ const Eigen::VectorXd& SuperelementBody::LocalForce(const Data& d, const Inertia
   // The load factors the force is for (all zero without inertia stiffening: K q alone).
   const Eigen::Matrix<double, 12, 1> a =
       load && !K_sigma_.empty() ? load->a : Eigen::Matrix<double, 12, 1>::Zero().eval();
-  if (d.local_force && d.local_force->a == a) return d.local_force->Q;
+  Data::LocalForceOf& kept = d.local_force;
+  if (kept.valid && kept.a == a) return kept.Q;
   const Eigen::VectorXd& q = d.q;
-  Eigen::VectorXd f = polynomial_ ? PolynomialForce(K_, *polynomial_, q) : Eigen::VectorXd(K_ * q);
-  if (!a.isZero(0.0)) f.noalias() += SigmaProducts(d) * a;
-  d.local_force = Data::LocalForceOf{a, std::move(f)};
-  return d.local_force->Q;
+  if (polynomial_) {
+    kept.Q = PolynomialForce(K_, *polynomial_, q);
+  } else {
+    kept.Q.resize(q.size());
+    kept.Q.noalias() = K_ * q;
+  }
+  if (!a.isZero(0.0)) kept.Q.noalias() += SigmaProducts(d) * a;
+  kept.a = a;
+  kept.valid = true;
+  return kept.Q;
 }
 
 Eigen::MatrixXd SuperelementBody::LocalTangent(const Eigen::VectorXd& q, const InertiaLoadFactors* load) const {

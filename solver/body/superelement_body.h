@@ -101,6 +101,7 @@ class SuperelementBody {
     Eigen::MatrixXd Phi_rig;  ///< n x 6
     std::vector<Eigen::Matrix3d> Jinv;  ///< D's rotation blocks J_l^-1(theta_k) (D is 1 elsewhere)
     Eigen::Matrix<double, 6, 6> S, S_inv;
+    Eigen::MatrixXd W;        ///< Phi_CB D (6 x n)
     Eigen::MatrixXd Z;        ///< 6 x n
     Eigen::MatrixXd T;        ///< n x n
     Eigen::MatrixXd B;        ///< n x n
@@ -123,7 +124,8 @@ class SuperelementBody {
     Eigen::VectorXd q;  ///< q_loc
     Kinematics kin;
     std::optional<ExactData> exact;                 ///< with the exact inertia
-    mutable std::optional<BodyVelocityMaps> maps;   ///< the corotational maps, made when first asked
+    mutable BodyVelocityMaps maps;   ///< the corotational maps, made when first asked (has_maps)
+    mutable bool has_maps = false;
     mutable std::optional<Eigen::MatrixXd> exact_mass;  ///< M_g of the exact inertia, made when first asked
     /// The local force Q (LocalForce) of the last load factors asked for, and with inertia
     /// stiffening the products K_sigma,k q_loc (n x 12): the residual and the matrix passes of an
@@ -131,12 +133,16 @@ class SuperelementBody {
     struct LocalForceOf {
       Eigen::Matrix<double, 12, 1> a;  ///< the load factors (zero: none)
       Eigen::VectorXd Q;
+      bool valid = false;
     };
-    mutable std::optional<LocalForceOf> local_force;
+    mutable LocalForceOf local_force;
     mutable std::optional<Eigen::MatrixXd> sigma_q;
   };
   /// The body's quantities at configuration `c` with its solved floating frame.
   Data Evaluate(const BodyConfiguration& c, const FrameSolution& frame) const;
+  /// The same into `d`, reusing its storage (a body's data kept from one Newton iteration to the
+  /// next allocates nothing for the kinematics). `c` may be d.c itself.
+  void Evaluate(const BodyConfiguration& c, const FrameSolution& frame, Data& d) const;
   /// The velocity maps of `d` (computed on the first call).
   const BodyVelocityMaps& MapsOf(const Data& d) const;
 
@@ -177,6 +183,7 @@ class SuperelementBody {
 
   /// Local coordinates q_loc (6N + m).
   Eigen::VectorXd LocalCoordinates(const BodyConfiguration& c, const FrameSolution& frame) const;
+  void LocalCoordinates(const BodyConfiguration& c, const FrameSolution& frame, Eigen::VectorXd& q) const;
 
   /// Elastic force f (6N + m; per node force then moment, global axes; then modal forces) and,
   /// if `tangent` is not null, its derivative with respect to (dx_k, dpi_k, d eta).
@@ -328,7 +335,8 @@ class SuperelementBody {
   }
 
  private:
-  Kinematics ComputeKinematics(const Eigen::VectorXd& q_loc) const;
+  // Into `k`, reusing its storage.
+  void ComputeKinematics(const Eigen::VectorXd& q_loc, Kinematics& k) const;
   // S = Phi_CB D Phi_rig alone (the floating frame's Newton iteration), node block by node block.
   Eigen::Matrix<double, 6, 6> FrameMatrix(const Eigen::VectorXd& q_loc) const;
   // P (system velocities -> local velocities) and the frame's angular velocity map U (3 x n).
