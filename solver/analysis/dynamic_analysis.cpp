@@ -495,7 +495,8 @@ DynamicResult SolveDynamic(const SystemModel& model, DynamicState& state, const 
     }
     result.steps += 1;
     result.newton_iterations += step.iterations;
-    DynamicStepReport r = MeasureWith(model, dofs, state, step.passes_kept ? work.passes : std::vector<BodyPass>{});
+    static const std::vector<BodyPass> kNone;
+    DynamicStepReport r = MeasureWith(model, dofs, state, step.passes_kept ? work.passes : kNone);
     r.h = h;
     r.iterations = step.iterations;
     r.rejected = result.rejected_by_error + result.newton_cuts;
