@@ -150,17 +150,16 @@ struct MatrixCombination {
 // K + c_C C + c_M M alone, combined body by body before the scatter (one sparse matrix built
 // instead of three and their sum), and out.C, out.M stay empty.
 void AddDynamicMatrices(const SystemModel& model, const DofMap& dofs, const DynamicState& s, double t,
-                        const std::vector<BodyPass>& passes, bool full_inertia_tangent, Assembly& out,
+                        BodyWorkspace& work, bool full_inertia_tangent, Assembly& out,
                         BodyThreads* threads = nullptr, const MatrixCombination* combine = nullptr) {
-  struct BodyMatrices {
-    Eigen::MatrixXd K, C, M;
-  };
   const int n_bodies = int(model.bodies.size());
-  std::vector<BodyMatrices> results(static_cast<size_t>(n_bodies));
+  const std::vector<BodyPass>& passes = work.passes;
+  std::vector<BodyWorkspace::BodyMatrices>& results = work.matrices;
+  results.resize(static_cast<size_t>(n_bodies));
   ForEachBody(threads, n_bodies, [&](int b) {
     const SuperelementBody& body = model.bodies[b];
     const BodyPass& pass = passes[size_t(b)];
-    BodyMatrices& r = results[size_t(b)];
+    BodyWorkspace::BodyMatrices& r = results[size_t(b)];
     const bool stiffening = body.has_inertia_stiffening();
     Eigen::MatrixXd d_load;
     body.ElasticForce(pass.data, nullptr, &r.K, stiffening ? &pass.load : nullptr, stiffening ? &d_load : nullptr);
@@ -174,15 +173,14 @@ void AddDynamicMatrices(const SystemModel& model, const DofMap& dofs, const Dyna
     r.K += body.InertiaConfigurationTangent(pass.data, pass.w, pass.wdot, full_inertia_tangent);
     Eigen::VectorXd unused = Eigen::VectorXd::Zero(body.n_coordinates());
     body.AddModalDamping(pass.w, unused, &r.C);
-    if (combine) {
-      r.K += combine->c_C * r.C + combine->c_M * r.M;
-      r.C.resize(0, 0);
-      r.M.resize(0, 0);
-    }
+    if (combine) r.K += combine->c_C * r.C + combine->c_M * r.M;
   });
-  Triplets K, C, M;
+  Triplets &K = work.K, &C = work.C, &M = work.M;
+  K.clear();
+  C.clear();
+  M.clear();
   for (int b = 0; b < n_bodies; ++b) {
-    const BodyMatrices& r = results[size_t(b)];
+    const BodyWorkspace::BodyMatrices& r = results[size_t(b)];
     const std::vector<MapEntry>& map = passes[size_t(b)].map;  // the residual pass's, same state
     ScatterBody(map, nullptr, &r.K, nullptr, &K);
     if (combine) continue;
@@ -208,7 +206,7 @@ Assembly AssembleDynamic(const SystemModel& model, const DofMap& dofs, DynamicSt
                          bool full_inertia_tangent = false) {
   BodyWorkspace work;
   Assembly out = AssembleDynamicResidual(model, dofs, s, t, work);
-  if (out.ok && matrices) AddDynamicMatrices(model, dofs, s, t, work.passes, full_inertia_tangent, out);
+  if (out.ok && matrices) AddDynamicMatrices(model, dofs, s, t, work, full_inertia_tangent, out);
   return out;
 }
 
@@ -345,7 +343,7 @@ StepOutcome GeneralizedAlphaStep(const SystemModel& model, const DofMap& dofs, c
     bool built = false;
     const auto S = [&] {
       const MatrixCombination combine{gamma_p, beta_p};
-      if (!built) AddDynamicMatrices(model, dofs, next, t_new, work.passes, options.full_inertia_tangent, a, &threads, &combine);
+      if (!built) AddDynamicMatrices(model, dofs, next, t_new, work, options.full_inertia_tangent, a, &threads, &combine);
       built = true;
       return a.K;  // K + gamma' C + beta' M
     };

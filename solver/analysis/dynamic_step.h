@@ -67,6 +67,11 @@ struct BodyTerms {
 struct BodyWorkspace {
   std::vector<BodyPass> passes;  // the last residual pass; after a converged step, at its state
   std::vector<BodyTerms> terms;
+  struct BodyMatrices {
+    Eigen::MatrixXd K, C, M;
+  };
+  std::vector<BodyMatrices> matrices;  // the last matrix pass
+  Triplets K, C, M;                    // its system triplets (cleared, capacity kept)
 };
 
 // Adds the bodies' terms in body order: the same sums whatever thread computed them. False (the

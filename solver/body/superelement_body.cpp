@@ -362,12 +362,18 @@ void SuperelementBody::ElasticForce(const Data& d, Eigen::VectorXd* f, Eigen::Ma
   }
   if (!tangent) return;
 
-  Eigen::MatrixXd Kt;
-  const Eigen::MatrixXd Kq = LocalTangent(q, load);
+  Eigen::MatrixXd& Kt = *tangent;  // written in place: a kept tangent's storage is reused
+  const Eigen::MatrixXd* Kq = &K_;
+  Eigen::MatrixXd Kq_loaded;
+  if (polynomial_ || (load && !K_sigma_.empty())) {
+    Kq_loaded = LocalTangent(q, load);
+    Kq = &Kq_loaded;
+  }
+  Kt.resize(n, n);
   if (options_.approximated) {
-    Kt = T0_.transpose() * Kq * kin.B;
+    Kt.noalias() = T0_.transpose() * (*Kq * kin.B);
   } else {
-    Kt = kin.B.transpose() * Kq * kin.B;  // K1
+    Kt.noalias() = kin.B.transpose() * (*Kq * kin.B);  // K1
   }
   if (options_.full_tangent) {
     // Fhat, Mhat (n x 6) from Qhat: node rows [0, F~; 0, 0] and [0, 0; 0, M~].
@@ -378,7 +384,7 @@ void SuperelementBody::ElasticForce(const Data& d, Eigen::VectorXd* f, Eigen::Ma
       FMhat.block<3, 3>(6 * a, 3) = F;
       FMhat.block<3, 3>(6 * a + 3, 3) = Skew<double>(Eigen::Vector3d(Qhat.segment<3>(6 * a + 3)));
     }
-    Kt -= FMhat * kin.Z;  // K3: rotation of the frame
+    Kt.noalias() -= FMhat * kin.Z;  // K3: rotation of the frame
     if (!options_.approximated) {
       Kt.noalias() -= kin.Z.transpose() * (Fhat.transpose() * kin.B);  // K2: variation of Phi_rig in T (6 x n first)
       // K4: variation of D (exact rotation kinematics), v = P^T Q, P = 1 - D Phi_rig S^-1 Phi_CB.
@@ -400,7 +406,6 @@ void SuperelementBody::ElasticForce(const Data& d, Eigen::VectorXd* f, Eigen::Ma
   const Eigen::Matrix3d R = frame.R, Rt = frame.R.transpose();
   TurnRowBlocks(Kt, 2 * n_nodes_, [&](int) { return R; });
   TurnColBlocks(Kt, 2 * n_nodes_, [&](int) { return Rt; });
-  *tangent = std::move(Kt);
 }
 
 void SuperelementBody::VelocityMaps(const Data& d, Eigen::MatrixXd* P, Eigen::MatrixXd* U) const {
