@@ -35,7 +35,7 @@ Eigen::MatrixXd Stack(const std::vector<Eigen::VectorXd>& rows, int cols) {
 }  // namespace
 
 ResultsRecorder::ResultsRecorder(const Scene& scene, const std::string& directory)
-    : scene_(scene), directory_(directory) {
+    : scene_(scene), dofs_(scene.model), directory_(directory) {
   // Animation frames: as asked, or about kAutoFrames per run (the output steps the analysis will
   // take: load steps, or time steps over output_every).
   constexpr double kAutoFrames = 500;
@@ -101,7 +101,7 @@ void ResultsRecorder::Record(double t, const SystemState& state, const Eigen::Ve
                              const std::vector<Eigen::Matrix<double, 6, 1>>* reactions,
                              const Eigen::VectorXd* accelerations) {
   const SystemModel& model = scene_.model;
-  const DofMap dofs(model);
+  const DofMap& dofs = dofs_;
   const int n = model.n_nodes();
   Eigen::VectorXd pos(3 * n), quat(4 * n), vel(3 * n), ang(3 * n);
   for (int k = 0; k < n; ++k) {

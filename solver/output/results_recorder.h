@@ -45,6 +45,7 @@ class ResultsRecorder {
 
  private:
   const Scene& scene_;
+  const DofMap dofs_;  ///< the scene model's numbering (the model does not change while recording)
   int animation_every_ = 1;  ///< one animation frame per this many output steps (spec, or auto)
   double frame_interval_ = 0;  ///< > 0: one animation frame per this much time (auto, with step: auto)
   double next_frame_time_ = 0;
