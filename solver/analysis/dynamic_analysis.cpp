@@ -194,12 +194,12 @@ void AddDynamicMatrices(const SystemModel& model, const DofMap& dofs, const Dyna
   AddJointGeometricStiffness(model, dofs, s.config, out.node_forces, K);
   if (combine) {
     for (const Eigen::Triplet<double>& e : C) K.emplace_back(e.row(), e.col(), combine->c_C * e.value());
-    out.K = ToMatrix(n, K);
+    out.K = work.K_build.Build(n, K);
     return;
   }
-  out.K = ToMatrix(n, K);
-  out.C = ToMatrix(n, C);
-  out.M = ToMatrix(n, M);
+  out.K = work.K_build.Build(n, K);
+  out.C = work.C_build.Build(n, C);
+  out.M = work.M_build.Build(n, M);
 }
 
 Assembly AssembleDynamic(const SystemModel& model, const DofMap& dofs, DynamicState& s, double t, bool matrices,

@@ -72,6 +72,7 @@ struct BodyWorkspace {
   };
   std::vector<BodyMatrices> matrices;  // the last matrix pass
   Triplets K, C, M;                    // its system triplets (cleared, capacity kept)
+  TripletAssembler K_build, C_build, M_build;  // their sparse matrices (slots kept)
 };
 
 // Adds the bodies' terms in body order: the same sums whatever thread computed them. False (the

@@ -3,6 +3,7 @@
 #include <klu.h>
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -249,6 +250,32 @@ SystemMatrix ToMatrix(int n, const Triplets& triplets) {
   SystemMatrix A(n, n);
   A.setFromTriplets(triplets.begin(), triplets.end());
   return A;
+}
+
+const SystemMatrix& TripletAssembler::Build(int n, const Triplets& triplets) {
+  const size_t m = triplets.size();
+  bool same = matrix_.rows() == n && rows_.size() == m;
+  for (size_t i = 0; same && i < m; ++i) same = triplets[i].row() == rows_[i] && triplets[i].col() == cols_[i];
+  if (!same) {
+    matrix_ = ToMatrix(n, triplets);
+    ++rebuilds_;
+    rows_.resize(m);
+    cols_.resize(m);
+    slots_.resize(m);
+    const int* outer = matrix_.outerIndexPtr();
+    const int* inner = matrix_.innerIndexPtr();
+    for (size_t i = 0; i < m; ++i) {
+      rows_[i] = triplets[i].row();
+      cols_[i] = triplets[i].col();
+      const int* found = std::lower_bound(inner + outer[cols_[i]], inner + outer[cols_[i] + 1], rows_[i]);
+      slots_[i] = int(found - inner);
+    }
+    return matrix_;
+  }
+  double* values = matrix_.valuePtr();
+  std::fill(values, values + matrix_.nonZeros(), 0.0);
+  for (size_t i = 0; i < m; ++i) values[slots_[i]] += triplets[i].value();
+  return matrix_;
 }
 
 Eigen::VectorXd GatherBody(const SystemModel& model, const DofMap& dofs, const SystemState& state, int b,

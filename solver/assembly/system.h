@@ -231,6 +231,21 @@ void ScatterBody(const std::vector<MapEntry>& map, const Eigen::VectorXd* f, con
 /// Builds an n x n sparse matrix from triplets (duplicates summed).
 SystemMatrix ToMatrix(int n, const Triplets& triplets);
 
+/// ToMatrix for triplets that come with the same rows and columns in the same order time after
+/// time (an assembly of a fixed model): the first build sorts them and keeps, for each triplet,
+/// its slot in the compressed matrix; the next ones with the same sequence only add the values
+/// into their slots (no sorting, no allocation; sums in triplet order, as setFromTriplets).
+class TripletAssembler {
+ public:
+  const SystemMatrix& Build(int n, const Triplets& triplets);
+  long rebuilds() const { return rebuilds_; }
+
+ private:
+  SystemMatrix matrix_;
+  std::vector<int> rows_, cols_, slots_;
+  long rebuilds_ = 0;
+};
+
 /// Sets the prescribed coordinates to their values at t: configuration (through the node's
 /// basis), and, when W / Wdot are given, their rates and accelerations.
 void ApplyPrescribed(const SystemModel& model, const DofMap& dofs, double t, SystemState& state,
