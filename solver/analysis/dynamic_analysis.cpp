@@ -65,10 +65,9 @@ bool AddBodyTerms(const SystemModel& model, const std::vector<BodyTerms>& terms,
     out.roundoff += r.roundoff;
     AddBodyNodeForces(model, int(b), r.r_b, parts.node_forces);
     const bool matrices = r.K.size() > 0;
-    const std::vector<MapEntry>& map = r.Map();
-    ScatterBody(map, &r.r_b, matrices ? &r.K : nullptr, &out.residual, matrices ? &parts.K : nullptr);
-    ScatterBody(map, &r.f_grav, matrices ? &r.C : nullptr, &out.f_ext, matrices ? &parts.C : nullptr);
-    if (matrices) ScatterBody(map, nullptr, &r.M, nullptr, &parts.M);
+    ScatterBody(r.map, &r.r_b, matrices ? &r.K : nullptr, &out.residual, matrices ? &parts.K : nullptr);
+    ScatterBody(r.map, &r.f_grav, matrices ? &r.C : nullptr, &out.f_ext, matrices ? &parts.C : nullptr);
+    if (matrices) ScatterBody(r.map, nullptr, &r.M, nullptr, &parts.M);
   }
   return true;
 }
@@ -131,8 +130,7 @@ Assembly AssembleDynamicResidual(const SystemModel& model, const DofMap& dofs, D
     r.scale = std::max({body.ForceNorm(f_int), body.ForceNorm(f_in), body.ForceNorm(r.f_grav), body.force_floor(),
                         body.ForceNorm(f_acc), body.ForceNorm(f_in - f_acc)});
     r.roundoff = body.RoundOffForce(c);
-    BodyMap(model, dofs, s.config, b, pass.map);
-    r.kept_map = &pass.map;
+    BodyMap(model, dofs, s.config, b, r.map);
     r.r_b = r.f_grav - f_int - f_in;
   });
   if (!AddBodyTerms(model, results, parts, out)) return out;
@@ -181,7 +179,7 @@ void AddDynamicMatrices(const SystemModel& model, const DofMap& dofs, const Dyna
   M.clear();
   for (int b = 0; b < n_bodies; ++b) {
     const BodyWorkspace::BodyMatrices& r = results[size_t(b)];
-    const std::vector<MapEntry>& map = passes[size_t(b)].map;  // the residual pass's, same state
+    const std::vector<MapEntry>& map = work.terms[size_t(b)].map;  // the residual pass's, same state
     ScatterBody(map, nullptr, &r.K, nullptr, &K);
     if (combine) continue;
     ScatterBody(map, nullptr, &r.C, nullptr, &C);
@@ -388,11 +386,14 @@ DynamicResult SolveDynamic(const SystemModel& model, DynamicState& state, const 
   double energy_scale = std::abs(E0);
   bool warned = false;
   if (const std::string w = RoundOffToleranceWarning(options.tolerance); !w.empty()) result.warnings.push_back(w);
-  auto fail = [&](const std::string& message) {
-    result.message = message;
+  const auto count_factorizations = [&] {
     result.factorizations = matrix.factorizations;
     result.pattern_analyses = matrix.solver.analyses();
     result.pivoted = matrix.solver.full_factorizations();
+  };
+  auto fail = [&](const std::string& message) {
+    result.message = message;
+    count_factorizations();
     return result;
   };
   while (state.t < options.end_time - 1e-12 * std::max(std::abs(options.end_time), options.step)) {
@@ -527,9 +528,7 @@ DynamicResult SolveDynamic(const SystemModel& model, DynamicState& state, const 
       --cuts;
     }
   }
-  result.factorizations = matrix.factorizations;
-  result.pattern_analyses = matrix.solver.analyses();
-  result.pivoted = matrix.solver.full_factorizations();
+  count_factorizations();
   result.ok = true;
   return result;
 }

@@ -41,13 +41,11 @@ void FinishAssembly(const SystemModel& model, const DofMap& dofs, const SystemSt
 // f(b) for every body, on the pool when there is one.
 void ForEachBody(BodyThreads* threads, int n, const std::function<void(int)>& f);
 
-// What the residual pass keeps of one body for the iteration matrix (AddDynamicMatrices), and
-// the body's map to the coordinates at that state.
+// What the residual pass keeps of one body for the iteration matrix (AddDynamicMatrices).
 struct BodyPass {
   SuperelementBody::Data data;
   Eigen::VectorXd w, wdot;
   InertiaLoadFactors load;
-  std::vector<MapEntry> map;
 };
 
 // One body's share of an assembly pass, computed on its own (in parallel with the others) and
@@ -58,15 +56,13 @@ struct BodyTerms {
   Eigen::MatrixXd K, C, M;      // empty in a residual-only pass
   double scale = 0.0, roundoff = 0.0;
   std::vector<MapEntry> map;
-  const std::vector<MapEntry>* kept_map = nullptr;  // the map when kept elsewhere (BodyPass)
-  const std::vector<MapEntry>& Map() const { return kept_map ? *kept_map : map; }
 };
 
 // The bodies' storage of a dynamic analysis, kept from one Newton iteration and one step to the
 // next so that evaluating a body reuses its matrices instead of allocating them (issue 14).
 struct BodyWorkspace {
   std::vector<BodyPass> passes;  // the last residual pass; after a converged step, at its state
-  std::vector<BodyTerms> terms;
+  std::vector<BodyTerms> terms;  // the last residual pass's; their maps serve the matrix pass too
   struct BodyMatrices {
     Eigen::MatrixXd K, C, M;
   };
