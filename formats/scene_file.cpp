@@ -299,6 +299,12 @@ SceneSpec ParseScene(const std::string& text, const std::string& name, const std
           if (!scene.functions.count(j.prescribed)) v->Fail("time function '" + j.prescribed + "' is not defined under 'functions'");
         }
       }
+      if (auto v = m.Optional("cut")) {
+        j.cut = v->Bool();
+        if (j.cut && !j.prescribed.empty()) {
+          v->Fail("a prescribed joint cannot be cut: its coordinate carries the drive (cut another joint of the loop)");
+        }
+      }
       m.CheckNoUnknownKeys();
       scene.joints.push_back(j);
     }

@@ -67,6 +67,7 @@ struct SceneJointSpec {
   Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();  ///< revolute/prismatic/cylindrical/universal (global)
   Eigen::Vector3d axis2 = Eigen::Vector3d::UnitY();  ///< universal: second axis (global at t = 0)
   std::string prescribed;  ///< time function of the joint coordinate (angle or travel); "" = free
+  bool cut = false;        ///< close it by constraint equations even where it could be a tree joint
   std::string where;
 };
 

@@ -129,12 +129,15 @@ int main(int argc, char** argv) {
       if (quiet) return;
       if (!force && Seconds(wall) - last_print < 1.0) return;
       last_print = Seconds(wall);
+      // Closed loops: the largest violation of their equations so far (a length).
+      char loops[64] = "";
+      if (!scene.model.cut_joints.empty()) std::snprintf(loops, sizeof loops, " loop gap %.2g", recorder.max_loop_violation());
       if (spec.analysis.adaptive_step) {
-        std::printf("femb-solve: t = %-10.6g steps %-7ld rejected %-5ld Newton iterations %-8ld wall %.2f s\n", t,
-                    step_count, rejected, total_iterations, Seconds(wall));
+        std::printf("femb-solve: t = %-10.6g steps %-7ld rejected %-5ld Newton iterations %-8ld wall %.2f s%s\n", t,
+                    step_count, rejected, total_iterations, Seconds(wall), loops);
       } else {
-        std::printf("femb-solve: t = %-10.6g steps %-7ld Newton iterations %-8ld wall %.2f s\n", t, step_count,
-                    total_iterations, Seconds(wall));
+        std::printf("femb-solve: t = %-10.6g steps %-7ld Newton iterations %-8ld wall %.2f s%s\n", t, step_count,
+                    total_iterations, Seconds(wall), loops);
       }
       std::fflush(stdout);
     };

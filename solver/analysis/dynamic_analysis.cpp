@@ -135,6 +135,7 @@ Assembly AssembleDynamicResidual(const SystemModel& model, const DofMap& dofs, D
   });
   if (!AddBodyTerms(model, results, parts, out)) return out;
   FinishAssembly(model, dofs, s.config, t, s.W, false, parts, out);
+  AddLoopConstraints(model, dofs, s.config, &out.residual, nullptr, &out.node_forces);
   return out;
 }
 
@@ -189,6 +190,7 @@ void AddDynamicMatrices(const SystemModel& model, const DofMap& dofs, const Dyna
   Eigen::VectorXd unused = Eigen::VectorXd::Zero(n);
   AddNodeLoads(model, s.config, t, unused, &K);
   AddSpringDampers(model, s.config, s.W, unused, &K, &C, nullptr);
+  AddLoopConstraints(model, dofs, s.config, nullptr, &K, nullptr);
   AddJointGeometricStiffness(model, dofs, s.config, out.node_forces, K);
   if (combine) {
     for (const Eigen::Triplet<double>& e : C) K.emplace_back(e.row(), e.col(), combine->c_C * e.value());
@@ -225,8 +227,40 @@ namespace {
 void ConsistentAccelerations(const SystemModel& model, const DofMap& dofs, DynamicState& s) {
   const Assembly b = AssembleDynamic(model, dofs, s, s.t, true);
   for (int j : dofs.solved()) s.Wdot[j] = 0.0;
-  const Eigen::VectorXd free_acc = SolveFree(dofs, b.M, b.residual - b.M * s.Wdot);
+  Eigen::VectorXd rhs = b.residual - b.M * s.Wdot;
+  SystemMatrix M = b.M;
+  if (dofs.n_multipliers() > 0) {
+    // Closed loops: [M G^T; G 0] [Wdot; d lambda] = [r; -Gdot W] (the constraints' second time
+    // derivative), with Gdot W = d^2 g / dt^2 along q(t) = q + t W (no coordinate acceleration),
+    // by central differences over a step that moves the model by 1e-4 of its size.
+    Triplets G;
+    AddLoopConstraints(model, dofs, s.config, nullptr, nullptr, nullptr, &G);
+    M = b.M + ToMatrix(dofs.n_dofs(), G);
+    const double L = std::max(BoundingDiagonal(model.node_x0), 1e-300);
+    double speed = 0.0;
+    for (int k = 0; k < model.n_nodes(); ++k) speed = std::max(speed, NodeMotion(s.config, k, s.W).head<3>().norm() +
+                                                                         L * NodeMotion(s.config, k, s.W).tail<3>().norm());
+    if (speed > 0) {
+      const double eps = 1e-4 * L / speed;
+      const auto g_at = [&](double e) {
+        SystemState q = s.config;
+        if (e != 0.0) ApplyIncrement(model, dofs, e * s.W, q);
+        Eigen::VectorXd r = Eigen::VectorXd::Zero(dofs.n_dofs());
+        q.lambda.setZero();
+        AddLoopConstraints(model, dofs, q, &r, nullptr, nullptr);
+        return Eigen::VectorXd(-r.tail(dofs.n_multipliers()));  // g
+      };
+      rhs.tail(dofs.n_multipliers()) = -(g_at(eps) - 2 * g_at(0.0) + g_at(-eps)) / (eps * eps);
+    } else {
+      rhs.tail(dofs.n_multipliers()).setZero();
+    }
+  }
+  const Eigen::VectorXd free_acc = SolveFree(dofs, M, rhs);
   for (int j : dofs.solved()) s.Wdot[j] = free_acc[j];
+  if (dofs.n_multipliers() > 0) {
+    s.config.lambda += free_acc.tail(dofs.n_multipliers());
+    dofs.ClearMultipliers(s.Wdot);
+  }
   s.a = s.Wdot;
   s.f_ext = b.f_ext;
   Eigen::VectorXd added = Eigen::VectorXd::Zero(dofs.n_dofs());
@@ -321,11 +355,16 @@ StepOutcome GeneralizedAlphaStep(const SystemModel& model, const DofMap& dofs, c
   const double tolerance = std::max(options.tolerance, kRoundOffTolerance);
   const Eigen::VectorXd weights = ResidualWeights(model, dofs);
   DivergenceTest divergence;
+  // Closed loops: the constraints hold to the tolerance times the model's size.
+  const double loop_tolerance = tolerance * std::max(BoundingDiagonal(model.node_x0), 1e-300);
+  const auto loops_closed = [&] {
+    return dofs.n_multipliers() == 0 || LoopViolation(model, dofs, next.config) <= loop_tolerance;
+  };
   for (; out.iterations < options.max_iterations; ++out.iterations) {
     Assembly a = AssembleDynamicResidual(model, dofs, next, t_new, work, &threads);
     if (!a.ok || !a.residual.allFinite()) return out;
     const double r_norm = FreeNorm(dofs, a.residual, weights);
-    if (r_norm <= std::max(tolerance * a.scale, a.roundoff) && out.iterations > 0) {
+    if (r_norm <= std::max(tolerance * a.scale, a.roundoff) && out.iterations > 0 && loops_closed()) {
       out.converged = true;
       next.a += (1 - alpha_f) / (1 - alpha_m) * next.Wdot;
       next.t = t_new;
@@ -350,6 +389,8 @@ StepOutcome GeneralizedAlphaStep(const SystemModel& model, const DofMap& dofs, c
     ApplyIncrement(model, dofs, delta, next.config);
     next.W += gamma_p * delta;
     next.Wdot += beta_p * delta;
+    dofs.ClearMultipliers(next.W);  // the multipliers took their increment in next.config
+    dofs.ClearMultipliers(next.Wdot);
   }
   return out;
 }
@@ -393,6 +434,7 @@ DynamicResult SolveDynamic(const SystemModel& model, DynamicState& state, const 
   };
   auto fail = [&](const std::string& message) {
     result.message = message;
+    if (const std::string why = LoopSingularity(model, state.config); !why.empty()) result.message += "; " + why;
     count_factorizations();
     return result;
   };

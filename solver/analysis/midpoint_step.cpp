@@ -231,6 +231,11 @@ Assembly AssembleMidpoint(const SystemModel& model, const DofMap& dofs, const Dy
     r.r_b = f_grav - f_int - f_in;
   });
   if (!AddBodyTerms(model, terms, parts, out)) return out;
+  // Closed loops: the constraint forces -G^T lambda_n+1 at the mid configuration (their work
+  // over the step, lambda . G(q_m) Delta, is lambda . (g_n+1 - g_n) = 0 up to O(h^3)); the
+  // equations themselves hold at the end of the step (MidpointStep).
+  k.mid.lambda = s1.config.lambda;
+  AddLoopConstraints(model, dofs, k.mid, &out.residual, nullptr, &parts.node_forces);
   // Loads at the mid time and configuration, spring-dampers at the mean rates Delta / h.
   FinishAssembly(model, dofs, k.mid, s0.t + 0.5 * h, k.delta / h, true, parts, out);
   f_ext_work = out.f_ext.dot(k.delta);
@@ -257,13 +262,22 @@ StepOutcome MidpointStep(const SystemModel& model, const DofMap& dofs, const Dyn
   const double tolerance = std::max(options.tolerance, kRoundOffTolerance);
   const Eigen::VectorXd weights = ResidualWeights(model, dofs);
   DivergenceTest divergence;
+  const int n_lambda = dofs.n_multipliers();
+  const double loop_tolerance = tolerance * std::max(BoundingDiagonal(model.node_x0), 1e-300);
   for (; out.iterations < options.max_iterations; ++out.iterations) {
     MidpointKinematics k = Midpoint(model, dofs, triples, state, h, next);
     double work = 0.0;
-    const Assembly a = AssembleMidpoint(model, dofs, state, p0, h, k, next, work, &threads);
+    Assembly a = AssembleMidpoint(model, dofs, state, p0, h, k, next, work, &threads);
     if (!a.ok || !a.residual.allFinite()) return out;
+    if (n_lambda > 0) {
+      // The loop equations at the end of the step: residual rows -g(q_n+1).
+      Eigen::VectorXd end = Eigen::VectorXd::Zero(dofs.n_dofs());
+      AddLoopConstraints(model, dofs, next.config, &end, nullptr, nullptr);
+      a.residual.tail(n_lambda) = end.tail(n_lambda);
+    }
     const double r_norm = FreeNorm(dofs, a.residual, weights);
-    if (r_norm <= std::max(tolerance * a.scale, a.roundoff) && out.iterations > 0) {
+    const bool loops_closed = n_lambda == 0 || LoopViolation(model, dofs, next.config) <= loop_tolerance;
+    if (r_norm <= std::max(tolerance * a.scale, a.roundoff) && out.iterations > 0 && loops_closed) {
       out.converged = true;
       next.t = t_new;
       // a: the mean acceleration over the step (t_n+1/2); Wdot: extrapolated to t_n+1 from
@@ -283,7 +297,19 @@ StepOutcome MidpointStep(const SystemModel& model, const DofMap& dofs, const Dyn
     }
     if (divergence.Diverged(out.iterations, r_norm)) return out;
     // Newton's increment delta at n+1: dW_n+1 = V delta, dq_m = T delta, dw_m ~ delta / h.
-    const auto S = [&] { return SystemMatrix(a.K * k.T + (1.0 / h) * (a.C + a.M * k.V)); };
+    const auto S = [&] {
+      SystemMatrix S = a.K * k.T + (1.0 / h) * (a.C + a.M * k.V);
+      if (n_lambda == 0) return S;
+      // Loops: d(-G_m^T lambda)/d delta = H_m T, its lambda columns G_m^T, the rows G_n+1.
+      Triplets at_mid, at_end;
+      AddLoopConstraints(model, dofs, k.mid, nullptr, &at_mid, nullptr, nullptr, kLoopHessian);
+      S += ToMatrix(dofs.n_dofs(), at_mid) * k.T;
+      at_mid.clear();
+      AddLoopConstraints(model, dofs, k.mid, nullptr, &at_mid, nullptr, nullptr, kLoopColumns);
+      AddLoopConstraints(model, dofs, next.config, nullptr, &at_end, nullptr, nullptr, kLoopRows);
+      at_end.insert(at_end.end(), at_mid.begin(), at_mid.end());
+      return SystemMatrix(S + ToMatrix(dofs.n_dofs(), at_end));
+    };
     Eigen::VectorXd delta;
     if (!matrix.Increment(dofs, options, h, S, a.residual, delta, out.singular_matrix)) return out;
     ApplyIncrement(model, dofs, delta, next.config);

@@ -1,6 +1,7 @@
 #include "solver/analysis/modal_analysis.h"
 
 #include <Eigen/Eigenvalues>
+#include <Eigen/QR>
 #include <cmath>
 
 namespace femb {
@@ -27,7 +28,9 @@ ModalResult LinearizedModes(const SystemModel& model, SystemState& state, double
   const Eigen::MatrixXd M(ToMatrix(n, M_entries));
   const Eigen::MatrixXd tangent(forces.tangent);
   // Prescribed coordinates are held at their values: modes of the others.
-  const std::vector<int>& free = dofs.solved();
+  std::vector<int> free;
+  for (int j : dofs.solved())
+    if (!dofs.multiplier(j)) free.push_back(j);
   Eigen::MatrixXd K(free.size(), free.size()), Mf(free.size(), free.size());
   for (size_t i = 0; i < free.size(); ++i) {
     for (size_t j = 0; j < free.size(); ++j) {
@@ -35,7 +38,24 @@ ModalResult LinearizedModes(const SystemModel& model, SystemState& state, double
       Mf(i, j) = 0.5 * (M(free[i], free[j]) + M(free[j], free[i]));
     }
   }
-  const int n_free = int(free.size());
+  // Closed loops: the motions that keep them closed, dq = N y with G N = 0 (N: an orthonormal
+  // basis of the null space of the constraint Jacobian on the free coordinates, from the QR
+  // factorization of G^T); K and M projected, N^T K N and N^T M N (K with the multipliers'
+  // geometric stiffness d(G^T lambda)/dq: a preloaded loop's stiffness).
+  Eigen::MatrixXd N = Eigen::MatrixXd::Identity(Eigen::Index(free.size()), Eigen::Index(free.size()));
+  if (dofs.n_multipliers() > 0) {
+    const int m = dofs.n_multipliers(), first = dofs.first_multiplier();
+    Eigen::MatrixXd Gt(free.size(), m);
+    for (size_t i = 0; i < free.size(); ++i)
+      for (int c = 0; c < m; ++c) Gt(Eigen::Index(i), c) = tangent(first + c, free[i]);
+    const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(Gt);
+    const int rank = int(qr.rank());
+    const Eigen::MatrixXd Q = qr.householderQ();
+    N = Q.rightCols(Q.cols() - rank);
+    K = (N.transpose() * K * N).eval();
+    Mf = (N.transpose() * Mf * N).eval();
+  }
+  const int n_free = int(N.cols());
   Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> eig(K, Mf);
   if (eig.info() != Eigen::Success) {
     result.message = "generalized eigen solver failed (is every unknown carrying mass?)";
@@ -48,7 +68,8 @@ ModalResult LinearizedModes(const SystemModel& model, SystemState& state, double
     result.frequencies_hz[k] = std::copysign(std::sqrt(std::abs(l)), l) / (2 * M_PI);
   }
   result.shapes = Eigen::MatrixXd::Zero(n, m);
-  for (size_t i = 0; i < free.size(); ++i) result.shapes.row(free[i]) = eig.eigenvectors().row(i).head(m);
+  const Eigen::MatrixXd shapes = N * eig.eigenvectors().leftCols(m);
+  for (size_t i = 0; i < free.size(); ++i) result.shapes.row(free[i]) = shapes.row(Eigen::Index(i));
   result.ok = true;
   return result;
 }

@@ -58,7 +58,10 @@ StaticResult SolveStatic(const SystemModel& model, SystemState& state, const Sta
       energy = f.elastic_energy;
       loads_after = f.loads;
       if (!std::isfinite(r_norm)) break;
-      if (it > 0 && (r_norm <= std::max(tolerance * std::max(f.force_scale, 1e-300), f.roundoff) || last_step <= 1e-13 * size)) {
+      const bool loops_closed =
+          dofs.n_multipliers() == 0 || LoopViolation(model, dofs, trial) <= tolerance * BoundingDiagonal(model.node_x0);
+      if (it > 0 && loops_closed &&
+          (r_norm <= std::max(tolerance * std::max(f.force_scale, 1e-300), f.roundoff) || last_step <= 1e-13 * size)) {
         converged = true;
         break;
       }
@@ -97,7 +100,7 @@ StaticResult SolveStatic(const SystemModel& model, SystemState& state, const Sta
         }
         break;
       }
-      last_step = delta.norm();
+      last_step = delta.head(dofs.first_multiplier()).norm();  // coordinates, not multipliers
       travelled += delta;
       ApplyIncrement(model, dofs, delta, trial);
     }

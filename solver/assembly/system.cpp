@@ -51,6 +51,11 @@ DofMap::DofMap(const SystemModel& model) : motion_(&model.motion) {
     mode_dof_.push_back(n_dofs_);
     n_dofs_ += body.n_modes();
   }
+  first_multiplier_ = n_dofs_;
+  for (const CutJoint& cut : model.cut_joints) {
+    multiplier_first_.push_back(n_dofs_);
+    n_dofs_ += int(cut.equations.size());
+  }
   prescribed_.assign(n_dofs_, false);
   for (const auto& p : model.prescribed) prescribed_[prescribed_index(p)] = true;
   for (int j = 0; j < n_dofs_; ++j) {
@@ -193,6 +198,7 @@ SystemState InitialState(const SystemModel& model) {
     s.eta.push_back(Eigen::VectorXd::Zero(body.n_modes()));
     s.frames.push_back(body.InitialFrame());
   }
+  s.lambda = Eigen::VectorXd::Zero(dofs.n_multipliers());
   UpdateKinematics(model, dofs, s);
   return s;
 }
@@ -358,12 +364,168 @@ SystemForces AssembleStatic(const SystemModel& model, const DofMap& dofs, System
                    &out.elastic_energy, &node_forces);
   out.residual += loads;
   out.force_scale = std::max(out.force_scale, (ResidualWeights(model, dofs).asDiagonal() * loads).norm());
+  AddLoopConstraints(model, dofs, state, &out.residual, with_tangent ? &tangent : nullptr, &node_forces);
   out.node_forces = node_forces;
   if (with_tangent) {
     AddJointGeometricStiffness(model, dofs, state, node_forces, tangent);
     out.tangent = ToMatrix(n, tangent);
   }
   return out;
+}
+
+void AddLoopConstraints(const SystemModel& model, const DofMap& dofs, const SystemState& state,
+                        Eigen::VectorXd* residual, Triplets* tangent, NodeForces* node_forces, Triplets* jacobian,
+                        int blocks) {
+  for (size_t c = 0; c < model.cut_joints.size(); ++c) {
+    const CutJoint& cut = model.cut_joints[c];
+    const NodeJoint& j = cut.joint;
+    const int nodes[2] = {j.parent, j.child};
+    const ConstraintBlock block = EvaluateConstraint(j, state.x[nodes[0]], state.R[nodes[0]], state.x[nodes[1]], state.R[nodes[1]]);
+    const int first = dofs.multiplier_first(int(c)), m = int(cut.equations.size());
+    Eigen::VectorXd l_full = Eigen::VectorXd::Zero(block.g.size());  // dropped equations: none
+    for (int i = 0; i < m; ++i) l_full[cut.equations[size_t(i)]] = state.lambda[first - dofs.first_multiplier() + i];
+    const Eigen::Matrix<double, 12, 1> f = block.G.transpose() * l_full;  // G^T lambda on (parent, child)
+    for (int e = 0; e < 2; ++e) {
+      const Eigen::Matrix<double, 6, 1> f_e = f.segment<6>(6 * e);
+      if (node_forces) node_forces->Add(nodes[e], -f_e);
+      if (residual) {
+        for (const auto& [col, vec] : state.J[nodes[e]]) (*residual)[col] -= vec.dot(f_e);
+      }
+    }
+    for (int i = 0; i < m; ++i) {
+      const int eq = cut.equations[size_t(i)];
+      if (residual) (*residual)[first + i] -= block.g[eq];
+      for (Triplets* t : {tangent, jacobian}) {
+        if (!t) continue;
+        const bool rows = t == jacobian || (blocks & kLoopRows), columns = t == jacobian || (blocks & kLoopColumns);
+        for (int e = 0; e < 2; ++e) {
+          for (const auto& [col, vec] : state.J[nodes[e]]) {
+            const double v = (block.G.block<1, 6>(eq, 6 * e) * vec)(0);
+            if (v == 0.0) continue;
+            if (rows) t->emplace_back(first + i, col, v);
+            if (columns) t->emplace_back(col, first + i, v);
+          }
+        }
+      }
+    }
+    if (!tangent || !(blocks & kLoopHessian) || l_full.isZero(0.0)) continue;
+    // d(G^T lambda)/dq through the node Jacobians (their own derivative: the node forces above).
+    const Eigen::Matrix<double, 12, 12> H =
+        ConstraintHessian(j, state.x[nodes[0]], state.R[nodes[0]], state.x[nodes[1]], state.R[nodes[1]], l_full);
+    for (int a = 0; a < 2; ++a) {
+      for (int b = 0; b < 2; ++b) {
+        const Eigen::Matrix<double, 6, 6> H_ab = H.block<6, 6>(6 * a, 6 * b);
+        if (H_ab.isZero(0.0)) continue;
+        for (const auto& [ci, vi] : state.J[nodes[a]]) {
+          const Eigen::Matrix<double, 1, 6> row = vi.transpose() * H_ab;
+          for (const auto& [cj, vj] : state.J[nodes[b]]) {
+            const double v = (row * vj)(0);
+            if (v != 0.0) tangent->emplace_back(ci, cj, v);
+          }
+        }
+      }
+    }
+  }
+}
+
+namespace {
+
+// Per kept equation of the cut joints, in order: how independent it is of the ones before it that
+// are (Gram-Schmidt on the rows of the constraint Jacobian over the coordinates solved for,
+// columns scaled to unit size so that units do not matter): the relative remainder, 1 for an
+// equation orthogonal to the others, 0 for a repeated one; independent above `tolerance`.
+std::vector<double> EquationRemainders(const SystemModel& model, const DofMap& dofs, const SystemState& state,
+                                       double tolerance) {
+  Triplets entries;
+  AddLoopConstraints(model, dofs, state, nullptr, nullptr, nullptr, &entries);
+  const int m = dofs.n_multipliers(), first = dofs.first_multiplier();
+  std::vector<int> column(size_t(dofs.n_dofs()), -1);
+  int n = 0;
+  for (int j : dofs.solved())
+    if (!dofs.multiplier(j)) column[size_t(j)] = n++;
+  Eigen::MatrixXd G = Eigen::MatrixXd::Zero(m, n);
+  for (const Eigen::Triplet<double>& e : entries)
+    if (e.row() >= first && e.col() < first && column[size_t(e.col())] >= 0) G(e.row() - first, column[size_t(e.col())]) += e.value();
+  for (int c = 0; c < n; ++c) {
+    const double size = G.col(c).cwiseAbs().maxCoeff();
+    if (size > 0) G.col(c) /= size;
+  }
+  std::vector<Eigen::VectorXd> basis;
+  std::vector<double> remainder(size_t(m), 0.0);
+  for (int i = 0; i < m; ++i) {
+    const double size = G.row(i).norm();
+    if (size == 0.0) continue;
+    Eigen::VectorXd v = G.row(i).transpose() / size;
+    for (int pass = 0; pass < 2; ++pass)
+      for (const Eigen::VectorXd& q : basis) v -= q.dot(v) * q;
+    remainder[size_t(i)] = v.norm();
+    if (v.norm() > tolerance) basis.push_back(v / v.norm());
+  }
+  return remainder;
+}
+
+}  // namespace
+
+std::vector<std::string> DropRedundantEquations(SystemModel& model) {
+  std::vector<std::string> notes(model.cut_joints.size());
+  if (model.cut_joints.empty()) return notes;
+  const DofMap dofs(model);
+  const std::vector<double> remainder = EquationRemainders(model, dofs, InitialState(model), 1e-8);
+  const int first = dofs.first_multiplier();
+  for (size_t c = 0; c < model.cut_joints.size(); ++c) {
+    CutJoint& cut = model.cut_joints[c];
+    std::vector<int> kept;
+    std::string dropped;
+    for (size_t i = 0; i < cut.equations.size(); ++i) {
+      if (remainder[size_t(dofs.multiplier_first(int(c)) - first) + i] > 1e-8) {
+        kept.push_back(cut.equations[i]);
+      } else {
+        dropped += (dropped.empty() ? "" : ", ") + ConstraintName(cut.joint, cut.equations[i]);
+      }
+    }
+    notes[c] = dropped;
+    cut.equations = kept;
+  }
+  return notes;
+}
+
+std::string LoopSingularity(const SystemModel& model, const SystemState& state) {
+  if (model.cut_joints.empty()) return "";
+  const DofMap dofs(model);
+  const std::vector<double> remainder = EquationRemainders(model, dofs, state, 1e-8);
+  double least = 1.0;
+  int worst = -1, equation = -1;
+  for (size_t c = 0; c < model.cut_joints.size(); ++c) {
+    for (size_t i = 0; i < model.cut_joints[c].equations.size(); ++i) {
+      const double r = remainder[size_t(dofs.multiplier_first(int(c)) - dofs.first_multiplier()) + i];
+      if (r < least) least = r, worst = int(c), equation = model.cut_joints[c].equations[i];
+    }
+  }
+  if (worst < 0 || least > 0.05) return "";
+  char buffer[80];
+  std::snprintf(buffer, sizeof buffer, " is within %.2g of the span of the other constraints", least);
+  return model.cut_joints[size_t(worst)].name + ": the loop it closes is at or near a singular configuration (a dead " +
+         "point: its " + ConstraintName(model.cut_joints[size_t(worst)].joint, equation) + buffer + ")";
+}
+
+double LoopViolation(const SystemModel& model, const DofMap& dofs, const SystemState& state, int* worst) {
+  (void)dofs;
+  double L = BoundingDiagonal(model.node_x0);
+  if (!(L > 0)) L = 1.0;
+  double largest = 0.0;
+  if (worst) *worst = model.cut_joints.empty() ? -1 : 0;
+  for (size_t c = 0; c < model.cut_joints.size(); ++c) {
+    const NodeJoint& j = model.cut_joints[c].joint;
+    const ConstraintBlock block = EvaluateConstraint(j, state.x[j.parent], state.R[j.parent], state.x[j.child], state.R[j.child]);
+    for (int eq : model.cut_joints[c].equations) {
+      const double v = std::abs(block.g[eq]) * (block.position[size_t(eq)] ? 1.0 : L);
+      if (v > largest) {
+        largest = v;
+        if (worst) *worst = int(c);
+      }
+    }
+  }
+  return largest;
 }
 
 void AddNodeLoads(const SystemModel& model, const SystemState& state, double t, Eigen::VectorXd& residual,
@@ -443,6 +605,7 @@ void ApplyIncrement(const SystemModel& model, const DofMap& dofs, const Eigen::V
   for (size_t b = 0; b < model.bodies.size(); ++b) {
     state.eta[b] += delta.segment(dofs.mode_dof(int(b)), model.bodies[b].n_modes());
   }
+  if (dofs.n_multipliers() > 0) state.lambda += delta.tail(dofs.n_multipliers());
   UpdateKinematics(model, dofs, state);
 }
 
@@ -498,12 +661,10 @@ bool FreeSolver::Factor(const DofMap& dofs, const SystemMatrix& S) {
   const int n = int(free_.size());
   position_.assign(size_t(S.rows()), -1);
   for (int i = 0; i < n; ++i) position_[size_t(free_[size_t(i)])] = i;
-  // The free block, column by column (free_ ascending keeps the rows sorted), and the diagonal
-  // scaling d_i = 1 / sqrt|s_ii| of the singularity test below.
+  // The free block, column by column (free_ ascending keeps the rows sorted).
   k.outer.assign(size_t(n) + 1, 0);
   k.inner.clear();
   k.values.clear();
-  Eigen::VectorXd d = Eigen::VectorXd::Ones(n);
   for (int c = 0; c < n; ++c) {
     for (SystemMatrix::InnerIterator it(S, free_[size_t(c)]); it; ++it) {
       const int row = position_[size_t(it.row())];
@@ -511,11 +672,39 @@ bool FreeSolver::Factor(const DofMap& dofs, const SystemMatrix& S) {
       if (!std::isfinite(it.value())) return false;
       k.inner.push_back(row);
       k.values.push_back(it.value());
-      if (row == c && it.value() != 0.0) d[c] = 1.0 / std::sqrt(std::abs(it.value()));
     }
     k.outer[size_t(c) + 1] = int(k.inner.size());
   }
   if (n == 0) return valid_ = true;
+  // Loop constraints: the multipliers' rows (G, of order 1) and columns (G^T) meet coordinates
+  // whose diagonal may be of order m / (beta h^2) (Arnold & Bruls 2007: the index-3 iteration
+  // matrix's condition grows as h^-2 unscaled). Row and column of multiplier i are scaled by
+  // s_i, the largest |S_jj| of the coordinates its equation involves: the factor is of D S D,
+  // D = diag(1, ..., s_i), and Solve returns D (D S D)^-1 D r.
+  scale_ = Eigen::VectorXd::Ones(n);
+  if (dofs.n_multipliers() > 0) {
+    Eigen::VectorXd diagonal = Eigen::VectorXd::Zero(n), s = Eigen::VectorXd::Zero(n);
+    for (int c = 0; c < n; ++c)
+      for (int p = k.outer[size_t(c)]; p < k.outer[size_t(c) + 1]; ++p)
+        if (k.inner[size_t(p)] == c) diagonal[c] = std::abs(k.values[size_t(p)]);
+    for (int c = 0; c < n; ++c) {
+      if (dofs.multiplier(free_[size_t(c)])) continue;
+      for (int p = k.outer[size_t(c)]; p < k.outer[size_t(c) + 1]; ++p) {
+        const int row = k.inner[size_t(p)];
+        if (dofs.multiplier(free_[size_t(row)])) s[row] = std::max(s[row], diagonal[c]);
+      }
+    }
+    for (int i = 0; i < n; ++i)
+      if (dofs.multiplier(free_[size_t(i)]) && s[i] > 0) scale_[i] = s[i];
+    for (int c = 0; c < n; ++c)
+      for (int p = k.outer[size_t(c)]; p < k.outer[size_t(c) + 1]; ++p)
+        k.values[size_t(p)] *= scale_[k.inner[size_t(p)]] * scale_[c];
+  }
+  // The diagonal scaling d_i = 1 / sqrt|s_ii| of the singularity test below.
+  Eigen::VectorXd d = Eigen::VectorXd::Ones(n);
+  for (int c = 0; c < n; ++c)
+    for (int p = k.outer[size_t(c)]; p < k.outer[size_t(c) + 1]; ++p)
+      if (k.inner[size_t(p)] == c && k.values[size_t(p)] != 0.0) d[c] = 1.0 / std::sqrt(std::abs(k.values[size_t(p)]));
   bool factored = false;
   if (!k.symbolic || k.outer != k.analysed_outer || k.inner != k.analysed_inner) {
     // A new pattern (the first factorization, or the model's structure changed).
@@ -563,10 +752,10 @@ bool FreeSolver::Factor(const DofMap& dofs, const SystemMatrix& S) {
 
 Eigen::VectorXd FreeSolver::Solve(const Eigen::VectorXd& r) const {
   Eigen::VectorXd rf(free_.size());
-  for (size_t i = 0; i < free_.size(); ++i) rf[i] = r[free_[i]];
+  for (size_t i = 0; i < free_.size(); ++i) rf[i] = r[free_[i]] * scale_[Eigen::Index(i)];
   if (rf.size() > 0) klu_solve(klu_->symbolic, klu_->numeric, int(rf.size()), 1, rf.data(), &klu_->common);
   Eigen::VectorXd d = Eigen::VectorXd::Zero(r.size());
-  for (size_t i = 0; i < free_.size(); ++i) d[free_[i]] = rf[i];
+  for (size_t i = 0; i < free_.size(); ++i) d[free_[i]] = rf[i] * scale_[Eigen::Index(i)];
   return d;
 }
 
@@ -644,6 +833,8 @@ Eigen::VectorXd ResidualWeights(const SystemModel& model, const DofMap& dofs) {
     const int m = model.bodies[b].n_modes();
     if (m > 0) w.segment(dofs.mode_dof(int(b)), m).setConstant(model.bodies[b].ModalForceWeight());
   }
+  // The multipliers' rows hold constraint violations, not forces: LoopViolation judges them.
+  if (dofs.n_multipliers() > 0) w.tail(dofs.n_multipliers()).setZero();
   return w;
 }
 

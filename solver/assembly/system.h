@@ -1,4 +1,5 @@
-// A multibody system of superelements on shared 6-DOF nodes, without Lagrange multipliers.
+// A multibody system of superelements on shared 6-DOF nodes, with Lagrange multipliers only
+// where a loop of joints must be closed (cut joints, solver/joints/loop_closure.h).
 // Nodes shared by bodies are rigid connections. Each node k moves in a subspace of its spatial
 // increments (dx, dpi): dq_k = S_k dz_k with its own coordinates z_k — S_k = 1 for a free
 // node, nothing for a clamp, [0; 1] for a spherical joint to ground, [0; a] for a revolute joint
@@ -24,6 +25,7 @@
 
 #include "solver/body/superelement_body.h"
 #include "solver/forces/spring_damper.h"
+#include "solver/joints/loop_closure.h"
 #include "solver/joints/node_joint.h"
 
 namespace femb {
@@ -55,6 +57,9 @@ struct SystemModel {
   std::vector<Prescribed> prescribed;
   /// Joints between nodes: each child node depends on its parent (a tree; no cycles).
   std::vector<NodeJoint> joints;
+  /// Joints that close loops of that tree: constraint equations with Lagrange multipliers
+  /// (solver/joints/loop_closure.h); their child keeps its own coordinates.
+  std::vector<CutJoint> cut_joints;
   std::vector<SuperelementBody> bodies;
   std::vector<std::vector<int>> body_nodes;  ///< system node of each interface of each body
   std::vector<std::string> body_names;       ///< for messages (may be empty)
@@ -88,6 +93,7 @@ struct SystemState {
   std::vector<Eigen::Matrix3d> R;
   std::vector<Eigen::VectorXd> eta;         ///< per body
   std::vector<FrameSolution> frames;        ///< per body, the last solved floating frame
+  Eigen::VectorXd lambda;                   ///< the cut joints' multipliers (DofMap::multiplier_first)
 };
 
 /// Numbering of the unknowns (coordinates).
@@ -106,6 +112,17 @@ class DofMap {
   const std::vector<int>& order() const { return order_; }
   /// First coordinate of body b's modal coordinates.
   int mode_dof(int b) const { return mode_dof_[b]; }
+  /// The unknowns after the coordinates: the multipliers of the cut joints' kept equations
+  /// (cut joint c's from multiplier_first(c)), n_multipliers() of them; none without loops.
+  int n_multipliers() const { return n_dofs_ - first_multiplier_; }
+  int multiplier_first(int c) const { return multiplier_first_[c]; }
+  int first_multiplier() const { return first_multiplier_; }
+  bool multiplier(int j) const { return j >= first_multiplier_; }
+  /// Sets the multipliers' entries of a vector over the unknowns to zero (velocities and
+  /// accelerations have none).
+  void ClearMultipliers(Eigen::VectorXd& v) const {
+    if (n_multipliers() > 0) v.tail(n_multipliers()).setZero();
+  }
 
   /// true for prescribed coordinates (not solved for).
   bool prescribed(int j) const { return prescribed_[j]; }
@@ -116,9 +133,9 @@ class DofMap {
 
  private:
   const std::vector<Eigen::MatrixXd>* motion_;
-  std::vector<int> node_first_, node_count_, joint_of_, order_, mode_dof_, solved_;
+  std::vector<int> node_first_, node_count_, joint_of_, order_, mode_dof_, solved_, multiplier_first_;
   std::vector<bool> prescribed_;
-  int n_dofs_ = 0;
+  int n_dofs_ = 0, first_multiplier_ = 0;
 };
 
 /// Node k clamped to ground.
@@ -163,6 +180,37 @@ void AddJointGeometricStiffness(const SystemModel& model, const DofMap& dofs, co
 /// axis is the driving torque. Other nodes: zero.
 std::vector<Eigen::Matrix<double, 6, 1>> JointReactions(const SystemModel& model, const DofMap& dofs,
                                                         const SystemState& state, const NodeForces& forces);
+
+/// The cut joints' constraint equations at `state` with its multipliers lambda: the residual's
+/// coordinate rows get -G^T lambda and its multiplier rows -g (Newton's S delta = r then asks
+/// G dq = -g), the node forces -G_node^T lambda (so AddJointGeometricStiffness adds the tree
+/// joints' share of their stiffness). With `tangent`: G in the multipliers' rows, G^T in their
+/// columns and d(G^T lambda)/dq through the node Jacobians -- those of the blocks in `blocks`
+/// (the midpoint scheme takes them from different configurations). With `jacobian`: G and G^T.
+enum LoopBlocks { kLoopRows = 1, kLoopColumns = 2, kLoopHessian = 4, kLoopAll = 7 };
+void AddLoopConstraints(const SystemModel& model, const DofMap& dofs, const SystemState& state,
+                        Eigen::VectorXd* residual, Triplets* tangent, NodeForces* node_forces,
+                        Triplets* jacobian = nullptr, int blocks = kLoopAll);
+/// The largest violation of the kept equations: positions in length units, rotations (dot
+/// products) times the model's size L so that both are lengths; 0 without loops. `worst`: the
+/// cut joint with it (-1 without loops).
+double LoopViolation(const SystemModel& model, const DofMap& dofs, const SystemState& state, int* worst = nullptr);
+
+/// Drops the cut joints' equations that repeat others at the initial state (an over-constrained
+/// mechanism: a planar four-bar of spatial revolute joints has 3 of its 5 closure equations
+/// satisfied by the plane itself). Row by row in order, each equation of the constraint
+/// Jacobian on the coordinates solved for (columns scaled to unit size: any units) is kept when
+/// it is independent of those kept before it (Gram-Schmidt, relative remainder above 1e-8).
+/// Returns per cut joint what its dropped equations held ("" when none). The reactions of a
+/// redundant loop are then one of many that balance it (statically indeterminate), as in any
+/// multibody code.
+std::vector<std::string> DropRedundantEquations(SystemModel& model);
+
+/// Closed loops at `state`: the cut joint whose kept equation is nearest to depending on the
+/// others (its row of the constraint Jacobian within 0.05, relative, of the span of the rows
+/// before it) -- the mechanism at or near a dead point, where Newton fails or the motion runs
+/// away -- named with the equation; "" when none (or no loops).
+std::string LoopSingularity(const SystemModel& model, const SystemState& state);
 
 /// Adds an interface node to `model` at a position and returns its index.
 int AddNode(SystemModel& model, const std::string& name, const Eigen::Vector3d& x,
@@ -284,6 +332,7 @@ class FreeSolver {
   struct Klu;
   std::unique_ptr<Klu> klu_;
   std::vector<int> free_, position_;
+  Eigen::VectorXd scale_;  ///< per free unknown: 1, or a multiplier's scaling (see Factor)
   bool valid_ = false;
   long analysed_ = 0, full_ = 0, refactored_ = 0;
 };

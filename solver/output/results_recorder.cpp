@@ -103,6 +103,10 @@ void ResultsRecorder::Record(double t, const SystemState& state, const Eigen::Ve
   const SystemModel& model = scene_.model;
   const DofMap& dofs = dofs_;
   const int n = model.n_nodes();
+  if (!model.cut_joints.empty()) {
+    loop_violation_.push_back(LoopViolation(model, dofs, state));
+    max_loop_violation_ = std::max(max_loop_violation_, loop_violation_.back());
+  }
   Eigen::VectorXd pos(3 * n), quat(4 * n), vel(3 * n), ang(3 * n);
   for (int k = 0; k < n; ++k) {
     pos.segment<3>(3 * k) = state.x[k] + scene_.origin;
@@ -295,6 +299,13 @@ void ResultsRecorder::Finish(const std::string& status) {
     }
     if (step_size_.size() == time_.size()) {
       w.Vector("/step_size", Eigen::Map<const Eigen::VectorXd>(step_size_.data(), long(step_size_.size())));
+    }
+    if (!model.cut_joints.empty()) {
+      w.CreateGroup("/loops");
+      std::vector<std::string> names;
+      for (const CutJoint& cut : model.cut_joints) names.push_back(cut.name);
+      w.Strings("/loops/cut_joints", names);
+      w.Vector("/loops/violation", Eigen::Map<const Eigen::VectorXd>(loop_violation_.data(), long(loop_violation_.size())));
     }
     w.CreateGroup("/nodes");
     w.Strings("/nodes/names", model.node_names);

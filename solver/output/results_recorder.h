@@ -42,6 +42,9 @@ class ResultsRecorder {
   const std::string& csv_path() const { return csv_path_; }
   const std::string& h5_path() const { return h5_path_; }
   long steps() const { return long(time_.size()); }
+  /// Closed loops: the largest violation of the cut joints' equations over the recorded steps
+  /// (LoopViolation: a length); 0 without loops.
+  double max_loop_violation() const { return max_loop_violation_; }
 
  private:
   const Scene& scene_;
@@ -53,7 +56,8 @@ class ResultsRecorder {
   long steps_taken_ = -1, rejected_by_error_ = 0, newton_cuts_ = 0;
   std::string directory_, csv_path_, h5_path_, csv_tmp_;
   std::ofstream csv_;
-  std::vector<double> time_, kinetic_, elastic_, work_;
+  std::vector<double> time_, kinetic_, elastic_, work_, loop_violation_;
+  double max_loop_violation_ = 0.0;
   std::vector<Eigen::VectorXd> momentum_;  // per step: linear (3), angular (3)
   std::vector<Eigen::VectorXd> positions_, quaternions_, velocities_, angular_velocities_, joints_, reactions_;
   std::vector<std::vector<Eigen::VectorXd>> modal_;     // per step, per body

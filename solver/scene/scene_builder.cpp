@@ -215,50 +215,96 @@ Scene BuildScene(const SceneSpec& spec) {
     scene.mesh_origin.push_back(se.floating_frame.origin);
     scene.stick_nodes.push_back(se.visualization ? std::vector<int>() : nodes);
   }
-  // Rigid offsets: a rigid body's tree is rooted at its centre-of-mass node, or at the one point
-  // that carries a joint (a pendulum's pivot), so that the joint acts on the root.
-  std::map<int, const SceneJointSpec*> joint_on;
-  for (const SceneJointSpec& j : spec.joints) joint_on[scene.node_index.at(j.node)] = &j;
+  // The joint tree (issue 15). Every node has at most one holder: a parent node it depends on
+  // through a tree joint, or the ground (a support's motion basis). The rigid bodies' offsets
+  // and then the scene's joints -- prescribed ones first, then in the scene's order -- go into
+  // the tree while they can; a joint that would give its node a second holder or close a cycle
+  // is cut: imposed by constraint equations with Lagrange multipliers, its node keeping its own
+  // coordinates (solver/joints/loop_closure.h). `cut: true` cuts a joint on purpose.
+  std::vector<const SceneJointSpec*> order;
+  for (const SceneJointSpec& j : spec.joints)
+    if (!j.prescribed.empty()) order.push_back(&j);
+  for (const SceneJointSpec& j : spec.joints)
+    if (j.prescribed.empty() && !j.cut) order.push_back(&j);
+  for (const SceneJointSpec& j : spec.joints)
+    if (j.cut) order.push_back(&j);
+  constexpr int kNoHolder = -2, kGround = -1;
+  std::vector<int> holder(size_t(model.n_nodes()), kNoHolder);
+  const auto is_ancestor = [&](int k, int m) {  // k on m's chain of holders (m itself included)
+    for (; m >= 0; m = holder[size_t(m)])
+      if (m == k) return true;
+    return false;
+  };
+  const auto hidden_ground = [&](int k) {  // a clamped node at node k, world axes
+    const int g = AddNode(model, model.node_names[k] + ".ground", model.node_x0[k], Eigen::Matrix3d::Identity());
+    Clamp(model, g);
+    holder.push_back(kGround);
+    return g;
+  };
+  const auto add_cut = [&](JointType type, int k, int p, const Eigen::Vector3d& axis, const Eigen::Vector3d& axis2,
+                           const std::string& name) {
+    CutJoint cut;
+    cut.joint = MakeNodeJoint(type, k, p, axis, model.node_x0[p], model.node_R0[p], model.node_x0[k], model.node_R0[k], axis2);
+    cut.name = name;
+    for (int i = 0; i < ConstraintCount(type); ++i) cut.equations.push_back(i);
+    model.cut_joints.push_back(cut);
+  };
+  const auto add_tree = [&](JointType type, int k, int p, const Eigen::Vector3d& axis, const Eigen::Vector3d& axis2) {
+    model.joints.push_back(MakeNodeJoint(type, k, p, axis, model.node_x0[p], model.node_R0[p], model.node_x0[k],
+                                         model.node_R0[k], axis2));
+    model.motion[k] = Eigen::MatrixXd(6, 0);  // the joint's coordinates replace the node's own
+    holder[size_t(k)] = p;
+  };
+  // Rigid bodies: the tree of one is rooted at its first point, in that order, that carries a
+  // joint not cut on purpose (a pendulum's pivot), so that the joint acts on the root; else at
+  // its centre of mass.
   std::map<int, int> root_of;  // COM node -> root node
-  for (const auto& [k, com] : rigid_attachments) {
-    if (!joint_on.count(k)) continue;
-    if (root_of.count(com) && root_of[com] != k) {
-      throw InputError(joint_on[k]->where + ": rigid body at node '" + model.node_names[com] + "' has joints on two of its points ('" +
-                       model.node_names[root_of[com]] + "', '" + model.node_names[k] +
-                       "'): a loop of rigid bodies and joints; make one of the connected bodies flexible");
-    }
-    if (joint_on.count(com)) {
-      throw InputError(joint_on[k]->where + ": rigid body at node '" + model.node_names[com] + "' has joints on its centre of mass and on point '" +
-                       model.node_names[k] + "': a loop of rigid bodies and joints");
-    }
-    root_of[com] = k;
+  for (const SceneJointSpec* j : order) {
+    if (j->cut) continue;
+    const int k = scene.node_index.at(j->node);
+    for (const auto& [point, com] : rigid_attachments)
+      if ((point == k || com == k) && !root_of.count(com)) root_of[com] = k;
   }
   for (const auto& [k, com] : rigid_attachments) {
     const bool rooted_here = root_of.count(com) && root_of[com] == k;
     const int child = rooted_here ? com : k, parent = rooted_here ? k : com;
-    model.joints.push_back(MakeNodeJoint(JointType::kRigid, child, parent, Eigen::Vector3d::UnitZ(), model.node_x0[parent],
-                                         model.node_R0[parent], model.node_x0[child], model.node_R0[child]));
-    model.motion[child] = Eigen::MatrixXd(6, 0);
+    if (holder[size_t(child)] != kNoHolder || is_ancestor(child, parent)) {
+      add_cut(JointType::kRigid, child, parent, Eigen::Vector3d::UnitZ(), Eigen::Vector3d::UnitY(),
+              "rigid offset of node '" + model.node_names[k] + "' on the body at node '" + model.node_names[com] + "'");
+      continue;
+    }
+    add_tree(JointType::kRigid, child, parent, Eigen::Vector3d::UnitZ(), Eigen::Vector3d::UnitY());
   }
   // The bounding box diagonal of the nodes: the scale of position tolerances.
   const double scene_length = BoundingDiagonal(model.node_x0);
-  for (const SceneJointSpec& j : spec.joints) {
+  for (const SceneJointSpec* jp : order) {
+    const SceneJointSpec& j = *jp;
     const int k = scene.node_index.at(j.node);
-    if (!j.parent.empty()) {
-      const int p = scene.node_index.at(j.parent);
-      RequireJointGap(j, model.node_x0[p], model.node_x0[k], scene_length);
-      model.joints.push_back(MakeNodeJoint(JointTypeFromName(j.type), k, p, j.axis, model.node_x0[p], model.node_R0[p],
-                                           model.node_x0[k], model.node_R0[k], j.axis2));
-      model.motion[k] = Eigen::MatrixXd(6, 0);  // the joint's coordinates replace the node's own
+    const int p = j.parent.empty() ? kGround : scene.node_index.at(j.parent);
+    if (p >= 0) RequireJointGap(j, model.node_x0[p], model.node_x0[k], scene_length);
+    const bool tree = !j.cut && holder[size_t(k)] == kNoHolder && !is_ancestor(k, p);
+    const JointType type = j.type == "clamp" ? JointType::kRigid : JointTypeFromName(j.type);
+    if (!tree) {
+      if (!j.prescribed.empty()) {
+        throw InputError(j.where + ": " + j.type + " joint of node '" + j.node + "' is prescribed but closes a loop (node '" +
+                         j.node + "' already hangs on " +
+                         (holder[size_t(k)] >= 0 ? "node '" + model.node_names[holder[size_t(k)]] + "'" : std::string("the ground")) +
+                         "); a drive must be a tree joint: swap 'node' and 'parent', or prescribe another joint of the loop");
+      }
+      const std::string name = j.where + ": " + j.type + " joint of node '" + j.node + "'" +
+                               (p >= 0 ? " on node '" + j.parent + "'" : std::string(" to the ground"));
+      add_cut(type, k, p >= 0 ? p : hidden_ground(k), j.axis, j.axis2, name);
+      continue;
+    }
+    if (p >= 0) {
+      add_tree(type, k, p, j.axis, j.axis2);
       if (!j.prescribed.empty()) model.prescribed.push_back(PrescribedBy(spec.functions.at(j.prescribed), k));
       continue;
     }
+    holder[size_t(k)] = kGround;
     if (j.type == "universal") {
       // To the ground: the parent is a hidden clamped node at the joint.
-      const int ground = AddNode(model, j.node + ".ground", model.node_x0[k], Eigen::Matrix3d::Identity());
-      Clamp(model, ground);
-      model.joints.push_back(MakeNodeJoint(JointType::kUniversal, k, ground, j.axis, model.node_x0[ground],
-                                           model.node_R0[ground], model.node_x0[k], model.node_R0[k], j.axis2));
+      add_tree(JointType::kUniversal, k, hidden_ground(k), j.axis, j.axis2);
       continue;
     }
     if (j.type == "clamp") Clamp(model, k);
@@ -267,6 +313,25 @@ Scene BuildScene(const SceneSpec& spec) {
     if (j.type == "prismatic") PrismaticToGround(model, k, j.axis);
     if (j.type == "cylindrical") CylindricalToGround(model, k, j.axis);
     if (!j.prescribed.empty()) model.prescribed.push_back(PrescribedBy(spec.functions.at(j.prescribed), k));
+  }
+  // An over-constrained loop (a planar four-bar of spatial revolute joints) has equations that
+  // repeat others: they are dropped, and the log says which.
+  const std::vector<std::string> dropped = DropRedundantEquations(model);
+  for (size_t c = 0; c < model.cut_joints.size(); ++c) {
+    const CutJoint& cut = model.cut_joints[c];
+    const int all = ConstraintCount(cut.joint.type), kept = int(cut.equations.size());
+    std::string note = cut.name + " closes a loop: ";
+    if (kept == 0) {
+      note += "the other joints already hold it; its " + std::to_string(all) + " equations repeat theirs and are dropped";
+    } else {
+      note += std::to_string(kept) + " constraint equations with Lagrange multipliers";
+      if (kept < all) {
+        note += "; " + std::to_string(all - kept) + " more (" + dropped[c] +
+                ") repeat other constraints (an over-constrained loop, e.g. planar links on spatial joints) and are "
+                "dropped: the reactions along them are not unique";
+      }
+    }
+    scene.notes.push_back(note);
   }
  // The joint graph (cycles, two parents) before anything walks it.
   std::unique_ptr<DofMap> dofs_ptr;
