@@ -277,9 +277,6 @@ SceneSpec ParseScene(const std::string& text, const std::string& name, const std
       } else if (j.type == "rigid") {
         type.Fail("a rigid joint needs a 'parent' node (to the ground use 'clamp')");
       }
-      for (const auto& other : scene.joints) {
-        if (other.node == j.node) item.Fail("node '" + j.node + "' already has a joint (" + other.where + ")");
-      }
       if (axial) {
         YamlValue axis = m.Required("axis");
         j.axis = axis.Vector3();

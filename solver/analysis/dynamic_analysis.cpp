@@ -83,14 +83,10 @@ Eigen::VectorXd DriveForces(const DofMap& dofs, const Eigen::VectorXd& residual)
 
 using namespace dynamic_internal;
 
-namespace {
+namespace dynamic_internal {
 
-// The generalized-alpha residual at state s and time t: frames solved (s.config.frames
-// updated), each body's kinematics evaluated once and kept in `passes` for the matrices, which
-// an iteration builds only when it needs them (not on the converged one, not with a kept
-// factorization). Bodies on `threads` threads; the result does not depend on their number.
 Assembly AssembleDynamicResidual(const SystemModel& model, const DofMap& dofs, DynamicState& s, double t,
-                                 BodyWorkspace& work, BodyThreads* threads = nullptr) {
+                                 BodyWorkspace& work, BodyThreads* threads) {
   AssemblyParts parts;
   Assembly out = StartAssembly(model, dofs, parts);
   const int n_bodies = int(model.bodies.size());
@@ -139,18 +135,9 @@ Assembly AssembleDynamicResidual(const SystemModel& model, const DofMap& dofs, D
   return out;
 }
 
-// Coefficients of an iteration matrix K + c_C C + c_M M (generalized-alpha: gamma', beta').
-struct MatrixCombination {
-  double c_C = 0.0, c_M = 0.0;
-};
-
-// The matrices K, C, M of the residual pass `out` (same state s and time t); bodies on
-// `threads` threads, added in body order. With `combine`, out.K receives the iteration matrix
-// K + c_C C + c_M M alone, combined body by body before the scatter (one sparse matrix built
-// instead of three and their sum), and out.C, out.M stay empty.
 void AddDynamicMatrices(const SystemModel& model, const DofMap& dofs, const DynamicState& s, double t,
                         BodyWorkspace& work, bool full_inertia_tangent, Assembly& out,
-                        BodyThreads* threads = nullptr, const MatrixCombination* combine = nullptr) {
+                        BodyThreads* threads, const MatrixCombination* combine) {
   const int n_bodies = int(model.bodies.size());
   const std::vector<BodyPass>& passes = work.passes;
   std::vector<BodyWorkspace::BodyMatrices>& results = work.matrices;
@@ -178,10 +165,40 @@ void AddDynamicMatrices(const SystemModel& model, const DofMap& dofs, const Dyna
   K.clear();
   C.clear();
   M.clear();
+  // The joints' convective accelerations depend on W: d f_in / dW gets M_b dc/dW (the Coriolis
+  // and centripetal coupling of chains with offsets), into C (or c_C of it into K).
+  // And their configuration: d f_in / dq gets M_b d(J Wdot + c)/dq (into K).
+  const bool chains = !model.joints.empty();
+  const std::vector<NodeJacobian> dc =
+      chains ? ConvectiveVelocityDerivative(model, dofs, s.config, s.W) : std::vector<NodeJacobian>();
+  const std::vector<NodeJacobian> dacc =
+      chains ? NodeAccelerationConfigurationDerivative(model, dofs, s.config, s.W, s.Wdot) : std::vector<NodeJacobian>();
+  // B^T M_b D for a body's node columns D (per node, sparse over the coordinates), scaled.
+  const auto add_node_columns = [&](const std::vector<MapEntry>& map, const Eigen::MatrixXd& M_b, int b,
+                                    const std::vector<NodeJacobian>& D, double scale, Triplets& into) {
+    for (size_t a = 0; a < model.body_nodes[size_t(b)].size(); ++a) {
+      for (const auto& [col, v] : D[size_t(model.body_nodes[size_t(b)][a])]) {
+        const Eigen::VectorXd y = M_b.middleCols<6>(Eigen::Index(6 * a)) * v;
+        for (const MapEntry& e : map) {
+          const double value = e.coefficient * y[e.local];
+          if (value != 0.0) into.emplace_back(e.coordinate, col, scale * value);
+        }
+      }
+    }
+  };
   for (int b = 0; b < n_bodies; ++b) {
     const BodyWorkspace::BodyMatrices& r = results[size_t(b)];
     const std::vector<MapEntry>& map = work.terms[size_t(b)].map;  // the residual pass's, same state
     ScatterBody(map, nullptr, &r.K, nullptr, &K);
+    if (chains) {
+      // r.M: d f_in / d wdot of the body (the combination above went into r.K only).
+      add_node_columns(map, r.M, b, dacc, 1.0, K);
+      if (combine) {
+        add_node_columns(map, r.M, b, dc, combine->c_C, K);
+      } else {
+        add_node_columns(map, r.M, b, dc, 1.0, C);
+      }
+    }
     if (combine) continue;
     ScatterBody(map, nullptr, &r.C, nullptr, &C);
     ScatterBody(map, nullptr, &r.M, nullptr, &M);
@@ -203,14 +220,14 @@ void AddDynamicMatrices(const SystemModel& model, const DofMap& dofs, const Dyna
 }
 
 Assembly AssembleDynamic(const SystemModel& model, const DofMap& dofs, DynamicState& s, double t, bool matrices,
-                         bool full_inertia_tangent = false) {
+                         bool full_inertia_tangent) {
   BodyWorkspace work;
   Assembly out = AssembleDynamicResidual(model, dofs, s, t, work);
   if (out.ok && matrices) AddDynamicMatrices(model, dofs, s, t, work, full_inertia_tangent, out);
   return out;
 }
 
-}  // namespace
+}  // namespace dynamic_internal
 
 std::vector<Eigen::Matrix<double, 6, 1>> DynamicReactions(const SystemModel& model, const DynamicState& state) {
   const DofMap dofs(model);

@@ -71,6 +71,31 @@ struct BodyWorkspace {
   TripletAssembler K_build, C_build, M_build;  // their sparse matrices (slots kept)
 };
 
+// The generalized-alpha residual at state s and time t: frames solved (s.config.frames
+// updated), each body's kinematics evaluated once and kept in the workspace's passes for the
+// matrices, which an iteration builds only when it needs them (not on the converged one, not
+// with a kept factorization). Bodies on `threads` threads; the result does not depend on their
+// number.
+Assembly AssembleDynamicResidual(const SystemModel& model, const DofMap& dofs, DynamicState& s, double t,
+                                 BodyWorkspace& work, BodyThreads* threads = nullptr);
+
+// Coefficients of an iteration matrix K + c_C C + c_M M (generalized-alpha: gamma', beta').
+struct MatrixCombination {
+  double c_C = 0.0, c_M = 0.0;
+};
+
+// The matrices K, C, M of the residual pass `out` (same state s and time t: K = -dr/dq, C =
+// -dr/dW, M = -dr/dWdot); bodies on `threads` threads, added in body order. With `combine`,
+// out.K receives the iteration matrix K + c_C C + c_M M alone, combined body by body before the
+// scatter (one sparse matrix built instead of three and their sum), and out.C, out.M stay empty.
+void AddDynamicMatrices(const SystemModel& model, const DofMap& dofs, const DynamicState& s, double t,
+                        BodyWorkspace& work, bool full_inertia_tangent, Assembly& out,
+                        BodyThreads* threads = nullptr, const MatrixCombination* combine = nullptr);
+
+// Residual and (with `matrices`) K, C, M at s, with a workspace of its own.
+Assembly AssembleDynamic(const SystemModel& model, const DofMap& dofs, DynamicState& s, double t, bool matrices,
+                         bool full_inertia_tangent = false);
+
 // Adds the bodies' terms in body order: the same sums whatever thread computed them. False (the
 // message in `out`) when a body's floating frame did not converge.
 bool AddBodyTerms(const SystemModel& model, const std::vector<BodyTerms>& terms, AssemblyParts& parts, Assembly& out);

@@ -157,6 +157,22 @@ std::vector<Eigen::Matrix<double, 6, 1>> NodeAccelerations(const SystemModel& mo
                                                            const SystemState& state, const Eigen::VectorXd& W,
                                                            const Eigen::VectorXd& Wdot);
 
+/// The derivative of the joints' convective accelerations (NodeAccelerations) with respect to
+/// the coordinate velocities W, per node as sparse columns (coordinate, 6-vector); empty for
+/// nodes without joints above them. Quadratic in W: the Coriolis and centripetal terms of a
+/// chain of joints with offsets, whose share d f_in / dW = M_b dc/dW belongs in the iteration
+/// matrix's C (without it Newton converged linearly on a rigid four-bar, 2 iterations a step).
+std::vector<NodeJacobian> ConvectiveVelocityDerivative(const SystemModel& model, const DofMap& dofs,
+                                                       const SystemState& state, const Eigen::VectorXd& W);
+
+/// The derivative of the node accelerations J_k(q) Wdot + c_k(q, W) (NodeAccelerations) with
+/// respect to the coordinates at fixed W and Wdot, per node as sparse columns; empty for nodes
+/// without joints above them; down the tree with the joints' maps (no state copies). Its share
+/// M_b d(acc)/dq belongs in the iteration matrix's K (on a rigid four-bar it was half of K).
+std::vector<NodeJacobian> NodeAccelerationConfigurationDerivative(const SystemModel& model, const DofMap& dofs,
+                                                                  const SystemState& state, const Eigen::VectorXd& W,
+                                                                  const Eigen::VectorXd& Wdot);
+
 /// Places the dependent nodes from their parents and recomputes the node Jacobians.
 void UpdateKinematics(const SystemModel& model, const DofMap& dofs, SystemState& state);
 

@@ -422,7 +422,11 @@ sed 's/^joints:/joints:\n  - {type: rigid, node: n3, parent: n5}\n  - {type: rig
 "$bin/femb-solve" "$work/cycle.yaml" -o "$work/cycle_out" > "$work/cycle_log.txt" 2>&1 \
   && grep -q "rigid joint of node 'n7' on node 'n3' closes a loop: the other joints already hold it; its 6 equations repeat theirs" "$work/cycle_log.txt" \
   && ok || fail "cycle of rigid joints: $(cat "$work/cycle_log.txt")"
-expect "two parents" 2 "node 'n3' already has a joint" 's/^joints:/joints:\n  - {type: rigid, node: n3, parent: n5}\n  - {type: rigid, node: n3, parent: n7}/'
+# A node with two joints: the second is cut (issue 15).
+sed 's/^joints:/joints:\n  - {type: rigid, node: n3, parent: n5}\n  - {type: rigid, node: n3, parent: n7}/' "$work/scene.yaml" > "$work/two.yaml"
+"$bin/femb-solve" "$work/two.yaml" -o "$work/two_out" > "$work/two_log.txt" 2>&1 \
+  && grep -q "rigid joint of node 'n3' on node 'n7' closes a loop: 6 constraint equations" "$work/two_log.txt" \
+  && ok || fail "node with two joints: $(cat "$work/two_log.txt")"
 # A joint whose nodes are apart at t = 0 (the gap would silently become a rigid arm).
 expect "joint gap" 2 "revolute joint between nodes 'n3' and 'n5': the nodes are 0.2 apart" 's/^joints:/joints:\n  - {type: revolute, node: n3, parent: n5, axis: [0, 0, 1]}/'
 # --set reaches list items by index (the docs say any key); a bad index is one line, exit 2.
