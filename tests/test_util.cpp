@@ -88,3 +88,17 @@ std::string femb::test::Replace(std::string text, const std::string& from, const
   if (at == std::string::npos) return text;
   return text.replace(at, from.size(), to);
 }
+
+Eigen::MatrixXd femb::test::StaticTangentByDifferences(const SystemModel& model, const DofMap& dofs,
+                                                       const SystemState& state, double lambda, double h) {
+  const int n = dofs.n_dofs();
+  Eigen::MatrixXd K(n, n);
+  for (int i = 0; i < n; ++i) {
+    SystemState plus = state, minus = state;
+    ApplyIncrement(model, dofs, h * Eigen::VectorXd::Unit(n, i), plus);
+    ApplyIncrement(model, dofs, -h * Eigen::VectorXd::Unit(n, i), minus);
+    K.col(i) = -(AssembleStatic(model, dofs, plus, lambda, false).residual -
+                 AssembleStatic(model, dofs, minus, lambda, false).residual) / (2 * h);
+  }
+  return K;
+}

@@ -25,6 +25,12 @@ Eigen::Vector2d ElasticaTip(double P, double EI, double L);
 /// force on n1.
 SystemModel ClampedOneBodyModel(const Superelement& se, double L, const Eigen::Vector3d& tip_force);
 
+/// -d(residual)/d(unknowns) of AssembleStatic at `state` (load factor `lambda`) by central
+/// differences with steps h along each unknown (ApplyIncrement): the reference for static
+/// tangents.
+Eigen::MatrixXd StaticTangentByDifferences(const SystemModel& model, const DofMap& dofs, const SystemState& state,
+                                           double lambda, double h = 1e-6);
+
 /// `text` with its first `from` replaced by `to`; fails the calling test when `from` is missing.
 std::string Replace(std::string text, const std::string& from, const std::string& to);
 

@@ -110,16 +110,7 @@ TEST(LoopClosure, StaticTangentWithCutJointsMatchesFiniteDifferences) {
     ASSERT_GT(LoopViolation(model, dofs, state), 1e-3);
     const SystemForces f0 = AssembleStatic(model, dofs, state, 1.0, true);
     ASSERT_TRUE(f0.ok);
-    const int n = dofs.n_dofs();
-    Eigen::MatrixXd K_fd(n, n);
-    for (int i = 0; i < n; ++i) {
-      const double h = 1e-6;
-      SystemState plus = state, minus = state;
-      ApplyIncrement(model, dofs, h * Eigen::VectorXd::Unit(n, i), plus);
-      ApplyIncrement(model, dofs, -h * Eigen::VectorXd::Unit(n, i), minus);
-      K_fd.col(i) = -(AssembleStatic(model, dofs, plus, 1.0, false).residual -
-                      AssembleStatic(model, dofs, minus, 1.0, false).residual) / (2 * h);
-    }
+    const Eigen::MatrixXd K_fd = test::StaticTangentByDifferences(model, dofs, state, 1.0);
     const Eigen::MatrixXd K(f0.tangent);
     const int m = dofs.n_multipliers(), c = dofs.first_multiplier();
     const double error = (K - K_fd).norm() / K_fd.norm();

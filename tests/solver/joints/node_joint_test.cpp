@@ -80,16 +80,7 @@ TEST(NodeJoint, StaticTangentWithEveryJointTypeMatchesFiniteDifferences) {
   SystemForces f0 = AssembleStatic(model, dofs, state, 1.0, true);
   ASSERT_TRUE(f0.ok);
   const int n = dofs.n_dofs();
-  Eigen::MatrixXd K_fd(n, n);
-  for (int i = 0; i < n; ++i) {
-    const double h = 1e-6;
-    SystemState plus = state, minus = state;
-    ApplyIncrement(model, dofs, h * Eigen::VectorXd::Unit(n, i), plus);
-    ApplyIncrement(model, dofs, -h * Eigen::VectorXd::Unit(n, i), minus);
-    const SystemForces fp = AssembleStatic(model, dofs, plus, 1.0, false);
-    const SystemForces fm = AssembleStatic(model, dofs, minus, 1.0, false);
-    K_fd.col(i) = -(fp.residual - fm.residual) / (2 * h);
-  }
+  const Eigen::MatrixXd K_fd = test::StaticTangentByDifferences(model, dofs, state, 1.0);
   const double error = (f0.tangent - K_fd).norm() / K_fd.norm();
   std::printf("[ info ] %d coordinates, relative tangent error %.2e\n", n, error);
   EXPECT_LT(error, 1e-6);
