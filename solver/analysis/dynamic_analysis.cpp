@@ -311,6 +311,23 @@ DynamicState InitialDynamicState(const SystemModel& model, const SystemState& co
     Eigen::VectorXd rhs = -(f.tangent * s.W);
     const Eigen::VectorXd W_free = SolveFree(dofs, f.tangent, rhs);
     for (int j : dofs.solved()) s.W[j] = W_free[j];
+    dofs.ClearMultipliers(s.W);  // (with loops their rows made G W = 0)
+  } else if (dofs.n_multipliers() > 0) {
+    // Closed loops with given velocities: the nearest velocities in the kinetic-energy norm that
+    // keep the loops closed, W_f + d with [M G^T; G 0] [d; mu] = [0; -G W] (prescribed rates kept).
+    Triplets G;
+    AddLoopConstraints(model, dofs, s.config, nullptr, nullptr, nullptr, &G);
+    const SystemMatrix Gm = ToMatrix(dofs.n_dofs(), G);
+    const Eigen::VectorXd GW = Gm * s.W;  // the multipliers' rows: G W (W's multiplier entries are 0)
+    if (GW.tail(dofs.n_multipliers()).lpNorm<Eigen::Infinity>() > 0) {
+      DynamicState copy = s;
+      const Assembly b = AssembleDynamic(model, dofs, copy, t0, true);
+      Eigen::VectorXd rhs = Eigen::VectorXd::Zero(dofs.n_dofs());
+      rhs.tail(dofs.n_multipliers()) = -GW.tail(dofs.n_multipliers());
+      const Eigen::VectorXd d = SolveFree(dofs, SystemMatrix(b.M + Gm), rhs);
+      for (int j : dofs.solved())
+        if (!dofs.multiplier(j)) s.W[j] += d[j];
+    }
   }
   ConsistentAccelerations(model, dofs, s);
   return s;

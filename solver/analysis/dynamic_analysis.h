@@ -102,7 +102,8 @@ struct DynamicResult {
 /// Initial state: configuration and velocities given; accelerations from M_g wdot = f_ext -
 /// f_int - f_gyro at t0. Prescribed coordinates get their rates; if they move and no other
 /// coordinate was given a velocity, the others start without deformation rate
-/// (K_ff W_f = -K_fp W_p) rather than at rest.
+/// (K_ff W_f = -K_fp W_p) rather than at rest. With closed loops, given velocities that would
+/// open them (G W != 0) are replaced by the nearest that do not, in the kinetic-energy norm.
 DynamicState InitialDynamicState(const SystemModel& model, const SystemState& config, const Eigen::VectorXd& W,
                                  double t0 = 0.0);
 

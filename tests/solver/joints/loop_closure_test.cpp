@@ -379,6 +379,33 @@ TEST(LoopClosure, DeadPointStopsTheRunAndNamesTheLoop) {
                            "configuration (a dead point"), std::string::npos) << r.message;
 }
 
+// Given velocities that would open the loop (the crank's rate alone, the other joints at rest)
+// are made consistent: the nearest in the kinetic-energy norm with G W = 0, the crank's rate
+// changed as little as the inertia allows; the rocker then moves as the closed form says,
+// dpsi/dtheta from the loop's velocity equations.
+TEST(LoopClosure, InitialVelocitiesThatWouldOpenTheLoopAreMadeConsistent) {
+  FourBar fb;
+  std::string text = fb.Scene("initial_velocity: {A: {joint: [3.0]}}\nanalysis: {type: dynamic, end_time: 0.01, step: 1.0e-3}\n");
+  text = test::Replace(text, ", prescribed: drive}", "}");
+  const Scene scene = BuildScene(ParseScene(text, "four_bar.yaml"));
+  const SystemModel& model = scene.model;
+  const DofMap dofs(model);
+  const DynamicState s = InitialDynamicState(model, InitialState(model), scene.initial_velocity);
+  Triplets G;
+  AddLoopConstraints(model, dofs, s.config, nullptr, nullptr, nullptr, &G);
+  const Eigen::VectorXd GW = ToMatrix(dofs.n_dofs(), G) * s.W;
+  const int A = scene.node_index.at("A"), C1 = scene.node_index.at("C1");
+  // C's velocity from the closed form: dC/dtheta by central differences of coupler_point.
+  const double theta_dot = s.W[dofs.node_first(A)], e = 1e-6;
+  const Eigen::Vector2d dC = (fb.C(fb.theta0 + e) - fb.C(fb.theta0 - e)) / (2 * e) * theta_dot;
+  const Eigen::Vector2d vC = NodeMotion(s.config, C1, s.W).head<2>();
+  std::printf("[ info ] crank rate 3 -> %.6f rad/s; |G W| %.2e; C's velocity %.6f, %.6f (closed form %.6f, %.6f)\n",
+              theta_dot, GW.tail(dofs.n_multipliers()).norm(), vC.x(), vC.y(), dC.x(), dC.y());
+  EXPECT_LT(GW.tail(dofs.n_multipliers()).norm(), 1e-12);
+  EXPECT_LT((vC - dC).norm(), 1e-8 * dC.norm());
+  EXPECT_GT(theta_dot, 0.0);
+}
+
 TEST(LoopClosure, PrescribedJointThatClosesALoopIsAnInputError) {
   FourBar fb;
   std::string text = fb.Scene("analysis: {type: dynamic, end_time: 1, step: 1.0e-3}\n");
