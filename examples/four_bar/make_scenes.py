@@ -81,6 +81,9 @@ def main():
               "    - {name: rod_a, node: B2, quantities: [position]}\n"
               "    - {name: rod_b, node: C1, quantities: [position]}\n")
     mid_probe = "    - {name: rod_mid, node: M, quantities: [position]}\n"
+    # The rocker's angle: the joint at D is the one cut to close the loop; its probe shows the
+    # angle from the placements.
+    rocker_probe = "    - {name: rocker, node: D, quantities: [joint]}\n"
     with open(f"{out}/coupler_2.yaml", "w") as f:
         f.write(part("coupler_2", b / 2, 2e11, 4, "One half of the four-bar's coupler (0.35 m, 6 mm steel rod)."))
     with open(f"{out}/crank.yaml", "w") as f:
@@ -93,7 +96,7 @@ def main():
     coupler_flexible = superelement("coupler0", "coupler_2.h5", B, M, "B2", "M") + superelement("coupler1", "coupler_2.h5", M, C, "M", "C1")
     with open(f"{out}/rigid.yaml", "w") as f:
         f.write("# The four-bar with every link rigid (make_scenes.py).\nname: four_bar_rigid\n" + head + crank_rigid +
-                rigid("coupler", B, C, "B2", "C1") + rocker_rigid + joints)
+                rigid("coupler", B, C, "B2", "C1") + rocker_rigid + joints + rocker_probe)
     with open(f"{out}/flexible.yaml", "w") as f:
         f.write("# The four-bar with a flexible coupler in 2 superelements, rigid crank and rocker (make_scenes.py).\n"
                 "name: four_bar_flexible\n" + head + crank_rigid + coupler_flexible + rocker_rigid + joints + mid_probe)

@@ -111,6 +111,23 @@ Eigen::Matrix<double, 12, 12> ConstraintHessian(const NodeJoint& j, const Eigen:
   return H;
 }
 
+Eigen::VectorXd CutJointCoordinates(const NodeJoint& j, const Eigen::Vector3d& x_p, const Eigen::Matrix3d& R_p,
+                                    const Eigen::Vector3d& x_c, const Eigen::Matrix3d& R_c) {
+  if (j.type != JointType::kRevolute && j.type != JointType::kPrismatic && j.type != JointType::kCylindrical) {
+    return Eigen::VectorXd();
+  }
+  const Eigen::Vector3d a = j.axis.normalized();
+  Eigen::Vector3d b1, b2;
+  CrossDirections(a, b1, b2);
+  Eigen::VectorXd z(j.n_coordinates());
+  if (j.s_index() >= 0) z[j.s_index()] = a.dot(R_p.transpose() * (x_c - x_p) - j.r0);
+  if (j.phi_index() >= 0) {
+    const Eigen::Vector3d turned = R_p.transpose() * R_c * j.Q0.transpose() * b1;
+    z[j.phi_index()] = std::atan2(b2.dot(turned), b1.dot(turned));
+  }
+  return z;
+}
+
 std::string ConstraintName(const NodeJoint& j, int i) {
   const std::vector<Equation> eqs = Equations(j);
   if (i < 0 || i >= int(eqs.size())) return "equation " + std::to_string(i);

@@ -62,6 +62,12 @@ Eigen::Matrix<double, 12, 12> ConstraintHessian(const NodeJoint& j, const Eigen:
                                                 const Eigen::Matrix3d& R_p, const Eigen::Vector3d& x_c,
                                                 const Eigen::Matrix3d& R_c, const Eigen::VectorXd& lambda);
 
+/// A cut revolute, prismatic or cylindrical joint's coordinates as the tree joint would have
+/// them (node_joint.h): s = a . (R_p^T (x_c - x_p) - r0), phi = the angle of R_p^T R_c Q0^T about a
+/// in (-pi, pi] (atan2 of its action on b1); empty for other types. For `joint` probes.
+Eigen::VectorXd CutJointCoordinates(const NodeJoint& j, const Eigen::Vector3d& x_p, const Eigen::Matrix3d& R_p,
+                                    const Eigen::Vector3d& x_c, const Eigen::Matrix3d& R_c);
+
 /// What equation i of the joint's full set holds back, for messages: "translation along the
 /// axis", "translation along (0, 1, 0)" (the parent's axes at t = 0), "tilt of the axis", ...
 std::string ConstraintName(const NodeJoint& j, int i);

@@ -82,6 +82,18 @@ ResultsRecorder::ResultsRecorder(const Scene& scene, const std::string& director
         for (const NodeJoint& j : scene.model.joints) {
           if (j.child == k) d = j.type == JointType::kSpherical ? 0 : j.n_coordinates();
         }
+        // A node whose revolute, prismatic or cylindrical joint was cut to close a loop: that
+        // joint's coordinates, from the placements (CutJointCoordinates).
+        for (size_t c = 0; d == 0 && c < scene.model.cut_joints.size(); ++c) {
+          const NodeJoint& j = scene.model.cut_joints[c].joint;
+          if (j.child != k || j.type == JointType::kRigid || j.type == JointType::kSpherical ||
+              j.type == JointType::kUniversal) {
+            continue;
+          }
+          d = j.n_coordinates();
+          probe_cut_.resize(scene.spec.probes.size(), -1);
+          probe_cut_[size_t(&p - scene.spec.probes.data())] = int(c);
+        }
         if (d == 0 || d >= 3) {
           throw InputError(p.where + ": probe '" + p.name + "': node '" + p.node +
                            "' has no revolute, prismatic, cylindrical or universal joint coordinate");
@@ -256,7 +268,22 @@ void ResultsRecorder::Record(double t, const SystemState& state, const Eigen::Ve
       if (q == "rotation") for (int i = 0; i < 4; ++i) csv_ << "," << Num(quat[4 * k + i]);
       if (q == "velocity") for (int i = 0; i < 3; ++i) csv_ << "," << Num(vel[3 * k + i]);
       if (q == "angular_velocity") for (int i = 0; i < 3; ++i) csv_ << "," << Num(ang[3 * k + i]);
-      if (q == "joint") for (int i = 0; i < state.z[k].size(); ++i) csv_ << "," << Num(state.z[k][i]);
+      if (q == "joint") {
+        const int c = pi < probe_cut_.size() ? probe_cut_[pi] : -1;
+        if (c < 0) {
+          for (int i = 0; i < state.z[k].size(); ++i) csv_ << "," << Num(state.z[k][i]);
+        } else {
+          const NodeJoint& j = model.cut_joints[size_t(c)].joint;
+          Eigen::VectorXd z = CutJointCoordinates(j, state.x[j.parent], state.R[j.parent], state.x[j.child], state.R[j.child]);
+          probe_last_.resize(scene_.spec.probes.size());
+          if (j.phi_index() >= 0 && probe_last_[pi].size() == z.size()) {  // continuous through +-pi
+            const double last = probe_last_[pi][j.phi_index()];
+            z[j.phi_index()] += 2 * M_PI * std::round((last - z[j.phi_index()]) / (2 * M_PI));
+          }
+          probe_last_[pi] = z;
+          for (int i = 0; i < z.size(); ++i) csv_ << "," << Num(z[i]);
+        }
+      }
       if (q == "reaction") for (int i = 0; i < 6; ++i) csv_ << "," << Num(reaction[6 * k + i]);
     }
   }

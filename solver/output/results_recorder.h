@@ -58,6 +58,10 @@ class ResultsRecorder {
   std::ofstream csv_;
   std::vector<double> time_, kinetic_, elastic_, work_, loop_violation_;
   double max_loop_violation_ = 0.0;
+  // Per probe: the cut joint whose coordinates a `joint` probe shows (its node has none of its
+  // own), or -1; and their last values (angles unwrapped to be continuous).
+  std::vector<int> probe_cut_;
+  std::vector<Eigen::VectorXd> probe_last_;
   std::vector<Eigen::VectorXd> momentum_;  // per step: linear (3), angular (3)
   std::vector<Eigen::VectorXd> positions_, quaternions_, velocities_, angular_velocities_, joints_, reactions_;
   std::vector<std::vector<Eigen::VectorXd>> modal_;     // per step, per body
