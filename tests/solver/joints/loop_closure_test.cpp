@@ -406,6 +406,18 @@ TEST(LoopClosure, InitialVelocitiesThatWouldOpenTheLoopAreMadeConsistent) {
   EXPECT_GT(theta_dot, 0.0);
 }
 
+// A loop that does not close at t = 0 (the rocker 1 mm too short: its point C misses the
+// coupler's): one line naming the joint and the gap.
+TEST(LoopClosure, LinksThatDoNotMeetAreAnInputErrorNamingTheJointAndTheGap) {
+  FourBar fb;
+  const Eigen::Vector2d D(fb.d, 0), C = fb.C(fb.theta0), C_short = D + (C - D) * (1 - 0.001 / fb.c);
+  std::string text = fb.Scene("analysis: {type: dynamic, end_time: 0.01, step: 1.0e-3}\n");
+  text = test::Replace(text, RigidLink("rocker", D, C, "D", "C2"), RigidLink("rocker", D, C_short, "D", "C2"));
+  const std::string message = test::ThrownMessage([&] { BuildScene(ParseScene(text, "four_bar.yaml")); });
+  EXPECT_NE(message.find("revolute joint between nodes 'C2' and 'C1': the nodes are 0.001 apart at t = 0"),
+            std::string::npos) << message;
+}
+
 TEST(LoopClosure, PrescribedJointThatClosesALoopIsAnInputError) {
   FourBar fb;
   std::string text = fb.Scene("analysis: {type: dynamic, end_time: 1, step: 1.0e-3}\n");
