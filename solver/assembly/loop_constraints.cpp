@@ -1,0 +1,169 @@
+// The cut joints' constraint equations in the system (issue 15): their assembly into the
+// residual and the iteration matrix, the rank test that drops redundant equations and names a
+// dead point, and the loops' violation. Declared in system.h; the equations of one joint are in
+// solver/joints/loop_closure.h.
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "solver/assembly/system.h"
+
+namespace femb {
+
+void AddLoopConstraints(const SystemModel& model, const DofMap& dofs, const SystemState& state,
+                        Eigen::VectorXd* residual, Triplets* tangent, NodeForces* node_forces, Triplets* jacobian,
+                        int blocks) {
+  for (size_t c = 0; c < model.cut_joints.size(); ++c) {
+    const CutJoint& cut = model.cut_joints[c];
+    const NodeJoint& j = cut.joint;
+    const int nodes[2] = {j.parent, j.child};
+    const ConstraintBlock block = EvaluateConstraint(j, state.x[nodes[0]], state.R[nodes[0]], state.x[nodes[1]], state.R[nodes[1]]);
+    const int first = dofs.multiplier_first(int(c)), m = int(cut.equations.size());
+    Eigen::VectorXd l_full = Eigen::VectorXd::Zero(block.g.size());  // dropped equations: none
+    for (int i = 0; i < m; ++i) l_full[cut.equations[size_t(i)]] = state.lambda[first - dofs.first_multiplier() + i];
+    const Eigen::Matrix<double, 12, 1> f = block.G.transpose() * l_full;  // G^T lambda on (parent, child)
+    for (int e = 0; e < 2; ++e) {
+      const Eigen::Matrix<double, 6, 1> f_e = f.segment<6>(6 * e);
+      if (node_forces) node_forces->Add(nodes[e], -f_e);
+      if (residual) {
+        for (const auto& [col, vec] : state.J[nodes[e]]) (*residual)[col] -= vec.dot(f_e);
+      }
+    }
+    for (int i = 0; i < m; ++i) {
+      const int eq = cut.equations[size_t(i)];
+      if (residual) (*residual)[first + i] -= block.g[eq];
+      for (Triplets* t : {tangent, jacobian}) {
+        if (!t) continue;
+        const bool rows = t == jacobian || (blocks & kLoopRows), columns = t == jacobian || (blocks & kLoopColumns);
+        for (int e = 0; e < 2; ++e) {
+          for (const auto& [col, vec] : state.J[nodes[e]]) {
+            const double v = (block.G.block<1, 6>(eq, 6 * e) * vec)(0);
+            if (v == 0.0) continue;
+            if (rows) t->emplace_back(first + i, col, v);
+            if (columns) t->emplace_back(col, first + i, v);
+          }
+        }
+      }
+    }
+    if (!tangent || !(blocks & kLoopHessian) || l_full.isZero(0.0)) continue;
+    // d(G^T lambda)/dq through the node Jacobians (their own derivative: the node forces above).
+    const Eigen::Matrix<double, 12, 12> H =
+        ConstraintHessian(j, state.x[nodes[0]], state.R[nodes[0]], state.x[nodes[1]], state.R[nodes[1]], l_full);
+    for (int a = 0; a < 2; ++a) {
+      for (int b = 0; b < 2; ++b) {
+        const Eigen::Matrix<double, 6, 6> H_ab = H.block<6, 6>(6 * a, 6 * b);
+        if (H_ab.isZero(0.0)) continue;
+        for (const auto& [ci, vi] : state.J[nodes[a]]) {
+          const Eigen::Matrix<double, 1, 6> row = vi.transpose() * H_ab;
+          for (const auto& [cj, vj] : state.J[nodes[b]]) {
+            const double v = (row * vj)(0);
+            if (v != 0.0) tangent->emplace_back(ci, cj, v);
+          }
+        }
+      }
+    }
+  }
+}
+
+namespace {
+
+// Per kept equation of the cut joints, in order: how independent it is of the ones before it that
+// are (Gram-Schmidt on the rows of the constraint Jacobian over the coordinates solved for,
+// columns scaled to unit size so that units do not matter): the relative remainder, 1 for an
+// equation orthogonal to the others, 0 for a repeated one; independent above `tolerance`.
+std::vector<double> EquationRemainders(const SystemModel& model, const DofMap& dofs, const SystemState& state,
+                                       double tolerance) {
+  Triplets entries;
+  AddLoopConstraints(model, dofs, state, nullptr, nullptr, nullptr, &entries);
+  const int m = dofs.n_multipliers(), first = dofs.first_multiplier();
+  std::vector<int> column(size_t(dofs.n_dofs()), -1);
+  int n = 0;
+  for (int j : dofs.solved())
+    if (!dofs.multiplier(j)) column[size_t(j)] = n++;
+  Eigen::MatrixXd G = Eigen::MatrixXd::Zero(m, n);
+  for (const Eigen::Triplet<double>& e : entries)
+    if (e.row() >= first && e.col() < first && column[size_t(e.col())] >= 0) G(e.row() - first, column[size_t(e.col())]) += e.value();
+  for (int c = 0; c < n; ++c) {
+    const double size = G.col(c).cwiseAbs().maxCoeff();
+    if (size > 0) G.col(c) /= size;
+  }
+  std::vector<Eigen::VectorXd> basis;
+  std::vector<double> remainder(size_t(m), 0.0);
+  for (int i = 0; i < m; ++i) {
+    const double size = G.row(i).norm();
+    if (size == 0.0) continue;
+    Eigen::VectorXd v = G.row(i).transpose() / size;
+    for (int pass = 0; pass < 2; ++pass)
+      for (const Eigen::VectorXd& q : basis) v -= q.dot(v) * q;
+    remainder[size_t(i)] = v.norm();
+    if (v.norm() > tolerance) basis.push_back(v / v.norm());
+  }
+  return remainder;
+}
+
+}  // namespace
+
+std::vector<std::string> DropRedundantEquations(SystemModel& model) {
+  std::vector<std::string> notes(model.cut_joints.size());
+  if (model.cut_joints.empty()) return notes;
+  const DofMap dofs(model);
+  const std::vector<double> remainder = EquationRemainders(model, dofs, InitialState(model), 1e-8);
+  const int first = dofs.first_multiplier();
+  for (size_t c = 0; c < model.cut_joints.size(); ++c) {
+    CutJoint& cut = model.cut_joints[c];
+    std::vector<int> kept;
+    std::string dropped;
+    for (size_t i = 0; i < cut.equations.size(); ++i) {
+      if (remainder[size_t(dofs.multiplier_first(int(c)) - first) + i] > 1e-8) {
+        kept.push_back(cut.equations[i]);
+      } else {
+        dropped += (dropped.empty() ? "" : ", ") + ConstraintName(cut.joint, cut.equations[i]);
+      }
+    }
+    notes[c] = dropped;
+    cut.equations = kept;
+  }
+  return notes;
+}
+
+std::string LoopSingularity(const SystemModel& model, const SystemState& state) {
+  if (model.cut_joints.empty()) return "";
+  const DofMap dofs(model);
+  const std::vector<double> remainder = EquationRemainders(model, dofs, state, 1e-8);
+  double least = 1.0;
+  int worst = -1, equation = -1;
+  for (size_t c = 0; c < model.cut_joints.size(); ++c) {
+    for (size_t i = 0; i < model.cut_joints[c].equations.size(); ++i) {
+      const double r = remainder[size_t(dofs.multiplier_first(int(c)) - dofs.first_multiplier()) + i];
+      if (r < least) least = r, worst = int(c), equation = model.cut_joints[c].equations[i];
+    }
+  }
+  if (worst < 0 || least > 0.05) return "";
+  char buffer[80];
+  std::snprintf(buffer, sizeof buffer, " is within %.2g of the span of the other constraints", least);
+  return model.cut_joints[size_t(worst)].name + ": the loop it closes is at or near a singular configuration (a dead " +
+         "point: its " + ConstraintName(model.cut_joints[size_t(worst)].joint, equation) + buffer + ")";
+}
+
+double LoopViolation(const SystemModel& model, const DofMap& dofs, const SystemState& state, int* worst) {
+  (void)dofs;
+  double L = BoundingDiagonal(model.node_x0);
+  if (!(L > 0)) L = 1.0;
+  double largest = 0.0;
+  if (worst) *worst = model.cut_joints.empty() ? -1 : 0;
+  for (size_t c = 0; c < model.cut_joints.size(); ++c) {
+    const NodeJoint& j = model.cut_joints[c].joint;
+    const ConstraintBlock block = EvaluateConstraint(j, state.x[j.parent], state.R[j.parent], state.x[j.child], state.R[j.child]);
+    for (int eq : model.cut_joints[c].equations) {
+      const double v = std::abs(block.g[eq]) * (block.position[size_t(eq)] ? 1.0 : L);
+      if (v > largest) {
+        largest = v;
+        if (worst) *worst = int(c);
+      }
+    }
+  }
+  return largest;
+}
+
+}  // namespace femb
