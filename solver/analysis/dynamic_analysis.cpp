@@ -349,7 +349,7 @@ DynamicStepReport MeasureWith(const SystemModel& model, const DofMap& dofs, cons
     const SuperelementBody::Data evaluated =
         kept ? SuperelementBody::Data{} : body.Evaluate(BodyConfigurationOf(model, s.config, int(b)), s.config.frames[b]);
     const SuperelementBody::Data& data = kept ? passes[b].data : evaluated;
-    const Eigen::VectorXd w = kept ? passes[b].w : GatherBody(model, dofs, s.config, int(b), s.W);
+    const Eigen::VectorXd w = kept ? passes[b].w : BodyVelocityOf(model, dofs, s, int(b));
     r.kinetic_energy += body.KineticEnergy(data, w);
     r.elastic_energy += body.ElasticEnergy(data);
     Eigen::Vector3d L, H;

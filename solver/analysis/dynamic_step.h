@@ -167,6 +167,10 @@ struct RotationNode {
 
 std::vector<RotationNode> RotationNodes(const SystemModel& model, const DofMap& dofs);
 
+// The velocities of body b's coordinates: the midpoint scheme's node velocities where the state
+// carries them (DynamicState::node_w), J(q) W otherwise.
+Eigen::VectorXd BodyVelocityOf(const SystemModel& model, const DofMap& dofs, const DynamicState& s, int b);
+
 // One step of the momentum-conserving midpoint scheme (midpoint_step.cpp) of size h from `state`
 // into `next`; t_new as for the generalized-alpha step.
 StepOutcome MidpointStep(const SystemModel& model, const DofMap& dofs, const DynamicOptions& options,

@@ -327,6 +327,8 @@ class SuperelementBody {
   /// moment of the undeformed body about the frame origin, C = int rho Phi (the translation rows
   /// of Phi_rig0^T M), m the mass.
   Eigen::Vector3d CenterOfMass(const BodyConfiguration& c, const FrameSolution& frame) const;
+  /// The body's mass.
+  double mass() const { return mass_; }
 
   /// Generalized force of a uniform acceleration field g (gravity): P^T M Phi_rig0 [R_j^T g; 0].
   Eigen::VectorXd GravityForce(const Data& d, const Eigen::Vector3d& g) const;
