@@ -390,15 +390,13 @@ StepOutcome GeneralizedAlphaStep(const SystemModel& model, const DofMap& dofs, c
   const Eigen::VectorXd weights = ResidualWeights(model, dofs);
   DivergenceTest divergence;
   // Closed loops: the constraints hold to the tolerance times the model's size.
-  const double loop_tolerance = tolerance * std::max(BoundingDiagonal(model.node_x0), 1e-300);
-  const auto loops_closed = [&] {
-    return dofs.n_multipliers() == 0 || LoopViolation(model, dofs, next.config) <= loop_tolerance;
-  };
+
   for (; out.iterations < options.max_iterations; ++out.iterations) {
     Assembly a = AssembleDynamicResidual(model, dofs, next, t_new, work, &threads);
     if (!a.ok || !a.residual.allFinite()) return out;
     const double r_norm = FreeNorm(dofs, a.residual, weights);
-    if (r_norm <= std::max(tolerance * a.scale, a.roundoff) && out.iterations > 0 && loops_closed()) {
+    if (r_norm <= std::max(tolerance * a.scale, a.roundoff) && out.iterations > 0 &&
+        LoopsClosed(model, next.config, tolerance)) {
       out.converged = true;
       next.a += (1 - alpha_f) / (1 - alpha_m) * next.Wdot;
       next.t = t_new;

@@ -396,7 +396,6 @@ StepOutcome MidpointStep(const SystemModel& model, const DofMap& dofs, const Dyn
   const Eigen::VectorXd weights = ResidualWeights(model, dofs);
   DivergenceTest divergence;
   const int n_lambda = dofs.n_multipliers();
-  const double loop_tolerance = tolerance * std::max(BoundingDiagonal(model.node_x0), 1e-300);
   for (; out.iterations < options.max_iterations; ++out.iterations) {
     MidpointKinematics k = Midpoint(model, dofs, triples, state, h, next);
     double work = 0.0;
@@ -409,8 +408,8 @@ StepOutcome MidpointStep(const SystemModel& model, const DofMap& dofs, const Dyn
       a.residual.tail(n_lambda) = end.tail(n_lambda);
     }
     const double r_norm = FreeNorm(dofs, a.residual, weights);
-    const bool loops_closed = n_lambda == 0 || LoopViolation(model, dofs, next.config) <= loop_tolerance;
-    if (r_norm <= std::max(tolerance * a.scale, a.roundoff) && out.iterations > 0 && loops_closed) {
+    if (r_norm <= std::max(tolerance * a.scale, a.roundoff) && out.iterations > 0 &&
+        LoopsClosed(model, next.config, tolerance)) {
       out.converged = true;
       next.t = t_new;
       // a: the mean acceleration over the step (t_n+1/2); Wdot: extrapolated to t_n+1 from

@@ -58,9 +58,7 @@ StaticResult SolveStatic(const SystemModel& model, SystemState& state, const Sta
       energy = f.elastic_energy;
       loads_after = f.loads;
       if (!std::isfinite(r_norm)) break;
-      const bool loops_closed =
-          dofs.n_multipliers() == 0 || LoopViolation(model, dofs, trial) <= tolerance * BoundingDiagonal(model.node_x0);
-      if (it > 0 && loops_closed &&
+      if (it > 0 && LoopsClosed(model, trial, tolerance) &&
           (r_norm <= std::max(tolerance * std::max(f.force_scale, 1e-300), f.roundoff) || last_step <= 1e-13 * size)) {
         converged = true;
         break;

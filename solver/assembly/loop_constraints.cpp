@@ -146,8 +146,7 @@ std::string LoopSingularity(const SystemModel& model, const SystemState& state) 
          "point: its " + ConstraintName(model.cut_joints[size_t(worst)].joint, equation) + buffer + ")";
 }
 
-double LoopViolation(const SystemModel& model, const DofMap& dofs, const SystemState& state, int* worst) {
-  (void)dofs;
+double LoopViolation(const SystemModel& model, const SystemState& state, int* worst) {
   double L = BoundingDiagonal(model.node_x0);
   if (!(L > 0)) L = 1.0;
   double largest = 0.0;
@@ -164,6 +163,11 @@ double LoopViolation(const SystemModel& model, const DofMap& dofs, const SystemS
     }
   }
   return largest;
+}
+
+bool LoopsClosed(const SystemModel& model, const SystemState& state, double tolerance) {
+  return model.cut_joints.empty() ||
+         LoopViolation(model, state) <= tolerance * std::max(BoundingDiagonal(model.node_x0), 1e-300);
 }
 
 }  // namespace femb

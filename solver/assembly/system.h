@@ -210,7 +210,10 @@ void AddLoopConstraints(const SystemModel& model, const DofMap& dofs, const Syst
 /// The largest violation of the kept equations: positions in length units, rotations (dot
 /// products) times the model's size L so that both are lengths; 0 without loops. `worst`: the
 /// cut joint with it (-1 without loops).
-double LoopViolation(const SystemModel& model, const DofMap& dofs, const SystemState& state, int* worst = nullptr);
+double LoopViolation(const SystemModel& model, const SystemState& state, int* worst = nullptr);
+/// Newton's test on the loops: no cut joints, or LoopViolation <= tolerance times the model's
+/// size (BoundingDiagonal of the nodes), the same relative tolerance as the forces'.
+bool LoopsClosed(const SystemModel& model, const SystemState& state, double tolerance);
 
 /// Drops the cut joints' equations that repeat others at the initial state (an over-constrained
 /// mechanism: a planar four-bar of spatial revolute joints has 3 of its 5 closure equations

@@ -116,7 +116,7 @@ void ResultsRecorder::Record(double t, const SystemState& state, const Eigen::Ve
   const DofMap& dofs = dofs_;
   const int n = model.n_nodes();
   if (!model.cut_joints.empty()) {
-    loop_violation_.push_back(LoopViolation(model, dofs, state));
+    loop_violation_.push_back(LoopViolation(model, state));
     max_loop_violation_ = std::max(max_loop_violation_, loop_violation_.back());
   }
   Eigen::VectorXd pos(3 * n), quat(4 * n), vel(3 * n), ang(3 * n);
