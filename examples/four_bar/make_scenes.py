@@ -84,6 +84,9 @@ def main():
     # The rocker's angle: the joint at D is the one cut to close the loop; its probe shows the
     # angle from the placements.
     rocker_probe = "    - {name: rocker, node: D, quantities: [joint]}\n"
+    # The ground's reactions: at A the driven tree joint's, at D the cut joint's (its multipliers).
+    reaction_probes = ("    - {name: ground_a, node: A, quantities: [reaction]}\n"
+                       "    - {name: ground_d, node: D, quantities: [reaction]}\n")
     with open(f"{out}/coupler_2.yaml", "w") as f:
         f.write(part("coupler_2", b / 2, 2e11, 4, "One half of the four-bar's coupler (0.35 m, 6 mm steel rod)."))
     with open(f"{out}/crank.yaml", "w") as f:
@@ -96,7 +99,7 @@ def main():
     coupler_flexible = superelement("coupler0", "coupler_2.h5", B, M, "B2", "M") + superelement("coupler1", "coupler_2.h5", M, C, "M", "C1")
     with open(f"{out}/rigid.yaml", "w") as f:
         f.write("# The four-bar with every link rigid (make_scenes.py).\nname: four_bar_rigid\n" + head + crank_rigid +
-                rigid("coupler", B, C, "B2", "C1") + rocker_rigid + joints + rocker_probe)
+                rigid("coupler", B, C, "B2", "C1") + rocker_rigid + joints + rocker_probe + reaction_probes)
     with open(f"{out}/flexible.yaml", "w") as f:
         f.write("# The four-bar with a flexible coupler in 2 superelements, rigid crank and rocker (make_scenes.py).\n"
                 "name: four_bar_flexible\n" + head + crank_rigid + coupler_flexible + rocker_rigid + joints + mid_probe)

@@ -165,6 +165,20 @@ double LoopViolation(const SystemModel& model, const SystemState& state, int* wo
   return largest;
 }
 
+std::vector<Eigen::Matrix<double, 6, 1>> CutJointReactions(const SystemModel& model, const SystemState& state) {
+  std::vector<Eigen::Matrix<double, 6, 1>> out;
+  int first = 0;  // the joint's first multiplier in state.lambda
+  for (const CutJoint& cut : model.cut_joints) {
+    const NodeJoint& j = cut.joint;
+    const ConstraintBlock block = EvaluateConstraint(j, state.x[j.parent], state.R[j.parent], state.x[j.child], state.R[j.child]);
+    Eigen::VectorXd l_full = Eigen::VectorXd::Zero(block.g.size());
+    for (size_t i = 0; i < cut.equations.size(); ++i) l_full[cut.equations[i]] = state.lambda[first + long(i)];
+    first += int(cut.equations.size());
+    out.push_back(-(block.G.rightCols<6>().transpose() * l_full));
+  }
+  return out;
+}
+
 bool LoopsClosed(const SystemModel& model, const SystemState& state, double tolerance) {
   return model.cut_joints.empty() ||
          LoopViolation(model, state) <= tolerance * std::max(BoundingDiagonal(model.node_x0), 1e-300);

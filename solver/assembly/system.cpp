@@ -626,6 +626,19 @@ std::vector<Eigen::Matrix<double, 6, 1>> JointReactions(const SystemModel& model
     const bool held = dofs.joint_of(k) >= 0 || dofs.S(k).cols() < 6;
     if (held) reactions[k] = -t[k];
   }
+  // A node that is the child of cut joints and held otherwise by nothing or by a rigid joint (a
+  // rigid body's point hangs on its body by one): the cut joints' reactions. That is what the
+  // scene's joint at the node exerts; the rigid offset's force is internal to the body.
+  const std::vector<Eigen::Matrix<double, 6, 1>> cut = CutJointReactions(model, state);
+  std::vector<bool> replaced(model.n_nodes(), false);
+  for (size_t c = 0; c < cut.size(); ++c) {
+    const int k = model.cut_joints[c].joint.child, j = dofs.joint_of(k);
+    const bool tree_held = j >= 0 ? model.joints[j].type != JointType::kRigid : dofs.S(k).cols() < 6;
+    if (tree_held) continue;
+    if (!replaced[k]) reactions[k].setZero();
+    replaced[k] = true;
+    reactions[k] += cut[c];
+  }
   return reactions;
 }
 

@@ -193,7 +193,9 @@ void AddJointGeometricStiffness(const SystemModel& model, const DofMap& dofs, co
 /// node and all that hangs from it: R_k = -t_k, t_k = f_k + sum over child joints A_c^T t_c, f
 /// the node forces of the assembly (applied minus internal and inertia forces). For a prescribed
 /// joint coordinate the reaction includes the drive: e.g. a driven revolute's moment about its
-/// axis is the driving torque. Other nodes: zero.
+/// axis is the driving torque. A node that is the child of cut joints and held otherwise by
+/// nothing or by a rigid joint (a rigid body's point): the cut joints' reactions
+/// (CutJointReactions). Other nodes: zero.
 std::vector<Eigen::Matrix<double, 6, 1>> JointReactions(const SystemModel& model, const DofMap& dofs,
                                                         const SystemState& state, const NodeForces& forces);
 
@@ -211,6 +213,11 @@ void AddLoopConstraints(const SystemModel& model, const DofMap& dofs, const Syst
 /// products) times the model's size L so that both are lengths; 0 without loops. `worst`: the
 /// cut joint with it (-1 without loops).
 double LoopViolation(const SystemModel& model, const SystemState& state, int* worst = nullptr);
+/// Per cut joint, the force and moment (global axes, moment about the child node) that the
+/// joint's parent node, or the ground, exerts on its child node through the joint: -G_c^T lambda,
+/// G_c the child's columns of the kept equations. Along a dropped (redundant) direction the
+/// mechanism's reactions are not unique and this one carries none.
+std::vector<Eigen::Matrix<double, 6, 1>> CutJointReactions(const SystemModel& model, const SystemState& state);
 /// Newton's test on the loops: no cut joints, or LoopViolation <= tolerance times the model's
 /// size (BoundingDiagonal of the nodes), the same relative tolerance as the forces'.
 bool LoopsClosed(const SystemModel& model, const SystemState& state, double tolerance);

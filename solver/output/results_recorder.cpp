@@ -140,6 +140,12 @@ void ResultsRecorder::Record(double t, const SystemState& state, const Eigen::Ve
     for (int k = 0; k < n; ++k) reaction.segment<6>(6 * k) = (*reactions)[k];
   }
   if (scene_.spec.reactions) reactions_.push_back(reaction);
+  if (scene_.spec.reactions && !model.cut_joints.empty()) {
+    const std::vector<Eigen::Matrix<double, 6, 1>> cut = CutJointReactions(model, state);
+    Eigen::VectorXd r(6 * long(cut.size()));
+    for (size_t c = 0; c < cut.size(); ++c) r.segment<6>(6 * long(c)) = cut[c];
+    loop_reactions_.push_back(r);
+  }
   quaternions_.push_back(quat);
   velocities_.push_back(vel);
   angular_velocities_.push_back(ang);
@@ -333,6 +339,7 @@ void ResultsRecorder::Finish(const std::string& status) {
       for (const CutJoint& cut : model.cut_joints) names.push_back(cut.name);
       w.Strings("/loops/cut_joints", names);
       w.Vector("/loops/violation", Eigen::Map<const Eigen::VectorXd>(loop_violation_.data(), long(loop_violation_.size())));
+      if (!loop_reactions_.empty()) w.Matrix("/loops/reaction", Stack(loop_reactions_, 6 * int(model.cut_joints.size())));
     }
     w.CreateGroup("/nodes");
     w.Strings("/nodes/names", model.node_names);

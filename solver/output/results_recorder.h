@@ -58,6 +58,7 @@ class ResultsRecorder {
   std::ofstream csv_;
   std::vector<double> time_, kinetic_, elastic_, work_, loop_violation_;
   double max_loop_violation_ = 0.0;
+  std::vector<Eigen::VectorXd> loop_reactions_;  ///< per output step, 6 per cut joint (with reactions)
   // Per probe: the cut joint whose coordinates a `joint` probe shows (its node has none of its
   // own), or -1; and their last values (angles unwrapped to be continuous).
   std::vector<int> probe_cut_;

@@ -378,6 +378,25 @@ TEST(LoopClosure, ParallelogramSwingHasThePendulumFrequencyOfItsClosedForm) {
   std::printf("[ info ] parallelogram swing: %.9f Hz, closed form %.9f Hz; multipliers at rest %.4g N\n",
               modes.frequencies_hz[0], f, state.lambda.norm());
   EXPECT_NEAR(modes.frequencies_hz[0], f, 1e-8 * f);
+  // The reactions at rest: by the mirror symmetry each pivot carries half the weight W, straight
+  // up, and no moment (every force is in the plane and the pivots turn freely about z). A is a
+  // tree joint (its support reaction), D the cut joint (its multipliers): both must be W / 2.
+  ASSERT_EQ(scene.model.cut_joints.size(), 1u);
+  const DofMap dofs(scene.model);
+  SystemState copy = state;
+  const SystemForces forces = AssembleStatic(scene.model, dofs, copy, 1.0, false);
+  const std::vector<Eigen::Matrix<double, 6, 1>> reactions = JointReactions(scene.model, dofs, copy, forces.node_forces);
+  const std::vector<Eigen::Matrix<double, 6, 1>> cut = CutJointReactions(scene.model, copy);
+  const double W = (2 * m_l + m_c) * g;
+  Eigen::Matrix<double, 6, 1> half = Eigen::Matrix<double, 6, 1>::Zero();
+  half[1] = W / 2;
+  const int nA = scene.node_index.at("A"), nD = scene.node_index.at("D");
+  std::printf("[ info ] parallelogram at rest: reaction at A (tree) %.6f N up, at D (cut) %.6f N up, W / 2 = %.6f N\n",
+              reactions[size_t(nA)][1], reactions[size_t(nD)][1], W / 2);
+  EXPECT_EQ(scene.model.cut_joints[0].joint.child, nD);
+  EXPECT_LT((reactions[size_t(nA)] - half).norm(), 1e-9 * W);
+  EXPECT_LT((cut[0] - half).norm(), 1e-9 * W);
+  EXPECT_LT((reactions[size_t(nD)] - cut[0]).norm(), 1e-15 * W);  // D's reaction is its cut joint's
 }
 
 // The rocker driven beyond its range: at the extreme the crank and the coupler fall in line (a
