@@ -113,6 +113,18 @@ Eigen::Matrix<double, 12, 12> ConstraintHessian(const NodeJoint& j, const Eigen:
 
 Eigen::VectorXd CutJointCoordinates(const NodeJoint& j, const Eigen::Vector3d& x_p, const Eigen::Matrix3d& R_p,
                                     const Eigen::Vector3d& x_c, const Eigen::Matrix3d& R_c) {
+  if (j.type == JointType::kUniversal) {
+    // rel = exp(z0 a) exp(z1 b), a the parent's axis, b the cross's second axis (b . a = 0):
+    // rel b = exp(z0 a) b turns b about a by z0; exp(-z0 a) rel a = exp(z1 b) a turns a about b.
+    const Eigen::Vector3d a = j.axis.normalized(), b = j.axis2.normalized();
+    const Eigen::Matrix3d rel = R_p.transpose() * R_c * j.Q0.transpose();
+    Eigen::VectorXd z(2);
+    const Eigen::Vector3d rb = rel * b;
+    z[0] = std::atan2(a.cross(b).dot(rb), b.dot(rb));
+    const Eigen::Vector3d ra = ExpSO3(Eigen::Vector3d(-z[0] * a)) * rel * a;
+    z[1] = std::atan2(b.cross(a).dot(ra), a.dot(ra));
+    return z;
+  }
   if (j.type != JointType::kRevolute && j.type != JointType::kPrismatic && j.type != JointType::kCylindrical) {
     return Eigen::VectorXd();
   }

@@ -62,9 +62,11 @@ Eigen::Matrix<double, 12, 12> ConstraintHessian(const NodeJoint& j, const Eigen:
                                                 const Eigen::Matrix3d& R_p, const Eigen::Vector3d& x_c,
                                                 const Eigen::Matrix3d& R_c, const Eigen::VectorXd& lambda);
 
-/// A cut revolute, prismatic or cylindrical joint's coordinates as the tree joint would have
-/// them (node_joint.h): s = a . (R_p^T (x_c - x_p) - r0), phi = the angle of R_p^T R_c Q0^T about a
-/// in (-pi, pi] (atan2 of its action on b1); empty for other types. For `joint` probes.
+/// A cut revolute, prismatic, cylindrical or universal joint's coordinates as the tree joint
+/// would have them (node_joint.h): s = a . (R_p^T (x_c - x_p) - r0), phi = the angle of
+/// R_p^T R_c Q0^T about a in (-pi, pi] (atan2 of its action on b1); universal: the two angles of
+/// R_p^T R_c Q0^T = exp(z0 a) exp(z1 b), each in (-pi, pi]. Empty for other types. For `joint`
+/// probes.
 Eigen::VectorXd CutJointCoordinates(const NodeJoint& j, const Eigen::Vector3d& x_p, const Eigen::Matrix3d& R_p,
                                     const Eigen::Vector3d& x_c, const Eigen::Matrix3d& R_c);
 

@@ -82,12 +82,11 @@ ResultsRecorder::ResultsRecorder(const Scene& scene, const std::string& director
         for (const NodeJoint& j : scene.model.joints) {
           if (j.child == k) d = j.type == JointType::kSpherical ? 0 : j.n_coordinates();
         }
-        // A node whose revolute, prismatic or cylindrical joint was cut to close a loop: that
-        // joint's coordinates, from the placements (CutJointCoordinates).
+        // A node whose revolute, prismatic, cylindrical or universal joint was cut to close a
+        // loop: that joint's coordinates, from the placements (CutJointCoordinates).
         for (size_t c = 0; d == 0 && c < scene.model.cut_joints.size(); ++c) {
           const NodeJoint& j = scene.model.cut_joints[c].joint;
-          if (j.child != k || j.type == JointType::kRigid || j.type == JointType::kSpherical ||
-              j.type == JointType::kUniversal) {
+          if (j.child != k || j.type == JointType::kRigid || j.type == JointType::kSpherical) {
             continue;
           }
           d = j.n_coordinates();
@@ -282,9 +281,11 @@ void ResultsRecorder::Record(double t, const SystemState& state, const Eigen::Ve
           const NodeJoint& j = model.cut_joints[size_t(c)].joint;
           Eigen::VectorXd z = CutJointCoordinates(j, state.x[j.parent], state.R[j.parent], state.x[j.child], state.R[j.child]);
           probe_last_.resize(scene_.spec.probes.size());
-          if (j.phi_index() >= 0 && probe_last_[pi].size() == z.size()) {  // continuous through +-pi
-            const double last = probe_last_[pi][j.phi_index()];
-            z[j.phi_index()] += 2 * M_PI * std::round((last - z[j.phi_index()]) / (2 * M_PI));
+          if (probe_last_[pi].size() == z.size()) {  // angles continuous through +-pi
+            for (int i = 0; i < z.size(); ++i) {
+              if (i != j.phi_index() && j.type != JointType::kUniversal) continue;
+              z[i] += 2 * M_PI * std::round((probe_last_[pi][i] - z[i]) / (2 * M_PI));
+            }
           }
           probe_last_[pi] = z;
           for (int i = 0; i < z.size(); ++i) csv_ << "," << Num(z[i]);

@@ -91,6 +91,28 @@ TEST(LoopClosure, ClosureAtThePlacementAndEquationCounts) {
   }
 }
 
+// A cut joint's coordinates from the placements (what a `joint` probe shows) against the tree
+// joint's own: the child placed by PlaceChild at known coordinates, in a general pose (tilted
+// axes, an offset placement), must give them back to round-off, angles beyond pi/2 included.
+TEST(LoopClosure, CutJointCoordinatesGiveBackTheTreeJointsCoordinates) {
+  const Eigen::Vector3d x_p(0.3, -0.2, 0.5), axis = Eigen::Vector3d(0.36, 0.48, 0.8), axis2(0.8, 0, -0.36);
+  const Eigen::Matrix3d R_p = ExpSO3(Eigen::Vector3d(0.4, -1.1, 0.7)), R_c0 = ExpSO3(Eigen::Vector3d(-0.3, 0.2, 0.9));
+  const Eigen::Vector3d x_c0 = x_p + R_p * Eigen::Vector3d(0.1, 0.2, -0.05);
+  for (const JointType type : {JointType::kRevolute, JointType::kPrismatic, JointType::kCylindrical, JointType::kUniversal}) {
+    const NodeJoint j = MakeNodeJoint(type, 1, 0, axis, x_p, R_p, x_c0, R_c0, axis2);
+    for (const double scale : {0.3, 1.0, 2.9}) {
+      Eigen::VectorXd z(j.n_coordinates());
+      for (int i = 0; i < z.size(); ++i) z[i] = scale * (i == 0 ? 0.8 : -0.6);
+      Eigen::Vector3d x_c;
+      Eigen::Matrix3d R_c = R_c0;
+      PlaceChild(j, x_p, R_p, z, &x_c, &R_c);
+      const Eigen::VectorXd back = CutJointCoordinates(j, x_p, R_p, x_c, R_c);
+      ASSERT_EQ(back.size(), z.size()) << JointName(type);
+      EXPECT_LT((back - z).norm(), 1e-12) << JointName(type) << " at " << z.transpose();
+    }
+  }
+}
+
 TEST(LoopClosure, StaticTangentWithCutJointsMatchesFiniteDifferences) {
   const double L = 0.5;
   const Superelement se = Rod(L, 2);
