@@ -1,11 +1,11 @@
 // The derivatives of the node accelerations of the joint tree (NodeAccelerations) with respect
 // to the coordinate velocities and the coordinates: the Coriolis, centripetal and configuration
-// terms of chains with offsets in the dynamic iteration matrix. Declared in system.h.
+// terms of chains with offsets in the dynamic iteration matrix. Declared in joint_tree.h.
 #include <Eigen/Dense>
 #include <algorithm>
 #include <vector>
 
-#include "solver/assembly/system.h"
+#include "solver/joints/joint_tree.h"
 
 namespace femb {
 

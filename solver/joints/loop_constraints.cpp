@@ -1,13 +1,14 @@
 // The cut joints' constraint equations in the system (issue 15): their assembly into the
 // residual and the iteration matrix, the rank test that drops redundant equations and names a
-// dead point, and the loops' violation. Declared in system.h; the equations of one joint are in
+// dead point, and the loops' violation and reactions. The equations of one joint are in
 // solver/joints/loop_closure.h.
+#include "solver/joints/loop_constraints.h"
+
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 
-#include "solver/assembly/system.h"
 
 namespace femb {
 

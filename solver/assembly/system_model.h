@@ -1,0 +1,175 @@
+// A multibody system of superelements on shared 6-DOF nodes, with Lagrange multipliers only
+// where a loop of joints must be closed (cut joints, solver/joints/loop_closure.h).
+// Nodes shared by bodies are rigid connections. Each node k moves in a subspace of its spatial
+// increments (dx, dpi): dq_k = S_k dz_k with its own coordinates z_k — S_k = 1 for a free
+// node, nothing for a clamp, [0; 1] for a spherical joint to ground, [0; a] for a revolute joint
+// to ground about the fixed axis a (R = exp(phi a~) R0 exactly), [a; 0] prismatic, [a 0; 0 a]
+// cylindrical. S_k is constant, so these joints add neither geometric nor convective terms.
+// A node may instead depend on a parent node through a NodeJoint (solver/joints/node_joint.h)
+// with the joint's own coordinates; its increments then follow dq_c = A dq_p + B dz, composed
+// down the tree into the node Jacobian J_k (dq_k = J_k dz), with the joints' geometric
+// stiffness and convective accelerations.
+// Unknowns: every node's coordinates, the modal coordinates of every body, then the cut
+// joints' multipliers (DofMap::first_multiplier; solver/joints/loop_constraints.h). A joint
+// coordinate may be prescribed by a time function: it stays in the vector of coordinates but
+// is not solved for. Model (immutable) and State are separate: f(const Model&, State&).
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+#include <functional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "solver/body/superelement_body.h"
+#include "solver/forces/spring_damper.h"
+#include "solver/joints/loop_closure.h"
+#include "solver/joints/node_joint.h"
+
+namespace femb {
+
+/// A force and moment on a node, scaled by the load factor. `follower`: given in the node's
+/// frame and turning with it; else fixed in space.
+struct NodeLoad {
+  int node = -1;
+  Eigen::Vector3d force = Eigen::Vector3d::Zero();
+  Eigen::Vector3d moment = Eigen::Vector3d::Zero();
+  bool follower = false;
+  /// Time function scaling the load (static: pseudo-time = load factor). Empty: identity.
+  std::function<double(double)> scale;
+  double Scale(double t) const { return scale ? scale(t) : t; }
+};
+
+struct SystemModel {
+  std::vector<std::string> node_names;
+  std::vector<Eigen::Vector3d> node_x0;   ///< initial positions
+  std::vector<Eigen::Matrix3d> node_R0;   ///< initial rotations
+  /// Per node: the basis S_k (6 x d_k) of its allowed spatial increments (see above).
+  std::vector<Eigen::MatrixXd> motion;
+  /// Prescribed node coordinates: node, coordinate index in z_k, value f(t), f'(t), f''(t).
+  struct Prescribed {
+    int node = -1;
+    int coordinate = 0;
+    std::function<double(double)> value, rate, acceleration;
+  };
+  std::vector<Prescribed> prescribed;
+  /// Joints between nodes: each child node depends on its parent (a tree; no cycles).
+  std::vector<NodeJoint> joints;
+  /// Joints that close loops of that tree: constraint equations with Lagrange multipliers
+  /// (solver/joints/loop_closure.h); their child keeps its own coordinates.
+  std::vector<CutJoint> cut_joints;
+  std::vector<SuperelementBody> bodies;
+  std::vector<std::vector<int>> body_nodes;  ///< system node of each interface of each body
+  std::vector<std::string> body_names;       ///< for messages (may be empty)
+  std::vector<NodeLoad> loads;
+  std::vector<SpringDamper> springs;
+  Eigen::Vector3d gravity = Eigen::Vector3d::Zero();  ///< uniform acceleration field
+  /// Static analyses: gravity grows linearly with the pseudo-time to full at this value (the
+  /// analysis' end_time); 0: no gravity in AssembleStatic (dynamic analyses add it themselves).
+  double static_gravity_end = 0.0;
+
+  int n_nodes() const { return int(node_names.size()); }
+};
+
+/// System matrices are sparse (assembled from triplets) and factorized sparse (FreeSolver);
+/// analyses that need a dense matrix (the tangent's inertia, singular motions) do so below
+/// kDenseLimit free coordinates.
+using SystemMatrix = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
+using Triplets = std::vector<Eigen::Triplet<double>>;
+inline constexpr int kDenseLimit = 400;
+/// Newton tolerances (residual relative to the force scale) below this are under the round-off
+/// floor of the residual: the analyses use this instead and say so.
+inline constexpr double kRoundOffTolerance = 1e-13;
+
+/// dq_k = J_k dz for one node: sparse columns (coordinate, 6-vector).
+using NodeJacobian = std::vector<std::pair<int, Eigen::Matrix<double, 6, 1>>>;
+
+struct SystemState {
+  std::vector<Eigen::VectorXd> z;           ///< per node: accumulated coordinates (joint values)
+  std::vector<NodeJacobian> J;              ///< per node, at this configuration
+  std::vector<Eigen::Vector3d> x;
+  std::vector<Eigen::Matrix3d> R;
+  std::vector<Eigen::VectorXd> eta;         ///< per body
+  std::vector<FrameSolution> frames;        ///< per body, the last solved floating frame
+  Eigen::VectorXd lambda;                   ///< the cut joints' multipliers (DofMap::multiplier_first)
+};
+
+/// Numbering of the unknowns (coordinates).
+class DofMap {
+ public:
+  explicit DofMap(const SystemModel& model);
+  int n_dofs() const { return n_dofs_; }
+  /// First coordinate of node k and how many it has (its basis S_k when independent; its
+  /// joint's coordinates when it depends on a parent).
+  int node_first(int k) const { return node_first_[k]; }
+  int node_count(int k) const { return node_count_[k]; }
+  const Eigen::MatrixXd& S(int k) const { return (*motion_)[k]; }
+  /// The joint making node k dependent, or -1.
+  int joint_of(int k) const { return joint_of_[k]; }
+  /// Nodes, parents before children.
+  const std::vector<int>& order() const { return order_; }
+  /// First coordinate of body b's modal coordinates.
+  int mode_dof(int b) const { return mode_dof_[b]; }
+  /// The unknowns after the coordinates: the multipliers of the cut joints' kept equations
+  /// (cut joint c's from multiplier_first(c)), n_multipliers() of them; none without loops.
+  int n_multipliers() const { return n_dofs_ - first_multiplier_; }
+  int multiplier_first(int c) const { return multiplier_first_[c]; }
+  int first_multiplier() const { return first_multiplier_; }
+  bool multiplier(int j) const { return j >= first_multiplier_; }
+  /// Sets the multipliers' entries of a vector over the unknowns to zero (velocities and
+  /// accelerations have none).
+  void ClearMultipliers(Eigen::VectorXd& v) const {
+    if (n_multipliers() > 0) v.tail(n_multipliers()).setZero();
+  }
+
+  /// true for prescribed coordinates (not solved for).
+  bool prescribed(int j) const { return prescribed_[j]; }
+  /// The coordinate of a prescribed entry.
+  int prescribed_index(const SystemModel::Prescribed& p) const { return node_first_[p.node] + p.coordinate; }
+  /// Indices of the coordinates solved for.
+  const std::vector<int>& solved() const { return solved_; }
+
+ private:
+  const std::vector<Eigen::MatrixXd>* motion_;
+  std::vector<int> node_first_, node_count_, joint_of_, order_, mode_dof_, solved_, multiplier_first_;
+  std::vector<bool> prescribed_;
+  int n_dofs_ = 0, first_multiplier_ = 0;
+};
+
+/// Node k clamped to ground.
+void Clamp(SystemModel& model, int k);
+/// Node k's position fixed, rotation free (spherical joint to ground).
+void Pin(SystemModel& model, int k);
+/// Revolute joint to ground about the fixed unit axis a (global): one rotation coordinate.
+void RevoluteToGround(SystemModel& model, int k, const Eigen::Vector3d& axis);
+/// Prismatic joint to ground along a (global): one translation coordinate, rotation fixed.
+void PrismaticToGround(SystemModel& model, int k, const Eigen::Vector3d& axis);
+/// Cylindrical joint to ground: translation along and rotation about a.
+void CylindricalToGround(SystemModel& model, int k, const Eigen::Vector3d& axis);
+
+/// Adds an interface node to `model` at a position and returns its index.
+int AddNode(SystemModel& model, const std::string& name, const Eigen::Vector3d& x,
+            const Eigen::Matrix3d& R = Eigen::Matrix3d::Identity());
+
+/// The initial state: nodes at their initial placement, modes at rest, frames at the bodies'
+/// undeformed frames, node Jacobians computed.
+SystemState InitialState(const SystemModel& model);
+
+/// Sets the prescribed coordinates to their values at t: configuration (through the node's
+/// basis), and, when W / Wdot are given, their rates and accelerations.
+void ApplyPrescribed(const SystemModel& model, const DofMap& dofs, double t, SystemState& state,
+                     Eigen::VectorXd* W, Eigen::VectorXd* Wdot);
+
+/// The diagonal of the bounding box of points (node positions): the model's size; 0 for fewer
+/// than two points.
+double BoundingDiagonal(const std::vector<Eigen::Vector3d>& points);
+
+/// Applies an increment of the unknowns: x += dx, R <- exp(dpi~) R, eta += d eta.
+void ApplyIncrement(const SystemModel& model, const DofMap& dofs, const Eigen::VectorXd& delta, SystemState& state);
+
+/// The body's configuration taken from the system state (into `c`: reusing its storage).
+BodyConfiguration BodyConfigurationOf(const SystemModel& model, const SystemState& state, int body);
+void BodyConfigurationOf(const SystemModel& model, const SystemState& state, int body, BodyConfiguration& c);
+
+}  // namespace femb

@@ -1,0 +1,137 @@
+#include "solver/joints/joint_tree.h"
+
+#include <Eigen/Dense>
+#include <vector>
+
+#include "solver/joints/loop_constraints.h"
+#include "solver/rotation.h"
+
+namespace femb {
+
+Eigen::Matrix<double, 6, 1> NodeMotion(const SystemState& state, int k, const Eigen::VectorXd& dz) {
+  Eigen::Matrix<double, 6, 1> v = Eigen::Matrix<double, 6, 1>::Zero();
+  if (dz.size() == 0) return v;
+  for (const auto& [col, vec] : state.J[k]) v += vec * dz[col];
+  return v;
+}
+
+void UpdateKinematics(const SystemModel& model, const DofMap& dofs, SystemState& state) {
+  state.J.assign(model.n_nodes(), NodeJacobian());
+  for (int k : dofs.order()) {
+    const int j = dofs.joint_of(k);
+    NodeJacobian& J = state.J[k];
+    if (j < 0) {
+      const Eigen::MatrixXd& S = dofs.S(k);
+      for (int c = 0; c < S.cols(); ++c) J.emplace_back(dofs.node_first(k) + c, S.col(c));
+      continue;
+    }
+    const NodeJoint& joint = model.joints[j];
+    const int p = joint.parent;
+    PlaceChild(joint, state.x[p], state.R[p], state.z[k], &state.x[k], &state.R[k]);
+    const JointMaps maps = ComputeJointMaps(joint, state.x[p], state.R[p], state.x[k], state.z[k]);
+    for (const auto& [col, vec] : state.J[p]) {
+      const Eigen::Matrix<double, 6, 1> v = maps.A * vec;
+      if (v.squaredNorm() > 0) J.emplace_back(col, v);
+    }
+    for (int c = 0; c < joint.n_coordinates(); ++c) J.emplace_back(dofs.node_first(k) + c, maps.B.col(c));
+  }
+}
+
+std::vector<Eigen::Matrix<double, 6, 1>> NodeAccelerations(const SystemModel& model, const DofMap& dofs,
+                                                           const SystemState& state, const Eigen::VectorXd& W,
+                                                           const Eigen::VectorXd& Wdot) {
+  std::vector<Eigen::Matrix<double, 6, 1>> acc(model.n_nodes(), Eigen::Matrix<double, 6, 1>::Zero());
+  std::vector<Eigen::Matrix<double, 6, 1>> convective(model.n_nodes(), Eigen::Matrix<double, 6, 1>::Zero());
+  for (int k : dofs.order()) {
+    const int j = dofs.joint_of(k);
+    if (j >= 0) {
+      const NodeJoint& joint = model.joints[j];
+      const int p = joint.parent;
+      const JointMaps maps = ComputeJointMaps(joint, state.x[p], state.R[p], state.x[k], state.z[k]);
+      const Eigen::VectorXd zdot = W.segment(dofs.node_first(k), dofs.node_count(k));
+      convective[k] = ChildConvective(joint, maps, state.x[p], state.R[p], state.x[k], NodeMotion(state, p, W), zdot,
+                                      convective[p]);
+    }
+    acc[k] = NodeMotion(state, k, Wdot) + convective[k];
+  }
+  return acc;
+}
+
+NodeForces ZeroNodeForces(const SystemModel& model) {
+  NodeForces f;
+  f.f.assign(model.n_nodes(), Eigen::Matrix<double, 6, 1>::Zero());
+  return f;
+}
+
+void AddJointGeometricStiffness(const SystemModel& model, const DofMap& dofs, const SystemState& state,
+                                const NodeForces& forces, Triplets& tangent) {
+  if (model.joints.empty()) return;
+  // Transmitted forces, children before parents: t_p += A^T t_c.
+  std::vector<Eigen::Matrix<double, 6, 1>> t = forces.f;
+  const std::vector<int>& order = dofs.order();
+  for (auto it = order.rbegin(); it != order.rend(); ++it) {
+    const int c = *it, j = dofs.joint_of(c);
+    if (j < 0) continue;
+    const NodeJoint& joint = model.joints[j];
+    const int p = joint.parent;
+    const JointMaps maps = ComputeJointMaps(joint, state.x[p], state.R[p], state.x[c], state.z[c]);
+    const JointGeometric g = ComputeJointGeometric(joint, maps, state.x[p], state.R[p], state.x[c], t[c]);
+    const int first = dofs.node_first(c), d = joint.n_coordinates();
+    // residual += J_p^T (A^T t_c) + E_c^T (B^T t_c); tangent = -d residual / dz, with
+    // d pi_p / dz the rotation rows of J_p (sparse columns).
+    for (const auto& [ci, vi] : state.J[p]) {
+      for (const auto& [cj, vj] : state.J[p]) {
+        const double v = vi.dot(g.dAf_dpi * vj.tail<3>());
+        if (v != 0.0) tangent.emplace_back(ci, cj, -v);
+      }
+      for (int k = 0; k < d; ++k) {
+        const double v = vi.dot(g.dAf_dz.col(k));
+        if (v != 0.0) tangent.emplace_back(ci, first + k, -v);
+      }
+    }
+    for (int k = 0; k < d; ++k) {
+      for (const auto& [cj, vj] : state.J[p]) {
+        const double v = g.dBf_dpi.row(k).dot(vj.tail<3>());
+        if (v != 0.0) tangent.emplace_back(first + k, cj, -v);
+      }
+      for (int l = 0; l < d; ++l) {
+        if (g.dBf_dz(k, l) != 0.0) tangent.emplace_back(first + k, first + l, -g.dBf_dz(k, l));
+      }
+    }
+    t[p] += maps.A.transpose() * t[c];
+  }
+}
+
+std::vector<Eigen::Matrix<double, 6, 1>> JointReactions(const SystemModel& model, const DofMap& dofs,
+                                                        const SystemState& state, const NodeForces& forces) {
+  std::vector<Eigen::Matrix<double, 6, 1>> t = forces.f;  // transmitted, children first
+  const std::vector<int>& order = dofs.order();
+  for (auto it = order.rbegin(); it != order.rend(); ++it) {
+    const int c = *it, j = dofs.joint_of(c);
+    if (j < 0) continue;
+    const NodeJoint& joint = model.joints[j];
+    const JointMaps maps = ComputeJointMaps(joint, state.x[joint.parent], state.R[joint.parent], state.x[c], state.z[c]);
+    t[joint.parent] += maps.A.transpose() * t[c];
+  }
+  std::vector<Eigen::Matrix<double, 6, 1>> reactions(model.n_nodes(), Eigen::Matrix<double, 6, 1>::Zero());
+  for (int k = 0; k < model.n_nodes(); ++k) {
+    const bool held = dofs.joint_of(k) >= 0 || dofs.S(k).cols() < 6;
+    if (held) reactions[k] = -t[k];
+  }
+  // A node that is the child of cut joints and held otherwise by nothing or by a rigid joint (a
+  // rigid body's point hangs on its body by one): the cut joints' reactions. That is what the
+  // scene's joint at the node exerts; the rigid offset's force is internal to the body.
+  const std::vector<Eigen::Matrix<double, 6, 1>> cut = CutJointReactions(model, state);
+  std::vector<bool> replaced(model.n_nodes(), false);
+  for (size_t c = 0; c < cut.size(); ++c) {
+    const int k = model.cut_joints[c].joint.child, j = dofs.joint_of(k);
+    const bool tree_held = j >= 0 ? model.joints[j].type != JointType::kRigid : dofs.S(k).cols() < 6;
+    if (tree_held) continue;
+    if (!replaced[k]) reactions[k].setZero();
+    replaced[k] = true;
+    reactions[k] += cut[c];
+  }
+  return reactions;
+}
+
+}  // namespace femb
