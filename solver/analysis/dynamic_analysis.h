@@ -74,7 +74,7 @@ struct DynamicState {
   Eigen::VectorXd f_drive;
   double h_last = 0.0;  ///< the step that reached this state (0 at the start)
   /// Midpoint scheme only: every node's velocity (xdot, omega), carried by the scheme's own
-  /// node kinematics rather than taken as J(q) W (see midpoint_step.cpp). Empty: J(q) W.
+  /// node kinematics rather than taken as J(q) W (see solver/integrators/midpoint.cpp). Empty: J(q) W.
   std::vector<Eigen::Matrix<double, 6, 1>> node_w;
 };
 

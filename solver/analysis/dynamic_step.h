@@ -1,6 +1,7 @@
-// Internal to the dynamic analysis: what the generalized-alpha step (dynamic_analysis.cpp) and
-// the momentum-conserving midpoint step (midpoint_step.cpp) share, the assembly of one pass
-// over the bodies and the kept iteration matrix. Not an interface for other code.
+// Internal to the dynamic analysis: what the two integrators (solver/integrators/:
+// generalized_alpha.cpp, midpoint.cpp) and the analysis driver (dynamic_analysis.cpp) share, the
+// assembly of one pass over the bodies and the kept iteration matrix. Not an interface for
+// other code.
 #pragma once
 
 #include <Eigen/Core>
@@ -171,7 +172,14 @@ std::vector<RotationNode> RotationNodes(const SystemModel& model, const DofMap& 
 // carries them (DynamicState::node_w), J(q) W otherwise.
 Eigen::VectorXd BodyVelocityOf(const SystemModel& model, const DofMap& dofs, const DynamicState& s, int b);
 
-// One step of the momentum-conserving midpoint scheme (midpoint_step.cpp) of size h from `state`
+// One generalized-alpha step of size h from `state` into `next` (solver/integrators/
+// generalized_alpha.cpp). t_new: the time reached, state.t + h, or just below a breakpoint the
+// step lands on (the loads and drives there are their left limits).
+StepOutcome GeneralizedAlphaStep(const SystemModel& model, const DofMap& dofs, const DynamicOptions& options,
+                                 const DynamicState& state, double h, double t_new, IterationMatrix& matrix,
+                                 BodyThreads& threads, BodyWorkspace& work, DynamicState& next);
+
+// One step of the momentum-conserving midpoint scheme (solver/integrators/midpoint.cpp) of size h from `state`
 // into `next`; t_new as for the generalized-alpha step.
 StepOutcome MidpointStep(const SystemModel& model, const DofMap& dofs, const DynamicOptions& options,
                          const std::vector<RotationNode>& triples, const DynamicState& state, double h, double t_new,

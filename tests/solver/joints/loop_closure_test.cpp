@@ -298,7 +298,7 @@ TEST(LoopClosure, IterationMatrixOfAMovingFourBarMatchesFiniteDifferences) {
 // external forces; (2) T + V with V = -sum m_b g . x_c,b from the bodies' centres of mass,
 // independent of the scheme. The scheme conserves the energy of a chain of rigid bodies exactly
 // (node velocities carried by the scheme, discrete gradients of the node Jacobians and of
-// gravity, source terms at the mean motion: midpoint_step.cpp), so both stay at Newton's
+// gravity, source terms at the mean motion: solver/integrators/midpoint.cpp), so both stay at Newton's
 // tolerance; before, the drift was O(h^2): 6.7e-5 at h = 1 ms. `open`: without the joint at D,
 // the same links are a triple pendulum (no loop).
 struct Swing {

@@ -131,7 +131,7 @@ TEST(NodeJoint, FlexibleDoublePendulumConservesEnergy) { DoublePendulum(JointTyp
 
 // The midpoint scheme on the same chain: its bodies have free nodes (n1, n3) and nodes on joints
 // (n0 on the ground, n2 on n1), so the scheme's node velocities come from W for some and from
-// the node motion for others (midpoint_step.cpp). Measured: 2.8e-5 (2 ms), 4.0e-6 (1 ms).
+// the node motion for others (solver/integrators/midpoint.cpp). Measured: 2.8e-5 (2 ms), 4.0e-6 (1 ms).
 TEST(NodeJoint, FlexibleDoublePendulumConservesEnergyWithTheMidpointScheme) {
   DoublePendulum(JointType::kRevolute, Eigen::Vector3d::Zero(), Integrator::kMidpoint);
 }

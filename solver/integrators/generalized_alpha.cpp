@@ -1,0 +1,214 @@
+// The generalized-alpha integrator (Chung & Hulbert 1993 on the Lie group of the nodes, Arnold &
+// Bruls 2007; index 3 with closed loops): its step, and the dynamic residual and iteration
+// matrix it assembles (shared with the consistent start and the reactions).
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <functional>
+
+#include "solver/analysis/dynamic_step.h"
+#include "solver/rotation.h"
+
+namespace femb::dynamic_internal {
+
+Assembly AssembleDynamicResidual(const SystemModel& model, const DofMap& dofs, DynamicState& s, double t,
+                                 BodyWorkspace& work, BodyThreads* threads) {
+  AssemblyParts parts;
+  Assembly out = StartAssembly(model, dofs, parts);
+  const int n_bodies = int(model.bodies.size());
+  std::vector<BodyPass>& passes = work.passes;
+  std::vector<BodyTerms>& results = work.terms;
+  passes.resize(static_cast<size_t>(n_bodies));
+  results.resize(static_cast<size_t>(n_bodies));
+  const std::vector<Eigen::Matrix<double, 6, 1>> node_acc = NodeAccelerations(model, dofs, s.config, s.W, s.Wdot);
+  ForEachBody(threads, n_bodies, [&](int b) {
+    const SuperelementBody& body = model.bodies[b];
+    BodyTerms& r = results[size_t(b)];
+    BodyPass& pass = passes[size_t(b)];
+    r.frame_ok = true;
+    BodyConfiguration& c = pass.data.c;  // evaluated in place: the pass's storage is reused
+    BodyConfigurationOf(model, s.config, b, c);
+    const FrameSolution frame = body.SolveFrameFrom(c, s.config.frames[b]);
+    if (!frame.ok) {
+      r.frame_ok = false;
+      return;
+    }
+    s.config.frames[b] = frame;
+    body.Evaluate(c, frame, pass.data);
+    pass.w = GatherBody(model, dofs, s.config, b, s.W);
+    pass.wdot = GatherBodyAcceleration(model, dofs, b, node_acc, s.Wdot);
+    // Inertia stiffening (issue 13): K + K_sigma(a), a from this iterate's frame motion; its
+    // velocity and acceleration derivatives go into C and M of the iteration matrix.
+    const bool stiffening = body.has_inertia_stiffening();
+    pass.load = stiffening ? body.InertiaLoads(pass.data, pass.w, pass.wdot, model.gravity) : InertiaLoadFactors{};
+    Eigen::VectorXd f_int, f_in, f_acc;
+    body.ElasticForce(pass.data, &f_int, nullptr, stiffening ? &pass.load : nullptr);
+    body.InertiaForce(pass.data, pass.w, pass.wdot, &f_in, nullptr, nullptr, &f_acc);
+    body.AddModalDamping(pass.w, f_in, nullptr);
+    r.f_grav.setZero(body.n_coordinates());
+    if (model.gravity.squaredNorm() > 0) r.f_grav = body.GravityForce(pass.data, model.gravity);
+    // Scale of the forces in balance, each term on its own (for a torque-free body M_g wdot and
+    // the gyroscopic terms cancel: their sum is no scale).
+    r.scale = std::max({body.ForceNorm(f_int), body.ForceNorm(f_in), body.ForceNorm(r.f_grav), body.force_floor(),
+                        body.ForceNorm(f_acc), body.ForceNorm(f_in - f_acc)});
+    r.roundoff = body.RoundOffForce(c);
+    BodyMap(model, dofs, s.config, b, r.map);
+    r.r_b = r.f_grav - f_int - f_in;
+  });
+  if (!AddBodyTerms(model, results, parts, out)) return out;
+  FinishAssembly(model, dofs, s.config, t, s.W, false, parts, out);
+  AddLoopConstraints(model, dofs, s.config, &out.residual, nullptr, &out.node_forces);
+  return out;
+}
+
+void AddDynamicMatrices(const SystemModel& model, const DofMap& dofs, const DynamicState& s, double t,
+                        BodyWorkspace& work, bool full_inertia_tangent, Assembly& out,
+                        BodyThreads* threads, const MatrixCombination* combine) {
+  const int n_bodies = int(model.bodies.size());
+  const std::vector<BodyPass>& passes = work.passes;
+  std::vector<BodyWorkspace::BodyMatrices>& results = work.matrices;
+  results.resize(static_cast<size_t>(n_bodies));
+  ForEachBody(threads, n_bodies, [&](int b) {
+    const SuperelementBody& body = model.bodies[b];
+    const BodyPass& pass = passes[size_t(b)];
+    BodyWorkspace::BodyMatrices& r = results[size_t(b)];
+    const bool stiffening = body.has_inertia_stiffening();
+    Eigen::MatrixXd d_load;
+    body.ElasticForce(pass.data, nullptr, &r.K, stiffening ? &pass.load : nullptr, stiffening ? &d_load : nullptr);
+    body.InertiaForce(pass.data, pass.w, pass.wdot, nullptr, &r.M, &r.C);
+    if (stiffening) {
+      r.M.noalias() += d_load * pass.load.d_wdot;
+      r.C.noalias() += d_load * pass.load.d_w;
+    }
+    // Configuration derivative of the inertia force: d(M_g wdot)/dq exactly; that of the
+    // quadratic velocity terms by central differences with options.full_inertia_tangent.
+    r.K += body.InertiaConfigurationTangent(pass.data, pass.w, pass.wdot, full_inertia_tangent);
+    Eigen::VectorXd unused = Eigen::VectorXd::Zero(body.n_coordinates());
+    body.AddModalDamping(pass.w, unused, &r.C);
+    if (combine) r.K += combine->c_C * r.C + combine->c_M * r.M;
+  });
+  Triplets &K = work.K, &C = work.C, &M = work.M;
+  K.clear();
+  C.clear();
+  M.clear();
+  // The joints' convective accelerations depend on W: d f_in / dW gets M_b dc/dW (the Coriolis
+  // and centripetal coupling of chains with offsets), into C (or c_C of it into K).
+  // And their configuration: d f_in / dq gets M_b d(J Wdot + c)/dq (into K).
+  const bool chains = !model.joints.empty();
+  const std::vector<NodeJacobian> dc =
+      chains ? ConvectiveVelocityDerivative(model, dofs, s.config, s.W) : std::vector<NodeJacobian>();
+  const std::vector<NodeJacobian> dacc =
+      chains ? NodeAccelerationConfigurationDerivative(model, dofs, s.config, s.W, s.Wdot) : std::vector<NodeJacobian>();
+  // B^T M_b D for a body's node columns D (per node, sparse over the coordinates), scaled.
+  const auto add_node_columns = [&](const std::vector<MapEntry>& map, const Eigen::MatrixXd& M_b, int b,
+                                    const std::vector<NodeJacobian>& D, double scale, Triplets& into) {
+    for (size_t a = 0; a < model.body_nodes[size_t(b)].size(); ++a) {
+      for (const auto& [col, v] : D[size_t(model.body_nodes[size_t(b)][a])]) {
+        const Eigen::VectorXd y = M_b.middleCols<6>(Eigen::Index(6 * a)) * v;
+        for (const MapEntry& e : map) {
+          const double value = e.coefficient * y[e.local];
+          if (value != 0.0) into.emplace_back(e.coordinate, col, scale * value);
+        }
+      }
+    }
+  };
+  for (int b = 0; b < n_bodies; ++b) {
+    const BodyWorkspace::BodyMatrices& r = results[size_t(b)];
+    const std::vector<MapEntry>& map = work.terms[size_t(b)].map;  // the residual pass's, same state
+    ScatterBody(map, nullptr, &r.K, nullptr, &K);
+    if (chains) {
+      // r.M: d f_in / d wdot of the body (the combination above went into r.K only).
+      add_node_columns(map, r.M, b, dacc, 1.0, K);
+      if (combine) {
+        add_node_columns(map, r.M, b, dc, combine->c_C, K);
+      } else {
+        add_node_columns(map, r.M, b, dc, 1.0, C);
+      }
+    }
+    if (combine) continue;
+    ScatterBody(map, nullptr, &r.C, nullptr, &C);
+    ScatterBody(map, nullptr, &r.M, nullptr, &M);
+  }
+  const int n = dofs.n_dofs();
+  Eigen::VectorXd unused = Eigen::VectorXd::Zero(n);
+  AddNodeLoads(model, s.config, t, unused, &K);
+  AddSpringDampers(model, s.config, s.W, unused, &K, &C, nullptr);
+  AddLoopConstraints(model, dofs, s.config, nullptr, &K, nullptr);
+  AddJointGeometricStiffness(model, dofs, s.config, out.node_forces, K);
+  if (combine) {
+    for (const Eigen::Triplet<double>& e : C) K.emplace_back(e.row(), e.col(), combine->c_C * e.value());
+    out.K = work.K_build.Build(n, K);
+    return;
+  }
+  out.K = work.K_build.Build(n, K);
+  out.C = work.C_build.Build(n, C);
+  out.M = work.M_build.Build(n, M);
+}
+
+Assembly AssembleDynamic(const SystemModel& model, const DofMap& dofs, DynamicState& s, double t, bool matrices,
+                         bool full_inertia_tangent) {
+  BodyWorkspace work;
+  Assembly out = AssembleDynamicResidual(model, dofs, s, t, work);
+  if (out.ok && matrices) AddDynamicMatrices(model, dofs, s, t, work, full_inertia_tangent, out);
+  return out;
+}
+
+// One generalized-alpha step of size h from `state` into `next` (Arnold & Bruls 2007).
+// t_new: the time reached, state.t + h, or just below a breakpoint the step lands on (the loads
+// and drives there are their left limits).
+StepOutcome GeneralizedAlphaStep(const SystemModel& model, const DofMap& dofs, const DynamicOptions& options,
+                                 const DynamicState& state, double h, double t_new, IterationMatrix& matrix,
+                                 BodyThreads& threads, BodyWorkspace& work, DynamicState& next) {
+  const double rho = std::clamp(options.rho_inf, 0.0, 1.0);
+  const double alpha_m = (2 * rho - 1) / (rho + 1), alpha_f = rho / (rho + 1);
+  const double gamma = 0.5 + alpha_f - alpha_m, beta = 0.25 * (gamma + 0.5) * (gamma + 0.5);
+  next = state;
+  const Eigen::VectorXd a_pred = (alpha_f * state.Wdot - alpha_m * state.a) / (1 - alpha_m);
+  next.a = a_pred;
+  next.Wdot.setZero();
+  next.W = state.W + h * (1 - gamma) * state.a + h * gamma * a_pred;
+  const Eigen::VectorXd dq = state.W + h * (0.5 - beta) * state.a + h * beta * a_pred;
+  ApplyIncrement(model, dofs, h * dq, next.config);
+  ApplyPrescribed(model, dofs, t_new, next.config, &next.W, &next.Wdot);
+  const double gamma_p = gamma / (beta * h), beta_p = (1 - alpha_m) / (beta * h * h * (1 - alpha_f));
+  StepOutcome out;
+  const double tolerance = std::max(options.tolerance, kRoundOffTolerance);
+  const Eigen::VectorXd weights = ResidualWeights(model, dofs);
+  DivergenceTest divergence;
+  for (; out.iterations < options.max_iterations; ++out.iterations) {
+    Assembly a = AssembleDynamicResidual(model, dofs, next, t_new, work, &threads);
+    if (!a.ok || !a.residual.allFinite()) return out;
+    const double r_norm = FreeNorm(dofs, a.residual, weights);
+    if (r_norm <= std::max(tolerance * a.scale, a.roundoff) && out.iterations > 0 &&
+        LoopsClosed(model, next.config, tolerance)) {
+      out.converged = true;
+      next.a += (1 - alpha_f) / (1 - alpha_m) * next.Wdot;
+      next.t = t_new;
+      // External work by the trapezoidal rule on the increment h (W_n + W_n+1) / 2.
+      next.external_work += 0.5 * (state.f_ext + a.f_ext).dot(h * 0.5 * (state.W + next.W));
+      next.f_ext = a.f_ext;
+      next.f_drive = DriveForces(dofs, a.residual);
+      next.drive_work += 0.5 * (state.f_drive + next.f_drive).dot(h * 0.5 * (state.W + next.W));
+      out.passes_kept = true;
+      return out;
+    }
+    if (divergence.Diverged(out.iterations, r_norm)) return out;
+    bool built = false;
+    const auto S = [&] {
+      const MatrixCombination combine{gamma_p, beta_p};
+      if (!built) AddDynamicMatrices(model, dofs, next, t_new, work, options.full_inertia_tangent, a, &threads, &combine);
+      built = true;
+      return a.K;  // K + gamma' C + beta' M
+    };
+    Eigen::VectorXd delta;
+    if (!matrix.Increment(dofs, options, h, S, a.residual, delta, out.singular_matrix)) return out;
+    ApplyIncrement(model, dofs, delta, next.config);
+    next.W += gamma_p * delta;
+    next.Wdot += beta_p * delta;
+    dofs.ClearMultipliers(next.W);  // the multipliers took their increment in next.config
+    dofs.ClearMultipliers(next.Wdot);
+  }
+  return out;
+}
+
+}  // namespace femb::dynamic_internal
