@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <iterator>
 #include <set>
 #include <sstream>
 
@@ -376,9 +377,15 @@ SceneSpec ParseScene(const std::string& text, const std::string& name, const std
     YamlMap m = analysis.Map();
     SceneAnalysisSpec& a = scene.analysis;
     YamlValue type = m.Required("type");
-    a.type = type.String();
-    if (a.type != "static" && a.type != "dynamic" && a.type != "modes") {
-      type.Fail("unknown analysis type '" + a.type + "' (known: static, dynamic, modes)");
+    const std::string type_name = type.String();
+    if (type_name == "static") {
+      a.type = AnalysisType::kStatic;
+    } else if (type_name == "dynamic") {
+      a.type = AnalysisType::kDynamic;
+    } else if (type_name == "modes") {
+      a.type = AnalysisType::kModes;
+    } else {
+      type.Fail("unknown analysis type '" + type_name + "' (known: static, dynamic, modes)");
     }
     if (auto v = m.Optional("count")) {
       a.mode_count = int(v->Integer());
@@ -409,7 +416,10 @@ SceneSpec ParseScene(const std::string& text, const std::string& name, const std
       a.rho_inf = v->Number();
       if (a.rho_inf < 0 || a.rho_inf > 1) v->Fail("rho_inf must be in [0, 1]");
     }
-    if (auto v = m.Optional("integrator")) a.integrator = v->OneOf({"generalized_alpha", "midpoint"});
+    if (auto v = m.Optional("integrator")) {
+      a.integrator = v->OneOf({"generalized_alpha", "midpoint"}) == "midpoint" ? IntegratorType::kMidpoint
+                                                                              : IntegratorType::kGeneralizedAlpha;
+    }
     if (auto v = m.Optional("tolerance")) a.tolerance = v->PositiveNumber();
     if (auto v = m.Optional("max_iterations")) a.max_iterations = int(v->NonNegativeInteger());
     if (auto v = m.Optional("output_every")) a.output_every = std::max(1, int(v->NonNegativeInteger()));
@@ -442,8 +452,11 @@ SceneSpec ParseScene(const std::string& text, const std::string& name, const std
         YamlValue q = pm.Required("quantities");
         for (const YamlValue& qi : q.List()) {
           const std::string s = qi.String();
-          if (s != "position" && s != "rotation" && s != "velocity" && s != "angular_velocity" && s != "joint" &&
-              s != "reaction" && s != "stress") {
+          static const ProbeQuantity all[] = {ProbeQuantity::kPosition, ProbeQuantity::kRotation, ProbeQuantity::kVelocity,
+                                              ProbeQuantity::kAngularVelocity, ProbeQuantity::kJoint,
+                                              ProbeQuantity::kReaction, ProbeQuantity::kStress};
+          const ProbeQuantity* found = std::find_if(std::begin(all), std::end(all), [&](ProbeQuantity x) { return s == Name(x); });
+          if (found == std::end(all)) {
             qi.Fail("unknown probe quantity '" + s +
                     "' (known: position, rotation, velocity, angular_velocity, joint, reaction; stress with body and point)");
           }
@@ -452,7 +465,7 @@ SceneSpec ParseScene(const std::string& text, const std::string& name, const std
                                   : "probe quantity '" + s + "' is a node quantity: give node, not body and point");
           }
           if (s == "reaction") scene.reactions = true;
-          p.quantities.push_back(s);
+          p.quantities.push_back(*found);
         }
         pm.CheckNoUnknownKeys();
         scene.probes.push_back(p);
@@ -462,6 +475,32 @@ SceneSpec ParseScene(const std::string& text, const std::string& name, const std
   }
   root.CheckNoUnknownKeys();
   return scene;
+}
+
+const char* Name(AnalysisType type) {
+  switch (type) {
+    case AnalysisType::kStatic: return "static";
+    case AnalysisType::kDynamic: return "dynamic";
+    case AnalysisType::kModes: return "modes";
+  }
+  return "?";
+}
+
+const char* Name(IntegratorType type) {
+  return type == IntegratorType::kMidpoint ? "midpoint" : "generalized_alpha";
+}
+
+const char* Name(ProbeQuantity quantity) {
+  switch (quantity) {
+    case ProbeQuantity::kPosition: return "position";
+    case ProbeQuantity::kRotation: return "rotation";
+    case ProbeQuantity::kVelocity: return "velocity";
+    case ProbeQuantity::kAngularVelocity: return "angular_velocity";
+    case ProbeQuantity::kJoint: return "joint";
+    case ProbeQuantity::kReaction: return "reaction";
+    case ProbeQuantity::kStress: return "stress";
+  }
+  return "?";
 }
 
 SceneSpec ReadSceneFile(const std::string& path, const std::vector<std::string>& overrides) {

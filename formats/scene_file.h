@@ -37,6 +37,16 @@ struct TimeFunctionSpec {
   std::vector<double> Breakpoints() const;
 };
 
+/// The analysis (SCENE_FORMAT.md `analysis.type`), the dynamic integrator (`analysis.integrator`)
+/// and the probe quantities, parsed from their names once; Name gives the name back (messages,
+/// the CSV header, results.h5's `analysis` attribute).
+enum class AnalysisType { kStatic, kDynamic, kModes };
+enum class IntegratorType { kGeneralizedAlpha, kMidpoint };
+enum class ProbeQuantity { kPosition, kRotation, kVelocity, kAngularVelocity, kJoint, kReaction, kStress };
+const char* Name(AnalysisType type);
+const char* Name(IntegratorType type);
+const char* Name(ProbeQuantity quantity);
+
 struct SceneBodySpec {
   std::string name;
   std::string type = "superelement";  ///< superelement | rigid
@@ -92,12 +102,12 @@ struct SceneProbeSpec {
   /// body's stress point nearest to `point` (scene coordinates at the initial placement).
   std::string body;
   Eigen::Vector3d point = Eigen::Vector3d::Zero();
-  std::vector<std::string> quantities;  ///< position, rotation, velocity, angular_velocity, joint, reaction | stress
+  std::vector<ProbeQuantity> quantities;  ///< node quantities, or kStress alone (body and point)
   std::string where;
 };
 
 struct SceneAnalysisSpec {
-  std::string type = "static";  ///< static, dynamic, modes
+  AnalysisType type = AnalysisType::kStatic;
   int mode_count = 10;          ///< modes: how many
   bool modes_about_static = false;  ///< modes: about the static state under the loads at end_time
   double end_time = 1.0;
@@ -113,7 +123,7 @@ struct SceneAnalysisSpec {
   double rho_inf = 0.9;
   /// dynamic: generalized_alpha (numerical damping by rho_inf) or midpoint (momentum-conserving,
   /// no damping; solver/analysis/dynamic_analysis.h)
-  std::string integrator = "generalized_alpha";
+  IntegratorType integrator = IntegratorType::kGeneralizedAlpha;
   double tolerance = 1e-8;
   int max_iterations = 25;
   int output_every = 1;

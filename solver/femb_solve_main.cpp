@@ -108,8 +108,8 @@ int main(int argc, char** argv) {
     const femb::DofMap dofs(scene.model);
     if (!quiet) {
       std::printf("femb-solve: %s: %zu bodies, %d nodes, %d unknowns, %s analysis%s\n", scene_path.c_str(),
-                  scene.model.bodies.size(), scene.model.n_nodes(), dofs.n_dofs(), spec.analysis.type.c_str(),
-                  spec.analysis.type == "dynamic"
+                  scene.model.bodies.size(), scene.model.n_nodes(), dofs.n_dofs(), femb::Name(spec.analysis.type),
+                  spec.analysis.type == femb::AnalysisType::kDynamic
                       ? (", " + std::to_string(threads) + (threads == 1 ? " thread" : " threads")).c_str()
                       : "");
       // One note per file, not per body.
@@ -141,7 +141,7 @@ int main(int argc, char** argv) {
       }
       std::fflush(stdout);
     };
-    if (spec.analysis.type == "modes") {
+    if (spec.analysis.type == femb::AnalysisType::kModes) {
       femb::SystemState state = femb::InitialState(scene.model);
       double load_time = 0.0;
       if (spec.analysis.modes_about_static) {
@@ -175,7 +175,7 @@ int main(int argc, char** argv) {
       if (!quiet) std::printf("femb-solve: frequencies in %s\n", path.c_str());
       return 0;
     }
-    if (spec.analysis.type == "static") {
+    if (spec.analysis.type == femb::AnalysisType::kStatic) {
       femb::SystemState state = femb::InitialState(scene.model);
       // Reactions only when the scene asks (an assembly per output step).
       auto static_reactions = [&](double lambda, const femb::SystemState& st) {
@@ -213,7 +213,7 @@ int main(int argc, char** argv) {
       options.step = spec.analysis.step;
       options.end_time = spec.analysis.end_time;
       options.rho_inf = spec.analysis.rho_inf;
-      if (spec.analysis.integrator == "midpoint") options.integrator = femb::Integrator::kMidpoint;
+      if (spec.analysis.integrator == femb::IntegratorType::kMidpoint) options.integrator = femb::Integrator::kMidpoint;
       options.tolerance = spec.analysis.tolerance;
       options.max_iterations = spec.analysis.max_iterations;
       options.reuse_jacobian = spec.analysis.reuse_jacobian;

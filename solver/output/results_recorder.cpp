@@ -40,12 +40,12 @@ ResultsRecorder::ResultsRecorder(const Scene& scene, const std::string& director
   // take: load steps, or time steps over output_every).
   constexpr double kAutoFrames = 500;
   const SceneAnalysisSpec& a = scene.spec.analysis;
-  const double outputs = a.type == "dynamic" ? a.end_time / (a.step * std::max(a.output_every, 1)) : double(a.steps);
+  const double outputs = a.type == AnalysisType::kDynamic ? a.end_time / (a.step * std::max(a.output_every, 1)) : double(a.steps);
   animation_every_ = scene.spec.animation_every > 0 ? scene.spec.animation_every
                                                     : std::max(1, int(std::ceil(outputs / kAutoFrames)));
   // Error-controlled steps: how many there will be is not known; a frame per end_time / 500
   // (the first output at or after each such time), or every output step of output_step.
-  if (a.type == "dynamic" && a.adaptive_step && scene.spec.animation_every == 0) {
+  if (a.type == AnalysisType::kDynamic && a.adaptive_step && scene.spec.animation_every == 0) {
     animation_every_ = 1;
     frame_interval_ = a.end_time / kAutoFrames;
     if (a.output_step > 0) frame_interval_ = std::max(frame_interval_, a.output_step);
@@ -62,17 +62,17 @@ ResultsRecorder::ResultsRecorder(const Scene& scene, const std::string& director
   static const char* xyz[3] = {"x", "y", "z"};
   static const char* wxyz[4] = {"w", "x", "y", "z"};
   for (const SceneProbeSpec& p : scene.spec.probes) {
-    for (const std::string& q : p.quantities) {
-      if (q == "rotation") {
-        for (const char* c : wxyz) csv_ << "," << p.name << "." << q << "." << c;
-      } else if (q == "stress") {
+    for (const ProbeQuantity q : p.quantities) {
+      if (q == ProbeQuantity::kRotation) {
+        for (const char* c : wxyz) csv_ << "," << p.name << "." << Name(q) << "." << c;
+      } else if (q == ProbeQuantity::kStress) {
         // The stress point's von Mises stress and tensor (part axes, issue 17).
         static const char* components[7] = {"von_mises", "xx", "yy", "zz", "yz", "xz", "xy"};
         for (const char* c : components) csv_ << "," << p.name << ".stress." << c;
-      } else if (q == "reaction") {
+      } else if (q == ProbeQuantity::kReaction) {
         static const char* components[6] = {"fx", "fy", "fz", "mx", "my", "mz"};
         for (const char* c : components) csv_ << "," << p.name << ".reaction." << c;
-      } else if (q == "joint") {
+      } else if (q == ProbeQuantity::kJoint) {
         // The node's joint coordinates (revolute: angle; prismatic: travel; cylindrical: both).
         // To the ground: the node's motion basis; between nodes: the joint's coordinates
         // (a revolute joint's angle between two bodies, ...). Spherical joints have rotation
@@ -99,7 +99,7 @@ ResultsRecorder::ResultsRecorder(const Scene& scene, const std::string& director
         }
         for (int i = 0; i < d; ++i) csv_ << "," << p.name << ".joint." << i;
       } else {
-        for (const char* c : xyz) csv_ << "," << p.name << "." << q << "." << c;
+        for (const char* c : xyz) csv_ << "," << p.name << "." << Name(q) << "." << c;
       }
     }
   }
@@ -185,7 +185,7 @@ void ResultsRecorder::Record(double t, const SystemState& state, const Eigen::Ve
   auto inertia = [&](size_t b) -> const Eigen::VectorXd* {
     if (!scene_.stresses[b] || scene_.stresses[b]->inertia_modes.size() == 0) return nullptr;
     if (factors[b].size() > 0) return &factors[b];
-    const bool dynamic = scene_.spec.analysis.type == "dynamic";
+    const bool dynamic = scene_.spec.analysis.type == AnalysisType::kDynamic;
     const Eigen::VectorXd zero = Eigen::VectorXd::Zero(dofs.n_dofs());
     const Eigen::VectorXd& V = W.size() == dofs.n_dofs() ? W : zero;
     const Eigen::VectorXd& A = accelerations && accelerations->size() == dofs.n_dofs() ? *accelerations : zero;
@@ -268,12 +268,12 @@ void ResultsRecorder::Record(double t, const SystemState& state, const Eigen::Ve
       continue;
     }
     const int k = scene_.node_index.at(p.node);
-    for (const std::string& q : p.quantities) {
-      if (q == "position") for (int i = 0; i < 3; ++i) csv_ << "," << Num(pos[3 * k + i]);
-      if (q == "rotation") for (int i = 0; i < 4; ++i) csv_ << "," << Num(quat[4 * k + i]);
-      if (q == "velocity") for (int i = 0; i < 3; ++i) csv_ << "," << Num(vel[3 * k + i]);
-      if (q == "angular_velocity") for (int i = 0; i < 3; ++i) csv_ << "," << Num(ang[3 * k + i]);
-      if (q == "joint") {
+    for (const ProbeQuantity q : p.quantities) {
+      if (q == ProbeQuantity::kPosition) for (int i = 0; i < 3; ++i) csv_ << "," << Num(pos[3 * k + i]);
+      if (q == ProbeQuantity::kRotation) for (int i = 0; i < 4; ++i) csv_ << "," << Num(quat[4 * k + i]);
+      if (q == ProbeQuantity::kVelocity) for (int i = 0; i < 3; ++i) csv_ << "," << Num(vel[3 * k + i]);
+      if (q == ProbeQuantity::kAngularVelocity) for (int i = 0; i < 3; ++i) csv_ << "," << Num(ang[3 * k + i]);
+      if (q == ProbeQuantity::kJoint) {
         const int c = pi < probe_cut_.size() ? probe_cut_[pi] : -1;
         if (c < 0) {
           for (int i = 0; i < state.z[k].size(); ++i) csv_ << "," << Num(state.z[k][i]);
@@ -291,7 +291,7 @@ void ResultsRecorder::Record(double t, const SystemState& state, const Eigen::Ve
           for (int i = 0; i < z.size(); ++i) csv_ << "," << Num(z[i]);
         }
       }
-      if (q == "reaction") for (int i = 0; i < 6; ++i) csv_ << "," << Num(reaction[6 * k + i]);
+      if (q == ProbeQuantity::kReaction) for (int i = 0; i < 6; ++i) csv_ << "," << Num(reaction[6 * k + i]);
     }
   }
   csv_ << "," << Num(kinetic) << "," << Num(elastic) << "," << Num(external_work) << "\n";
@@ -322,7 +322,7 @@ void ResultsRecorder::Finish(const std::string& status) {
     w.Attribute("/", "format", "femb-results");
     w.Attribute("/", "format_version", "1.0");
     w.Attribute("/", "scene", scene_.spec.file);
-    w.Attribute("/", "analysis", scene_.spec.analysis.type);
+    w.Attribute("/", "analysis", std::string(Name(scene_.spec.analysis.type)));
     w.Attribute("/", "status", status);
     w.Attribute("/", "units", scene_.spec.units);
     w.Vector("/time", Eigen::Map<const Eigen::VectorXd>(time_.data(), long(time_.size())));

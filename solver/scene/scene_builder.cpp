@@ -166,7 +166,7 @@ Scene BuildScene(const SceneSpec& spec) {
       throw InputError(b.where + ": body '" + b.name + "': options.inertia is exact but " + file.string() +
                        " has no inertia invariants (reduce it with reduction.geometric_stiffening: true)");
     }
-    if (spec.analysis.integrator == "midpoint" && options.exact_inertia && !se.inertia_gamma.empty()) {
+    if (spec.analysis.integrator == IntegratorType::kMidpoint && options.exact_inertia && !se.inertia_gamma.empty()) {
       scene.notes.push_back("body '" + b.name + "': the midpoint integrator uses the corotational inertia (thesis "
                             "3.22), not the file's exact one (generalized_alpha does)");
     }
@@ -344,7 +344,7 @@ Scene BuildScene(const SceneSpec& spec) {
   for (const SceneLoadSpec& l : spec.loads) {
     if (l.type == "gravity") {
       model.gravity += l.g;
-      if (spec.analysis.type != "dynamic") model.static_gravity_end = spec.analysis.end_time;
+      if (spec.analysis.type != AnalysisType::kDynamic) model.static_gravity_end = spec.analysis.end_time;
       continue;
     }
     if (l.type == "spring") {
@@ -371,7 +371,7 @@ Scene BuildScene(const SceneSpec& spec) {
     if (!l.function.empty()) {
       const TimeFunctionSpec f = spec.functions.at(l.function);
       load.scale = [f](double t) { return f.Evaluate(t); };
-    } else if (spec.analysis.type == "dynamic") {
+    } else if (spec.analysis.type == AnalysisType::kDynamic) {
       load.scale = [](double) { return 1.0; };
     }
     model.loads.push_back(load);

@@ -44,8 +44,8 @@ TEST(SceneFile, GoodFileParses) {
   EXPECT_EQ(s.bodies[0].nodes.at("B"), "tip");
   ASSERT_EQ(s.joints.size(), 1u);
   EXPECT_EQ(s.joints[0].prescribed, "drive");
-  EXPECT_EQ(s.analysis.type, "dynamic");
-  EXPECT_EQ(s.analysis.integrator, "midpoint");
+  EXPECT_EQ(s.analysis.type, AnalysisType::kDynamic);
+  EXPECT_EQ(s.analysis.integrator, IntegratorType::kMidpoint);
   EXPECT_DOUBLE_EQ(s.analysis.step, 1e-3);
   EXPECT_FALSE(s.analysis.adaptive_step);
   EXPECT_EQ(s.functions.at("spin").type, TimeFunctionType::kSpinUp);

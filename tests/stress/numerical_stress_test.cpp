@@ -57,7 +57,7 @@ Outcome Simulate(const std::string& name, const std::string& scene, const std::m
   Outcome run;
   run.origin = s.origin;
   const SceneAnalysisSpec& a = s.spec.analysis;
-  if (a.type == "static") {
+  if (a.type == AnalysisType::kStatic) {
     SystemState state = InitialState(s.model);
     StaticOptions options;
     options.end_time = a.end_time;
@@ -79,7 +79,7 @@ Outcome Simulate(const std::string& name, const std::string& scene, const std::m
   options.end_time = a.end_time;
   options.rho_inf = a.rho_inf;
   options.tolerance = a.tolerance;
-  if (a.integrator == "midpoint") options.integrator = Integrator::kMidpoint;
+  if (a.integrator == IntegratorType::kMidpoint) options.integrator = Integrator::kMidpoint;
   if (tweak) tweak(options);
   const DynamicStepReport r0 = Measure(s.model, state);
   const double E0 = r0.kinetic_energy + r0.elastic_energy;
