@@ -182,12 +182,11 @@ SceneSpec ParseScene(const std::string& text, const std::string& name, const std
       if (other.name == b.name) item.Fail("body name '" + b.name + "' used twice");
     }
     if (auto t = m.Optional("type")) {
-      b.type = t->String();
-      if (b.type != "superelement" && b.type != "rigid") {
-        t->Fail("unknown body type '" + b.type + "' (known: superelement, rigid)");
-      }
+      const std::string name = t->String();
+      if (name != "superelement" && name != "rigid") t->Fail("unknown body type '" + name + "' (known: superelement, rigid)");
+      b.type = name == "rigid" ? SceneBodyType::kRigid : SceneBodyType::kSuperelement;
     }
-    if (b.type == "superelement") {
+    if (b.type == SceneBodyType::kSuperelement) {
       b.superelement = m.Required("superelement").String();
     } else {
       b.mass = m.Required("mass").PositiveNumber();
@@ -218,13 +217,13 @@ SceneSpec ParseScene(const std::string& text, const std::string& name, const std
     }
     YamlValue node_map = m.Required("nodes");
     for (const auto& [iname, scene_node] : node_map.Map().Entries()) {
-      if (b.type == "rigid" && iname != "com" && !b.points.count(iname)) {
+      if (b.type == SceneBodyType::kRigid && iname != "com" && !b.points.count(iname)) {
         scene_node.Fail("rigid body '" + b.name + "' has no point '" + iname + "' (define it under 'points'; 'com' is the centre of mass)");
       }
       b.nodes[iname] = scene_node.String();
       nodes.insert(scene_node.String());
     }
-    if (b.type == "rigid" && !b.nodes.count("com")) {
+    if (b.type == SceneBodyType::kRigid && !b.nodes.count("com")) {
       b.nodes["com"] = b.name + ".com";
       nodes.insert(b.nodes["com"]);
     }
@@ -264,25 +263,30 @@ SceneSpec ParseScene(const std::string& text, const std::string& name, const std
       SceneJointSpec j;
       j.where = item.Where();
       YamlValue type = m.Required("type");
-      j.type = type.String();
-      const bool axial = j.type == "revolute" || j.type == "prismatic" || j.type == "cylindrical" || j.type == "universal";
-      if (j.type != "clamp" && j.type != "spherical" && j.type != "rigid" && !axial) {
-        type.Fail("unknown joint type '" + j.type +
+      const std::string name = type.String();
+      const bool axial = name == "revolute" || name == "prismatic" || name == "cylindrical" || name == "universal";
+      if (name != "clamp" && name != "spherical" && name != "rigid" && !axial) {
+        type.Fail("unknown joint type '" + name +
                   "' (known: clamp, spherical, revolute, prismatic, cylindrical, universal, rigid)");
       }
+      static const SceneJointType all[] = {SceneJointType::kClamp,     SceneJointType::kRigid,
+                                           SceneJointType::kSpherical, SceneJointType::kRevolute,
+                                           SceneJointType::kPrismatic, SceneJointType::kCylindrical,
+                                           SceneJointType::kUniversal};
+      j.type = *std::find_if(std::begin(all), std::end(all), [&](SceneJointType x) { return name == Name(x); });
       j.node = check_node(m.Required("node"));
       if (auto p = m.Optional("parent")) {
         j.parent = check_node(*p);
         if (j.parent == j.node) p->Fail("a node cannot be its own parent");
-        if (j.type == "clamp") type.Fail("a clamp holds a node to the ground; between two nodes use 'rigid'");
-      } else if (j.type == "rigid") {
+        if (name == "clamp") type.Fail("a clamp holds a node to the ground; between two nodes use 'rigid'");
+      } else if (name == "rigid") {
         type.Fail("a rigid joint needs a 'parent' node (to the ground use 'clamp')");
       }
       if (axial) {
         YamlValue axis = m.Required("axis");
         j.axis = axis.Vector3();
         if (j.axis.norm() == 0) axis.Fail("axis must not be zero");
-        if (j.type == "universal") {
+        if (name == "universal") {
           YamlValue axis2 = m.Required("axis2");
           j.axis2 = axis2.Vector3();
           if (std::abs(j.axis.normalized().dot(j.axis2.normalized())) > 1e-6) {
@@ -290,8 +294,8 @@ SceneSpec ParseScene(const std::string& text, const std::string& name, const std
           }
         }
         if (auto v = m.Optional("prescribed")) {
-          if (j.type == "cylindrical" || j.type == "universal") {
-            v->Fail("prescribed motion of a " + j.type + " joint is not supported; use revolute or prismatic");
+          if (name == "cylindrical" || name == "universal") {
+            v->Fail("prescribed motion of a " + name + " joint is not supported; use revolute or prismatic");
           }
           j.prescribed = v->String();
           if (!scene.functions.count(j.prescribed)) v->Fail("time function '" + j.prescribed + "' is not defined under 'functions'");
@@ -314,8 +318,9 @@ SceneSpec ParseScene(const std::string& text, const std::string& name, const std
       SceneLoadSpec l;
       l.where = item.Where();
       YamlValue type = m.Required("type");
-      l.type = type.String();
-      if (l.type == "force") {
+      const std::string name = type.String();
+      if (name == "force") {
+        l.type = SceneLoadType::kForce;
         l.node = check_node(m.Required("node"));
         if (auto v = m.Optional("force")) l.force = v->Vector3();
         if (auto v = m.Optional("moment")) l.moment = v->Vector3();
@@ -324,9 +329,11 @@ SceneSpec ParseScene(const std::string& text, const std::string& name, const std
           l.function = v->String();
           if (!scene.functions.count(l.function)) v->Fail("time function '" + l.function + "' is not defined under 'functions'");
         }
-      } else if (l.type == "gravity") {
+      } else if (name == "gravity") {
+        l.type = SceneLoadType::kGravity;
         l.g = m.Required("g").Vector3();
-      } else if (l.type == "spring") {
+      } else if (name == "spring") {
+        l.type = SceneLoadType::kSpring;
         l.node = check_node(m.Required("node"));
         auto node_b = m.Optional("node_b");
         auto point = m.Optional("point");
@@ -345,7 +352,7 @@ SceneSpec ParseScene(const std::string& text, const std::string& name, const std
           if (l.free_length < 0) v->Fail("free length must be >= 0");
         }
       } else {
-        type.Fail("unknown load type '" + l.type + "' (known: force, gravity, spring)");
+        type.Fail("unknown load type '" + name + "' (known: force, gravity, spring)");
       }
       m.CheckNoUnknownKeys();
       scene.loads.push_back(l);
@@ -475,6 +482,30 @@ SceneSpec ParseScene(const std::string& text, const std::string& name, const std
   }
   root.CheckNoUnknownKeys();
   return scene;
+}
+
+const char* Name(SceneBodyType type) { return type == SceneBodyType::kRigid ? "rigid" : "superelement"; }
+
+const char* Name(SceneJointType type) {
+  switch (type) {
+    case SceneJointType::kClamp: return "clamp";
+    case SceneJointType::kRigid: return "rigid";
+    case SceneJointType::kSpherical: return "spherical";
+    case SceneJointType::kRevolute: return "revolute";
+    case SceneJointType::kPrismatic: return "prismatic";
+    case SceneJointType::kCylindrical: return "cylindrical";
+    case SceneJointType::kUniversal: return "universal";
+  }
+  return "?";
+}
+
+const char* Name(SceneLoadType type) {
+  switch (type) {
+    case SceneLoadType::kForce: return "force";
+    case SceneLoadType::kGravity: return "gravity";
+    case SceneLoadType::kSpring: return "spring";
+  }
+  return "?";
 }
 
 const char* Name(AnalysisType type) {

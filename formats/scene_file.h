@@ -43,13 +43,20 @@ struct TimeFunctionSpec {
 enum class AnalysisType { kStatic, kDynamic, kModes };
 enum class IntegratorType { kGeneralizedAlpha, kMidpoint };
 enum class ProbeQuantity { kPosition, kRotation, kVelocity, kAngularVelocity, kJoint, kReaction, kStress };
+/// Bodies, joints and loads by type (SCENE_FORMAT.md `bodies`, `joints`, `loads`).
+enum class SceneBodyType { kSuperelement, kRigid };
+enum class SceneJointType { kClamp, kRigid, kSpherical, kRevolute, kPrismatic, kCylindrical, kUniversal };
+enum class SceneLoadType { kForce, kGravity, kSpring };
+const char* Name(SceneBodyType type);
+const char* Name(SceneJointType type);
+const char* Name(SceneLoadType type);
 const char* Name(AnalysisType type);
 const char* Name(IntegratorType type);
 const char* Name(ProbeQuantity quantity);
 
 struct SceneBodySpec {
   std::string name;
-  std::string type = "superelement";  ///< superelement | rigid
+  SceneBodyType type = SceneBodyType::kSuperelement;
   std::string superelement;      ///< file path (relative paths are relative to the scene file)
   // rigid: mass, centre of mass and inertia about it (part axes), attachment points (part axes)
   double mass = 0.0;
@@ -71,7 +78,7 @@ struct SceneBodySpec {
 };
 
 struct SceneJointSpec {
-  std::string type;  ///< clamp, spherical, revolute, prismatic, cylindrical, rigid (rigid needs a parent)
+  SceneJointType type = SceneJointType::kClamp;  ///< kRigid needs a parent; kClamp has none
   std::string node;
   std::string parent;  ///< "" = to ground; else the node this one depends on
   Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();  ///< revolute/prismatic/cylindrical/universal (global)
@@ -82,7 +89,7 @@ struct SceneJointSpec {
 };
 
 struct SceneLoadSpec {
-  std::string type;  ///< force (force and/or moment on a node), gravity, spring
+  SceneLoadType type = SceneLoadType::kForce;  ///< force and/or moment on a node, gravity, spring
   std::string node;
   Eigen::Vector3d force = Eigen::Vector3d::Zero(), moment = Eigen::Vector3d::Zero();
   bool follower = false;

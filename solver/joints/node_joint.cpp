@@ -7,16 +7,6 @@
 
 namespace femb {
 
-JointType JointTypeFromName(const std::string& name) {
-  if (name == "rigid") return JointType::kRigid;
-  if (name == "revolute") return JointType::kRevolute;
-  if (name == "prismatic") return JointType::kPrismatic;
-  if (name == "cylindrical") return JointType::kCylindrical;
-  if (name == "spherical") return JointType::kSpherical;
-  if (name == "universal") return JointType::kUniversal;
-  throw std::invalid_argument("unknown joint type " + name);
-}
-
 int NodeJoint::n_coordinates() const {
   switch (type) {
     case JointType::kRigid: return 0;

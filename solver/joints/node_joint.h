@@ -20,9 +20,6 @@ namespace femb {
 
 enum class JointType { kRigid, kRevolute, kPrismatic, kCylindrical, kSpherical, kUniversal };
 
-/// "rigid", "revolute", ...; throws std::invalid_argument for other names.
-JointType JointTypeFromName(const std::string& name);
-
 struct NodeJoint {
   JointType type = JointType::kRigid;
   int child = -1, parent = -1;

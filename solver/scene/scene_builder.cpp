@@ -40,19 +40,37 @@ bool FixedToGround(const SystemModel& model, int k) {
 // Joints that share a point (spherical, revolute, universal; cylindrical up to a shift along its
 // axis) refuse nodes that are apart at t = 0: the offset would silently become a rigid arm of
 // the parent (node_joint.h: x_c = x_p + R_p r0). Tolerance 1e-6 of the scene's size.
+// The solver's joint for a scene joint (a clamp between two nodes is a rigid joint).
+JointType SolverJointType(SceneJointType type) {
+  switch (type) {
+    case SceneJointType::kClamp:
+    case SceneJointType::kRigid: return JointType::kRigid;
+    case SceneJointType::kSpherical: return JointType::kSpherical;
+    case SceneJointType::kRevolute: return JointType::kRevolute;
+    case SceneJointType::kPrismatic: return JointType::kPrismatic;
+    case SceneJointType::kCylindrical: return JointType::kCylindrical;
+    case SceneJointType::kUniversal: return JointType::kUniversal;
+  }
+  return JointType::kRigid;
+}
+
 void RequireJointGap(const SceneJointSpec& j, const Eigen::Vector3d& x_p, const Eigen::Vector3d& x_c,
                      double scene_length) {
   Eigen::Vector3d gap = x_c - x_p;
-  if (j.type == "cylindrical") gap -= gap.dot(j.axis.normalized()) * j.axis.normalized();
-  if (j.type != "spherical" && j.type != "revolute" && j.type != "universal" && j.type != "cylindrical") return;
+  const bool cylindrical = j.type == SceneJointType::kCylindrical;
+  if (cylindrical) gap -= gap.dot(j.axis.normalized()) * j.axis.normalized();
+  if (j.type != SceneJointType::kSpherical && j.type != SceneJointType::kRevolute && j.type != SceneJointType::kUniversal &&
+      !cylindrical) {
+    return;
+  }
   const double tolerance = 1e-6 * std::max(scene_length, 1e-3 * std::max(x_p.norm(), x_c.norm()));
   if (gap.norm() <= tolerance) return;
   char buffer[400];
   std::snprintf(buffer, sizeof buffer,
                 ": %s joint between nodes '%s' and '%s': the nodes are %.6g apart at t = 0 (gap (%.6g, %.6g, %.6g)%s); "
                 "a %s joint needs them at one point: move the bodies or use a rigid joint for an offset",
-                j.type.c_str(), j.node.c_str(), j.parent.c_str(), gap.norm(), gap.x(), gap.y(), gap.z(),
-                j.type == "cylindrical" ? " across the axis" : "", j.type.c_str());
+                Name(j.type), j.node.c_str(), j.parent.c_str(), gap.norm(), gap.x(), gap.y(), gap.z(),
+                cylindrical ? " across the axis" : "", Name(j.type));
   throw InputError(j.where + buffer);
 }
 
@@ -69,7 +87,7 @@ Scene BuildScene(const SceneSpec& spec) {
   for (const SceneBodySpec& b_spec : spec.bodies) {
     SceneBodySpec b = b_spec;
     b.position -= scene.origin;
-    if (b.type == "rigid") {
+    if (b.type == SceneBodyType::kRigid) {
       // A rigid body: one node at the centre of mass carrying the 6 x 6 rigid mass, no
       // stiffness; its attachment points are rigid offsets (dependent nodes) of that node.
       Superelement se;
@@ -283,15 +301,15 @@ Scene BuildScene(const SceneSpec& spec) {
     const int p = j.parent.empty() ? kGround : scene.node_index.at(j.parent);
     if (p >= 0) RequireJointGap(j, model.node_x0[p], model.node_x0[k], scene_length);
     const bool tree = !j.cut && holder[size_t(k)] == kNoHolder && !is_ancestor(k, p);
-    const JointType type = j.type == "clamp" ? JointType::kRigid : JointTypeFromName(j.type);
+    const JointType type = SolverJointType(j.type);
     if (!tree) {
       if (!j.prescribed.empty()) {
-        throw InputError(j.where + ": " + j.type + " joint of node '" + j.node + "' is prescribed but closes a loop (node '" +
+        throw InputError(j.where + ": " + Name(j.type) + " joint of node '" + j.node + "' is prescribed but closes a loop (node '" +
                          j.node + "' already hangs on " +
                          (holder[size_t(k)] >= 0 ? "node '" + model.node_names[holder[size_t(k)]] + "'" : std::string("the ground")) +
                          "); a drive must be a tree joint: swap 'node' and 'parent', or prescribe another joint of the loop");
       }
-      const std::string name = j.where + ": " + j.type + " joint of node '" + j.node + "'" +
+      const std::string name = j.where + ": " + Name(j.type) + " joint of node '" + j.node + "'" +
                                (p >= 0 ? " on node '" + j.parent + "'" : std::string(" to the ground"));
       add_cut(type, k, p >= 0 ? p : hidden_ground(k), j.axis, j.axis2, name);
       continue;
@@ -302,16 +320,16 @@ Scene BuildScene(const SceneSpec& spec) {
       continue;
     }
     holder[size_t(k)] = kGround;
-    if (j.type == "universal") {
+    if (j.type == SceneJointType::kUniversal) {
       // To the ground: the parent is a hidden clamped node at the joint.
       add_tree(JointType::kUniversal, k, hidden_ground(k), j.axis, j.axis2);
       continue;
     }
-    if (j.type == "clamp") Clamp(model, k);
-    if (j.type == "spherical") Pin(model, k);
-    if (j.type == "revolute") RevoluteToGround(model, k, j.axis);
-    if (j.type == "prismatic") PrismaticToGround(model, k, j.axis);
-    if (j.type == "cylindrical") CylindricalToGround(model, k, j.axis);
+    if (j.type == SceneJointType::kClamp) Clamp(model, k);
+    if (j.type == SceneJointType::kSpherical) Pin(model, k);
+    if (j.type == SceneJointType::kRevolute) RevoluteToGround(model, k, j.axis);
+    if (j.type == SceneJointType::kPrismatic) PrismaticToGround(model, k, j.axis);
+    if (j.type == SceneJointType::kCylindrical) CylindricalToGround(model, k, j.axis);
     if (!j.prescribed.empty()) model.prescribed.push_back(PrescribedBy(spec.functions.at(j.prescribed), k));
   }
   // An over-constrained loop (a planar four-bar of spatial revolute joints) has equations that
@@ -342,12 +360,12 @@ Scene BuildScene(const SceneSpec& spec) {
   }
   const DofMap& dofs = *dofs_ptr;
   for (const SceneLoadSpec& l : spec.loads) {
-    if (l.type == "gravity") {
+    if (l.type == SceneLoadType::kGravity) {
       model.gravity += l.g;
       if (spec.analysis.type != AnalysisType::kDynamic) model.static_gravity_end = spec.analysis.end_time;
       continue;
     }
-    if (l.type == "spring") {
+    if (l.type == SceneLoadType::kSpring) {
       SpringDamper s;
       s.node_a = scene.node_index.at(l.node);
       s.node_b = l.node_b.empty() ? -1 : scene.node_index.at(l.node_b);
@@ -413,7 +431,7 @@ Scene BuildScene(const SceneSpec& spec) {
     const SceneBodySpec& body = spec.bodies[size_t(b)];
     if (!scene.stresses[size_t(b)]) {
       throw InputError(p.where + ": probe '" + p.name + "': body '" + p.body + "' has no modal stresses" +
-                       (body.type == "rigid" ? std::string(" (a rigid body)")
+                       (body.type == SceneBodyType::kRigid ? std::string(" (a rigid body)")
                                              : " in " + body.superelement + " (reduce it with the mesh kept: reduction.keep_mesh, reduction.stresses)"));
     }
     const ModalStress& st = *scene.stresses[size_t(b)];
