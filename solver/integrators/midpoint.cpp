@@ -88,6 +88,14 @@ Eigen::Matrix<double, 6, 1> EndNodeVelocity(const Eigen::Vector3d& x0, const Eig
   return w1;
 }
 
+// A node's motion over the step, (x_n+1 - x_n, log(R_n+1 R_n^T)): what the bodies' balance pairs
+// with their energy, and what the forces' discrete gradients are made to work along.
+Eigen::Matrix<double, 6, 1> NodeStep(const SystemState& c0, const SystemState& c1, int node) {
+  Eigen::Matrix<double, 6, 1> m;
+  m << c1.x[node] - c0.x[node], LogSO3(c1.R[node] * c0.R[node].transpose());
+  return m;
+}
+
 Eigen::Matrix<double, 6, 1> NodeVelocity(const DynamicState& s, int node) {
   return s.node_w.empty() ? NodeMotion(s.config, node, s.W) : s.node_w[size_t(node)];
 }
@@ -189,16 +197,14 @@ MidpointKinematics Midpoint(const SystemModel& model, const DofMap& dofs, const 
 // coordinates and free nodes map exactly and get nothing. The correction is O(h^2) of the forces
 // and is left out of the iteration matrix.
 void AddDiscreteGradientCorrection(const SystemModel& model, const DofMap& dofs, const SystemState& c0,
-                                   const SystemState& c1, const MidpointKinematics& k, Assembly& out) {
+                                   const SystemState& c1, const MidpointKinematics& k, double L2, Assembly& out) {
   if (model.joints.empty()) return;
   const int n = dofs.first_multiplier();
-  const double L2 = std::pow(std::max(BoundingDiagonal(model.node_x0), 1e-300), 2);
   Eigen::VectorXd D = Eigen::VectorXd::Zero(n);
   double gap_work = 0.0;
   for (int node = 0; node < model.n_nodes(); ++node) {
     if (dofs.joint_of(node) < 0) continue;
-    Eigen::Matrix<double, 6, 1> gap;
-    gap << c1.x[node] - c0.x[node], LogSO3(c1.R[node] * c0.R[node].transpose());
+    Eigen::Matrix<double, 6, 1> gap = NodeStep(c0, c1, node);
     for (const auto& [col, vec] : k.mid.J[node]) {
       gap -= vec * k.delta[col];
       D[col] += vec.head<3>().squaredNorm() + L2 * vec.tail<3>().squaredNorm();
@@ -250,11 +256,7 @@ Assembly AssembleMidpoint(const SystemModel& model, const DofMap& dofs, const Dy
     const Eigen::VectorXd p1 = body.GeneralizedMomentum(maps1, w1);
     // Node motion over the step.
     Eigen::VectorXd wm(body.n_coordinates());
-    for (int a = 0; a < body.n_nodes(); ++a) {
-      const int node = model.body_nodes[b][a];
-      wm.segment<3>(6 * a) = (s1.config.x[node] - s0.config.x[node]) / h;
-      wm.segment<3>(6 * a + 3) = LogSO3(s1.config.R[node] * s0.config.R[node].transpose()) / h;
-    }
+    for (int a = 0; a < body.n_nodes(); ++a) wm.segment<6>(6 * a) = NodeStep(s0.config, s1.config, model.body_nodes[b][a]) / h;
     wm.tail(body.n_modes()) = (s1.config.eta[b] - s0.config.eta[b]) / h;
     Eigen::VectorXd f_in, f_int;
     Eigen::MatrixXd &Kb = r.K, &Mb = r.M, &Cb = r.C;
@@ -267,13 +269,13 @@ Assembly AssembleMidpoint(const SystemModel& model, const DofMap& dofs, const Dy
     if (body.options().quadratic_velocity_terms) {
       // Source terms with the node motion of each half step, so that their moment matches the
       // change of sum x_k x p_k exactly: x_m is not the mean of x_n and x_n+1.
-      Eigen::VectorXd w_second = wm, w_first = wm;
-      for (int a = 0; a < body.n_nodes(); ++a) {
-        const int node = model.body_nodes[b][a];
-        w_second.segment<3>(6 * a) = 2.0 * (s1.config.x[node] - k.mid.x[node]) / h;
-        w_first.segment<3>(6 * a) = 2.0 * (k.mid.x[node] - s0.config.x[node]) / h;
-      }
       if (free_node[size_t(b)]) {
+        Eigen::VectorXd w_second = wm, w_first = wm;
+        for (int a = 0; a < body.n_nodes(); ++a) {
+          const int node = model.body_nodes[b][a];
+          w_second.segment<3>(6 * a) = 2.0 * (s1.config.x[node] - k.mid.x[node]) / h;
+          w_first.segment<3>(6 * a) = 2.0 * (k.mid.x[node] - s0.config.x[node]) / h;
+        }
         f_in = (p1 - p0[b]) / h -
                0.5 * (body.MomentumSource(maps_m, w_second, p1) + body.MomentumSource(maps_m, w_first, p0[b]));
       } else {
@@ -348,7 +350,7 @@ Assembly AssembleMidpoint(const SystemModel& model, const DofMap& dofs, const Dy
   AddLoopConstraints(model, dofs, k.mid, &out.residual, nullptr, &parts.node_forces);
   // Loads at the mid time and configuration, spring-dampers at the mean rates Delta / h.
   FinishAssembly(model, dofs, k.mid, s0.t + 0.5 * h, k.delta / h, true, parts, out);
-  AddDiscreteGradientCorrection(model, dofs, s0.config, s1.config, k, out);
+  AddDiscreteGradientCorrection(model, dofs, s0.config, s1.config, k, L2, out);
   // The external work of the step, as the forces' discrete gradients do it: gravity's potential
   // change, and the nodal loads (at q_m) times the nodes' motion.
   f_ext_work = 0.0;
@@ -358,9 +360,7 @@ Assembly AssembleMidpoint(const SystemModel& model, const DofMap& dofs, const Dy
     Eigen::VectorXd unused = Eigen::VectorXd::Zero(dofs.n_dofs());
     AddNodeLoads(model, k.mid, s0.t + 0.5 * h, unused, nullptr, &loads);
     for (int node = 0; node < model.n_nodes(); ++node) {
-      Eigen::Matrix<double, 6, 1> m;
-      m << s1.config.x[node] - s0.config.x[node], LogSO3(s1.config.R[node] * s0.config.R[node].transpose());
-      f_ext_work += m.dot(loads.f[size_t(node)]);
+      f_ext_work += NodeStep(s0.config, s1.config, node).dot(loads.f[size_t(node)]);
     }
   }
   return out;
