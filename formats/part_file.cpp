@@ -412,10 +412,6 @@ PartSpec ParsePart(const std::string& text, const std::string& name,
     if (auto v = m.Optional("method")) {
       part.reduction.method = v->OneOf({"craig_bampton", "free_interface", "general"});
       part.reduction.where_method = v->Where();
-      if (part.reduction.method == "general" && part.type != "imported") {
-        v->Fail("method general reads shapes on the DOFs of imported matrices: it needs type: imported (for femb's own "
-                "parts use free_interface)");
-      }
     }
     if (auto v = m.Optional("basis")) {
       YamlMap b = v->Map();

@@ -56,6 +56,7 @@ Check Finite(const Superelement& se) {
   for (const Eigen::MatrixXd& K_sigma : se.inertia_stiffness) {
     datasets.emplace_back("/reduced/geometric_stiffness/inertia", K_sigma);
   }
+  if (se.interface_constraint.rows() > 0) datasets.emplace_back("/reduced/interface_constraint", se.interface_constraint);
   for (const Eigen::MatrixXd& G : se.inertia_gamma) datasets.emplace_back("/reduced/inertia_invariants/Gamma", G);
   for (const Eigen::MatrixXd& X : se.inertia_xi) datasets.emplace_back("/reduced/inertia_invariants/Xi", X);
   if (se.visualization) {
@@ -192,6 +193,24 @@ SuperelementChecks CheckSuperelement(const Superelement& se) {
   a.checks.push_back({"modal_derivative_pairs", bad_pair.empty(),
                       bad_pair.empty() ? std::to_string(se.modal_derivative_pairs.size()) + " pairs in range" : bad_pair,
                       "/reduced/modal_derivative_pairs"});
+
+  if (se.interface_constraint.rows() > 0) {
+    // Thesis 8.2 case 4: the constraint must leave the rigid motions free (C Phi_rig0 = 0 on the
+    // interface rows) and have independent rows.
+    const Eigen::MatrixXd& C = se.interface_constraint;
+    const bool shaped = C.cols() == se.n_interface_dofs() && C.rows() < C.cols();
+    double rigid = 1.0, condition = 0.0;
+    if (shaped) {
+      const Eigen::MatrixXd CP = C * Phi_rig0.topRows(C.cols());
+      rigid = CP.norm() / std::max(C.norm() * Phi_rig0.topRows(C.cols()).norm(), 1e-300);
+      const Eigen::VectorXd sv = Eigen::JacobiSVD<Eigen::MatrixXd>(C).singularValues();
+      condition = sv.size() && sv[0] > 0 ? sv[sv.size() - 1] / sv[0] : 0.0;
+    }
+    a.checks.push_back({"interface_constraint", shaped && rigid <= 1e-8 && condition > 1e-8,
+                        std::to_string(C.rows()) + " rows" + Sci(", ||C Phi_rig0|| / (||C|| ||Phi_rig0||) = %.3g", rigid) +
+                            Sci(", smallest / largest singular value %.3g", condition),
+                        "/reduced/interface_constraint"});
+  }
 
   const double m_reduced = (Phi_rig0.col(0).transpose() * se.M * Phi_rig0.col(0))(0, 0);
   const double mass_error =

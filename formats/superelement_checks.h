@@ -40,6 +40,8 @@ struct SuperelementChecks {
 ///   floating_frame          max|Phi_CB Phi_rig0 - 1| <= 1e-8 (thesis 3.7, 3.20)
 ///   interface_orientations  every orientation orthonormal with determinant +1 (to 1e-9)
 ///   modal_derivative_pairs  every pair names reduced coordinates of the file
+///   interface_constraint    (only with one) C Phi_rig0 = 0 on the interface rows (1e-8) and
+///                           independent rows (singular values within 1e8)
 ///   mass                    the stored mass equals the one of the reduced M to 1e-6
 SuperelementChecks CheckSuperelement(const Superelement& se);
 

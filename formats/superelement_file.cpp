@@ -85,6 +85,13 @@ void WriteContent(const Superelement& se, h5::Writer& w) {
     for (int k = 0; k < kInertiaLoadCaseCount; ++k) cases += std::string(k ? " " : "") + kInertiaLoadCases[k];
     w.Attribute("/reduced/geometric_stiffness/inertia", "load_cases", cases);
   }
+  if (se.interface_constraint.rows() > 0) {
+    if (se.interface_constraint.cols() != se.n_interface_dofs()) {
+      throw InputError("the interface constraint has " + std::to_string(se.interface_constraint.cols()) +
+                       " columns, the file " + std::to_string(se.n_interface_dofs()) + " interface coordinates");
+    }
+    w.Matrix("/reduced/interface_constraint", se.interface_constraint);
+  }
   if (!se.inertia_gamma.empty()) {
     // The inertia invariants (superelement.h), stacked: Gamma 3n x n (x, y, z), Xi 6n x n.
     const long n = se.n_reduced_dofs();
@@ -287,6 +294,17 @@ Superelement ReadSuperelementFile(const std::string& path, const SuperelementRea
     RequireShape(r, "/reduced/geometric_stiffness/inertia", kInertiaLoadCaseCount * n, n);
     const Eigen::MatrixXd stacked = r.Matrix("/reduced/geometric_stiffness/inertia");
     for (int k = 0; k < kInertiaLoadCaseCount; ++k) se.inertia_stiffness.push_back(stacked.middleRows(k * n, n));
+  }
+  if (r.Exists("/reduced/interface_constraint")) {
+    const std::vector<hsize_t> shape = r.Shape("/reduced/interface_constraint");
+    const long rows = shape.size() == 2 ? long(shape[0]) : 0;
+    if (shape.size() != 2) RequireShape(r, "/reduced/interface_constraint", 1, 6 * N);  // names the shape
+    if (rows < 1 || rows > 6 * N - 6) {
+      throw InputError(path + ": dataset /reduced/interface_constraint has " + std::to_string(rows) + " rows (need 1 to " +
+                       std::to_string(6 * N - 6) + ": the rigid motions stay free)");
+    }
+    RequireShape(r, "/reduced/interface_constraint", rows, 6 * N);
+    se.interface_constraint = r.Matrix("/reduced/interface_constraint");
   }
   if (r.Exists("/reduced/inertia_invariants")) {
     RequireShape(r, "/reduced/inertia_invariants/Gamma", 3 * n, n);

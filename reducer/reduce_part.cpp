@@ -159,11 +159,12 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
     return result;
   }
 
+  Eigen::MatrixXd interface_constraint;  // thesis 8.2 case 4 (m < 6N)
   if (free_interface || general) {
     // Thesis 8.2 (reducer/reduction/general_basis.h). free_interface: the part's lowest free-free
     // modes with the static constraint modes (which carry the interface stiffness exactly);
-    // general: the user's shapes on the imported DOFs, fitted to the model DOFs (least squares:
-    // an RBE2 face moves rigidly in the model, the shapes may not).
+    // general: the user's shapes on the imported DOFs or the mesh's, fitted to the model DOFs
+    // (least squares: an RBE2 face moves rigidly in the model, the shapes may not).
     Stopwatch basis_clock;
     Eigen::MatrixXd V;
     std::string where, source;
@@ -195,8 +196,13 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
       source = std::to_string(k) + " free-free modes (" + freqs + (k > 4 ? ", ..." : "") + " Hz) + " + std::to_string(n_b) +
                " static modes";
     } else {
-      const Eigen::MatrixXd V_full = ReadShapeMatrix(part.reduction.basis_file, model.full_map.rows());
-      const SparseMatrix& T = model.full_map;
+      // The shapes' rows: the imported matrices' DOFs, or for femb's own parts the mesh's nodes
+      // (dofs_per_node each, node-major, the order of /visualization/nodes): the RBE2 couplings
+      // eliminate coupled solid nodes (mesh_map); beam DOFs are the model's own.
+      SparseMatrix identity(model.n_dofs(), model.n_dofs());
+      identity.setIdentity();
+      const SparseMatrix& T = model.full_map.size() ? model.full_map : model.mesh_map.size() ? model.mesh_map : identity;
+      const Eigen::MatrixXd V_full = ReadShapeMatrix(part.reduction.basis_file, T.rows());
       Eigen::SimplicialLDLT<SparseMatrix> normal(SparseMatrix(T.transpose() * T));
       V = normal.solve(Eigen::MatrixXd(T.transpose() * V_full));
       const double off_rigid = (Eigen::MatrixXd(T * V) - V_full).norm() / std::max(V_full.norm(), 1e-300);
@@ -205,7 +211,8 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
       std::snprintf(b, sizeof b, " (%.2g of their norm off the RBE2 faces' rigid motion)", off_rigid);
       source = std::to_string(V.cols()) + " shapes from " + part.reduction.basis_file + b;
     }
-    const GeneralBasisResult g = ReduceOnGeneralBasis(model, V);
+    const Eigen::MatrixXd static_modes = cb.shapes.leftCols(n_b);
+    const GeneralBasisResult g = ReduceOnGeneralBasis(model, V, &static_modes);
     if (!g.ok) {
       if (g.input_error) throw InputError(where + ": " + g.message);
       result.message = g.message;
@@ -215,10 +222,18 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
     cb.M = g.M;
     cb.shapes = g.shapes;
     cb.lambda = g.lambda;
+    interface_constraint = g.interface_constraint;
+    std::string constrained;
+    for (size_t i = 0; i < g.constraint_direction.size(); ++i) {
+      static const char* kNames[6] = {"u_x", "u_y", "u_z", "theta_x", "theta_y", "theta_z"};
+      const int at = g.constraint_direction[i];
+      constrained += (i ? ", " : "; constrained inside the body (thesis 8.2 case 4): ") +
+                     model.interface_names[size_t(at / 6)] + "." + kNames[at % 6];
+    }
     std::snprintf(detail, sizeof detail, "%s: %d of %d shapes with the rigid fields independent, interface rank %d of %d "
                   "(thesis 8.2), %ld reduced DOFs",
                   source.c_str(), g.columns_kept, g.columns_given + 6, g.interface_rank, n_b, long(g.K.rows()));
-    report(free_interface ? "free-interface basis" : "general basis", basis_clock.Seconds(), detail);
+    report(free_interface ? "free-interface basis" : "general basis", basis_clock.Seconds(), detail + constrained);
   }
 
   clock.Restart();
@@ -231,6 +246,7 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
   }
   se.K = cb.K;
   se.M = cb.M;
+  se.interface_constraint = interface_constraint;
   se.internal_frequencies_hz.resize(cb.lambda.size());
   for (int k = 0; k < cb.lambda.size(); ++k) se.internal_frequencies_hz[k] = FrequencyHz(cb.lambda[k]);
   se.n_full_dofs = model.n_dofs();

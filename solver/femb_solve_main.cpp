@@ -131,7 +131,7 @@ int main(int argc, char** argv) {
       last_print = Seconds(wall);
       // Closed loops: the largest violation of their equations so far (a length).
       char loops[64] = "";
-      if (!scene.model.cut_joints.empty()) std::snprintf(loops, sizeof loops, " loop gap %.2g", recorder.max_loop_violation());
+      if (scene.model.has_constraints()) std::snprintf(loops, sizeof loops, " loop gap %.2g", recorder.max_loop_violation());
       if (spec.analysis.adaptive_step) {
         std::printf("femb-solve: t = %-10.6g steps %-7ld rejected %-5ld Newton iterations %-8ld wall %.2f s%s\n", t,
                     step_count, rejected, total_iterations, Seconds(wall), loops);

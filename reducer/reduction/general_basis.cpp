@@ -1,6 +1,7 @@
 #include "reducer/reduction/general_basis.h"
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <string>
 
 #include "reducer/reduction/craig_bampton.h"
@@ -25,7 +26,8 @@ SparseMatrix InterfaceRows(const FeModel& model) {
   return B;
 }
 
-GeneralBasisResult ReduceOnGeneralBasis(const FeModel& model, const Eigen::MatrixXd& V_given) {
+GeneralBasisResult ReduceOnGeneralBasis(const FeModel& model, const Eigen::MatrixXd& V_given,
+                                        const Eigen::MatrixXd* static_modes) {
   GeneralBasisResult r;
   const int N = int(model.interface_names.size()), nb = 6 * N;
   // 1. Rigid-body fields appended; M-orthonormal, dependent columns dropped.
@@ -43,34 +45,42 @@ GeneralBasisResult ReduceOnGeneralBasis(const FeModel& model, const Eigen::Matri
   for (size_t j = 0; j < keep.size(); ++j) Q.col(long(j)) = V * gram.eigenvectors().col(keep[j]) / std::sqrt(g[keep[j]]);
   r.columns_kept = int(Q.cols());
 
-  // 2. The interface span (8.12) and its SVD.
+  // 2. The interface span (8.12) and its SVD, rotation rows scaled by the part's size L so that
+  // the rank and the constraint do not depend on the units.
+  double L = 0.0;
+  if (model.nodes.rows() > 1) L = (model.nodes.colwise().maxCoeff() - model.nodes.colwise().minCoeff()).norm();
+  if (!(L > 0)) L = 1.0;
+  Eigen::VectorXd scale(nb);
+  for (int k = 0; k < N; ++k) scale.segment<6>(6 * k) << 1, 1, 1, L, L, L;
   const SparseMatrix B = InterfaceRows(model);
-  const Eigen::MatrixXd Phi_IP = B * Q;  // 6N x M
+  const Eigen::MatrixXd Phi_IP = scale.asDiagonal() * (B * Q);  // 6N x M, lengths
   Eigen::JacobiSVD<Eigen::MatrixXd> svd(Phi_IP, Eigen::ComputeFullU | Eigen::ComputeFullV);
   const Eigen::VectorXd s = svd.singularValues();
   const double s_max = s.size() ? s[0] : 0.0;
   int m = 0;
   for (int k = 0; k < s.size(); ++k) m += s[k] > 1e-8 * s_max;
   r.interface_rank = m;
-  if (m < nb) {
-    // Case 4: name the interface coordinate that dominates the first unspanned direction.
-    const Eigen::VectorXd u = svd.matrixU().col(m);
-    Eigen::Index at = 0;
-    u.cwiseAbs().maxCoeff(&at);
-    static const char* kNames[6] = {"u_x", "u_y", "u_z", "theta_x", "theta_y", "theta_z"};
-    r.message = "the deformation shapes (with the rigid-body fields) move only " + std::to_string(m) + " of the " +
-                std::to_string(nb) + " interface coordinates: interface '" + model.interface_names[size_t(at / 6)] +
-                "' " + kNames[at % 6] + " (and " + std::to_string(nb - m - 1) +
-                " more directions) cannot move relative to the others; add shapes that move it (residual attachment "
-                "or static modes) - femb does not constrain interface directions inside a body";
-    r.input_error = true;
-    return r;
+  const int n_constraints = nb - m;
+  if (n_constraints > 0) {
+    // Case 4: C = U_2^T L; each row named by the interface coordinate it weighs most.
+    r.constraint_length = L;
+    r.interface_constraint = svd.matrixU().rightCols(n_constraints).transpose() * scale.asDiagonal();
+    for (int i = 0; i < n_constraints; ++i) {
+      Eigen::Index at = 0;
+      svd.matrixU().col(m + i).cwiseAbs().maxCoeff(&at);
+      r.constraint_direction.push_back(int(at));
+    }
   }
-  const long n_internal = Q.cols() - nb;
-  // Phi0 = Q Phi_IP^+ = Q V_s S^-1 U^T; Psi0 = Q N (the right singular vectors past the rank).
-  const Eigen::MatrixXd pinv = svd.matrixV().leftCols(nb) * s.head(nb).cwiseInverse().asDiagonal() *
-                               svd.matrixU().transpose();
+  const long n_internal = Q.cols() - m;
+  // Phi0 = Q (L Phi_IP)^+ L = Q V_s S^-1 U_1^T L; Psi0 = Q N (the right singular vectors past the rank).
+  const Eigen::MatrixXd pinv = svd.matrixV().leftCols(m) * s.head(m).cwiseInverse().asDiagonal() *
+                               svd.matrixU().leftCols(m).transpose() * scale.asDiagonal();
   Eigen::MatrixXd Phi = Q * pinv;
+  if (n_constraints > 0 && static_modes) {
+    // The constrained directions' field: the static modes' (B Psi_c = 1), so B Phi = 1.
+    const Eigen::MatrixXd U2 = svd.matrixU().rightCols(n_constraints);
+    Phi += *static_modes * (scale.cwiseInverse().asDiagonal() * U2 * r.interface_constraint);
+  }
   Eigen::MatrixXd Psi = Q * svd.matrixV().rightCols(n_internal);
 
   // 3. Condensation within the basis; 4. internal eigen-coordinates. K enters through K Phi and

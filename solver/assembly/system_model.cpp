@@ -55,6 +55,10 @@ DofMap::DofMap(const SystemModel& model) : motion_(&model.motion) {
     multiplier_first_.push_back(n_dofs_);
     n_dofs_ += int(cut.equations.size());
   }
+  for (const SuperelementBody& body : model.bodies) {
+    body_multiplier_first_.push_back(body.n_constraints() > 0 ? n_dofs_ : -1);
+    n_dofs_ += body.n_constraints();
+  }
   prescribed_.assign(n_dofs_, false);
   for (const auto& p : model.prescribed) prescribed_[prescribed_index(p)] = true;
   for (int j = 0; j < n_dofs_; ++j) {

@@ -10,7 +10,8 @@
 // down the tree into the node Jacobian J_k (dq_k = J_k dz), with the joints' geometric
 // stiffness and convective accelerations.
 // Unknowns: every node's coordinates, the modal coordinates of every body, then the cut
-// joints' multipliers (DofMap::first_multiplier; solver/joints/loop_constraints.h). A joint
+// joints' multipliers and those of the bodies' interface constraints (thesis 8.2 case 4)
+// (DofMap::first_multiplier; solver/joints/loop_constraints.h). A joint
 // coordinate may be prescribed by a time function: it stays in the vector of coordinates but
 // is not solved for. Model (immutable) and State are separate: f(const Model&, State&).
 #pragma once
@@ -70,6 +71,13 @@ struct SystemModel {
   double static_gravity_end = 0.0;
 
   int n_nodes() const { return int(node_names.size()); }
+  /// True with Lagrange multipliers: cut joints, or bodies with an interface constraint.
+  bool has_constraints() const {
+    if (!cut_joints.empty()) return true;
+    for (const SuperelementBody& body : bodies)
+      if (body.n_constraints() > 0) return true;
+    return false;
+  }
 };
 
 /// System matrices are sparse (assembled from triplets) and factorized sparse (FreeSolver);
@@ -92,7 +100,7 @@ struct SystemState {
   std::vector<Eigen::Matrix3d> R;
   std::vector<Eigen::VectorXd> eta;         ///< per body
   std::vector<FrameSolution> frames;        ///< per body, the last solved floating frame
-  Eigen::VectorXd lambda;                   ///< the cut joints' multipliers (DofMap::multiplier_first)
+  Eigen::VectorXd lambda;                   ///< the multipliers (DofMap::multiplier_first, body_multiplier_first)
 };
 
 /// Numbering of the unknowns (coordinates).
@@ -112,9 +120,13 @@ class DofMap {
   /// First coordinate of body b's modal coordinates.
   int mode_dof(int b) const { return mode_dof_[b]; }
   /// The unknowns after the coordinates: the multipliers of the cut joints' kept equations
-  /// (cut joint c's from multiplier_first(c)), n_multipliers() of them; none without loops.
+  /// (cut joint c's from multiplier_first(c)) and of the bodies' interface constraints,
+  /// n_multipliers() of them; none without loops or constrained bodies.
   int n_multipliers() const { return n_dofs_ - first_multiplier_; }
   int multiplier_first(int c) const { return multiplier_first_[c]; }
+  /// After the cut joints': body b's multipliers of its interface constraint (thesis 8.2 case 4,
+  /// SuperelementBody::InterfaceConstraint), n_constraints() of them; -1 when it has none.
+  int body_multiplier_first(int b) const { return body_multiplier_first_[b]; }
   int first_multiplier() const { return first_multiplier_; }
   bool multiplier(int j) const { return j >= first_multiplier_; }
   /// Sets the multipliers' entries of a vector over the unknowns to zero (velocities and
@@ -132,7 +144,8 @@ class DofMap {
 
  private:
   const std::vector<Eigen::MatrixXd>* motion_;
-  std::vector<int> node_first_, node_count_, joint_of_, order_, mode_dof_, solved_, multiplier_first_;
+  std::vector<int> node_first_, node_count_, joint_of_, order_, mode_dof_, solved_, multiplier_first_,
+      body_multiplier_first_;
   std::vector<bool> prescribed_;
   int n_dofs_ = 0, first_multiplier_ = 0;
 };

@@ -26,6 +26,7 @@ SuperelementBody::SuperelementBody(const Superelement& se, const SuperelementOpt
       K_(se.K),
       M_(se.M),
       Phi_CB_(se.floating_frame.Phi_CB),
+      C_(se.interface_constraint.rows() > 0 ? se.interface_constraint : Eigen::MatrixXd(0, 6 * se.n_interface_nodes())),
       placement_R_(placement_R),
       placement_x_(placement_x),
       origin_part_(se.floating_frame.origin) {
@@ -338,6 +339,38 @@ double SuperelementBody::ElasticEnergy(const Data& d) const {
   return polynomial_ ? PolynomialEnergy(K_, *polynomial_, q) : 0.5 * q.dot(K_ * q);
 }
 
+void SuperelementBody::AddGeometricTangent(const Data& d, const Eigen::VectorXd& Q, const Eigen::VectorXd& Qhat,
+                                           bool approximated, Eigen::MatrixXd& Kt) const {
+  const int n = n_coordinates();
+  const Eigen::VectorXd& q = d.q;
+  const Kinematics& kin = d.kin;
+  // Fhat, Mhat (n x 6) from Qhat: node rows [0, F~; 0, 0] and [0, 0; 0, M~].
+  Eigen::MatrixXd Fhat = Eigen::MatrixXd::Zero(n, 6), FMhat = Eigen::MatrixXd::Zero(n, 6);
+  for (int a = 0; a < n_nodes_; ++a) {
+    const Eigen::Matrix3d F = Skew<double>(Eigen::Vector3d(Qhat.segment<3>(6 * a)));
+    Fhat.block<3, 3>(6 * a, 3) = F;
+    FMhat.block<3, 3>(6 * a, 3) = F;
+    FMhat.block<3, 3>(6 * a + 3, 3) = Skew<double>(Eigen::Vector3d(Qhat.segment<3>(6 * a + 3)));
+  }
+  Kt.noalias() -= FMhat * kin.Z;  // K3: rotation of the frame
+  if (!approximated) {
+    Kt.noalias() -= kin.Z.transpose() * (Fhat.transpose() * kin.B);  // K2: variation of Phi_rig in T (6 x n first)
+    // K4: variation of D (exact rotation kinematics), v = P^T Q, P = 1 - D Phi_rig S^-1 Phi_CB.
+    Eigen::VectorXd DtQ = Q;  // D^T Q
+    for (int a = 0; a < n_nodes_; ++a) DtQ.segment<3>(6 * a + 3) = kin.Jinv[size_t(a)].transpose() * Q.segment<3>(6 * a + 3);
+    const Eigen::VectorXd v = Q - Phi_CB_.transpose() * (kin.S_inv.transpose() * (kin.Phi_rig.transpose() * DtQ));
+    // G is block diagonal (a 3 x 3 block per node rotation): T^T G B = sum_a T_a^T (G_a B_a)
+    // with T_a, B_a node a's rotation rows.
+    Eigen::Matrix<double, 3, Eigen::Dynamic> GB(3, n);
+    for (int a = 0; a < n_nodes_; ++a) {
+      const Eigen::Matrix3d G = LeftJacobianInverseTransposeDerivative(Eigen::Vector3d(q.segment<3>(6 * a + 3)),
+                                                                       Eigen::Vector3d(v.segment<3>(6 * a + 3)));
+      GB.noalias() = G * kin.B.middleRows<3>(6 * a + 3);
+      Kt.noalias() += kin.T.middleRows<3>(6 * a + 3).transpose() * GB;
+    }
+  }
+}
+
 void SuperelementBody::ElasticForce(const Data& d, Eigen::VectorXd* f, Eigen::MatrixXd* tangent,
                                     const InertiaLoadFactors* load, Eigen::MatrixXd* d_load) const {
   const int n = n_coordinates();
@@ -375,37 +408,35 @@ void SuperelementBody::ElasticForce(const Data& d, Eigen::VectorXd* f, Eigen::Ma
   } else {
     Kt.noalias() = kin.B.transpose() * (*Kq * kin.B);  // K1
   }
-  if (options_.full_tangent) {
-    // Fhat, Mhat (n x 6) from Qhat: node rows [0, F~; 0, 0] and [0, 0; 0, M~].
-    Eigen::MatrixXd Fhat = Eigen::MatrixXd::Zero(n, 6), FMhat = Eigen::MatrixXd::Zero(n, 6);
-    for (int a = 0; a < n_nodes_; ++a) {
-      const Eigen::Matrix3d F = Skew<double>(Eigen::Vector3d(Qhat.segment<3>(6 * a)));
-      Fhat.block<3, 3>(6 * a, 3) = F;
-      FMhat.block<3, 3>(6 * a, 3) = F;
-      FMhat.block<3, 3>(6 * a + 3, 3) = Skew<double>(Eigen::Vector3d(Qhat.segment<3>(6 * a + 3)));
-    }
-    Kt.noalias() -= FMhat * kin.Z;  // K3: rotation of the frame
-    if (!options_.approximated) {
-      Kt.noalias() -= kin.Z.transpose() * (Fhat.transpose() * kin.B);  // K2: variation of Phi_rig in T (6 x n first)
-      // K4: variation of D (exact rotation kinematics), v = P^T Q, P = 1 - D Phi_rig S^-1 Phi_CB.
-      Eigen::VectorXd DtQ = Q;  // D^T Q
-      for (int a = 0; a < n_nodes_; ++a) DtQ.segment<3>(6 * a + 3) = kin.Jinv[size_t(a)].transpose() * Q.segment<3>(6 * a + 3);
-      const Eigen::VectorXd v = Q - Phi_CB_.transpose() * (kin.S_inv.transpose() * (kin.Phi_rig.transpose() * DtQ));
-      // G is block diagonal (a 3 x 3 block per node rotation): T^T G B = sum_a T_a^T (G_a B_a)
-      // with T_a, B_a node a's rotation rows.
-      Eigen::Matrix<double, 3, Eigen::Dynamic> GB(3, n);
-      for (int a = 0; a < n_nodes_; ++a) {
-        const Eigen::Matrix3d G = LeftJacobianInverseTransposeDerivative(Eigen::Vector3d(q.segment<3>(6 * a + 3)),
-                                                                         Eigen::Vector3d(v.segment<3>(6 * a + 3)));
-        GB.noalias() = G * kin.B.middleRows<3>(6 * a + 3);
-        Kt.noalias() += kin.T.middleRows<3>(6 * a + 3).transpose() * GB;
-      }
-    }
-  }
+  if (options_.full_tangent) AddGeometricTangent(d, Q, Qhat, options_.approximated, Kt);
   // Rbar Kt Rbar^T, block by block.
   const Eigen::Matrix3d R = frame.R, Rt = frame.R.transpose();
   TurnRowBlocks(Kt, 2 * n_nodes_, [&](int) { return R; });
   TurnColBlocks(Kt, 2 * n_nodes_, [&](int) { return Rt; });
+}
+
+void SuperelementBody::InterfaceConstraint(const Data& d, Eigen::VectorXd* g, Eigen::MatrixXd* G,
+                                           const Eigen::VectorXd* lambda, Eigen::MatrixXd* H) const {
+  const int n = n_coordinates(), r = n_constraints(), nb = 6 * n_nodes_;
+  const Eigen::Matrix3d R = d.frame.R, Rt = d.frame.R.transpose();
+  if (g) *g = C_ * d.q.head(nb);
+  if (G) {
+    // d q_loc = B Rbar^T dq (exact, also with the approximated option: this is a constraint).
+    G->resize(r, n);
+    G->noalias() = C_ * d.kin.B.topRows(nb);
+    TurnColBlocks(*G, 2 * n_nodes_, [&](int) { return Rt; });
+  }
+  if (!H) return;
+  // G^T lambda = Rbar B^T Q with Q = C^T lambda (zero on the modal rows): the elastic force's
+  // form with a local force that does not depend on the configuration, so its derivative is
+  // K2 + K3 + K4 of that Q (no K1).
+  Eigen::VectorXd Q = Eigen::VectorXd::Zero(n);
+  Q.head(nb) = C_.transpose() * *lambda;
+  const Eigen::VectorXd Qhat = d.kin.B.transpose() * Q;
+  H->setZero(n, n);
+  AddGeometricTangent(d, Q, Qhat, false, *H);
+  TurnRowBlocks(*H, 2 * n_nodes_, [&](int) { return R; });
+  TurnColBlocks(*H, 2 * n_nodes_, [&](int) { return Rt; });
 }
 
 void SuperelementBody::VelocityMaps(const Data& d, Eigen::MatrixXd* P, Eigen::MatrixXd* U) const {

@@ -197,6 +197,17 @@ class SuperelementBody {
     ElasticForce(Evaluate(c, frame), f, tangent, load, d_load);
   }
 
+  /// Thesis 8.2 case 4: a basis that moves only m < 6N interface directions holds the others
+  /// with the file's C q_int = 0 (formats/superelement.h interface_constraint; r rows, lengths).
+  /// femb-solve adds it to the system with Lagrange multipliers (solver/joints/loop_constraints.h).
+  int n_constraints() const { return int(C_.rows()); }
+  /// At `d`: g = C q_int (r); G = dg/dq = C B Rbar^T on the body's coordinates (r x n, exact: the
+  /// local map of the file comment); with `lambda`, H = d(G^T lambda)/dq (n x n). G^T lambda is
+  /// the elastic force's form Rbar B^T Q with the local force Q = [C^T lambda; 0], which does not
+  /// depend on the configuration: H is that force's K2 + K3 + K4 (tangent stiffness paper).
+  void InterfaceConstraint(const Data& d, Eigen::VectorXd* g, Eigen::MatrixXd* G, const Eigen::VectorXd* lambda,
+                           Eigen::MatrixXd* H) const;
+
   /// True when the body uses the geometric stiffness of inertia load cases (file and option).
   bool has_inertia_stiffening() const { return !K_sigma_.empty(); }
 
@@ -378,6 +389,11 @@ class SuperelementBody {
   int n_nodes_ = 0, n_modes_ = 0;
   SuperelementOptions options_;
   Eigen::MatrixXd K_, M_, Phi_CB_;
+  Eigen::MatrixXd C_;  ///< interface constraint (r x 6N; no rows: none)
+  // K2 + K3 + K4 of a local force Q (Qhat = B^T Q, or T0^T Q when `approximated`: K3 alone),
+  // added to the local Kt (not turned by Rbar).
+  void AddGeometricTangent(const Data& d, const Eigen::VectorXd& Q, const Eigen::VectorXd& Qhat, bool approximated,
+                           Eigen::MatrixXd& Kt) const;
   std::optional<PolynomialStiffness> polynomial_;  ///< set when the file has it and the option is on
   // Local internal force and its tangent: K q or the polynomial's.
   // The force is kept in d (Data::local_force) for the next call with the same load factors.

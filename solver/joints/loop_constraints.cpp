@@ -8,9 +8,58 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
+
+#include "solver/assembly/system.h"
 
 
 namespace femb {
+
+namespace {
+
+// The bodies' interface constraints (thesis 8.2 case 4): g = C q_int of each constrained body,
+// its Jacobian G through the body's map (BodyMap: node Jacobians, modal coordinates) and
+// d(G^T lambda)/dq, in the same blocks as the cut joints'.
+void AddBodyConstraints(const SystemModel& model, const DofMap& dofs, const SystemState& state, Eigen::VectorXd* residual,
+                        Triplets* tangent, NodeForces* node_forces, Triplets* jacobian, int blocks) {
+  for (size_t b = 0; b < model.bodies.size(); ++b) {
+    const SuperelementBody& body = model.bodies[b];
+    const int r = body.n_constraints();
+    if (r == 0) continue;
+    const FrameSolution frame = body.SolveFrameFrom(BodyConfigurationOf(model, state, int(b)), state.frames[b]);
+    if (!frame.ok) continue;  // the body's own assembly reports it
+    const SuperelementBody::Data d = body.Evaluate(BodyConfigurationOf(model, state, int(b)), frame);
+    const int first = dofs.body_multiplier_first(int(b));
+    const Eigen::VectorXd lambda = state.lambda.segment(first - dofs.first_multiplier(), r);
+    const bool hessian = tangent && (blocks & kLoopHessian) && !lambda.isZero(0.0);
+    Eigen::VectorXd g;
+    Eigen::MatrixXd G, H;
+    body.InterfaceConstraint(d, &g, &G, hessian ? &lambda : nullptr, hessian ? &H : nullptr);
+    const Eigen::VectorXd f = G.transpose() * lambda;  // on the body's coordinates
+    if (node_forces) AddBodyNodeForces(model, int(b), -f, *node_forces);
+    const std::vector<MapEntry> map = BodyMap(model, dofs, state, int(b));
+    if (residual) {
+      const Eigen::VectorXd minus_f = -f;
+      ScatterBody(map, &minus_f, nullptr, residual, nullptr);
+      residual->segment(first, r) -= g;
+    }
+    for (Triplets* t : {tangent, jacobian}) {
+      if (!t) continue;
+      const bool rows = t == jacobian || (blocks & kLoopRows), columns = t == jacobian || (blocks & kLoopColumns);
+      for (const MapEntry& e : map) {
+        for (int i = 0; i < r; ++i) {
+          const double v = e.coefficient * G(i, e.local);
+          if (v == 0.0) continue;
+          if (rows) t->emplace_back(first + i, e.coordinate, v);
+          if (columns) t->emplace_back(e.coordinate, first + i, v);
+        }
+      }
+    }
+    if (hessian) ScatterBody(map, nullptr, &H, nullptr, tangent);
+  }
+}
+
+}  // namespace
 
 void AddLoopConstraints(const SystemModel& model, const DofMap& dofs, const SystemState& state,
                         Eigen::VectorXd* residual, Triplets* tangent, NodeForces* node_forces, Triplets* jacobian,
@@ -65,6 +114,7 @@ void AddLoopConstraints(const SystemModel& model, const DofMap& dofs, const Syst
       }
     }
   }
+  AddBodyConstraints(model, dofs, state, residual, tangent, node_forces, jacobian, blocks);
 }
 
 namespace {
@@ -151,7 +201,7 @@ double LoopViolation(const SystemModel& model, const SystemState& state, int* wo
   double L = BoundingDiagonal(model.node_x0);
   if (!(L > 0)) L = 1.0;
   double largest = 0.0;
-  if (worst) *worst = model.cut_joints.empty() ? -1 : 0;
+  if (worst) *worst = -1;
   for (size_t c = 0; c < model.cut_joints.size(); ++c) {
     const NodeJoint& j = model.cut_joints[c].joint;
     const ConstraintBlock block = EvaluateConstraint(j, state.x[j.parent], state.R[j.parent], state.x[j.child], state.R[j.child]);
@@ -161,6 +211,19 @@ double LoopViolation(const SystemModel& model, const SystemState& state, int* wo
         largest = v;
         if (worst) *worst = int(c);
       }
+    }
+  }
+  for (size_t b = 0; b < model.bodies.size(); ++b) {
+    const SuperelementBody& body = model.bodies[b];
+    if (body.n_constraints() == 0) continue;
+    const BodyConfiguration c = BodyConfigurationOf(model, state, int(b));
+    const FrameSolution frame = body.SolveFrameFrom(c, state.frames[b]);
+    Eigen::VectorXd g;
+    body.InterfaceConstraint(body.Evaluate(c, frame), &g, nullptr, nullptr, nullptr);  // lengths
+    const double v = frame.ok ? g.lpNorm<Eigen::Infinity>() : std::numeric_limits<double>::infinity();
+    if (v > largest) {
+      largest = v;
+      if (worst) *worst = int(model.cut_joints.size() + b);
     }
   }
   return largest;
@@ -181,7 +244,7 @@ std::vector<Eigen::Matrix<double, 6, 1>> CutJointReactions(const SystemModel& mo
 }
 
 bool LoopsClosed(const SystemModel& model, const SystemState& state, double tolerance) {
-  return model.cut_joints.empty() ||
+  return !model.has_constraints() ||
          LoopViolation(model, state) <= tolerance * std::max(BoundingDiagonal(model.node_x0), 1e-300);
 }
 

@@ -1,5 +1,6 @@
 // Closed loops in the system (issue 15): the cut joints' constraint equations with Lagrange
-// multipliers, assembled into the residual and the iteration matrix; the rank test that drops
+// multipliers, assembled into the residual and the iteration matrix, and the same for the
+// interface constraints of bodies whose basis moves fewer directions (thesis 8.2 case 4); the rank test that drops
 // redundant equations and names a dead point; the loops' violation and reactions. The
 // equations of one joint are in solver/joints/loop_closure.h.
 #pragma once
@@ -13,7 +14,8 @@
 
 namespace femb {
 
-/// The cut joints' constraint equations at `state` with its multipliers lambda: the residual's
+/// The cut joints' constraint equations and the bodies' interface constraints
+/// (SuperelementBody::InterfaceConstraint) at `state` with its multipliers lambda: the residual's
 /// coordinate rows get -G^T lambda and its multiplier rows -g (Newton's S delta = r then asks
 /// G dq = -g), the node forces -G_node^T lambda (so AddJointGeometricStiffness adds the tree
 /// joints' share of their stiffness). With `tangent`: G in the multipliers' rows, G^T in their
@@ -24,15 +26,16 @@ void AddLoopConstraints(const SystemModel& model, const DofMap& dofs, const Syst
                         Eigen::VectorXd* residual, Triplets* tangent, NodeForces* node_forces,
                         Triplets* jacobian = nullptr, int blocks = kLoopAll);
 /// The largest violation of the kept equations: positions in length units, rotations (dot
-/// products) times the model's size L so that both are lengths; 0 without loops. `worst`: the
-/// cut joint with it (-1 without loops).
+/// products) times the model's size L so that both are lengths, and the bodies' interface
+/// constraints (lengths); 0 without any. `worst`: the cut joint with it, or cut_joints.size() + b
+/// for body b's constraint (-1 without any).
 double LoopViolation(const SystemModel& model, const SystemState& state, int* worst = nullptr);
 /// Per cut joint, the force and moment (global axes, moment about the child node) that the
 /// joint's parent node, or the ground, exerts on its child node through the joint: -G_c^T lambda,
 /// G_c the child's columns of the kept equations. Along a dropped (redundant) direction the
 /// mechanism's reactions are not unique and this one carries none.
 std::vector<Eigen::Matrix<double, 6, 1>> CutJointReactions(const SystemModel& model, const SystemState& state);
-/// Newton's test on the loops: no cut joints, or LoopViolation <= tolerance times the model's
+/// Newton's test on the loops: no constraints, or LoopViolation <= tolerance times the model's
 /// size (BoundingDiagonal of the nodes), the same relative tolerance as the forces'.
 bool LoopsClosed(const SystemModel& model, const SystemState& state, double tolerance);
 

@@ -114,7 +114,7 @@ void ResultsRecorder::Record(double t, const SystemState& state, const Eigen::Ve
   const SystemModel& model = scene_.model;
   const DofMap& dofs = dofs_;
   const int n = model.n_nodes();
-  if (!model.cut_joints.empty()) {
+  if (model.has_constraints()) {
     loop_violation_.push_back(LoopViolation(model, state));
     max_loop_violation_ = std::max(max_loop_violation_, loop_violation_.back());
   }
