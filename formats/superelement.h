@@ -160,7 +160,7 @@ struct Superelement {
   std::vector<Eigen::MatrixXd> inertia_gamma, inertia_xi;
   /// A basis that moves only m < 6N interface directions (thesis 8.2, case 4; reduction.method
   /// general): C (r x 6N, r = 6N - m) with C q_int = 0 on the local interface coordinates of the
-  /// floating frame (translations, rotations). Its rows are orthonormal after the rotation
+  /// floating frame (translations, rotations). Its rows have unit length after the rotation
   /// columns are divided by the part's size, so C q_int is a length. femb-solve enforces it with
   /// Lagrange multipliers (SuperelementBody::InterfaceConstraint). No rows: none.
   Eigen::MatrixXd interface_constraint;

@@ -65,6 +65,25 @@ std::string TextSummary(const Superelement& se, const SuperelementAnalysis& a, c
     s += F("  geometric stiffening: 12 inertia load cases (a, alpha, omega products), %d x %d each\n",
            se.n_reduced_dofs(), se.n_reduced_dofs());
   }
+  if (se.interface_constraint.rows() > 0) {
+    // Thesis 8.2 case 4: name each row by the interface coordinate it weighs most (rotation
+    // columns are lengths times the part's size, so compare them as such).
+    static const char* kNames[6] = {"u_x", "u_y", "u_z", "theta_x", "theta_y", "theta_z"};
+    const Eigen::MatrixXd& C = se.interface_constraint;
+    std::string rows;
+    for (long i = 0; i < C.rows(); ++i) {
+      const Eigen::VectorXd w = C.row(i).cwiseAbs().transpose();
+      rows += i ? "; " : "";
+      bool first = true;
+      for (long k = 0; k < w.size(); ++k) {
+        if (w[k] < 0.5 * w.maxCoeff()) continue;
+        rows += F("%s%s.%s", first ? "" : " & ", se.interfaces[size_t(k / 6)].name.c_str(), kNames[k % 6]);
+        first = false;
+      }
+    }
+    s += F("  interface constraint (basis moves %ld of %d interface directions; femb-solve holds the others): %s\n",
+           long(se.n_interface_dofs() - C.rows()), se.n_interface_dofs(), rows.c_str());
+  }
   if (!se.inertia_gamma.empty()) {
     s += F("  inertia invariants: Gamma (3) and Xi (6), %d x %d each (exact kinetic energy in the floating frame)\n",
            se.n_reduced_dofs(), se.n_reduced_dofs());

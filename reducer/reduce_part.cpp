@@ -226,9 +226,11 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
     std::string constrained;
     for (size_t i = 0; i < g.constraint_direction.size(); ++i) {
       static const char* kNames[6] = {"u_x", "u_y", "u_z", "theta_x", "theta_y", "theta_z"};
-      const int at = g.constraint_direction[i];
-      constrained += (i ? ", " : "; constrained inside the body (thesis 8.2 case 4): ") +
-                     model.interface_names[size_t(at / 6)] + "." + kNames[at % 6];
+      constrained += i ? "; " : "; constrained inside the body (thesis 8.2 case 4): ";
+      for (size_t j = 0; j < g.constraint_direction[i].size(); ++j) {
+        const int at = g.constraint_direction[i][j];
+        constrained += (j ? " & " : "") + model.interface_names[size_t(at / 6)] + "." + kNames[at % 6];
+      }
     }
     std::snprintf(detail, sizeof detail, "%s: %d of %d shapes with the rigid fields independent, interface rank %d of %d "
                   "(thesis 8.2), %ld reduced DOFs",

@@ -62,13 +62,33 @@ GeneralBasisResult ReduceOnGeneralBasis(const FeModel& model, const Eigen::Matri
   r.interface_rank = m;
   const int n_constraints = nb - m;
   if (n_constraints > 0) {
-    // Case 4: C = U_2^T L; each row named by the interface coordinate it weighs most.
-    r.constraint_length = L;
-    r.interface_constraint = svd.matrixU().rightCols(n_constraints).transpose() * scale.asDiagonal();
+    // Case 4: C = E L with E the reduced row echelon form of U_2^T (Gauss-Jordan, full pivoting)
+    // with unit rows: the same constraint, but each row on as few coordinates as the null space
+    // allows (a rod: A.u_x - B.u_x and A.theta_x - B.theta_x, not two mixtures of them).
+    Eigen::MatrixXd E = svd.matrixU().rightCols(n_constraints).transpose();
+    std::vector<bool> used(size_t(nb), false);
     for (int i = 0; i < n_constraints; ++i) {
-      Eigen::Index at = 0;
-      svd.matrixU().col(m + i).cwiseAbs().maxCoeff(&at);
-      r.constraint_direction.push_back(int(at));
+      int pr = i, pc = 0;
+      double best = -1.0;
+      for (int a = i; a < n_constraints; ++a)
+        for (int b = 0; b < nb; ++b)
+          if (!used[size_t(b)] && std::abs(E(a, b)) > best) best = std::abs(E(a, b)), pr = a, pc = b;
+      E.row(i).swap(E.row(pr));
+      used[size_t(pc)] = true;
+      E.row(i) /= E(i, pc);
+      for (int a = 0; a < n_constraints; ++a)
+        if (a != i) E.row(a) -= E(a, pc) * E.row(i);
+    }
+    for (int i = 0; i < n_constraints; ++i) E.row(i).normalize();
+    r.constraint_length = L;
+    r.interface_constraint = E * scale.asDiagonal();
+    for (int i = 0; i < n_constraints; ++i) {
+      const Eigen::VectorXd w = E.row(i).cwiseAbs().transpose();
+      std::vector<int> at;
+      for (int k = 0; k < nb; ++k)
+        if (w[k] >= 0.5 * w.maxCoeff()) at.push_back(k);
+      std::sort(at.begin(), at.end(), [&](int a, int b) { return w[a] > w[b]; });
+      r.constraint_direction.push_back(at);
     }
   }
   const long n_internal = Q.cols() - m;

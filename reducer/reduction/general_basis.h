@@ -16,8 +16,8 @@
 //         local interface coordinates should be constrained such that this subspace is
 //         suppressed". The SVD is taken of L Phi_IP (rotation rows times the part's size L, so
 //         that every row is a length); its left singular vectors past the rank, U_2, give the
-//         constraint C q_int = 0 with C = U_2^T L (r x 6N, r = 6N - m: lengths, orthonormal
-//         rows), stored in the file for femb-solve to enforce with multipliers
+//         constraint C q_int = 0 with C = E L (r x 6N, r = 6N - m; E the reduced row echelon
+//         form of U_2^T with unit rows, so that each row involves few coordinates), stored in the file for femb-solve to enforce with multipliers
 //         (SuperelementBody::InterfaceConstraint). Phi0 = V (L Phi_IP)^+ L moves the spanned
 //         directions; the constrained ones get the static constraint modes' field
 //         Psi_c L^-1 U_2 U_2^T L (when `static_modes` are given; else none): it never deforms the
@@ -54,8 +54,9 @@ struct GeneralBasisResult {
   /// otherwise. L: the size that scales its rotation columns (C q_int is a length).
   Eigen::MatrixXd interface_constraint;
   double constraint_length = 1.0;
-  /// Case 4: for each constraint row, the interface coordinate it weighs most (6 k + d).
-  std::vector<int> constraint_direction;
+  /// Case 4: for each constraint row, the interface coordinates (6 k + d) it weighs at least
+  /// half as much as its largest (lengths: rotations times L), largest first.
+  std::vector<std::vector<int>> constraint_direction;
 };
 
 /// The interface coordinates as rows acting on model DOFs (6N x n_dofs): RBE2 DOFs and RBE3 W.

@@ -99,17 +99,24 @@ TEST(GeneralBasis, TooFewShapesToMoveEveryInterfaceDirectionAreConstrained) {
   ASSERT_EQ(g.interface_constraint.rows(), 2);
   ASSERT_EQ(g.interface_constraint.cols(), 12);
   ASSERT_EQ(g.K.rows(), 12);  // no internal coordinates: 10 shapes, all at the interfaces
-  // The constrained directions: u_x and theta_x (the rod lies along x), one each.
-  std::vector<int> components;
-  for (int at : g.constraint_direction) components.push_back(at % 6);
-  std::sort(components.begin(), components.end());
-  EXPECT_EQ(components, (std::vector<int>{0, 3}));
-  // Orthonormal rows once the rotation columns are divided by the part's size (0.3 m).
+  // The constrained directions: the relative u_x and theta_x of A and B (the rod lies along x).
+  std::vector<std::vector<int>> directions = g.constraint_direction;
+  for (std::vector<int>& d : directions) std::sort(d.begin(), d.end());
+  std::sort(directions.begin(), directions.end());
+  EXPECT_EQ(directions, (std::vector<std::vector<int>>{{0, 6}, {3, 9}}));
+  // Once the rotation columns are divided by the part's size (0.3 m): the rows (A.u_x - B.u_x)
+  // and (A.theta_x - B.theta_x), of unit length, in some order and sign.
   Eigen::VectorXd unscale = Eigen::VectorXd::Ones(12);
   for (int k = 0; k < 2; ++k) unscale.segment<3>(6 * k + 3).setConstant(1.0 / g.constraint_length);
   EXPECT_NEAR(g.constraint_length, 0.3, 1e-12);
   const Eigen::MatrixXd Cs = g.interface_constraint * unscale.asDiagonal();
-  EXPECT_LT((Cs * Cs.transpose() - Eigen::Matrix2d::Identity()).norm(), 1e-12);
+  for (int i = 0; i < 2; ++i) {
+    const int c = std::abs(Cs(i, 0)) > 0.5 ? 0 : 3;
+    Eigen::RowVectorXd expected = Eigen::RowVectorXd::Zero(12);
+    expected[c] = Cs(i, c) > 0 ? M_SQRT1_2 : -M_SQRT1_2;
+    expected[c + 6] = -expected[c];
+    EXPECT_LT((Cs.row(i) - expected).norm(), 1e-10) << Cs.row(i);
+  }
   // The rigid motions are free: C Phi_rig0 = 0 (interface rows of the rigid fields).
   const Eigen::MatrixXd rigid = InterfaceRows(model) * RigidFields(model);
   EXPECT_LT((g.interface_constraint * rigid).norm() / rigid.norm(), 1e-10);
