@@ -6,6 +6,7 @@
 
 #include <Eigen/SparseCholesky>
 
+#include "formats/hdf5_file.h"
 #include "formats/input_error.h"
 #include "reducer/fe/beam_model.h"
 #include "reducer/fe/imported_model.h"
@@ -24,6 +25,31 @@
 #endif
 
 namespace femb {
+
+namespace {
+
+// The deformation shapes of reduction.method general: a Matrix Market file (ReadShapeMatrix), or
+// an HDF5 file (.h5, .hdf5) with the dataset /shapes, one row per DOF and one column per shape
+// (h5py: f["shapes"] = V).
+Eigen::MatrixXd ReadShapes(const std::string& path, long rows) {
+  const size_t dot = path.find_last_of('.');
+  const std::string ext = dot == std::string::npos ? "" : path.substr(dot);
+  if (ext != ".h5" && ext != ".hdf5") return ReadShapeMatrix(path, rows);
+  const h5::Reader r(path);
+  if (!r.Exists("/shapes")) throw InputError(path + ": no dataset /shapes (one row per DOF, one column per shape)");
+  const std::vector<hsize_t> shape = r.Shape("/shapes");
+  if (shape.size() != 2 || long(shape[0]) != rows || shape[1] < 1) {
+    std::string got;
+    for (hsize_t d : shape) got += (got.empty() ? "" : " x ") + std::to_string(d);
+    throw InputError(path + ": /shapes is (" + got + "), expected (" + std::to_string(rows) +
+                     " x shapes): one row per DOF, in the matrices' (or the mesh's) order");
+  }
+  Eigen::MatrixXd V = r.Matrix("/shapes");
+  if (!V.allFinite()) throw InputError(path + ": /shapes has a value that is not finite");
+  return V;
+}
+
+}  // namespace
 namespace {
 
 // The pairs of Craig-Bampton coordinates whose modal derivatives are asked for.
@@ -202,7 +228,7 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
       SparseMatrix identity(model.n_dofs(), model.n_dofs());
       identity.setIdentity();
       const SparseMatrix& T = model.full_map.size() ? model.full_map : model.mesh_map.size() ? model.mesh_map : identity;
-      const Eigen::MatrixXd V_full = ReadShapeMatrix(part.reduction.basis_file, T.rows());
+      const Eigen::MatrixXd V_full = ReadShapes(part.reduction.basis_file, T.rows());
       Eigen::SimplicialLDLT<SparseMatrix> normal(SparseMatrix(T.transpose() * T));
       V = normal.solve(Eigen::MatrixXd(T.transpose() * V_full));
       const double off_rigid = (Eigen::MatrixXd(T * V) - V_full).norm() / std::max(V_full.norm(), 1e-300);

@@ -251,6 +251,26 @@ cp "$src/examples/beam_rod/part.yaml" "$work/rod_mm/bending.yaml"
 "$bin/femb-inspect" "$work/rod_bending.h5" --check > "$work/bending.txt" \
   && grep -q "interface constraint (basis moves 10 of 12 interface directions" "$work/bending.txt" && ok \
   || fail "inspect the constrained rod: $(cat "$work/bending.txt")"
+# The same shapes as HDF5 (/shapes, written by h5py) give the same file; a wrong row count is
+# one line, exit 2, no output.
+$py - "$work/rod_mm" <<'PY' && ok || fail "bending shapes as HDF5"
+import sys, h5py, scipy.io
+d = sys.argv[1]
+V = scipy.io.mmread(d + "/bending.mtx")
+with h5py.File(d + "/bending.h5", "w") as f: f["shapes"] = V
+with h5py.File(d + "/short.h5", "w") as f: f["shapes"] = V[:-1]
+PY
+"$bin/femb-reduce" -q "$work/rod_mm/bending.yaml" -o "$work/rod_bending_h5.h5" --set reduction.method=general \
+  --set reduction.basis.file=bending.h5 --set reduction.floating_frame=mean_axes && $py - "$work/rod_bending.h5" "$work/rod_bending_h5.h5" <<'PY' && ok || fail "HDF5 shapes differ"
+import sys, h5py, numpy as np
+a, b = (h5py.File(p)["reduced"] for p in sys.argv[1:])
+for k in ["K", "M", "interface_constraint"]:
+    assert np.abs(a[k][()] - b[k][()]).max() <= 1e-12 * np.abs(a[k][()]).max(), k
+PY
+"$bin/femb-reduce" -q "$work/rod_mm/bending.yaml" -o "$work/short.h5" --set reduction.method=general \
+  --set reduction.basis.file=short.h5 2> "$work/err.txt"
+[ $? = 2 ] && [ "$(wc -l < "$work/err.txt")" = 1 ] && grep -q "short.h5: /shapes is (65 x 4), expected (66 x shapes)" "$work/err.txt" \
+  && [ ! -e "$work/short.h5" ] && ok || fail "HDF5 shapes with a wrong row count: $(cat "$work/err.txt")"
 cat > "$work/rod_mm/pull.yaml" <<'YAML'
 name: pull
 units: SI
