@@ -5,7 +5,7 @@
 // such rods in a general pose); an axial force and a torque neither stretch nor twist the rod
 // while a Craig-Bampton rod of the same beam stretches by P L / (E A) (closed form); a small
 // transverse load gives the reduced model's own linear answer (the same matrices solved with
-// the constraint by hand), stiffer than beam theory; a swinging pendulum of two
+// the constraint by hand), stiffer than beam theory, and so do the linearized modes; a swinging pendulum of two
 // such rods keeps its constraint closed and its energy with the midpoint scheme.
 #include <gtest/gtest.h>
 
@@ -21,6 +21,7 @@
 #include "reducer/reduction/full_modes.h"
 #include "solver/analysis/dynamic_analysis.h"
 #include "solver/analysis/dynamic_step.h"
+#include "solver/analysis/modal_analysis.h"
 #include "solver/analysis/static_analysis.h"
 #include "solver/assembly/system.h"
 #include "solver/rotation.h"
@@ -171,6 +172,34 @@ TEST(InterfaceConstraint, SmallTransverseLoadGivesTheReducedModelsLinearAnswer) 
   // the rod's ends, so the clamped root's bending moment is not in the basis (what residual
   // attachment modes would add).
   EXPECT_LT(tip[1], beam_theory * (1 + 1e-9));
+}
+
+// Linearized modes of the clamped bending-only rod (null-space projection of the multipliers)
+// against the reduced model's own constrained eigenproblem: B's coordinates on the null space of
+// C_B, K_BB and M_BB projected (1e-8).
+TEST(InterfaceConstraint, LinearizedModesAreThoseOfTheConstrainedReducedModel) {
+  const Superelement se = Rod(true);
+  SystemModel model = test::ClampedOneBodyModel(se, kL, Eigen::Vector3d::Zero());
+  SystemState state = InitialState(model);
+  const ModalResult modes = LinearizedModes(model, state, 0.0);
+  ASSERT_TRUE(modes.ok) << modes.message;
+  Eigen::FullPivLU<Eigen::MatrixXd> lu(se.interface_constraint.rightCols(6));
+  const Eigen::MatrixXd N = lu.kernel();
+  ASSERT_EQ(N.cols(), 4);
+  Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> eig(N.transpose() * se.K.block(6, 6, 6, 6) * N,
+                                                                N.transpose() * se.M.block(6, 6, 6, 6) * N,
+                                                                Eigen::EigenvaluesOnly);
+  ASSERT_EQ(modes.frequencies_hz.size(), 4);
+  double worst = 0.0;
+  for (int j = 0; j < 4; ++j) {
+    const double f = std::sqrt(eig.eigenvalues()[j]) / (2 * M_PI);
+    worst = std::max(worst, std::abs(modes.frequencies_hz[j] / f - 1));
+  }
+  std::printf("[ info ] clamped bending-only rod: %d modes (%.2f, %.2f, %.2f, %.2f Hz), within %.2e of the constrained "
+              "reduced model's\n",
+              int(modes.frequencies_hz.size()), modes.frequencies_hz[0], modes.frequencies_hz[1], modes.frequencies_hz[2],
+              modes.frequencies_hz[3], worst);
+  EXPECT_LT(worst, 1e-8);
 }
 
 // Released horizontal, the two bending-only rods swing for 1 s. The constraint stays closed to
