@@ -131,14 +131,16 @@ SystemForces AssembleStatic(const SystemModel& model, const DofMap& dofs, System
     out.elastic_energy += body.ElasticEnergy(data);
     out.force_scale = std::max({out.force_scale, body.ForceNorm(f), body.force_floor()});
     out.roundoff += body.RoundOffForce(c);
+    const double ramp = gravity_on ? std::min(lambda / model.static_gravity_end, 1.0) : 0.0;
+    // Gravity in a static analysis, ramped to full at pseudo-time static_gravity_end; its
+    // configuration derivative in the tangent (S = -dr/dq: minus GravityTangent). The dynamic
+    // iteration matrix leaves it out (the mass term dominates it at small steps).
+    if (with_tangent && gravity_on && ramp > 0) K -= body.GravityTangent(data, ramp * model.gravity);
     const Eigen::VectorXd minus_f = -f;
     ScatterBody(BodyMap(model, dofs, state, int(b)), &minus_f, with_tangent ? &K : nullptr, &out.residual,
                 with_tangent ? &tangent : nullptr);
     AddBodyNodeForces(model, int(b), minus_f, node_forces);
-    if (model.static_gravity_end > 0 && model.gravity.squaredNorm() > 0) {
-      // Gravity in a static analysis, ramped to full at pseudo-time static_gravity_end (its
-      // configuration derivative is left out of the tangent, as in the dynamic iteration matrix).
-      const double ramp = std::min(lambda / model.static_gravity_end, 1.0);
+    if (gravity_on) {
       const Eigen::VectorXd f_grav = body.GravityForce(data, ramp * model.gravity);
       ScatterBody(BodyMap(model, dofs, state, int(b)), &f_grav, nullptr, &gravity, nullptr);
       AddBodyNodeForces(model, int(b), f_grav, node_forces);

@@ -761,4 +761,26 @@ Eigen::VectorXd SuperelementBody::GravityForce(const Data& data, const Eigen::Ve
   return f;
 }
 
+Eigen::MatrixXd SuperelementBody::GravityTangent(const Data& d, const Eigen::Vector3d& g) const {
+  const int n = n_coordinates();
+  if (!has_exact_inertia()) {
+    // GravityForce = P^T M P wdot_g = M_g wdot_g with wdot_g = g on every node's translation rows
+    // (P wdot_g = Phi_rig0 [R_j^T g; 0]): its configuration derivative is MomentumDerivative's.
+    BodyVelocity wdot_g = Eigen::VectorXd::Zero(n);
+    for (int a = 0; a < n_nodes_; ++a) wdot_g.segment<3>(6 * a) = g;
+    return MomentumDerivative(MapsOf(d), wdot_g);
+  }
+  // The exact inertia's field: central differences with the frame re-solved, as for its inertia
+  // force (ExactInertiaConfigurationTangent).
+  Eigen::MatrixXd tangent(n, n);
+  for (int i = 0; i < n; ++i) {
+    double step = 0.0;
+    const BodyConfiguration plus = Perturbed(d.c, i, 1.0, &step), minus = Perturbed(d.c, i, -1.0, &step);
+    tangent.col(i) = (GravityForce(Evaluate(plus, SolveFrame(plus, d.frame)), g) -
+                      GravityForce(Evaluate(minus, SolveFrame(minus, d.frame)), g)) /
+                     (2 * step);
+  }
+  return tangent;
+}
+
 }  // namespace femb

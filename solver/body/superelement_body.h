@@ -346,6 +346,12 @@ class SuperelementBody {
   Eigen::VectorXd GravityForce(const BodyConfiguration& c, const FrameSolution& frame, const Eigen::Vector3d& g) const {
     return GravityForce(Evaluate(c, frame), g);
   }
+  /// d GravityForce / dq (n x n): the weight's distribution over the nodes and modes turns with
+  /// the floating frame. Corotational inertia: GravityForce = M_g wdot_g (wdot_g = g on the node
+  /// translations), so MomentumDerivative(maps, wdot_g), exact; exact inertia: central
+  /// differences (steps as in InertiaConfigurationTangent). A pendulum hanging from a pin owes
+  /// its whole restoring stiffness to it.
+  Eigen::MatrixXd GravityTangent(const Data& d, const Eigen::Vector3d& g) const;
 
  private:
   // Into `k`, reusing its storage.

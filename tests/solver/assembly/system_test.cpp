@@ -1,0 +1,217 @@
+// The system assembly (issue 14 item 0: unit tests for it): the numbering of the unknowns
+// (nodes on every kind of support, joint children, modal coordinates, the multipliers of cut
+// joints and of body constraints, prescribed coordinates), increments that keep each support's
+// motion exact (a revolute node turns about its fixed axis by the sum of its increments), the
+// static residual of a free body balancing its loads (the internal forces have no resultant and
+// no moment: the floating frame's rigid-body invariance), and the static tangent of a chain on
+// cylindrical, spherical and prismatic supports under a follower load and gravity (the weight's
+// configuration derivative included) against central differences.
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+#include <cmath>
+#include <random>
+
+#include "solver/assembly/system.h"
+#include "solver/rotation.h"
+#include "test_util.h"
+
+namespace femb {
+namespace {
+
+constexpr double kL = 0.4;
+
+Superelement Rod(int modes) {
+  return test::Reduce(test::StraightBeamYaml(kL, 6, "{shape: circle, diameter: 0.02}", "{E: 2.0e9, nu: 0.3, rho: 7800}",
+                                             "[{name: A}, {name: B}]",
+                                             "reduction: {internal_modes: " + std::to_string(modes) + "}\n"));
+}
+
+void AddRod(SystemModel& model, const Superelement& se, int a, int b) {
+  model.bodies.emplace_back(se, SuperelementOptions{}, Eigen::Matrix3d::Identity(), model.node_x0[size_t(a)]);
+  model.body_nodes.push_back({a, b});
+}
+
+TEST(System, DofMapNumbersNodesModesAndMultipliers) {
+  Superelement rod = Rod(2);
+  Superelement held = rod;
+  held.interface_constraint = Eigen::MatrixXd::Zero(1, 12);  // A.u_x = B.u_x: no stretch
+  held.interface_constraint(0, 0) = M_SQRT1_2;
+  held.interface_constraint(0, 6) = -M_SQRT1_2;
+  SystemModel model;
+  for (int k = 0; k < 6; ++k) AddNode(model, "n" + std::to_string(k), Eigen::Vector3d(kL * (k / 2 + k % 2), 0, 0));
+  // n0 (0) - n1 (L): rod 0; n2 (L) - n3 (2L): rod 1, held; n4 (2L) - n5 (3L): rod 2.
+  AddRod(model, rod, 0, 1);
+  AddRod(model, held, 2, 3);
+  AddRod(model, rod, 4, 5);
+  RevoluteToGround(model, 0, Eigen::Vector3d::UnitZ());  // 1 coordinate
+  model.joints.push_back(MakeNodeJoint(JointType::kSpherical, 2, 1, Eigen::Vector3d::UnitZ(), model.node_x0[1],
+                                       model.node_R0[1], model.node_x0[2], model.node_R0[2]));  // 3
+  Pin(model, 3);                                                                              // 3
+  Clamp(model, 4);                                                                            // 0
+  // n5 free (6), closing a loop to n3 through a cut revolute joint (5 equations).
+  CutJoint cut;
+  cut.joint = MakeNodeJoint(JointType::kRevolute, 5, 3, Eigen::Vector3d::UnitZ(), model.node_x0[3], model.node_R0[3],
+                            model.node_x0[5], model.node_R0[5]);
+  cut.name = "cut";
+  for (int i = 0; i < 5; ++i) cut.equations.push_back(i);
+  model.cut_joints.push_back(cut);
+  model.prescribed.push_back({0, 0, [](double t) { return t; }, [](double) { return 1.0; }, [](double) { return 0.0; }});
+  const DofMap dofs(model);
+  const int counts[6] = {1, 6, 3, 3, 0, 6};
+  int first = 0;
+  for (int k = 0; k < 6; ++k) {
+    EXPECT_EQ(dofs.node_first(k), first) << k;
+    EXPECT_EQ(dofs.node_count(k), counts[k]) << k;
+    first += counts[k];
+  }
+  EXPECT_EQ(dofs.joint_of(2), 0);
+  EXPECT_EQ(dofs.joint_of(1), -1);
+  for (int b = 0; b < 3; ++b) EXPECT_EQ(dofs.mode_dof(b), first + 2 * b) << b;
+  EXPECT_EQ(dofs.first_multiplier(), first + 6);
+  EXPECT_EQ(dofs.multiplier_first(0), first + 6);
+  EXPECT_EQ(dofs.body_multiplier_first(0), -1);
+  EXPECT_EQ(dofs.body_multiplier_first(1), first + 6 + 5);
+  EXPECT_EQ(dofs.body_multiplier_first(2), -1);
+  EXPECT_EQ(dofs.n_multipliers(), 6);
+  EXPECT_EQ(dofs.n_dofs(), first + 6 + 6);
+  EXPECT_TRUE(model.has_constraints());
+  // The prescribed revolute coordinate is not solved for; everything else is.
+  EXPECT_TRUE(dofs.prescribed(0));
+  EXPECT_EQ(int(dofs.solved().size()), dofs.n_dofs() - 1);
+  EXPECT_EQ(dofs.solved().front(), 1);
+  // Parents before children.
+  const std::vector<int>& order = dofs.order();
+  EXPECT_LT(std::find(order.begin(), order.end(), 1) - order.begin(), std::find(order.begin(), order.end(), 2) - order.begin());
+}
+
+TEST(System, IncrementsKeepEachSupportsMotionExact) {
+  const Superelement rod = Rod(0);
+  SystemModel model;
+  const Eigen::Vector3d axis = Eigen::Vector3d(0.36, 0.48, 0.8);
+  const Eigen::Matrix3d R0 = ExpSO3(Eigen::Vector3d(0.3, -0.2, 0.5));
+  AddNode(model, "revolute", Eigen::Vector3d::Zero(), R0);
+  AddNode(model, "prismatic", Eigen::Vector3d(kL, 0, 0), R0);
+  AddNode(model, "free", Eigen::Vector3d(2 * kL, 0, 0), R0);
+  AddRod(model, rod, 0, 1);
+  AddRod(model, rod, 1, 2);
+  RevoluteToGround(model, 0, axis);
+  PrismaticToGround(model, 1, axis);
+  const DofMap dofs(model);
+  SystemState state = InitialState(model);
+  const double phi[3] = {0.7, -1.9, 2.6};
+  double total = 0.0;
+  Eigen::Matrix3d R_free = R0;
+  Eigen::Vector3d x_free = model.node_x0[2];
+  for (const double p : phi) {
+    Eigen::VectorXd delta = Eigen::VectorXd::Zero(dofs.n_dofs());
+    delta[dofs.node_first(0)] = p;
+    delta[dofs.node_first(1)] = 0.1 * p;
+    const Eigen::Matrix<double, 6, 1> free_step = (Eigen::Matrix<double, 6, 1>() << 0.01, -0.02, 0.03, p, 0.5 * p, -p).finished();
+    delta.segment<6>(dofs.node_first(2)) = free_step;
+    ApplyIncrement(model, dofs, delta, state);
+    total += p;
+    R_free = ExpSO3(Eigen::Vector3d(free_step.tail<3>())) * R_free;  // spatial increments
+    x_free += free_step.head<3>();
+  }
+  const Eigen::Matrix3d R_expected = ExpSO3(Eigen::Vector3d(total * axis)) * R0;
+  EXPECT_LT((state.R[0] - R_expected).norm(), 1e-14);
+  EXPECT_LT(state.x[0].norm(), 1e-15);
+  EXPECT_LT((state.x[1] - (model.node_x0[1] + 0.1 * total * axis)).norm(), 1e-15);
+  EXPECT_LT((state.R[1] - R0).norm(), 1e-15);
+  EXPECT_LT((state.R[2] - R_free).norm(), 1e-14);
+  EXPECT_LT((state.x[2] - x_free).norm(), 1e-15);
+  // The node Jacobians: the revolute node's column is its axis on the rotation rows.
+  ASSERT_EQ(state.J[0].size(), 1u);
+  EXPECT_LT((state.J[0][0].second.tail<3>() - axis).norm(), 1e-15);
+  EXPECT_LT(state.J[0][0].second.head<3>().norm(), 1e-15);
+}
+
+TEST(System, StaticResidualOfAFreeBodyBalancesItsLoads) {
+  const Superelement rod = Rod(2);
+  SystemModel model;
+  AddNode(model, "a", Eigen::Vector3d::Zero());
+  AddNode(model, "b", Eigen::Vector3d(kL, 0, 0));
+  AddRod(model, rod, 0, 1);
+  NodeLoad load;
+  load.node = 1;
+  load.force = Eigen::Vector3d(3, -5, 2);
+  load.moment = Eigen::Vector3d(0.2, 0.1, -0.4);
+  model.loads.push_back(load);
+  const DofMap dofs(model);
+  SystemState state = InitialState(model);
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-1, 1);
+  Eigen::VectorXd shift(dofs.n_dofs());
+  for (int i = 0; i < shift.size(); ++i) shift[i] = 0.3 * u(rng);  // a large rotation and a deformation
+  ApplyIncrement(model, dofs, shift, state);
+  const SystemForces f = AssembleStatic(model, dofs, state, 1.0, false);
+  ASSERT_TRUE(f.ok) << f.message;
+  // residual = loads - internal forces; the internal forces of a body have no resultant and no
+  // moment about the origin (rotation rows: spatial moments about each node).
+  Eigen::Vector3d force = Eigen::Vector3d::Zero(), moment = Eigen::Vector3d::Zero();
+  for (int k = 0; k < 2; ++k) {
+    const Eigen::Matrix<double, 6, 1> r = f.residual.segment<6>(dofs.node_first(k));
+    force += r.head<3>();
+    moment += state.x[size_t(k)].cross(Eigen::Vector3d(r.head<3>())) + r.tail<3>();
+  }
+  const Eigen::Vector3d load_moment = state.x[1].cross(load.force) + load.moment;
+  const double scale = f.residual.norm();
+  std::printf("[ info ] free body, deformed and turned: resultant %.2e N off the load, moment %.2e N m off (residual "
+              "%.3g)\n",
+              (force - load.force).norm(), (moment - load_moment).norm(), scale);
+  EXPECT_GT(scale, 10 * load.force.norm());  // the deformation's internal forces are large
+  EXPECT_LT((force - load.force).norm(), 1e-9 * scale);
+  EXPECT_LT((moment - load_moment).norm(), 1e-9 * scale * kL);
+}
+
+// Also with a stiffened file, whose bodies use the exact inertia (its weight's tangent by
+// differences) and the weight's geometric stiffness.
+TEST(System, StaticTangentOnEveryKindOfSupportMatchesFiniteDifferences) {
+  for (const bool stiffened : {false, true}) {
+  const Superelement rod =
+      stiffened ? test::Reduce(test::StraightBeamYaml(kL, 6, "{shape: circle, diameter: 0.02}",
+                                                      "{E: 2.0e9, nu: 0.3, rho: 7800}", "[{name: A}, {name: B}]",
+                                                      "reduction: {internal_modes: 2, geometric_stiffening: true}\n"))
+                : Rod(2);
+  SystemModel model;
+  const Eigen::Vector3d axis = Eigen::Vector3d(0.36, 0.48, 0.8);
+  AddNode(model, "n0", Eigen::Vector3d::Zero());
+  AddNode(model, "n1", Eigen::Vector3d(kL, 0, 0));
+  AddNode(model, "n2", Eigen::Vector3d(2 * kL, 0, 0));
+  AddNode(model, "n3", Eigen::Vector3d(3 * kL, 0, 0));
+  AddRod(model, rod, 0, 1);
+  AddRod(model, rod, 1, 2);
+  AddRod(model, rod, 2, 3);
+  CylindricalToGround(model, 0, axis);
+  Pin(model, 2);
+  PrismaticToGround(model, 3, Eigen::Vector3d::UnitX());
+  NodeLoad load;
+  load.node = 1;
+  load.force = Eigen::Vector3d(10, -20, 15);
+  load.moment = Eigen::Vector3d(1, 2, -1);
+  load.follower = true;
+  model.loads.push_back(load);
+  model.gravity = Eigen::Vector3d(0, -9.81, 0);
+  model.static_gravity_end = 1.0;
+  const DofMap dofs(model);
+  SystemState state = InitialState(model);
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<double> u(-1, 1);
+  Eigen::VectorXd shift(dofs.n_dofs());
+  for (int i = 0; i < shift.size(); ++i) shift[i] = 0.05 * u(rng);
+  ApplyIncrement(model, dofs, shift, state);
+  const SystemForces f = AssembleStatic(model, dofs, state, 1.0, true);
+  ASSERT_TRUE(f.ok) << f.message;
+  const Eigen::MatrixXd K(f.tangent);
+  const Eigen::MatrixXd K_fd = test::StaticTangentByDifferences(model, dofs, state, 1.0);
+  const double error = (K - K_fd).norm() / K_fd.norm();
+  std::printf("[ info ] 3 %s rods on cylindrical, spherical and prismatic supports, follower load, gravity: %d "
+              "unknowns, tangent error %.2e\n",
+              stiffened ? "stiffened" : "linear", dofs.n_dofs(), error);
+  EXPECT_LT(error, 1e-6);
+  }
+}
+
+}  // namespace
+}  // namespace femb
