@@ -133,8 +133,8 @@ SystemForces AssembleStatic(const SystemModel& model, const DofMap& dofs, System
     out.roundoff += body.RoundOffForce(c);
     const double ramp = gravity_on ? std::min(lambda / model.static_gravity_end, 1.0) : 0.0;
     // Gravity in a static analysis, ramped to full at pseudo-time static_gravity_end; its
-    // configuration derivative in the tangent (S = -dr/dq: minus GravityTangent). The dynamic
-    // iteration matrix leaves it out (the mass term dominates it at small steps).
+    // configuration derivative in the tangent (S = -dr/dq: minus GravityTangent; the dynamic
+    // iteration matrix takes it with the inertia's, generalized_alpha.cpp).
     if (with_tangent && gravity_on && ramp > 0) K -= body.GravityTangent(data, ramp * model.gravity);
     const Eigen::VectorXd minus_f = -f;
     ScatterBody(BodyMap(model, dofs, state, int(b)), &minus_f, with_tangent ? &K : nullptr, &out.residual,

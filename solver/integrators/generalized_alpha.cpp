@@ -80,9 +80,18 @@ void AddDynamicMatrices(const SystemModel& model, const DofMap& dofs, const Dyna
       r.M.noalias() += d_load * pass.load.d_wdot;
       r.C.noalias() += d_load * pass.load.d_w;
     }
-    // Configuration derivative of the inertia force: d(M_g wdot)/dq exactly; that of the
-    // quadratic velocity terms by central differences with options.full_inertia_tangent.
-    r.K += body.InertiaConfigurationTangent(pass.data, pass.w, pass.wdot, full_inertia_tangent);
+    // Configuration derivative of the inertia force less the weight: d(M_g wdot)/dq exactly; that
+    // of the quadratic velocity terms by central differences with options.full_inertia_tangent.
+    // The weight is the inertia force's acceleration part at the uniform field g (GravityForce =
+    // f_acc(wdot_g), wdot_g = g on the node translations, for the corotational and the exact
+    // inertia alike), so f_in - f_grav = f_in(w, wdot - wdot_g) and one call takes both.
+    if (model.gravity.squaredNorm() > 0) {
+      BodyVelocity wdot = pass.wdot;
+      for (int a = 0; a < body.n_nodes(); ++a) wdot.segment<3>(6 * a) -= model.gravity;
+      r.K += body.InertiaConfigurationTangent(pass.data, pass.w, wdot, full_inertia_tangent);
+    } else {
+      r.K += body.InertiaConfigurationTangent(pass.data, pass.w, pass.wdot, full_inertia_tangent);
+    }
     Eigen::VectorXd unused = Eigen::VectorXd::Zero(body.n_coordinates());
     body.AddModalDamping(pass.w, unused, &r.C);
     if (combine) r.K += combine->c_C * r.C + combine->c_M * r.M;
