@@ -6,6 +6,8 @@
 // no moment: the floating frame's rigid-body invariance), and the static tangent of a chain on
 // cylindrical, spherical and prismatic supports under a follower load and gravity (the weight's
 // configuration derivative included) against central differences.
+#include "solver/assembly/system.h"
+
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
@@ -14,7 +16,6 @@
 
 #include "solver/analysis/dynamic_analysis.h"
 #include "solver/analysis/dynamic_step.h"
-#include "solver/assembly/system.h"
 #include "solver/rotation.h"
 #include "test_util.h"
 
@@ -23,14 +24,18 @@ namespace {
 
 constexpr double kL = 0.4;
 
-Superelement Rod(int modes) {
-  return test::Reduce(test::StraightBeamYaml(kL, 6, "{shape: circle, diameter: 0.02}", "{E: 2.0e9, nu: 0.3, rho: 7800}",
-                                             "[{name: A}, {name: B}]",
-                                             "reduction: {internal_modes: " + std::to_string(modes) + "}\n"));
+// A rod along x; `stiffened`: with geometric stiffening and the exact inertia.
+Superelement Rod(int modes, bool stiffened = false) {
+  return test::Reduce(
+      test::StraightBeamYaml(kL, 6, "{shape: circle, diameter: 0.02}",
+                             "{E: 2.0e9, nu: 0.3, rho: 7800}", "[{name: A}, {name: B}]",
+                             "reduction: {internal_modes: " + std::to_string(modes) +
+                                 (stiffened ? ", geometric_stiffening: true" : "") + "}\n"));
 }
 
 void AddRod(SystemModel& model, const Superelement& se, int a, int b) {
-  model.bodies.emplace_back(se, SuperelementOptions{}, Eigen::Matrix3d::Identity(), model.node_x0[size_t(a)]);
+  model.bodies.emplace_back(se, SuperelementOptions{}, Eigen::Matrix3d::Identity(),
+                            model.node_x0[size_t(a)]);
   model.body_nodes.push_back({a, b});
 }
 
@@ -41,24 +46,27 @@ TEST(System, DofMapNumbersNodesModesAndMultipliers) {
   held.interface_constraint(0, 0) = M_SQRT1_2;
   held.interface_constraint(0, 6) = -M_SQRT1_2;
   SystemModel model;
-  for (int k = 0; k < 6; ++k) AddNode(model, "n" + std::to_string(k), Eigen::Vector3d(kL * (k / 2 + k % 2), 0, 0));
+  for (int k = 0; k < 6; ++k)
+    AddNode(model, "n" + std::to_string(k), Eigen::Vector3d(kL * (k / 2 + k % 2), 0, 0));
   // n0 (0) - n1 (L): rod 0; n2 (L) - n3 (2L): rod 1, held; n4 (2L) - n5 (3L): rod 2.
   AddRod(model, rod, 0, 1);
   AddRod(model, held, 2, 3);
   AddRod(model, rod, 4, 5);
   RevoluteToGround(model, 0, Eigen::Vector3d::UnitZ());  // 1 coordinate
-  model.joints.push_back(MakeNodeJoint(JointType::kSpherical, 2, 1, Eigen::Vector3d::UnitZ(), model.node_x0[1],
-                                       model.node_R0[1], model.node_x0[2], model.node_R0[2]));  // 3
-  Pin(model, 3);                                                                              // 3
-  Clamp(model, 4);                                                                            // 0
+  model.joints.push_back(MakeNodeJoint(JointType::kSpherical, 2, 1, Eigen::Vector3d::UnitZ(),
+                                       model.node_x0[1], model.node_R0[1], model.node_x0[2],
+                                       model.node_R0[2]));  // 3
+  Pin(model, 3);                                            // 3
+  Clamp(model, 4);                                          // 0
   // n5 free (6), closing a loop to n3 through a cut revolute joint (5 equations).
   CutJoint cut;
-  cut.joint = MakeNodeJoint(JointType::kRevolute, 5, 3, Eigen::Vector3d::UnitZ(), model.node_x0[3], model.node_R0[3],
-                            model.node_x0[5], model.node_R0[5]);
+  cut.joint = MakeNodeJoint(JointType::kRevolute, 5, 3, Eigen::Vector3d::UnitZ(), model.node_x0[3],
+                            model.node_R0[3], model.node_x0[5], model.node_R0[5]);
   cut.name = "cut";
   for (int i = 0; i < 5; ++i) cut.equations.push_back(i);
   model.cut_joints.push_back(cut);
-  model.prescribed.push_back({0, 0, [](double t) { return t; }, [](double) { return 1.0; }, [](double) { return 0.0; }});
+  model.prescribed.push_back(
+      {0, 0, [](double t) { return t; }, [](double) { return 1.0; }, [](double) { return 0.0; }});
   const DofMap dofs(model);
   const int counts[6] = {1, 6, 3, 3, 0, 6};
   int first = 0;
@@ -84,7 +92,8 @@ TEST(System, DofMapNumbersNodesModesAndMultipliers) {
   EXPECT_EQ(dofs.solved().front(), 1);
   // Parents before children.
   const std::vector<int>& order = dofs.order();
-  EXPECT_LT(std::find(order.begin(), order.end(), 1) - order.begin(), std::find(order.begin(), order.end(), 2) - order.begin());
+  EXPECT_LT(std::find(order.begin(), order.end(), 1) - order.begin(),
+            std::find(order.begin(), order.end(), 2) - order.begin());
 }
 
 TEST(System, IncrementsKeepEachSupportsMotionExact) {
@@ -109,7 +118,8 @@ TEST(System, IncrementsKeepEachSupportsMotionExact) {
     Eigen::VectorXd delta = Eigen::VectorXd::Zero(dofs.n_dofs());
     delta[dofs.node_first(0)] = p;
     delta[dofs.node_first(1)] = 0.1 * p;
-    const Eigen::Matrix<double, 6, 1> free_step = (Eigen::Matrix<double, 6, 1>() << 0.01, -0.02, 0.03, p, 0.5 * p, -p).finished();
+    const Eigen::Matrix<double, 6, 1> free_step =
+        (Eigen::Matrix<double, 6, 1>() << 0.01, -0.02, 0.03, p, 0.5 * p, -p).finished();
     delta.segment<6>(dofs.node_first(2)) = free_step;
     ApplyIncrement(model, dofs, delta, state);
     total += p;
@@ -145,7 +155,8 @@ TEST(System, StaticResidualOfAFreeBodyBalancesItsLoads) {
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> u(-1, 1);
   Eigen::VectorXd shift(dofs.n_dofs());
-  for (int i = 0; i < shift.size(); ++i) shift[i] = 0.3 * u(rng);  // a large rotation and a deformation
+  for (int i = 0; i < shift.size(); ++i)
+    shift[i] = 0.3 * u(rng);  // a large rotation and a deformation
   ApplyIncrement(model, dofs, shift, state);
   const SystemForces f = AssembleStatic(model, dofs, state, 1.0, false);
   ASSERT_TRUE(f.ok) << f.message;
@@ -159,9 +170,11 @@ TEST(System, StaticResidualOfAFreeBodyBalancesItsLoads) {
   }
   const Eigen::Vector3d load_moment = state.x[1].cross(load.force) + load.moment;
   const double scale = f.residual.norm();
-  std::printf("[ info ] free body, deformed and turned: resultant %.2e N off the load, moment %.2e N m off (residual "
-              "%.3g)\n",
-              (force - load.force).norm(), (moment - load_moment).norm(), scale);
+  std::printf(
+      "[ info ] free body, deformed and turned: resultant %.2e N off the load, moment %.2e N m off "
+      "(residual "
+      "%.3g)\n",
+      (force - load.force).norm(), (moment - load_moment).norm(), scale);
   EXPECT_GT(scale, 10 * load.force.norm());  // the deformation's internal forces are large
   EXPECT_LT((force - load.force).norm(), 1e-9 * scale);
   EXPECT_LT((moment - load_moment).norm(), 1e-9 * scale * kL);
@@ -171,50 +184,47 @@ TEST(System, StaticResidualOfAFreeBodyBalancesItsLoads) {
 // differences) and the weight's geometric stiffness.
 TEST(System, StaticTangentOnEveryKindOfSupportMatchesFiniteDifferences) {
   for (const bool stiffened : {false, true}) {
-  const Superelement rod =
-      stiffened ? test::Reduce(test::StraightBeamYaml(kL, 6, "{shape: circle, diameter: 0.02}",
-                                                      "{E: 2.0e9, nu: 0.3, rho: 7800}", "[{name: A}, {name: B}]",
-                                                      "reduction: {internal_modes: 2, geometric_stiffening: true}\n"))
-                : Rod(2);
-  SystemModel model;
-  const Eigen::Vector3d axis = Eigen::Vector3d(0.36, 0.48, 0.8);
-  AddNode(model, "n0", Eigen::Vector3d::Zero());
-  AddNode(model, "n1", Eigen::Vector3d(kL, 0, 0));
-  AddNode(model, "n2", Eigen::Vector3d(2 * kL, 0, 0));
-  AddNode(model, "n3", Eigen::Vector3d(3 * kL, 0, 0));
-  AddRod(model, rod, 0, 1);
-  AddRod(model, rod, 1, 2);
-  AddRod(model, rod, 2, 3);
-  CylindricalToGround(model, 0, axis);
-  Pin(model, 2);
-  PrismaticToGround(model, 3, Eigen::Vector3d::UnitX());
-  NodeLoad load;
-  load.node = 1;
-  load.force = Eigen::Vector3d(10, -20, 15);
-  load.moment = Eigen::Vector3d(1, 2, -1);
-  load.follower = true;
-  model.loads.push_back(load);
-  model.gravity = Eigen::Vector3d(0, -9.81, 0);
-  model.static_gravity_end = 1.0;
-  const DofMap dofs(model);
-  SystemState state = InitialState(model);
-  std::mt19937 rng(17);
-  std::uniform_real_distribution<double> u(-1, 1);
-  Eigen::VectorXd shift(dofs.n_dofs());
-  for (int i = 0; i < shift.size(); ++i) shift[i] = 0.05 * u(rng);
-  ApplyIncrement(model, dofs, shift, state);
-  const SystemForces f = AssembleStatic(model, dofs, state, 1.0, true);
-  ASSERT_TRUE(f.ok) << f.message;
-  const Eigen::MatrixXd K(f.tangent);
-  const Eigen::MatrixXd K_fd = test::StaticTangentByDifferences(model, dofs, state, 1.0);
-  const double error = (K - K_fd).norm() / K_fd.norm();
-  std::printf("[ info ] 3 %s rods on cylindrical, spherical and prismatic supports, follower load, gravity: %d "
-              "unknowns, tangent error %.2e\n",
-              stiffened ? "stiffened" : "linear", dofs.n_dofs(), error);
-  EXPECT_LT(error, 1e-6);
+    const Superelement rod = Rod(2, stiffened);
+    SystemModel model;
+    const Eigen::Vector3d axis = Eigen::Vector3d(0.36, 0.48, 0.8);
+    AddNode(model, "n0", Eigen::Vector3d::Zero());
+    AddNode(model, "n1", Eigen::Vector3d(kL, 0, 0));
+    AddNode(model, "n2", Eigen::Vector3d(2 * kL, 0, 0));
+    AddNode(model, "n3", Eigen::Vector3d(3 * kL, 0, 0));
+    AddRod(model, rod, 0, 1);
+    AddRod(model, rod, 1, 2);
+    AddRod(model, rod, 2, 3);
+    CylindricalToGround(model, 0, axis);
+    Pin(model, 2);
+    PrismaticToGround(model, 3, Eigen::Vector3d::UnitX());
+    NodeLoad load;
+    load.node = 1;
+    load.force = Eigen::Vector3d(10, -20, 15);
+    load.moment = Eigen::Vector3d(1, 2, -1);
+    load.follower = true;
+    model.loads.push_back(load);
+    model.gravity = Eigen::Vector3d(0, -9.81, 0);
+    model.static_gravity_end = 1.0;
+    const DofMap dofs(model);
+    SystemState state = InitialState(model);
+    std::mt19937 rng(17);
+    std::uniform_real_distribution<double> u(-1, 1);
+    Eigen::VectorXd shift(dofs.n_dofs());
+    for (int i = 0; i < shift.size(); ++i) shift[i] = 0.05 * u(rng);
+    ApplyIncrement(model, dofs, shift, state);
+    const SystemForces f = AssembleStatic(model, dofs, state, 1.0, true);
+    ASSERT_TRUE(f.ok) << f.message;
+    const Eigen::MatrixXd K(f.tangent);
+    const Eigen::MatrixXd K_fd = test::StaticTangentByDifferences(model, dofs, state, 1.0);
+    const double error = (K - K_fd).norm() / K_fd.norm();
+    std::printf(
+        "[ info ] 3 %s rods on cylindrical, spherical and prismatic supports, follower load, "
+        "gravity: %d "
+        "unknowns, tangent error %.2e\n",
+        stiffened ? "stiffened" : "linear", dofs.n_dofs(), error);
+    EXPECT_LT(error, 1e-6);
   }
 }
-
 
 // The dynamic iteration matrix's K = -dr/dq of a flexible chain under gravity, at rest (no
 // velocity terms) in a displaced configuration with accelerations, against central differences
@@ -223,11 +233,7 @@ TEST(System, StaticTangentOnEveryKindOfSupportMatchesFiniteDifferences) {
 // the uniform field g, so one derivative takes both).
 TEST(System, DynamicIterationMatrixUnderGravityMatchesFiniteDifferences) {
   for (const bool stiffened : {false, true}) {
-    const Superelement rod =
-        stiffened ? test::Reduce(test::StraightBeamYaml(kL, 6, "{shape: circle, diameter: 0.02}",
-                                                        "{E: 2.0e9, nu: 0.3, rho: 7800}", "[{name: A}, {name: B}]",
-                                                        "reduction: {internal_modes: 2, geometric_stiffening: true}\n"))
-                  : Rod(2);
+    const Superelement rod = Rod(2, stiffened);
     SystemModel model;
     AddNode(model, "n0", Eigen::Vector3d::Zero());
     AddNode(model, "n1", Eigen::Vector3d(kL, 0, 0));
@@ -236,7 +242,8 @@ TEST(System, DynamicIterationMatrixUnderGravityMatchesFiniteDifferences) {
     AddRod(model, rod, 0, 1);
     AddRod(model, rod, 2, 3);
     RevoluteToGround(model, 0, Eigen::Vector3d::UnitZ());
-    model.joints.push_back(MakeNodeJoint(JointType::kRevolute, 2, 1, Eigen::Vector3d(0.36, 0.48, 0.8), model.node_x0[1],
+    model.joints.push_back(MakeNodeJoint(JointType::kRevolute, 2, 1,
+                                         Eigen::Vector3d(0.36, 0.48, 0.8), model.node_x0[1],
                                          model.node_R0[1], model.node_x0[2], model.node_R0[2]));
     model.gravity = Eigen::Vector3d(0, -9.81, 0);
     const DofMap dofs(model);
@@ -268,12 +275,15 @@ TEST(System, DynamicIterationMatrixUnderGravityMatchesFiniteDifferences) {
       K_fd.col(j) = -(residual(plus) - residual(minus)) / (2 * h);
     }
     const double error = (K - K_fd).norm() / K_fd.norm();
-    std::printf("[ info ] %s flexible double pendulum at rest under gravity, accelerating: K against differences "
-                "%.2e\n",
-                stiffened ? "stiffened" : "linear", error);
+    std::printf(
+        "[ info ] %s flexible double pendulum at rest under gravity, accelerating: K against "
+        "differences "
+        "%.2e\n",
+        stiffened ? "stiffened" : "linear", error);
     // The exact inertia's configuration derivative is the corotational one's without
     // full_inertia_tangent (superelement_body.h): exact only for the corotational inertia.
-    EXPECT_LT(error, stiffened ? 1e-5 : 1e-6);  // measured 2.1e-6 and 1.3e-10 (3.5e-6 without the weight)
+    EXPECT_LT(error,
+              stiffened ? 1e-5 : 1e-6);  // measured 2.1e-6 and 1.3e-10 (3.5e-6 without the weight)
   }
 }
 
