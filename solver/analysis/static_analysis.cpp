@@ -22,6 +22,39 @@ int NegativeEigenvalues(const DofMap& dofs, const SystemMatrix& S) {
   return negative;
 }
 
+// The minimum-norm Newton step of a singular tangent whose free motions the residual does not
+// drive: S scaled to unit diagonal (D S D, as DescribeSingular), its SVD, rank at 1e-13 of the
+// largest singular value; when the residual's part along the left null vectors is within 1e-8 of
+// its size, the truncated pseudo-inverse's step. A pendulum hanging from its pin, started
+// unstretched, has no stiffness against swinging until its weight has stretched it (the tension's
+// geometric stiffness): its first step is this one, along the rod, and the next tangent is
+// regular. False above the dense limit or when the residual drives a free motion (a missing
+// support: the caller names it).
+bool MinimumNormStep(const DofMap& dofs, const SystemMatrix& S, const Eigen::VectorXd& residual, Eigen::VectorXd* delta) {
+  const std::vector<int>& free = dofs.solved();
+  const int n = int(free.size());
+  if (n == 0 || n > kDenseLimit) return false;
+  const Eigen::MatrixXd A = DenseFreeMatrix(dofs, S);
+  Eigen::VectorXd d(n), r(n);
+  for (int i = 0; i < n; ++i) {
+    const double a = std::abs(A(i, i));
+    d[i] = a > 0 ? 1.0 / std::sqrt(a) : 1.0;
+    r[i] = d[i] * residual[free[size_t(i)]];
+  }
+  const Eigen::BDCSVD<Eigen::MatrixXd> svd(d.asDiagonal() * A * d.asDiagonal(), Eigen::ComputeFullU | Eigen::ComputeFullV);
+  const Eigen::VectorXd& sv = svd.singularValues();
+  int rank = 0;
+  while (rank < n && sv[rank] > 1e-13 * sv[0]) ++rank;
+  if (rank == n || rank == 0) return false;
+  const Eigen::VectorXd driven = svd.matrixU().rightCols(n - rank).transpose() * r;
+  if (driven.norm() > 1e-8 * r.norm()) return false;
+  const Eigen::VectorXd step = d.asDiagonal() * (svd.matrixV().leftCols(rank) *
+                                                 (svd.matrixU().leftCols(rank).transpose() * r).cwiseQuotient(sv.head(rank)));
+  *delta = Eigen::VectorXd::Zero(dofs.n_dofs());
+  for (int i = 0; i < n; ++i) (*delta)[free[size_t(i)]] = step[i];
+  return delta->allFinite();
+}
+
 }  // namespace
 
 StaticResult SolveStatic(const SystemModel& model, SystemState& state, const StaticOptions& options,
@@ -51,6 +84,7 @@ StaticResult SolveStatic(const SystemModel& model, SystemState& state, const Sta
     int it = 0;
     double r_norm = 0.0, energy = 0.0, last_step = 1e300;
     Eigen::VectorXd travelled = Eigen::VectorXd::Zero(dofs.n_dofs()), loads_after;
+    bool minimum_norm = false;  // the first step of the run was MinimumNormStep's
     for (; it < options.max_iterations; ++it) {
       const SystemForces f = AssembleStatic(model, dofs, trial, target, true);
       if (!f.ok) break;
@@ -85,13 +119,21 @@ StaticResult SolveStatic(const SystemModel& model, SystemState& state, const Sta
         last_negative = negative;
         last_sign_lambda = target;
       }
-      const Eigen::VectorXd delta = regular ? solver.Solve(f.residual) : Eigen::VectorXd();
+      Eigen::VectorXd delta = regular ? solver.Solve(f.residual) : Eigen::VectorXd();
       if (!regular || !delta.allFinite()) {
         // At the start, a singular tangent is the model's, not the step's: name the free motion
-        // instead of cutting steps.
-        if (result.steps.empty() && it == 0) {
+        // instead of cutting steps -- unless the loads do not drive it and one minimum-norm step
+        // makes the tangent regular (MinimumNormStep).
+        if (result.steps.empty() && (it == 0 || (it == 1 && minimum_norm))) {
           const std::string why = DescribeSingular(model, dofs, trial, f.tangent);
           if (!why.empty()) {
+            if (it == 0 && MinimumNormStep(dofs, f.tangent, f.residual, &delta)) {
+              minimum_norm = true;
+              last_step = delta.head(dofs.first_multiplier()).norm();
+              travelled += delta;
+              ApplyIncrement(model, dofs, delta, trial);
+              continue;
+            }
             result.message = "static tangent at the start: " + why;
             return result;
           }

@@ -16,6 +16,8 @@
 
 #include "solver/analysis/dynamic_analysis.h"
 #include "solver/analysis/dynamic_step.h"
+#include "solver/analysis/modal_analysis.h"
+#include "solver/analysis/static_analysis.h"
 #include "solver/rotation.h"
 #include "test_util.h"
 
@@ -285,6 +287,47 @@ TEST(System, DynamicIterationMatrixUnderGravityMatchesFiniteDifferences) {
     EXPECT_LT(error,
               stiffened ? 1e-5 : 1e-6);  // measured 2.1e-6 and 1.3e-10 (3.5e-6 without the weight)
   }
+}
+
+// A steel rod hanging from a revolute joint to ground, solved statically from its unstretched
+// placement: the first tangent is singular (no tension yet, so nothing resists a swing), the
+// weight does not drive the swing, and one minimum-norm step along the rod makes it regular.
+// References: the stretch under its own weight, rho g L^2 / (2 E) (closed form), and the swing
+// frequency about that state, the compound pendulum's sqrt(3 g / 2 L) / 2 pi (the rod is stiff:
+// its bending frequencies are 100x higher); the swing's stiffness is the weight's tangent and
+// the tension's geometric stiffness together.
+TEST(System, HangingRodSolvesStaticallyAndSwingsAtThePendulumFrequency) {
+  const double E = 2.0e11, rho = 7800, g = 9.81;
+  const Superelement rod = test::Reduce(test::StraightBeamYaml(
+      kL, 6, "{shape: circle, diameter: 0.02}", "{E: 2.0e11, nu: 0.3, rho: 7800}",
+      "[{name: A}, {name: B}]", "reduction: {internal_modes: 2}\n"));
+  SystemModel model;
+  const Eigen::Matrix3d down = ExpSO3(Eigen::Vector3d(0, 0, -M_PI / 2));
+  AddNode(model, "a", Eigen::Vector3d::Zero(), down);
+  AddNode(model, "b", Eigen::Vector3d(0, -kL, 0), down);
+  model.bodies.emplace_back(rod, SuperelementOptions{}, down, Eigen::Vector3d::Zero());
+  model.body_nodes.push_back({0, 1});
+  RevoluteToGround(model, 0, Eigen::Vector3d::UnitZ());
+  model.gravity = Eigen::Vector3d(0, -g, 0);
+  model.static_gravity_end = 1.0;
+  SystemState state = InitialState(model);
+  StaticOptions options;
+  options.steps = 2;
+  const StaticResult r = SolveStatic(model, state, options);
+  ASSERT_TRUE(r.ok) << r.message;
+  const double stretch = -state.x[1].y() - kL, closed = rho * g * kL * kL / (2 * E);
+  const ModalResult modes = LinearizedModes(model, state, 1.0, 3);
+  ASSERT_TRUE(modes.ok) << modes.message;
+  const double pendulum = std::sqrt(3 * g / (2 * kL)) / (2 * M_PI);
+  std::printf(
+      "[ info ] hanging rod: stretch %.6e m (rho g L^2 / 2E %.6e m); swing %.5f Hz (compound "
+      "pendulum %.5f "
+      "Hz, %+.3f%%), next mode %.1f Hz\n",
+      stretch, closed, modes.frequencies_hz[0], pendulum,
+      100 * (modes.frequencies_hz[0] / pendulum - 1), modes.frequencies_hz[1]);
+  EXPECT_NEAR(stretch, closed, 1e-3 * closed);
+  EXPECT_NEAR(modes.frequencies_hz[0], pendulum, 1e-3 * pendulum);
+  EXPECT_GT(modes.frequencies_hz[1], 50 * pendulum);
 }
 
 }  // namespace
