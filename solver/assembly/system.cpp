@@ -118,10 +118,11 @@ SystemForces AssembleStatic(const SystemModel& model, const DofMap& dofs, System
     const SuperelementBody::Data data = body.Evaluate(c, frame);
     Eigen::VectorXd f;
     Eigen::MatrixXd K;
+    // Gravity in a static analysis, ramped to full at pseudo-time static_gravity_end.
     const bool gravity_on = model.static_gravity_end > 0 && model.gravity.squaredNorm() > 0;
+    const double ramp = gravity_on ? std::min(lambda / model.static_gravity_end, 1.0) : 0.0;
     if (gravity_on && body.has_inertia_stiffening()) {
       // The stress of the body's own weight stiffens it (issue 13: load factors -R_j^T g at rest).
-      const double ramp = std::min(lambda / model.static_gravity_end, 1.0);
       const Eigen::VectorXd zero = Eigen::VectorXd::Zero(body.n_coordinates());
       const InertiaLoadFactors load = body.InertiaLoads(data, zero, zero, ramp * model.gravity);
       body.ElasticForce(data, &f, with_tangent ? &K : nullptr, &load);
@@ -131,18 +132,16 @@ SystemForces AssembleStatic(const SystemModel& model, const DofMap& dofs, System
     out.elastic_energy += body.ElasticEnergy(data);
     out.force_scale = std::max({out.force_scale, body.ForceNorm(f), body.force_floor()});
     out.roundoff += body.RoundOffForce(c);
-    const double ramp = gravity_on ? std::min(lambda / model.static_gravity_end, 1.0) : 0.0;
-    // Gravity in a static analysis, ramped to full at pseudo-time static_gravity_end; its
-    // configuration derivative in the tangent (S = -dr/dq: minus GravityTangent; the dynamic
-    // iteration matrix takes it with the inertia's, generalized_alpha.cpp).
+    // The weight's configuration derivative in the tangent (S = -dr/dq: minus GravityTangent; the
+    // dynamic iteration matrix takes it with the inertia's, generalized_alpha.cpp).
     if (with_tangent && gravity_on && ramp > 0) K -= body.GravityTangent(data, ramp * model.gravity);
+    const std::vector<MapEntry> map = BodyMap(model, dofs, state, int(b));
     const Eigen::VectorXd minus_f = -f;
-    ScatterBody(BodyMap(model, dofs, state, int(b)), &minus_f, with_tangent ? &K : nullptr, &out.residual,
-                with_tangent ? &tangent : nullptr);
+    ScatterBody(map, &minus_f, with_tangent ? &K : nullptr, &out.residual, with_tangent ? &tangent : nullptr);
     AddBodyNodeForces(model, int(b), minus_f, node_forces);
     if (gravity_on) {
       const Eigen::VectorXd f_grav = body.GravityForce(data, ramp * model.gravity);
-      ScatterBody(BodyMap(model, dofs, state, int(b)), &f_grav, nullptr, &gravity, nullptr);
+      ScatterBody(map, &f_grav, nullptr, &gravity, nullptr);
       AddBodyNodeForces(model, int(b), f_grav, node_forces);
     }
   }

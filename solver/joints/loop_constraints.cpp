@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <optional>
 
 #include "solver/assembly/system.h"
 
@@ -16,6 +17,16 @@
 namespace femb {
 
 namespace {
+
+// Body b's data at `state`, its floating frame solved from the last one; none when the frame
+// does not converge (the body's own assembly reports that).
+std::optional<SuperelementBody::Data> BodyDataAt(const SystemModel& model, const SystemState& state, int b) {
+  const SuperelementBody& body = model.bodies[size_t(b)];
+  const BodyConfiguration c = BodyConfigurationOf(model, state, b);
+  const FrameSolution frame = body.SolveFrameFrom(c, state.frames[size_t(b)]);
+  if (!frame.ok) return std::nullopt;
+  return body.Evaluate(c, frame);
+}
 
 // The bodies' interface constraints (thesis 8.2 case 4): g = C q_int of each constrained body,
 // its Jacobian G through the body's map (BodyMap: node Jacobians, modal coordinates) and
@@ -26,15 +37,14 @@ void AddBodyConstraints(const SystemModel& model, const DofMap& dofs, const Syst
     const SuperelementBody& body = model.bodies[b];
     const int r = body.n_constraints();
     if (r == 0) continue;
-    const FrameSolution frame = body.SolveFrameFrom(BodyConfigurationOf(model, state, int(b)), state.frames[b]);
-    if (!frame.ok) continue;  // the body's own assembly reports it
-    const SuperelementBody::Data d = body.Evaluate(BodyConfigurationOf(model, state, int(b)), frame);
+    const std::optional<SuperelementBody::Data> d = BodyDataAt(model, state, int(b));
+    if (!d) continue;
     const int first = dofs.body_multiplier_first(int(b));
     const Eigen::VectorXd lambda = state.lambda.segment(first - dofs.first_multiplier(), r);
     const bool hessian = tangent && (blocks & kLoopHessian) && !lambda.isZero(0.0);
     Eigen::VectorXd g;
     Eigen::MatrixXd G, H;
-    body.InterfaceConstraint(d, &g, &G, hessian ? &lambda : nullptr, hessian ? &H : nullptr);
+    body.InterfaceConstraint(*d, &g, &G, hessian ? &lambda : nullptr, hessian ? &H : nullptr);
     const Eigen::VectorXd f = G.transpose() * lambda;  // on the body's coordinates
     if (node_forces) AddBodyNodeForces(model, int(b), -f, *node_forces);
     const std::vector<MapEntry> map = BodyMap(model, dofs, state, int(b));
@@ -216,11 +226,10 @@ double LoopViolation(const SystemModel& model, const SystemState& state, int* wo
   for (size_t b = 0; b < model.bodies.size(); ++b) {
     const SuperelementBody& body = model.bodies[b];
     if (body.n_constraints() == 0) continue;
-    const BodyConfiguration c = BodyConfigurationOf(model, state, int(b));
-    const FrameSolution frame = body.SolveFrameFrom(c, state.frames[b]);
+    const std::optional<SuperelementBody::Data> d = BodyDataAt(model, state, int(b));
     Eigen::VectorXd g;
-    body.InterfaceConstraint(body.Evaluate(c, frame), &g, nullptr, nullptr, nullptr);  // lengths
-    const double v = frame.ok ? g.lpNorm<Eigen::Infinity>() : std::numeric_limits<double>::infinity();
+    if (d) body.InterfaceConstraint(*d, &g, nullptr, nullptr, nullptr);  // lengths
+    const double v = d ? g.lpNorm<Eigen::Infinity>() : std::numeric_limits<double>::infinity();
     if (v > largest) {
       largest = v;
       if (worst) *worst = int(model.cut_joints.size() + b);
