@@ -25,3 +25,7 @@ echo
 # Fixed vs error-controlled steps (step: auto) on every dynamic seed case (about 10 minutes once
 # the examples' references exist in build/example_out, e.g. after ctest; else they are run first).
 /usr/bin/python3 benchmarks/step_control.py build/bin
+echo
+# Why the geometric stiffening is opt-in (issue 13): the four-bar coupler's energy with and without
+# it (about 30 s).
+/usr/bin/python3 benchmarks/stiffening_energy.py build/bin out/stiffening_energy

@@ -108,8 +108,9 @@ struct ReductionSpec {
   ModalDerivativeSpec modal_derivatives;
   std::string floating_frame = "center_of_mass";
   /// Geometric stiffening (issue 13): the geometric stiffness of the basis vectors' stresses and
-  /// of the 12 unit inertia load cases, stored for femb-solve. Opt-in for now: see
-  /// PART_FORMAT.md for what it reaches (the issue's 1-body accuracy targets are not met yet).
+  /// of the 12 unit inertia load cases, stored for femb-solve. Opt-in: switched on everywhere, the
+  /// basis-stress force (the geometric stiffness form, not a gradient) pumps energy into the
+  /// flexible four-bar coupler (README, issue 13), which linear bodies do not.
   bool geometric_stiffening = false;
   /// Store the mesh and mode shapes (visualization group); unset: only for models up to
   /// kKeepMeshMaxDofs DOFs (the shapes take n_dofs x n_reduced doubles).

@@ -164,7 +164,12 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
     };
   }
   // Geometric stiffening (issue 13): the unit inertia load cases are solved on the same factor.
-  const bool stiffening = part.reduction.geometric_stiffening;
+  // A basis without deformation (one interface node, no internal modes: the six rigid motions)
+  // has nothing to stiffen, and its exact and corotational kinetic energies are the same.
+  const bool stiffening = part.reduction.geometric_stiffening && n_b + m > 6;
+  if (part.reduction.geometric_stiffening && !stiffening) {
+    if (progress) progress("stiffening", 0.0, "none stored: the basis is the six rigid motions (one interface node, no internal modes)");
+  }
   const Eigen::MatrixXd inertia_fields = stiffening ? InertiaFields(model) : Eigen::MatrixXd();
   const bool free_interface = part.reduction.method == "free_interface";
   const bool general = part.reduction.method == "general";

@@ -167,14 +167,18 @@ Scene BuildScene(const SceneSpec& spec) {
     options.polynomial_force = b.polynomial_force;
     options.modal_damping = b.modal_damping;
     // Geometric stiffening (issue 13): what the file has, unless switched off; asked for
-    // explicitly from a file without it is an error, otherwise a note.
-    options.geometric_stiffening = b.geometric_stiffening.value_or(true);
+    // explicitly from a file without it is an error, otherwise a note. The midpoint integrator
+    // conserves the energy of linear bodies with the corotational inertia (thesis 3.22) exactly;
+    // the stiffening's basis-stress force is not a gradient and the corotational inertia gives
+    // wrong Southwell slopes with it (README), so there it is used only when asked for.
+    const bool midpoint = spec.analysis.integrator == IntegratorType::kMidpoint;
+    options.geometric_stiffening = b.geometric_stiffening.value_or(!midpoint);
     const bool file_has_stiffening = !se.inertia_stiffness.empty();
     if (b.geometric_stiffening.value_or(false) && !file_has_stiffening) {
       throw InputError(b.where + ": body '" + b.name + "': options.geometric_stiffening is true but " + file.string() +
                        " has no geometric stiffening (reduce it with reduction.geometric_stiffening: true)");
     }
-    if (!b.geometric_stiffening.has_value() && !file_has_stiffening) {
+    if (!b.geometric_stiffening.has_value() && !file_has_stiffening && se.n_reduced_dofs() > 6) {
       scene.notes.push_back("body '" + b.name + "': " + file.string() +
                             " has no geometric stiffening; the body is linear inside (re-reduce it to add it)");
     }
@@ -184,7 +188,11 @@ Scene BuildScene(const SceneSpec& spec) {
       throw InputError(b.where + ": body '" + b.name + "': options.inertia is exact but " + file.string() +
                        " has no inertia invariants (reduce it with reduction.geometric_stiffening: true)");
     }
-    if (spec.analysis.integrator == IntegratorType::kMidpoint && options.exact_inertia && !se.inertia_gamma.empty()) {
+    if (midpoint && file_has_stiffening && !b.geometric_stiffening.has_value()) {
+      scene.notes.push_back("body '" + b.name + "': the midpoint integrator keeps the body linear inside, with the "
+                            "corotational inertia (thesis 3.22) whose energy it conserves exactly: the file's geometric "
+                            "stiffening is not used (generalized_alpha uses it; options.geometric_stiffening: true forces it)");
+    } else if (midpoint && options.exact_inertia && !se.inertia_gamma.empty()) {
       scene.notes.push_back("body '" + b.name + "': the midpoint integrator uses the corotational inertia (thesis "
                             "3.22), not the file's exact one (generalized_alpha does)");
     }

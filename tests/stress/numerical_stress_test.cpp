@@ -248,9 +248,14 @@ TEST(NumericalStress, FortyModesAtALongStepAreStableOrStopped) {
 // for the two segments in series, and the dynamic run is stable.
 // Reference: tip deflection of a stepped cantilever, P (L1^3 + 3 L1^2 L2 + 3 L1 L2^2) / 3EI_1 +
 // P L2^3 / 3 EI_2 (EI_2 = 1e6 EI_1); criterion 1e-3 (shear deformation of the rods: d/L = 0.02).
+// Linear bodies: the heavy rod's weight bends the soft one by 30 degrees inside one body, where
+// the geometric stiffening's basis-stress force (the geometric stiffness form, not the gradient
+// of the stored cubic energy: formats/reduced_polynomial.h) leaves an energy balance of 2% of the
+// kinetic energy, independent of the step, which is the model's and not the integrator's.
 TEST(NumericalStress, StiffnessAndMassContrastBetweenBodies) {
-  const Superelement soft = test::Reduce(RodYaml(0.3, 2, false));
-  const Superelement hard = test::Reduce(RodYaml(0.3, 2, false, 1e6, 1e5));
+  const std::vector<std::string> linear = {"reduction.geometric_stiffening=false"};
+  const Superelement soft = test::Reduce(RodYaml(0.3, 2, false), linear);
+  const Superelement hard = test::Reduce(RodYaml(0.3, 2, false, 1e6, 1e5), linear);
   const std::string bodies =
       "name: contrast\nunits: SI\nbodies:\n"
       "  - {name: soft, superelement: soft.h5, nodes: {A: n0, B: n1}}\n"

@@ -8,11 +8,18 @@
 #include <Eigen/Dense>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
 
+#include "formats/part_file.h"
+#include "formats/scene_file.h"
+#include "formats/superelement_file.h"
+#include "reducer/reduce_part.h"
 #include "solver/analysis/dynamic_analysis.h"
 #include "solver/analysis/static_analysis.h"
 #include "solver/body/superelement_body.h"
 #include "solver/rotation.h"
+#include "solver/scene/scene_builder.h"
 #include "test_util.h"
 
 namespace femb {
@@ -187,6 +194,50 @@ TEST(GeometricStiffening, TensionedCantileverInOneBodyMatchesTheClosedForm) {
       }
     }
   }
+}
+
+// A part whose basis is the six rigid motions (one interface node, no internal modes) has nothing
+// to stiffen: asked for the stiffening, it reduces (it used to stop with "the polynomial internal
+// force's linear part differs from K_r by 1": both are round-off) and stores none.
+TEST(GeometricStiffening, RigidBasisReducesAndStoresNone) {
+  const std::string yaml = test::StraightBeamYaml(0.3, 4, "{shape: circle, diameter: 0.01}", "{E: 2.0e11, nu: 0.3, rho: 7800}",
+                                                  "[{name: A}]", "reduction: {internal_modes: 0, geometric_stiffening: true, "
+                                                  "floating_frame: 'interface:A'}\n");
+  const ReduceResult r = ReducePart(ParsePart(yaml, "rigid.yaml"), nullptr);
+  ASSERT_TRUE(r.ok) << r.message;
+  EXPECT_EQ(r.superelement.n_reduced_dofs(), 6);
+  EXPECT_TRUE(r.superelement.inertia_stiffness.empty());
+  EXPECT_FALSE(r.superelement.polynomial.has_value());
+}
+
+// The midpoint integrator conserves the energy of linear bodies with the corotational inertia
+// exactly; the stiffening's basis-stress force is not a gradient. So a stiffened file is used
+// linear there unless the body asks for the stiffening (with a note either way), and with its
+// stiffening under generalized-alpha.
+TEST(GeometricStiffening, MidpointUsesAStiffenedFileLinearUnlessAsked) {
+  const std::string dir = ::testing::TempDir() + "stiffening_midpoint";
+  std::filesystem::create_directories(dir);
+  WriteSuperelementFile(Tube(2, true), dir + "/tube.h5");
+  auto scene = [&](const std::string& integrator, const std::string& options) {
+    const std::string path = dir + "/scene.yaml";
+    std::ofstream(path) << "name: s\nunits: SI\nbodies:\n  - {name: tube, superelement: tube.h5, nodes: {A: a, B: b}"
+                        << options << "}\njoints:\n  - {type: revolute, node: a, axis: [0, 0, 1]}\n"
+                        << "analysis: {type: dynamic, end_time: 0.01, step: 1.0e-3, integrator: " << integrator << "}\n";
+    return BuildScene(ReadSceneFile(path));
+  };
+  auto noted = [](const Scene& s, const std::string& text) {
+    for (const std::string& note : s.notes)
+      if (note.find(text) != std::string::npos) return true;
+    return false;
+  };
+  const Scene alpha = scene("generalized_alpha", "");
+  EXPECT_TRUE(alpha.model.bodies[0].options().geometric_stiffening);
+  const Scene midpoint = scene("midpoint", "");
+  EXPECT_FALSE(midpoint.model.bodies[0].options().geometric_stiffening);
+  EXPECT_TRUE(noted(midpoint, "the file's geometric stiffening is not used"));
+  const Scene forced = scene("midpoint", ", options: {geometric_stiffening: true}");
+  EXPECT_TRUE(forced.model.bodies[0].options().geometric_stiffening);
+  EXPECT_TRUE(noted(forced, "the midpoint integrator uses the corotational inertia"));
 }
 
 }  // namespace

@@ -25,7 +25,7 @@ Superelement Rod(double L, int modes, const std::string& frame = "center_of_mass
       "beam:\n  points: {A: [0, 0, 0], B: [" + std::to_string(L) + ", 0, 0]}\n"
       "  segments: [{from: A, to: B, elements: 4}]\n"
       "interfaces: [{name: A}, {name: B}]\nreduction: {internal_modes: " + std::to_string(modes) +
-      ", floating_frame: " + frame + "}\n");
+      ", floating_frame: " + frame + ", geometric_stiffening: false}\n");
 }
 
 // A chain of six rods, node pairs at the joints: revolute (axis z), prismatic (axis x),
