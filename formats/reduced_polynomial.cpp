@@ -1,5 +1,6 @@
 #include "formats/reduced_polynomial.h"
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/SparseCore>
 #include <vector>
 
@@ -79,13 +80,44 @@ Eigen::VectorXd PairProducts(const Eigen::VectorXd& q) {
   return z;
 }
 
+PolynomialStiffness WithCondensation(const Eigen::MatrixXd& K, PolynomialStiffness p) {
+  if (p.cubic()) return p;
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(0.5 * (K + K.transpose()));
+  const Eigen::VectorXd& lambda = eig.eigenvalues();
+  const double floor = 1e-10 * lambda.cwiseAbs().maxCoeff();
+  Eigen::VectorXd inverse = Eigen::VectorXd::Zero(lambda.size());
+  for (int i = 0; i < int(lambda.size()); ++i)
+    if (lambda[i] > floor) inverse[i] = 1.0 / lambda[i];
+  p.K_plus = eig.eigenvectors() * inverse.asDiagonal() * eig.eigenvectors().transpose();
+  return p;
+}
+
+namespace {
+// The condensed quadratic polynomial's eps = q + K^+ A z (header).
+Eigen::VectorXd Condensed(const PolynomialStiffness& p, const Eigen::VectorXd& q) {
+  return q + p.K_plus * (p.A * PairProducts(q));
+}
+}  // namespace
+
+Eigen::VectorXd StressCoordinates(const PolynomialStiffness& p, const Eigen::VectorXd& q) {
+  return p.cubic() ? q : Condensed(p, q);
+}
+
 double PolynomialEnergy(const Eigen::MatrixXd& K, const PolynomialStiffness& p, const Eigen::VectorXd& q) {
+  if (!p.cubic()) {
+    const Eigen::VectorXd eps = Condensed(p, q);
+    return 0.5 * eps.dot(K * eps);
+  }
   const Eigen::VectorXd z = PairProducts(q);
-  return 0.5 * q.dot(K * q) + q.dot(p.A * z) + (p.cubic() ? z.dot(p.B * z) : 0.0);
+  return 0.5 * q.dot(K * q) + q.dot(p.A * z) + z.dot(p.B * z);
 }
 
 Eigen::VectorXd PolynomialForce(const Eigen::MatrixXd& K, const PolynomialStiffness& p, const Eigen::VectorXd& q) {
-  if (!p.cubic()) return K * q + PairJacobianTransposeTimes(q, p.A.transpose() * q);  // geometric stiffness form
+  if (!p.cubic()) {
+    // E^T y = y + J^T (A^T (K^+ y)), y = K eps.
+    const Eigen::VectorXd y = K * Condensed(p, q);
+    return y + PairJacobianTransposeTimes(q, p.A.transpose() * (p.K_plus * y));
+  }
   const Eigen::VectorXd z = PairProducts(q);
   const Eigen::VectorXd w = p.A.transpose() * q + 2 * (p.B * z);
   return K * q + p.A * z + PairJacobianTransposeTimes(q, w);
@@ -94,10 +126,12 @@ Eigen::VectorXd PolynomialForce(const Eigen::MatrixXd& K, const PolynomialStiffn
 Eigen::MatrixXd PolynomialTangent(const Eigen::MatrixXd& K, const PolynomialStiffness& p, const Eigen::VectorXd& q) {
   const Eigen::MatrixXd AJ = TimesPairJacobian(p.A, q);
   if (!p.cubic()) {
-    // d/dq [J^T (A^T q)] = (A J)^T + sum_p (A^T q)_p d2 z_p / dq2 (not symmetric).
-    Eigen::MatrixXd T = K + AJ.transpose();
-    AddPairHessian(p.A.transpose() * q, &T);
-    return T;
+    const Eigen::VectorXd y = K * Condensed(p, q);
+    Eigen::MatrixXd E = p.K_plus * AJ;
+    E.diagonal().array() += 1.0;
+    Eigen::MatrixXd T = E.transpose() * (K * E);
+    AddPairHessian(p.A.transpose() * (p.K_plus * y), &T);
+    return 0.5 * (T + T.transpose());
   }
   const Eigen::VectorXd z = PairProducts(q);
   const Eigen::SparseMatrix<double> J = PairJacobian(q);

@@ -13,29 +13,51 @@ namespace femb {
 
 // Without modal derivatives, the geometric stiffening of issue 13 stores the quadratic part A
 // only (B empty, 0 x 0). A holds the third-order tensor of the geometric stiffness of each basis
-// vector's stress: K_sigma,j = Phi^T G(sigma(phi_j)) Phi has entries (k, l) = 2 A(j, p(k, l)).
-// The force used is then the geometric stiffness of the current deformation's stress,
-//   f(q) = K q + sum_j q_j K_sigma,j q = K q + J^T (A^T q)   (Wallrapp's K_e1 term of the SID),
-// i.e. the Green-Lagrange quadratic force without its foreshortening part A z (the force
-// q^T K_sigma,i q / 2 that bending exerts on a stretching coordinate i). Without the quartic
-// term that part makes the energy q^T K q / 2 + q^T A z unbounded below as soon as the basis
-// holds an axial coordinate (an interface's stretch) beside bending: u' = -v'^2 / 2 then releases
-// energy EA v'^4 / 8 (measured: a 1-body tensioned cantilever showed 2 negative tangent
-// eigenvalues, and the rotating beam deflected more, not less). The quartic term B of a
-// bending-only basis would lock (a stretch that only modal derivatives can relieve), so the full
-// polynomial stays with modal derivatives. The tangent of this force is not symmetric.
+// vector's stress: K_sigma,j = Phi^T G(sigma(phi_j)) Phi has entries (k, l) = 2 A(j, p(k, l)),
+// and (A z)_i = q^T K_sigma,i q / 2 is the force that the deformation's quadratic strain exerts
+// on coordinate i (e.g. the shortening that bending imposes on an interface's stretch).
+//
+// The energy used is the Green-Lagrange energy up to its cubic term, completed to a square with
+// the part of the quartic term that the basis itself can represent (a static condensation of
+// the quadratic strain onto the basis, the reduced-space analogue of the quadratic manifold of
+// Jain, Tiso and Rutzmoser, 2017):
+//   W(q) = eps^T K eps / 2,   eps = q + K^+ A z(q)
+//        = q^T K q / 2 + q^T A z + (A z)^T K^+ (A z) / 2        (K K^+ A z = A z: rigid fields
+//                                                                  have no stress),
+//   f = dW/dq = E^T K eps,  E = d eps / dq = 1 + K^+ A J,  J = dz/dq,
+//   K_t = E^T K E + sum_p (A^T K^+ K eps)_p d2 z_p / dq2   (symmetric).
+// To second order f is the Green-Lagrange quadratic force K q + A z + J^T (A^T q): the geometric
+// stiffness of the current stress and its reciprocal, the shortening force. The quartic part of
+// the square is what keeps the energy bounded below: with the cubic term alone, an axial
+// coordinate (an interface's stretch) beside bending releases EA v'^4 / 8 through u' = -v'^2 / 2
+// (measured: 2 negative tangent eigenvalues on a 1-body tensioned cantilever). It is a lower
+// bound of the true quartic z^T B z, whose excess (membrane strain the basis cannot carry) would
+// lock a bending-only basis; the full polynomial stays with modal derivatives. W >= 0, so a
+// stiffened body conserves energy like a linear one (the geometric stiffness form
+// K q + J^T (A^T q) used before 2026-11-27 is not a gradient, and pumped a four-bar coupler's
+// bending until the run stopped: benchmarks/stiffening_energy.py).
 struct PolynomialStiffness {
   Eigen::MatrixXd A, B;
+  /// Without B: K^+, the pseudo-inverse of the reduced stiffness (WithCondensation).
+  Eigen::MatrixXd K_plus;
   int n() const { return int(A.rows()); }
   bool cubic() const { return B.size() > 0; }
 };
 
+/// p with K^+ set when it is quadratic (A only): the eigenvalues of K below 1e-10 of the
+/// largest (the rigid fields) are left out.
+PolynomialStiffness WithCondensation(const Eigen::MatrixXd& K, PolynomialStiffness p);
+
+/// The coordinates whose linear stress is the body's: eps = q + K^+ A z for the condensed
+/// quadratic polynomial (the membrane strain its basis carries, e.g. a bent member's shortening),
+/// q for the cubic one (whose stress recovery keeps the strain's quadratic part itself).
+Eigen::VectorXd StressCoordinates(const PolynomialStiffness& p, const Eigen::VectorXd& q);
 /// z(q), P entries.
 Eigen::VectorXd PairProducts(const Eigen::VectorXd& q);
 double PolynomialEnergy(const Eigen::MatrixXd& K, const PolynomialStiffness& p, const Eigen::VectorXd& q);
-/// f(q) = K q + A z + J^T (A^T q) + 2 J^T B z, J = dz/dq (cubic); K q + J^T (A^T q) (A only).
+/// f(q) = K q + A z + J^T (A^T q) + 2 J^T B z, J = dz/dq (cubic); E^T K eps (A only, above).
 Eigen::VectorXd PolynomialForce(const Eigen::MatrixXd& K, const PolynomialStiffness& p, const Eigen::VectorXd& q);
-/// df/dq (symmetric for the cubic polynomial).
+/// df/dq (symmetric).
 Eigen::MatrixXd PolynomialTangent(const Eigen::MatrixXd& K, const PolynomialStiffness& p, const Eigen::VectorXd& q);
 
 }  // namespace femb

@@ -65,7 +65,7 @@ SuperelementBody::SuperelementBody(const Superelement& se, const SuperelementOpt
   // A file's polynomial is the modal derivatives' cubic force (option polynomial_force) or,
   // without derivatives, the geometric stiffening's quadratic force (option geometric_stiffening).
   if (se.polynomial && (se.polynomial->cubic() ? options_.polynomial_force : options_.geometric_stiffening)) {
-    polynomial_ = se.polynomial;
+    polynomial_ = WithCondensation(K_, *se.polynomial);
   }
   const int n = n_coordinates();
   if (options_.geometric_stiffening) {

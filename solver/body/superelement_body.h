@@ -183,6 +183,11 @@ class SuperelementBody {
 
   /// Local coordinates q_loc (6N + m).
   Eigen::VectorXd LocalCoordinates(const BodyConfiguration& c, const FrameSolution& frame) const;
+  /// The coordinates the modal stresses are taken at: q_loc, or with the geometric stiffening's
+  /// condensed polynomial its eps = q + K^+ A z (formats/reduced_polynomial.h).
+  Eigen::VectorXd StressCoordinates(const Eigen::VectorXd& q) const {
+    return polynomial_ ? femb::StressCoordinates(*polynomial_, q) : q;
+  }
   void LocalCoordinates(const BodyConfiguration& c, const FrameSolution& frame, Eigen::VectorXd& q) const;
 
   /// Elastic force f (6N + m; per node force then moment, global axes; then modal forces) and,

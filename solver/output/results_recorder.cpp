@@ -177,6 +177,11 @@ void ResultsRecorder::Record(double t, const SystemState& state, const Eigen::Ve
     if (q_loc[b].size() == 0) q_loc[b] = model.bodies[b].LocalCoordinates(BodyConfigurationOf(model, state, int(b)), state.frames[b]);
     return q_loc[b];
   };
+  std::vector<Eigen::VectorXd> q_stress(model.bodies.size());
+  auto stress_coordinates = [&](size_t b) -> const Eigen::VectorXd& {
+    if (q_stress[b].size() == 0) q_stress[b] = model.bodies[b].StressCoordinates(local(b));
+    return q_stress[b];
+  };
   // The inertia load factors of body b's frame (SuperelementBody::InertiaLoads) when its modal
   // stresses include the inertia load cases: d'Alembert with gravity (static analyses: gravity
   // as ramped by the analysis, no motion).
@@ -211,7 +216,7 @@ void ResultsRecorder::Record(double t, const SystemState& state, const Eigen::Ve
       }
       Eigen::MatrixXd stress;
       Eigen::VectorXd von_mises;
-      NodeStresses(*scene_.stresses[b], local(b), n_mesh, &stress, &von_mises, inertia(b));
+      NodeStresses(*scene_.stresses[b], stress_coordinates(b), n_mesh, &stress, &von_mises, inertia(b));
       Eigen::Index worst = 0;
       max_von_mises_[b].push_back(von_mises.size() ? von_mises.maxCoeff(&worst) : 0.0);
       max_von_mises_node_[b].push_back(int(worst));
@@ -262,7 +267,7 @@ void ResultsRecorder::Record(double t, const SystemState& state, const Eigen::Ve
     const SceneProbeSpec& p = scene_.spec.probes[pi];
     if (!p.body.empty()) {  // a stress probe: its stress point
       const auto [b, point] = scene_.stress_probes[pi];
-      const Eigen::Matrix<double, 6, 1> s = PointStress(*scene_.stresses[size_t(b)], point, local(size_t(b)), inertia(size_t(b)));
+      const Eigen::Matrix<double, 6, 1> s = PointStress(*scene_.stresses[size_t(b)], point, stress_coordinates(size_t(b)), inertia(size_t(b)));
       csv_ << "," << Num(VonMises(s));
       for (int i = 0; i < 6; ++i) csv_ << "," << Num(s[i]);
       continue;
