@@ -449,7 +449,7 @@ PartSpec ParsePart(const std::string& text, const std::string& name,
     }
     if (auto v = m.Optional("geometric_stiffening")) {
       part.reduction.geometric_stiffening = v->Bool();
-      if (part.reduction.geometric_stiffening && part.type == "imported") {
+      if (*part.reduction.geometric_stiffening && part.type == "imported") {
         v->Fail("geometric stiffening needs femb's own elements (the stress of each field); imported matrices do not have them");
       }
     }
@@ -480,7 +480,7 @@ PartSpec ParsePart(const std::string& text, const std::string& name,
     }
     m.CheckNoUnknownKeys();
     if (part.reduction.method != "craig_bampton" &&
-        (part.reduction.modal_derivatives.enabled || part.reduction.geometric_stiffening)) {
+        (part.reduction.modal_derivatives.enabled || part.reduction.geometric_stiffening.value_or(false))) {
       throw InputError(part.reduction.where_method + ": modal derivatives and geometric stiffening are built on the "
                        "Craig-Bampton basis: use reduction.method: craig_bampton with them");
     }

@@ -108,10 +108,14 @@ struct ReductionSpec {
   ModalDerivativeSpec modal_derivatives;
   std::string floating_frame = "center_of_mass";
   /// Geometric stiffening (issue 13): the geometric stiffness of the basis vectors' stresses and
-  /// of the 12 unit inertia load cases, stored for femb-solve. Opt-in: switched on everywhere, the
-  /// basis-stress force (the geometric stiffness form, not a gradient) pumps energy into the
-  /// flexible four-bar coupler (README, issue 13), which linear bodies do not.
-  bool geometric_stiffening = false;
+  /// of the 12 unit inertia load cases, and the inertia invariants of the exact kinetic energy,
+  /// stored for femb-solve. Unset: on wherever it can be built (GeometricStiffening below).
+  std::optional<bool> geometric_stiffening;
+  /// What the reduction does: the key's value, or on for femb's own parts reduced by
+  /// Craig-Bampton (the only ones with the element stresses and the basis it is built on).
+  bool GeometricStiffening(const std::string& part_type) const {
+    return geometric_stiffening.value_or(method == "craig_bampton" && part_type != "imported");
+  }
   /// Store the mesh and mode shapes (visualization group); unset: only for models up to
   /// kKeepMeshMaxDofs DOFs (the shapes take n_dofs x n_reduced doubles).
   std::optional<bool> keep_mesh;

@@ -166,8 +166,8 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
   // Geometric stiffening (issue 13): the unit inertia load cases are solved on the same factor.
   // A basis without deformation (one interface node, no internal modes: the six rigid motions)
   // has nothing to stiffen, and its exact and corotational kinetic energies are the same.
-  const bool stiffening = part.reduction.geometric_stiffening && n_b + m > 6;
-  if (part.reduction.geometric_stiffening && !stiffening) {
+  const bool stiffening = part.reduction.GeometricStiffening(part.type) && n_b + m > 6;
+  if (part.reduction.geometric_stiffening.value_or(false) && !stiffening) {
     if (progress) progress("stiffening", 0.0, "none stored: the basis is the six rigid motions (one interface node, no internal modes)");
   }
   const Eigen::MatrixXd inertia_fields = stiffening ? InertiaFields(model) : Eigen::MatrixXd();

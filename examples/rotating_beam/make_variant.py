@@ -3,7 +3,7 @@
 mass): OUTDIR/seg.yaml and OUTDIR/scene.yaml. Probes `hinge` (joint angle and rate) and `tip`.
 
 usage: make_variant.py OUTDIR N [STEP] [END_TIME] [--stiffening]
---stiffening: the segment with reduction.geometric_stiffening (issue 13).
+--stiffening: the segment with reduction.geometric_stiffening (issue 13); without it, linear (explicitly).
 """
 import os
 import sys
@@ -20,8 +20,7 @@ end = float(sys.argv[4]) if len(sys.argv) > 4 else 0.1
 w = 100.0
 os.makedirs(out, exist_ok=True)
 L = tube.write_segment(out, n)
-if stiffened:
-    stiffening.apply(os.path.join(out, "seg.yaml"))
+stiffening.apply(os.path.join(out, "seg.yaml"), stiffened)
 bodies = "\n".join(f"  - {{name: b{k}, superelement: seg.h5, placement: {{position: [{k * L!r}, 0, 0]}}, "
                    f"nodes: {{A: n{k}, B: n{k + 1}}}}}" for k in range(n))
 velocities = "\n".join(f"  n{k}: {{linear: [0, {w * k * L!r}, 0], angular: [0, 0, {w}]}}" for k in range(1, n + 1))

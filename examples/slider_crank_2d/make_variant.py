@@ -3,7 +3,7 @@
 length 0.3/N) and OUTDIR/scene.yaml (crank, N rod segments chained through shared nodes, slider).
 
 usage: make_variant.py N OUTDIR [STEP] [MODES] [OPTIONS] [--stiffening]
---stiffening: the rod segment with reduction.geometric_stiffening (issue 13).
+--stiffening: the rod segment with reduction.geometric_stiffening (issue 13); without it, linear (explicitly).
 OPTIONS: a YAML flow map of the rod bodies' options, e.g. '{transformations: approximated}'.
 N must be even (the rod midpoint is then a node, probe rod_mid). Probes: crank (joint),
 rod_a, rod_mid, rod_b (position), slider (position, joint).
@@ -19,8 +19,7 @@ stiffened = stiffening.take_flag(sys.argv)
 n, out, step, modes, options = rod.parse_args(sys.argv)
 here = os.path.dirname(os.path.abspath(__file__))
 L = rod.write_segment(out, n, modes)
-if stiffened:
-    stiffening.apply(os.path.join(out, f"rod_{n}.yaml"))
+stiffening.apply(os.path.join(out, f"rod_{n}.yaml"), stiffened)
 names = rod.node_names(n)
 bodies = "\n".join(
     f"  - {{name: rod{i}, superelement: rod_{n}.h5, placement: {{position: [{0.15 + i * L!r}, 0, 0]}}, "

@@ -3,7 +3,7 @@
 prescribed by spin_up with final speed OMEGA, Ts = 15 s; probes `hub` and `tip`).
 
 usage: make_variant.py OUTDIR N [STEP] [OMEGA] [--stiffening]
---stiffening: the segment with reduction.geometric_stiffening (issue 13).
+--stiffening: the segment with reduction.geometric_stiffening (issue 13); without it, linear (explicitly).
 """
 import os
 import sys
@@ -31,8 +31,7 @@ beam:
 interfaces: [{{name: A}}, {{name: B}}]
 reduction: {{internal_modes: 2, floating_frame: center_of_mass}}
 """)
-if stiffened:
-    stiffening.apply(os.path.join(out, "seg.yaml"))
+stiffening.apply(os.path.join(out, "seg.yaml"), stiffened)
 bodies = "\n".join(f"  - {{name: b{k}, superelement: seg.h5, placement: {{position: [{k * L!r}, 0, 0]}}, "
                    f"nodes: {{A: n{k}, B: n{k + 1}}}}}" for k in range(n))
 with open(os.path.join(out, "scene.yaml"), "w") as g:

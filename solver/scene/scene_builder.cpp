@@ -182,8 +182,9 @@ Scene BuildScene(const SceneSpec& spec) {
       scene.notes.push_back("body '" + b.name + "': " + file.string() +
                             " has no geometric stiffening; the body is linear inside (re-reduce it to add it)");
     }
-    // The exact kinetic energy (issue 13) likewise: the file's inertia invariants unless switched off.
-    options.exact_inertia = b.exact_inertia.value_or(true);
+    // The exact kinetic energy (issue 13) likewise: the file's inertia invariants unless switched
+    // off, or under the midpoint integrator, whose conservation is the corotational energy's.
+    options.exact_inertia = b.exact_inertia.value_or(!midpoint);
     if (b.exact_inertia.value_or(false) && se.inertia_gamma.empty()) {
       throw InputError(b.where + ": body '" + b.name + "': options.inertia is exact but " + file.string() +
                        " has no inertia invariants (reduce it with reduction.geometric_stiffening: true)");
@@ -192,9 +193,10 @@ Scene BuildScene(const SceneSpec& spec) {
       scene.notes.push_back("body '" + b.name + "': the midpoint integrator keeps the body linear inside, with the "
                             "corotational inertia (thesis 3.22) whose energy it conserves exactly: the file's geometric "
                             "stiffening is not used (generalized_alpha uses it; options.geometric_stiffening: true forces it)");
-    } else if (midpoint && options.exact_inertia && !se.inertia_gamma.empty()) {
+    } else if (midpoint && !b.exact_inertia.has_value() && !se.inertia_gamma.empty()) {
       scene.notes.push_back("body '" + b.name + "': the midpoint integrator uses the corotational inertia (thesis "
-                            "3.22), not the file's exact one (generalized_alpha does)");
+                            "3.22), whose energy it conserves exactly, not the file's exact one (generalized_alpha does; "
+                            "options.inertia: exact forces it)");
     }
     std::vector<int> nodes;
     for (const auto& [iname, _] : b.nodes) {

@@ -283,9 +283,9 @@ TEST(GeometricStiffening, RigidBasisReducesAndStoresNone) {
 }
 
 // The midpoint integrator conserves the energy of linear bodies with the corotational inertia
-// exactly; the stiffening's basis-stress force is not a gradient. So a stiffened file is used
-// linear there unless the body asks for the stiffening (with a note either way), and with its
-// stiffening under generalized-alpha.
+// exactly (its elastic force is no exact discrete gradient of the stiffened energy). So a
+// stiffened file is used linear with the corotational inertia there unless the body asks (with
+// a note either way), and with its stiffening and exact inertia under generalized-alpha.
 TEST(GeometricStiffening, MidpointUsesAStiffenedFileLinearUnlessAsked) {
   const std::string dir = ::testing::TempDir() + "stiffening_midpoint";
   std::filesystem::create_directories(dir);
@@ -306,6 +306,8 @@ TEST(GeometricStiffening, MidpointUsesAStiffenedFileLinearUnlessAsked) {
   EXPECT_TRUE(alpha.model.bodies[0].options().geometric_stiffening);
   const Scene midpoint = scene("midpoint", "");
   EXPECT_FALSE(midpoint.model.bodies[0].options().geometric_stiffening);
+  EXPECT_FALSE(midpoint.model.bodies[0].options().exact_inertia);
+  EXPECT_TRUE(alpha.model.bodies[0].options().exact_inertia);
   EXPECT_TRUE(noted(midpoint, "the file's geometric stiffening is not used"));
   const Scene forced = scene("midpoint", ", options: {geometric_stiffening: true}");
   EXPECT_TRUE(forced.model.bodies[0].options().geometric_stiffening);
