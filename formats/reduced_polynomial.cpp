@@ -85,10 +85,13 @@ PolynomialStiffness WithCondensation(const Eigen::MatrixXd& K, PolynomialStiffne
   const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(0.5 * (K + K.transpose()));
   const Eigen::VectorXd& lambda = eig.eigenvalues();
   const double floor = 1e-10 * lambda.cwiseAbs().maxCoeff();
-  Eigen::VectorXd inverse = Eigen::VectorXd::Zero(lambda.size());
+  std::vector<int> kept;
   for (int i = 0; i < int(lambda.size()); ++i)
-    if (lambda[i] > floor) inverse[i] = 1.0 / lambda[i];
-  p.K_plus = eig.eigenvectors() * inverse.asDiagonal() * eig.eigenvectors().transpose();
+    if (lambda[i] > floor) kept.push_back(i);
+  p.K_plus_root.resize(long(kept.size()), K.cols());
+  for (size_t r = 0; r < kept.size(); ++r)
+    p.K_plus_root.row(long(r)) = eig.eigenvectors().col(kept[r]).transpose() / std::sqrt(lambda[kept[r]]);
+  p.K_plus = p.K_plus_root.transpose() * p.K_plus_root;
   return p;
 }
 
@@ -114,9 +117,10 @@ double PolynomialEnergy(const Eigen::MatrixXd& K, const PolynomialStiffness& p, 
 
 Eigen::VectorXd PolynomialForce(const Eigen::MatrixXd& K, const PolynomialStiffness& p, const Eigen::VectorXd& q) {
   if (!p.cubic()) {
-    // E^T y = y + J^T (A^T (K^+ y)), y = K eps.
-    const Eigen::VectorXd y = K * Condensed(p, q);
-    return y + PairJacobianTransposeTimes(q, p.A.transpose() * (p.K_plus * y));
+    // E^T K eps = K eps + J^T (A^T K^+ K eps) = K eps + J^T (A^T eps): K^+ K is the projection
+    // off the rigid fields, and a rigid field has no stress (A^T of it vanishes).
+    const Eigen::VectorXd eps = Condensed(p, q);
+    return K * eps + PairJacobianTransposeTimes(q, p.A.transpose() * eps);
   }
   const Eigen::VectorXd z = PairProducts(q);
   const Eigen::VectorXd w = p.A.transpose() * q + 2 * (p.B * z);
@@ -126,11 +130,12 @@ Eigen::VectorXd PolynomialForce(const Eigen::MatrixXd& K, const PolynomialStiffn
 Eigen::MatrixXd PolynomialTangent(const Eigen::MatrixXd& K, const PolynomialStiffness& p, const Eigen::VectorXd& q) {
   const Eigen::MatrixXd AJ = TimesPairJacobian(p.A, q);
   if (!p.cubic()) {
-    const Eigen::VectorXd y = K * Condensed(p, q);
-    Eigen::MatrixXd E = p.K_plus * AJ;
-    E.diagonal().array() += 1.0;
-    Eigen::MatrixXd T = E.transpose() * (K * E);
-    AddPairHessian(p.A.transpose() * (p.K_plus * y), &T);
+    // E^T K E = K + A J + (A J)^T + (A J)^T K^+ (A J) (K K^+ A J = A J: the columns of A J, the
+    // derivatives of A z, have no rigid part), plus the pair Hessian at A^T eps (as the force).
+    Eigen::MatrixXd T = K + AJ + AJ.transpose();
+    const Eigen::MatrixXd RAJ = p.K_plus_root * AJ;
+    T.noalias() += RAJ.transpose() * RAJ;
+    AddPairHessian(p.A.transpose() * Condensed(p, q), &T);
     return 0.5 * (T + T.transpose());
   }
   const Eigen::VectorXd z = PairProducts(q);

@@ -24,8 +24,9 @@ namespace femb {
 //   W(q) = eps^T K eps / 2,   eps = q + K^+ A z(q)
 //        = q^T K q / 2 + q^T A z + (A z)^T K^+ (A z) / 2        (K K^+ A z = A z: rigid fields
 //                                                                  have no stress),
-//   f = dW/dq = E^T K eps,  E = d eps / dq = 1 + K^+ A J,  J = dz/dq,
-//   K_t = E^T K E + sum_p (A^T K^+ K eps)_p d2 z_p / dq2   (symmetric).
+//   f = dW/dq = E^T K eps = K eps + J^T (A^T eps),  E = d eps / dq = 1 + K^+ A J,  J = dz/dq,
+//   K_t = E^T K E + sum_p (A^T eps)_p d2 z_p / dq2   (symmetric; A^T K^+ K = A^T: rigid fields
+//   have no stress).
 // To second order f is the Green-Lagrange quadratic force K q + A z + J^T (A^T q): the geometric
 // stiffness of the current stress and its reciprocal, the shortening force. The quartic part of
 // the square is what keeps the energy bounded below: with the cubic term alone, an axial
@@ -38,8 +39,9 @@ namespace femb {
 // bending until the run stopped: benchmarks/stiffening_energy.py).
 struct PolynomialStiffness {
   Eigen::MatrixXd A, B;
-  /// Without B: K^+, the pseudo-inverse of the reduced stiffness (WithCondensation).
-  Eigen::MatrixXd K_plus;
+  /// Without B: K^+, the pseudo-inverse of the reduced stiffness, and a root R of it, K^+ = R^T R
+  /// (rank rows; WithCondensation).
+  Eigen::MatrixXd K_plus, K_plus_root;
   int n() const { return int(A.rows()); }
   bool cubic() const { return B.size() > 0; }
 };
