@@ -36,7 +36,7 @@ CASES = [
      "rotating_beam/deflection.py", []),
     ("slider_crank_2d", "10 bodies", "OUT/10_bodies/scene.yaml", [], "reference_20_bodies",
      "slider_crank_2d/deflection.py", []),
-    ("slider_crank_2d", "2 bodies, stiffened", "OUT/2_bodies_stiffened/scene.yaml", [], "reference_20_bodies",
+    ("slider_crank_2d", "2 bodies, stiffened", "EX/scene.yaml", [], "reference_20_bodies",
      "slider_crank_2d/deflection.py", []),
     ("slider_crank_3d", "10 bodies", "OUT/10_bodies/scene.yaml", [], "reference_20_bodies",
      "slider_crank_2d/deflection.py", []),

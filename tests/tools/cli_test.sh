@@ -36,7 +36,10 @@ full = j["full_free_free_frequencies_hz"]; assert len(full) == 16
 # reduced frequencies are Rayleigh-Ritz upper bounds of the full ones
 for r, f in zip(ff[6:10], full[6:10]):
     assert r >= f * (1 - 1e-9) and r < 1.01 * f, (r, f)
+# Geometric stiffening is on by default for femb's own Craig-Bampton parts (issue 13).
+assert j["geometric_stiffening"] is True
 PY
+  grep -q "stiffening .* 12 inertia load case geometric stiffnesses" "$work/$ex.log" && ok || fail "$ex: no stiffening progress line"
 done
 
 # --dump: K as CSV is 16 x 16; PhiCB as Matrix Market 6 x 16.
@@ -222,6 +225,13 @@ YAML
 grep -q "B: 1 nodes by plane" "$work/imported.log" && grep -q "rigid-body residual" "$work/imported.log" && ok \
   || fail "imported progress lines: $(cat "$work/imported.log")"
 "$bin/femb-inspect" "$work/rod_imported.h5" --check > /dev/null && ok || fail "inspect --check imported"
+# Imported matrices have no element stresses: no geometric stiffening by default, and asking
+# for it is one line with exit 2.
+"$bin/femb-inspect" "$work/rod_imported.h5" --json | $py -c "import json,sys; assert json.load(sys.stdin)['geometric_stiffening'] is False" \
+  && ok || fail "imported part has geometric stiffening"
+"$bin/femb-reduce" "$work/rod_mm/imported.yaml" -o "$work/rod_imported_gs.h5" --set reduction.geometric_stiffening=true 2> "$work/err.txt"; code=$?
+[ $code = 2 ] && grep -q "geometric stiffening needs femb's own elements" "$work/err.txt" && [ ! -e "$work/rod_imported_gs.h5" ] && ok \
+  || fail "imported with stiffening: exit $code $(cat "$work/err.txt")"
 "$bin/femb-inspect" "$work/rod_imported.h5" --vtu "$work/rod_vtu" > /dev/null && [ -f "$work/rod_vtu/beam_rod_006.vtu" ] && ok \
   || fail "inspect --vtu imported"
 $py - "$work/beam_rod.h5" "$work/rod_imported.h5" <<'PY' && ok || fail "imported frequencies differ from native"
