@@ -116,28 +116,34 @@ double PolynomialEnergy(const Eigen::MatrixXd& K, const PolynomialStiffness& p, 
 }
 
 Eigen::VectorXd PolynomialForce(const Eigen::MatrixXd& K, const PolynomialStiffness& p, const Eigen::VectorXd& q) {
-  if (!p.cubic()) {
-    // E^T K eps = K eps + J^T (A^T K^+ K eps) = K eps + J^T (A^T eps): K^+ K is the projection
-    // off the rigid fields, and a rigid field has no stress (A^T of it vanishes).
-    const Eigen::VectorXd eps = Condensed(p, q);
-    return K * eps + PairJacobianTransposeTimes(q, p.A.transpose() * eps);
-  }
+  if (!p.cubic()) return CondensedForce(K, p, q, Condensed(p, q));
   const Eigen::VectorXd z = PairProducts(q);
   const Eigen::VectorXd w = p.A.transpose() * q + 2 * (p.B * z);
   return K * q + p.A * z + PairJacobianTransposeTimes(q, w);
 }
 
-Eigen::MatrixXd PolynomialTangent(const Eigen::MatrixXd& K, const PolynomialStiffness& p, const Eigen::VectorXd& q) {
+Eigen::VectorXd CondensedForce(const Eigen::MatrixXd& K, const PolynomialStiffness& p, const Eigen::VectorXd& q,
+                               const Eigen::VectorXd& eps) {
+  // E^T K eps = K eps + J^T (A^T K^+ K eps) = K eps + J^T (A^T eps): K^+ K is the projection
+  // off the rigid fields, and a rigid field has no stress (A^T of it vanishes).
+  return K * eps + PairJacobianTransposeTimes(q, p.A.transpose() * eps);
+}
+
+Eigen::MatrixXd CondensedTangent(const Eigen::MatrixXd& K, const PolynomialStiffness& p, const Eigen::VectorXd& q,
+                                 const Eigen::VectorXd& eps) {
+  // E^T K E = K + A J + (A J)^T + (A J)^T K^+ (A J) (K K^+ A J = A J: the columns of A J, the
+  // derivatives of A z, have no rigid part), plus the pair Hessian at A^T eps (as the force).
   const Eigen::MatrixXd AJ = TimesPairJacobian(p.A, q);
-  if (!p.cubic()) {
-    // E^T K E = K + A J + (A J)^T + (A J)^T K^+ (A J) (K K^+ A J = A J: the columns of A J, the
-    // derivatives of A z, have no rigid part), plus the pair Hessian at A^T eps (as the force).
-    Eigen::MatrixXd T = K + AJ + AJ.transpose();
-    const Eigen::MatrixXd RAJ = p.K_plus_root * AJ;
-    T.noalias() += RAJ.transpose() * RAJ;
-    AddPairHessian(p.A.transpose() * Condensed(p, q), &T);
-    return 0.5 * (T + T.transpose());
-  }
+  Eigen::MatrixXd T = K + AJ + AJ.transpose();
+  const Eigen::MatrixXd RAJ = p.K_plus_root * AJ;
+  T.noalias() += RAJ.transpose() * RAJ;
+  AddPairHessian(p.A.transpose() * eps, &T);
+  return 0.5 * (T + T.transpose());
+}
+
+Eigen::MatrixXd PolynomialTangent(const Eigen::MatrixXd& K, const PolynomialStiffness& p, const Eigen::VectorXd& q) {
+  if (!p.cubic()) return CondensedTangent(K, p, q, Condensed(p, q));
+  const Eigen::MatrixXd AJ = TimesPairJacobian(p.A, q);
   const Eigen::VectorXd z = PairProducts(q);
   const Eigen::SparseMatrix<double> J = PairJacobian(q);
   const Eigen::MatrixXd BJ = p.B * J;

@@ -61,5 +61,11 @@ double PolynomialEnergy(const Eigen::MatrixXd& K, const PolynomialStiffness& p, 
 Eigen::VectorXd PolynomialForce(const Eigen::MatrixXd& K, const PolynomialStiffness& p, const Eigen::VectorXd& q);
 /// df/dq (symmetric).
 Eigen::MatrixXd PolynomialTangent(const Eigen::MatrixXd& K, const PolynomialStiffness& p, const Eigen::VectorXd& q);
+/// The condensed quadratic polynomial's force and tangent at q with its eps = StressCoordinates(p, q)
+/// already at hand (a body evaluates it once per iteration).
+Eigen::VectorXd CondensedForce(const Eigen::MatrixXd& K, const PolynomialStiffness& p, const Eigen::VectorXd& q,
+                               const Eigen::VectorXd& eps);
+Eigen::MatrixXd CondensedTangent(const Eigen::MatrixXd& K, const PolynomialStiffness& p, const Eigen::VectorXd& q,
+                                 const Eigen::VectorXd& eps);
 
 }  // namespace femb

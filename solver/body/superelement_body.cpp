@@ -196,6 +196,7 @@ void SuperelementBody::Evaluate(const BodyConfiguration& c, const FrameSolution&
   d.local_force.valid = false;
   d.exact_mass.reset();
   d.sigma_q.reset();
+  d.eps.reset();
 }
 
 const BodyVelocityMaps& SuperelementBody::MapsOf(const Data& d) const {
@@ -275,7 +276,7 @@ const Eigen::VectorXd& SuperelementBody::LocalForce(const Data& d, const Inertia
   if (kept.valid && kept.a == a) return kept.Q;
   const Eigen::VectorXd& q = d.q;
   if (polynomial_) {
-    kept.Q = PolynomialForce(K_, *polynomial_, q);
+    kept.Q = polynomial_->cubic() ? PolynomialForce(K_, *polynomial_, q) : CondensedForce(K_, *polynomial_, q, Condensed(d));
   } else {
     kept.Q.resize(q.size());
     kept.Q.noalias() = K_ * q;
@@ -286,8 +287,16 @@ const Eigen::VectorXd& SuperelementBody::LocalForce(const Data& d, const Inertia
   return kept.Q;
 }
 
-Eigen::MatrixXd SuperelementBody::LocalTangent(const Eigen::VectorXd& q, const InertiaLoadFactors* load) const {
-  Eigen::MatrixXd K = polynomial_ ? PolynomialTangent(K_, *polynomial_, q) : K_;
+const Eigen::VectorXd& SuperelementBody::Condensed(const Data& d) const {
+  if (!d.eps) d.eps = StressCoordinates(d.q);
+  return *d.eps;
+}
+
+Eigen::MatrixXd SuperelementBody::LocalTangent(const Data& d, const InertiaLoadFactors* load) const {
+  const Eigen::VectorXd& q = d.q;
+  Eigen::MatrixXd K = !polynomial_             ? K_
+                      : polynomial_->cubic() ? PolynomialTangent(K_, *polynomial_, q)
+                                             : CondensedTangent(K_, *polynomial_, q, Condensed(d));
   if (load && !K_sigma_.empty()) {
     for (int k = 0; k < kInertiaLoadCaseCount; ++k)
       if (load->a[k] != 0.0) K += load->a[k] * K_sigma_[size_t(k)];
@@ -399,7 +408,7 @@ void SuperelementBody::ElasticForce(const Data& d, Eigen::VectorXd* f, Eigen::Ma
   const Eigen::MatrixXd* Kq = &K_;
   Eigen::MatrixXd Kq_loaded;
   if (polynomial_ || (load && !K_sigma_.empty())) {
-    Kq_loaded = LocalTangent(q, load);
+    Kq_loaded = LocalTangent(d, load);
     Kq = &Kq_loaded;
   }
   Kt.resize(n, n);

@@ -137,6 +137,7 @@ class SuperelementBody {
     };
     mutable LocalForceOf local_force;
     mutable std::optional<Eigen::MatrixXd> sigma_q;
+    mutable std::optional<Eigen::VectorXd> eps;  ///< the condensed polynomial's q + K^+ A z, made when first asked
   };
   /// The body's quantities at configuration `c` with its solved floating frame.
   Data Evaluate(const BodyConfiguration& c, const FrameSolution& frame) const;
@@ -409,7 +410,9 @@ class SuperelementBody {
   // Local internal force and its tangent: K q or the polynomial's.
   // The force is kept in d (Data::local_force) for the next call with the same load factors.
   const Eigen::VectorXd& LocalForce(const Data& d, const InertiaLoadFactors* load = nullptr) const;
-  Eigen::MatrixXd LocalTangent(const Eigen::VectorXd& q, const InertiaLoadFactors* load = nullptr) const;
+  Eigen::MatrixXd LocalTangent(const Data& d, const InertiaLoadFactors* load = nullptr) const;
+  // The condensed polynomial's eps at d (geometric stiffening without modal derivatives), kept in d.
+  const Eigen::VectorXd& Condensed(const Data& d) const;
   // K_sigma,k q_loc for the 12 load cases (n x 12), kept in d.
   const Eigen::MatrixXd& SigmaProducts(const Data& d) const;
   std::vector<Eigen::MatrixXd> K_sigma_;  ///< the 12 inertia load case geometric stiffnesses, or none
