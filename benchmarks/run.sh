@@ -26,6 +26,5 @@ echo
 # the examples' references exist in build/example_out, e.g. after ctest; else they are run first).
 /usr/bin/python3 benchmarks/step_control.py build/bin
 echo
-# Why the geometric stiffening is opt-in (issue 13): the four-bar coupler's energy with and without
-# it (about 30 s).
+# The four-bar coupler's energy with and without geometric stiffening (issue 13; about 40 s).
 /usr/bin/python3 benchmarks/stiffening_energy.py build/bin out/stiffening_energy

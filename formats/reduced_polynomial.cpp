@@ -91,14 +91,13 @@ PolynomialStiffness WithCondensation(const Eigen::MatrixXd& K, PolynomialStiffne
   p.K_plus_root.resize(long(kept.size()), K.cols());
   for (size_t r = 0; r < kept.size(); ++r)
     p.K_plus_root.row(long(r)) = eig.eigenvectors().col(kept[r]).transpose() / std::sqrt(lambda[kept[r]]);
-  p.K_plus = p.K_plus_root.transpose() * p.K_plus_root;
   return p;
 }
 
 namespace {
 // The condensed quadratic polynomial's eps = q + K^+ A z (header).
 Eigen::VectorXd Condensed(const PolynomialStiffness& p, const Eigen::VectorXd& q) {
-  return q + p.K_plus * (p.A * PairProducts(q));
+  return q + p.K_plus_root.transpose() * (p.K_plus_root * (p.A * PairProducts(q)));
 }
 }  // namespace
 

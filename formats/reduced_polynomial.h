@@ -39,15 +39,15 @@ namespace femb {
 // bending until the run stopped: benchmarks/stiffening_energy.py).
 struct PolynomialStiffness {
   Eigen::MatrixXd A, B;
-  /// Without B: K^+, the pseudo-inverse of the reduced stiffness, and a root R of it, K^+ = R^T R
-  /// (rank rows; WithCondensation).
-  Eigen::MatrixXd K_plus, K_plus_root;
+  /// Without B: a root R of K^+, the pseudo-inverse of the reduced stiffness, K^+ = R^T R (rank
+  /// rows; WithCondensation).
+  Eigen::MatrixXd K_plus_root;
   int n() const { return int(A.rows()); }
   bool cubic() const { return B.size() > 0; }
 };
 
-/// p with K^+ set when it is quadratic (A only): the eigenvalues of K below 1e-10 of the
-/// largest (the rigid fields) are left out.
+/// p with the root of K^+ set when it is quadratic (A only): the eigenvalues of K below 1e-10 of
+/// the largest (the rigid fields) are left out.
 PolynomialStiffness WithCondensation(const Eigen::MatrixXd& K, PolynomialStiffness p);
 
 /// The coordinates whose linear stress is the body's: eps = q + K^+ A z for the condensed

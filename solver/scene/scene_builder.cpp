@@ -169,8 +169,9 @@ Scene BuildScene(const SceneSpec& spec) {
     // Geometric stiffening (issue 13): what the file has, unless switched off; asked for
     // explicitly from a file without it is an error, otherwise a note. The midpoint integrator
     // conserves the energy of linear bodies with the corotational inertia (thesis 3.22) exactly;
-    // the stiffening's basis-stress force is not a gradient and the corotational inertia gives
-    // wrong Southwell slopes with it (README), so there it is used only when asked for.
+    // its elastic force is no exact discrete gradient of the stiffened energy, and the
+    // corotational inertia gives wrong Southwell slopes with the stiffening (README), so there it
+    // is used only when asked for.
     const bool midpoint = spec.analysis.integrator == IntegratorType::kMidpoint;
     options.geometric_stiffening = b.geometric_stiffening.value_or(!midpoint);
     const bool file_has_stiffening = !se.inertia_stiffness.empty();
@@ -190,10 +191,11 @@ Scene BuildScene(const SceneSpec& spec) {
                        " has no inertia invariants (reduce it with reduction.geometric_stiffening: true)");
     }
     if (midpoint && file_has_stiffening && !b.geometric_stiffening.has_value()) {
-      scene.notes.push_back("body '" + b.name + "': the midpoint integrator keeps the body linear inside, with the "
-                            "corotational inertia (thesis 3.22) whose energy it conserves exactly: the file's geometric "
-                            "stiffening is not used (generalized_alpha uses it; options.geometric_stiffening: true forces it)");
-    } else if (midpoint && !b.exact_inertia.has_value() && !se.inertia_gamma.empty()) {
+      scene.notes.push_back("body '" + b.name + "': the midpoint integrator keeps the body linear inside, whose energy it "
+                            "conserves exactly: the file's geometric stiffening is not used (generalized_alpha uses it; "
+                            "options.geometric_stiffening: true forces it)");
+    }
+    if (midpoint && !b.exact_inertia.has_value() && !se.inertia_gamma.empty()) {
       scene.notes.push_back("body '" + b.name + "': the midpoint integrator uses the corotational inertia (thesis "
                             "3.22), whose energy it conserves exactly, not the file's exact one (generalized_alpha does; "
                             "options.inertia: exact forces it)");
