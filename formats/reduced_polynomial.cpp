@@ -25,11 +25,11 @@ Eigen::SparseMatrix<double> PairJacobian(const Eigen::VectorXd& q) {
   return J;
 }
 
-// J^T v without forming J (no allocation but the result): per pair p = (j, k), m_p q_k v_p to
-// entry j and m_p q_j v_p to entry k (2 q_j v_p once for a diagonal pair).
-Eigen::VectorXd PairJacobianTransposeTimes(const Eigen::VectorXd& q, const Eigen::VectorXd& v) {
+// J^T v without forming J, into `out`: per pair p = (j, k), m_p q_k v_p to entry j and m_p q_j
+// v_p to entry k (2 q_j v_p once for a diagonal pair).
+void PairJacobianTransposeTimes(const Eigen::VectorXd& q, const Eigen::VectorXd& v, Eigen::VectorXd& out) {
   const int n = int(q.size());
-  Eigen::VectorXd out = Eigen::VectorXd::Zero(n);
+  out.setZero(n);
   int p = 0;
   for (int j = 0; j < n; ++j) {
     out[j] += 2.0 * q[j] * v[p++];
@@ -38,14 +38,19 @@ Eigen::VectorXd PairJacobianTransposeTimes(const Eigen::VectorXd& q, const Eigen
       out[k] += 2.0 * q[j] * v[p];
     }
   }
+}
+
+Eigen::VectorXd PairJacobianTransposeTimes(const Eigen::VectorXd& q, const Eigen::VectorXd& v) {
+  Eigen::VectorXd out;
+  PairJacobianTransposeTimes(q, v, out);
   return out;
 }
 
 // A J (rows of A times J) without forming J: column j of A J gathers m_p q_k A_p over the pairs
 // p = (j, k) and (k, j).
-Eigen::MatrixXd TimesPairJacobian(const Eigen::MatrixXd& A, const Eigen::VectorXd& q) {
+void TimesPairJacobian(const Eigen::MatrixXd& A, const Eigen::VectorXd& q, Eigen::MatrixXd& out) {
   const int n = int(q.size());
-  Eigen::MatrixXd out = Eigen::MatrixXd::Zero(A.rows(), n);
+  out.setZero(A.rows(), n);
   int p = 0;
   for (int j = 0; j < n; ++j) {
     out.col(j) += (2.0 * q[j]) * A.col(p++);
@@ -54,6 +59,11 @@ Eigen::MatrixXd TimesPairJacobian(const Eigen::MatrixXd& A, const Eigen::VectorX
       out.col(k) += (2.0 * q[j]) * A.col(p);
     }
   }
+}
+
+Eigen::MatrixXd TimesPairJacobian(const Eigen::MatrixXd& A, const Eigen::VectorXd& q) {
+  Eigen::MatrixXd out;
+  TimesPairJacobian(A, q, out);
   return out;
 }
 
@@ -71,12 +81,19 @@ void AddPairHessian(const Eigen::VectorXd& w, Eigen::MatrixXd* T) {
 
 }  // namespace
 
-Eigen::VectorXd PairProducts(const Eigen::VectorXd& q) {
+namespace {
+void PairProductsInto(const Eigen::VectorXd& q, Eigen::VectorXd& z) {
   const int n = int(q.size());
-  Eigen::VectorXd z(n * (n + 1) / 2);
+  z.resize(n * (n + 1) / 2);
   int p = 0;
   for (int j = 0; j < n; ++j)
     for (int k = j; k < n; ++k, ++p) z[p] = (j == k ? 1.0 : 2.0) * q[j] * q[k];
+}
+}  // namespace
+
+Eigen::VectorXd PairProducts(const Eigen::VectorXd& q) {
+  Eigen::VectorXd z;
+  PairProductsInto(q, z);
   return z;
 }
 
@@ -119,6 +136,37 @@ Eigen::VectorXd PolynomialForce(const Eigen::MatrixXd& K, const PolynomialStiffn
   const Eigen::VectorXd z = PairProducts(q);
   const Eigen::VectorXd w = p.A.transpose() * q + 2 * (p.B * z);
   return K * q + p.A * z + PairJacobianTransposeTimes(q, w);
+}
+
+void CondensedCoordinates(const PolynomialStiffness& p, const Eigen::VectorXd& q, Eigen::VectorXd& eps,
+                          PolynomialScratch& s) {
+  PairProductsInto(q, s.z);
+  s.Az.noalias() = p.A * s.z;
+  s.RAz.noalias() = p.K_plus_root * s.Az;
+  eps = q;
+  eps.noalias() += p.K_plus_root.transpose() * s.RAz;
+}
+
+void CondensedForce(const Eigen::MatrixXd& K, const PolynomialStiffness& p, const Eigen::VectorXd& q,
+                    const Eigen::VectorXd& eps, Eigen::VectorXd& f, PolynomialScratch& s) {
+  s.Ate.noalias() = p.A.transpose() * eps;
+  PairJacobianTransposeTimes(q, s.Ate, s.u);
+  f.noalias() = K * eps;
+  f += s.u;
+}
+
+void CondensedTangent(const Eigen::MatrixXd& K, const PolynomialStiffness& p, const Eigen::VectorXd& q,
+                      const Eigen::VectorXd& eps, Eigen::MatrixXd& T, PolynomialScratch& s) {
+  TimesPairJacobian(p.A, q, s.AJ);
+  T = K + s.AJ + s.AJ.transpose();
+  s.RAJ.noalias() = p.K_plus_root * s.AJ;
+  T.noalias() += s.RAJ.transpose() * s.RAJ;
+  s.Ate.noalias() = p.A.transpose() * eps;
+  AddPairHessian(s.Ate, &T);
+  // 0.5 (T + T^T) in place, entry pair by entry pair (the same numbers).
+  const Eigen::Index n = T.rows();
+  for (Eigen::Index j = 0; j < n; ++j)
+    for (Eigen::Index k = j + 1; k < n; ++k) T(j, k) = T(k, j) = 0.5 * (T(j, k) + T(k, j));
 }
 
 Eigen::VectorXd CondensedForce(const Eigen::MatrixXd& K, const PolynomialStiffness& p, const Eigen::VectorXd& q,

@@ -68,4 +68,20 @@ Eigen::VectorXd CondensedForce(const Eigen::MatrixXd& K, const PolynomialStiffne
 Eigen::MatrixXd CondensedTangent(const Eigen::MatrixXd& K, const PolynomialStiffness& p, const Eigen::VectorXd& q,
                                  const Eigen::VectorXd& eps);
 
+/// The temporaries of the condensed polynomial's functions below, kept by the caller from call
+/// to call so that they allocate nothing once sized (a body's Data; issue 14). Contents mean
+/// nothing between calls.
+struct PolynomialScratch {
+  Eigen::VectorXd z, Az, RAz, Ate, u;
+  Eigen::MatrixXd AJ, RAJ;
+};
+/// The same as StressCoordinates (condensed: eps = q + K^+ A z), CondensedForce and
+/// CondensedTangent, into their outputs' storage; the same numbers.
+void CondensedCoordinates(const PolynomialStiffness& p, const Eigen::VectorXd& q, Eigen::VectorXd& eps,
+                          PolynomialScratch& s);
+void CondensedForce(const Eigen::MatrixXd& K, const PolynomialStiffness& p, const Eigen::VectorXd& q,
+                    const Eigen::VectorXd& eps, Eigen::VectorXd& f, PolynomialScratch& s);
+void CondensedTangent(const Eigen::MatrixXd& K, const PolynomialStiffness& p, const Eigen::VectorXd& q,
+                      const Eigen::VectorXd& eps, Eigen::MatrixXd& T, PolynomialScratch& s);
+
 }  // namespace femb

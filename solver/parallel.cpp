@@ -38,7 +38,7 @@ void BodyThreads::Work(Pass& pass) {
     try {
       (*pass.f)(i);
     } catch (...) {
-      pass.errors[size_t(i)] = std::current_exception();
+      (*pass.errors)[size_t(i)] = std::current_exception();
     }
     pass.done.fetch_add(1, std::memory_order_release);
   }
@@ -70,7 +70,7 @@ void BodyThreads::Helper() {
   }
 }
 
-void BodyThreads::ForEach(int n, const std::function<void(int)>& f) {
+void BodyThreads::ForEach(int n, BodyTask f) {
   if (helpers_.empty() || n <= 1) {
     for (int i = 0; i < n; ++i) f(i);
     return;
@@ -78,7 +78,8 @@ void BodyThreads::ForEach(int n, const std::function<void(int)>& f) {
   Pass pass;
   pass.f = &f;
   pass.n = n;
-  pass.errors.resize(size_t(n));
+  errors_.assign(size_t(n), nullptr);
+  pass.errors = &errors_;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     pass_ = &pass;
@@ -95,7 +96,7 @@ void BodyThreads::ForEach(int n, const std::function<void(int)>& f) {
     pass_ = nullptr;
   }
   while (pass.users.load(std::memory_order_acquire) > 0) std::this_thread::yield();
-  for (const std::exception_ptr& e : pass.errors) {
+  for (const std::exception_ptr& e : errors_) {
     if (e) std::rethrow_exception(e);
   }
 }

@@ -23,6 +23,21 @@ namespace femb {
 /// The processors this process may run on (its CPU affinity), at least 1.
 int DefaultThreads();
 
+/// A callable f(i) passed by reference, without a copy: what ForEach runs. Unlike a
+/// std::function it never allocates (a lambda capturing more than two references would), so a
+/// pass allocates nothing (issue 14). The callable must outlive the pass.
+class BodyTask {
+ public:
+  template <class F>
+  BodyTask(const F& f)  // NOLINT: implicit, from any lambda
+      : object_(&f), call_([](const void* o, int i) { (*static_cast<const F*>(o))(i); }) {}
+  void operator()(int i) const { call_(object_, i); }
+
+ private:
+  const void* object_;
+  void (*call_)(const void*, int);
+};
+
 /// A pool of threads - 1 helper threads that run the bodies of a pass with the calling thread.
 class BodyThreads {
  public:
@@ -36,14 +51,14 @@ class BodyThreads {
   /// Calls f(i) for i in [0, n), each once, on the calling thread and the helpers. f must write
   /// only to slot i of its outputs. An exception thrown by f(i) is rethrown after the pass (the
   /// one of the lowest i, as a serial loop would).
-  void ForEach(int n, const std::function<void(int)>& f);
+  void ForEach(int n, BodyTask f);
 
  private:
   struct Pass {
-    const std::function<void(int)>* f = nullptr;
+    const BodyTask* f = nullptr;
     int n = 0;
     std::atomic<int> next{0}, done{0}, users{0};
-    std::vector<std::exception_ptr> errors;
+    std::vector<std::exception_ptr>* errors = nullptr;  ///< per i; the pool's, kept between passes
   };
   static void Work(Pass& pass);
   void Helper();
@@ -55,6 +70,7 @@ class BodyThreads {
   long generation_ = 0;             ///< counts passes (under mutex_)
   std::atomic<long> published_{0};  ///< generation_, for helpers looking without the lock
   bool stop_ = false;
+  std::vector<std::exception_ptr> errors_;  ///< a pass's (Pass::errors): its storage is reused
 };
 
 }  // namespace femb

@@ -15,22 +15,35 @@ namespace femb {
 
 namespace dynamic_internal {
 
+void StartAssembly(const SystemModel& model, const DofMap& dofs, AssemblyParts& parts, Assembly& out) {
+  out.ok = true;
+  out.message.clear();
+  out.residual.setZero(dofs.n_dofs());
+  out.f_ext.setZero(dofs.n_dofs());
+  out.scale = 0.0;
+  out.roundoff = 0.0;
+  parts.K.clear();
+  parts.C.clear();
+  parts.M.clear();
+  parts.node_forces.f.assign(size_t(model.n_nodes()), Eigen::Matrix<double, 6, 1>::Zero());
+}
+
 Assembly StartAssembly(const SystemModel& model, const DofMap& dofs, AssemblyParts& parts) {
   Assembly out;
-  out.residual = Eigen::VectorXd::Zero(dofs.n_dofs());
-  out.f_ext = Eigen::VectorXd::Zero(dofs.n_dofs());
-  parts.node_forces = ZeroNodeForces(model);
+  StartAssembly(model, dofs, parts, out);
   return out;
 }
 
 void FinishAssembly(const SystemModel& model, const DofMap& dofs, const SystemState& config, double t,
                     const Eigen::VectorXd& W, bool matrices, AssemblyParts& parts, Assembly& out) {
+  // The scratch vectors of this thread (kept: an assembly allocates nothing once they have their size).
+  thread_local Eigen::VectorXd loads, springs, weights;
   const int n = dofs.n_dofs();
-  Eigen::VectorXd loads = Eigen::VectorXd::Zero(n);
+  loads.setZero(n);
   AddNodeLoads(model, config, t, loads, matrices ? &parts.K : nullptr, &parts.node_forces);
   out.residual += loads;
   out.f_ext += loads;
-  Eigen::VectorXd springs = Eigen::VectorXd::Zero(n);
+  springs.setZero(n);
   AddSpringDampers(model, config, W, springs, matrices ? &parts.K : nullptr, matrices ? &parts.C : nullptr, nullptr,
                    &parts.node_forces);
   out.residual += springs;
@@ -40,17 +53,9 @@ void FinishAssembly(const SystemModel& model, const DofMap& dofs, const SystemSt
     out.C = ToMatrix(n, parts.C);
     out.M = ToMatrix(n, parts.M);
   }
-  const Eigen::VectorXd w = ResidualWeights(model, dofs);
-  out.scale = std::max({out.scale, (w.asDiagonal() * springs).norm(), (w.asDiagonal() * loads).norm(), 1e-300});
-  out.node_forces = parts.node_forces;
-}
-
-void ForEachBody(BodyThreads* threads, int n, const std::function<void(int)>& f) {
-  if (threads) {
-    threads->ForEach(n, f);
-  } else {
-    for (int b = 0; b < n; ++b) f(b);
-  }
+  ResidualWeights(model, dofs, weights);
+  out.scale = std::max({out.scale, (weights.asDiagonal() * springs).norm(), (weights.asDiagonal() * loads).norm(), 1e-300});
+  out.node_forces.f = parts.node_forces.f;
 }
 
 bool AddBodyTerms(const SystemModel& model, const std::vector<BodyTerms>& terms, AssemblyParts& parts, Assembly& out) {
@@ -73,10 +78,15 @@ bool AddBodyTerms(const SystemModel& model, const std::vector<BodyTerms>& terms,
 }
 
 Eigen::VectorXd DriveForces(const DofMap& dofs, const Eigen::VectorXd& residual) {
-  Eigen::VectorXd f = Eigen::VectorXd::Zero(residual.size());
+  Eigen::VectorXd f;
+  DriveForces(dofs, residual, f);
+  return f;
+}
+
+void DriveForces(const DofMap& dofs, const Eigen::VectorXd& residual, Eigen::VectorXd& f) {
+  f.setZero(residual.size());
   for (int j = 0; j < dofs.n_dofs(); ++j)
     if (dofs.prescribed(j)) f[j] = -residual[j];
-  return f;
 }
 
 }  // namespace dynamic_internal
@@ -196,21 +206,27 @@ DynamicStepReport MeasureWith(const SystemModel& model, const DofMap& dofs, cons
   DynamicStepReport r;
   r.t = s.t;
   r.external_work = s.external_work;
-  Eigen::VectorXd unused = Eigen::VectorXd::Zero(dofs.n_dofs());
-  AddSpringDampers(model, s.config, s.W, unused, nullptr, nullptr, &r.elastic_energy);  // spring energy
+  if (!model.springs.empty()) {
+    Eigen::VectorXd unused = Eigen::VectorXd::Zero(dofs.n_dofs());
+    AddSpringDampers(model, s.config, s.W, unused, nullptr, nullptr, &r.elastic_energy);  // spring energy
+  }
+  const bool kept = passes.size() == model.bodies.size();
   for (size_t b = 0; b < model.bodies.size(); ++b) {
     const SuperelementBody& body = model.bodies[b];
-    const bool kept = passes.size() == model.bodies.size();
-    const SuperelementBody::Data evaluated =
-        kept ? SuperelementBody::Data{} : body.Evaluate(BodyConfigurationOf(model, s.config, int(b)), s.config.frames[b]);
-    const SuperelementBody::Data& data = kept ? passes[b].data : evaluated;
-    const Eigen::VectorXd w = kept ? passes[b].w : BodyVelocityOf(model, dofs, s, int(b));
-    r.kinetic_energy += body.KineticEnergy(data, w);
-    r.elastic_energy += body.ElasticEnergy(data);
-    Eigen::Vector3d L, H;
-    body.Momentum(data, w, &L, &H);
-    r.linear_momentum += L;
-    r.angular_momentum += H;
+    const auto measure = [&](const SuperelementBody::Data& data, const Eigen::VectorXd& w) {
+      r.kinetic_energy += body.KineticEnergy(data, w);
+      r.elastic_energy += body.ElasticEnergy(data);
+      Eigen::Vector3d L, H;
+      body.Momentum(data, w, &L, &H);
+      r.linear_momentum += L;
+      r.angular_momentum += H;
+    };
+    if (kept) {
+      measure(passes[b].data, passes[b].w);  // the converged iteration's data: nothing evaluated here
+    } else {
+      measure(body.Evaluate(BodyConfigurationOf(model, s.config, int(b)), s.config.frames[b]),
+              BodyVelocityOf(model, dofs, s, int(b)));
+    }
   }
   return r;
 }
@@ -233,6 +249,7 @@ DynamicResult SolveDynamic(const SystemModel& model, DynamicState& state, const 
   IterationMatrix matrix;
   BodyThreads threads(options.threads);
   BodyWorkspace work;
+  DynamicState next;  // the step's result; its storage is reused from step to step
   // Time is counted in steps: t = t_base + n h while the step stays nominal (summing h over 1e6
   // steps drifted by 1e-8 s and left a last step of 1e-8 s that Newton could not take), and a
   // remainder below 1% of a step is merged into the last one.
@@ -269,7 +286,6 @@ DynamicResult SolveDynamic(const SystemModel& model, DynamicState& state, const 
       const double remaining = options.end_time - state.t;
       if (remaining <= 1.01 * h) h = remaining;
     }
-    DynamicState next;
     matrix.with_this_factor = 0;  // a step may use the kept factor for reuse_max_iterations iterations
     const double t_new =
         options.adaptive && control.at_breakpoint() ? std::nextafter(control.boundary(), -HUGE_VAL) : state.t + h;
@@ -277,9 +293,9 @@ DynamicResult SolveDynamic(const SystemModel& model, DynamicState& state, const 
         options.integrator == Integrator::kMidpoint
             ? MidpointStep(model, dofs, options, triples, state, h, t_new, matrix, threads, next)
             : GeneralizedAlphaStep(model, dofs, options, state, h, t_new, matrix, threads, work, next);
-    if (!step.converged && result.steps == 0 && result.newton_cuts == 0 && step.singular_matrix.size() > 0) {
+    if (!step.converged && result.steps == 0 && result.newton_cuts == 0 && step.singular_matrix) {
       // The first iteration matrix is singular: the model's, not the step's.
-      const std::string why = DescribeSingular(model, dofs, state.config, step.singular_matrix);
+      const std::string why = DescribeSingular(model, dofs, state.config, *step.singular_matrix);
       if (!why.empty()) {
         result.message = "iteration matrix at the start: " + why;
         return result;

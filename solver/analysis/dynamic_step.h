@@ -6,6 +6,7 @@
 
 #include <Eigen/Core>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -32,6 +33,8 @@ struct AssemblyParts {
   NodeForces node_forces;
 };
 
+// Starts an assembly in `out` (residual and f_ext zero, parts emptied): storage reused.
+void StartAssembly(const SystemModel& model, const DofMap& dofs, AssemblyParts& parts, Assembly& out);
 Assembly StartAssembly(const SystemModel& model, const DofMap& dofs, AssemblyParts& parts);
 
 // Nodal loads at t, spring-dampers at velocities W (both on `config`), the joints' geometric
@@ -39,8 +42,15 @@ Assembly StartAssembly(const SystemModel& model, const DofMap& dofs, AssemblyPar
 void FinishAssembly(const SystemModel& model, const DofMap& dofs, const SystemState& config, double t,
                     const Eigen::VectorXd& W, bool matrices, AssemblyParts& parts, Assembly& out);
 
-// f(b) for every body, on the pool when there is one.
-void ForEachBody(BodyThreads* threads, int n, const std::function<void(int)>& f);
+// f(b) for every body, on the pool when there is one (f is called, never copied).
+template <class F>
+void ForEachBody(BodyThreads* threads, int n, const F& f) {
+  if (threads) {
+    threads->ForEach(n, f);
+  } else {
+    for (int b = 0; b < n; ++b) f(b);
+  }
+}
 
 // What the residual pass keeps of one body for the iteration matrix (AddDynamicMatrices).
 struct BodyPass {
@@ -57,6 +67,7 @@ struct BodyTerms {
   Eigen::MatrixXd K, C, M;      // empty in a residual-only pass
   double scale = 0.0, roundoff = 0.0;
   std::vector<MapEntry> map;
+  Eigen::VectorXd f_int, f_in, f_acc, f_quadratic;  // the pass's scratch (storage kept)
 };
 
 // The bodies' storage of a dynamic analysis, kept from one Newton iteration and one step to the
@@ -66,10 +77,24 @@ struct BodyWorkspace {
   std::vector<BodyTerms> terms;  // the last residual pass's; their maps serve the matrix pass too
   struct BodyMatrices {
     Eigen::MatrixXd K, C, M;
+    Eigen::MatrixXd d_load, inertia_K;  // scratch (storage kept)
+    BodyVelocity wdot;
+    Eigen::VectorXd unused;
   };
   std::vector<BodyMatrices> matrices;  // the last matrix pass
   Triplets K, C, M;                    // its system triplets (cleared, capacity kept)
   TripletAssembler K_build, C_build, M_build;  // their sparse matrices (slots kept)
+  // The system-level storage of an assembly and of a step, kept so that neither allocates.
+  AssemblyParts parts;
+  Assembly assembly;
+  std::vector<Eigen::Matrix<double, 6, 1>> node_acc;
+  std::vector<NodeJacobian> dc, dacc;
+  Eigen::VectorXd unused, column, weights, dq, delta;
+  // ResidualWeights(model, dofs), computed on the first call (they depend on the model only).
+  const Eigen::VectorXd& Weights(const SystemModel& model, const DofMap& dofs) {
+    if (weights.size() != dofs.n_dofs()) weights = ResidualWeights(model, dofs);
+    return weights;
+  }
 };
 
 // The generalized-alpha residual at state s and time t: frames solved (s.config.frames
@@ -77,6 +102,9 @@ struct BodyWorkspace {
 // matrices, which an iteration builds only when it needs them (not on the converged one, not
 // with a kept factorization). Bodies on `threads` threads; the result does not depend on their
 // number.
+// Into `out` (its storage reused: no allocation once the workspace has its sizes).
+void AssembleDynamicResidual(const SystemModel& model, const DofMap& dofs, DynamicState& s, double t,
+                             BodyWorkspace& work, BodyThreads* threads, Assembly& out);
 Assembly AssembleDynamicResidual(const SystemModel& model, const DofMap& dofs, DynamicState& s, double t,
                                  BodyWorkspace& work, BodyThreads* threads = nullptr);
 
@@ -104,6 +132,7 @@ bool AddBodyTerms(const SystemModel& model, const std::vector<BodyTerms>& terms,
 // The generalized forces the prescribed motions exert: minus the residual on the prescribed
 // coordinates (zero elsewhere).
 Eigen::VectorXd DriveForces(const DofMap& dofs, const Eigen::VectorXd& residual);
+void DriveForces(const DofMap& dofs, const Eigen::VectorXd& residual, Eigen::VectorXd& f);
 
 // The factorized iteration matrix, kept across iterations and steps with Jacobian reuse.
 struct IterationMatrix {
@@ -112,8 +141,10 @@ struct IterationMatrix {
   int with_this_factor = 0;
   long factorizations = 0;
 
-  // Factors S unless the kept factor may be reused; false when S is singular.
-  bool Update(const DofMap& dofs, const DynamicOptions& options, double h, const std::function<SystemMatrix()>& S) {
+  // Factors S() (a callable returning the matrix) unless the kept factor may be reused; false
+  // when S is singular.
+  template <class MatrixOf>
+  bool Update(const DofMap& dofs, const DynamicOptions& options, double h, const MatrixOf& S) {
     if (options.reuse_jacobian && solver.valid() && factored_h == h && with_this_factor < options.reuse_max_iterations) {
       ++with_this_factor;
       return true;
@@ -127,13 +158,14 @@ struct IterationMatrix {
 
   // Newton's increment S^-1 r with the kept or a new factor. False when S is singular or the
   // increment is not finite; S is then in `singular`.
-  bool Increment(const DofMap& dofs, const DynamicOptions& options, double h, const std::function<SystemMatrix()>& S,
-                 const Eigen::VectorXd& r, Eigen::VectorXd& delta, SystemMatrix& singular) {
+  template <class MatrixOf>
+  bool Increment(const DofMap& dofs, const DynamicOptions& options, double h, const MatrixOf& S,
+                 const Eigen::VectorXd& r, Eigen::VectorXd& delta, std::unique_ptr<SystemMatrix>& singular) {
     if (Update(dofs, options, h, S)) {
-      delta = solver.Solve(r);
+      solver.Solve(r, delta);
       if (delta.allFinite()) return true;
     }
-    singular = S();
+    singular = std::make_unique<SystemMatrix>(S());
     return false;
   }
 };
@@ -155,7 +187,9 @@ struct DivergenceTest {
 struct StepOutcome {
   bool converged = false;
   int iterations = 0;
-  SystemMatrix singular_matrix;  ///< the iteration matrix when its factorization failed
+  /// The iteration matrix when its factorization failed (empty otherwise; a pointer, since an
+  /// empty sparse matrix allocates on construction and a step allocates nothing).
+  std::unique_ptr<SystemMatrix> singular_matrix;
   bool passes_kept = false;  ///< the workspace's passes hold the bodies' data at the converged state
 };
 

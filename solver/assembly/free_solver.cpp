@@ -68,9 +68,11 @@ bool FreeSolver::Factor(const DofMap& dofs, const SystemMatrix& S) {
   // matrix's condition grows as h^-2 unscaled). Row and column of multiplier i are scaled by
   // s_i, the largest |S_jj| of the coordinates its equation involves: the factor is of D S D,
   // D = diag(1, ..., s_i), and Solve returns D (D S D)^-1 D r.
-  scale_ = Eigen::VectorXd::Ones(n);
+  scale_.setOnes(n);
   if (dofs.n_multipliers() > 0) {
-    Eigen::VectorXd diagonal = Eigen::VectorXd::Zero(n), s = Eigen::VectorXd::Zero(n);
+    Eigen::VectorXd &diagonal = diagonal_, &s = multiplier_scale_;
+    diagonal.setZero(n);
+    s.setZero(n);
     for (int c = 0; c < n; ++c)
       for (int p = k.outer[size_t(c)]; p < k.outer[size_t(c) + 1]; ++p)
         if (k.inner[size_t(p)] == c) diagonal[c] = std::abs(k.values[size_t(p)]);
@@ -88,7 +90,8 @@ bool FreeSolver::Factor(const DofMap& dofs, const SystemMatrix& S) {
         k.values[size_t(p)] *= scale_[k.inner[size_t(p)]] * scale_[c];
   }
   // The diagonal scaling d_i = 1 / sqrt|s_ii| of the singularity test below.
-  Eigen::VectorXd d = Eigen::VectorXd::Ones(n);
+  Eigen::VectorXd& d = d_;
+  d.setOnes(n);
   for (int c = 0; c < n; ++c)
     for (int p = k.outer[size_t(c)]; p < k.outer[size_t(c) + 1]; ++p)
       if (k.inner[size_t(p)] == c && k.values[size_t(p)] != 0.0) d[c] = 1.0 / std::sqrt(std::abs(k.values[size_t(p)]));
@@ -125,7 +128,9 @@ bool FreeSolver::Factor(const DofMap& dofs, const SystemMatrix& S) {
   }
   double inverse = 0.0;
   for (int probe = 0; probe < 2; ++probe) {
-    Eigen::VectorXd x(n), y(n);
+    Eigen::VectorXd &x = x_, &y = y_;
+    x.resize(n);
+    y.resize(n);
     for (int i = 0; i < n; ++i) x[i] = ((i * (probe + 3) + probe) % 5 < 2) ? -1.0 : 1.0;
     y = d.cwiseInverse().asDiagonal() * x;
     klu_solve(k.symbolic, k.numeric, n, 1, y.data(), &k.common);
@@ -138,12 +143,18 @@ bool FreeSolver::Factor(const DofMap& dofs, const SystemMatrix& S) {
 }
 
 Eigen::VectorXd FreeSolver::Solve(const Eigen::VectorXd& r) const {
-  Eigen::VectorXd rf(free_.size());
+  Eigen::VectorXd d;
+  Solve(r, d);
+  return d;
+}
+
+void FreeSolver::Solve(const Eigen::VectorXd& r, Eigen::VectorXd& d) const {
+  Eigen::VectorXd& rf = rf_;
+  rf.resize(Eigen::Index(free_.size()));
   for (size_t i = 0; i < free_.size(); ++i) rf[i] = r[free_[i]] * scale_[Eigen::Index(i)];
   if (rf.size() > 0) klu_solve(klu_->symbolic, klu_->numeric, int(rf.size()), 1, rf.data(), &klu_->common);
-  Eigen::VectorXd d = Eigen::VectorXd::Zero(r.size());
+  d.setZero(r.size());
   for (size_t i = 0; i < free_.size(); ++i) d[free_[i]] = rf[i] * scale_[Eigen::Index(i)];
-  return d;
 }
 
 Eigen::VectorXd SolveFree(const DofMap& dofs, const SystemMatrix& S, const Eigen::VectorXd& r) {

@@ -31,6 +31,8 @@ class FreeSolver {
   FreeSolver& operator=(const FreeSolver&) = delete;
   bool Factor(const DofMap& dofs, const SystemMatrix& S);
   Eigen::VectorXd Solve(const Eigen::VectorXd& r) const;
+  /// The same into `d` (its storage reused: no allocation once sized).
+  void Solve(const Eigen::VectorXd& r, Eigen::VectorXd& d) const;
   bool valid() const { return valid_; }
   void Invalidate() { valid_ = false; }
   /// Sparsity patterns analysed, factorizations that pivoted anew (klu_factor), and those that
@@ -44,6 +46,9 @@ class FreeSolver {
   std::unique_ptr<Klu> klu_;
   std::vector<int> free_, position_;
   Eigen::VectorXd scale_;  ///< per free unknown: 1, or a multiplier's scaling (see Factor)
+  // Scratch of Factor and Solve, kept so that neither allocates once sized.
+  Eigen::VectorXd diagonal_, multiplier_scale_, d_, x_, y_;
+  mutable Eigen::VectorXd rf_;
   bool valid_ = false;
   long analysed_ = 0, full_ = 0, refactored_ = 0;
 };

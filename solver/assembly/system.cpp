@@ -74,21 +74,34 @@ const SystemMatrix& TripletAssembler::Build(int n, const Triplets& triplets) {
 
 Eigen::VectorXd GatherBody(const SystemModel& model, const DofMap& dofs, const SystemState& state, int b,
                            const Eigen::VectorXd& W) {
+  Eigen::VectorXd w;
+  GatherBody(model, dofs, state, b, W, w);
+  return w;
+}
+
+void GatherBody(const SystemModel& model, const DofMap& dofs, const SystemState& state, int b,
+                const Eigen::VectorXd& W, Eigen::VectorXd& w) {
   const SuperelementBody& body = model.bodies[b];
-  Eigen::VectorXd w = Eigen::VectorXd::Zero(body.n_coordinates());
+  w.resize(body.n_coordinates());
   for (int a = 0; a < body.n_nodes(); ++a) w.segment<6>(6 * a) = NodeMotion(state, model.body_nodes[b][a], W);
   w.tail(body.n_modes()) = W.segment(dofs.mode_dof(b), body.n_modes());
-  return w;
 }
 
 Eigen::VectorXd GatherBodyAcceleration(const SystemModel& model, const DofMap& dofs, int b,
                                        const std::vector<Eigen::Matrix<double, 6, 1>>& node_acc,
                                        const Eigen::VectorXd& Wdot) {
+  Eigen::VectorXd w;
+  GatherBodyAcceleration(model, dofs, b, node_acc, Wdot, w);
+  return w;
+}
+
+void GatherBodyAcceleration(const SystemModel& model, const DofMap& dofs, int b,
+                            const std::vector<Eigen::Matrix<double, 6, 1>>& node_acc, const Eigen::VectorXd& Wdot,
+                            Eigen::VectorXd& w) {
   const SuperelementBody& body = model.bodies[b];
-  Eigen::VectorXd w = Eigen::VectorXd::Zero(body.n_coordinates());
+  w.resize(body.n_coordinates());
   for (int a = 0; a < body.n_nodes(); ++a) w.segment<6>(6 * a) = node_acc[model.body_nodes[b][a]];
   w.tail(body.n_modes()) = Wdot.segment(dofs.mode_dof(b), body.n_modes());
-  return w;
 }
 
 void AddBodyNodeForces(const SystemModel& model, int b, const Eigen::VectorXd& r_b, NodeForces& forces) {
@@ -222,9 +235,15 @@ void AddSpringDampers(const SystemModel& model, const SystemState& state, const 
 }
 
 Eigen::VectorXd ResidualWeights(const SystemModel& model, const DofMap& dofs) {
+  Eigen::VectorXd w;
+  ResidualWeights(model, dofs, w);
+  return w;
+}
+
+void ResidualWeights(const SystemModel& model, const DofMap& dofs, Eigen::VectorXd& w) {
   double L = BoundingDiagonal(model.node_x0);
   if (!(L > 0)) L = 1.0;
-  Eigen::VectorXd w = Eigen::VectorXd::Ones(dofs.n_dofs());
+  w.setOnes(dofs.n_dofs());
   for (int k = 0; k < model.n_nodes(); ++k) {
     const int first = dofs.node_first(k), j = dofs.joint_of(k);
     if (j < 0) {
@@ -245,7 +264,6 @@ Eigen::VectorXd ResidualWeights(const SystemModel& model, const DofMap& dofs) {
   }
   // The multipliers' rows hold constraint violations, not forces: LoopViolation judges them.
   if (dofs.n_multipliers() > 0) w.tail(dofs.n_multipliers()).setZero();
-  return w;
 }
 
 double FreeNorm(const DofMap& dofs, const Eigen::VectorXd& r, const Eigen::VectorXd& weights) {

@@ -49,10 +49,16 @@ void AddSpringDampers(const SystemModel& model, const SystemState& state, const 
 /// coordinate velocities W.
 Eigen::VectorXd GatherBody(const SystemModel& model, const DofMap& dofs, const SystemState& state, int b,
                            const Eigen::VectorXd& W);
+/// The same into `w` (its storage reused).
+void GatherBody(const SystemModel& model, const DofMap& dofs, const SystemState& state, int b,
+                const Eigen::VectorXd& W, Eigen::VectorXd& w);
 /// Body b's node accelerations (with the joints' convective terms) and modal accelerations.
 Eigen::VectorXd GatherBodyAcceleration(const SystemModel& model, const DofMap& dofs, int b,
                                        const std::vector<Eigen::Matrix<double, 6, 1>>& node_acc,
                                        const Eigen::VectorXd& Wdot);
+void GatherBodyAcceleration(const SystemModel& model, const DofMap& dofs, int b,
+                            const std::vector<Eigen::Matrix<double, 6, 1>>& node_acc, const Eigen::VectorXd& Wdot,
+                            Eigen::VectorXd& w);
 
 /// The linear map from coordinates to body b's local coordinate increments as (local index,
 /// coordinate, coefficient) entries: dq_b[i] = sum c dz[j].
@@ -96,6 +102,7 @@ class TripletAssembler {
 /// coordinates (mass-normalized: their forces are force / sqrt(mass)). Newton's convergence test
 /// on the weighted norm gives the same answer in SI and in mm-t-s.
 Eigen::VectorXd ResidualWeights(const SystemModel& model, const DofMap& dofs);
+void ResidualWeights(const SystemModel& model, const DofMap& dofs, Eigen::VectorXd& w);
 /// Weighted norm of r over the coordinates solved for.
 double FreeNorm(const DofMap& dofs, const Eigen::VectorXd& r, const Eigen::VectorXd& weights);
 

@@ -132,12 +132,12 @@ void BodyConfigurationOf(const SystemModel& model, const SystemState& state, int
 void ApplyIncrement(const SystemModel& model, const DofMap& dofs, const Eigen::VectorXd& delta, SystemState& state) {
   for (int k = 0; k < model.n_nodes(); ++k) {
     if (dofs.node_count(k) == 0) continue;
-    const Eigen::VectorXd dz = delta.segment(dofs.node_first(k), dofs.node_count(k));
+    const auto dz = delta.segment(dofs.node_first(k), dofs.node_count(k));
     state.z[k] += dz;
     const int j = dofs.joint_of(k);
     Eigen::Matrix<double, 6, 1> d = Eigen::Matrix<double, 6, 1>::Zero();
     if (j < 0) {
-      d = dofs.S(k) * dz;
+      d.noalias() = dofs.S(k) * dz;
       state.x[k] += d.head<3>();
     } else if (model.joints[j].type == JointType::kSpherical) {
       d.tail<3>() = dz;  // the child's own rotation; its position follows the parent
@@ -154,7 +154,8 @@ void ApplyIncrement(const SystemModel& model, const DofMap& dofs, const Eigen::V
 void ApplyPrescribed(const SystemModel& model, const DofMap& dofs, double t, SystemState& state, Eigen::VectorXd* W,
                      Eigen::VectorXd* Wdot) {
   if (model.prescribed.empty()) return;
-  Eigen::VectorXd delta = Eigen::VectorXd::Zero(dofs.n_dofs());
+  thread_local Eigen::VectorXd delta;  // kept: its storage is reused
+  delta.setZero(dofs.n_dofs());
   for (const auto& p : model.prescribed) {
     const int j = dofs.prescribed_index(p);
     delta[j] = p.value(t) - state.z[p.node][p.coordinate];

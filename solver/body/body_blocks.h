@@ -29,6 +29,15 @@ inline Eigen::VectorXd TurnBlocks(const Eigen::Matrix3d& R, const Eigen::VectorX
   return out;
 }
 
+// out = TurnBlocks(R, v, blocks), into out's storage (out may be v itself).
+inline void TurnBlocksInto(const Eigen::Matrix3d& R, const Eigen::VectorXd& v, int blocks, Eigen::VectorXd& out) {
+  if (&out != &v) out = v;
+  for (int a = 0; a < blocks; ++a) {
+    const Eigen::Vector3d x = out.segment<3>(3 * a);
+    out.segment<3>(3 * a) = R * x;
+  }
+}
+
 // X <- blockdiag(A(0), ..., A(blocks - 1), 1) X in place: the first `blocks` row triples each
 // turned by its 3 x 3 matrix A(a), column by column (fixed-size products, no temporaries; a
 // dense n x n product with the block-diagonal Rbar would cost n / 3 times more).

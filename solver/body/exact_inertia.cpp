@@ -11,57 +11,85 @@ namespace femb {
 
 using body_blocks::QuadraticDerivative;
 using body_blocks::TurnBlocks;
+using body_blocks::TurnBlocksInto;
 using body_blocks::TurnColBlocks;
 using body_blocks::TurnRowBlocks;
 
-SuperelementBody::ExactData SuperelementBody::Exact(const Eigen::VectorXd& q, const Kinematics& kin) const {
+void SuperelementBody::Exact(const Eigen::VectorXd& q, const Kinematics& kin, ExactData& d) const {
   const int n = n_coordinates();
-  ExactData d;
   d.Y = kin.B;
   d.Y.noalias() += Phi_rig0_ * kin.Z;
-  const Eigen::VectorXd xq = Xi_stack_ * q;
-  d.H = GammaColumns(q);
-  d.XQ = Eigen::Map<const Eigen::MatrixXd>(xq.data(), n, 9);
+  GammaColumns(q, d.H);
+  // The stacked product Xi q (9 n) is the n x 9 matrix XQ column by column.
+  d.XQ.resize(n, 9);
+  Eigen::Map<Eigen::VectorXd>(d.XQ.data(), Eigen::Index(n) * 9).noalias() = Xi_stack_ * q;
   for (int a = 0; a < 3; ++a)
     for (int b = 0; b < 3; ++b) d.Xq(a, b) = q.dot(d.XQ.col(3 * a + b));
-  return d;
+  d.has_products = false;
 }
 
-Eigen::MatrixXd SuperelementBody::GammaColumns(const Eigen::VectorXd& v) const {
-  const Eigen::VectorXd stacked = Gamma_stack_ * v;
-  return Eigen::Map<const Eigen::MatrixXd>(stacked.data(), n_coordinates(), 3);
+void SuperelementBody::GammaColumns(const Eigen::VectorXd& v, Eigen::MatrixXd& out) const {
+  out.resize(n_coordinates(), 3);
+  Eigen::Map<Eigen::VectorXd>(out.data(), Eigen::Index(n_coordinates()) * 3).noalias() = Gamma_stack_ * v;
 }
 
 const SuperelementBody::ExactData& SuperelementBody::ExactProducts(const Data& data) const {
   const ExactData& d = *data.exact;
-  if (d.MY.size() == 0) {
+  if (!d.has_products) {
     d.MY.noalias() = M_ * d.Y;
     d.HtY.noalias() = d.H.transpose() * d.Y;
+    d.has_products = true;
   }
   return d;
 }
 
 Eigen::VectorXd SuperelementBody::ExactInertiaForce(const Data& data, const BodyVelocity& w,
                                                     const BodyVelocity& wdot, Eigen::VectorXd* f_acc) const {
+  Eigen::VectorXd f;
+  ExactInertiaForce(data, w, wdot, f, f_acc);
+  return f;
+}
+
+// Every temporary in data.exact_scratch (ExactScratch), each product into its own vector before
+// the sums: no allocation once sized, and the same numbers as the expressions they replace.
+void SuperelementBody::ExactInertiaForce(const Data& data, const BodyVelocity& w, const BodyVelocity& wdot,
+                                         Eigen::VectorXd& f, Eigen::VectorXd* f_acc) const {
   const int blocks = 2 * n_nodes_;
   const ExactData& d = *data.exact;
+  ExactScratch& s = data.exact_scratch;
   const Eigen::Matrix3d& R = data.frame.R;
+  const Eigen::Matrix3d Rt = R.transpose();
   const Eigen::MatrixXd& Z = data.kin.Z;
   const Eigen::MatrixXd& B = data.kin.B;
-  const Eigen::VectorXd Rw = TurnBlocks(R.transpose(), w, blocks);
-  const Eigen::Matrix<double, 6, 1> xi = Z * Rw;
+  Eigen::VectorXd& Rw = s.Rw;
+  TurnBlocksInto(Rt, w, blocks, Rw);
+  Eigen::Matrix<double, 6, 1> xi;
+  xi.noalias() = Z * Rw;
   const Eigen::Vector3d v = xi.head<3>(), Om = xi.tail<3>();
-  const Eigen::VectorXd qd = B * Rw;
+  Eigen::VectorXd& qd = s.qd;
+  qd.noalias() = B * Rw;
   // r = Rbar^T wdot - c (header): xidot = Z r, qddot_loc = B r, ydot = Y r.
-  Eigen::VectorXd r = TurnBlocks(R.transpose(), wdot, blocks);
+  Eigen::VectorXd& r = s.r;
+  TurnBlocksInto(Rt, wdot, blocks, r);
   if (f_acc) {
     // The same force at w = 0: r = Rbar^T wdot, xi = qd = y = 0.
-    const Eigen::Vector3d Omd0 = Z.bottomRows<3>() * r;
-    const Eigen::VectorXd yd0 = d.Y * r;
-    const Eigen::VectorXd pi_q_dot0 = M_ * yd0 + d.H * Omd0;
-    Eigen::Matrix<double, 6, 1> f_xi0 = Phi_rig0_.transpose() * pi_q_dot0;
-    f_xi0.tail<3>() += d.H.transpose() * yd0 + d.Xq * Omd0;
-    *f_acc = TurnBlocks(R, Eigen::VectorXd(Z.transpose() * f_xi0 + B.transpose() * pi_q_dot0), blocks);
+    Eigen::Vector3d Omd0;
+    Omd0.noalias() = Z.bottomRows<3>() * r;
+    Eigen::VectorXd& yd0 = s.y;
+    yd0.noalias() = d.Y * r;
+    Eigen::VectorXd& pi_q_dot0 = s.pi_q_dot;
+    pi_q_dot0.noalias() = M_ * yd0;
+    s.t1.noalias() = d.H * Omd0;
+    pi_q_dot0 += s.t1;
+    Eigen::Matrix<double, 6, 1> f_xi0;
+    f_xi0.noalias() = Phi_rig0_.transpose() * pi_q_dot0;
+    Eigen::Vector3d Hty0;
+    Hty0.noalias() = d.H.transpose() * yd0;
+    f_xi0.tail<3>() += Hty0 + d.Xq * Omd0;
+    f_acc->noalias() = Z.transpose() * f_xi0;
+    s.t1.noalias() = B.transpose() * pi_q_dot0;
+    *f_acc += s.t1;
+    TurnBlocksInto(R, *f_acc, blocks, *f_acc);
   }
   for (int a = 0; a < blocks; ++a) r.segment<3>(3 * a) -= Om.cross(Eigen::Vector3d(Rw.segment<3>(3 * a)));
   for (int k = 0; k < n_nodes_; ++k) {
@@ -69,133 +97,230 @@ Eigen::VectorXd SuperelementBody::ExactInertiaForce(const Data& data, const Body
     r.segment<3>(6 * k + 3) -=
         LeftJacobianRate(Eigen::Vector3d(data.q.segment<3>(6 * k + 3)), Eigen::Vector3d(qd.segment<3>(6 * k + 3)));
   }
-  const Eigen::Vector3d Omd = Z.bottomRows<3>() * r;
-  const Eigen::VectorXd y = Phi_rig0_ * xi + qd, yd = d.Y * r;
-  const Eigen::MatrixXd Hd = GammaColumns(qd);
-  const Eigen::VectorXd pi_q = M_ * y + d.H * Om;
-  const Eigen::VectorXd pi_q_dot = M_ * yd + d.H * Omd + Hd * Om;
-  Eigen::VectorXd f_q = pi_q_dot;  // minus dT/dq below
-  Eigen::Vector3d h = d.H.transpose() * y + d.Xq * Om, hd = d.H.transpose() * yd + Hd.transpose() * y + d.Xq * Omd;
+  Eigen::Vector3d Omd;
+  Omd.noalias() = Z.bottomRows<3>() * r;
+  Eigen::VectorXd &y = s.y, &yd = s.yd;
+  y.noalias() = Phi_rig0_ * xi;
+  y += qd;
+  yd.noalias() = d.Y * r;
+  Eigen::MatrixXd& Hd = s.Hd;
+  GammaColumns(qd, Hd);
+  Eigen::VectorXd &pi_q = s.pi_q, &pi_q_dot = s.pi_q_dot;
+  pi_q.noalias() = M_ * y;
+  s.t1.noalias() = d.H * Om;
+  pi_q += s.t1;
+  pi_q_dot.noalias() = M_ * yd;
+  s.t1.noalias() = d.H * Omd;
+  s.t2.noalias() = Hd * Om;
+  pi_q_dot += s.t1;
+  pi_q_dot += s.t2;
+  Eigen::VectorXd& f_q = s.f_q;
+  f_q = pi_q_dot;  // minus dT/dq below
+  Eigen::Vector3d Hty, Htyd, Hdty;
+  Hty.noalias() = d.H.transpose() * y;
+  Htyd.noalias() = d.H.transpose() * yd;
+  Hdty.noalias() = Hd.transpose() * y;
+  Eigen::Vector3d h = Hty + d.Xq * Om, hd = Htyd + Hdty + d.Xq * Omd;
   for (int a = 0; a < 3; ++a) {
-    f_q -= Om[a] * (Gamma_[size_t(a)].transpose() * y);
+    s.t1.noalias() = Gamma_[size_t(a)].transpose() * y;
+    f_q -= Om[a] * s.t1;
     for (int b = 0; b < 3; ++b) {
       f_q -= Om[a] * Om[b] * d.XQ.col(3 * a + b);
       hd[a] += Om[b] * qd.dot(d.XQ.col(3 * a + b) + d.XQ.col(3 * b + a));
     }
   }
   // pi_xi = Phi_rig0^T pi_q + [0; h]; f_xi = d/dt pi_xi + Kirchhoff's terms.
-  Eigen::Matrix<double, 6, 1> pi_xi = Phi_rig0_.transpose() * pi_q;
-  Eigen::Matrix<double, 6, 1> f_xi = Phi_rig0_.transpose() * pi_q_dot;
+  Eigen::Matrix<double, 6, 1> pi_xi, f_xi;
+  pi_xi.noalias() = Phi_rig0_.transpose() * pi_q;
+  f_xi.noalias() = Phi_rig0_.transpose() * pi_q_dot;
   pi_xi.tail<3>() += h;
   f_xi.tail<3>() += hd;
   const Eigen::Vector3d pi_v = pi_xi.head<3>(), pi_w = pi_xi.tail<3>();
   f_xi.head<3>() += Om.cross(pi_v);
   f_xi.tail<3>() += Om.cross(pi_w) + v.cross(pi_v);
-  return TurnBlocks(R, Eigen::VectorXd(Z.transpose() * f_xi + B.transpose() * f_q), blocks);
+  f.noalias() = Z.transpose() * f_xi;
+  s.t1.noalias() = B.transpose() * f_q;
+  f += s.t1;
+  TurnBlocksInto(R, f, blocks, f);
 }
 
 Eigen::MatrixXd SuperelementBody::ExactGyroscopic(const Data& data, const BodyVelocity& w) const {
+  Eigen::MatrixXd G;
+  ExactGyroscopic(data, w, G);
+  return G;
+}
+
+void SuperelementBody::ExactGyroscopic(const Data& data, const BodyVelocity& w, Eigen::MatrixXd& G) const {
   // ExactInertiaForce is A(q) wdot + g(q, w), g quadratic in w with no wdot: its derivative by
   // w is that of g. Forward mode by hand: every quantity of the force that depends on w carries
-  // its n columns d/dw (prefix d), in the order of ExactInertiaForce.
+  // its n columns d/dw (prefix d), in the order of ExactInertiaForce. The temporaries are
+  // data.exact_scratch's, each product into its own before the sums (as ExactInertiaForce).
   const int n = n_coordinates(), blocks = 2 * n_nodes_;
   const ExactData& d = ExactProducts(data);
+  ExactScratch& s = data.exact_scratch;
   const Eigen::Matrix3d& R = data.frame.R;
   const Eigen::MatrixXd& Z = data.kin.Z;
   const Eigen::MatrixXd& B = data.kin.B;
   const Eigen::Matrix3d Rt = R.transpose();
-  const auto times_Rbar_t = [&](Eigen::MatrixXd X) {  // X Rbar^T
-    TurnColBlocks(X, blocks, [&](int) { return Rt; });
-    return X;
-  };
-  const Eigen::VectorXd Rw = TurnBlocks(R.transpose(), w, blocks);
-  const Eigen::Matrix<double, 6, 1> xi = Z * Rw;
+  Eigen::VectorXd& Rw = s.Rw;
+  TurnBlocksInto(Rt, w, blocks, Rw);
+  Eigen::Matrix<double, 6, 1> xi;
+  xi.noalias() = Z * Rw;
   const Eigen::Vector3d v = xi.head<3>(), Om = xi.tail<3>();
-  const Eigen::MatrixXd dxi = times_Rbar_t(Z);
-  const Eigen::MatrixXd dv = dxi.topRows<3>(), dOm = dxi.bottomRows<3>();
-  const Eigen::VectorXd qd = B * Rw;
-  const Eigen::MatrixXd dqd = times_Rbar_t(B);
+  Eigen::MatrixXd& dxi = s.dxi;  // Z Rbar^T
+  dxi = Z;
+  TurnColBlocks(dxi, blocks, [&](int) { return Rt; });
+  Eigen::MatrixXd &dv = s.dv, &dOm = s.dOm;
+  dv = dxi.topRows<3>();
+  dOm = dxi.bottomRows<3>();
+  Eigen::VectorXd& qd = s.qd;
+  qd.noalias() = B * Rw;
+  Eigen::MatrixXd& dqd = s.dqd;  // B Rbar^T
+  dqd = B;
+  TurnColBlocks(dqd, blocks, [&](int) { return Rt; });
   // r = Rbar^T wdot - c(w): dr = -dc. d(Rbar^T w) = Rbar^T: block a is R^T at column block a.
-  Eigen::MatrixXd dr = Eigen::MatrixXd::Zero(n, n);
+  Eigen::MatrixXd& dr = s.dr;
+  dr.setZero(n, n);
   const Eigen::Matrix3d Om_x = Skew<double>(Om);
+  Eigen::MatrixXd &t3 = s.t3, &t4 = s.t4, &t5 = s.t5, &t6 = s.t6;
   for (int a = 0; a < blocks; ++a) {
     dr.middleRows<3>(3 * a).noalias() += Skew<double>(Eigen::Vector3d(Rw.segment<3>(3 * a))) * dOm;
     dr.block<3, 3>(3 * a, 3 * a) -= Om_x * Rt;
   }
   for (int k = 0; k < n_nodes_; ++k) {
-    dr.middleRows<3>(6 * k) -= -Skew<double>(Eigen::Vector3d(qd.segment<3>(6 * k))) * dOm + Om_x * dqd.middleRows<3>(6 * k);
+    const Eigen::Matrix3d minus_qd_x = -Skew<double>(Eigen::Vector3d(qd.segment<3>(6 * k)));
+    t3.noalias() = minus_qd_x * dOm;
+    t4.noalias() = Om_x * dqd.middleRows<3>(6 * k);
+    dr.middleRows<3>(6 * k) -= t3 + t4;
     // LeftJacobianRate is quadratic in thetadot: its derivative by polarization, exactly.
     const Eigen::Vector3d theta = data.q.segment<3>(6 * k + 3), thetadot = qd.segment<3>(6 * k + 3);
     const Eigen::Matrix3d DL =
         QuadraticDerivative(thetadot, [&](const Eigen::Vector3d& e) { return LeftJacobianRate(theta, e); });
-    dr.middleRows<3>(6 * k + 3) -= DL * dqd.middleRows<3>(6 * k + 3);
+    t3.noalias() = DL * dqd.middleRows<3>(6 * k + 3);
+    dr.middleRows<3>(6 * k + 3) -= t3;
   }
-  const Eigen::MatrixXd dOmd = Z.bottomRows<3>() * dr;
-  const Eigen::VectorXd y = Phi_rig0_ * xi + qd;
-  const Eigen::MatrixXd dy = Phi_rig0_ * dxi + dqd;
+  Eigen::MatrixXd& dOmd = s.dOmd;
+  dOmd.noalias() = Z.bottomRows<3>() * dr;
+  Eigen::VectorXd& y = s.y;
+  y.noalias() = Phi_rig0_ * xi;
+  y += qd;
+  Eigen::MatrixXd& dy = s.dy;
+  dy.noalias() = Phi_rig0_ * dxi;
+  dy += dqd;
   // Gamma(Om) = sum_a Om_a Gamma_a: the three Gamma_a dqd and Gamma_a^T dy products in one each;
   // the rows y^T Gamma_a dqd as (Gamma_a^T y)^T dqd.
-  Eigen::MatrixXd G_Om = Om[0] * Gamma_[0];
+  Eigen::MatrixXd& G_Om = s.G_Om;
+  G_Om = Om[0] * Gamma_[0];
   for (int a = 1; a < 3; ++a) G_Om += Om[a] * Gamma_[size_t(a)];
-  const Eigen::MatrixXd Hd = GammaColumns(qd);  // Gamma_a qd
-  Eigen::MatrixXd Gty(n, 3);                     // Gamma_a^T y
+  Eigen::MatrixXd& Hd = s.Hd;  // Gamma_a qd
+  GammaColumns(qd, Hd);
+  Eigen::MatrixXd& Gty = s.Gty;  // Gamma_a^T y
+  Gty.resize(n, 3);
   for (int a = 0; a < 3; ++a) Gty.col(a).noalias() = Gamma_[size_t(a)].transpose() * y;
-  const Eigen::VectorXd pi_q = M_ * y + d.H * Om;
+  Eigen::VectorXd& pi_q = s.pi_q;
+  pi_q.noalias() = M_ * y;
+  s.t1.noalias() = d.H * Om;
+  pi_q += s.t1;
   // M dyd and H^T dyd with dyd = Y dr: (M Y) dr and (H^T Y) dr, M Y and H^T Y kept per configuration.
   // d pi_qdot = base + G_Om dqd and df_q = d pi_qdot - G_Om^T dy - Gty dOm with
   // dy = Phi_rig0 dxi + dqd: the two n x n products with G_Om as one, (G_Om - G_Om^T) dqd.
-  Eigen::MatrixXd base = d.MY * dr;
+  Eigen::MatrixXd& base = s.base;
+  base.noalias() = d.MY * dr;
   base.noalias() += d.H * dOmd;
   base.noalias() += Hd * dOm;
-  Eigen::MatrixXd df_q = base;
+  Eigen::MatrixXd& df_q = s.df_q;
+  df_q = base;
   {
-    const Eigen::MatrixXd G_skew = G_Om - G_Om.transpose();
+    Eigen::MatrixXd& G_skew = s.G_skew;
+    G_skew = G_Om - G_Om.transpose();
     df_q.noalias() += G_skew * dqd;
-    const Eigen::MatrixXd GtP = G_Om.transpose() * Phi_rig0_;  // n x 6
+    Eigen::MatrixXd& GtP = s.GtP;  // n x 6
+    GtP.noalias() = G_Om.transpose() * Phi_rig0_;
     df_q.noalias() -= GtP * dxi;
     df_q.noalias() -= Gty * dOm;
   }
-  const Eigen::Vector3d h = d.H.transpose() * y + d.Xq * Om;
-  const Eigen::MatrixXd dh = d.H.transpose() * dy + d.Xq * dOm;
-  Eigen::MatrixXd dhd = d.HtY * dr + d.Xq * dOmd + Gty.transpose() * dqd + Hd.transpose() * dy;
+  Eigen::Vector3d Hty;
+  Hty.noalias() = d.H.transpose() * y;
+  const Eigen::Vector3d h = Hty + d.Xq * Om;
+  Eigen::MatrixXd& dh = s.dh;
+  t3.noalias() = d.H.transpose() * dy;
+  t4.noalias() = d.Xq * dOm;
+  dh = t3 + t4;
+  Eigen::MatrixXd& dhd = s.dhd;
+  dhd.noalias() = d.HtY * dr;
+  t3.noalias() = d.Xq * dOmd;
+  t4.noalias() = Gty.transpose() * dqd;
+  t5.noalias() = Hd.transpose() * dy;
+  dhd += t3;
+  dhd += t4;
+  dhd += t5;
+  Eigen::RowVectorXd &row = s.row, &row2 = s.row2;
+  Eigen::VectorXd& S_ab = s.S_ab;
   for (int a = 0; a < 3; ++a) {
     for (int b = 0; b < 3; ++b) {
       const auto XQab = d.XQ.col(3 * a + b);
-      df_q -= XQab * (Om[b] * dOm.row(a) + Om[a] * dOm.row(b));
-      const Eigen::VectorXd S_ab = XQab + d.XQ.col(3 * b + a);
-      dhd.row(a) += qd.dot(S_ab) * dOm.row(b) + Om[b] * (S_ab.transpose() * dqd);
+      row = Om[b] * dOm.row(a) + Om[a] * dOm.row(b);
+      df_q.noalias() -= XQab * row;
+      S_ab = XQab + d.XQ.col(3 * b + a);
+      row2.noalias() = S_ab.transpose() * dqd;
+      dhd.row(a) += qd.dot(S_ab) * dOm.row(b) + Om[b] * row2;
     }
   }
-  Eigen::Matrix<double, 6, 1> pi_xi = Phi_rig0_.transpose() * pi_q;
+  Eigen::Matrix<double, 6, 1> pi_xi;
+  pi_xi.noalias() = Phi_rig0_.transpose() * pi_q;
   pi_xi.tail<3>() += h;
   const Eigen::Vector3d pi_v = pi_xi.head<3>(), pi_w = pi_xi.tail<3>();
   // d pi_q = M dy + H dOm enters only through Phi_rig0^T: 6 rows.
-  Eigen::MatrixXd dpi_xi = PtM_ * dy + (Phi_rig0_.transpose() * d.H) * dOm;
+  Eigen::MatrixXd& dpi_xi = s.dpi_xi;
+  dpi_xi.noalias() = PtM_ * dy;
+  s.PH.noalias() = Phi_rig0_.transpose() * d.H;
+  s.t8.noalias() = s.PH * dOm;  // 6 x n
+  dpi_xi += s.t8;
   dpi_xi.bottomRows<3>() += dh;
-  Eigen::MatrixXd df_xi = Phi_rig0_.transpose() * base;
-  df_xi.noalias() += (Phi_rig0_.transpose() * G_Om) * dqd;
+  Eigen::MatrixXd& df_xi = s.df_xi;
+  df_xi.noalias() = Phi_rig0_.transpose() * base;
+  s.PG.noalias() = Phi_rig0_.transpose() * G_Om;
+  df_xi.noalias() += s.PG * dqd;
   df_xi.bottomRows<3>() += dhd;
-  const Eigen::MatrixXd dpi_v = dpi_xi.topRows<3>(), dpi_w = dpi_xi.bottomRows<3>();
-  df_xi.topRows<3>() += -Skew<double>(pi_v) * dOm + Om_x * dpi_v;
-  df_xi.bottomRows<3>() += -Skew<double>(pi_w) * dOm + Om_x * dpi_w - Skew<double>(pi_v) * dv + Skew<double>(v) * dpi_v;
-  Eigen::MatrixXd G = Z.transpose() * df_xi + B.transpose() * df_q;
+  Eigen::MatrixXd &dpi_v = s.dpi_v, &dpi_w = s.dpi_w;
+  dpi_v = dpi_xi.topRows<3>();
+  dpi_w = dpi_xi.bottomRows<3>();
+  const Eigen::Matrix3d minus_pi_v_x = -Skew<double>(pi_v), minus_pi_w_x = -Skew<double>(pi_w);
+  t3.noalias() = minus_pi_v_x * dOm;
+  t4.noalias() = Om_x * dpi_v;
+  df_xi.topRows<3>() += t3 + t4;
+  t3.noalias() = minus_pi_w_x * dOm;
+  t4.noalias() = Om_x * dpi_w;
+  t5.noalias() = Skew<double>(pi_v) * dv;
+  t6.noalias() = Skew<double>(v) * dpi_v;
+  df_xi.bottomRows<3>() += t3 + t4 - t5 + t6;
+  G.noalias() = Z.transpose() * df_xi;
+  s.t7.noalias() = B.transpose() * df_q;
+  G += s.t7;
   TurnRowBlocks(G, blocks, [&](int) { return R; });
-  return G;
 }
 
 const Eigen::MatrixXd& SuperelementBody::ExactMass(const Data& data) const {
-  if (data.exact_mass) return *data.exact_mass;
+  if (data.has_exact_mass) return data.exact_mass;
   const ExactData& d = ExactProducts(data);
   const Eigen::Matrix3d& R = data.frame.R;
-  const Eigen::MatrixXd Zr = data.kin.Z.bottomRows<3>();
-  const Eigen::MatrixXd YHZ = d.Y.transpose() * d.H * Zr;
-  Eigen::MatrixXd Mg = d.Y.transpose() * d.MY + YHZ + YHZ.transpose() + Zr.transpose() * d.Xq * Zr;
+  const auto Zr = data.kin.Z.bottomRows<3>();
+  BodyScratch& s = data.scratch;
+  s.n3a.noalias() = d.Y.transpose() * d.H;  // n x 3
+  Eigen::MatrixXd& YHZ = s.nn1;              // (Y^T H) Zr
+  YHZ.noalias() = s.n3a * Zr;
+  s.n3b.noalias() = Zr.transpose() * d.Xq;  // n x 3
+  Eigen::MatrixXd& Mg = data.exact_mass;
+  Mg.noalias() = d.Y.transpose() * d.MY;
+  Mg += YHZ;
+  Mg += YHZ.transpose();
+  Mg.noalias() += s.n3b * Zr;
   // Rbar Mbar Rbar^T block by block.
   const Eigen::Matrix3d Rt = R.transpose();
   TurnRowBlocks(Mg, 2 * n_nodes_, [&](int) { return R; });
   TurnColBlocks(Mg, 2 * n_nodes_, [&](int) { return Rt; });
-  data.exact_mass = std::move(Mg);
-  return *data.exact_mass;
+  data.has_exact_mass = true;
+  return Mg;
 }
 
 Eigen::MatrixXd SuperelementBody::ExactInertiaConfigurationTangent(const Data& d, const BodyVelocity& w,

@@ -15,6 +15,7 @@ constexpr double kMaxLocalRotation = 2.0;
 }  // namespace
 
 using body_blocks::TurnBlocks;
+using body_blocks::TurnBlocksInto;
 using body_blocks::TurnColBlocks;
 using body_blocks::TurnRowBlocks;
 
@@ -152,10 +153,12 @@ void SuperelementBody::ComputeKinematics(const Eigen::VectorXd& q, Kinematics& k
     block.setIdentity();
     block.block<3, 3>(0, 3) = -r_skew;
     Jinv[size_t(a)] = LeftJacobianInverse<double>(Eigen::Vector3d(q.segment<3>(6 * a + 3)));
-    W.middleCols<3>(6 * a + 3) = Phi_CB_.middleCols<3>(6 * a + 3) * Jinv[size_t(a)];
+    W.middleCols<3>(6 * a + 3).noalias() = Phi_CB_.middleCols<3>(6 * a + 3) * Jinv[size_t(a)];
     // S = Phi_CB D Phi_rig = W Phi_rig (FrameMatrix, with D's blocks at hand).
     k.S.leftCols<3>() += W.middleCols<3>(6 * a);
-    k.S.rightCols<3>() += W.middleCols<3>(6 * a + 3) - W.middleCols<3>(6 * a) * r_skew;
+    Eigen::Matrix<double, 6, 3> Wr;  // fixed size: no temporary on the heap
+    Wr.noalias() = W.middleCols<3>(6 * a) * r_skew;
+    k.S.rightCols<3>() += W.middleCols<3>(6 * a + 3) - Wr;
   }
   // S^-1 once (a 6 x 6 LU); Z and the elastic tangent's K4 take fixed-size products with it
   // instead of a triangular solve with n right-hand sides each.
@@ -188,15 +191,16 @@ void SuperelementBody::Evaluate(const BodyConfiguration& c, const FrameSolution&
   LocalCoordinates(d.c, frame, d.q);
   ComputeKinematics(d.q, d.kin);
   if (has_exact_inertia()) {
-    d.exact = Exact(d.q, d.kin);
+    if (!d.exact) d.exact.emplace();
+    Exact(d.q, d.kin, *d.exact);
   } else {
     d.exact.reset();
   }
   d.has_maps = false;
   d.local_force.valid = false;
-  d.exact_mass.reset();
-  d.sigma_q.reset();
-  d.eps.reset();
+  d.has_exact_mass = false;
+  d.has_sigma_q = false;
+  d.has_eps = false;
 }
 
 const BodyVelocityMaps& SuperelementBody::MapsOf(const Data& d) const {
@@ -226,11 +230,23 @@ double SuperelementBody::RoundOffForce(const BodyConfiguration& c) const {
 }
 
 FrameSolution SuperelementBody::SolveFrameFrom(const BodyConfiguration& c, const FrameSolution& last) const {
-  const FrameSolution frame = SolveFrame(c, last);
-  return frame.ok ? frame : SolveFrame(c, GuessFrame(c));
+  Eigen::VectorXd q;
+  return SolveFrameFrom(c, last, q);
+}
+
+FrameSolution SuperelementBody::SolveFrameFrom(const BodyConfiguration& c, const FrameSolution& last,
+                                               Eigen::VectorXd& q) const {
+  const FrameSolution frame = SolveFrame(c, last, q);
+  return frame.ok ? frame : SolveFrame(c, GuessFrame(c), q);
 }
 
 FrameSolution SuperelementBody::SolveFrame(const BodyConfiguration& c, const FrameSolution& guess) const {
+  Eigen::VectorXd q;
+  return SolveFrame(c, guess, q);
+}
+
+FrameSolution SuperelementBody::SolveFrame(const BodyConfiguration& c, const FrameSolution& guess,
+                                           Eigen::VectorXd& q) const {
   FrameSolution frame = guess;
   frame.ok = false;
   // Translations relative to the body size, plus the round-off of the absolute positions (a
@@ -239,10 +255,10 @@ FrameSolution SuperelementBody::SolveFrame(const BodyConfiguration& c, const Fra
   for (int k = 0; k < n_nodes_; ++k) size = std::max(size, X_[k].norm());
   for (const Eigen::Vector3d& x : c.x) far = std::max(far, x.norm());
   const double tolerance = 1e-13 * size + 32 * std::numeric_limits<double>::epsilon() * far;
-  Eigen::VectorXd q(n_coordinates());
   for (int it = 0; it < 30; ++it) {
     LocalCoordinates(c, frame, q);
-    Eigen::Matrix<double, 6, 1> g = Phi_CB_ * q;
+    Eigen::Matrix<double, 6, 1> g;
+    g.noalias() = Phi_CB_ * q;
     frame.iterations = it;
     if (g.head<3>().norm() <= std::max(tolerance, 1e-300) && g.tail<3>().norm() <= 1e-13) {
       // A root with local rotations beyond kMaxLocalRotation is a spurious branch of the log
@@ -260,12 +276,14 @@ FrameSolution SuperelementBody::SolveFrame(const BodyConfiguration& c, const Fra
 }
 
 const Eigen::MatrixXd& SuperelementBody::SigmaProducts(const Data& d) const {
-  if (!d.sigma_q) {
+  if (!d.has_sigma_q) {
     const int n = n_coordinates();
-    const Eigen::VectorXd stacked = K_sigma_stack_ * d.q;
-    d.sigma_q = Eigen::Map<const Eigen::MatrixXd>(stacked.data(), n, kInertiaLoadCaseCount);
+    // The stacked product K_sigma q (12 n) is the n x 12 matrix column by column.
+    d.sigma_q.resize(n, kInertiaLoadCaseCount);
+    Eigen::Map<Eigen::VectorXd>(d.sigma_q.data(), Eigen::Index(n) * kInertiaLoadCaseCount).noalias() = K_sigma_stack_ * d.q;
+    d.has_sigma_q = true;
   }
-  return *d.sigma_q;
+  return d.sigma_q;
 }
 
 const Eigen::VectorXd& SuperelementBody::LocalForce(const Data& d, const InertiaLoadFactors* load) const {
@@ -276,7 +294,11 @@ const Eigen::VectorXd& SuperelementBody::LocalForce(const Data& d, const Inertia
   if (kept.valid && kept.a == a) return kept.Q;
   const Eigen::VectorXd& q = d.q;
   if (polynomial_) {
-    kept.Q = polynomial_->cubic() ? PolynomialForce(K_, *polynomial_, q) : CondensedForce(K_, *polynomial_, q, Condensed(d));
+    if (polynomial_->cubic()) {
+      kept.Q = PolynomialForce(K_, *polynomial_, q);
+    } else {
+      CondensedForce(K_, *polynomial_, q, Condensed(d), kept.Q, d.polynomial_scratch);
+    }
   } else {
     kept.Q.resize(q.size());
     kept.Q.noalias() = K_ * q;
@@ -288,36 +310,50 @@ const Eigen::VectorXd& SuperelementBody::LocalForce(const Data& d, const Inertia
 }
 
 const Eigen::VectorXd& SuperelementBody::Condensed(const Data& d) const {
-  if (!d.eps) d.eps = StressCoordinates(d.q);
-  return *d.eps;
+  if (!d.has_eps) {
+    CondensedCoordinates(*polynomial_, d.q, d.eps, d.polynomial_scratch);
+    d.has_eps = true;
+  }
+  return d.eps;
 }
 
-Eigen::MatrixXd SuperelementBody::LocalTangent(const Data& d, const InertiaLoadFactors* load) const {
+void SuperelementBody::LocalTangent(const Data& d, const InertiaLoadFactors* load, Eigen::MatrixXd& K) const {
   const Eigen::VectorXd& q = d.q;
-  Eigen::MatrixXd K = !polynomial_             ? K_
-                      : polynomial_->cubic() ? PolynomialTangent(K_, *polynomial_, q)
-                                             : CondensedTangent(K_, *polynomial_, q, Condensed(d));
+  if (!polynomial_) {
+    K = K_;
+  } else if (polynomial_->cubic()) {
+    K = PolynomialTangent(K_, *polynomial_, q);
+  } else {
+    CondensedTangent(K_, *polynomial_, q, Condensed(d), K, d.polynomial_scratch);
+  }
   if (load && !K_sigma_.empty()) {
     for (int k = 0; k < kInertiaLoadCaseCount; ++k)
       if (load->a[k] != 0.0) K += load->a[k] * K_sigma_[size_t(k)];
   }
-  return K;
 }
 
 InertiaLoadFactors SuperelementBody::InertiaLoads(const Data& d, const BodyVelocity& w, const BodyVelocity& wdot,
                                                    const Eigen::Vector3d& gravity) const {
-  const int n = n_coordinates();
   InertiaLoadFactors out;
-  out.d_w = Eigen::MatrixXd::Zero(12, n);
-  out.d_wdot = Eigen::MatrixXd::Zero(12, n);
+  InertiaLoads(d, w, wdot, gravity, out);
+  return out;
+}
+
+void SuperelementBody::InertiaLoads(const Data& d, const BodyVelocity& w, const BodyVelocity& wdot,
+                                    const Eigen::Vector3d& gravity, InertiaLoadFactors& out) const {
+  const int n = n_coordinates();
+  out.d_w.setZero(12, n);
+  out.d_wdot.setZero(12, n);
   const Eigen::VectorXd& q = d.q;
   const Kinematics& kin = d.kin;
   const FrameSolution& frame = d.frame;
   // Z Rbar^T: node vectors to frame axes, then the frame's part.
-  Eigen::MatrixXd ZR = kin.Z;
-  for (int a = 0; a < 2 * n_nodes_; ++a) ZR.middleCols<3>(3 * a) = kin.Z.middleCols<3>(3 * a) * frame.R.transpose();
+  Eigen::MatrixXd& ZR = d.scratch.n6a;
+  ZR = kin.Z;
+  const Eigen::Matrix3d Rt = frame.R.transpose();
+  for (int a = 0; a < 2 * n_nodes_; ++a) ZR.middleCols<3>(3 * a).noalias() = kin.Z.middleCols<3>(3 * a) * Rt;
   const Eigen::Vector3d omega = ZR.bottomRows<3>() * w;
-  const Eigen::MatrixXd d_omega = ZR.bottomRows<3>();  // 3 x n
+  const auto d_omega = ZR.bottomRows<3>();  // 3 x n
   // Node accelerations in frame axes minus the centrifugal part of the rigid motion.
   Eigen::Matrix<double, 6, 1> acc = ZR * wdot;
   Eigen::Matrix<double, 6, 3> d_acc_d_omega = Eigen::Matrix<double, 6, 3>::Zero();
@@ -327,8 +363,8 @@ InertiaLoadFactors SuperelementBody::InertiaLoads(const Data& d, const BodyVeloc
     // d/d omega [omega (omega . r) - |omega|^2 r] = (omega . r) 1 + omega r^T - 2 r omega^T.
     const Eigen::Matrix3d d_centrifugal =
         omega.dot(r) * Eigen::Matrix3d::Identity() + omega * r.transpose() - 2.0 * r * omega.transpose();
-    acc -= kin.Z.middleCols<3>(6 * a) * centrifugal;
-    d_acc_d_omega -= kin.Z.middleCols<3>(6 * a) * d_centrifugal;
+    acc.noalias() -= kin.Z.middleCols<3>(6 * a) * centrifugal;
+    d_acc_d_omega.noalias() -= kin.Z.middleCols<3>(6 * a) * d_centrifugal;
   }
   out.a.head<3>() = acc.head<3>() - frame.R.transpose() * gravity;
   out.a.segment<3>(3) = acc.tail<3>();
@@ -338,14 +374,18 @@ InertiaLoadFactors SuperelementBody::InertiaLoads(const Data& d, const BodyVeloc
   Eigen::Matrix<double, 6, 3> d_products;
   d_products << 2 * omega.x(), 0, 0, 0, 2 * omega.y(), 0, 0, 0, 2 * omega.z(), omega.y(), omega.x(), 0, omega.z(), 0,
       omega.x(), 0, omega.z(), omega.y();
-  out.d_w.topRows<6>() = d_acc_d_omega * d_omega;
-  out.d_w.bottomRows<6>() = d_products * d_omega;
-  return out;
+  out.d_w.topRows<6>().noalias() = d_acc_d_omega * d_omega;
+  out.d_w.bottomRows<6>().noalias() = d_products * d_omega;
 }
 
 double SuperelementBody::ElasticEnergy(const Data& d) const {
   const Eigen::VectorXd& q = d.q;
-  return polynomial_ ? PolynomialEnergy(K_, *polynomial_, q) : 0.5 * q.dot(K_ * q);
+  if (polynomial_ && polynomial_->cubic()) return PolynomialEnergy(K_, *polynomial_, q);
+  // Linear: q^T K q / 2; the condensed polynomial: eps^T K eps / 2 with the data's eps.
+  const Eigen::VectorXd& e = polynomial_ ? Condensed(d) : q;
+  Eigen::VectorXd& Ke = d.scratch.v1;
+  Ke.noalias() = K_ * e;
+  return 0.5 * e.dot(Ke);
 }
 
 void SuperelementBody::AddGeometricTangent(const Data& d, const Eigen::VectorXd& Q, const Eigen::VectorXd& Qhat,
@@ -354,7 +394,9 @@ void SuperelementBody::AddGeometricTangent(const Data& d, const Eigen::VectorXd&
   const Eigen::VectorXd& q = d.q;
   const Kinematics& kin = d.kin;
   // Fhat, Mhat (n x 6) from Qhat: node rows [0, F~; 0, 0] and [0, 0; 0, M~].
-  Eigen::MatrixXd Fhat = Eigen::MatrixXd::Zero(n, 6), FMhat = Eigen::MatrixXd::Zero(n, 6);
+  Eigen::MatrixXd &Fhat = d.scratch.n6a, &FMhat = d.scratch.n6b;
+  Fhat.setZero(n, 6);
+  FMhat.setZero(n, 6);
   for (int a = 0; a < n_nodes_; ++a) {
     const Eigen::Matrix3d F = Skew<double>(Eigen::Vector3d(Qhat.segment<3>(6 * a)));
     Fhat.block<3, 3>(6 * a, 3) = F;
@@ -363,14 +405,23 @@ void SuperelementBody::AddGeometricTangent(const Data& d, const Eigen::VectorXd&
   }
   Kt.noalias() -= FMhat * kin.Z;  // K3: rotation of the frame
   if (!approximated) {
-    Kt.noalias() -= kin.Z.transpose() * (Fhat.transpose() * kin.B);  // K2: variation of Phi_rig in T (6 x n first)
+    Eigen::MatrixXd& FtB = d.scratch.n6c;  // 6 x n first
+    FtB.noalias() = Fhat.transpose() * kin.B;
+    Kt.noalias() -= kin.Z.transpose() * FtB;  // K2: variation of Phi_rig in T
     // K4: variation of D (exact rotation kinematics), v = P^T Q, P = 1 - D Phi_rig S^-1 Phi_CB.
-    Eigen::VectorXd DtQ = Q;  // D^T Q
+    Eigen::VectorXd& DtQ = d.scratch.v1;  // D^T Q
+    DtQ = Q;
     for (int a = 0; a < n_nodes_; ++a) DtQ.segment<3>(6 * a + 3) = kin.Jinv[size_t(a)].transpose() * Q.segment<3>(6 * a + 3);
-    const Eigen::VectorXd v = Q - Phi_CB_.transpose() * (kin.S_inv.transpose() * (kin.Phi_rig.transpose() * DtQ));
+    Eigen::Matrix<double, 6, 1> PtDtQ;
+    PtDtQ.noalias() = kin.Phi_rig.transpose() * DtQ;
+    const Eigen::Matrix<double, 6, 1> SPtDtQ = kin.S_inv.transpose() * PtDtQ;
+    Eigen::VectorXd& v = d.scratch.v2;
+    v = Q;
+    v.noalias() -= Phi_CB_.transpose() * SPtDtQ;
     // G is block diagonal (a 3 x 3 block per node rotation): T^T G B = sum_a T_a^T (G_a B_a)
     // with T_a, B_a node a's rotation rows.
-    Eigen::Matrix<double, 3, Eigen::Dynamic> GB(3, n);
+    Eigen::MatrixXd& GB = d.scratch.n3a;
+    GB.resize(3, n);
     for (int a = 0; a < n_nodes_; ++a) {
       const Eigen::Matrix3d G = LeftJacobianInverseTransposeDerivative(Eigen::Vector3d(q.segment<3>(6 * a + 3)),
                                                                        Eigen::Vector3d(v.segment<3>(6 * a + 3)));
@@ -388,15 +439,24 @@ void SuperelementBody::ElasticForce(const Data& d, Eigen::VectorXd* f, Eigen::Ma
   const FrameSolution& frame = d.frame;
   if (!load || K_sigma_.empty()) load = nullptr;
   const Eigen::VectorXd& Q = LocalForce(d, load);
-  const Eigen::VectorXd Qhat = options_.approximated ? Eigen::VectorXd(T0_.transpose() * Q)
-                                                     : Eigen::VectorXd(kin.B.transpose() * Q);
+  Eigen::VectorXd& Qhat = d.scratch.v3;  // B^T Q (T0^T Q approximated)
+  Qhat.resize(n);
+  if (options_.approximated) {
+    Qhat.noalias() = T0_.transpose() * Q;
+  } else {
+    Qhat.noalias() = kin.B.transpose() * Q;
+  }
   // Rbar: R_j on every node's force and moment, identity on modal rows.
-  if (f) *f = TurnBlocks(frame.R, Qhat, 2 * n_nodes_);
+  if (f) TurnBlocksInto(frame.R, Qhat, 2 * n_nodes_, *f);
   if (d_load) {
     if (load) {
       // Rbar B^T [K_sigma,k q]: node rows turned by R_j.
-      *d_load = options_.approximated ? Eigen::MatrixXd(T0_.transpose() * SigmaProducts(d))
-                                      : Eigen::MatrixXd(kin.B.transpose() * SigmaProducts(d));
+      d_load->resize(n, kInertiaLoadCaseCount);
+      if (options_.approximated) {
+        d_load->noalias() = T0_.transpose() * SigmaProducts(d);
+      } else {
+        d_load->noalias() = kin.B.transpose() * SigmaProducts(d);
+      }
       TurnRowBlocks(*d_load, 2 * n_nodes_, [&](int) { return frame.R; });
     } else {
       d_load->setZero(n, kInertiaLoadCaseCount);
@@ -406,16 +466,17 @@ void SuperelementBody::ElasticForce(const Data& d, Eigen::VectorXd* f, Eigen::Ma
 
   Eigen::MatrixXd& Kt = *tangent;  // written in place: a kept tangent's storage is reused
   const Eigen::MatrixXd* Kq = &K_;
-  Eigen::MatrixXd Kq_loaded;
   if (polynomial_ || (load && !K_sigma_.empty())) {
-    Kq_loaded = LocalTangent(d, load);
-    Kq = &Kq_loaded;
+    LocalTangent(d, load, d.scratch.nn1);
+    Kq = &d.scratch.nn1;
   }
+  Eigen::MatrixXd& KB = d.scratch.nn2;
+  KB.noalias() = *Kq * kin.B;
   Kt.resize(n, n);
   if (options_.approximated) {
-    Kt.noalias() = T0_.transpose() * (*Kq * kin.B);
+    Kt.noalias() = T0_.transpose() * KB;
   } else {
-    Kt.noalias() = kin.B.transpose() * (*Kq * kin.B);  // K1
+    Kt.noalias() = kin.B.transpose() * KB;  // K1
   }
   if (options_.full_tangent) AddGeometricTangent(d, Q, Qhat, options_.approximated, Kt);
   // Rbar Kt Rbar^T, block by block.
@@ -453,16 +514,18 @@ void SuperelementBody::VelocityMaps(const Data& d, Eigen::MatrixXd* P, Eigen::Ma
   const BodyConfiguration& c = d.c;
   const FrameSolution& frame = d.frame;
   const Kinematics& kin = d.kin;
-  *P = Eigen::MatrixXd::Identity(n, n);
+  P->setIdentity(n, n);
   for (int a = 0; a < n_nodes_; ++a) {
     P->block<3, 3>(6 * a, 6 * a) = frame.R.transpose();
     P->block<3, 3>(6 * a + 3, 6 * a + 3) = options_.cardona_option_b ? c.R[a].transpose() : frame.R.transpose();
   }
   // Spatial variation of the frame rotation: d pi_j = R_j (Z Rbar^T dq)_rot (thesis 3.17).
-  Eigen::MatrixXd Zr = kin.Z.bottomRows<3>();
+  Eigen::MatrixXd& Zr = d.scratch.n3a;
+  Zr = kin.Z.bottomRows<3>();
   const Eigen::Matrix3d Rt = frame.R.transpose();
   TurnColBlocks(Zr, 2 * n_nodes_, [&](int) { return Rt; });
-  *U = frame.R * Zr;
+  U->resize(3, n);
+  U->noalias() = frame.R * Zr;
 }
 
 Eigen::MatrixXd SuperelementBody::VelocityMapRate(const Eigen::MatrixXd& U, const BodyVelocity& w) const {
@@ -482,14 +545,25 @@ Eigen::MatrixXd SuperelementBody::VelocityMapRate(const Eigen::MatrixXd& U, cons
 
 Eigen::VectorXd SuperelementBody::QuadraticInertia(const Eigen::MatrixXd& U, const Eigen::MatrixXd& Mg,
                                                    const BodyVelocity& w) const {
+  Eigen::VectorXd out;
+  BodyScratch scratch;
+  QuadraticInertia(U, Mg, w, out, scratch);
+  return out;
+}
+
+void SuperelementBody::QuadraticInertia(const Eigen::MatrixXd& U, const Eigen::MatrixXd& Mg, const BodyVelocity& w,
+                                        Eigen::VectorXd& out, BodyScratch& scratch) const {
   // G = VelocityMapRate(U, w) is never formed: its rows are xdot_a~ U (and omega_a~ U, option A;
   // the diagonal block omega_a~, option B), so G w = [xdot_a x omega_j; omega_a x omega_j (A) or
   // 0 (B); 0] and G^T p = U^T sum_a (p_a x xdot_a + p_rot,a x omega_a (A)) (+ option B:
   // p_rot,a x omega_a on node a's rotation rows).
   const bool B = options_.cardona_option_b;
-  const Eigen::Vector3d omega_j = U * w;
-  const Eigen::VectorXd p = Mg * w;
-  Eigen::VectorXd Gw = Eigen::VectorXd::Zero(n_coordinates());
+  Eigen::Vector3d omega_j;
+  omega_j.noalias() = U * w;
+  Eigen::VectorXd& p = scratch.v1;
+  p.noalias() = Mg * w;
+  Eigen::VectorXd& Gw = scratch.v2;
+  Gw.setZero(n_coordinates());
   Eigen::Vector3d v = Eigen::Vector3d::Zero();
   for (int a = 0; a < n_nodes_; ++a) {
     const Eigen::Vector3d xdot = w.segment<3>(6 * a), omega = w.segment<3>(6 * a + 3);
@@ -501,7 +575,7 @@ Eigen::VectorXd SuperelementBody::QuadraticInertia(const Eigen::MatrixXd& U, con
       v += p_r.cross(omega);
     }
   }
-  Eigen::VectorXd out = Mg * Gw;
+  out.noalias() = Mg * Gw;
   out.noalias() -= U.transpose() * v;
   for (int a = 0; a < n_nodes_; ++a) {
     const Eigen::Vector3d omega = w.segment<3>(6 * a + 3);
@@ -511,11 +585,11 @@ Eigen::VectorXd SuperelementBody::QuadraticInertia(const Eigen::MatrixXd& U, con
     out.segment<3>(6 * a) += omega_j.cross(p_x);
     if (!B) out.segment<3>(6 * a + 3) += (omega_j - omega).cross(p_r);
   }
-  return out;
 }
 
-Eigen::MatrixXd SuperelementBody::QuadraticInertiaDerivative(const Eigen::MatrixXd& U, const Eigen::MatrixXd& Mg,
-                                                              const BodyVelocity& w) const {
+void SuperelementBody::QuadraticInertiaDerivative(const Eigen::MatrixXd& U, const Eigen::MatrixXd& Mg,
+                                                  const BodyVelocity& w, Eigen::MatrixXd& D,
+                                                  BodyScratch& scratch) const {
   // g(w) = M_g s(w) - G(w)^T p + (Omega_P - Omega_hat) p, s = G(w) w, p = M_g w; G(w) = L(w) U
   // with L the stacked blocks xdot_a~ (and omega_a~ on the rotation rows, option A), so that
   // every product below is O(n^2). Derivative term by term (d/dw):
@@ -527,42 +601,51 @@ Eigen::MatrixXd SuperelementBody::QuadraticInertiaDerivative(const Eigen::Matrix
   //             -p_rot,a~ (U - E_rot,a) + (omega_j - omega_a)~ M_g rows.
   const int n = n_coordinates();
   const bool B = options_.cardona_option_b;
-  const Eigen::Vector3d omega_j = U * w;
-  const Eigen::VectorXd p = Mg * w;
-  Eigen::MatrixXd L = Eigen::MatrixXd::Zero(n, 3);
+  Eigen::Vector3d omega_j;
+  omega_j.noalias() = U * w;
+  Eigen::VectorXd& p = scratch.v1;
+  p.noalias() = Mg * w;
+  Eigen::MatrixXd& L = scratch.n3a;
+  L.setZero(n, 3);
   for (int a = 0; a < n_nodes_; ++a) {
     L.middleRows<3>(6 * a) = Skew<double>(Eigen::Vector3d(w.segment<3>(6 * a)));
     if (!B) L.middleRows<3>(6 * a + 3) = Skew<double>(Eigen::Vector3d(w.segment<3>(6 * a + 3)));
   }
   // ds = L U + N (N: the -omega_j~ blocks on the diagonal); for B the rotation rows of ds vanish.
-  Eigen::MatrixXd D = (Mg * L) * U;
+  Eigen::MatrixXd& MgL = scratch.n3b;
+  MgL.noalias() = Mg * L;
+  D.resize(n, n);
+  D.noalias() = MgL * U;
   const Eigen::Matrix3d Wj = Skew<double>(omega_j);
   for (int a = 0; a < n_nodes_; ++a) {
-    D.middleCols<3>(6 * a) -= Mg.middleCols<3>(6 * a) * Wj;
-    if (!B) D.middleCols<3>(6 * a + 3) -= Mg.middleCols<3>(6 * a + 3) * Wj;
+    D.middleCols<3>(6 * a).noalias() -= Mg.middleCols<3>(6 * a) * Wj;
+    if (!B) D.middleCols<3>(6 * a + 3).noalias() -= Mg.middleCols<3>(6 * a + 3) * Wj;
   }
   // -G^T M_g: G = L U (+ for B the diagonal rotation blocks omega_a~).
-  D -= U.transpose() * (L.transpose() * Mg);
+  Eigen::MatrixXd& LtMg = scratch.n3c;
+  LtMg.noalias() = L.transpose() * Mg;
+  D.noalias() -= U.transpose() * LtMg;
   for (int a = 0; a < n_nodes_; ++a) {
     const Eigen::Matrix3d Pa = Skew<double>(Eigen::Vector3d(p.segment<3>(6 * a)));
     const Eigen::Matrix3d Pr = Skew<double>(Eigen::Vector3d(p.segment<3>(6 * a + 3)));
     const Eigen::Matrix3d Wa = Skew<double>(Eigen::Vector3d(w.segment<3>(6 * a + 3)));
-    if (B) D.middleRows<3>(6 * a + 3) -= Wa.transpose() * Mg.middleRows<3>(6 * a + 3);
+    if (B) D.middleRows<3>(6 * a + 3).noalias() -= Wa.transpose() * Mg.middleRows<3>(6 * a + 3);
     // -Q.
-    D.middleCols<3>(6 * a) -= U.transpose() * Pa;
+    D.middleCols<3>(6 * a).noalias() -= U.transpose() * Pa;
     if (B) {
       D.block<3, 3>(6 * a + 3, 6 * a + 3) -= Pr;
     } else {
-      D.middleCols<3>(6 * a + 3) -= U.transpose() * Pr;
+      D.middleCols<3>(6 * a + 3).noalias() -= U.transpose() * Pr;
     }
     // (Omega_P - Omega_hat) p.
-    D.middleRows<3>(6 * a) += -Pa * U + Wj * Mg.middleRows<3>(6 * a);
+    D.middleRows<3>(6 * a).noalias() -= Pa * U;
+    D.middleRows<3>(6 * a).noalias() += Wj * Mg.middleRows<3>(6 * a);
     if (!B) {
-      D.middleRows<3>(6 * a + 3) += -Pr * U + (Wj - Wa) * Mg.middleRows<3>(6 * a + 3);
+      D.middleRows<3>(6 * a + 3).noalias() -= Pr * U;
+      D.middleRows<3>(6 * a + 3).noalias() += (Wj - Wa) * Mg.middleRows<3>(6 * a + 3);
       D.block<3, 3>(6 * a + 3, 6 * a + 3) += Pr;
     }
   }
-  return D;
 }
 
 void SuperelementBody::InertiaForce(const Data& d, const BodyVelocity& w, const BodyVelocity& wdot,
@@ -570,46 +653,63 @@ void SuperelementBody::InertiaForce(const Data& d, const BodyVelocity& w, const 
                                     Eigen::VectorXd* f_acc) const {
   const int n = n_coordinates();
   if (has_exact_inertia()) {
-    const Eigen::VectorXd zero = Eigen::VectorXd::Zero(n);
+    Eigen::VectorXd& zero = d.scratch.v4;
+    if (!options_.quadratic_velocity_terms || (!f_in && f_acc)) zero.setZero(n);
     if (f_in) {
-      *f_in = ExactInertiaForce(d, options_.quadratic_velocity_terms ? w : zero, wdot, f_acc);
+      ExactInertiaForce(d, options_.quadratic_velocity_terms ? w : zero, wdot, *f_in, f_acc);
     } else if (f_acc) {
-      *f_acc = ExactInertiaForce(d, zero, wdot);
+      ExactInertiaForce(d, zero, wdot, *f_acc, nullptr);
     }
     if (mass) *mass = ExactMass(d);
     if (gyroscopic) {
-      gyroscopic->setZero(n, n);
-      if (!options_.quadratic_velocity_terms) return;
-      *gyroscopic = ExactGyroscopic(d, w);
+      if (!options_.quadratic_velocity_terms) {
+        gyroscopic->setZero(n, n);
+        return;
+      }
+      ExactGyroscopic(d, w, *gyroscopic);
     }
     return;
   }
   const BodyVelocityMaps& maps = MapsOf(d);
   const Eigen::MatrixXd& U = maps.U;
   const Eigen::MatrixXd& Mg = maps.Mg;
-  if (f_acc) *f_acc = Mg * wdot;
+  if (f_acc) f_acc->noalias() = Mg * wdot;
   if (f_in) {
-    *f_in = Mg * wdot;
-    if (options_.quadratic_velocity_terms) *f_in += QuadraticInertia(U, Mg, w);
+    f_in->noalias() = Mg * wdot;
+    if (options_.quadratic_velocity_terms) {
+      Eigen::VectorXd& quadratic = d.scratch.v3;
+      QuadraticInertia(U, Mg, w, quadratic, d.scratch);
+      *f_in += quadratic;
+    }
   }
   if (mass) *mass = Mg;
   if (gyroscopic) {
-    gyroscopic->setZero(n, n);
-    if (!options_.quadratic_velocity_terms) return;
-    *gyroscopic = QuadraticInertiaDerivative(U, Mg, w);
+    if (!options_.quadratic_velocity_terms) {
+      gyroscopic->setZero(n, n);
+      return;
+    }
+    QuadraticInertiaDerivative(U, Mg, w, *gyroscopic, d.scratch);
   }
 }
 
 Eigen::MatrixXd SuperelementBody::InertiaConfigurationTangent(const Data& d, const BodyVelocity& w,
                                                               const BodyVelocity& wdot, bool quadratic) const {
+  Eigen::MatrixXd tangent;
+  InertiaConfigurationTangent(d, w, wdot, quadratic, tangent);
+  return tangent;
+}
+
+void SuperelementBody::InertiaConfigurationTangent(const Data& d, const BodyVelocity& w, const BodyVelocity& wdot,
+                                                   bool quadratic, Eigen::MatrixXd& tangent) const {
   // Exact inertia: the whole force by central differences with `quadratic`; without, the
   // corotational d(M_g wdot)/dq, which has its leading part (the turning of the frame; the exact
   // mass differs from it at the order of q_loc Omega) for a fraction of the cost.
   if (has_exact_inertia() && quadratic && options_.quadratic_velocity_terms) {
-    return ExactInertiaConfigurationTangent(d, w, wdot);
+    tangent = ExactInertiaConfigurationTangent(d, w, wdot);
+    return;
   }
-  Eigen::MatrixXd tangent = MomentumDerivative(MapsOf(d), wdot);
-  if (!quadratic || !options_.quadratic_velocity_terms) return tangent;
+  MomentumDerivative(MapsOf(d), wdot, tangent, d.scratch);
+  if (!quadratic || !options_.quadratic_velocity_terms) return;
   const int n = n_coordinates();
   for (int i = 0; i < n; ++i) {
     Eigen::VectorXd g[2];
@@ -622,7 +722,6 @@ Eigen::MatrixXd SuperelementBody::InertiaConfigurationTangent(const Data& d, con
     }
     tangent.col(i) += (g[0] - g[1]) / (2 * step);
   }
-  return tangent;
 }
 
 // Perturbed configuration for the central differences of the inertia force: coordinate i by
@@ -660,8 +759,10 @@ void SuperelementBody::AddModalDamping(const BodyVelocity& w, Eigen::VectorXd& f
 }
 
 double SuperelementBody::KineticEnergy(const Data& d, const BodyVelocity& w) const {
-  if (has_exact_inertia()) return 0.5 * w.dot(ExactMass(d) * w);
-  return 0.5 * w.dot(MapsOf(d).Mg * w);
+  const Eigen::MatrixXd& Mg = has_exact_inertia() ? ExactMass(d) : MapsOf(d).Mg;
+  Eigen::VectorXd& p = d.scratch.v1;
+  p.noalias() = Mg * w;
+  return 0.5 * w.dot(p);
 }
 
 BodyVelocityMaps SuperelementBody::Maps(const BodyConfiguration& c, const FrameSolution& frame) const {
@@ -673,33 +774,44 @@ Eigen::VectorXd SuperelementBody::GeneralizedMomentum(const BodyVelocityMaps& ma
 }
 
 Eigen::MatrixXd SuperelementBody::MomentumDerivative(const BodyVelocityMaps& maps, const BodyVelocity& w) const {
+  Eigen::MatrixXd D;
+  BodyScratch scratch;
+  MomentumDerivative(maps, w, D, scratch);
+  return D;
+}
+
+void SuperelementBody::MomentumDerivative(const BodyVelocityMaps& maps, const BodyVelocity& w, Eigen::MatrixXd& D,
+                                          BodyScratch& scratch) const {
   const Eigen::MatrixXd& U = maps.U;
-  const Eigen::VectorXd p = maps.Mg * w;
+  Eigen::VectorXd& p = scratch.v1;
+  p.noalias() = maps.Mg * w;
   // dp = dP^T mu + M_g G dq, mu = M P w; P^T turns each node block with R_j (or R_k).
   // M_g G = (M_g L) U (+ option B: M_g's rotation columns times omega_a~), L the stacked
   // xdot_a~ (and omega_a~, option A) of VelocityMapRate: O(n^2) instead of an n x n product.
   const int n = n_coordinates();
-  Eigen::MatrixXd L = Eigen::MatrixXd::Zero(n, 3);
+  Eigen::MatrixXd& L = scratch.n3a;
+  L.setZero(n, 3);
   for (int a = 0; a < n_nodes_; ++a) {
     L.middleRows<3>(6 * a) = Skew<double>(Eigen::Vector3d(w.segment<3>(6 * a)));
     if (!options_.cardona_option_b) L.middleRows<3>(6 * a + 3) = Skew<double>(Eigen::Vector3d(w.segment<3>(6 * a + 3)));
   }
-  const Eigen::MatrixXd MgL = maps.Mg * L;
-  Eigen::MatrixXd D = MgL * U;
+  Eigen::MatrixXd& MgL = scratch.n3b;
+  MgL.noalias() = maps.Mg * L;
+  D.resize(n, n);
+  D.noalias() = MgL * U;
   if (options_.cardona_option_b) {
     for (int a = 0; a < n_nodes_; ++a)
-      D.middleCols<3>(6 * a + 3) += maps.Mg.middleCols<3>(6 * a + 3) * Skew<double>(Eigen::Vector3d(w.segment<3>(6 * a + 3)));
+      D.middleCols<3>(6 * a + 3).noalias() += maps.Mg.middleCols<3>(6 * a + 3) * Skew<double>(Eigen::Vector3d(w.segment<3>(6 * a + 3)));
   }
   for (int a = 0; a < n_nodes_; ++a) {
-    D.middleRows<3>(6 * a) -= Skew<double>(Eigen::Vector3d(p.segment<3>(6 * a))) * U;
+    D.middleRows<3>(6 * a).noalias() -= Skew<double>(Eigen::Vector3d(p.segment<3>(6 * a))) * U;
     const Eigen::Matrix3d p_rot = Skew<double>(Eigen::Vector3d(p.segment<3>(6 * a + 3)));
     if (options_.cardona_option_b) {
       D.block<3, 3>(6 * a + 3, 6 * a + 3) -= p_rot;
     } else {
-      D.middleRows<3>(6 * a + 3) -= p_rot * U;
+      D.middleRows<3>(6 * a + 3).noalias() -= p_rot * U;
     }
   }
-  return D;
 }
 
 void SuperelementBody::MomentumSourceDerivatives(const BodyVelocityMaps& maps, const BodyVelocity& w,
@@ -737,7 +849,9 @@ Eigen::VectorXd SuperelementBody::MomentumSource(const BodyVelocityMaps& maps, c
 void SuperelementBody::Momentum(const Data& d, const BodyVelocity& w, Eigen::Vector3d* linear,
                                 Eigen::Vector3d* angular) const {
   const BodyConfiguration& c = d.c;
-  const Eigen::VectorXd p = has_exact_inertia() ? Eigen::VectorXd(ExactMass(d) * w) : GeneralizedMomentum(MapsOf(d), w);
+  const Eigen::MatrixXd& Mg = has_exact_inertia() ? ExactMass(d) : MapsOf(d).Mg;
+  Eigen::VectorXd& p = d.scratch.v1;
+  p.noalias() = Mg * w;
   linear->setZero();
   angular->setZero();
   for (int a = 0; a < n_nodes_; ++a) {
@@ -752,22 +866,33 @@ Eigen::Vector3d SuperelementBody::CenterOfMass(const BodyConfiguration& c, const
 }
 
 Eigen::VectorXd SuperelementBody::GravityForce(const Data& data, const Eigen::Vector3d& g) const {
+  Eigen::VectorXd f;
+  GravityForce(data, g, f);
+  return f;
+}
+
+void SuperelementBody::GravityForce(const Data& data, const Eigen::Vector3d& g, Eigen::VectorXd& f) const {
   const FrameSolution& frame = data.frame;
+  Eigen::VectorXd& yg = data.scratch.v1;
+  const Eigen::Vector3d g_frame = frame.R.transpose() * g;
+  yg.noalias() = Phi_rig0_.leftCols<3>() * g_frame;
   if (has_exact_inertia()) {
     // Virtual work of g on the field: y_g = Phi_rig0 [R_j^T g; 0] (a uniform field), delta of the
     // field = Phi (Phi_rig0 delta xi + delta q_loc) + delta theta_j x (Phi q):
     // f = Rbar (Y^T M y_g + Z_r^T H^T y_g).
     const ExactData& d = *data.exact;
-    const Eigen::VectorXd yg = Phi_rig0_.leftCols<3>() * (frame.R.transpose() * g);
-    const Eigen::VectorXd local =
-        d.Y.transpose() * (M_ * yg) + data.kin.Z.bottomRows<3>().transpose() * (d.H.transpose() * yg);
-    return TurnBlocks(frame.R, local, 2 * n_nodes_);
+    Eigen::VectorXd& Myg = data.scratch.v2;
+    Myg.noalias() = M_ * yg;
+    const Eigen::Vector3d Hty = d.H.transpose() * yg;
+    f.noalias() = d.Y.transpose() * Myg;
+    f.noalias() += data.kin.Z.bottomRows<3>().transpose() * Hty;
+    TurnBlocksInto(frame.R, f, 2 * n_nodes_, f);
+    return;
   }
   // P^T block by block (P is block diagonal: its 3 x 3 node blocks, then 1 on the modal rows).
   const Eigen::MatrixXd& P = MapsOf(data).P;
-  Eigen::VectorXd f = M_ * (Phi_rig0_.leftCols<3>() * (frame.R.transpose() * g));
+  f.noalias() = M_ * yg;
   for (int a = 0; a < 2 * n_nodes_; ++a) f.segment<3>(3 * a) = P.block<3, 3>(3 * a, 3 * a).transpose() * Eigen::Vector3d(f.segment<3>(3 * a));
-  return f;
 }
 
 Eigen::MatrixXd SuperelementBody::GravityTangent(const Data& d, const Eigen::Vector3d& g) const {

@@ -87,6 +87,24 @@ struct BodyVelocityMaps {
   Eigen::MatrixXd P, U, Mg;
 };
 
+/// Scratch storage of a body's kernels at one configuration (SuperelementBody::Data::scratch):
+/// the temporaries of the forces and matrices, kept with the data from one Newton iteration to
+/// the next so that evaluating a body allocates nothing once they have their sizes (issue 14).
+/// Their contents mean nothing between calls. One matrix per shape and use in an iteration (a
+/// resize to another number of entries would allocate): n x n, n x 6 (or 6 x n), n x 3 (3 x n).
+struct BodyScratch {
+  Eigen::VectorXd v1, v2, v3, v4;
+  Eigen::MatrixXd nn1, nn2, n6a, n6b, n6c, n3a, n3b, n3c;
+};
+
+/// The exact inertia's temporaries (ExactInertiaForce, ExactGyroscopic), as BodyScratch.
+struct ExactScratch {
+  Eigen::VectorXd Rw, qd, r, y, yd, pi_q, pi_q_dot, f_q, t1, t2, S_ab;
+  Eigen::MatrixXd Hd, dxi, dv, dOm, dqd, dr, dOmd, dy, G_Om, Gty, base, df_q, G_skew, GtP, dh, dhd, dpi_xi, PH, df_xi,
+      PG, dpi_v, dpi_w, t3, t4, t5, t6, t7, t8;
+  Eigen::RowVectorXd row, row2;
+};
+
 /// Immutable model of one superelement (from its file) plus its placement in the scene.
 class SuperelementBody {
  public:
@@ -112,8 +130,11 @@ class SuperelementBody {
     Eigen::MatrixXd H;                  ///< n x 3: Gamma_a q
     Eigen::MatrixXd XQ;                 ///< n x 9: Xi_ab q in column 3 a + b (Xi_ba = Xi_ab^T)
     Eigen::Matrix3d Xq;                 ///< q^T Xi_ab q
-    /// For the matrices only (ExactMass, ExactGyroscopic), made when first asked: M Y and H^T Y (3 x n).
+    /// For the matrices only (ExactMass, ExactGyroscopic), made when first asked (has_products):
+    /// M Y and H^T Y (3 x n).
     mutable Eigen::MatrixXd MY, HtY;
+    mutable bool has_products = false;
+    Eigen::VectorXd xq;  ///< scratch of Exact
   };
   /// Everything one configuration of the body determines, computed once (Evaluate) and passed to
   /// every force, matrix and energy evaluated there: an assembly pass evaluates each body's
@@ -123,10 +144,11 @@ class SuperelementBody {
     FrameSolution frame;
     Eigen::VectorXd q;  ///< q_loc
     Kinematics kin;
-    std::optional<ExactData> exact;                 ///< with the exact inertia
+    std::optional<ExactData> exact;                 ///< with the exact inertia (kept: its storage reused)
     mutable BodyVelocityMaps maps;   ///< the corotational maps, made when first asked (has_maps)
     mutable bool has_maps = false;
-    mutable std::optional<Eigen::MatrixXd> exact_mass;  ///< M_g of the exact inertia, made when first asked
+    mutable Eigen::MatrixXd exact_mass;  ///< M_g of the exact inertia, made when first asked (has_exact_mass)
+    mutable bool has_exact_mass = false;
     /// The local force Q (LocalForce) of the last load factors asked for, and with inertia
     /// stiffening the products K_sigma,k q_loc (n x 12): the residual and the matrix passes of an
     /// iteration share them.
@@ -136,8 +158,13 @@ class SuperelementBody {
       bool valid = false;
     };
     mutable LocalForceOf local_force;
-    mutable std::optional<Eigen::MatrixXd> sigma_q;
-    mutable std::optional<Eigen::VectorXd> eps;  ///< the condensed polynomial's q + K^+ A z, made when first asked
+    mutable Eigen::MatrixXd sigma_q;  ///< when has_sigma_q
+    mutable bool has_sigma_q = false;
+    mutable Eigen::VectorXd eps;  ///< the condensed polynomial's q + K^+ A z, made when first asked (has_eps)
+    mutable bool has_eps = false;
+    mutable PolynomialScratch polynomial_scratch;
+    mutable BodyScratch scratch;  ///< the kernels' temporaries (BodyScratch)
+    mutable ExactScratch exact_scratch;  ///< the exact inertia's (ExactScratch)
   };
   /// The body's quantities at configuration `c` with its solved floating frame.
   Data Evaluate(const BodyConfiguration& c, const FrameSolution& frame) const;
@@ -181,6 +208,9 @@ class SuperelementBody {
   FrameSolution SolveFrame(const BodyConfiguration& c, const FrameSolution& guess) const;
   /// SolveFrame from the last frame, and failing that from GuessFrame (ok = false if both fail).
   FrameSolution SolveFrameFrom(const BodyConfiguration& c, const FrameSolution& last) const;
+  /// The same with `q` as its scratch for the local coordinates (no allocation once sized).
+  FrameSolution SolveFrameFrom(const BodyConfiguration& c, const FrameSolution& last, Eigen::VectorXd& q) const;
+  FrameSolution SolveFrame(const BodyConfiguration& c, const FrameSolution& guess, Eigen::VectorXd& q) const;
 
   /// Local coordinates q_loc (6N + m).
   Eigen::VectorXd LocalCoordinates(const BodyConfiguration& c, const FrameSolution& frame) const;
@@ -233,6 +263,9 @@ class SuperelementBody {
   /// configuration (the configuration dependence of R_j and Z is left out of the tangent).
   InertiaLoadFactors InertiaLoads(const Data& d, const BodyVelocity& w, const BodyVelocity& wdot,
                                   const Eigen::Vector3d& gravity) const;
+  /// The same into `out` (its storage reused).
+  void InertiaLoads(const Data& d, const BodyVelocity& w, const BodyVelocity& wdot, const Eigen::Vector3d& gravity,
+                    InertiaLoadFactors& out) const;
   InertiaLoadFactors InertiaLoads(const BodyConfiguration& c, const FrameSolution& frame, const BodyVelocity& w,
                                   const BodyVelocity& wdot, const Eigen::Vector3d& gravity) const {
     return InertiaLoads(Evaluate(c, frame), w, wdot, gravity);
@@ -292,6 +325,9 @@ class SuperelementBody {
   /// size, 1e-7 rad, 1e-7 of the modal scale).
   Eigen::MatrixXd InertiaConfigurationTangent(const Data& d, const BodyVelocity& w, const BodyVelocity& wdot,
                                               bool quadratic) const;
+  /// The same into `tangent` (its storage reused).
+  void InertiaConfigurationTangent(const Data& d, const BodyVelocity& w, const BodyVelocity& wdot, bool quadratic,
+                                   Eigen::MatrixXd& tangent) const;
   Eigen::MatrixXd InertiaConfigurationTangent(const BodyConfiguration& c, const FrameSolution& frame,
                                               const BodyVelocity& w, const BodyVelocity& wdot, bool quadratic) const {
     return InertiaConfigurationTangent(Evaluate(c, frame), w, wdot, quadratic);
@@ -318,6 +354,9 @@ class SuperelementBody {
   /// derivative of the generalized momentum (midpoint iteration matrix; with w = wdot, the
   /// configuration derivative of M_g wdot).
   Eigen::MatrixXd MomentumDerivative(const BodyVelocityMaps& maps, const BodyVelocity& w) const;
+  /// The same into `D` with the temporaries in `scratch` (no allocation once sized).
+  void MomentumDerivative(const BodyVelocityMaps& maps, const BodyVelocity& w, Eigen::MatrixXd& D,
+                          BodyScratch& scratch) const;
 
   /// The momentum balance in the form dp/dt = s(q, w, p) + applied - elastic forces, with
   ///   s = G^T p + Omega_hat p    (dT/dq at fixed spatial velocities, and omega_k x p_k on the
@@ -349,6 +388,8 @@ class SuperelementBody {
 
   /// Generalized force of a uniform acceleration field g (gravity): P^T M Phi_rig0 [R_j^T g; 0].
   Eigen::VectorXd GravityForce(const Data& d, const Eigen::Vector3d& g) const;
+  /// The same into `f` (its storage reused).
+  void GravityForce(const Data& d, const Eigen::Vector3d& g, Eigen::VectorXd& f) const;
   Eigen::VectorXd GravityForce(const BodyConfiguration& c, const FrameSolution& frame, const Eigen::Vector3d& g) const {
     return GravityForce(Evaluate(c, frame), g);
   }
@@ -370,24 +411,30 @@ class SuperelementBody {
   Eigen::MatrixXd VelocityMapRate(const Eigen::MatrixXd& U, const BodyVelocity& w) const;
   // The quadratic part of f_in: M_g G w + (Omega_P - Omega_hat) p - G^T p.
   Eigen::VectorXd QuadraticInertia(const Eigen::MatrixXd& U, const Eigen::MatrixXd& Mg, const BodyVelocity& w) const;
-  // Its derivative by w (exact, O(n^2) products).
-  Eigen::MatrixXd QuadraticInertiaDerivative(const Eigen::MatrixXd& U, const Eigen::MatrixXd& Mg,
-                                             const BodyVelocity& w) const;
+  void QuadraticInertia(const Eigen::MatrixXd& U, const Eigen::MatrixXd& Mg, const BodyVelocity& w,
+                        Eigen::VectorXd& out, BodyScratch& scratch) const;
+  // Its derivative by w (exact, O(n^2) products), into D.
+  void QuadraticInertiaDerivative(const Eigen::MatrixXd& U, const Eigen::MatrixXd& Mg, const BodyVelocity& w,
+                                  Eigen::MatrixXd& D, BodyScratch& scratch) const;
   Eigen::MatrixXd Phi_rig0_;
   // CenterOfMass: the mass m, the undeformed first moment s_0 about the frame origin, and C.
   double mass_ = 0.0;
   Eigen::Vector3d first_moment0_ = Eigen::Vector3d::Zero();
   Eigen::MatrixXd first_moment_map_;  ///< 3 x n
-  // Exact inertia (has_exact_inertia): per-configuration data, the force, the mass matrix M_g.
-  ExactData Exact(const Eigen::VectorXd& q, const Kinematics& kin) const;
+  // Exact inertia (has_exact_inertia): per-configuration data (into `d`, its storage reused), the
+  // force, the mass matrix M_g.
+  void Exact(const Eigen::VectorXd& q, const Kinematics& kin, ExactData& d) const;
   // With `f_acc`, also the part linear in wdot alone (M_g wdot) from the same products.
   Eigen::VectorXd ExactInertiaForce(const Data& d, const BodyVelocity& w, const BodyVelocity& wdot,
                                     Eigen::VectorXd* f_acc = nullptr) const;
+  void ExactInertiaForce(const Data& d, const BodyVelocity& w, const BodyVelocity& wdot, Eigen::VectorXd& f,
+                         Eigen::VectorXd* f_acc) const;
   // M Y and H^T Y of d.exact, made on the first call.
   const ExactData& ExactProducts(const Data& d) const;
   const Eigen::MatrixXd& ExactMass(const Data& d) const;  // computed once per Data
   // d f_in / d w of the exact inertia force (forward mode, exact).
   Eigen::MatrixXd ExactGyroscopic(const Data& d, const BodyVelocity& w) const;
+  void ExactGyroscopic(const Data& d, const BodyVelocity& w, Eigen::MatrixXd& G) const;
   Eigen::MatrixXd ExactInertiaConfigurationTangent(const Data& d, const BodyVelocity& w,
                                                    const BodyVelocity& wdot) const;
   BodyConfiguration Perturbed(const BodyConfiguration& c, int i, double sign, double* step) const;
@@ -395,8 +442,8 @@ class SuperelementBody {
   // The invariants stacked for one matrix-vector product each: [Gamma_0; Gamma_1; Gamma_2]
   // (3n x n) and Xi_ab at row block 3 a + b (9n x n, Xi_ba = Xi_ab^T); Phi_rig0^T M (6 x n).
   Eigen::MatrixXd Gamma_stack_, Xi_stack_, PtM_;
-  // [Gamma_0 v, Gamma_1 v, Gamma_2 v] (n x 3) from the stack.
-  Eigen::MatrixXd GammaColumns(const Eigen::VectorXd& v) const;
+  // [Gamma_0 v, Gamma_1 v, Gamma_2 v] (n x 3) from the stack, into `out` (its storage reused).
+  void GammaColumns(const Eigen::VectorXd& v, Eigen::MatrixXd& out) const;
 
   int n_nodes_ = 0, n_modes_ = 0;
   SuperelementOptions options_;
@@ -410,7 +457,8 @@ class SuperelementBody {
   // Local internal force and its tangent: K q or the polynomial's.
   // The force is kept in d (Data::local_force) for the next call with the same load factors.
   const Eigen::VectorXd& LocalForce(const Data& d, const InertiaLoadFactors* load = nullptr) const;
-  Eigen::MatrixXd LocalTangent(const Data& d, const InertiaLoadFactors* load = nullptr) const;
+  // Into K.
+  void LocalTangent(const Data& d, const InertiaLoadFactors* load, Eigen::MatrixXd& K) const;
   // The condensed polynomial's eps at d (geometric stiffening without modal derivatives), kept in d.
   const Eigen::VectorXd& Condensed(const Data& d) const;
   // K_sigma,k q_loc for the 12 load cases (n x 12), kept in d.

@@ -11,16 +11,17 @@
 
 namespace femb::dynamic_internal {
 
-Assembly AssembleDynamicResidual(const SystemModel& model, const DofMap& dofs, DynamicState& s, double t,
-                                 BodyWorkspace& work, BodyThreads* threads) {
-  AssemblyParts parts;
-  Assembly out = StartAssembly(model, dofs, parts);
+void AssembleDynamicResidual(const SystemModel& model, const DofMap& dofs, DynamicState& s, double t,
+                             BodyWorkspace& work, BodyThreads* threads, Assembly& out) {
+  AssemblyParts& parts = work.parts;
+  StartAssembly(model, dofs, parts, out);
   const int n_bodies = int(model.bodies.size());
   std::vector<BodyPass>& passes = work.passes;
   std::vector<BodyTerms>& results = work.terms;
   passes.resize(static_cast<size_t>(n_bodies));
   results.resize(static_cast<size_t>(n_bodies));
-  const std::vector<Eigen::Matrix<double, 6, 1>> node_acc = NodeAccelerations(model, dofs, s.config, s.W, s.Wdot);
+  NodeAccelerations(model, dofs, s.config, s.W, s.Wdot, work.node_acc);
+  const std::vector<Eigen::Matrix<double, 6, 1>>& node_acc = work.node_acc;
   ForEachBody(threads, n_bodies, [&](int b) {
     const SuperelementBody& body = model.bodies[b];
     BodyTerms& r = results[size_t(b)];
@@ -28,36 +29,50 @@ Assembly AssembleDynamicResidual(const SystemModel& model, const DofMap& dofs, D
     r.frame_ok = true;
     BodyConfiguration& c = pass.data.c;  // evaluated in place: the pass's storage is reused
     BodyConfigurationOf(model, s.config, b, c);
-    const FrameSolution frame = body.SolveFrameFrom(c, s.config.frames[b]);
+    const FrameSolution frame = body.SolveFrameFrom(c, s.config.frames[b], pass.data.q);
     if (!frame.ok) {
       r.frame_ok = false;
       return;
     }
     s.config.frames[b] = frame;
     body.Evaluate(c, frame, pass.data);
-    pass.w = GatherBody(model, dofs, s.config, b, s.W);
-    pass.wdot = GatherBodyAcceleration(model, dofs, b, node_acc, s.Wdot);
+    GatherBody(model, dofs, s.config, b, s.W, pass.w);
+    GatherBodyAcceleration(model, dofs, b, node_acc, s.Wdot, pass.wdot);
     // Inertia stiffening (issue 13): K + K_sigma(a), a from this iterate's frame motion; its
     // velocity and acceleration derivatives go into C and M of the iteration matrix.
     const bool stiffening = body.has_inertia_stiffening();
-    pass.load = stiffening ? body.InertiaLoads(pass.data, pass.w, pass.wdot, model.gravity) : InertiaLoadFactors{};
-    Eigen::VectorXd f_int, f_in, f_acc;
+    if (stiffening) {
+      body.InertiaLoads(pass.data, pass.w, pass.wdot, model.gravity, pass.load);
+    } else {
+      pass.load.a.setZero();
+    }
+    Eigen::VectorXd &f_int = r.f_int, &f_in = r.f_in, &f_acc = r.f_acc;
     body.ElasticForce(pass.data, &f_int, nullptr, stiffening ? &pass.load : nullptr);
     body.InertiaForce(pass.data, pass.w, pass.wdot, &f_in, nullptr, nullptr, &f_acc);
     body.AddModalDamping(pass.w, f_in, nullptr);
-    r.f_grav.setZero(body.n_coordinates());
-    if (model.gravity.squaredNorm() > 0) r.f_grav = body.GravityForce(pass.data, model.gravity);
+    if (model.gravity.squaredNorm() > 0) {
+      body.GravityForce(pass.data, model.gravity, r.f_grav);
+    } else {
+      r.f_grav.setZero(body.n_coordinates());
+    }
     // Scale of the forces in balance, each term on its own (for a torque-free body M_g wdot and
     // the gyroscopic terms cancel: their sum is no scale).
+    r.f_quadratic = f_in - f_acc;
     r.scale = std::max({body.ForceNorm(f_int), body.ForceNorm(f_in), body.ForceNorm(r.f_grav), body.force_floor(),
-                        body.ForceNorm(f_acc), body.ForceNorm(f_in - f_acc)});
+                        body.ForceNorm(f_acc), body.ForceNorm(r.f_quadratic)});
     r.roundoff = body.RoundOffForce(c);
     BodyMap(model, dofs, s.config, b, r.map);
     r.r_b = r.f_grav - f_int - f_in;
   });
-  if (!AddBodyTerms(model, results, parts, out)) return out;
+  if (!AddBodyTerms(model, results, parts, out)) return;
   FinishAssembly(model, dofs, s.config, t, s.W, false, parts, out);
   AddLoopConstraints(model, dofs, s.config, &out.residual, nullptr, &out.node_forces);
+}
+
+Assembly AssembleDynamicResidual(const SystemModel& model, const DofMap& dofs, DynamicState& s, double t,
+                                 BodyWorkspace& work, BodyThreads* threads) {
+  Assembly out;
+  AssembleDynamicResidual(model, dofs, s, t, work, threads, out);
   return out;
 }
 
@@ -73,7 +88,7 @@ void AddDynamicMatrices(const SystemModel& model, const DofMap& dofs, const Dyna
     const BodyPass& pass = passes[size_t(b)];
     BodyWorkspace::BodyMatrices& r = results[size_t(b)];
     const bool stiffening = body.has_inertia_stiffening();
-    Eigen::MatrixXd d_load;
+    Eigen::MatrixXd& d_load = r.d_load;
     body.ElasticForce(pass.data, nullptr, &r.K, stiffening ? &pass.load : nullptr, stiffening ? &d_load : nullptr);
     body.InertiaForce(pass.data, pass.w, pass.wdot, nullptr, &r.M, &r.C);
     if (stiffening) {
@@ -86,14 +101,15 @@ void AddDynamicMatrices(const SystemModel& model, const DofMap& dofs, const Dyna
     // f_acc(wdot_g), wdot_g = g on the node translations, for the corotational and the exact
     // inertia alike), so f_in - f_grav = f_in(w, wdot - wdot_g) and one call takes both.
     if (model.gravity.squaredNorm() > 0) {
-      BodyVelocity wdot = pass.wdot;
-      for (int a = 0; a < body.n_nodes(); ++a) wdot.segment<3>(6 * a) -= model.gravity;
-      r.K += body.InertiaConfigurationTangent(pass.data, pass.w, wdot, full_inertia_tangent);
+      r.wdot = pass.wdot;
+      for (int a = 0; a < body.n_nodes(); ++a) r.wdot.segment<3>(6 * a) -= model.gravity;
+      body.InertiaConfigurationTangent(pass.data, pass.w, r.wdot, full_inertia_tangent, r.inertia_K);
     } else {
-      r.K += body.InertiaConfigurationTangent(pass.data, pass.w, pass.wdot, full_inertia_tangent);
+      body.InertiaConfigurationTangent(pass.data, pass.w, pass.wdot, full_inertia_tangent, r.inertia_K);
     }
-    Eigen::VectorXd unused = Eigen::VectorXd::Zero(body.n_coordinates());
-    body.AddModalDamping(pass.w, unused, &r.C);
+    r.K += r.inertia_K;
+    r.unused.setZero(body.n_coordinates());
+    body.AddModalDamping(pass.w, r.unused, &r.C);
     if (combine) r.K += combine->c_C * r.C + combine->c_M * r.M;
   });
   Triplets &K = work.K, &C = work.C, &M = work.M;
@@ -104,16 +120,20 @@ void AddDynamicMatrices(const SystemModel& model, const DofMap& dofs, const Dyna
   // and centripetal coupling of chains with offsets), into C (or c_C of it into K).
   // And their configuration: d f_in / dq gets M_b d(J Wdot + c)/dq (into K).
   const bool chains = !model.joints.empty();
-  const std::vector<NodeJacobian> dc =
-      chains ? ConvectiveVelocityDerivative(model, dofs, s.config, s.W) : std::vector<NodeJacobian>();
-  const std::vector<NodeJacobian> dacc =
-      chains ? NodeAccelerationConfigurationDerivative(model, dofs, s.config, s.W, s.Wdot) : std::vector<NodeJacobian>();
+  if (chains) {
+    ConvectiveVelocityDerivative(model, dofs, s.config, s.W, work.dc);
+    NodeAccelerationConfigurationDerivative(model, dofs, s.config, s.W, s.Wdot, work.dacc);
+  }
+  const std::vector<NodeJacobian>& dc = work.dc;
+  const std::vector<NodeJacobian>& dacc = work.dacc;
   // B^T M_b D for a body's node columns D (per node, sparse over the coordinates), scaled.
+  Eigen::VectorXd& y = work.column;
   const auto add_node_columns = [&](const std::vector<MapEntry>& map, const Eigen::MatrixXd& M_b, int b,
                                     const std::vector<NodeJacobian>& D, double scale, Triplets& into) {
     for (size_t a = 0; a < model.body_nodes[size_t(b)].size(); ++a) {
       for (const auto& [col, v] : D[size_t(model.body_nodes[size_t(b)][a])]) {
-        const Eigen::VectorXd y = M_b.middleCols<6>(Eigen::Index(6 * a)) * v;
+        y.resize(M_b.rows());
+        y.noalias() = M_b.middleCols<6>(Eigen::Index(6 * a)) * v;
         for (const MapEntry& e : map) {
           const double value = e.coefficient * y[e.local];
           if (value != 0.0) into.emplace_back(e.coordinate, col, scale * value);
@@ -139,7 +159,8 @@ void AddDynamicMatrices(const SystemModel& model, const DofMap& dofs, const Dyna
     ScatterBody(map, nullptr, &r.M, nullptr, &M);
   }
   const int n = dofs.n_dofs();
-  Eigen::VectorXd unused = Eigen::VectorXd::Zero(n);
+  Eigen::VectorXd& unused = work.unused;
+  unused.setZero(n);
   AddNodeLoads(model, s.config, t, unused, &K);
   AddSpringDampers(model, s.config, s.W, unused, &K, &C, nullptr);
   AddLoopConstraints(model, dofs, s.config, nullptr, &K, nullptr);
@@ -171,21 +192,21 @@ StepOutcome GeneralizedAlphaStep(const SystemModel& model, const DofMap& dofs, c
   const double rho = std::clamp(options.rho_inf, 0.0, 1.0);
   const double alpha_m = (2 * rho - 1) / (rho + 1), alpha_f = rho / (rho + 1);
   const double gamma = 0.5 + alpha_f - alpha_m, beta = 0.25 * (gamma + 0.5) * (gamma + 0.5);
-  next = state;
-  const Eigen::VectorXd a_pred = (alpha_f * state.Wdot - alpha_m * state.a) / (1 - alpha_m);
-  next.a = a_pred;
+  next = state;  // storage reused: `next` is the caller's, of the same sizes after the first step
+  next.a = (alpha_f * state.Wdot - alpha_m * state.a) / (1 - alpha_m);  // the predicted a
   next.Wdot.setZero();
-  next.W = state.W + h * (1 - gamma) * state.a + h * gamma * a_pred;
-  const Eigen::VectorXd dq = state.W + h * (0.5 - beta) * state.a + h * beta * a_pred;
-  ApplyIncrement(model, dofs, h * dq, next.config);
+  next.W = state.W + h * (1 - gamma) * state.a + h * gamma * next.a;
+  work.dq = h * (state.W + h * (0.5 - beta) * state.a + h * beta * next.a);
+  ApplyIncrement(model, dofs, work.dq, next.config);
   ApplyPrescribed(model, dofs, t_new, next.config, &next.W, &next.Wdot);
   const double gamma_p = gamma / (beta * h), beta_p = (1 - alpha_m) / (beta * h * h * (1 - alpha_f));
   StepOutcome out;
   const double tolerance = std::max(options.tolerance, kRoundOffTolerance);
-  const Eigen::VectorXd weights = ResidualWeights(model, dofs);
+  const Eigen::VectorXd& weights = work.Weights(model, dofs);
   DivergenceTest divergence;
+  Assembly& a = work.assembly;
   for (; out.iterations < options.max_iterations; ++out.iterations) {
-    Assembly a = AssembleDynamicResidual(model, dofs, next, t_new, work, &threads);
+    AssembleDynamicResidual(model, dofs, next, t_new, work, &threads, a);
     if (!a.ok || !a.residual.allFinite()) return out;
     const double r_norm = FreeNorm(dofs, a.residual, weights);
     if (r_norm <= std::max(tolerance * a.scale, a.roundoff) && out.iterations > 0 &&
@@ -196,20 +217,20 @@ StepOutcome GeneralizedAlphaStep(const SystemModel& model, const DofMap& dofs, c
       // External work by the trapezoidal rule on the increment h (W_n + W_n+1) / 2.
       next.external_work += 0.5 * (state.f_ext + a.f_ext).dot(h * 0.5 * (state.W + next.W));
       next.f_ext = a.f_ext;
-      next.f_drive = DriveForces(dofs, a.residual);
+      DriveForces(dofs, a.residual, next.f_drive);
       next.drive_work += 0.5 * (state.f_drive + next.f_drive).dot(h * 0.5 * (state.W + next.W));
       out.passes_kept = true;
       return out;
     }
     if (divergence.Diverged(out.iterations, r_norm)) return out;
     bool built = false;
-    const auto S = [&] {
+    const auto S = [&]() -> const SystemMatrix& {
       const MatrixCombination combine{gamma_p, beta_p};
       if (!built) AddDynamicMatrices(model, dofs, next, t_new, work, options.full_inertia_tangent, a, &threads, &combine);
       built = true;
       return a.K;  // K + gamma' C + beta' M
     };
-    Eigen::VectorXd delta;
+    Eigen::VectorXd& delta = work.delta;
     if (!matrix.Increment(dofs, options, h, S, a.residual, delta, out.singular_matrix)) return out;
     ApplyIncrement(model, dofs, delta, next.config);
     next.W += gamma_p * delta;

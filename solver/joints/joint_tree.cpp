@@ -16,7 +16,8 @@ Eigen::Matrix<double, 6, 1> NodeMotion(const SystemState& state, int k, const Ei
 }
 
 void UpdateKinematics(const SystemModel& model, const DofMap& dofs, SystemState& state) {
-  state.J.assign(model.n_nodes(), NodeJacobian());
+  state.J.resize(size_t(model.n_nodes()));
+  for (NodeJacobian& J : state.J) J.clear();  // their storage is kept: no allocation once sized
   for (int k : dofs.order()) {
     const int j = dofs.joint_of(k);
     NodeJacobian& J = state.J[k];
@@ -40,21 +41,28 @@ void UpdateKinematics(const SystemModel& model, const DofMap& dofs, SystemState&
 std::vector<Eigen::Matrix<double, 6, 1>> NodeAccelerations(const SystemModel& model, const DofMap& dofs,
                                                            const SystemState& state, const Eigen::VectorXd& W,
                                                            const Eigen::VectorXd& Wdot) {
-  std::vector<Eigen::Matrix<double, 6, 1>> acc(model.n_nodes(), Eigen::Matrix<double, 6, 1>::Zero());
-  std::vector<Eigen::Matrix<double, 6, 1>> convective(model.n_nodes(), Eigen::Matrix<double, 6, 1>::Zero());
+  std::vector<Eigen::Matrix<double, 6, 1>> acc;
+  NodeAccelerations(model, dofs, state, W, Wdot, acc);
+  return acc;
+}
+
+void NodeAccelerations(const SystemModel& model, const DofMap& dofs, const SystemState& state,
+                       const Eigen::VectorXd& W, const Eigen::VectorXd& Wdot,
+                       std::vector<Eigen::Matrix<double, 6, 1>>& acc) {
+  thread_local std::vector<Eigen::Matrix<double, 6, 1>> convective;  // kept: its storage is reused
+  acc.assign(size_t(model.n_nodes()), Eigen::Matrix<double, 6, 1>::Zero());
+  convective.assign(size_t(model.n_nodes()), Eigen::Matrix<double, 6, 1>::Zero());
   for (int k : dofs.order()) {
     const int j = dofs.joint_of(k);
     if (j >= 0) {
       const NodeJoint& joint = model.joints[j];
       const int p = joint.parent;
       const JointMaps maps = ComputeJointMaps(joint, state.x[p], state.R[p], state.x[k], state.z[k]);
-      const Eigen::VectorXd zdot = W.segment(dofs.node_first(k), dofs.node_count(k));
-      convective[k] = ChildConvective(joint, maps, state.x[p], state.R[p], state.x[k], NodeMotion(state, p, W), zdot,
-                                      convective[p]);
+      convective[k] = ChildConvective(joint, maps, state.x[p], state.R[p], state.x[k], NodeMotion(state, p, W),
+                                      W.segment(dofs.node_first(k), dofs.node_count(k)), convective[p]);
     }
     acc[k] = NodeMotion(state, k, Wdot) + convective[k];
   }
-  return acc;
 }
 
 NodeForces ZeroNodeForces(const SystemModel& model) {
@@ -67,7 +75,8 @@ void AddJointGeometricStiffness(const SystemModel& model, const DofMap& dofs, co
                                 const NodeForces& forces, Triplets& tangent) {
   if (model.joints.empty()) return;
   // Transmitted forces, children before parents: t_p += A^T t_c.
-  std::vector<Eigen::Matrix<double, 6, 1>> t = forces.f;
+  thread_local std::vector<Eigen::Matrix<double, 6, 1>> t;  // kept: its storage is reused
+  t = forces.f;
   const std::vector<int>& order = dofs.order();
   for (auto it = order.rbegin(); it != order.rend(); ++it) {
     const int c = *it, j = dofs.joint_of(c);

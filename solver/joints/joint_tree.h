@@ -17,6 +17,10 @@ Eigen::Matrix<double, 6, 1> NodeMotion(const SystemState& state, int k, const Ei
 std::vector<Eigen::Matrix<double, 6, 1>> NodeAccelerations(const SystemModel& model, const DofMap& dofs,
                                                            const SystemState& state, const Eigen::VectorXd& W,
                                                            const Eigen::VectorXd& Wdot);
+/// The same into `acc` (its storage reused).
+void NodeAccelerations(const SystemModel& model, const DofMap& dofs, const SystemState& state,
+                       const Eigen::VectorXd& W, const Eigen::VectorXd& Wdot,
+                       std::vector<Eigen::Matrix<double, 6, 1>>& acc);
 
 /// The derivative of the joints' convective accelerations (NodeAccelerations) with respect to
 /// the coordinate velocities W, per node as sparse columns (coordinate, 6-vector); empty for
@@ -25,6 +29,9 @@ std::vector<Eigen::Matrix<double, 6, 1>> NodeAccelerations(const SystemModel& mo
 /// matrix's C (without it Newton converged linearly on a rigid four-bar, 2 iterations a step).
 std::vector<NodeJacobian> ConvectiveVelocityDerivative(const SystemModel& model, const DofMap& dofs,
                                                        const SystemState& state, const Eigen::VectorXd& W);
+/// The same into `dc` (its storage reused).
+void ConvectiveVelocityDerivative(const SystemModel& model, const DofMap& dofs, const SystemState& state,
+                                  const Eigen::VectorXd& W, std::vector<NodeJacobian>& dc);
 
 /// The derivative of the node accelerations J_k(q) Wdot + c_k(q, W) (NodeAccelerations) with
 /// respect to the coordinates at fixed W and Wdot, per node as sparse columns; empty for nodes
@@ -33,6 +40,10 @@ std::vector<NodeJacobian> ConvectiveVelocityDerivative(const SystemModel& model,
 std::vector<NodeJacobian> NodeAccelerationConfigurationDerivative(const SystemModel& model, const DofMap& dofs,
                                                                   const SystemState& state, const Eigen::VectorXd& W,
                                                                   const Eigen::VectorXd& Wdot);
+/// The same into `out` (its storage reused).
+void NodeAccelerationConfigurationDerivative(const SystemModel& model, const DofMap& dofs, const SystemState& state,
+                                             const Eigen::VectorXd& W, const Eigen::VectorXd& Wdot,
+                                             std::vector<NodeJacobian>& out);
 
 /// Places the dependent nodes from their parents and recomputes the node Jacobians.
 void UpdateKinematics(const SystemModel& model, const DofMap& dofs, SystemState& state);

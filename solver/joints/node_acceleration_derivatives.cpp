@@ -11,14 +11,22 @@ namespace femb {
 
 std::vector<NodeJacobian> ConvectiveVelocityDerivative(const SystemModel& model, const DofMap& dofs,
                                                        const SystemState& state, const Eigen::VectorXd& W) {
-  std::vector<NodeJacobian> dc(size_t(model.n_nodes()));
+  std::vector<NodeJacobian> dc;
+  ConvectiveVelocityDerivative(model, dofs, state, W, dc);
+  return dc;
+}
+
+void ConvectiveVelocityDerivative(const SystemModel& model, const DofMap& dofs, const SystemState& state,
+                                  const Eigen::VectorXd& W, std::vector<NodeJacobian>& dc) {
+  dc.resize(size_t(model.n_nodes()));
+  for (NodeJacobian& d : dc) d.clear();  // storage kept
   for (int k : dofs.order()) {
     const int j = dofs.joint_of(k);
     if (j < 0) continue;
     const NodeJoint& joint = model.joints[size_t(j)];
     const int p = joint.parent;
     const JointMaps maps = ComputeJointMaps(joint, state.x[p], state.R[p], state.x[k], state.z[k]);
-    const Eigen::VectorXd zdot = W.segment(dofs.node_first(k), dofs.node_count(k));
+    const JointVector zdot = W.segment(dofs.node_first(k), dofs.node_count(k));
     const Eigen::Vector3d rho = state.x[k] - state.x[p], g = state.R[p] * joint.axis;
     const Eigen::Vector3d omega = NodeMotion(state, p, W).tail<3>();
     const double sdot = joint.s_index() >= 0 ? zdot[joint.s_index()] : 0.0;
@@ -66,12 +74,19 @@ std::vector<NodeJacobian> ConvectiveVelocityDerivative(const SystemModel& model,
       if (e.squaredNorm() > 0) add(first + 1, e);
     }
   }
-  return dc;
 }
 
 std::vector<NodeJacobian> NodeAccelerationConfigurationDerivative(const SystemModel& model, const DofMap& dofs,
                                                                   const SystemState& state, const Eigen::VectorXd& W,
                                                                   const Eigen::VectorXd& Wdot) {
+  std::vector<NodeJacobian> out;
+  NodeAccelerationConfigurationDerivative(model, dofs, state, W, Wdot, out);
+  return out;
+}
+
+void NodeAccelerationConfigurationDerivative(const SystemModel& model, const DofMap& dofs, const SystemState& state,
+                                             const Eigen::VectorXd& W, const Eigen::VectorXd& Wdot,
+                                             std::vector<NodeJacobian>& out) {
   using Vec6 = Eigen::Matrix<double, 6, 1>;
   const int n = model.n_nodes();
   // Down the tree, per node: velocity and acceleration, and per coordinate their derivatives.
@@ -84,9 +99,16 @@ std::vector<NodeJacobian> NodeAccelerationConfigurationDerivative(const SystemMo
     int col;
     Vec6 dvel, dacc;
   };
-  std::vector<std::vector<Column>> d(static_cast<size_t>(n));
-  std::vector<Vec6> vel(static_cast<size_t>(n)), acc(static_cast<size_t>(n));
-  std::vector<NodeJacobian> out(static_cast<size_t>(n));
+  // This thread's scratch, kept from call to call (its storage reused: no allocation once sized).
+  thread_local std::vector<std::vector<Column>> d;
+  thread_local std::vector<Vec6> vel, acc;
+  thread_local std::vector<int> cols;
+  d.resize(static_cast<size_t>(n));
+  for (std::vector<Column>& column : d) column.clear();
+  vel.resize(static_cast<size_t>(n));
+  acc.resize(static_cast<size_t>(n));
+  out.resize(static_cast<size_t>(n));
+  for (NodeJacobian& column : out) column.clear();
   for (int k : dofs.order()) {
     const int j = dofs.joint_of(k);
     if (j < 0) {
@@ -97,7 +119,7 @@ std::vector<NodeJacobian> NodeAccelerationConfigurationDerivative(const SystemMo
     const NodeJoint& joint = model.joints[size_t(j)];
     const int p = joint.parent, first = dofs.node_first(k), m = dofs.node_count(k);
     const JointMaps maps = ComputeJointMaps(joint, state.x[p], state.R[p], state.x[k], state.z[k]);
-    const Eigen::VectorXd zdot = W.segment(first, m), zddot = Wdot.segment(first, m);
+    const JointVector zdot = W.segment(first, m), zddot = Wdot.segment(first, m);
     const Eigen::Vector3d rho = state.x[k] - state.x[p], g = state.R[p] * joint.axis;
     const Vec6& vp = vel[size_t(p)];
     const Vec6& ap = acc[size_t(p)];
@@ -118,7 +140,7 @@ std::vector<NodeJacobian> NodeAccelerationConfigurationDerivative(const SystemMo
     vel[size_t(k)] = maps.A * vp + maps.B * zdot;
     acc[size_t(k)] = maps.A * ap + maps.B * zddot + terms(w, rho, g, g1, g2);
     // The coordinates that move this node's velocity or acceleration.
-    std::vector<int> cols;
+    cols.clear();
     for (const Column& c : d[size_t(p)]) cols.push_back(c.col);
     for (const auto& [col, v] : state.J[size_t(p)])
       if (v.tail<3>().squaredNorm() > 0) cols.push_back(col);
@@ -132,7 +154,7 @@ std::vector<NodeJacobian> NodeAccelerationConfigurationDerivative(const SystemMo
       Eigen::Vector3d dpi = Eigen::Vector3d::Zero();
       for (const auto& [c, v] : state.J[size_t(p)])
         if (c == col) dpi = v.tail<3>();
-      Eigen::VectorXd dz = Eigen::VectorXd::Zero(m);
+      JointVector dz = JointVector::Zero(m);
       if (col >= first && col < first + m) dz[col - first] = 1.0;
       const double ds = is >= 0 ? dz[is] : 0.0;  // an angle moves nothing here (universal: below)
       const Eigen::Vector3d drho = dpi.cross(rho) + ds * g, dg = dpi.cross(g);
@@ -140,7 +162,7 @@ std::vector<NodeJacobian> NodeAccelerationConfigurationDerivative(const SystemMo
       if (universal) dg1 = dpi.cross(g1), dg2 = dpi.cross(g2) + dz[0] * g1.cross(g2);
       const Eigen::Vector3d dw = dvp.tail<3>();
       // d(B v) for v = zdot or zddot.
-      auto dB = [&](const Eigen::VectorXd& v) {
+      auto dB = [&](const JointVector& v) {
         Vec6 r = Vec6::Zero();
         if (is >= 0) r.head<3>() += dg * v[is];
         if (ip >= 0) r.tail<3>() += dg * v[ip];
@@ -164,7 +186,6 @@ std::vector<NodeJacobian> NodeAccelerationConfigurationDerivative(const SystemMo
       if (dacc.squaredNorm() > 0) out[size_t(k)].emplace_back(col, dacc);
     }
   }
-  return out;
 }
 
 }  // namespace femb

@@ -72,7 +72,7 @@ JointMaps ComputeJointMaps(const NodeJoint& j, const Eigen::Vector3d& x_p, const
   m.A.setIdentity();
   m.A.block<3, 3>(0, 3) = -Skew<double>(rho);
   if (j.type == JointType::kSpherical) m.A.block<3, 3>(3, 3).setZero();
-  m.B = Eigen::Matrix<double, 6, Eigen::Dynamic>::Zero(6, j.n_coordinates());
+  m.B.setZero(6, j.n_coordinates());
   if (j.s_index() >= 0) m.B.col(j.s_index()).head<3>() = g;
   if (j.phi_index() >= 0) m.B.col(j.phi_index()).tail<3>() = g;
   if (j.type == JointType::kSpherical) m.B.bottomRows<3>().setIdentity();
@@ -81,7 +81,7 @@ JointMaps ComputeJointMaps(const NodeJoint& j, const Eigen::Vector3d& x_p, const
 
 Eigen::Matrix<double, 6, 1> ChildConvective(const NodeJoint& j, const JointMaps& maps, const Eigen::Vector3d& x_p,
                                             const Eigen::Matrix3d& R_p, const Eigen::Vector3d& x_c,
-                                            const Eigen::Matrix<double, 6, 1>& w_p, const Eigen::VectorXd& zdot,
+                                            const Eigen::Matrix<double, 6, 1>& w_p, const Eigen::Ref<const Eigen::VectorXd>& zdot,
                                             const Eigen::Matrix<double, 6, 1>& c_p) {
   const Eigen::Vector3d rho = x_c - x_p, g = R_p * j.axis, omega_p = w_p.tail<3>();
   const double sdot = j.s_index() >= 0 ? zdot[j.s_index()] : 0.0;
@@ -105,9 +105,9 @@ JointGeometric ComputeJointGeometric(const NodeJoint& j, const JointMaps& maps, 
   const int d = j.n_coordinates();
   JointGeometric out;
   out.dAf_dpi.setZero();
-  out.dAf_dz = Eigen::Matrix<double, 6, Eigen::Dynamic>::Zero(6, d);
-  out.dBf_dpi = Eigen::Matrix<double, Eigen::Dynamic, 3>::Zero(d, 3);
-  out.dBf_dz = Eigen::MatrixXd::Zero(d, d);
+  out.dAf_dz.setZero(6, d);
+  out.dBf_dpi.setZero(d, 3);
+  out.dBf_dz.setZero(d, d);
   // A^T f = [F; rho x F (+ M)]: d(rho x F) = -F~ d rho, d rho = -rho~ d pi_p + g ds.
   out.dAf_dpi.bottomRows<3>() = Skew<double>(F) * Skew<double>(rho);
   if (j.s_index() >= 0) out.dAf_dz.col(j.s_index()).tail<3>() = -Skew<double>(F) * g;

@@ -44,10 +44,16 @@ NodeJoint MakeNodeJoint(JointType type, int child, int parent, const Eigen::Vect
 void PlaceChild(const NodeJoint& j, const Eigen::Vector3d& x_p, const Eigen::Matrix3d& R_p, const Eigen::VectorXd& z,
                 Eigen::Vector3d* x_c, Eigen::Matrix3d* R_c);
 
+/// At most 3 joint coordinates (spherical): the joints' small matrices and vectors have a fixed
+/// largest size and live on the stack (no heap allocation in a time step, issue 14).
+inline constexpr int kMaxJointCoordinates = 3;
+using JointColumns = Eigen::Matrix<double, 6, Eigen::Dynamic, 0, 6, kMaxJointCoordinates>;
+using JointVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxJointCoordinates, 1>;
+
 /// The maps of dq_c = A dq_p + B dz at a configuration.
 struct JointMaps {
   Eigen::Matrix<double, 6, 6> A;
-  Eigen::Matrix<double, 6, Eigen::Dynamic> B;
+  JointColumns B;
 };
 JointMaps ComputeJointMaps(const NodeJoint& j, const Eigen::Vector3d& x_p, const Eigen::Matrix3d& R_p,
                            const Eigen::Vector3d& x_c);
@@ -59,7 +65,7 @@ JointMaps ComputeJointMaps(const NodeJoint& j, const Eigen::Vector3d& x_p, const
 /// Convective acceleration of the child: c_c = A c_p + [omega_p x rhodot; 0] + Bdot zdot.
 Eigen::Matrix<double, 6, 1> ChildConvective(const NodeJoint& j, const JointMaps& maps, const Eigen::Vector3d& x_p,
                                             const Eigen::Matrix3d& R_p, const Eigen::Vector3d& x_c,
-                                            const Eigen::Matrix<double, 6, 1>& w_p, const Eigen::VectorXd& zdot,
+                                            const Eigen::Matrix<double, 6, 1>& w_p, const Eigen::Ref<const Eigen::VectorXd>& zdot,
                                             const Eigen::Matrix<double, 6, 1>& c_p);
 
 /// Derivative of (A^T f, B^T f) — the generalized force the child's force f = (F, M) puts on
@@ -69,9 +75,9 @@ Eigen::Matrix<double, 6, 1> ChildConvective(const NodeJoint& j, const JointMaps&
 ///   dBf_dpi (d x 3): d(B^T f)/d pi_p,   dBf_dz (d x d): d(B^T f)/dz (universal: g2 turns with phi1).
 struct JointGeometric {
   Eigen::Matrix<double, 6, 3> dAf_dpi;
-  Eigen::Matrix<double, 6, Eigen::Dynamic> dAf_dz;
-  Eigen::Matrix<double, Eigen::Dynamic, 3> dBf_dpi;
-  Eigen::MatrixXd dBf_dz;
+  JointColumns dAf_dz;
+  Eigen::Matrix<double, Eigen::Dynamic, 3, 0, kMaxJointCoordinates, 3> dBf_dpi;
+  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxJointCoordinates, kMaxJointCoordinates> dBf_dz;
 };
 JointGeometric ComputeJointGeometric(const NodeJoint& j, const JointMaps& maps, const Eigen::Vector3d& x_p,
                                      const Eigen::Matrix3d& R_p, const Eigen::Vector3d& x_c,
