@@ -49,8 +49,12 @@ double StepController::Fit(double t, double h) {
 double StepController::Error(const DynamicState& s0, const DynamicState& s1, double h) {
   const bool midpoint = options_.integrator == Integrator::kMidpoint;
   const double dt_A = midpoint ? 0.5 * (h + s0.h_last) : h;
-  jerk_ = midpoint ? Eigen::VectorXd((s1.a - s0.a) / dt_A) : Eigen::VectorXd((s1.Wdot - s0.Wdot) / dt_A);
-  const bool with_velocity = jerk_prev_.size() == jerk_.size();
+  if (midpoint) {
+    jerk_ = (s1.a - s0.a) / dt_A;  // into jerk_'s storage: no allocation once sized
+  } else {
+    jerk_ = (s1.Wdot - s0.Wdot) / dt_A;
+  }
+  const bool with_velocity = has_jerk_prev_ && jerk_prev_.size() == jerk_.size();
   const double h3 = h * h * h, tol_q = options_.step_tolerance * D_;
   double E = 0.0;
   for (int i : dofs_.solved()) {
@@ -64,7 +68,8 @@ double StepController::Error(const DynamicState& s0, const DynamicState& s1, dou
 }
 
 double StepController::Accept(const DynamicState& s1, double h, double E, bool after_rejection) {
-  jerk_prev_ = at_breakpoint() ? Eigen::VectorXd() : jerk_;
+  has_jerk_prev_ = !at_breakpoint();
+  if (has_jerk_prev_) jerk_prev_.swap(jerk_);  // jerk_ is written anew by the next Error
   for (size_t k = 0; k < x0_.size(); ++k) D_ = std::max(D_, (s1.config.x[k] - x0_[k]).norm());
   // PI control (Gustafsson 1991; Hairer & Wanner II, IV.2): the exponents 0.7/3 and 0.4/3 of
   // this and the last accepted error ratio damp the step's oscillation that pure

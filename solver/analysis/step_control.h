@@ -70,6 +70,7 @@ class StepController {
   const DynamicOptions& options_;
   const DofMap& dofs_;
   Eigen::VectorXd weights_, jerk_, jerk_prev_;
+  bool has_jerk_prev_ = false;  ///< jerk_prev_ holds the last accepted step's (none after a breakpoint)
   std::vector<Eigen::Vector3d> x0_;
   double t0_ = 0;
   std::vector<double> breakpoints_;

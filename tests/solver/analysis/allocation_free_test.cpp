@@ -8,11 +8,12 @@
 // Covered: generalized-alpha with fixed steps; bodies from linear files (the corotational
 // inertia) and from stiffened files (geometric stiffening, exact inertia); free, clamped,
 // revolute-to-ground (driven) and prismatic-to-ground nodes; revolute joints between nodes;
-// gravity and a dead load. Not covered (they may still allocate): the midpoint scheme,
-// error-controlled steps, closed loops and interface constraints, spring-dampers, follower
+// gravity and a dead load; bodies on one thread and on two; fixed and error-controlled steps
+// (but the restart at a breakpoint of a load or drive). Not covered (they may still allocate):
+// the midpoint scheme, closed loops and interface constraints, spring-dampers, follower
 // loads, results recording (femb-solve's output, outside SolveDynamic).
 // FEMB_ALLOCATION_TRACE=1 prints the call stack of every allocation counted (to find them);
-// =linear or =stiffened: of those cases only.
+// =linear, =stiffened, =threads or =adaptive: of those cases only.
 #include <execinfo.h>
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -102,13 +103,15 @@ SystemModel SliderCrank(const Superelement& crank, const Superelement& rod, doub
 }
 
 // The allocations of each step of a 30-step run from the third step on: their largest number.
-long LargestAllocationsPerStep(const SystemModel& model, double h, const char* kind, long* steps) {
+long LargestAllocationsPerStep(const SystemModel& model, double h, const char* kind, long* steps, int threads = 1,
+                               bool adaptive = false) {
   DynamicState s = InitialDynamicState(model, InitialState(model), Eigen::VectorXd::Zero(DofMap(model).n_dofs()));
   DynamicOptions options;
   options.step = h;
   options.end_time = 30 * h;
   options.rho_inf = 0.8;
-  options.threads = 1;
+  options.threads = threads;
+  options.adaptive = adaptive;  // from h, at the default step_tolerance
   long last = 0, largest = 0, counted = 0;
   int step = 0;
   const char* trace_kind = std::getenv("FEMB_ALLOCATION_TRACE");
@@ -151,6 +154,18 @@ TEST(AllocationFree, GeneralizedAlphaStepsAllocateNothing) {
                 stiffened ? "stiffened" : "linear", crank, steps);
     EXPECT_EQ(crank, 0);
   }
+  // Bodies on two threads (BodyThreads): a pass allocates nothing either, on any thread.
+  const Superelement se = Tube(0.25, true);
+  long steps = 0;
+  const long two = LargestAllocationsPerStep(Chain(se, 0.25), 1e-3, "threads", &steps, 2);
+  std::printf("[ info ] stiffened chain on 2 threads: at most %ld allocations in a step (%ld steps counted)\n", two, steps);
+  EXPECT_EQ(two, 0);
+  // Error-controlled steps (analysis.step: auto): the error estimate and the step's choice.
+  const long adaptive =
+      LargestAllocationsPerStep(SliderCrank(Tube(0.15, true), se, 0.15, 0.25), 1e-5, "adaptive", &steps, 1, true);
+  std::printf("[ info ] stiffened slider-crank, step: auto: at most %ld allocations in a step (%ld steps counted)\n",
+              adaptive, steps);
+  EXPECT_EQ(adaptive, 0);
 }
 #endif
 
