@@ -39,7 +39,7 @@ double Seconds(std::chrono::steady_clock::time_point start) {
 void RecordModeShapes(const femb::Scene& scene, const femb::SystemState& state, const femb::ModalResult& modes,
                       double load_time, femb::ResultsRecorder& recorder) {
   const femb::SystemModel& model = scene.model;
-  const femb::DofMap dofs(model);
+  const femb::DofMap& dofs = model.dofs();
   const double size = model.n_nodes() > 1 ? femb::BoundingDiagonal(state.x) : 1.0;
   for (int k = 0; k < modes.shapes.cols(); ++k) {
     const Eigen::VectorXd v = modes.shapes.col(k);
@@ -105,7 +105,7 @@ int main(int argc, char** argv) {
     const femb::Scene scene = femb::BuildScene(spec);
     if (output.empty()) output = "out/" + spec.name;
     femb::ResultsRecorder recorder(scene, output);
-    const femb::DofMap dofs(scene.model);
+    const femb::DofMap& dofs = scene.model.dofs();
     if (!quiet) {
       std::printf("femb-solve: %s: %zu bodies, %d nodes, %d unknowns, %s analysis%s\n", scene_path.c_str(),
                   scene.model.bodies.size(), scene.model.n_nodes(), dofs.n_dofs(), femb::Name(spec.analysis.type),

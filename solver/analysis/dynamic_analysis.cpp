@@ -95,7 +95,7 @@ using namespace dynamic_internal;
 
 
 std::vector<Eigen::Matrix<double, 6, 1>> DynamicReactions(const SystemModel& model, const DynamicState& state) {
-  const DofMap dofs(model);
+  const DofMap& dofs = model.dofs();
   DynamicState s = state;
   const Assembly a = AssembleDynamic(model, dofs, s, s.t, false);
   if (!a.ok) return std::vector<Eigen::Matrix<double, 6, 1>>(model.n_nodes(), Eigen::Matrix<double, 6, 1>::Zero());
@@ -154,7 +154,7 @@ void ConsistentAccelerations(const SystemModel& model, const DofMap& dofs, Dynam
 
 DynamicState InitialDynamicState(const SystemModel& model, const SystemState& config, const Eigen::VectorXd& W,
                                  double t0) {
-  const DofMap dofs(model);
+  const DofMap& dofs = model.dofs();
   DynamicState s;
   s.config = config;
   s.W = W;
@@ -233,14 +233,14 @@ DynamicStepReport MeasureWith(const SystemModel& model, const DofMap& dofs, cons
 }  // namespace
 
 DynamicStepReport Measure(const SystemModel& model, DynamicState& s) {
-  return MeasureWith(model, DofMap(model), s, {});
+  return MeasureWith(model, model.dofs(), s, {});
 }
 
 
 DynamicResult SolveDynamic(const SystemModel& model, DynamicState& state, const DynamicOptions& options,
                            const std::function<void(const DynamicStepReport&, const DynamicState&)>& on_step) {
   DynamicResult result;
-  const DofMap dofs(model);
+  const DofMap& dofs = model.dofs();
   const std::vector<RotationNode> triples = RotationNodes(model, dofs);
   StepController control(model, dofs, options, state.t);
   double h = options.adaptive ? control.FirstStep() : options.step;

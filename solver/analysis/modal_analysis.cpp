@@ -8,7 +8,7 @@ namespace femb {
 
 ModalResult LinearizedModes(const SystemModel& model, SystemState& state, double load_time, int count) {
   ModalResult result;
-  const DofMap dofs(model);
+  const DofMap& dofs = model.dofs();
   const SystemForces forces = AssembleStatic(model, dofs, state, load_time, true);
   if (!forces.ok) {
     result.message = forces.message;

@@ -60,7 +60,7 @@ bool MinimumNormStep(const DofMap& dofs, const SystemMatrix& S, const Eigen::Vec
 StaticResult SolveStatic(const SystemModel& model, SystemState& state, const StaticOptions& options,
                          const std::function<void(const StaticStepReport&, const SystemState&)>& on_step) {
   StaticResult result;
-  const DofMap dofs(model);
+  const DofMap& dofs = model.dofs();
   const double end = options.end_time, nominal = options.end_time / options.steps;
   // Increments below round-off of the positions also mean convergence (an unloaded state has a
   // residual of round-off size and no force scale to compare it with).

@@ -11,7 +11,50 @@
 
 namespace femb {
 
-DofMap::DofMap(const SystemModel& model) : motion_(&model.motion) {
+namespace {
+// Calls f(v) for every number of the model's structure that its DofMap depends on besides the
+// motion bases (DofMap::Shape), in a fixed order.
+template <class F>
+void ForEachShapeNumber(const SystemModel& model, const F& f) {
+  for (int v : {model.n_nodes(), int(model.joints.size()), int(model.bodies.size()), int(model.cut_joints.size()),
+                int(model.prescribed.size())})
+    f(v);
+  for (const NodeJoint& j : model.joints) f(j.child), f(j.parent), f(j.n_coordinates());
+  for (const SuperelementBody& body : model.bodies) f(body.n_modes()), f(body.n_constraints());
+  for (const CutJoint& cut : model.cut_joints) f(int(cut.equations.size()));
+  for (const auto& p : model.prescribed) f(p.node), f(p.coordinate);
+}
+}  // namespace
+
+std::vector<int> DofMap::Shape(const SystemModel& model) {
+  std::vector<int> shape;
+  ForEachShapeNumber(model, [&](int v) { shape.push_back(v); });
+  return shape;
+}
+
+bool DofMap::Matches(const SystemModel& model) const {
+  // Without allocating: the loops' checks call it once per Newton iteration.
+  if (model.motion.size() != motion_.size()) return false;
+  size_t i = 0;
+  bool same = true;
+  ForEachShapeNumber(model, [&](int v) {
+    same = same && i < shape_.size() && shape_[i] == v;
+    ++i;
+  });
+  if (!same || i != shape_.size()) return false;
+  for (size_t k = 0; k < motion_.size(); ++k) {
+    const Eigen::MatrixXd& S = model.motion[k];
+    if (S.rows() != motion_[k].rows() || S.cols() != motion_[k].cols() || S != motion_[k]) return false;
+  }
+  return true;
+}
+
+const DofMap& SystemModel::dofs() const {
+  if (!dofs_ || !dofs_->Matches(*this)) dofs_ = std::make_shared<const DofMap>(*this);
+  return *dofs_;
+}
+
+DofMap::DofMap(const SystemModel& model) : motion_(model.motion), shape_(Shape(model)) {
   const int n = model.n_nodes();
   joint_of_.assign(n, -1);
   for (size_t j = 0; j < model.joints.size(); ++j) {
@@ -98,7 +141,7 @@ int AddNode(SystemModel& model, const std::string& name, const Eigen::Vector3d& 
 }
 
 SystemState InitialState(const SystemModel& model) {
-  const DofMap dofs(model);
+  const DofMap& dofs = model.dofs();
   SystemState s;
   s.x = model.node_x0;
   s.R = model.node_R0;

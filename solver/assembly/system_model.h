@@ -19,6 +19,7 @@
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 #include <functional>
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
@@ -41,6 +42,8 @@ struct NodeLoad {
   std::function<double(double)> scale;
   double Scale(double t) const { return scale ? scale(t) : t; }
 };
+
+class DofMap;
 
 struct SystemModel {
   std::vector<std::string> node_names;
@@ -71,6 +74,11 @@ struct SystemModel {
   double static_gravity_end = 0.0;
 
   int n_nodes() const { return int(node_names.size()); }
+  /// The model's numbering of its unknowns (DofMap), made on the first call and kept with the
+  /// model (a copy of the model shares it); made anew when the model's structure changed since
+  /// (nodes, their supports, joints, prescribed coordinates, bodies, cut joints). The analyses
+  /// take it from here instead of each building its own. Not from several threads at once.
+  const DofMap& dofs() const;
   /// True with Lagrange multipliers: cut joints, or bodies with an interface constraint.
   bool has_constraints() const {
     if (!cut_joints.empty()) return true;
@@ -78,6 +86,9 @@ struct SystemModel {
       if (body.n_constraints() > 0) return true;
     return false;
   }
+
+ private:
+  mutable std::shared_ptr<const DofMap> dofs_;  ///< dofs(), immutable once made
 };
 
 /// System matrices are sparse (assembled from triplets) and factorized sparse (FreeSolver);
@@ -103,16 +114,19 @@ struct SystemState {
   Eigen::VectorXd lambda;                   ///< the multipliers (DofMap::multiplier_first, body_multiplier_first)
 };
 
-/// Numbering of the unknowns (coordinates).
+/// Numbering of the unknowns (coordinates). It keeps its own copy of the motion bases, so it
+/// stays valid when the model it came from is moved or destroyed (SystemModel::dofs()).
 class DofMap {
  public:
   explicit DofMap(const SystemModel& model);
+  /// True when `model` has the structure this map was made from (Shape; the motion bases equal).
+  bool Matches(const SystemModel& model) const;
   int n_dofs() const { return n_dofs_; }
   /// First coordinate of node k and how many it has (its basis S_k when independent; its
   /// joint's coordinates when it depends on a parent).
   int node_first(int k) const { return node_first_[k]; }
   int node_count(int k) const { return node_count_[k]; }
-  const Eigen::MatrixXd& S(int k) const { return (*motion_)[k]; }
+  const Eigen::MatrixXd& S(int k) const { return motion_[k]; }
   /// The joint making node k dependent, or -1.
   int joint_of(int k) const { return joint_of_[k]; }
   /// Nodes, parents before children.
@@ -143,7 +157,11 @@ class DofMap {
   const std::vector<int>& solved() const { return solved_; }
 
  private:
-  const std::vector<Eigen::MatrixXd>* motion_;
+  // What numbers the unknowns besides the motion bases: nodes, joints (child, parent,
+  // coordinates), bodies (modes, constraints), cut joints' equations, prescribed coordinates.
+  static std::vector<int> Shape(const SystemModel& model);
+  std::vector<Eigen::MatrixXd> motion_;
+  std::vector<int> shape_;
   std::vector<int> node_first_, node_count_, joint_of_, order_, mode_dof_, solved_, multiplier_first_,
       body_multiplier_first_;
   std::vector<bool> prescribed_;

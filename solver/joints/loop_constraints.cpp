@@ -168,7 +168,7 @@ std::vector<double> EquationRemainders(const SystemModel& model, const DofMap& d
 std::vector<std::string> DropRedundantEquations(SystemModel& model) {
   std::vector<std::string> notes(model.cut_joints.size());
   if (model.cut_joints.empty()) return notes;
-  const DofMap dofs(model);
+  const DofMap& dofs = model.dofs();
   const std::vector<double> remainder = EquationRemainders(model, dofs, InitialState(model), 1e-8);
   const int first = dofs.first_multiplier();
   for (size_t c = 0; c < model.cut_joints.size(); ++c) {
@@ -190,7 +190,7 @@ std::vector<std::string> DropRedundantEquations(SystemModel& model) {
 
 std::string LoopSingularity(const SystemModel& model, const SystemState& state) {
   if (model.cut_joints.empty()) return "";
-  const DofMap dofs(model);
+  const DofMap& dofs = model.dofs();
   const std::vector<double> remainder = EquationRemainders(model, dofs, state, 1e-8);
   double least = 1.0;
   int worst = -1, equation = -1;

@@ -35,7 +35,7 @@ Eigen::MatrixXd Stack(const std::vector<Eigen::VectorXd>& rows, int cols) {
 }  // namespace
 
 ResultsRecorder::ResultsRecorder(const Scene& scene, const std::string& directory)
-    : scene_(scene), dofs_(scene.model), directory_(directory) {
+    : scene_(scene), dofs_(scene.model.dofs()), directory_(directory) {
   // Animation frames: as asked, or about kAutoFrames per run (the output steps the analysis will
   // take: load steps, or time steps over output_every).
   constexpr double kAutoFrames = 500;
@@ -355,7 +355,7 @@ void ResultsRecorder::Finish(const std::string& status) {
     w.Matrix("/nodes/angular_velocity", Stack(angular_velocities_, 3 * n));
     if (!reactions_.empty()) w.Matrix("/nodes/reaction", Stack(reactions_, 6 * n));
     std::vector<std::string> labels;
-    const DofMap dofs(model);
+    const DofMap& dofs = model.dofs();
     for (int k = 0; k < n; ++k) {
       if (!JointNode(k)) continue;
       for (int i = 0; i < dofs.node_count(k); ++i) labels.push_back(model.node_names[k] + "." + std::to_string(i));

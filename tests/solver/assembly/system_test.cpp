@@ -99,6 +99,35 @@ TEST(System, DofMapNumbersNodesModesAndMultipliers) {
             std::find(order.begin(), order.end(), 2) - order.begin());
 }
 
+// Issue 14 item 0: the model owns its numbering (SystemModel::dofs()): made once and shared by
+// the analyses, made anew when the structure changes, and valid after the model is gone (the
+// map keeps its own motion bases; it used to point into the model, which a Scene moves).
+TEST(System, ModelOwnsItsDofMap) {
+  const Superelement rod = Rod(2);
+  SystemModel model;
+  AddNode(model, "a", Eigen::Vector3d::Zero());
+  AddNode(model, "b", Eigen::Vector3d(kL, 0, 0));
+  AddRod(model, rod, 0, 1);
+  const DofMap* first = &model.dofs();
+  EXPECT_EQ(first->n_dofs(), 14);  // two free nodes and two modes
+  EXPECT_EQ(&model.dofs(), first);  // kept, not made again
+  const SystemModel copy = model;
+  EXPECT_EQ(&copy.dofs(), first);  // a copy of the model shares it
+  RevoluteToGround(model, 0, Eigen::Vector3d::UnitZ());  // the structure changes: a new map
+  EXPECT_EQ(model.dofs().n_dofs(), 9);
+  EXPECT_EQ(model.dofs().node_count(0), 1);
+  RevoluteToGround(model, 0, Eigen::Vector3d::UnitY());  // same shape, another axis: a new map
+  EXPECT_EQ(model.dofs().S(0).col(0).tail<3>(), Eigen::Vector3d::UnitY());
+  EXPECT_EQ(copy.dofs().n_dofs(), 14);  // the copy keeps its own
+  std::unique_ptr<DofMap> kept;
+  {
+    SystemModel moved = std::move(model);
+    kept = std::make_unique<DofMap>(moved.dofs());
+  }
+  EXPECT_EQ(kept->S(0).col(0).tail<3>(), Eigen::Vector3d::UnitY());  // its own copy of the bases
+  EXPECT_EQ(kept->S(1).cols(), 6);
+}
+
 TEST(System, IncrementsKeepEachSupportsMotionExact) {
   const Superelement rod = Rod(0);
   SystemModel model;
