@@ -26,5 +26,8 @@ echo
 # the examples' references exist in build/example_out, e.g. after ctest; else they are run first).
 /usr/bin/python3 benchmarks/step_control.py build/bin
 echo
+# The solver's hot path against the commit issue 14 measured (9db5b40; builds it once in
+# /tmp, about 10 minutes, then about 2 minutes): not run here, run it by hand:
+#   bash benchmarks/hot_path_vs_base.sh [BASE]
 # The four-bar coupler's energy with and without geometric stiffening (issue 13; about 40 s).
 /usr/bin/python3 benchmarks/stiffening_energy.py build/bin out/stiffening_energy
