@@ -42,6 +42,15 @@ void AddRod(SystemModel& model, const Superelement& se, int a, int b) {
   model.body_nodes.push_back({a, b});
 }
 
+// One rod on two free nodes, a at the origin and b at (kL, 0, 0).
+SystemModel OneFreeRod(const Superelement& rod) {
+  SystemModel model;
+  AddNode(model, "a", Eigen::Vector3d::Zero());
+  AddNode(model, "b", Eigen::Vector3d(kL, 0, 0));
+  AddRod(model, rod, 0, 1);
+  return model;
+}
+
 TEST(System, DofMapNumbersNodesModesAndMultipliers) {
   Superelement rod = Rod(2);
   Superelement held = rod;
@@ -104,10 +113,7 @@ TEST(System, DofMapNumbersNodesModesAndMultipliers) {
 // map keeps its own motion bases; it used to point into the model, which a Scene moves).
 TEST(System, ModelOwnsItsDofMap) {
   const Superelement rod = Rod(2);
-  SystemModel model;
-  AddNode(model, "a", Eigen::Vector3d::Zero());
-  AddNode(model, "b", Eigen::Vector3d(kL, 0, 0));
-  AddRod(model, rod, 0, 1);
+  SystemModel model = OneFreeRod(rod);
   const DofMap* first = &model.dofs();
   EXPECT_EQ(first->n_dofs(), 14);  // two free nodes and two modes
   EXPECT_EQ(&model.dofs(), first);  // kept, not made again
@@ -173,10 +179,7 @@ TEST(System, IncrementsKeepEachSupportsMotionExact) {
 
 TEST(System, StaticResidualOfAFreeBodyBalancesItsLoads) {
   const Superelement rod = Rod(2);
-  SystemModel model;
-  AddNode(model, "a", Eigen::Vector3d::Zero());
-  AddNode(model, "b", Eigen::Vector3d(kL, 0, 0));
-  AddRod(model, rod, 0, 1);
+  SystemModel model = OneFreeRod(rod);
   NodeLoad load;
   load.node = 1;
   load.force = Eigen::Vector3d(3, -5, 2);
