@@ -434,7 +434,6 @@ void SuperelementBody::AddGeometricTangent(const Data& d, const Eigen::VectorXd&
 void SuperelementBody::ElasticForce(const Data& d, Eigen::VectorXd* f, Eigen::MatrixXd* tangent,
                                     const InertiaLoadFactors* load, Eigen::MatrixXd* d_load) const {
   const int n = n_coordinates();
-  const Eigen::VectorXd& q = d.q;
   const Kinematics& kin = d.kin;
   const FrameSolution& frame = d.frame;
   if (!load || K_sigma_.empty()) load = nullptr;
