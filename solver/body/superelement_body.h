@@ -133,7 +133,9 @@ class SuperelementBody {
     /// For the matrices only (ExactMass, ExactGyroscopic), made when first asked (has_products):
     /// M Y and H^T Y (3 x n).
     mutable Eigen::MatrixXd MY, HtY;
-    mutable bool has_products = false;
+    // No default member initializer: clang then finds ExactData not default-constructible while
+    // SuperelementBody is incomplete (std::optional<ExactData> in Data). Exact sets it.
+    mutable bool has_products;
     Eigen::VectorXd xq;  ///< scratch of Exact
   };
   /// Everything one configuration of the body determines, computed once (Evaluate) and passed to
