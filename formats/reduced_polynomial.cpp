@@ -114,7 +114,10 @@ PolynomialStiffness WithCondensation(const Eigen::MatrixXd& K, PolynomialStiffne
 namespace {
 // The condensed quadratic polynomial's eps = q + K^+ A z (header).
 Eigen::VectorXd Condensed(const PolynomialStiffness& p, const Eigen::VectorXd& q) {
-  return q + p.K_plus_root.transpose() * (p.K_plus_root * (p.A * PairProducts(q)));
+  Eigen::VectorXd eps;
+  PolynomialScratch s;
+  CondensedCoordinates(p, q, eps, s);
+  return eps;
 }
 }  // namespace
 
@@ -149,6 +152,8 @@ void CondensedCoordinates(const PolynomialStiffness& p, const Eigen::VectorXd& q
 
 void CondensedForce(const Eigen::MatrixXd& K, const PolynomialStiffness& p, const Eigen::VectorXd& q,
                     const Eigen::VectorXd& eps, Eigen::VectorXd& f, PolynomialScratch& s) {
+  // E^T K eps = K eps + J^T (A^T K^+ K eps) = K eps + J^T (A^T eps): K^+ K is the projection
+  // off the rigid fields, and a rigid field has no stress (A^T of it vanishes).
   s.Ate.noalias() = p.A.transpose() * eps;
   PairJacobianTransposeTimes(q, s.Ate, s.u);
   f.noalias() = K * eps;
@@ -157,6 +162,8 @@ void CondensedForce(const Eigen::MatrixXd& K, const PolynomialStiffness& p, cons
 
 void CondensedTangent(const Eigen::MatrixXd& K, const PolynomialStiffness& p, const Eigen::VectorXd& q,
                       const Eigen::VectorXd& eps, Eigen::MatrixXd& T, PolynomialScratch& s) {
+  // E^T K E = K + A J + (A J)^T + (A J)^T K^+ (A J) (K K^+ A J = A J: the columns of A J, the
+  // derivatives of A z, have no rigid part), plus the pair Hessian at A^T eps (as the force).
   TimesPairJacobian(p.A, q, s.AJ);
   T = K + s.AJ + s.AJ.transpose();
   s.RAJ.noalias() = p.K_plus_root * s.AJ;
@@ -171,21 +178,18 @@ void CondensedTangent(const Eigen::MatrixXd& K, const PolynomialStiffness& p, co
 
 Eigen::VectorXd CondensedForce(const Eigen::MatrixXd& K, const PolynomialStiffness& p, const Eigen::VectorXd& q,
                                const Eigen::VectorXd& eps) {
-  // E^T K eps = K eps + J^T (A^T K^+ K eps) = K eps + J^T (A^T eps): K^+ K is the projection
-  // off the rigid fields, and a rigid field has no stress (A^T of it vanishes).
-  return K * eps + PairJacobianTransposeTimes(q, p.A.transpose() * eps);
+  Eigen::VectorXd f;
+  PolynomialScratch s;
+  CondensedForce(K, p, q, eps, f, s);
+  return f;
 }
 
 Eigen::MatrixXd CondensedTangent(const Eigen::MatrixXd& K, const PolynomialStiffness& p, const Eigen::VectorXd& q,
                                  const Eigen::VectorXd& eps) {
-  // E^T K E = K + A J + (A J)^T + (A J)^T K^+ (A J) (K K^+ A J = A J: the columns of A J, the
-  // derivatives of A z, have no rigid part), plus the pair Hessian at A^T eps (as the force).
-  const Eigen::MatrixXd AJ = TimesPairJacobian(p.A, q);
-  Eigen::MatrixXd T = K + AJ + AJ.transpose();
-  const Eigen::MatrixXd RAJ = p.K_plus_root * AJ;
-  T.noalias() += RAJ.transpose() * RAJ;
-  AddPairHessian(p.A.transpose() * eps, &T);
-  return 0.5 * (T + T.transpose());
+  Eigen::MatrixXd T;
+  PolynomialScratch s;
+  CondensedTangent(K, p, q, eps, T, s);
+  return T;
 }
 
 Eigen::MatrixXd PolynomialTangent(const Eigen::MatrixXd& K, const PolynomialStiffness& p, const Eigen::VectorXd& q) {

@@ -22,14 +22,8 @@ Eigen::Matrix3d QuadraticDerivative(const Eigen::Vector3d& w, const Quadratic& g
   return D;
 }
 
-// R applied to the first `blocks` 3-vectors of v (node forces and moments; modal rows as they are).
-inline Eigen::VectorXd TurnBlocks(const Eigen::Matrix3d& R, const Eigen::VectorXd& v, int blocks) {
-  Eigen::VectorXd out = v;
-  for (int a = 0; a < blocks; ++a) out.segment<3>(3 * a) = R * v.segment<3>(3 * a);
-  return out;
-}
-
-// out = TurnBlocks(R, v, blocks), into out's storage (out may be v itself).
+// out = R applied to the first `blocks` 3-vectors of v (node forces and moments; modal rows as
+// they are), into out's storage (out may be v itself).
 inline void TurnBlocksInto(const Eigen::Matrix3d& R, const Eigen::VectorXd& v, int blocks, Eigen::VectorXd& out) {
   if (&out != &v) out = v;
   for (int a = 0; a < blocks; ++a) {

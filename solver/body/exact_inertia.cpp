@@ -10,7 +10,6 @@
 namespace femb {
 
 using body_blocks::QuadraticDerivative;
-using body_blocks::TurnBlocks;
 using body_blocks::TurnBlocksInto;
 using body_blocks::TurnColBlocks;
 using body_blocks::TurnRowBlocks;
@@ -142,12 +141,6 @@ void SuperelementBody::ExactInertiaForce(const Data& data, const BodyVelocity& w
   s.t1.noalias() = B.transpose() * f_q;
   f += s.t1;
   TurnBlocksInto(R, f, blocks, f);
-}
-
-Eigen::MatrixXd SuperelementBody::ExactGyroscopic(const Data& data, const BodyVelocity& w) const {
-  Eigen::MatrixXd G;
-  ExactGyroscopic(data, w, G);
-  return G;
 }
 
 void SuperelementBody::ExactGyroscopic(const Data& data, const BodyVelocity& w, Eigen::MatrixXd& G) const {

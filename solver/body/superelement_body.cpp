@@ -14,7 +14,6 @@ namespace {
 constexpr double kMaxLocalRotation = 2.0;
 }  // namespace
 
-using body_blocks::TurnBlocks;
 using body_blocks::TurnBlocksInto;
 using body_blocks::TurnColBlocks;
 using body_blocks::TurnRowBlocks;

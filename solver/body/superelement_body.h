@@ -435,7 +435,6 @@ class SuperelementBody {
   const ExactData& ExactProducts(const Data& d) const;
   const Eigen::MatrixXd& ExactMass(const Data& d) const;  // computed once per Data
   // d f_in / d w of the exact inertia force (forward mode, exact).
-  Eigen::MatrixXd ExactGyroscopic(const Data& d, const BodyVelocity& w) const;
   void ExactGyroscopic(const Data& d, const BodyVelocity& w, Eigen::MatrixXd& G) const;
   Eigen::MatrixXd ExactInertiaConfigurationTangent(const Data& d, const BodyVelocity& w,
                                                    const BodyVelocity& wdot) const;

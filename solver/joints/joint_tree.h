@@ -27,9 +27,7 @@ void NodeAccelerations(const SystemModel& model, const DofMap& dofs, const Syste
 /// nodes without joints above them. Quadratic in W: the Coriolis and centripetal terms of a
 /// chain of joints with offsets, whose share d f_in / dW = M_b dc/dW belongs in the iteration
 /// matrix's C (without it Newton converged linearly on a rigid four-bar, 2 iterations a step).
-std::vector<NodeJacobian> ConvectiveVelocityDerivative(const SystemModel& model, const DofMap& dofs,
-                                                       const SystemState& state, const Eigen::VectorXd& W);
-/// The same into `dc` (its storage reused).
+/// Into `dc` (its storage reused).
 void ConvectiveVelocityDerivative(const SystemModel& model, const DofMap& dofs, const SystemState& state,
                                   const Eigen::VectorXd& W, std::vector<NodeJacobian>& dc);
 
@@ -37,10 +35,7 @@ void ConvectiveVelocityDerivative(const SystemModel& model, const DofMap& dofs, 
 /// respect to the coordinates at fixed W and Wdot, per node as sparse columns; empty for nodes
 /// without joints above them; down the tree with the joints' maps (no state copies). Its share
 /// M_b d(acc)/dq belongs in the iteration matrix's K (on a rigid four-bar it was half of K).
-std::vector<NodeJacobian> NodeAccelerationConfigurationDerivative(const SystemModel& model, const DofMap& dofs,
-                                                                  const SystemState& state, const Eigen::VectorXd& W,
-                                                                  const Eigen::VectorXd& Wdot);
-/// The same into `out` (its storage reused).
+/// Into `out` (its storage reused).
 void NodeAccelerationConfigurationDerivative(const SystemModel& model, const DofMap& dofs, const SystemState& state,
                                              const Eigen::VectorXd& W, const Eigen::VectorXd& Wdot,
                                              std::vector<NodeJacobian>& out);

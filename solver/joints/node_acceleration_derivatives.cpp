@@ -9,13 +9,6 @@
 
 namespace femb {
 
-std::vector<NodeJacobian> ConvectiveVelocityDerivative(const SystemModel& model, const DofMap& dofs,
-                                                       const SystemState& state, const Eigen::VectorXd& W) {
-  std::vector<NodeJacobian> dc;
-  ConvectiveVelocityDerivative(model, dofs, state, W, dc);
-  return dc;
-}
-
 void ConvectiveVelocityDerivative(const SystemModel& model, const DofMap& dofs, const SystemState& state,
                                   const Eigen::VectorXd& W, std::vector<NodeJacobian>& dc) {
   dc.resize(size_t(model.n_nodes()));
@@ -74,14 +67,6 @@ void ConvectiveVelocityDerivative(const SystemModel& model, const DofMap& dofs, 
       if (e.squaredNorm() > 0) add(first + 1, e);
     }
   }
-}
-
-std::vector<NodeJacobian> NodeAccelerationConfigurationDerivative(const SystemModel& model, const DofMap& dofs,
-                                                                  const SystemState& state, const Eigen::VectorXd& W,
-                                                                  const Eigen::VectorXd& Wdot) {
-  std::vector<NodeJacobian> out;
-  NodeAccelerationConfigurationDerivative(model, dofs, state, W, Wdot, out);
-  return out;
 }
 
 void NodeAccelerationConfigurationDerivative(const SystemModel& model, const DofMap& dofs, const SystemState& state,
