@@ -107,7 +107,7 @@ def common_settings(raw=False):
     """Formulation switches shared by both cases: (group, label, variant changes or options, --set)."""
     s = [("transformations", "approximated", "{transformations: approximated}", []),
          ("tangent", "K1-only tangent", "{tangent: K1}", []),
-         ("tangent", "Jacobian reuse", "", ["analysis.jacobian_reuse=true"]),
+         ("tangent", "Jacobian reuse", "", ["analysis.jacobian_reuse=steps"]),
          ("velocity terms", "no quadratic velocity terms", "{quadratic_velocity_terms: false}", [])]
     return s if raw else [(g, label, dict(options=o) if o else {}, sets) for g, label, o, sets in s]
 

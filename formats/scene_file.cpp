@@ -430,7 +430,13 @@ SceneSpec ParseScene(const std::string& text, const std::string& name, const std
     if (auto v = m.Optional("tolerance")) a.tolerance = v->PositiveNumber();
     if (auto v = m.Optional("max_iterations")) a.max_iterations = int(v->NonNegativeInteger());
     if (auto v = m.Optional("output_every")) a.output_every = std::max(1, int(v->NonNegativeInteger()));
-    if (auto v = m.Optional("jacobian_reuse")) a.reuse_jacobian = v->Bool();
+    if (auto v = m.Optional("jacobian_reuse")) {
+      // true and false: the values before `step` existed (across steps, and full Newton).
+      const std::string s = v->OneOf({"step", "steps", "none", "true", "false"});
+      a.jacobian_reuse = s == "step"                     ? JacobianReuseType::kStep
+                         : s == "steps" || s == "true" ? JacobianReuseType::kSteps
+                                                       : JacobianReuseType::kNone;
+    }
     if (auto v = m.Optional("gyroscopic_tangent")) a.gyroscopic_tangent = v->Bool();
     m.CheckNoUnknownKeys();
   }

@@ -42,6 +42,7 @@ struct TimeFunctionSpec {
 /// the CSV header, results.h5's `analysis` attribute).
 enum class AnalysisType { kStatic, kDynamic, kModes };
 enum class IntegratorType { kGeneralizedAlpha, kMidpoint };
+enum class JacobianReuseType { kDefault, kNone, kStep, kSteps };  ///< analysis.jacobian_reuse: none | step | steps (kDefault: unset)
 enum class ProbeQuantity { kPosition, kRotation, kVelocity, kAngularVelocity, kJoint, kReaction, kStress };
 /// Bodies, joints and loads by type (SCENE_FORMAT.md `bodies`, `joints`, `loads`).
 enum class SceneBodyType { kSuperelement, kRigid };
@@ -134,7 +135,7 @@ struct SceneAnalysisSpec {
   double tolerance = 1e-8;
   int max_iterations = 25;
   int output_every = 1;
-  bool reuse_jacobian = false;  ///< dynamic: keep the factorized iteration matrix while it converges
+  JacobianReuseType jacobian_reuse = JacobianReuseType::kDefault;  ///< dynamic: which Newton iterations factor anew
   bool gyroscopic_tangent = false;  ///< generalized-alpha: configuration derivative of the quadratic velocity terms in S
 };
 

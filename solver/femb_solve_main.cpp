@@ -216,7 +216,12 @@ int main(int argc, char** argv) {
       if (spec.analysis.integrator == femb::IntegratorType::kMidpoint) options.integrator = femb::Integrator::kMidpoint;
       options.tolerance = spec.analysis.tolerance;
       options.max_iterations = spec.analysis.max_iterations;
-      options.reuse_jacobian = spec.analysis.reuse_jacobian;
+      switch (spec.analysis.jacobian_reuse) {
+        case femb::JacobianReuseType::kDefault: break;  // the integrator's (femb::JacobianReuseOf)
+        case femb::JacobianReuseType::kNone: options.jacobian_reuse = femb::JacobianReuse::kNone; break;
+        case femb::JacobianReuseType::kStep: options.jacobian_reuse = femb::JacobianReuse::kStep; break;
+        case femb::JacobianReuseType::kSteps: options.jacobian_reuse = femb::JacobianReuse::kSteps; break;
+      }
       options.full_inertia_tangent = spec.analysis.gyroscopic_tangent;
       options.threads = threads;
       options.adaptive = spec.analysis.adaptive_step;

@@ -205,6 +205,7 @@ StepOutcome GeneralizedAlphaStep(const SystemModel& model, const DofMap& dofs, c
   const Eigen::VectorXd& weights = work.Weights(model, dofs);
   DivergenceTest divergence;
   Assembly& a = work.assembly;
+  matrix.BeginStep();
   for (; out.iterations < options.max_iterations; ++out.iterations) {
     AssembleDynamicResidual(model, dofs, next, t_new, work, &threads, a);
     if (!a.ok || !a.residual.allFinite()) return out;
@@ -231,7 +232,7 @@ StepOutcome GeneralizedAlphaStep(const SystemModel& model, const DofMap& dofs, c
       return a.K;  // K + gamma' C + beta' M
     };
     Eigen::VectorXd& delta = work.delta;
-    if (!matrix.Increment(dofs, options, h, S, a.residual, delta, out.singular_matrix)) return out;
+    if (!matrix.Increment(dofs, options, h, r_norm, S, a.residual, delta, out.singular_matrix)) return out;
     ApplyIncrement(model, dofs, delta, next.config);
     next.W += gamma_p * delta;
     next.Wdot += beta_p * delta;

@@ -396,6 +396,7 @@ StepOutcome MidpointStep(const SystemModel& model, const DofMap& dofs, const Dyn
   const Eigen::VectorXd weights = ResidualWeights(model, dofs);
   DivergenceTest divergence;
   const int n_lambda = dofs.n_multipliers();
+  matrix.BeginStep();
   for (; out.iterations < options.max_iterations; ++out.iterations) {
     MidpointKinematics k = Midpoint(model, dofs, triples, state, h, next);
     double work = 0.0;
@@ -444,7 +445,7 @@ StepOutcome MidpointStep(const SystemModel& model, const DofMap& dofs, const Dyn
       return SystemMatrix(S + ToMatrix(dofs.n_dofs(), at_end));
     };
     Eigen::VectorXd delta;
-    if (!matrix.Increment(dofs, options, h, S, a.residual, delta, out.singular_matrix)) return out;
+    if (!matrix.Increment(dofs, options, h, r_norm, S, a.residual, delta, out.singular_matrix)) return out;
     ApplyIncrement(model, dofs, delta, next.config);
   }
   return out;

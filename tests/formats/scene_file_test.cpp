@@ -63,6 +63,21 @@ TEST(SceneFile, StepAutoAndItsLimits) {
   EXPECT_DOUBLE_EQ(ParseScene(kGood, "scene.yaml", {"analysis.step=auto"}).analysis.step_tolerance, 1e-5);
 }
 
+TEST(SceneFile, JacobianReuseTakesItsNamesAndTheOldBooleans) {
+  const auto reuse = [](const std::string& value) {
+    return ParseScene(kGood, "scene.yaml", {"analysis.jacobian_reuse=" + value}).analysis.jacobian_reuse;
+  };
+  EXPECT_EQ(ParseScene(kGood, "scene.yaml").analysis.jacobian_reuse, JacobianReuseType::kDefault);
+  EXPECT_EQ(reuse("step"), JacobianReuseType::kStep);
+  EXPECT_EQ(reuse("steps"), JacobianReuseType::kSteps);
+  EXPECT_EQ(reuse("none"), JacobianReuseType::kNone);
+  EXPECT_EQ(reuse("true"), JacobianReuseType::kSteps);  // the boolean's meaning before `step`
+  EXPECT_EQ(reuse("false"), JacobianReuseType::kNone);
+  const std::string bad = Error(kGood, {"analysis.jacobian_reuse=sometimes"});
+  EXPECT_NE(bad.find("jacobian_reuse"), std::string::npos) << bad;
+  EXPECT_NE(bad.find("expected step, steps, none, true or false, got 'sometimes'"), std::string::npos) << bad;
+}
+
 TEST(SceneFile, TimeFunctionsFollowTheirClosedForms) {
   const SceneSpec s = ParseScene(kGood, "scene.yaml");
   const TimeFunctionSpec& ramp = s.functions.at("drive");
