@@ -619,7 +619,13 @@ void SuperelementBody::Momentum(const Data& d, const BodyVelocity& w, Eigen::Vec
 }
 
 Eigen::Vector3d SuperelementBody::CenterOfMass(const BodyConfiguration& c, const FrameSolution& frame) const {
-  const Eigen::Vector3d moment = first_moment0_ + first_moment_map_ * LocalCoordinates(c, frame);
+  return CenterOfMass(LocalCoordinates(c, frame), frame);
+}
+
+Eigen::Vector3d SuperelementBody::CenterOfMass(const Eigen::VectorXd& q_loc, const FrameSolution& frame) const {
+  Eigen::Vector3d moment;
+  moment.noalias() = first_moment_map_ * q_loc;
+  moment += first_moment0_;
   return frame.x + frame.R * (mass_ > 0 ? Eigen::Vector3d(moment / mass_) : Eigen::Vector3d::Zero());
 }
 

@@ -385,6 +385,8 @@ class SuperelementBody {
   /// moment of the undeformed body about the frame origin, C = int rho Phi (the translation rows
   /// of Phi_rig0^T M), m the mass.
   Eigen::Vector3d CenterOfMass(const BodyConfiguration& c, const FrameSolution& frame) const;
+  /// The same from the local coordinates q_loc = LocalCoordinates(c, frame).
+  Eigen::Vector3d CenterOfMass(const Eigen::VectorXd& q_loc, const FrameSolution& frame) const;
   /// The body's mass.
   double mass() const { return mass_; }
 

@@ -4,7 +4,9 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <charconv>
 #include <cstdio>
+#include <stdexcept>
 #include <filesystem>
 
 #include "formats/hdf5_file.h"
@@ -26,13 +28,19 @@ std::string Num(double v) {
   return buffer;
 }
 
-Eigen::MatrixXd Stack(const std::vector<Eigen::VectorXd>& rows, int cols) {
-  Eigen::MatrixXd m(rows.size(), cols);
-  for (size_t i = 0; i < rows.size(); ++i) m.row(long(i)) = rows[i].transpose();
-  return m;
+// A CSV number: printf's %.10g (std::to_chars with a precision is specified as printf), without
+// a std::string or a locale per number.
+void Put(std::ofstream& out, double v) {
+  char buffer[32];
+  const std::to_chars_result r = std::to_chars(buffer, buffer + sizeof buffer, v, std::chars_format::general, 10);
+  out.write(buffer, r.ptr - buffer);
 }
 
 }  // namespace
+
+Eigen::MatrixXd ResultsRecorder::Rows::Matrix() const {
+  return Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(values.data(), count, width);
+}
 
 ResultsRecorder::ResultsRecorder(const Scene& scene, const std::string& directory)
     : scene_(scene), dofs_(scene.model.dofs()), directory_(directory) {
@@ -50,6 +58,31 @@ ResultsRecorder::ResultsRecorder(const Scene& scene, const std::string& director
     frame_interval_ = a.end_time / kAutoFrames;
     if (a.output_step > 0) frame_interval_ = std::max(frame_interval_, a.output_step);
   }
+  // The series' widths (Rows).
+  const SystemModel& model = scene.model;
+  const int n = model.n_nodes();
+  const size_t n_bodies = model.bodies.size();
+  positions_.width = velocities_.width = angular_velocities_.width = 3 * n;
+  quaternions_.width = 4 * n;
+  reactions_.width = 6 * n;
+  momentum_.width = 6;
+  loop_reactions_.width = 6 * int(model.cut_joints.size());
+  joint_node_.resize(size_t(n));
+  for (int k = 0; k < n; ++k) {
+    joint_node_[size_t(k)] = JointNode(k);
+    if (joint_node_[size_t(k)]) joints_.width += dofs_.node_count(k);
+  }
+  modal_.resize(n_bodies);
+  frames_.resize(n_bodies);
+  for (size_t b = 0; b < n_bodies; ++b) {
+    modal_[b].width = model.bodies[b].n_modes();
+    frames_[b].width = 10;
+  }
+  q_loc_.resize(n_bodies);
+  q_stress_.resize(n_bodies);
+  factors_.resize(n_bodies);
+  has_stress_coordinates_.assign(n_bodies, 0);
+  has_factors_.assign(n_bodies, 0);
   std::error_code ec;
   std::filesystem::create_directories(directory, ec);
   if (ec) throw InputError(directory + ": cannot create output folder (" + ec.message() + ")");
@@ -118,78 +151,80 @@ void ResultsRecorder::Record(double t, const SystemState& state, const Eigen::Ve
     loop_violation_.push_back(LoopViolation(model, state));
     max_loop_violation_ = std::max(max_loop_violation_, loop_violation_.back());
   }
-  Eigen::VectorXd pos(3 * n), quat(4 * n), vel(3 * n), ang(3 * n);
+  // Every series appends its row in place (Rows): no allocation per output step once grown.
+  double* const pos = positions_.Append();
+  double* const quat = quaternions_.Append();
+  double* const vel = velocities_.Append();
+  double* const ang = angular_velocities_.Append();
   for (int k = 0; k < n; ++k) {
-    pos.segment<3>(3 * k) = state.x[k] + scene_.origin;
-    quat.segment<4>(4 * k) = Quaternion(state.R[k]);
+    Eigen::Vector3d::Map(pos + 3 * k) = state.x[k] + scene_.origin;
+    Eigen::Vector4d::Map(quat + 4 * k) = Quaternion(state.R[k]);
     const Eigen::Matrix<double, 6, 1> v = NodeMotion(state, k, W);
-    vel.segment<3>(3 * k) = v.head<3>();
-    ang.segment<3>(3 * k) = v.tail<3>();
+    Eigen::Vector3d::Map(vel + 3 * k) = v.head<3>();
+    Eigen::Vector3d::Map(ang + 3 * k) = v.tail<3>();
   }
   time_.push_back(t);
   kinetic_.push_back(kinetic);
   elastic_.push_back(elastic);
   work_.push_back(external_work);
-  Eigen::VectorXd momentum(6);
-  momentum << linear_momentum, angular_momentum + scene_.origin.cross(linear_momentum);  // about the global origin
-  momentum_.push_back(momentum);
-  positions_.push_back(pos);
-  Eigen::VectorXd reaction = Eigen::VectorXd::Zero(6 * n);
-  if (reactions) {
-    for (int k = 0; k < n; ++k) reaction.segment<6>(6 * k) = (*reactions)[k];
+  double* const momentum = momentum_.Append();
+  Eigen::Vector3d::Map(momentum) = linear_momentum;
+  Eigen::Vector3d::Map(momentum + 3) = angular_momentum + scene_.origin.cross(linear_momentum);  // about the global origin
+  // The reaction at node k (zero without `reactions`).
+  const auto reaction = [&](int k, int i) { return reactions ? (*reactions)[size_t(k)][i] : 0.0; };
+  if (scene_.spec.reactions) {
+    double* const r = reactions_.Append();
+    for (int k = 0; k < n; ++k)
+      for (int i = 0; i < 6; ++i) r[6 * k + i] = reaction(k, i);
   }
-  if (scene_.spec.reactions) reactions_.push_back(reaction);
   if (scene_.spec.reactions && !model.cut_joints.empty()) {
     const std::vector<Eigen::Matrix<double, 6, 1>> cut = CutJointReactions(model, state);
-    Eigen::VectorXd r(6 * long(cut.size()));
-    for (size_t c = 0; c < cut.size(); ++c) r.segment<6>(6 * long(c)) = cut[c];
-    loop_reactions_.push_back(r);
+    double* const r = loop_reactions_.Append();
+    for (size_t c = 0; c < cut.size(); ++c) Eigen::Matrix<double, 6, 1>::Map(r + 6 * c) = cut[c];
   }
-  quaternions_.push_back(quat);
-  velocities_.push_back(vel);
-  angular_velocities_.push_back(ang);
-  std::vector<Eigen::VectorXd> modal, frames;
+  // Per body: modal coordinates, floating frame and centre of mass; the local coordinates (kept
+  // for the mesh, the stresses and the probes of this output step).
   for (size_t b = 0; b < model.bodies.size(); ++b) {
-    modal.push_back(state.eta[b]);
-    Eigen::VectorXd f(10);
-    const Eigen::Vector3d com = model.bodies[b].CenterOfMass(BodyConfigurationOf(model, state, int(b)), state.frames[b]);
-    f << state.frames[b].x + scene_.origin, Quaternion(state.frames[b].R), com + scene_.origin;
-    frames.push_back(f);
+    const SuperelementBody& body = model.bodies[b];
+    double* const modal = modal_[b].Append();
+    for (int i = 0; i < modal_[b].width; ++i) modal[i] = state.eta[b][i];
+    BodyConfigurationOf(model, state, int(b), config_);
+    body.LocalCoordinates(config_, state.frames[b], q_loc_[b]);
+    const Eigen::Vector3d com = body.CenterOfMass(q_loc_[b], state.frames[b]);
+    double* const f = frames_[b].Append();
+    Eigen::Vector3d::Map(f) = state.frames[b].x + scene_.origin;
+    Eigen::Vector4d::Map(f + 3) = Quaternion(state.frames[b].R);
+    Eigen::Vector3d::Map(f + 7) = com + scene_.origin;
+    has_stress_coordinates_[b] = 0;
+    has_factors_[b] = 0;
   }
-  modal_.push_back(modal);
   // Joint coordinates: the coordinates of every node that has a joint (revolute angle,
   // prismatic travel, ...), in node order.
-  std::vector<double> joint_values;
+  double* const joint_values = joints_.Append();
+  int joint_count = 0;
   for (int k = 0; k < n; ++k) {
-    if (!JointNode(k)) continue;
-    for (int i = 0; i < state.z[k].size(); ++i) joint_values.push_back(state.z[k][i]);
+    if (!joint_node_[size_t(k)]) continue;
+    if (joint_count + state.z[k].size() > joints_.width) throw std::logic_error("ResultsRecorder: joint coordinates changed in number");
+    for (int i = 0; i < state.z[k].size(); ++i) joint_values[joint_count++] = state.z[k][i];
   }
-  joints_.push_back(Eigen::Map<Eigen::VectorXd>(joint_values.data(), long(joint_values.size())));
-  frames_.push_back(frames);
   bool frame = (time_.size() - 1) % size_t(animation_every_) == 0;
   if (frame_interval_ > 0) {
     frame = t >= next_frame_time_ - 1e-9 * frame_interval_;
     if (frame) next_frame_time_ = (std::floor(t / frame_interval_ + 1e-9) + 1) * frame_interval_;
   }
-  // Local coordinates of body b (once per output step, for the mesh, the stresses, the probes).
-  std::vector<Eigen::VectorXd> q_loc(model.bodies.size());
-  auto local = [&](size_t b) -> const Eigen::VectorXd& {
-    if (q_loc[b].size() == 0) q_loc[b] = model.bodies[b].LocalCoordinates(BodyConfigurationOf(model, state, int(b)), state.frames[b]);
-    return q_loc[b];
-  };
-  std::vector<Eigen::VectorXd> q_stress(model.bodies.size());
+  const auto local = [&](size_t b) -> const Eigen::VectorXd& { return q_loc_[b]; };
   auto stress_coordinates = [&](size_t b) -> const Eigen::VectorXd& {
-    if (q_stress[b].size() == 0) q_stress[b] = model.bodies[b].StressCoordinates(local(b));
-    return q_stress[b];
+    if (!has_stress_coordinates_[b]) q_stress_[b] = model.bodies[b].StressCoordinates(local(b));
+    has_stress_coordinates_[b] = 1;
+    return q_stress_[b];
   };
   // The inertia load factors of body b's frame (SuperelementBody::InertiaLoads) when its modal
   // stresses include the inertia load cases: d'Alembert with gravity (static analyses: gravity
   // as ramped by the analysis, no motion).
-  std::vector<Eigen::VectorXd> factors(model.bodies.size());
   std::vector<Eigen::Matrix<double, 6, 1>> node_acc;
   auto inertia = [&](size_t b) -> const Eigen::VectorXd* {
     if (!scene_.stresses[b] || scene_.stresses[b]->inertia_modes.size() == 0) return nullptr;
-    if (factors[b].size() > 0) return &factors[b];
+    if (has_factors_[b]) return &factors_[b];
     const bool dynamic = scene_.spec.analysis.type == AnalysisType::kDynamic;
     const Eigen::VectorXd zero = Eigen::VectorXd::Zero(dofs.n_dofs());
     const Eigen::VectorXd& V = W.size() == dofs.n_dofs() ? W : zero;
@@ -197,11 +232,12 @@ void ResultsRecorder::Record(double t, const SystemState& state, const Eigen::Ve
     if (node_acc.empty()) node_acc = NodeAccelerations(model, dofs, state, V, A);
     double g = dynamic ? 1.0 : 0.0;
     if (!dynamic && model.static_gravity_end > 0) g = std::min(t / model.static_gravity_end, 1.0);
-    factors[b] = model.bodies[b]
-                     .InertiaLoads(BodyConfigurationOf(model, state, int(b)), state.frames[b], GatherBody(model, dofs, state, int(b), V),
-                                   GatherBodyAcceleration(model, dofs, int(b), node_acc, A), g * model.gravity)
-                     .a;
-    return &factors[b];
+    factors_[b] = model.bodies[b]
+                      .InertiaLoads(BodyConfigurationOf(model, state, int(b)), state.frames[b], GatherBody(model, dofs, state, int(b), V),
+                                    GatherBodyAcceleration(model, dofs, int(b), node_acc, A), g * model.gravity)
+                      .a;
+    has_factors_[b] = 1;
+    return &factors_[b];
   };
   if (scene_.spec.stresses) {
     const bool frame_fields = frame && scene_.spec.animation;  // the animation's node fields
@@ -262,26 +298,30 @@ void ResultsRecorder::Record(double t, const SystemState& state, const Eigen::Ve
     mesh_deformations_.push_back(deformations);
   }
 
-  csv_ << Num(t);
+  Put(csv_, t);
+  const auto put = [&](double v) {
+    csv_.put(',');
+    Put(csv_, v);
+  };
   for (size_t pi = 0; pi < scene_.spec.probes.size(); ++pi) {
     const SceneProbeSpec& p = scene_.spec.probes[pi];
     if (!p.body.empty()) {  // a stress probe: its stress point
       const auto [b, point] = scene_.stress_probes[pi];
       const Eigen::Matrix<double, 6, 1> s = PointStress(*scene_.stresses[size_t(b)], point, stress_coordinates(size_t(b)), inertia(size_t(b)));
-      csv_ << "," << Num(VonMises(s));
-      for (int i = 0; i < 6; ++i) csv_ << "," << Num(s[i]);
+      put(VonMises(s));
+      for (int i = 0; i < 6; ++i) put(s[i]);
       continue;
     }
     const int k = scene_.node_index.at(p.node);
     for (const ProbeQuantity q : p.quantities) {
-      if (q == ProbeQuantity::kPosition) for (int i = 0; i < 3; ++i) csv_ << "," << Num(pos[3 * k + i]);
-      if (q == ProbeQuantity::kRotation) for (int i = 0; i < 4; ++i) csv_ << "," << Num(quat[4 * k + i]);
-      if (q == ProbeQuantity::kVelocity) for (int i = 0; i < 3; ++i) csv_ << "," << Num(vel[3 * k + i]);
-      if (q == ProbeQuantity::kAngularVelocity) for (int i = 0; i < 3; ++i) csv_ << "," << Num(ang[3 * k + i]);
+      if (q == ProbeQuantity::kPosition) for (int i = 0; i < 3; ++i) put(pos[3 * k + i]);
+      if (q == ProbeQuantity::kRotation) for (int i = 0; i < 4; ++i) put(quat[4 * k + i]);
+      if (q == ProbeQuantity::kVelocity) for (int i = 0; i < 3; ++i) put(vel[3 * k + i]);
+      if (q == ProbeQuantity::kAngularVelocity) for (int i = 0; i < 3; ++i) put(ang[3 * k + i]);
       if (q == ProbeQuantity::kJoint) {
         const int c = pi < probe_cut_.size() ? probe_cut_[pi] : -1;
         if (c < 0) {
-          for (int i = 0; i < state.z[k].size(); ++i) csv_ << "," << Num(state.z[k][i]);
+          for (int i = 0; i < state.z[k].size(); ++i) put(state.z[k][i]);
         } else {
           const NodeJoint& j = model.cut_joints[size_t(c)].joint;
           Eigen::VectorXd z = CutJointCoordinates(j, state.x[j.parent], state.R[j.parent], state.x[j.child], state.R[j.child]);
@@ -293,13 +333,16 @@ void ResultsRecorder::Record(double t, const SystemState& state, const Eigen::Ve
             }
           }
           probe_last_[pi] = z;
-          for (int i = 0; i < z.size(); ++i) csv_ << "," << Num(z[i]);
+          for (int i = 0; i < z.size(); ++i) put(z[i]);
         }
       }
-      if (q == ProbeQuantity::kReaction) for (int i = 0; i < 6; ++i) csv_ << "," << Num(reaction[6 * k + i]);
+      if (q == ProbeQuantity::kReaction) for (int i = 0; i < 6; ++i) put(reaction(k, i));
     }
   }
-  csv_ << "," << Num(kinetic) << "," << Num(elastic) << "," << Num(external_work) << "\n";
+  put(kinetic);
+  put(elastic);
+  put(external_work);
+  csv_.put('\n');
 }
 
 bool ResultsRecorder::JointNode(int k) const {
@@ -345,15 +388,15 @@ void ResultsRecorder::Finish(const std::string& status) {
       for (const CutJoint& cut : model.cut_joints) names.push_back(cut.name);
       w.Strings("/loops/cut_joints", names);
       w.Vector("/loops/violation", Eigen::Map<const Eigen::VectorXd>(loop_violation_.data(), long(loop_violation_.size())));
-      if (!loop_reactions_.empty()) w.Matrix("/loops/reaction", Stack(loop_reactions_, 6 * int(model.cut_joints.size())));
+      if (loop_reactions_.count > 0) w.Matrix("/loops/reaction", loop_reactions_.Matrix());
     }
     w.CreateGroup("/nodes");
     w.Strings("/nodes/names", model.node_names);
-    w.Matrix("/nodes/position", Stack(positions_, 3 * n));
-    w.Matrix("/nodes/quaternion", Stack(quaternions_, 4 * n));
-    w.Matrix("/nodes/velocity", Stack(velocities_, 3 * n));
-    w.Matrix("/nodes/angular_velocity", Stack(angular_velocities_, 3 * n));
-    if (!reactions_.empty()) w.Matrix("/nodes/reaction", Stack(reactions_, 6 * n));
+    w.Matrix("/nodes/position", positions_.Matrix());
+    w.Matrix("/nodes/quaternion", quaternions_.Matrix());
+    w.Matrix("/nodes/velocity", velocities_.Matrix());
+    w.Matrix("/nodes/angular_velocity", angular_velocities_.Matrix());
+    if (reactions_.count > 0) w.Matrix("/nodes/reaction", reactions_.Matrix());
     std::vector<std::string> labels;
     const DofMap& dofs = model.dofs();
     for (int k = 0; k < n; ++k) {
@@ -361,25 +404,20 @@ void ResultsRecorder::Finish(const std::string& status) {
       for (int i = 0; i < dofs.node_count(k); ++i) labels.push_back(model.node_names[k] + "." + std::to_string(i));
     }
     w.Strings("/nodes/joint_coordinate_labels", labels);
-    w.Matrix("/nodes/joint_coordinates", Stack(joints_, int(labels.size())));
+    w.Matrix("/nodes/joint_coordinates", joints_.Matrix());
     w.CreateGroup("/energy");
     w.Vector("/energy/kinetic", Eigen::Map<const Eigen::VectorXd>(kinetic_.data(), long(kinetic_.size())));
     w.Vector("/energy/elastic", Eigen::Map<const Eigen::VectorXd>(elastic_.data(), long(elastic_.size())));
     w.Vector("/energy/external_work", Eigen::Map<const Eigen::VectorXd>(work_.data(), long(work_.size())));
-    const Eigen::MatrixXd momentum = Stack(momentum_, 6);
+    const Eigen::MatrixXd momentum = momentum_.Matrix();
     w.Matrix("/energy/linear_momentum", momentum.leftCols(3));
     w.Matrix("/energy/angular_momentum", momentum.rightCols(3));
     w.CreateGroup("/bodies");
     for (size_t b = 0; b < model.bodies.size(); ++b) {
       const std::string g = "/bodies/" + scene_.body_names[b];
       w.CreateGroup(g);
-      std::vector<Eigen::VectorXd> modal, frames;
-      for (size_t s = 0; s < time_.size(); ++s) {
-        modal.push_back(modal_[s][b]);
-        frames.push_back(frames_[s][b]);
-      }
-      w.Matrix(g + "/modal_coordinates", Stack(modal, model.bodies[b].n_modes()));
-      const Eigen::MatrixXd frame_and_com = Stack(frames, 10);
+      w.Matrix(g + "/modal_coordinates", modal_[b].Matrix());
+      const Eigen::MatrixXd frame_and_com = frames_[b].Matrix();
       w.Matrix(g + "/floating_frame", frame_and_com.leftCols(7));
       w.Matrix(g + "/center_of_mass", frame_and_com.rightCols(3));
       std::vector<std::string> nodes;
