@@ -153,9 +153,8 @@ void DriveForces(const DofMap& dofs, const Eigen::VectorXd& residual, Eigen::Vec
 // small, skip the matrices and the factorization (an iteration's larger part: on the 2 stiffened
 // slider-crank bodies at h = 100 us the matrices cost 3x the residual). Measured there: 1.86 ->
 // 1.93 iterations and 1.86 -> 1.00 factorizations per step, 0.31 -> 0.22 s, the same error;
-// contraction thresholds from 0.03 to 1 gave the same times (with 0.1, a slowly converging step
-// goes back to full Newton early). An
-// iteration that contracts less (a strongly nonlinear step) returns to full Newton at once.
+// contraction thresholds from 0.03 to 1 gave the same times. With 0.1, an iteration that
+// contracts less (a strongly nonlinear step) returns to full Newton at once.
 // Across steps (kSteps) the factor is kept while Newton converges within reuse_max_iterations:
 // the matrices turn with the bodies, and at this code's tight default tolerance that costs many
 // more iterations (the same slider-crank: 7.0 per step against 1.9), so it is an option only.
