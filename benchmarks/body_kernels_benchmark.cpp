@@ -19,7 +19,8 @@
 #include <vector>
 
 #include "benchmarks/allocation_count.h"
-#include "benchmarks/reduced_part.h"
+#include "formats/part_file.h"
+#include "reducer/reduce_part.h"
 #include "solver/body/superelement_body.h"
 #include "solver/rotation.h"
 
@@ -81,17 +82,20 @@ int main(int argc, char** argv) {
   double sink = 0.0;
   for (int kind = 0; kind < 3; ++kind) {
     const bool stiffening = kind >= 1;
-    const femb::Superelement se = femb::bench::ReducedByTheTool(argv[0],
+    const femb::PartSpec part = femb::ParsePart(
         "name: seg\ntype: beam\nmaterial: {E: 70.0e9, nu: 0.3, rho: 2700}\n"
         "section: {shape: tube, outer_radius: 0.01, wall: 0.001}\n"
         "beam:\n  points: {A: [0, 0, 0], B: [0.5, 0, 0]}\n"
         "  segments: [{from: A, to: B, elements: 8}]\n"
         "interfaces: [{name: A}, {name: B}]\nreduction: {internal_modes: " + std::to_string(modes) +
-            ", keep_mesh: false, geometric_stiffening: " + std::string(stiffening ? "true" : "false") + "}\n");
+            ", keep_mesh: false, geometric_stiffening: " + std::string(stiffening ? "true" : "false") + "}\n",
+        "bench.yaml");
+    const femb::ReduceResult reduced = femb::ReducePart(part, nullptr);
+    if (!reduced.ok) return 3;
     femb::SuperelementOptions options;
     options.geometric_stiffening = kind == 2;
     Setup& u = setups[size_t(kind)];
-    u.body = std::make_unique<femb::SuperelementBody>(se, options);
+    u.body = std::make_unique<femb::SuperelementBody>(reduced.superelement, options);
     const femb::SuperelementBody& body = *u.body;
     const int n = body.n_coordinates();
     // A deformed, turned configuration and a spinning, accelerating motion.

@@ -16,7 +16,8 @@
 #include <algorithm>
 
 #include "benchmarks/allocation_count.h"
-#include "benchmarks/reduced_part.h"
+#include "formats/part_file.h"
+#include "reducer/reduce_part.h"
 #include "solver/analysis/dynamic_analysis.h"
 #include "solver/parallel.h"
 
@@ -38,18 +39,21 @@ int main(int argc, char** argv) {
    double linear_ms = 0.0;
    for (bool stiffening : kinds) {
     const double Lb = 1.0 / n_bodies;
-    const femb::Superelement se = femb::bench::ReducedByTheTool(argv[0],
+    const femb::PartSpec part = femb::ParsePart(
         "name: seg\ntype: beam\nmaterial: {E: 70.0e9, nu: 0.3, rho: 2700}\n"
         "section: {shape: tube, outer_radius: 0.01, wall: 0.001}\n"
         "beam:\n  points: {A: [0, 0, 0], B: [" + std::to_string(Lb) + ", 0, 0]}\n"
         "  segments: [{from: A, to: B, elements: 2}]\n"
         "interfaces: [{name: A}, {name: B}]\nreduction: {internal_modes: 2, keep_mesh: false, geometric_stiffening: " +
-            std::string(stiffening ? "true" : "false") + "}\n");
+            std::string(stiffening ? "true" : "false") + "}\n",
+        "bench.yaml");
+    const femb::ReduceResult reduced = femb::ReducePart(part, nullptr);
+    if (!reduced.ok) return 3;
     femb::SystemModel model;
     for (int i = 0; i <= n_bodies; ++i) femb::AddNode(model, "n" + std::to_string(i), Eigen::Vector3d(i * Lb, 0, 0));
     femb::Clamp(model, 0);
     for (int i = 0; i < n_bodies; ++i) {
-      model.bodies.emplace_back(se, femb::SuperelementOptions{}, Eigen::Matrix3d::Identity(),
+      model.bodies.emplace_back(reduced.superelement, femb::SuperelementOptions{}, Eigen::Matrix3d::Identity(),
                                 Eigen::Vector3d(i * Lb, 0, 0));
       model.body_nodes.push_back({i, i + 1});
     }

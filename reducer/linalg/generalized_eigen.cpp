@@ -8,6 +8,8 @@
 #include <numeric>
 #include <stdexcept>
 
+#include "reducer/linalg/dense_products.h"
+
 namespace femb {
 namespace {
 
@@ -148,7 +150,7 @@ EigenResult BlockLanczosEigenpairs(const SparseMatrix& K, const SparseMatrix& M,
   // part after the solves) by Cholesky QR twice, dropping directions that vanish.
   auto orthonormalize = [&](Eigen::MatrixXd& W, Eigen::MatrixXd& MW) {
     for (int pass = 0; pass < 2; ++pass) {
-      const Eigen::MatrixXd G = W.transpose() * MW;
+      const Eigen::MatrixXd G = TransposeTimes(W, MW);
       Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(0.5 * (G + G.transpose()));
       const double top = es.eigenvalues().maxCoeff();
       std::vector<int> keep;
@@ -157,8 +159,8 @@ EigenResult BlockLanczosEigenpairs(const SparseMatrix& K, const SparseMatrix& M,
       Eigen::MatrixXd basis(G.rows(), long(keep.size()));
       for (size_t k = 0; k < keep.size(); ++k)
         basis.col(long(k)) = es.eigenvectors().col(keep[k]) / std::sqrt(es.eigenvalues()[keep[k]]);
-      W = W * basis;
-      MW = MW * basis;
+      W = Times(W, basis);
+      MW = Times(MW, basis);
     }
   };
   // Basis V (M-orthonormal), A V and M V, stored in matrices that grow by half their width
@@ -190,7 +192,7 @@ EigenResult BlockLanczosEigenpairs(const SparseMatrix& K, const SparseMatrix& M,
     // Rayleigh-Ritz: T = V^T M A V (symmetric: A is self-adjoint in the M inner product),
     // grown by the new block's rows and columns.
     T.conservativeResize(m, m);
-    const Eigen::MatrixXd new_cols = MV.leftCols(m).transpose() * AQ;
+    const Eigen::MatrixXd new_cols = TransposeTimes(MV.leftCols(m), AQ);
     T.rightCols(add) = new_cols;
     T.bottomRows(add) = new_cols.transpose();
     // The next block's direction: A Q orthogonalized against the whole basis (twice). With the
@@ -198,9 +200,9 @@ EigenResult BlockLanczosEigenpairs(const SparseMatrix& K, const SparseMatrix& M,
     // A V y - theta V y = W y_new (y_new: y's rows of the newest block), so its M-norm is
     // sqrt(y_new^T (W^T M W) y_new): no n-sized work to test convergence.
     Eigen::MatrixXd W = AQ;
-    for (int pass = 0; pass < 2; ++pass) W -= V.leftCols(m) * (MV.leftCols(m).transpose() * W);
+    for (int pass = 0; pass < 2; ++pass) Gemm(V.leftCols(m), false, TransposeTimes(MV.leftCols(m), W), false, W, -1.0, 1.0);
     Eigen::MatrixXd MW = M * W;
-    const Eigen::MatrixXd G = W.transpose() * MW;
+    const Eigen::MatrixXd G = TransposeTimes(W, MW);
     if (m >= nev) {
       Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(0.5 * (T + T.transpose()));
       bool converged = true;
@@ -217,7 +219,7 @@ EigenResult BlockLanczosEigenpairs(const SparseMatrix& K, const SparseMatrix& M,
           result.lambda[k] = sigma + 1.0 / es.eigenvalues()[m - 1 - k];
           Y.col(k) = es.eigenvectors().col(m - 1 - k);
         }
-        result.vectors = V.leftCols(m) * Y;
+        result.vectors = Times(V.leftCols(m), Y);
         break;
       }
     }

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "reducer/linalg/dense_products.h"
 #include "reducer/linalg/generalized_eigen.h"
 
 namespace femb {
@@ -159,11 +160,11 @@ void InertiaInvariants(const FeModel& model, const Eigen::MatrixXd& shapes, std:
   std::array<Eigen::MatrixXd, 3> M_turned;
   for (int a = 0; a < 3; ++a) {
     M_turned[size_t(a)] = model.M * turned[size_t(a)];
-    gamma->push_back(shapes.transpose() * M_turned[size_t(a)]);
+    gamma->push_back(TransposeTimes(shapes, M_turned[size_t(a)]));
   }
   const int pairs[6][2] = {{0, 0}, {1, 1}, {2, 2}, {0, 1}, {0, 2}, {1, 2}};
   for (const auto& ab : pairs) {
-    Eigen::MatrixXd X = turned[size_t(ab[0])].transpose() * M_turned[size_t(ab[1])];
+    Eigen::MatrixXd X = TransposeTimes(turned[size_t(ab[0])], M_turned[size_t(ab[1])]);
     if (ab[0] == ab[1]) X = 0.5 * (X + X.transpose()).eval();
     xi->push_back(std::move(X));
   }
@@ -428,9 +429,9 @@ CraigBamptonResult CraigBamptonReduce(const FeModel& model, int internal_modes,
   for (int k = 0; k < n_i; ++k)
     if (d > 0) r.shapes.row(interior[k]).tail(d) = Theta.row(k);
   const Eigen::MatrixXd K_shapes = model.K * r.shapes;  // evaluated first: Eigen would nest it lazily
-  r.K = r.shapes.transpose() * K_shapes;
+  r.K = TransposeTimes(r.shapes, K_shapes);
   const Eigen::MatrixXd M_shapes = model.M * r.shapes;
-  r.M = r.shapes.transpose() * M_shapes;
+  r.M = TransposeTimes(r.shapes, M_shapes);
   r.K = 0.5 * (r.K + r.K.transpose()).eval();
   r.M = 0.5 * (r.M + r.M.transpose()).eval();
   if (progress) progress("projection", clock.Seconds(), Format("%.0f reduced DOFs", n_r));

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <string>
 
+#include "reducer/linalg/dense_products.h"
 #include "reducer/reduction/craig_bampton.h"
 
 namespace femb {
@@ -35,7 +36,7 @@ GeneralBasisResult ReduceOnGeneralBasis(const FeModel& model, const Eigen::Matri
   V << RigidFields(model), V_given;
   r.columns_given = int(V_given.cols());
   const Eigen::MatrixXd MV = model.M * V;
-  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> gram(V.transpose() * MV);
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> gram(TransposeTimes(V, MV));
   const Eigen::VectorXd g = gram.eigenvalues();
   const double g_max = g.maxCoeff();
   std::vector<int> keep;
@@ -109,8 +110,9 @@ GeneralBasisResult ReduceOnGeneralBasis(const FeModel& model, const Eigen::Matri
   Eigen::MatrixXd K_Psi(model.n_dofs(), 0);
   if (n_internal > 0) {
     K_Psi = model.K * Psi;
-    const Eigen::MatrixXd Kpp = 0.5 * (Psi.transpose() * K_Psi + (Psi.transpose() * K_Psi).transpose());
-    const Eigen::MatrixXd Mpp = Psi.transpose() * (model.M * Psi);
+    const Eigen::MatrixXd PtKP = TransposeTimes(Psi, K_Psi);
+    const Eigen::MatrixXd Kpp = 0.5 * (PtKP + PtKP.transpose());
+    const Eigen::MatrixXd Mpp = TransposeTimes(Psi, Eigen::MatrixXd(model.M * Psi));
     Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> eig(Kpp, 0.5 * (Mpp + Mpp.transpose()));
     if (eig.info() != Eigen::Success || !(eig.eigenvalues().minCoeff() > 0)) {
       r.message = "the shapes' internal part (zero at the interfaces) has no stiffness in some direction (a mechanism "
@@ -118,20 +120,20 @@ GeneralBasisResult ReduceOnGeneralBasis(const FeModel& model, const Eigen::Matri
       r.input_error = true;
       return r;
     }
-    Psi = Psi * eig.eigenvectors();  // K = diag(lambda), M = 1 on the internal block
-    K_Psi = K_Psi * eig.eigenvectors();
+    Psi = Times(Psi, eig.eigenvectors());  // K = diag(lambda), M = 1 on the internal block
+    K_Psi = Times(K_Psi, eig.eigenvectors());
     r.lambda = eig.eigenvalues();
-    const Eigen::MatrixXd C = r.lambda.cwiseInverse().asDiagonal() * (Psi.transpose() * K_Phi);
-    Phi -= Psi * C;
-    K_Phi -= K_Psi * C;
+    const Eigen::MatrixXd C = r.lambda.cwiseInverse().asDiagonal() * TransposeTimes(Psi, K_Phi);
+    Gemm(Psi, false, C, false, Phi, -1.0, 1.0);
+    Gemm(K_Psi, false, C, false, K_Phi, -1.0, 1.0);
   }
   r.shapes.resize(model.n_dofs(), nb + n_internal);
   r.shapes << Phi, Psi;
   Eigen::MatrixXd KS(model.n_dofs(), nb + n_internal);
   KS << K_Phi, K_Psi;
   const Eigen::MatrixXd MS = model.M * r.shapes;
-  r.K = r.shapes.transpose() * KS;
-  r.M = r.shapes.transpose() * MS;
+  r.K = TransposeTimes(r.shapes, KS);
+  r.M = TransposeTimes(r.shapes, MS);
   r.K = 0.5 * (r.K + r.K.transpose()).eval();
   r.M = 0.5 * (r.M + r.M.transpose()).eval();
   r.ok = true;
