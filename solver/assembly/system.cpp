@@ -247,10 +247,7 @@ void ResidualWeights(const SystemModel& model, const DofMap& dofs, Eigen::Vector
   for (int k = 0; k < model.n_nodes(); ++k) {
     const int first = dofs.node_first(k), j = dofs.joint_of(k);
     if (j < 0) {
-      const Eigen::MatrixXd& S = dofs.S(k);
-      for (int c = 0; c < S.cols(); ++c) {
-        if (S.col(c).tail<3>().norm() > 0) w[first + c] = 1.0 / L;
-      }
+      w.segment<3>(first + 3).setConstant(1.0 / L);  // a free node's rotation increments
       continue;
     }
     const NodeJoint& joint = model.joints[j];

@@ -12,8 +12,8 @@
 namespace femb {
 
 namespace {
-// Calls f(v) for every number of the model's structure that its DofMap depends on besides the
-// motion bases (DofMap::Shape), in a fixed order.
+// Calls f(v) for every number of the model's structure that its DofMap depends on
+// (DofMap::Shape), in a fixed order.
 template <class F>
 void ForEachShapeNumber(const SystemModel& model, const F& f) {
   for (int v : {model.n_nodes(), int(model.joints.size()), int(model.bodies.size()), int(model.cut_joints.size()),
@@ -34,19 +34,13 @@ std::vector<int> DofMap::Shape(const SystemModel& model) {
 
 bool DofMap::Matches(const SystemModel& model) const {
   // Without allocating: the loops' checks call it once per Newton iteration.
-  if (model.motion.size() != motion_.size()) return false;
   size_t i = 0;
   bool same = true;
   ForEachShapeNumber(model, [&](int v) {
     same = same && i < shape_.size() && shape_[i] == v;
     ++i;
   });
-  if (!same || i != shape_.size()) return false;
-  for (size_t k = 0; k < motion_.size(); ++k) {
-    const Eigen::MatrixXd& S = model.motion[k];
-    if (S.rows() != motion_[k].rows() || S.cols() != motion_[k].cols() || S != motion_[k]) return false;
-  }
-  return true;
+  return same && i == shape_.size();
 }
 
 const DofMap& SystemModel::dofs() const {
@@ -54,11 +48,14 @@ const DofMap& SystemModel::dofs() const {
   return *dofs_;
 }
 
-DofMap::DofMap(const SystemModel& model) : motion_(model.motion), shape_(Shape(model)) {
+DofMap::DofMap(const SystemModel& model) : shape_(Shape(model)) {
   const int n = model.n_nodes();
   joint_of_.assign(n, -1);
   for (size_t j = 0; j < model.joints.size(); ++j) {
-    const int c = model.joints[j].child;
+    const int c = model.joints[j].child, p = model.joints[j].parent;
+    if (c < 0 || c >= n || p < kGround || p >= n) {
+      throw InputError("joint " + std::to_string(j) + " names a node that does not exist");
+    }
     if (joint_of_[c] >= 0) {
       throw InputError("node '" + model.node_names[c] + "' has two parent joints");
     }
@@ -86,7 +83,7 @@ DofMap::DofMap(const SystemModel& model) : motion_(model.motion), shape_(Shape(m
   }
   for (int k = 0; k < n; ++k) {
     node_first_.push_back(n_dofs_);
-    node_count_.push_back(joint_of_[k] >= 0 ? model.joints[joint_of_[k]].n_coordinates() : int(model.motion[k].cols()));
+    node_count_.push_back(joint_of_[k] >= 0 ? model.joints[joint_of_[k]].n_coordinates() : 6);
     n_dofs_ += node_count_.back();
   }
   for (const SuperelementBody& body : model.bodies) {
@@ -109,34 +106,47 @@ DofMap::DofMap(const SystemModel& model) : motion_(model.motion), shape_(Shape(m
   }
 }
 
-void Clamp(SystemModel& model, int k) { model.motion[k] = Eigen::MatrixXd(6, 0); }
-
-void Pin(SystemModel& model, int k) {
-  model.motion[k] = Eigen::MatrixXd::Zero(6, 3);
-  model.motion[k].bottomRows(3).setIdentity();
+void JointToGround(SystemModel& model, JointType type, int k, const Eigen::Vector3d& axis,
+                   const Eigen::Vector3d& axis2) {
+  const NodeJoint joint = MakeNodeJoint(type, k, kGround, axis, Eigen::Vector3d::Zero(), Eigen::Matrix3d::Identity(),
+                                        model.node_x0[k], model.node_R0[k], axis2);
+  for (NodeJoint& j : model.joints) {
+    if (j.child == k && j.parent == kGround) {
+      j = joint;  // a new support for the node
+      return;
+    }
+  }
+  model.joints.push_back(joint);
 }
 
+void Clamp(SystemModel& model, int k) { JointToGround(model, JointType::kRigid, k, Eigen::Vector3d::UnitZ()); }
+
+void Pin(SystemModel& model, int k) { JointToGround(model, JointType::kSpherical, k, Eigen::Vector3d::UnitZ()); }
+
 void RevoluteToGround(SystemModel& model, int k, const Eigen::Vector3d& axis) {
-  model.motion[k] = Eigen::MatrixXd::Zero(6, 1);
-  model.motion[k].col(0).tail<3>() = axis.normalized();
+  JointToGround(model, JointType::kRevolute, k, axis);
 }
 
 void PrismaticToGround(SystemModel& model, int k, const Eigen::Vector3d& axis) {
-  model.motion[k] = Eigen::MatrixXd::Zero(6, 1);
-  model.motion[k].col(0).head<3>() = axis.normalized();
+  JointToGround(model, JointType::kPrismatic, k, axis);
 }
 
 void CylindricalToGround(SystemModel& model, int k, const Eigen::Vector3d& axis) {
-  model.motion[k] = Eigen::MatrixXd::Zero(6, 2);
-  model.motion[k].col(0).head<3>() = axis.normalized();
-  model.motion[k].col(1).tail<3>() = axis.normalized();
+  JointToGround(model, JointType::kCylindrical, k, axis);
+}
+
+bool FixedToGround(const SystemModel& model, int k) {
+  for (const NodeJoint& j : model.joints) {
+    if (j.child != k) continue;
+    return j.n_coordinates() == 0 && (j.parent == kGround || FixedToGround(model, j.parent));
+  }
+  return false;  // free
 }
 
 int AddNode(SystemModel& model, const std::string& name, const Eigen::Vector3d& x, const Eigen::Matrix3d& R) {
   model.node_names.push_back(name);
   model.node_x0.push_back(x);
   model.node_R0.push_back(R);
-  model.motion.push_back(Eigen::MatrixXd::Identity(6, 6));
   return model.n_nodes() - 1;
 }
 
@@ -180,7 +190,7 @@ void ApplyIncrement(const SystemModel& model, const DofMap& dofs, const Eigen::V
     const int j = dofs.joint_of(k);
     Eigen::Matrix<double, 6, 1> d = Eigen::Matrix<double, 6, 1>::Zero();
     if (j < 0) {
-      d.noalias() = dofs.S(k) * dz;
+      d = dz;  // a free node's own spatial increments
       state.x[k] += d.head<3>();
     } else if (model.joints[j].type == JointType::kSpherical) {
       d.tail<3>() = dz;  // the child's own rotation; its position follows the parent

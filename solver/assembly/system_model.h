@@ -1,14 +1,14 @@
 // A multibody system of superelements on shared 6-DOF nodes, with Lagrange multipliers only
 // where a loop of joints must be closed (cut joints, solver/joints/loop_closure.h).
-// Nodes shared by bodies are rigid connections. Each node k moves in a subspace of its spatial
-// increments (dx, dpi): dq_k = S_k dz_k with its own coordinates z_k — S_k = 1 for a free
-// node, nothing for a clamp, [0; 1] for a spherical joint to ground, [0; a] for a revolute joint
-// to ground about the fixed axis a (R = exp(phi a~) R0 exactly), [a; 0] prismatic, [a 0; 0 a]
-// cylindrical. S_k is constant, so these joints add neither geometric nor convective terms.
-// A node may instead depend on a parent node through a NodeJoint (solver/joints/node_joint.h)
-// with the joint's own coordinates; its increments then follow dq_c = A dq_p + B dz, composed
-// down the tree into the node Jacobian J_k (dq_k = J_k dz), with the joints' geometric
-// stiffness and convective accelerations.
+// Nodes shared by bodies are rigid connections. A node is free (its own 6 coordinates: spatial
+// increments dq_k = (dx, dpi)) unless it hangs on a NodeJoint (solver/joints/node_joint.h):
+// then it depends on its parent node through the joint's own coordinates z (none for a rigid
+// joint, one for a revolute, ...), its increments following dq_c = A dq_p + B dz, composed down
+// the tree into the node Jacobian J_k (dq_k = J_k dz), with the joints' geometric stiffness and
+// convective accelerations. Supports are joints like any other, to the ground (kGround): the
+// fixed parent at the origin with world axes and no coordinates. A clamp is a rigid joint to
+// the ground, a pin a spherical one, a revolute to the ground turns the node about its fixed
+// axis: R = exp(phi a~) R0. One representation for every joint (issue 14 item 0).
 // Unknowns: every node's coordinates, the modal coordinates of every body, then the cut
 // joints' multipliers and those of the bodies' interface constraints (thesis 8.2 case 4)
 // (DofMap::first_multiplier; solver/joints/loop_constraints.h). A joint
@@ -49,8 +49,6 @@ struct SystemModel {
   std::vector<std::string> node_names;
   std::vector<Eigen::Vector3d> node_x0;   ///< initial positions
   std::vector<Eigen::Matrix3d> node_R0;   ///< initial rotations
-  /// Per node: the basis S_k (6 x d_k) of its allowed spatial increments (see above).
-  std::vector<Eigen::MatrixXd> motion;
   /// Prescribed node coordinates: node, coordinate index in z_k, value f(t), f'(t), f''(t).
   struct Prescribed {
     int node = -1;
@@ -58,7 +56,8 @@ struct SystemModel {
     std::function<double(double)> value, rate, acceleration;
   };
   std::vector<Prescribed> prescribed;
-  /// Joints between nodes: each child node depends on its parent (a tree; no cycles).
+  /// Joints between nodes and to the ground (parent kGround): each child node depends on its
+  /// parent (a tree; no cycles); a node that is no joint's child is free.
   std::vector<NodeJoint> joints;
   /// Joints that close loops of that tree: constraint equations with Lagrange multipliers
   /// (solver/joints/loop_closure.h); their child keeps its own coordinates.
@@ -114,21 +113,21 @@ struct SystemState {
   Eigen::VectorXd lambda;                   ///< the multipliers (DofMap::multiplier_first, body_multiplier_first)
 };
 
-/// Numbering of the unknowns (coordinates). It keeps its own copy of the motion bases, so it
-/// stays valid when the model it came from is moved or destroyed (SystemModel::dofs()).
+/// Numbering of the unknowns (coordinates). It holds no reference to the model, so it stays
+/// valid when the model it came from is moved or destroyed (SystemModel::dofs()).
 class DofMap {
  public:
   explicit DofMap(const SystemModel& model);
-  /// True when `model` has the structure this map was made from (Shape; the motion bases equal).
+  /// True when `model` has the structure this map was made from (Shape).
   bool Matches(const SystemModel& model) const;
   int n_dofs() const { return n_dofs_; }
-  /// First coordinate of node k and how many it has (its basis S_k when independent; its
-  /// joint's coordinates when it depends on a parent).
+  /// First coordinate of node k and how many it has (6 when free; its joint's coordinates when
+  /// it hangs on a joint).
   int node_first(int k) const { return node_first_[k]; }
   int node_count(int k) const { return node_count_[k]; }
-  const Eigen::MatrixXd& S(int k) const { return motion_[k]; }
-  /// The joint making node k dependent, or -1.
+  /// The joint node k hangs on (to a parent node or to the ground), or -1: a free node.
   int joint_of(int k) const { return joint_of_[k]; }
+  bool free(int k) const { return joint_of_[k] < 0; }
   /// Nodes, parents before children.
   const std::vector<int>& order() const { return order_; }
   /// First coordinate of body b's modal coordinates.
@@ -157,10 +156,9 @@ class DofMap {
   const std::vector<int>& solved() const { return solved_; }
 
  private:
-  // What numbers the unknowns besides the motion bases: nodes, joints (child, parent,
-  // coordinates), bodies (modes, constraints), cut joints' equations, prescribed coordinates.
+  // What numbers the unknowns: nodes, joints (child, parent, coordinates), bodies (modes,
+  // constraints), cut joints' equations, prescribed coordinates.
   static std::vector<int> Shape(const SystemModel& model);
-  std::vector<Eigen::MatrixXd> motion_;
   std::vector<int> shape_;
   std::vector<int> node_first_, node_count_, joint_of_, order_, mode_dof_, solved_, multiplier_first_,
       body_multiplier_first_;
@@ -168,7 +166,9 @@ class DofMap {
   int n_dofs_ = 0, first_multiplier_ = 0;
 };
 
-/// Node k clamped to ground.
+/// Supports: joints of node k to the ground (parent kGround), at its initial placement. Each
+/// replaces the node's support if it has one (a node hangs on one joint).
+/// Node k clamped to ground (a rigid joint).
 void Clamp(SystemModel& model, int k);
 /// Node k's position fixed, rotation free (spherical joint to ground).
 void Pin(SystemModel& model, int k);
@@ -178,6 +178,12 @@ void RevoluteToGround(SystemModel& model, int k, const Eigen::Vector3d& axis);
 void PrismaticToGround(SystemModel& model, int k, const Eigen::Vector3d& axis);
 /// Cylindrical joint to ground: translation along and rotation about a.
 void CylindricalToGround(SystemModel& model, int k, const Eigen::Vector3d& axis);
+/// Any joint of node k to the ground (axes global; universal: axis2 the second axis).
+void JointToGround(SystemModel& model, JointType type, int k, const Eigen::Vector3d& axis,
+                   const Eigen::Vector3d& axis2 = Eigen::Vector3d::UnitY());
+/// True when node k cannot move: it hangs on a joint without coordinates (rigid, clamp) on the
+/// ground or on a node that cannot move either.
+bool FixedToGround(const SystemModel& model, int k);
 
 /// Adds an interface node to `model` at a position and returns its index.
 int AddNode(SystemModel& model, const std::string& name, const Eigen::Vector3d& x,

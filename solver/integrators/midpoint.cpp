@@ -41,14 +41,9 @@ std::vector<RotationNode> RotationNodes(const SystemModel& model, const DofMap& 
   std::vector<RotationNode> nodes;
   for (int k = 0; k < model.n_nodes(); ++k) {
     const int j = dofs.joint_of(k);
-    if (j >= 0) {
-      if (model.joints[j].type == JointType::kSpherical) nodes.push_back({k, dofs.node_first(k), -1});
-      continue;
-    }
-    const Eigen::MatrixXd& S = dofs.S(k);
-    if (S.cols() == 6 && S.isIdentity()) {
-      nodes.push_back({k, dofs.node_first(k) + 3, dofs.node_first(k)});
-    } else if (S.cols() == 3 && S.topRows(3).isZero() && S.bottomRows(3).isIdentity()) {
+    if (j < 0) {
+      nodes.push_back({k, dofs.node_first(k) + 3, dofs.node_first(k)});  // free
+    } else if (model.joints[j].type == JointType::kSpherical) {
       nodes.push_back({k, dofs.node_first(k), -1});
     }
   }
@@ -231,7 +226,7 @@ Assembly AssembleMidpoint(const SystemModel& model, const DofMap& dofs, const Dy
   // Bodies with a free node (6 own coordinates) keep the momentum-conserving source terms.
   std::vector<char> free_node(static_cast<size_t>(n_bodies), 0);
   for (int b = 0; b < n_bodies; ++b) {
-    for (int node : model.body_nodes[b]) free_node[size_t(b)] |= dofs.joint_of(node) < 0 && dofs.S(node).cols() == 6;
+    for (int node : model.body_nodes[b]) free_node[size_t(b)] |= dofs.free(node);
   }
   std::vector<double> gravity_work(static_cast<size_t>(n_bodies), 0.0);
   ForEachBody(threads, n_bodies, [&](int b) {

@@ -8,9 +8,17 @@
 
 namespace femb {
 
+ParentNode ParentOf(const SystemState& state, int p) {
+  static const Eigen::Vector3d origin = Eigen::Vector3d::Zero();
+  static const Eigen::Matrix3d axes = Eigen::Matrix3d::Identity();
+  static const NodeJacobian none;
+  if (p == kGround) return {origin, axes, none};
+  return {state.x[size_t(p)], state.R[size_t(p)], state.J[size_t(p)]};
+}
+
 Eigen::Matrix<double, 6, 1> NodeMotion(const SystemState& state, int k, const Eigen::VectorXd& dz) {
   Eigen::Matrix<double, 6, 1> v = Eigen::Matrix<double, 6, 1>::Zero();
-  if (dz.size() == 0) return v;
+  if (dz.size() == 0 || k == kGround) return v;
   for (const auto& [col, vec] : state.J[k]) v += vec * dz[col];
   return v;
 }
@@ -21,16 +29,15 @@ void UpdateKinematics(const SystemModel& model, const DofMap& dofs, SystemState&
   for (int k : dofs.order()) {
     const int j = dofs.joint_of(k);
     NodeJacobian& J = state.J[k];
-    if (j < 0) {
-      const Eigen::MatrixXd& S = dofs.S(k);
-      for (int c = 0; c < S.cols(); ++c) J.emplace_back(dofs.node_first(k) + c, S.col(c));
+    if (j < 0) {  // free: its own spatial increments
+      for (int c = 0; c < 6; ++c) J.emplace_back(dofs.node_first(k) + c, Eigen::Matrix<double, 6, 1>::Unit(c));
       continue;
     }
     const NodeJoint& joint = model.joints[j];
-    const int p = joint.parent;
-    PlaceChild(joint, state.x[p], state.R[p], state.z[k], &state.x[k], &state.R[k]);
-    const JointMaps maps = ComputeJointMaps(joint, state.x[p], state.R[p], state.x[k], state.z[k]);
-    for (const auto& [col, vec] : state.J[p]) {
+    const ParentNode parent = ParentOf(state, joint.parent);
+    PlaceChild(joint, parent.x, parent.R, state.z[k], &state.x[k], &state.R[k]);
+    const JointMaps maps = ComputeJointMaps(joint, parent.x, parent.R, state.x[k], state.z[k]);
+    for (const auto& [col, vec] : parent.J) {
       const Eigen::Matrix<double, 6, 1> v = maps.A * vec;
       if (v.squaredNorm() > 0) J.emplace_back(col, v);
     }
@@ -57,9 +64,11 @@ void NodeAccelerations(const SystemModel& model, const DofMap& dofs, const Syste
     if (j >= 0) {
       const NodeJoint& joint = model.joints[j];
       const int p = joint.parent;
-      const JointMaps maps = ComputeJointMaps(joint, state.x[p], state.R[p], state.x[k], state.z[k]);
-      convective[k] = ChildConvective(joint, maps, state.x[p], state.R[p], state.x[k], NodeMotion(state, p, W),
-                                      W.segment(dofs.node_first(k), dofs.node_count(k)), convective[p]);
+      const ParentNode parent = ParentOf(state, p);
+      const JointMaps maps = ComputeJointMaps(joint, parent.x, parent.R, state.x[k], state.z[k]);
+      convective[k] = ChildConvective(joint, maps, parent.x, parent.R, state.x[k], NodeMotion(state, p, W),
+                                      W.segment(dofs.node_first(k), dofs.node_count(k)),
+                                      p == kGround ? Eigen::Matrix<double, 6, 1>::Zero() : convective[p]);
     }
     acc[k] = NodeMotion(state, k, Wdot) + convective[k];
   }
@@ -83,13 +92,14 @@ void AddJointGeometricStiffness(const SystemModel& model, const DofMap& dofs, co
     if (j < 0) continue;
     const NodeJoint& joint = model.joints[j];
     const int p = joint.parent;
-    const JointMaps maps = ComputeJointMaps(joint, state.x[p], state.R[p], state.x[c], state.z[c]);
-    const JointGeometric g = ComputeJointGeometric(joint, maps, state.x[p], state.R[p], state.x[c], t[c]);
+    const ParentNode parent = ParentOf(state, p);
+    const JointMaps maps = ComputeJointMaps(joint, parent.x, parent.R, state.x[c], state.z[c]);
+    const JointGeometric g = ComputeJointGeometric(joint, maps, parent.x, parent.R, state.x[c], t[c]);
     const int first = dofs.node_first(c), d = joint.n_coordinates();
     // residual += J_p^T (A^T t_c) + E_c^T (B^T t_c); tangent = -d residual / dz, with
     // d pi_p / dz the rotation rows of J_p (sparse columns).
-    for (const auto& [ci, vi] : state.J[p]) {
-      for (const auto& [cj, vj] : state.J[p]) {
+    for (const auto& [ci, vi] : parent.J) {
+      for (const auto& [cj, vj] : parent.J) {
         const double v = vi.dot(g.dAf_dpi * vj.tail<3>());
         if (v != 0.0) tangent.emplace_back(ci, cj, -v);
       }
@@ -99,7 +109,7 @@ void AddJointGeometricStiffness(const SystemModel& model, const DofMap& dofs, co
       }
     }
     for (int k = 0; k < d; ++k) {
-      for (const auto& [cj, vj] : state.J[p]) {
+      for (const auto& [cj, vj] : parent.J) {
         const double v = g.dBf_dpi.row(k).dot(vj.tail<3>());
         if (v != 0.0) tangent.emplace_back(first + k, cj, -v);
       }
@@ -107,7 +117,7 @@ void AddJointGeometricStiffness(const SystemModel& model, const DofMap& dofs, co
         if (g.dBf_dz(k, l) != 0.0) tangent.emplace_back(first + k, first + l, -g.dBf_dz(k, l));
       }
     }
-    t[p] += maps.A.transpose() * t[c];
+    if (p != kGround) t[p] += maps.A.transpose() * t[c];
   }
 }
 
@@ -119,13 +129,14 @@ std::vector<Eigen::Matrix<double, 6, 1>> JointReactions(const SystemModel& model
     const int c = *it, j = dofs.joint_of(c);
     if (j < 0) continue;
     const NodeJoint& joint = model.joints[j];
-    const JointMaps maps = ComputeJointMaps(joint, state.x[joint.parent], state.R[joint.parent], state.x[c], state.z[c]);
+    if (joint.parent == kGround) continue;  // what the ground takes
+    const ParentNode parent = ParentOf(state, joint.parent);
+    const JointMaps maps = ComputeJointMaps(joint, parent.x, parent.R, state.x[c], state.z[c]);
     t[joint.parent] += maps.A.transpose() * t[c];
   }
   std::vector<Eigen::Matrix<double, 6, 1>> reactions(model.n_nodes(), Eigen::Matrix<double, 6, 1>::Zero());
   for (int k = 0; k < model.n_nodes(); ++k) {
-    const bool held = dofs.joint_of(k) >= 0 || dofs.S(k).cols() < 6;
-    if (held) reactions[k] = -t[k];
+    if (!dofs.free(k)) reactions[k] = -t[k];  // held by a joint to a parent or to the ground
   }
   // A node that is the child of cut joints and held otherwise by nothing or by a rigid joint (a
   // rigid body's point hangs on its body by one): the cut joints' reactions. That is what the
@@ -134,7 +145,8 @@ std::vector<Eigen::Matrix<double, 6, 1>> JointReactions(const SystemModel& model
   std::vector<bool> replaced(model.n_nodes(), false);
   for (size_t c = 0; c < cut.size(); ++c) {
     const int k = model.cut_joints[c].joint.child, j = dofs.joint_of(k);
-    const bool tree_held = j >= 0 ? model.joints[j].type != JointType::kRigid : dofs.S(k).cols() < 6;
+    // Held by a tree joint that is not a rigid body's offset (a support to the ground is).
+    const bool tree_held = j >= 0 && (model.joints[j].type != JointType::kRigid || model.joints[j].parent == kGround);
     if (tree_held) continue;
     if (!replaced[k]) reactions[k].setZero();
     replaced[k] = true;

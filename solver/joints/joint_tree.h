@@ -10,8 +10,18 @@
 
 namespace femb {
 
-/// Spatial increment or velocity (dx, dpi) of node k from coordinate increments or rates.
+/// Spatial increment or velocity (dx, dpi) of node k from coordinate increments or rates; zero
+/// for the ground (kGround).
 Eigen::Matrix<double, 6, 1> NodeMotion(const SystemState& state, int k, const Eigen::VectorXd& dz);
+
+/// A joint's parent as the tree sees it: node p's placement and Jacobian, or for the ground
+/// (kGround) the origin, world axes and no coordinates.
+struct ParentNode {
+  const Eigen::Vector3d& x;
+  const Eigen::Matrix3d& R;
+  const NodeJacobian& J;
+};
+ParentNode ParentOf(const SystemState& state, int p);
 
 /// Node accelerations J_k Wdot + convective terms of the joints.
 std::vector<Eigen::Matrix<double, 6, 1>> NodeAccelerations(const SystemModel& model, const DofMap& dofs,
@@ -55,7 +65,7 @@ void AddJointGeometricStiffness(const SystemModel& model, const DofMap& dofs, co
                                 const NodeForces& forces, Triplets& tangent);
 
 /// Support and joint reactions at a converged state: for every node held by something (a
-/// support: a motion basis of fewer than 6 columns; or a parent node through a joint), the force
+/// support: a joint to the ground; or a parent node through a joint), the force
 /// and moment (global axes, moment about the node) that the support or the parent exerts on the
 /// node and all that hangs from it: R_k = -t_k, t_k = f_k + sum over child joints A_c^T t_c, f
 /// the node forces of the assembly (applied minus internal and inertia forces). For a prescribed

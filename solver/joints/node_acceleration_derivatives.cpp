@@ -18,9 +18,11 @@ void ConvectiveVelocityDerivative(const SystemModel& model, const DofMap& dofs, 
     if (j < 0) continue;
     const NodeJoint& joint = model.joints[size_t(j)];
     const int p = joint.parent;
-    const JointMaps maps = ComputeJointMaps(joint, state.x[p], state.R[p], state.x[k], state.z[k]);
+    if (p == kGround && joint.type != JointType::kUniversal) continue;  // constant maps: no terms
+    const ParentNode parent = ParentOf(state, p);
+    const JointMaps maps = ComputeJointMaps(joint, parent.x, parent.R, state.x[k], state.z[k]);
     const JointVector zdot = W.segment(dofs.node_first(k), dofs.node_count(k));
-    const Eigen::Vector3d rho = state.x[k] - state.x[p], g = state.R[p] * joint.axis;
+    const Eigen::Vector3d rho = state.x[k] - parent.x, g = parent.R * joint.axis;
     const Eigen::Vector3d omega = NodeMotion(state, p, W).tail<3>();
     const double sdot = joint.s_index() >= 0 ? zdot[joint.s_index()] : 0.0;
     const double phidot = joint.phi_index() >= 0 ? zdot[joint.phi_index()] : 0.0;
@@ -36,10 +38,11 @@ void ConvectiveVelocityDerivative(const SystemModel& model, const DofMap& dofs, 
       }
       d.emplace_back(col, v);
     };
-    for (const auto& [col, v] : dc[size_t(p)]) add(col, maps.A * v);
+    if (p != kGround)
+      for (const auto& [col, v] : dc[size_t(p)]) add(col, maps.A * v);
     Eigen::Vector3d g1 = Eigen::Vector3d::Zero(), g2 = Eigen::Vector3d::Zero();
     if (joint.type == JointType::kUniversal) g1 = maps.B.col(0).tail<3>(), g2 = maps.B.col(1).tail<3>();
-    for (const auto& [col, v] : state.J[size_t(p)]) {
+    for (const auto& [col, v] : parent.J) {
       const Eigen::Vector3d r = v.tail<3>();  // d omega / dW_col
       if (r.squaredNorm() == 0) continue;
       Eigen::Matrix<double, 6, 1> e;
@@ -103,11 +106,15 @@ void NodeAccelerationConfigurationDerivative(const SystemModel& model, const Dof
     }
     const NodeJoint& joint = model.joints[size_t(j)];
     const int p = joint.parent, first = dofs.node_first(k), m = dofs.node_count(k);
-    const JointMaps maps = ComputeJointMaps(joint, state.x[p], state.R[p], state.x[k], state.z[k]);
+    const ParentNode parent = ParentOf(state, p);
+    const JointMaps maps = ComputeJointMaps(joint, parent.x, parent.R, state.x[k], state.z[k]);
     const JointVector zdot = W.segment(first, m), zddot = Wdot.segment(first, m);
-    const Eigen::Vector3d rho = state.x[k] - state.x[p], g = state.R[p] * joint.axis;
-    const Vec6& vp = vel[size_t(p)];
-    const Vec6& ap = acc[size_t(p)];
+    const Eigen::Vector3d rho = state.x[k] - parent.x, g = parent.R * joint.axis;
+    static const Vec6 at_rest = Vec6::Zero();  // the ground's velocity and acceleration
+    static const std::vector<Column> no_columns;
+    const Vec6& vp = p == kGround ? at_rest : vel[size_t(p)];
+    const Vec6& ap = p == kGround ? at_rest : acc[size_t(p)];
+    const std::vector<Column>& dp = p == kGround ? no_columns : d[size_t(p)];
     const Eigen::Vector3d w = vp.tail<3>();
     const int is = joint.s_index(), ip = joint.phi_index();
     const bool universal = joint.type == JointType::kUniversal;
@@ -126,18 +133,18 @@ void NodeAccelerationConfigurationDerivative(const SystemModel& model, const Dof
     acc[size_t(k)] = maps.A * ap + maps.B * zddot + terms(w, rho, g, g1, g2);
     // The coordinates that move this node's velocity or acceleration.
     cols.clear();
-    for (const Column& c : d[size_t(p)]) cols.push_back(c.col);
-    for (const auto& [col, v] : state.J[size_t(p)])
+    for (const Column& c : dp) cols.push_back(c.col);
+    for (const auto& [col, v] : parent.J)
       if (v.tail<3>().squaredNorm() > 0) cols.push_back(col);
     for (int i = 0; i < m; ++i) cols.push_back(first + i);
     std::sort(cols.begin(), cols.end());
     cols.erase(std::unique(cols.begin(), cols.end()), cols.end());
     for (int col : cols) {
       Vec6 dvp = Vec6::Zero(), dap = Vec6::Zero();
-      for (const Column& c : d[size_t(p)])
+      for (const Column& c : dp)
         if (c.col == col) dvp = c.dvel, dap = c.dacc;
       Eigen::Vector3d dpi = Eigen::Vector3d::Zero();
-      for (const auto& [c, v] : state.J[size_t(p)])
+      for (const auto& [c, v] : parent.J)
         if (c == col) dpi = v.tail<3>();
       JointVector dz = JointVector::Zero(m);
       if (col >= first && col < first + m) dz[col - first] = 1.0;

@@ -20,9 +20,13 @@ namespace femb {
 
 enum class JointType { kRigid, kRevolute, kPrismatic, kCylindrical, kSpherical, kUniversal };
 
+/// The parent of a joint to the ground: a fixed node at the origin with world axes and no
+/// coordinates (x_p = 0, R_p = 1, no Jacobian, no motion). A clamp is a rigid joint to it.
+inline constexpr int kGround = -1;
+
 struct NodeJoint {
   JointType type = JointType::kRigid;
-  int child = -1, parent = -1;
+  int child = -1, parent = kGround;
   Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();   ///< unit, parent frame
   Eigen::Vector3d axis2 = Eigen::Vector3d::UnitY();  ///< universal: second axis, parent frame at phi1 = 0
   Eigen::Vector3d r0 = Eigen::Vector3d::Zero();      ///< child position, parent frame
@@ -34,7 +38,8 @@ struct NodeJoint {
   int phi_index() const;
 };
 
-/// A joint from the initial placements of both nodes; axes are global.
+/// A joint from the initial placements of both nodes; axes are global. To the ground (parent
+/// kGround): x_p = 0, R_p = 1.
 NodeJoint MakeNodeJoint(JointType type, int child, int parent, const Eigen::Vector3d& axis,
                         const Eigen::Vector3d& x_p, const Eigen::Matrix3d& R_p, const Eigen::Vector3d& x_c,
                         const Eigen::Matrix3d& R_c, const Eigen::Vector3d& axis2 = Eigen::Vector3d::UnitY());

@@ -107,11 +107,11 @@ ResultsRecorder::ResultsRecorder(const Scene& scene, const std::string& director
         for (const char* c : components) csv_ << "," << p.name << ".reaction." << c;
       } else if (q == ProbeQuantity::kJoint) {
         // The node's joint coordinates (revolute: angle; prismatic: travel; cylindrical: both).
-        // To the ground: the node's motion basis; between nodes: the joint's coordinates
-        // (a revolute joint's angle between two bodies, ...). Spherical joints have rotation
-        // increments, not coordinates a probe could show.
+        // To the ground or between nodes: the joint's coordinates (a revolute joint's angle
+        // between two bodies, ...). Spherical joints have rotation increments, not coordinates
+        // a probe could show.
         const int k = scene.node_index.at(p.node);
-        int d = int(scene.model.motion[k].cols());
+        int d = 0;
         for (const NodeJoint& j : scene.model.joints) {
           if (j.child == k) d = j.type == JointType::kSpherical ? 0 : j.n_coordinates();
         }
@@ -346,14 +346,13 @@ void ResultsRecorder::Record(double t, const SystemState& state, const Eigen::Ve
 }
 
 bool ResultsRecorder::JointNode(int k) const {
-  // A node with joint coordinates: dependent on a parent, or moving in a 1-2 dimensional basis
-  // (revolute, prismatic, cylindrical to the ground). Free (6) and spherical (3) nodes: no.
-  const SystemModel& model = scene_.model;
-  for (const NodeJoint& j : model.joints) {
-    if (j.child == k) return true;
+  // A node with joint coordinates: dependent on a parent node (any joint), or on a revolute,
+  // prismatic, cylindrical or universal joint to the ground. Free nodes, clamps and pins: no.
+  for (const NodeJoint& j : scene_.model.joints) {
+    if (j.child != k) continue;
+    return j.parent != kGround || (j.type != JointType::kRigid && j.type != JointType::kSpherical);
   }
-  const long d = model.motion[k].cols();
-  return d == 1 || d == 2;
+  return false;
 }
 
 void ResultsRecorder::Finish(const std::string& status) {

@@ -26,17 +26,6 @@ SystemModel::Prescribed PrescribedBy(const TimeFunctionSpec& f, int k) {
   p.acceleration = [f](double t) { return f.Acceleration(t); };
   return p;
 }
-// A node that cannot move: no coordinates of its own and, if it hangs on a joint, a joint
-// without coordinates on a parent that cannot move either.
-bool FixedToGround(const SystemModel& model, int k) {
-  if (model.motion[k].cols() > 0) return false;
-  for (const NodeJoint& j : model.joints) {
-    if (j.child != k) continue;
-    return j.n_coordinates() == 0 && FixedToGround(model, j.parent);
-  }
-  return true;
-}
-
 // Joints that share a point (spherical, revolute, universal; cylindrical up to a shift along its
 // axis) refuse nodes that are apart at t = 0: the offset would silently become a rigid arm of
 // the parent (node_joint.h: x_c = x_p + R_p r0). Tolerance 1e-6 of the scene's size.
@@ -245,8 +234,8 @@ Scene BuildScene(const SceneSpec& spec) {
     scene.mesh_origin.push_back(se.floating_frame.origin);
     scene.stick_nodes.push_back(se.visualization ? std::vector<int>() : nodes);
   }
-  // The joint tree (issue 15). Every node has at most one holder: a parent node it depends on
-  // through a tree joint, or the ground (a support's motion basis). The rigid bodies' offsets
+  // The joint tree (issue 15). Every node has at most one holder: a parent node or the ground
+  // (kGround), which it hangs on through a tree joint. The rigid bodies' offsets
   // and then the scene's joints -- prescribed ones first, then in the scene's order -- go into
   // the tree while they can; a joint that would give its node a second holder or close a cycle
   // is cut: imposed by constraint equations with Lagrange multipliers, its node keeping its own
@@ -258,7 +247,7 @@ Scene BuildScene(const SceneSpec& spec) {
     if (j.prescribed.empty() && !j.cut) order.push_back(&j);
   for (const SceneJointSpec& j : spec.joints)
     if (j.cut) order.push_back(&j);
-  constexpr int kNoHolder = -2, kGround = -1;
+  constexpr int kNoHolder = -2;
   std::vector<int> holder(size_t(model.n_nodes()), kNoHolder);
   const auto is_ancestor = [&](int k, int m) {  // k on m's chain of holders (m itself included)
     for (; m >= 0; m = holder[size_t(m)])
@@ -280,9 +269,12 @@ Scene BuildScene(const SceneSpec& spec) {
     model.cut_joints.push_back(cut);
   };
   const auto add_tree = [&](JointType type, int k, int p, const Eigen::Vector3d& axis, const Eigen::Vector3d& axis2) {
-    model.joints.push_back(MakeNodeJoint(type, k, p, axis, model.node_x0[p], model.node_R0[p], model.node_x0[k],
-                                         model.node_R0[k], axis2));
-    model.motion[k] = Eigen::MatrixXd(6, 0);  // the joint's coordinates replace the node's own
+    if (p == kGround) {
+      JointToGround(model, type, k, axis, axis2);
+    } else {
+      model.joints.push_back(MakeNodeJoint(type, k, p, axis, model.node_x0[p], model.node_R0[p], model.node_x0[k],
+                                           model.node_R0[k], axis2));
+    }
     holder[size_t(k)] = p;
   };
   // Rigid bodies: the tree of one is rooted at its first point, in that order, that carries a
@@ -326,22 +318,7 @@ Scene BuildScene(const SceneSpec& spec) {
       add_cut(type, k, p >= 0 ? p : hidden_ground(k), j.axis, j.axis2, name);
       continue;
     }
-    if (p >= 0) {
-      add_tree(type, k, p, j.axis, j.axis2);
-      if (!j.prescribed.empty()) model.prescribed.push_back(PrescribedBy(spec.functions.at(j.prescribed), k));
-      continue;
-    }
-    holder[size_t(k)] = kGround;
-    if (j.type == SceneJointType::kUniversal) {
-      // To the ground: the parent is a hidden clamped node at the joint.
-      add_tree(JointType::kUniversal, k, hidden_ground(k), j.axis, j.axis2);
-      continue;
-    }
-    if (j.type == SceneJointType::kClamp) Clamp(model, k);
-    if (j.type == SceneJointType::kSpherical) Pin(model, k);
-    if (j.type == SceneJointType::kRevolute) RevoluteToGround(model, k, j.axis);
-    if (j.type == SceneJointType::kPrismatic) PrismaticToGround(model, k, j.axis);
-    if (j.type == SceneJointType::kCylindrical) CylindricalToGround(model, k, j.axis);
+    add_tree(type, k, p, j.axis, j.axis2);  // to a node or to the ground alike
     if (!j.prescribed.empty()) model.prescribed.push_back(PrescribedBy(spec.functions.at(j.prescribed), k));
   }
   // An over-constrained loop (a planar four-bar of spatial revolute joints) has equations that
@@ -409,20 +386,34 @@ Scene BuildScene(const SceneSpec& spec) {
   scene.initial_velocity = Eigen::VectorXd::Zero(dofs.n_dofs());
   for (const auto& [node, v] : spec.initial_velocities) {
     const int k = scene.node_index.at(node);
-    if (dofs.joint_of(k) >= 0) {
+    const int j = dofs.joint_of(k);
+    if (j >= 0 && model.joints[size_t(j)].parent != kGround) {
       throw InputError(spec.file + ": initial_velocity: node '" + node +
                        "' depends on a parent through a joint; give the velocity of its parent");
     }
     if (dofs.node_count(k) == 0) continue;
     Eigen::Matrix<double, 6, 1> v6;
     v6 << v.first, v.second;
-    // Least squares on the node's motion basis (exact when the velocity is admissible).
-    scene.initial_velocity.segment(dofs.node_first(k), dofs.node_count(k)) =
-        dofs.S(k).colPivHouseholderQr().solve(v6);
+    if (j < 0) {  // a free node: its own spatial velocity
+      scene.initial_velocity.segment<6>(dofs.node_first(k)) = v6;
+      continue;
+    }
+    // On a joint to the ground: least squares on the joint's motions B (exact when the velocity
+    // is admissible).
+    const NodeJoint& joint = model.joints[size_t(j)];
+    const JointColumns B = ComputeJointMaps(joint, Eigen::Vector3d::Zero(), Eigen::Matrix3d::Identity(),
+                                            model.node_x0[k], Eigen::VectorXd::Zero(joint.n_coordinates())).B;
+    scene.initial_velocity.segment(dofs.node_first(k), dofs.node_count(k)) = B.colPivHouseholderQr().solve(v6);
   }
   for (const auto& [node, rates] : spec.initial_joint_rates) {
     const int k = scene.node_index.at(node);
-    const bool has_joint = dofs.joint_of(k) >= 0 || (dofs.node_count(k) > 0 && dofs.node_count(k) < 3);
+    const int j = dofs.joint_of(k);
+    // A pin (spherical to the ground) has rotation increments, not joint coordinates: it takes
+    // an angular velocity; a clamp has none.
+    const bool support_without_rates =
+        j >= 0 && model.joints[size_t(j)].parent == kGround &&
+        (model.joints[size_t(j)].type == JointType::kSpherical || model.joints[size_t(j)].type == JointType::kRigid);
+    const bool has_joint = j >= 0 && !support_without_rates;
     if (!has_joint || int(rates.size()) != dofs.node_count(k)) {
       throw InputError(spec.file + ": initial_velocity: node '" + node + "' has " +
                        (has_joint ? std::to_string(dofs.node_count(k)) + " joint coordinates" : std::string("no joint")) +

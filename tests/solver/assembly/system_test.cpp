@@ -87,8 +87,13 @@ TEST(System, DofMapNumbersNodesModesAndMultipliers) {
     EXPECT_EQ(dofs.node_count(k), counts[k]) << k;
     first += counts[k];
   }
-  EXPECT_EQ(dofs.joint_of(2), 0);
+  // Supports are joints to the ground too: n0's revolute is joint 0, n2's spherical joint 1.
+  EXPECT_EQ(dofs.joint_of(0), 0);
+  EXPECT_EQ(dofs.joint_of(2), 1);
+  EXPECT_EQ(model.joints[2].parent, kGround);
+  EXPECT_EQ(dofs.joint_of(4), 3);
   EXPECT_EQ(dofs.joint_of(1), -1);
+  EXPECT_TRUE(dofs.free(1));
   for (int b = 0; b < 3; ++b) EXPECT_EQ(dofs.mode_dof(b), first + 2 * b) << b;
   EXPECT_EQ(dofs.first_multiplier(), first + 6);
   EXPECT_EQ(dofs.multiplier_first(0), first + 6);
@@ -110,7 +115,8 @@ TEST(System, DofMapNumbersNodesModesAndMultipliers) {
 
 // Issue 14 item 0: the model owns its numbering (SystemModel::dofs()): made once and shared by
 // the analyses, made anew when the structure changes, and valid after the model is gone (the
-// map keeps its own motion bases; it used to point into the model, which a Scene moves).
+// map holds no reference into the model, which a Scene moves). Supports are joints to the
+// ground: a second support of a node replaces the first.
 TEST(System, ModelOwnsItsDofMap) {
   const Superelement rod = Rod(2);
   SystemModel model = OneFreeRod(rod);
@@ -122,16 +128,21 @@ TEST(System, ModelOwnsItsDofMap) {
   RevoluteToGround(model, 0, Eigen::Vector3d::UnitZ());  // the structure changes: a new map
   EXPECT_EQ(model.dofs().n_dofs(), 9);
   EXPECT_EQ(model.dofs().node_count(0), 1);
-  RevoluteToGround(model, 0, Eigen::Vector3d::UnitY());  // same shape, another axis: a new map
-  EXPECT_EQ(model.dofs().S(0).col(0).tail<3>(), Eigen::Vector3d::UnitY());
+  RevoluteToGround(model, 0, Eigen::Vector3d::UnitY());  // same shape, another axis
+  ASSERT_EQ(model.joints.size(), 1u);                     // replaced, not added
+  EXPECT_EQ(model.dofs().n_dofs(), 9);
+  const SystemState state = InitialState(model);
+  ASSERT_EQ(state.J[0].size(), 1u);
+  EXPECT_EQ(state.J[0][0].second.tail<3>(), Eigen::Vector3d::UnitY());
   EXPECT_EQ(copy.dofs().n_dofs(), 14);  // the copy keeps its own
   std::unique_ptr<DofMap> kept;
   {
     SystemModel moved = std::move(model);
     kept = std::make_unique<DofMap>(moved.dofs());
   }
-  EXPECT_EQ(kept->S(0).col(0).tail<3>(), Eigen::Vector3d::UnitY());  // its own copy of the bases
-  EXPECT_EQ(kept->S(1).cols(), 6);
+  EXPECT_EQ(kept->node_count(0), 1);  // valid without the model
+  EXPECT_TRUE(kept->free(1));
+  EXPECT_EQ(kept->node_count(1), 6);
 }
 
 TEST(System, IncrementsKeepEachSupportsMotionExact) {

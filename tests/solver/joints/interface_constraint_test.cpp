@@ -89,7 +89,7 @@ TEST(InterfaceConstraint, StaticTangentMatchesFiniteDifferences) {
   const Superelement se = Rod(true);
   SystemModel model = Chain(se);
   // A hinge about a tilted axis and a load with a moment, so that every block is exercised.
-  model.joints[0] =
+  model.joints[1] =  // joint 0 is n0's revolute to the ground
       MakeNodeJoint(JointType::kRevolute, 2, 1, Eigen::Vector3d(0.36, 0.48, 0.8), model.node_x0[1],
                     model.node_R0[1], model.node_x0[2], model.node_R0[2]);
   NodeLoad load;

@@ -56,7 +56,6 @@ SystemModel Loop(const Superelement& se, double L, JointType type) {
   Clamp(model, 0);
   model.joints.push_back(MakeNodeJoint(JointType::kRevolute, 2, 1, Eigen::Vector3d(0, 0.6, 0.8), model.node_x0[1],
                                        model.node_R0[1], model.node_x0[2], model.node_R0[2]));
-  model.motion[2] = Eigen::MatrixXd(6, 0);
   CutJoint cut;
   cut.joint = MakeNodeJoint(type, 4, 2, Eigen::Vector3d(0.36, 0.48, 0.8), model.node_x0[2], model.node_R0[2],
                             model.node_x0[4], model.node_R0[4], Eigen::Vector3d(0.8, 0, -0.36));
