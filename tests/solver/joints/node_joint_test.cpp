@@ -1,7 +1,7 @@
 // Joints between nodes: the static tangent of a system with every joint type (including the
 // joints' geometric stiffness) against central finite differences of the residual, exact
-// constraint satisfaction, and the convective terms through the energy balance of a flexible
-// double pendulum.
+// constraint satisfaction, the convective terms through the energy balance of a flexible
+// double pendulum, and supports as joints to the ground (issue 14 item 0).
 #include "solver/joints/node_joint.h"
 
 #include <gtest/gtest.h>
@@ -202,6 +202,93 @@ void DoublePendulum(JointType second, const Eigen::Vector3d& spin, Integrator in
   }
   EXPECT_LT(drift_fine, 1e-3);
   EXPECT_GT(drift_coarse / drift_fine, 3.0);  // second order: the error is the integrator's
+}
+
+// Issue 14 item 0: a support is a joint to the ground (kGround: the fixed parent at the origin,
+// world axes). Each type's node Jacobian is the motion basis supports had before (revolute
+// [0; a], prismatic [a; 0], cylindrical both, pin [0; 1], universal [0; a1], [0; a2]), and a
+// flexible rod hanging on it moves exactly as on the same joint to a clamped node at the joint
+// (the tree's general path, with the parent's placement, Jacobian and motion): the tip's path
+// under gravity over 0.2 s equal to 1e-12 m, the two computing the same quantities in another
+// order. Clamps and rigid joints on clamped nodes cannot move (FixedToGround).
+TEST(NodeJoint, SupportsAreJointsToTheGroundAndMoveAsOnAClampedNode) {
+  const double L = 0.5;
+  const Superelement se = Rod(L, 2);
+  const Eigen::Vector3d a = Eigen::Vector3d(0.36, 0.48, 0.8), a2 = Eigen::Vector3d(0.8, 0, -0.36);
+  const Eigen::Vector3d x0(0.1, -0.2, 0.3);
+  const Eigen::Matrix3d R0 = ExpSO3(Eigen::Vector3d(0.2, -0.1, 0.4));
+  for (const JointType type : {JointType::kRevolute, JointType::kPrismatic, JointType::kCylindrical,
+                               JointType::kSpherical, JointType::kUniversal}) {
+    SCOPED_TRACE(int(type));
+    // to_clamped: the same joint on a clamped node at the joint, world axes.
+    auto make = [&](bool to_clamped) {
+      SystemModel model;
+      AddNode(model, "n0", x0, R0);
+      AddNode(model, "n1", x0 + R0 * Eigen::Vector3d(L, 0, 0), R0);
+      model.bodies.emplace_back(se, SuperelementOptions{}, R0, x0);
+      model.body_nodes.push_back({0, 1});
+      if (to_clamped) {
+        const int g = AddNode(model, "g", x0);
+        Clamp(model, g);
+        model.joints.push_back(MakeNodeJoint(type, 0, g, a, x0, Eigen::Matrix3d::Identity(), x0, R0, a2));
+      } else {
+        JointToGround(model, type, 0, a, a2);
+      }
+      model.gravity = Eigen::Vector3d(0, -9.81, 0);
+      return model;
+    };
+    const SystemModel grounded = make(false), clamped = make(true);
+    ASSERT_EQ(grounded.joints.size(), 1u);
+    EXPECT_EQ(grounded.joints[0].parent, kGround);
+    EXPECT_FALSE(FixedToGround(grounded, 0));
+    EXPECT_TRUE(FixedToGround(clamped, 2));
+    // The node Jacobian: the support's motion basis.
+    const SystemState s0 = InitialState(grounded);
+    const DofMap& dofs = grounded.dofs();
+    Eigen::MatrixXd S = Eigen::MatrixXd::Zero(6, dofs.node_count(0));
+    for (const auto& [col, v] : s0.J[0]) S.col(col - dofs.node_first(0)) = v;
+    Eigen::MatrixXd expected(6, dofs.node_count(0));
+    const Eigen::Vector3d z = Eigen::Vector3d::Zero(), u = a.normalized(), u2 = a2.normalized();
+    if (type == JointType::kRevolute) expected << z, u;
+    if (type == JointType::kPrismatic) expected << u, z;
+    if (type == JointType::kCylindrical) expected << u, z, z, u;
+    if (type == JointType::kSpherical) expected << Eigen::Matrix3d::Zero(), Eigen::Matrix3d::Identity();
+    if (type == JointType::kUniversal) expected << z, z, u, u2;
+    EXPECT_LT((S - expected).norm(), 1e-15) << S;
+    // The motion: the same on both.
+    std::vector<Eigen::Vector3d> tips[2];
+    for (int m = 0; m < 2; ++m) {
+      const SystemModel& model = m == 0 ? grounded : clamped;
+      DynamicState s = InitialDynamicState(model, InitialState(model), Eigen::VectorXd::Zero(model.dofs().n_dofs()));
+      DynamicOptions options;
+      options.step = 2e-3;
+      options.end_time = 0.2;
+      const DynamicResult result = SolveDynamic(
+          model, s, options, [&](const DynamicStepReport&, const DynamicState& st) { tips[m].push_back(st.config.x[1]); });
+      ASSERT_TRUE(result.ok) << result.message;
+    }
+    ASSERT_EQ(tips[0].size(), tips[1].size());
+    double largest = 0, moved = 0;
+    for (size_t i = 0; i < tips[0].size(); ++i) {
+      largest = std::max(largest, (tips[0][i] - tips[1][i]).norm());
+      moved = std::max(moved, (tips[0][i] - tips[0][0]).norm());
+    }
+    std::printf("[ info ] joint type %d to the ground: tip moved %.3f m, largest difference %.1e m\n", int(type), moved,
+                largest);
+    EXPECT_GT(moved, 0.01);  // it moves (falls, slides or swings)
+    EXPECT_LT(largest, 1e-12);
+  }
+  // A clamp is a rigid joint to the ground; a rigid joint on a clamped node cannot move either.
+  SystemModel model;
+  AddNode(model, "c", Eigen::Vector3d::Zero());
+  AddNode(model, "d", Eigen::Vector3d::UnitX());
+  Clamp(model, 0);
+  model.joints.push_back(MakeNodeJoint(JointType::kRigid, 1, 0, a, Eigen::Vector3d::Zero(), Eigen::Matrix3d::Identity(),
+                                       Eigen::Vector3d::UnitX(), Eigen::Matrix3d::Identity()));
+  EXPECT_EQ(model.joints[0].type, JointType::kRigid);
+  EXPECT_EQ(model.dofs().n_dofs(), 0);
+  EXPECT_TRUE(FixedToGround(model, 0));
+  EXPECT_TRUE(FixedToGround(model, 1));
 }
 
 }  // namespace
