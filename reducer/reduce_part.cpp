@@ -334,7 +334,7 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
       result.message = "the polynomial internal force's linear part differs from K_r by " + std::to_string(mismatch);
       return result;
     }
-    se.polynomial = PolynomialStiffness{std::move(poly.A), std::move(poly.B)};
+    se.polynomial = PolynomialStiffness{std::move(poly.A), std::move(poly.B), Eigen::MatrixXd()};
     const long nr = se.K.rows(), P = nr * (nr + 1) / 2;
     if (stiffening) {
       // The inertia invariants for the exact kinetic energy of the reduced field in the frame.

@@ -119,7 +119,10 @@ void AddDynamicMatrices(const SystemModel& model, const DofMap& dofs, const Dyna
   // The joints' convective accelerations depend on W: d f_in / dW gets M_b dc/dW (the Coriolis
   // and centripetal coupling of chains with offsets), into C (or c_C of it into K).
   // And their configuration: d f_in / dq gets M_b d(J Wdot + c)/dq (into K).
-  const bool chains = !model.joints.empty();
+  // Supports (joints to the ground with constant maps) have no such terms.
+  const bool chains = std::any_of(model.joints.begin(), model.joints.end(), [](const NodeJoint& j) {
+    return j.parent != kGround || j.type == JointType::kUniversal;
+  });
   if (chains) {
     ConvectiveVelocityDerivative(model, dofs, s.config, s.W, work.dc);
     NodeAccelerationConfigurationDerivative(model, dofs, s.config, s.W, s.Wdot, work.dacc);

@@ -173,7 +173,7 @@ TEST(ModalDerivatives, FiniteRigidRotationCostsNoStrainEnergyWithTheRotationComp
   const ReducedPolynomial completed =
       ReduceSvk(solid, V, InterfaceRotationCompletion(se.visualization->nodes, V, points, se.floating_frame.origin));
   EXPECT_LT((completed.B - se.polynomial->B).norm(), 1e-12 * completed.B.norm());  // what the reducer stored
-  const PolynomialStiffness without{plain.A, plain.B};
+  const PolynomialStiffness without{plain.A, plain.B, Eigen::MatrixXd()};
   const int n = se.n_reduced_dofs();
   for (double theta : {0.05, 0.1}) {
     const Eigen::Matrix3d R = Eigen::AngleAxisd(theta, Eigen::Vector3d::UnitY()).toRotationMatrix();

@@ -12,6 +12,7 @@
 
 #include "solver/analysis/dynamic_analysis.h"
 #include "solver/assembly/system.h"
+#include "solver/joints/joint_tree.h"
 #include "solver/rotation.h"
 #include "test_util.h"
 
@@ -98,10 +99,16 @@ TEST(NodeJoint, ConstraintsHoldExactlyAtAnyConfiguration) {
     for (int i = 0; i < d.size(); ++i) d[i] = 0.5 * u(rng);
     ApplyIncrement(model, dofs, d, s);
   }
-  // Revolute c1 on e0: same point, relative rotation about the parent's z axis only.
+  // Revolute c1 on e0: same point, relative rotation about the parent's z axis only. The clamp
+  // of the first node is a rigid joint to the ground (ParentOf: the origin, world axes).
   for (const NodeJoint& j : model.joints) {
-    const Eigen::Matrix3d rel = s.R[j.parent].transpose() * s.R[j.child];
-    const Eigen::Vector3d offset = s.R[j.parent].transpose() * (s.x[j.child] - s.x[j.parent]);
+    const ParentNode parent = ParentOf(s, j.parent);
+    const Eigen::Matrix3d rel = parent.R.transpose() * s.R[j.child];
+    const Eigen::Vector3d offset = parent.R.transpose() * (s.x[j.child] - parent.x);
+    if (j.type == JointType::kRigid) {
+      EXPECT_LT((rel - j.Q0).norm(), 1e-12);
+      EXPECT_LT((offset - j.r0).norm(), 1e-12);
+    }
     if (j.type == JointType::kRevolute) {
       EXPECT_LT(offset.norm(), 1e-12);
       EXPECT_LT((rel * j.axis - j.axis).norm(), 1e-12);  // the axis is fixed in both
