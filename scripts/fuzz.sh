@@ -26,7 +26,8 @@ fi
 targets=(yaml_fuzz part_fuzz scene_fuzz superelement_fuzz matrix_fuzz)
 CC=clang CXX=clang++ cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DFEMB_FUZZ=ON \
   -DFEMB_BUILD_TESTS=OFF >/dev/null
-cmake --build build-fuzz -j "$(nproc)" --target "${targets[@]}" -- --no-print-directory -s 2>&1 | grep -v "^\[" || true
+cmake --build build-fuzz -j "$(nproc)" --target femb_fuzz_targets -- --no-print-directory -s 2>&1 | grep -v "^\[" || true
+for t in "${targets[@]}"; do test -x "build-fuzz/fuzz/$t" || { echo "fuzz: $t did not build"; exit 1; }; done
 
 work=$(pwd)/build-fuzz/work
 rm -rf "$work" && mkdir -p "$work" build-fuzz/artifacts
