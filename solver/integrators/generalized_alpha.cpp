@@ -120,9 +120,8 @@ void AddDynamicMatrices(const SystemModel& model, const DofMap& dofs, const Dyna
   // and centripetal coupling of chains with offsets), into C (or c_C of it into K).
   // And their configuration: d f_in / dq gets M_b d(J Wdot + c)/dq (into K).
   // Supports (joints to the ground with constant maps) have no such terms.
-  const bool chains = std::any_of(model.joints.begin(), model.joints.end(), [](const NodeJoint& j) {
-    return j.parent != kGround || j.type == JointType::kUniversal;
-  });
+  const bool chains =
+      std::any_of(model.joints.begin(), model.joints.end(), [](const NodeJoint& j) { return !ConstantMaps(j); });
   if (chains) {
     ConvectiveVelocityDerivative(model, dofs, s.config, s.W, work.dc);
     NodeAccelerationConfigurationDerivative(model, dofs, s.config, s.W, s.Wdot, work.dacc);

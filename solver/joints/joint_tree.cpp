@@ -89,7 +89,7 @@ void AddJointGeometricStiffness(const SystemModel& model, const DofMap& dofs, co
   const std::vector<int>& order = dofs.order();
   for (auto it = order.rbegin(); it != order.rend(); ++it) {
     const int c = *it, j = dofs.joint_of(c);
-    if (j < 0) continue;
+    if (j < 0 || ConstantMaps(model.joints[j])) continue;  // a support passes nothing on either
     const NodeJoint& joint = model.joints[j];
     const int p = joint.parent;
     const ParentNode parent = ParentOf(state, p);

@@ -18,7 +18,7 @@ void ConvectiveVelocityDerivative(const SystemModel& model, const DofMap& dofs, 
     if (j < 0) continue;
     const NodeJoint& joint = model.joints[size_t(j)];
     const int p = joint.parent;
-    if (p == kGround && joint.type != JointType::kUniversal) continue;  // constant maps: no terms
+    if (ConstantMaps(joint)) continue;  // no terms
     const ParentNode parent = ParentOf(state, p);
     const JointMaps maps = ComputeJointMaps(joint, parent.x, parent.R, state.x[k], state.z[k]);
     const JointVector zdot = W.segment(dofs.node_first(k), dofs.node_count(k));

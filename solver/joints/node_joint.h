@@ -38,6 +38,10 @@ struct NodeJoint {
   int phi_index() const;
 };
 
+/// A support whose maps A, B are constant (a joint to the ground other than universal): no
+/// convective acceleration, no geometric stiffness, no derivatives of either.
+inline bool ConstantMaps(const NodeJoint& j) { return j.parent == kGround && j.type != JointType::kUniversal; }
+
 /// A joint from the initial placements of both nodes; axes are global. To the ground (parent
 /// kGround): x_p = 0, R_p = 1.
 NodeJoint MakeNodeJoint(JointType type, int child, int parent, const Eigen::Vector3d& axis,
