@@ -60,7 +60,7 @@ def solve(bin_dir, scene, out, sets, repeats):
         if r.returncode != 0:
             lines = r.stderr.strip().splitlines()
             return None, lines[-1] if lines else f"exit {r.returncode}"
-        m = re.search(r"done in [0-9.]+ s: (\d+) steps", r.stdout)
+        m = re.search(r"done in [0-9.]+ s[^:]*: (\d+) steps", r.stdout)
         steps = int(m.group(1)) if m else 0
         m = re.search(r"(\d+) steps rejected", r.stdout)
         rejected = int(m.group(1)) if m else 0

@@ -106,6 +106,7 @@ int main(int argc, char** argv) {
     if (output.empty()) output = "out/" + spec.name;
     femb::ResultsRecorder recorder(scene, output);
     const femb::DofMap& dofs = scene.model.dofs();
+    const double read_seconds = Seconds(wall);  // scene, superelement files, model
     if (!quiet) {
       std::printf("femb-solve: %s: %zu bodies, %d nodes, %d unknowns, %s analysis%s\n", scene_path.c_str(),
                   scene.model.bodies.size(), scene.model.n_nodes(), dofs.n_dofs(), femb::Name(spec.analysis.type),
@@ -265,6 +266,7 @@ int main(int argc, char** argv) {
       }
       recorder.StepCounts(r.steps, r.rejected_by_error, r.newton_cuts);
     }
+    const double solve_end = Seconds(wall);
     recorder.Finish(status);
     progress(spec.analysis.end_time, true);
     if (!ok) {
@@ -273,9 +275,14 @@ int main(int argc, char** argv) {
       return 3;
     }
     if (!quiet) {
-      std::printf("femb-solve: done in %.2f s: %ld steps, %.2f Newton iterations per step; results in %s, %s\n",
-                  Seconds(wall), step_count, step_count ? double(total_iterations) / step_count : 0.0,
-                  recorder.h5_path().c_str(), recorder.csv_path().c_str());
+      // The phases: reading (scene, superelement files, model), the analysis with its per-step
+      // recording, writing results.h5 and the animation.
+      const double end = Seconds(wall);
+      std::printf("femb-solve: done in %.2f s (reading %.3f s, solving %.3f s, writing %.3f s): %ld steps, %.2f "
+                  "Newton iterations per step; results in %s, %s\n",
+                  end, read_seconds, solve_end - read_seconds, end - solve_end, step_count,
+                  step_count ? double(total_iterations) / step_count : 0.0, recorder.h5_path().c_str(),
+                  recorder.csv_path().c_str());
     }
     return 0;
   } catch (const femb::InputError& e) {
