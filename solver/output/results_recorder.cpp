@@ -38,8 +38,25 @@ void Put(std::ofstream& out, double v) {
 
 }  // namespace
 
+double* ResultsRecorder::Rows::Append() {
+  const long per_chunk = ChunkRows(), slot = count % per_chunk;
+  ++count;
+  if (width == 0) return nullptr;
+  if (slot == 0) chunks.push_back(std::unique_ptr<double[]>(new double[size_t(per_chunk) * size_t(width)]));
+  double* const row = chunks.back().get() + slot * width;
+  std::fill(row, row + width, 0.0);
+  return row;
+}
+
 Eigen::MatrixXd ResultsRecorder::Rows::Matrix() const {
-  return Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(values.data(), count, width);
+  using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  Eigen::MatrixXd out(count, width);
+  const long per_chunk = ChunkRows();
+  for (size_t c = 0; c < chunks.size(); ++c) {
+    const long first = long(c) * per_chunk, rows = std::min(per_chunk, count - first);
+    out.middleRows(first, rows) = Eigen::Map<const RowMajor>(chunks[c].get(), rows, width);
+  }
+  return out;
 }
 
 ResultsRecorder::ResultsRecorder(const Scene& scene, const std::string& directory)
