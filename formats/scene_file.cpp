@@ -438,6 +438,10 @@ SceneSpec ParseScene(const std::string& text, const std::string& name, const std
                                                        : JacobianReuseType::kNone;
     }
     if (auto v = m.Optional("gyroscopic_tangent")) a.gyroscopic_tangent = v->Bool();
+    if (auto v = m.Optional("body_matrices_every")) {
+      a.body_matrices_every = int(v->Integer());
+      if (a.body_matrices_every < 1) v->Fail("body_matrices_every must be a whole number of steps, at least 1");
+    }
     m.CheckNoUnknownKeys();
   }
 

@@ -137,6 +137,7 @@ struct SceneAnalysisSpec {
   int output_every = 1;
   JacobianReuseType jacobian_reuse = JacobianReuseType::kDefault;  ///< dynamic: which Newton iterations factor anew
   bool gyroscopic_tangent = false;  ///< generalized-alpha: configuration derivative of the quadratic velocity terms in S
+  int body_matrices_every = 0;      ///< generalized-alpha: bodies' matrices computed every n-th step (0: unset, the solver's default)
 };
 
 struct SceneSpec {

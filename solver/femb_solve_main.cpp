@@ -224,6 +224,7 @@ int main(int argc, char** argv) {
         case femb::JacobianReuseType::kSteps: options.jacobian_reuse = femb::JacobianReuse::kSteps; break;
       }
       options.full_inertia_tangent = spec.analysis.gyroscopic_tangent;
+      if (spec.analysis.body_matrices_every > 0) options.body_matrices_every = spec.analysis.body_matrices_every;
       options.threads = threads;
       options.adaptive = spec.analysis.adaptive_step;
       if (options.adaptive) options.step = 1e-4 * spec.analysis.end_time;  // the first step tried
@@ -259,6 +260,11 @@ int main(int argc, char** argv) {
         std::printf("femb-solve: %ld factorizations of the iteration matrix; its sparsity pattern analysed %s; pivots "
                     "chosen in %ld, reused in %ld\n", r.factorizations, analysed.c_str(), r.pivoted,
                     r.factorizations - r.pivoted);
+        if (r.body_matrices_turned > 0) {
+          std::printf("femb-solve: bodies' matrices computed %ld times, turned with their floating frames %ld times "
+                      "(analysis.body_matrices_every %d)\n", r.body_matrices_computed, r.body_matrices_turned,
+                      options.body_matrices_every);
+        }
       }
       if (!quiet && spec.analysis.adaptive_step) {
         std::printf("femb-solve: %ld steps rejected (%ld by the error test, %ld by Newton)\n",

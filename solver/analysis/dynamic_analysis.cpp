@@ -272,6 +272,8 @@ DynamicResult SolveDynamic(const SystemModel& model, DynamicState& state, const 
     result.factorizations = matrix.factorizations;
     result.pattern_analyses = matrix.solver.analyses();
     result.pivoted = matrix.solver.full_factorizations();
+    result.body_matrices_computed = work.matrices_computed;
+    result.body_matrices_turned = work.matrices_turned;
   };
   auto fail = [&](const std::string& message) {
     result.message = message;

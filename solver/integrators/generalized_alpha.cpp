@@ -7,6 +7,7 @@
 #include <functional>
 
 #include "solver/analysis/dynamic_step.h"
+#include "solver/body/body_blocks.h"
 #include "solver/rotation.h"
 
 namespace femb::dynamic_internal {
@@ -76,17 +77,52 @@ Assembly AssembleDynamicResidual(const SystemModel& model, const DofMap& dofs, D
   return out;
 }
 
+namespace {
+
+// X = A Y A^T over a body's node triples (the first `blocks` row and column triples; modal rows
+// and columns as they are), into X's storage.
+void TurnNodeBlocks(const Eigen::MatrixXd& Y, int blocks, const Eigen::Matrix3d& A, Eigen::MatrixXd& X) {
+  X = Y;
+  body_blocks::TurnRowBlocks(X, blocks, [&](int) { return A; });
+  const Eigen::Matrix3d At = A.transpose();
+  body_blocks::TurnColBlocks(X, blocks, [&](int) { return At; });
+}
+
+}  // namespace
+
 void AddDynamicMatrices(const SystemModel& model, const DofMap& dofs, const DynamicState& s, double t,
                         BodyWorkspace& work, bool full_inertia_tangent, Assembly& out,
-                        BodyThreads* threads, const MatrixCombination* combine) {
+                        BodyThreads* threads, const MatrixCombination* combine, int every) {
   const int n_bodies = int(model.bodies.size());
   const std::vector<BodyPass>& passes = work.passes;
   std::vector<BodyWorkspace::BodyMatrices>& results = work.matrices;
   results.resize(static_cast<size_t>(n_bodies));
+  // Which bodies turn their kept matrices (decided here, in body order: the same for any number
+  // of threads).
+  for (int b = 0; b < n_bodies; ++b) {
+    BodyWorkspace::BodyMatrices& r = results[size_t(b)];
+    const bool kept = every > 1 && r.age >= 0 && r.age < every - 1 && r.K_frame.rows() == model.bodies[b].n_coordinates();
+    r.age = kept ? r.age + 1 : (every > 1 || r.age >= 0 ? 0 : -1);  // a pass that computes keeps them anew
+    ++(kept ? work.matrices_turned : work.matrices_computed);
+  }
   ForEachBody(threads, n_bodies, [&](int b) {
     const SuperelementBody& body = model.bodies[b];
     const BodyPass& pass = passes[size_t(b)];
     BodyWorkspace::BodyMatrices& r = results[size_t(b)];
+    // A body's forces are objective (gravity aside, which enters K through the inertia
+    // tangent's wdot - g): turning the whole body by Q turns every node block of its matrices,
+    // X -> Q X Q^T. So X_frame = Rbar^T X Rbar changes only with the deformation and the
+    // velocities in the frame, and Rbar X_frame Rbar^T is the matrix at this pass but for that
+    // change since X_frame was computed.
+    const int blocks = 2 * body.n_nodes();
+    const Eigen::Matrix3d& R = pass.data.frame.R;
+    if (r.age > 0) {
+      TurnNodeBlocks(r.K_frame, blocks, R, r.K);
+      TurnNodeBlocks(r.C_frame, blocks, R, r.C);
+      TurnNodeBlocks(r.M_frame, blocks, R, r.M);
+      if (combine) r.K += combine->c_C * r.C + combine->c_M * r.M;
+      return;
+    }
     const bool stiffening = body.has_inertia_stiffening();
     Eigen::MatrixXd& d_load = r.d_load;
     body.ElasticForce(pass.data, nullptr, &r.K, stiffening ? &pass.load : nullptr, stiffening ? &d_load : nullptr);
@@ -110,6 +146,12 @@ void AddDynamicMatrices(const SystemModel& model, const DofMap& dofs, const Dyna
     r.K += r.inertia_K;
     r.unused.setZero(body.n_coordinates());
     body.AddModalDamping(pass.w, r.unused, &r.C);
+    if (r.age == 0) {
+      const Eigen::Matrix3d Rt = R.transpose();
+      TurnNodeBlocks(r.K, blocks, Rt, r.K_frame);
+      TurnNodeBlocks(r.C, blocks, Rt, r.C_frame);
+      TurnNodeBlocks(r.M, blocks, Rt, r.M_frame);
+    }
     if (combine) r.K += combine->c_C * r.C + combine->c_M * r.M;
   });
   Triplets &K = work.K, &C = work.C, &M = work.M;
@@ -229,7 +271,12 @@ StepOutcome GeneralizedAlphaStep(const SystemModel& model, const DofMap& dofs, c
     bool built = false;
     const auto S = [&]() -> const SystemMatrix& {
       const MatrixCombination combine{gamma_p, beta_p};
-      if (!built) AddDynamicMatrices(model, dofs, next, t_new, work, options.full_inertia_tangent, a, &threads, &combine);
+      // The step's first matrix may take the bodies' kept matrices (body_matrices_every); a
+      // second one (the first did not contract tenfold) and full Newton compute them all.
+      const int every = JacobianReuseOf(options) != JacobianReuse::kNone && !matrix.factored_in_step
+                            ? std::max(options.body_matrices_every, 1)
+                            : 1;
+      if (!built) AddDynamicMatrices(model, dofs, next, t_new, work, options.full_inertia_tangent, a, &threads, &combine, every);
       built = true;
       return a.K;  // K + gamma' C + beta' M
     };

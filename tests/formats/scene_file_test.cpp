@@ -63,6 +63,15 @@ TEST(SceneFile, StepAutoAndItsLimits) {
   EXPECT_DOUBLE_EQ(ParseScene(kGood, "scene.yaml", {"analysis.step=auto"}).analysis.step_tolerance, 1e-5);
 }
 
+TEST(SceneFile, BodyMatricesEveryIsAWholeNumberOfSteps) {
+  EXPECT_EQ(ParseScene(kGood, "scene.yaml").analysis.body_matrices_every, 0);  // unset: the solver's default
+  EXPECT_EQ(ParseScene(kGood, "scene.yaml", {"analysis.body_matrices_every=3"}).analysis.body_matrices_every, 3);
+  for (const char* bad : {"0", "-2", "1.5", "often"}) {
+    const std::string message = Error(kGood, {std::string("analysis.body_matrices_every=") + bad});
+    EXPECT_NE(message.find("body_matrices_every"), std::string::npos) << bad << ": " << message;
+  }
+}
+
 TEST(SceneFile, JacobianReuseTakesItsNamesAndTheOldBooleans) {
   const auto reuse = [](const std::string& value) {
     return ParseScene(kGood, "scene.yaml", {"analysis.jacobian_reuse=" + value}).analysis.jacobian_reuse;
