@@ -261,7 +261,7 @@ int main(int argc, char** argv) {
                     "chosen in %ld, reused in %ld\n", r.factorizations, analysed.c_str(), r.pivoted,
                     r.factorizations - r.pivoted);
         if (r.body_matrices_turned > 0) {
-          std::printf("femb-solve: bodies' matrices computed %ld times, turned with their floating frames %ld times "
+          std::printf("femb-solve: bodies' inertia matrices computed %ld times, turned with their floating frames %ld times "
                       "(analysis.body_matrices_every %d)\n", r.body_matrices_computed, r.body_matrices_turned,
                       options.body_matrices_every);
         }

@@ -62,17 +62,27 @@ struct DynamicOptions {
   /// body at omega h = 0.04, at ~4x the assembly time; off by default.
   bool full_inertia_tangent = false;
   int reuse_max_iterations = 6;  ///< kSteps: iterations with one factor before a new one
-  /// Generalized-alpha with a kept factor (kStep, kSteps): each body's matrices (elastic tangent,
-  /// mass, gyroscopic and inertia tangents) are computed at the first matrix pass of every
-  /// `body_matrices_every`-th step and kept in the body's floating frame; the steps between turn
-  /// them with the frame, Rbar X Rbar^T (a body's forces are objective: turning the body turns its
-  /// matrices exactly so), which costs O(n^2) instead of the matrices' O(n^3). Within a step a
-  /// second matrix pass (an iteration that did not contract tenfold) computes them all. Only
-  /// Newton's matrix lags, and by the change of the bodies' deformation and velocities over a
-  /// few steps: the residual is exact, so the motion is the same to the Newton tolerance.
-  /// Measured (benchmarks, 2026-11-27): the 10-body slider-crank at h = 10 us 2.44 -> 1.90 s
-  /// at 1.00 iterations per step with 4; 1: every step (before this option).
-  int body_matrices_every = 4;
+  /// Generalized-alpha with a kept factor (kStep, kSteps): each body's inertia matrices (mass
+  /// and gyroscopic: the exact inertia's are a body's most expensive kernel, 15 us of a 30 us
+  /// iteration) are computed at the first matrix pass of every `body_matrices_every`-th step and
+  /// kept in the body's floating frame; the steps between turn them with the frame, Rbar X Rbar^T
+  /// (the inertia force is objective: turning the body turns its matrices exactly so), O(n^2)
+  /// instead of O(n^3). The elastic tangent and the inertia's configuration tangent are computed
+  /// every time: they carry internal forces and accelerations that change fast (keeping them too
+  /// made Newton wander on a stiff 40-mode pendulum at h = 5 ms, tests/tools/solve_cli_test.sh).
+  /// Within a step a second matrix pass (an iteration that did not contract tenfold) computes them
+  /// all. Only Newton's matrix lags: the residual is exact, the motion the same to the tolerance.
+  /// Measured (2026-11-27, one thread, solving time with 1 / 4 / 8 / 16): the 2-body stiffened
+  /// slider-crank at h = 10 us 1.58 / 1.26 / 1.28 / 1.26 s (1.00 / 1.12 / 1.31 / 1.53 iterations
+  /// per step), spin_up_beam 1.43 / 1.21 / 1.24 / 1.25 s, rotating_beam 0.59 / 0.49 / 0.46 /
+  /// 0.44 s, cantilever_transient 0.37 / 0.33 / 0.31 / 0.30 s, spinning_beam 0.256 / 0.267 /
+  /// 0.286 / 0.259 s (2.5 -> 3.3 iterations: its gyroscopic matrix changes fastest), the 10-body
+  /// linear slider-crank 2.62 / 2.32 / 2.32 / 2.45 s. Off (1) by default: Newton's last
+  /// iteration then contracts linearly, so a run agrees with itself across unit systems or
+  /// rounding only to the tolerance (a convergence decision that flips moves it by that much:
+  /// the SI / mm-t-s pendulum of tests/stress/numerical_stress_test.cpp 6e-10 of its swing
+  /// against its 1e-10 bound, one step of 1000 converging one iteration sooner).
+  int body_matrices_every = 1;
   /// Error-controlled steps: `step` is the first step; each later one is chosen so that the
   /// estimated local error of the positions (and the velocities' error times the step) stays
   /// below step_tolerance times the largest node travel so far (at least 1e-3 of the model's
@@ -134,7 +144,7 @@ struct DynamicResult {
   long factorizations = 0;  ///< of the iteration matrix
   long pattern_analyses = 0;  ///< of its sparsity pattern (once unless the pattern changes)
   long pivoted = 0;           ///< factorizations that chose their pivots anew (the others reused them)
-  long body_matrices_computed = 0;  ///< bodies' matrices computed (body_matrices_every), all bodies
+  long body_matrices_computed = 0;  ///< bodies' inertia matrices computed (body_matrices_every), all bodies
   long body_matrices_turned = 0;    ///< and turned with their frames instead
 };
 

@@ -87,9 +87,10 @@ struct BodyWorkspace {
     Eigen::MatrixXd d_load, inertia_K;  // scratch (storage kept)
     BodyVelocity wdot;
     Eigen::VectorXd unused;
-    // The last computed K, C, M in the body's floating frame, Rbar^T X Rbar, and how many matrix
-    // passes since have turned them instead (AddDynamicMatrices, `every`); -1: none kept.
-    Eigen::MatrixXd K_frame, C_frame, M_frame;
+    // The inertia force's last computed mass and gyroscopic matrices in the body's floating
+    // frame, Rbar^T X Rbar, and how many matrix passes since have turned them instead
+    // (AddDynamicMatrices, `every`); -1: none kept.
+    Eigen::MatrixXd M_frame, C_frame;
     int age = -1;
   };
   std::vector<BodyMatrices> matrices;  // the last matrix pass
@@ -130,9 +131,9 @@ struct MatrixCombination {
 // out.K receives the iteration matrix K + c_C C + c_M M alone, combined body by body before the
 // scatter (one sparse matrix built instead of three and their sum), and out.C, out.M stay empty.
 // every > 1 (Newton's iteration matrix only, DynamicOptions::body_matrices_every): a body whose
-// matrices were computed fewer than `every` passes ago takes them turned with its floating frame,
-// Rbar X_frame Rbar^T, instead of computing them (the joints' and loads' terms are computed
-// every time); 1: every body's computed at s.
+// inertia matrices (mass, gyroscopic) were computed fewer than `every` passes ago takes them
+// turned with its floating frame, Rbar X_frame Rbar^T, instead of computing them (everything
+// else is computed every time); 1: all computed at s.
 void AddDynamicMatrices(const SystemModel& model, const DofMap& dofs, const DynamicState& s, double t,
                         BodyWorkspace& work, bool full_inertia_tangent, Assembly& out,
                         BodyThreads* threads = nullptr, const MatrixCombination* combine = nullptr, int every = 1);

@@ -101,7 +101,7 @@ void AddDynamicMatrices(const SystemModel& model, const DofMap& dofs, const Dyna
   // of threads).
   for (int b = 0; b < n_bodies; ++b) {
     BodyWorkspace::BodyMatrices& r = results[size_t(b)];
-    const bool kept = every > 1 && r.age >= 0 && r.age < every - 1 && r.K_frame.rows() == model.bodies[b].n_coordinates();
+    const bool kept = every > 1 && r.age >= 0 && r.age < every - 1 && r.M_frame.rows() == model.bodies[b].n_coordinates();
     r.age = kept ? r.age + 1 : (every > 1 || r.age >= 0 ? 0 : -1);  // a pass that computes keeps them anew
     ++(kept ? work.matrices_turned : work.matrices_computed);
   }
@@ -109,24 +109,31 @@ void AddDynamicMatrices(const SystemModel& model, const DofMap& dofs, const Dyna
     const SuperelementBody& body = model.bodies[b];
     const BodyPass& pass = passes[size_t(b)];
     BodyWorkspace::BodyMatrices& r = results[size_t(b)];
-    // A body's forces are objective (gravity aside, which enters K through the inertia
-    // tangent's wdot - g): turning the whole body by Q turns every node block of its matrices,
-    // X -> Q X Q^T. So X_frame = Rbar^T X Rbar changes only with the deformation and the
-    // velocities in the frame, and Rbar X_frame Rbar^T is the matrix at this pass but for that
-    // change since X_frame was computed.
-    const int blocks = 2 * body.n_nodes();
-    const Eigen::Matrix3d& R = pass.data.frame.R;
-    if (r.age > 0) {
-      TurnNodeBlocks(r.K_frame, blocks, R, r.K);
-      TurnNodeBlocks(r.C_frame, blocks, R, r.C);
-      TurnNodeBlocks(r.M_frame, blocks, R, r.M);
-      if (combine) r.K += combine->c_C * r.C + combine->c_M * r.M;
-      return;
-    }
     const bool stiffening = body.has_inertia_stiffening();
     Eigen::MatrixXd& d_load = r.d_load;
     body.ElasticForce(pass.data, nullptr, &r.K, stiffening ? &pass.load : nullptr, stiffening ? &d_load : nullptr);
-    body.InertiaForce(pass.data, pass.w, pass.wdot, nullptr, &r.M, &r.C);
+    // The inertia force's mass and gyroscopic matrices (the exact inertia's are a body's most
+    // expensive kernel): computed, or the kept ones turned. The inertia force is objective:
+    // turning the whole body and its motion by Q turns every node block of the two matrices,
+    // X -> Q X Q^T (tests/solver/analysis/body_matrix_reuse_test.cpp). So X_frame = Rbar^T X Rbar
+    // changes only with the deformation and the velocities in the frame, and Rbar X_frame Rbar^T
+    // is the matrix of this pass but for their change since. The elastic tangent and the
+    // inertia's configuration tangent are computed every time: they carry the internal forces
+    // (K2, K3, stiffening) and the accelerations, which change fast (a stiff body's unresolved
+    // modes) and whose lag made Newton wander on a stiff pendulum at h = 5 ms.
+    const int blocks = 2 * body.n_nodes();
+    const Eigen::Matrix3d& R = pass.data.frame.R;
+    if (r.age > 0) {
+      TurnNodeBlocks(r.M_frame, blocks, R, r.M);
+      TurnNodeBlocks(r.C_frame, blocks, R, r.C);
+    } else {
+      body.InertiaForce(pass.data, pass.w, pass.wdot, nullptr, &r.M, &r.C);
+      if (r.age == 0) {
+        const Eigen::Matrix3d Rt = R.transpose();
+        TurnNodeBlocks(r.M, blocks, Rt, r.M_frame);
+        TurnNodeBlocks(r.C, blocks, Rt, r.C_frame);
+      }
+    }
     if (stiffening) {
       r.M.noalias() += d_load * pass.load.d_wdot;
       r.C.noalias() += d_load * pass.load.d_w;
@@ -146,12 +153,6 @@ void AddDynamicMatrices(const SystemModel& model, const DofMap& dofs, const Dyna
     r.K += r.inertia_K;
     r.unused.setZero(body.n_coordinates());
     body.AddModalDamping(pass.w, r.unused, &r.C);
-    if (r.age == 0) {
-      const Eigen::Matrix3d Rt = R.transpose();
-      TurnNodeBlocks(r.K, blocks, Rt, r.K_frame);
-      TurnNodeBlocks(r.C, blocks, Rt, r.C_frame);
-      TurnNodeBlocks(r.M, blocks, Rt, r.M_frame);
-    }
     if (combine) r.K += combine->c_C * r.C + combine->c_M * r.M;
   });
   Triplets &K = work.K, &C = work.C, &M = work.M;
@@ -271,8 +272,8 @@ StepOutcome GeneralizedAlphaStep(const SystemModel& model, const DofMap& dofs, c
     bool built = false;
     const auto S = [&]() -> const SystemMatrix& {
       const MatrixCombination combine{gamma_p, beta_p};
-      // The step's first matrix may take the bodies' kept matrices (body_matrices_every); a
-      // second one (the first did not contract tenfold) and full Newton compute them all.
+      // The step's first matrix may take the bodies' kept inertia matrices (body_matrices_every);
+      // a second one (the first did not contract tenfold) and full Newton compute them all.
       const int every = JacobianReuseOf(options) != JacobianReuse::kNone && !matrix.factored_in_step
                             ? std::max(options.body_matrices_every, 1)
                             : 1;

@@ -6,8 +6,9 @@
 //    4e-17 to 2e-14 relative; bound 1e-12). For a linear body with the corotational inertia and
 //    for a stiffened one with the exact inertia;
 //  - a stiffened slider-crank (crank driven at 150 rad/s, rod in 2 bodies, gravity) with the
-//    matrices computed every 4th step takes the same motion as with them computed every step,
-//    within the Newton tolerance, and computes a quarter of them.
+//    inertia matrices computed every 4th step (the others turned with the frames) takes the same
+//    motion as with them computed every step, within the Newton tolerance, and computes a quarter
+//    of them. (Only the inertia's matrices are kept: see DynamicOptions::body_matrices_every.)
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
