@@ -26,6 +26,10 @@ echo
 # the examples' references exist in build/example_out, e.g. after ctest; else they are run first).
 /usr/bin/python3 benchmarks/step_control.py build/bin
 echo
+# Time to accuracy on the slider-crank issue 14 compared with its peer: rigid crank and slider,
+# the rod in 2 stiffened bodies; steps, Newton tolerances, body_matrices_every (about 30 s).
+/usr/bin/python3 benchmarks/peer_slider_crank.py build/bin --out out/peer_slider_crank
+echo
 # The solver's hot path against the commit issue 14 measured (9db5b40; builds it once in
 # /tmp, about 10 minutes, then about 2 minutes): not run here, run it by hand:
 #   bash benchmarks/hot_path_vs_base.sh [BASE]
