@@ -201,8 +201,12 @@ DynamicState InitialDynamicState(const SystemModel& model, const SystemState& co
 namespace {
 // Measure with the bodies' data of the converged iteration at this state (`passes`, one per
 // body) or, when empty, evaluated here.
+// The step's measures with `passes` the converged iteration's (nothing evaluated: each body's
+// share on the threads into `work.measures`, then summed in body order, the same bits for any
+// number of threads), or, without them (passes of another size), each body evaluated here.
 DynamicStepReport MeasureWith(const SystemModel& model, const DofMap& dofs, const DynamicState& s,
-                              const std::vector<BodyPass>& passes) {
+                              const std::vector<BodyPass>& passes, BodyThreads* threads = nullptr,
+                              std::vector<BodyMeasure>* measures = nullptr) {
   DynamicStepReport r;
   r.t = s.t;
   r.external_work = s.external_work;
@@ -210,23 +214,31 @@ DynamicStepReport MeasureWith(const SystemModel& model, const DofMap& dofs, cons
     Eigen::VectorXd unused = Eigen::VectorXd::Zero(dofs.n_dofs());
     AddSpringDampers(model, s.config, s.W, unused, nullptr, nullptr, &r.elastic_energy);  // spring energy
   }
-  const bool kept = passes.size() == model.bodies.size();
-  for (size_t b = 0; b < model.bodies.size(); ++b) {
-    const SuperelementBody& body = model.bodies[b];
-    const auto measure = [&](const SuperelementBody::Data& data, const Eigen::VectorXd& w) {
-      r.kinetic_energy += body.KineticEnergy(data, w);
-      r.elastic_energy += body.ElasticEnergy(data);
-      Eigen::Vector3d L, H;
-      body.Momentum(data, w, &L, &H);
-      r.linear_momentum += L;
-      r.angular_momentum += H;
-    };
-    if (kept) {
-      measure(passes[b].data, passes[b].w);  // the converged iteration's data: nothing evaluated here
-    } else {
-      measure(body.Evaluate(BodyConfigurationOf(model, s.config, int(b)), s.config.frames[b]),
-              BodyVelocityOf(model, dofs, s, int(b)));
-    }
+  const int n_bodies = int(model.bodies.size());
+  const auto measure = [&](int b, const SuperelementBody::Data& data, const Eigen::VectorXd& w, BodyMeasure& m) {
+    const SuperelementBody& body = model.bodies[size_t(b)];
+    const Eigen::VectorXd& p = body.MassTimes(data, w);  // M_g w, once for the energy and the momenta
+    m.kinetic = 0.5 * w.dot(p);
+    body.MomentumFrom(data, p, &m.linear, &m.angular);
+    m.elastic = body.ElasticEnergy(data);
+  };
+  const auto add = [&](const BodyMeasure& m) {
+    r.kinetic_energy += m.kinetic;
+    r.elastic_energy += m.elastic;
+    r.linear_momentum += m.linear;
+    r.angular_momentum += m.angular;
+  };
+  if (passes.size() == model.bodies.size() && measures) {
+    measures->resize(size_t(n_bodies));
+    ForEachBody(threads, n_bodies, [&](int b) { measure(b, passes[size_t(b)].data, passes[size_t(b)].w, (*measures)[size_t(b)]); });
+    for (const BodyMeasure& m : *measures) add(m);
+    return r;
+  }
+  for (int b = 0; b < n_bodies; ++b) {
+    BodyMeasure m;
+    measure(b, model.bodies[size_t(b)].Evaluate(BodyConfigurationOf(model, s.config, b), s.config.frames[b]),
+            BodyVelocityOf(model, dofs, s, b), m);
+    add(m);
   }
   return r;
 }
@@ -379,7 +391,7 @@ DynamicResult SolveDynamic(const SystemModel& model, DynamicState& state, const 
     result.steps += 1;
     result.newton_iterations += step.iterations;
     static const std::vector<BodyPass> kNone;
-    DynamicStepReport r = MeasureWith(model, dofs, state, step.passes_kept ? work.passes : kNone);
+    DynamicStepReport r = MeasureWith(model, dofs, state, step.passes_kept ? work.passes : kNone, &threads, &work.measures);
     r.h = h;
     r.iterations = step.iterations;
     r.rejected = result.rejected_by_error + result.newton_cuts;

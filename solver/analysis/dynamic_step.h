@@ -77,6 +77,12 @@ struct BodyTerms {
   Eigen::VectorXd f_int, f_in, f_acc, f_quadratic;  // the pass's scratch (storage kept)
 };
 
+// One body's share of a step's measures (energies, momenta).
+struct BodyMeasure {
+  double kinetic = 0.0, elastic = 0.0;
+  Eigen::Vector3d linear = Eigen::Vector3d::Zero(), angular = Eigen::Vector3d::Zero();
+};
+
 // The bodies' storage of a dynamic analysis, kept from one Newton iteration and one step to the
 // next so that evaluating a body reuses its matrices instead of allocating them (issue 14).
 struct BodyWorkspace {
@@ -95,6 +101,7 @@ struct BodyWorkspace {
   };
   std::vector<BodyMatrices> matrices;  // the last matrix pass
   long matrices_computed = 0, matrices_turned = 0;  // body matrix passes of each kind, all bodies
+  std::vector<BodyMeasure> measures;                 // the step's measures, per body
   Triplets K, C, M;                    // its system triplets (cleared, capacity kept)
   TripletAssembler K_build, C_build, M_build;  // their sparse matrices (slots kept)
   // The system-level storage of an assembly and of a step, kept so that neither allocates.

@@ -70,26 +70,7 @@ void SuperelementBody::ExactInertiaForce(const Data& data, const BodyVelocity& w
   // r = Rbar^T wdot - c (header): xidot = Z r, qddot_loc = B r, ydot = Y r.
   Eigen::VectorXd& r = s.r;
   TurnBlocksInto(Rt, wdot, blocks, r);
-  if (f_acc) {
-    // The same force at w = 0: r = Rbar^T wdot, xi = qd = y = 0.
-    Eigen::Vector3d Omd0;
-    Omd0.noalias() = Z.bottomRows<3>() * r;
-    Eigen::VectorXd& yd0 = s.y;
-    yd0.noalias() = d.Y * r;
-    Eigen::VectorXd& pi_q_dot0 = s.pi_q_dot;
-    pi_q_dot0.noalias() = M_ * yd0;
-    s.t1.noalias() = d.H * Omd0;
-    pi_q_dot0 += s.t1;
-    Eigen::Matrix<double, 6, 1> f_xi0;
-    f_xi0.noalias() = Phi_rig0_.transpose() * pi_q_dot0;
-    Eigen::Vector3d Hty0;
-    Hty0.noalias() = d.H.transpose() * yd0;
-    f_xi0.tail<3>() += Hty0 + d.Xq * Omd0;
-    f_acc->noalias() = Z.transpose() * f_xi0;
-    s.t1.noalias() = B.transpose() * pi_q_dot0;
-    *f_acc += s.t1;
-    TurnBlocksInto(R, *f_acc, blocks, *f_acc);
-  }
+  if (f_acc) ExactMassTimesTurned(data, r, *f_acc);
   for (int a = 0; a < blocks; ++a) r.segment<3>(3 * a) -= Om.cross(Eigen::Vector3d(Rw.segment<3>(3 * a)));
   for (int k = 0; k < n_nodes_; ++k) {
     r.segment<3>(6 * k) -= Om.cross(Eigen::Vector3d(qd.segment<3>(6 * k)));
@@ -141,6 +122,32 @@ void SuperelementBody::ExactInertiaForce(const Data& data, const BodyVelocity& w
   s.t1.noalias() = B.transpose() * f_q;
   f += s.t1;
   TurnBlocksInto(R, f, blocks, f);
+}
+
+// The force at w = 0 for the acceleration Rbar r (r = Rbar^T wdot; xi = qd = y = 0): M_g wdot,
+// in O(n^2) (s.y, s.pi_q_dot and s.t1 are overwritten).
+void SuperelementBody::ExactMassTimesTurned(const Data& data, const Eigen::VectorXd& r, Eigen::VectorXd& out) const {
+  const ExactData& d = *data.exact;
+  ExactScratch& s = data.exact_scratch;
+  const Eigen::MatrixXd& Z = data.kin.Z;
+  const Eigen::MatrixXd& B = data.kin.B;
+  Eigen::Vector3d Omd0;
+  Omd0.noalias() = Z.bottomRows<3>() * r;
+  Eigen::VectorXd& yd0 = s.y;
+  yd0.noalias() = d.Y * r;
+  Eigen::VectorXd& pi_q_dot0 = s.pi_q_dot;
+  pi_q_dot0.noalias() = M_ * yd0;
+  s.t1.noalias() = d.H * Omd0;
+  pi_q_dot0 += s.t1;
+  Eigen::Matrix<double, 6, 1> f_xi0;
+  f_xi0.noalias() = Phi_rig0_.transpose() * pi_q_dot0;
+  Eigen::Vector3d Hty0;
+  Hty0.noalias() = d.H.transpose() * yd0;
+  f_xi0.tail<3>() += Hty0 + d.Xq * Omd0;
+  out.noalias() = Z.transpose() * f_xi0;
+  s.t1.noalias() = B.transpose() * pi_q_dot0;
+  out += s.t1;
+  TurnBlocksInto(data.frame.R, out, 2 * n_nodes_, out);
 }
 
 void SuperelementBody::ExactGyroscopic(const Data& data, const BodyVelocity& w, Eigen::MatrixXd& G) const {

@@ -606,10 +606,12 @@ void SuperelementBody::AddModalDamping(const BodyVelocity& w, Eigen::VectorXd& f
 
 void SuperelementBody::Momentum(const Data& d, const BodyVelocity& w, Eigen::Vector3d* linear,
                                 Eigen::Vector3d* angular) const {
+  MomentumFrom(d, MassTimes(d, w), linear, angular);
+}
+
+void SuperelementBody::MomentumFrom(const Data& d, const Eigen::VectorXd& p, Eigen::Vector3d* linear,
+                                    Eigen::Vector3d* angular) const {
   const BodyConfiguration& c = d.c;
-  const Eigen::MatrixXd& Mg = has_exact_inertia() ? ExactMass(d) : MapsOf(d).Mg;
-  Eigen::VectorXd& p = d.scratch.v1;
-  p.noalias() = Mg * w;
   linear->setZero();
   angular->setZero();
   for (int a = 0; a < n_nodes_; ++a) {

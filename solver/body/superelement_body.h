@@ -339,6 +339,8 @@ class SuperelementBody {
   /// with respect to w (added to `f` and `C`).
   void AddModalDamping(const BodyVelocity& w, Eigen::VectorXd& f, Eigen::MatrixXd* C) const;
 
+  /// M_g w, into d.scratch.v1 (the exact inertia: without forming M_g).
+  const Eigen::VectorXd& MassTimes(const Data& d, const BodyVelocity& w) const;
   /// Kinetic energy v^T M v / 2.
   double KineticEnergy(const Data& d, const BodyVelocity& w) const;
   double KineticEnergy(const BodyConfiguration& c, const FrameSolution& frame, const BodyVelocity& w) const {
@@ -376,6 +378,8 @@ class SuperelementBody {
   /// Linear momentum and angular momentum about the global origin (Noether: sums of the
   /// generalized momenta p = M_g w of the nodes).
   void Momentum(const Data& d, const BodyVelocity& w, Eigen::Vector3d* linear, Eigen::Vector3d* angular) const;
+  /// The same from the generalized momentum p = M_g w (MassTimes).
+  void MomentumFrom(const Data& d, const Eigen::VectorXd& p, Eigen::Vector3d* linear, Eigen::Vector3d* angular) const;
   void Momentum(const BodyConfiguration& c, const FrameSolution& frame, const BodyVelocity& w,
                 Eigen::Vector3d* linear, Eigen::Vector3d* angular) const {
     Momentum(Evaluate(c, frame), w, linear, angular);
@@ -438,6 +442,7 @@ class SuperelementBody {
   const Eigen::MatrixXd& ExactMass(const Data& d) const;  // computed once per Data
   // d f_in / d w of the exact inertia force (forward mode, exact).
   void ExactGyroscopic(const Data& d, const BodyVelocity& w, Eigen::MatrixXd& G) const;
+  void ExactMassTimesTurned(const Data& data, const Eigen::VectorXd& r, Eigen::VectorXd& out) const;
   Eigen::MatrixXd ExactInertiaConfigurationTangent(const Data& d, const BodyVelocity& w,
                                                    const BodyVelocity& wdot) const;
   BodyConfiguration Perturbed(const BodyConfiguration& c, int i, double sign, double* step) const;
