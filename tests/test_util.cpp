@@ -73,6 +73,47 @@ SystemModel ClampedOneBodyModel(const Superelement& se, double L, const Eigen::V
   return model;
 }
 
+Superelement TubeSegment(double L, int elements, bool stiffened) {
+  return Reduce("name: seg\ntype: beam\nmaterial: {E: 70.0e9, nu: 0.3, rho: 2700}\n"
+                "section: {shape: tube, outer_radius: 0.01, wall: 0.001}\n"
+                "beam:\n  points: {A: [0, 0, 0], B: [" + std::to_string(L) + ", 0, 0]}\n"
+                "  segments: [{from: A, to: B, elements: " + std::to_string(elements) + "}]\n"
+                "interfaces: [{name: A}, {name: B}]\nreduction: {internal_modes: 2, keep_mesh: false, "
+                "geometric_stiffening: " + std::string(stiffened ? "true" : "false") + "}\n");
+}
+
+SystemModel SliderCrankModel(const Superelement& crank, const Superelement& rod, double Lc, double Lr) {
+  SystemModel model;
+  const int O = AddNode(model, "O", Eigen::Vector3d::Zero());
+  const int A = AddNode(model, "A", Eigen::Vector3d(Lc, 0, 0));
+  const int a = AddNode(model, "rod_a", Eigen::Vector3d(Lc, 0, 0));
+  const int m = AddNode(model, "rod_mid", Eigen::Vector3d(Lc + Lr, 0, 0));
+  const int b = AddNode(model, "rod_b", Eigen::Vector3d(Lc + 2 * Lr, 0, 0));
+  const int s = AddNode(model, "slider", Eigen::Vector3d(Lc + 2 * Lr, 0, 0));
+  model.bodies.emplace_back(crank, SuperelementOptions{}, Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero());
+  model.body_nodes.push_back({O, A});
+  for (int i = 0; i < 2; ++i) {
+    model.bodies.emplace_back(rod, SuperelementOptions{}, Eigen::Matrix3d::Identity(),
+                              Eigen::Vector3d(Lc + i * Lr, 0, 0));
+    model.body_nodes.push_back({i == 0 ? a : m, i == 0 ? m : b});
+  }
+  RevoluteToGround(model, O, Eigen::Vector3d::UnitZ());
+  SystemModel::Prescribed drive;
+  drive.node = O;
+  drive.value = [](double t) { return 150.0 * t; };
+  drive.rate = [](double) { return 150.0; };
+  drive.acceleration = [](double) { return 0.0; };
+  model.prescribed.push_back(drive);
+  PrismaticToGround(model, s, Eigen::Vector3d::UnitX());
+  const Eigen::Vector3d z = Eigen::Vector3d::UnitZ();
+  model.joints.push_back(MakeNodeJoint(JointType::kRevolute, a, A, z, model.node_x0[A], model.node_R0[A],
+                                       model.node_x0[a], model.node_R0[a]));
+  model.joints.push_back(MakeNodeJoint(JointType::kRevolute, b, s, z, model.node_x0[s], model.node_R0[s],
+                                       model.node_x0[b], model.node_R0[b]));
+  model.gravity = Eigen::Vector3d(0, -9.81, 0);
+  return model;
+}
+
 Superelement Reduce(const std::string& yaml, const std::vector<std::string>& overrides) {
   PartSpec part = ParsePart(yaml, "test.yaml", overrides);
   ReduceResult r = ReducePart(part, nullptr);

@@ -25,6 +25,17 @@ Eigen::Vector2d ElasticaTip(double P, double EI, double L);
 /// force on n1.
 SystemModel ClampedOneBodyModel(const Superelement& se, double L, const Eigen::Vector3d& tip_force);
 
+/// An aluminium tube segment (outer radius 10 mm, wall 1 mm) of length L along x in `elements`
+/// beam elements, interfaces A and B at its ends, 2 internal modes, with or without geometric
+/// stiffening (and with it the exact inertia), reduced in memory.
+Superelement TubeSegment(double L, int elements, bool stiffened);
+
+/// A slider-crank: crank O-A of length Lc (body `crank`, default options) driven at 150 rad/s
+/// about z (revolute to ground, prescribed), a rod of two bodies `rod` of length Lr each hinged to
+/// A (node rod_a) and to the slider node (rod_b), which slides along x (prismatic to ground);
+/// nodes O, A, rod_a, rod_mid, rod_b, slider (indices 0-5); gravity -9.81 along y.
+SystemModel SliderCrankModel(const Superelement& crank, const Superelement& rod, double Lc, double Lr);
+
 /// -d(residual)/d(unknowns) of AssembleStatic at `state` (load factor `lambda`) by central
 /// differences with steps h along each unknown (ApplyIncrement): the reference for static
 /// tangents.

@@ -23,14 +23,7 @@
 namespace femb {
 namespace {
 
-Superelement Tube(double L, bool stiffened) {
-  return test::Reduce("name: seg\ntype: beam\nmaterial: {E: 70.0e9, nu: 0.3, rho: 2700}\n"
-                      "section: {shape: tube, outer_radius: 0.01, wall: 0.001}\n"
-                      "beam:\n  points: {A: [0, 0, 0], B: [" + std::to_string(L) + ", 0, 0]}\n"
-                      "  segments: [{from: A, to: B, elements: 8}]\n"
-                      "interfaces: [{name: A}, {name: B}]\nreduction: {internal_modes: 2, keep_mesh: false, "
-                      "geometric_stiffening: " + std::string(stiffened ? "true" : "false") + "}\n");
-}
+Superelement Tube(double L, bool stiffened) { return test::TubeSegment(L, 8, stiffened); }
 
 struct BodyMatrices {
   Eigen::MatrixXd K, K_load_w, K_load_wdot, M, G, K_inertia;
@@ -105,43 +98,10 @@ TEST(BodyMatrices, TurnWithTheBody) {
   }
 }
 
-// A slider-crank: crank O-A driven at 150 rad/s about z, a rod of two stiffened bodies hinged to
-// A and to the slider node, which slides along x; gravity.
-SystemModel SliderCrank() {
-  const Superelement crank = Tube(0.15, true), rod = Tube(0.25, true);
-  SystemModel model;
-  const int O = AddNode(model, "O", Eigen::Vector3d::Zero());
-  const int A = AddNode(model, "A", Eigen::Vector3d(0.15, 0, 0));
-  const int a = AddNode(model, "rod_a", Eigen::Vector3d(0.15, 0, 0));
-  const int m = AddNode(model, "rod_mid", Eigen::Vector3d(0.4, 0, 0));
-  const int b = AddNode(model, "rod_b", Eigen::Vector3d(0.65, 0, 0));
-  const int s = AddNode(model, "slider", Eigen::Vector3d(0.65, 0, 0));
-  model.bodies.emplace_back(crank, SuperelementOptions{}, Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero());
-  model.body_nodes.push_back({O, A});
-  for (int i = 0; i < 2; ++i) {
-    model.bodies.emplace_back(rod, SuperelementOptions{}, Eigen::Matrix3d::Identity(), Eigen::Vector3d(0.15 + 0.25 * i, 0, 0));
-    model.body_nodes.push_back({i == 0 ? a : m, i == 0 ? m : b});
-  }
-  RevoluteToGround(model, O, Eigen::Vector3d::UnitZ());
-  SystemModel::Prescribed drive;
-  drive.node = O;
-  drive.value = [](double t) { return 150.0 * t; };
-  drive.rate = [](double) { return 150.0; };
-  drive.acceleration = [](double) { return 0.0; };
-  model.prescribed.push_back(drive);
-  PrismaticToGround(model, s, Eigen::Vector3d::UnitX());
-  const Eigen::Vector3d z = Eigen::Vector3d::UnitZ();
-  model.joints.push_back(MakeNodeJoint(JointType::kRevolute, a, A, z, model.node_x0[A], model.node_R0[A],
-                                       model.node_x0[a], model.node_R0[a]));
-  model.joints.push_back(MakeNodeJoint(JointType::kRevolute, b, s, z, model.node_x0[s], model.node_R0[s],
-                                       model.node_x0[b], model.node_R0[b]));
-  model.gravity = Eigen::Vector3d(0, -9.81, 0);
-  return model;
-}
-
 TEST(BodyMatrices, KeptInTheirFramesGiveTheSameMotion) {
-  const SystemModel model = SliderCrank();
-  const int mid = 3;
+  // The crank and the two rod bodies stiffened (exact inertia), gravity.
+  const SystemModel model = test::SliderCrankModel(Tube(0.15, true), Tube(0.25, true), 0.15, 0.25);
+  const int mid = 3;  // rod_mid
   struct Run {
     DynamicResult result;
     std::vector<Eigen::Vector3d> mid_path;
