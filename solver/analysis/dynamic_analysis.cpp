@@ -199,11 +199,10 @@ DynamicState InitialDynamicState(const SystemModel& model, const SystemState& co
 }
 
 namespace {
-// Measure with the bodies' data of the converged iteration at this state (`passes`, one per
-// body) or, when empty, evaluated here.
 // The step's measures with `passes` the converged iteration's (nothing evaluated: each body's
 // share on the threads into `work.measures`, then summed in body order, the same bits for any
-// number of threads), or, without them (passes of another size), each body evaluated here.
+// number of threads), or, without them (passes of another size, or no `measures`), each body
+// evaluated here.
 DynamicStepReport MeasureWith(const SystemModel& model, const DofMap& dofs, const DynamicState& s,
                               const std::vector<BodyPass>& passes, BodyThreads* threads = nullptr,
                               std::vector<BodyMeasure>* measures = nullptr) {

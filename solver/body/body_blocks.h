@@ -1,6 +1,6 @@
 // Block helpers of the superelement body's kernels (superelement_body.cpp, exact_inertia.cpp):
 // node vectors and matrices turned by 3 x 3 blocks, the exact derivative of a quadratic function.
-// Internal to solver/body.
+// Internal to the solver: solver/body, and generalized-alpha's kept inertia matrices.
 #pragma once
 
 #include <Eigen/Core>

@@ -60,12 +60,11 @@ class ResultsRecorder {
   std::ofstream csv_;
   std::vector<double> time_, kinetic_, elastic_, work_, loop_violation_;
   double max_loop_violation_ = 0.0;
-  // Rows of one width, one per output step, in one flat array: an output step appends to it
-  // without allocating once its capacity has grown (amortized doubling). The per-step vectors
-  // these replaced cost ~170 allocations an output step: 18% of the 10-body slider-crank's run.
-  // A series of rows of `width` values in chunks of about 64 KB that never move: a step's row
-  // costs no copy of the earlier ones (a growing vector copied and zero-filled the whole series
-  // at each doubling: 4-6% of a short-step run's time, in page faults and memmove).
+  // Rows of one width, one per output step (the per-step vectors these replaced cost ~170
+  // allocations an output step: 18% of the 10-body slider-crank's run), in chunks of about 64 KB
+  // that never move: a step's row costs no copy of the earlier ones (one flat vector copied and
+  // zero-filled the whole series at each doubling; a profile put 4% of the samples there, the
+  // wall time moved within noise).
   struct Rows {
     int width = 0;
     long count = 0;
