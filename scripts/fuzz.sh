@@ -1,12 +1,13 @@
 #!/usr/bin/env bash
 # Third CI stage: libFuzzer targets (tests/fuzz) built with clang, AddressSanitizer and
-# UndefinedBehaviorSanitizer in build-fuzz/, each run from a seed corpus made of the examples'
+# UndefinedBehaviorSanitizer in build-asan/ (scripts/sanitizer_tree.sh: the sanitizer stage's tree,
+# whose library objects they share), each run from a seed corpus made of the examples'
 # files for a fixed number of inputs with a fixed random seed (about 30 s each here), so that a
 # run is reproducible: the same commit explores the same inputs on every machine, and a failure
 # in CI is one that `bash scripts/fuzz.sh` shows locally. FEMB_FUZZ_SCALE multiplies the input
 # counts (a longer exploratory run: FEMB_FUZZ_SCALE=20 FEMB_FUZZ_SEED=$RANDOM); FEMB_FUZZ_SECONDS
 # (default 120) caps each target's time on a slow machine. A crash, a hang (10 s per input) or an exception that
-# is not an InputError stops the run; the input is kept in build-fuzz/artifacts/ and becomes a
+# is not an InputError stops the run; the input is kept in build-asan/artifacts/ and becomes a
 # regression test. Needs build/bin/femb-reduce (scripts/build.sh) for the seed superelement.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -14,23 +15,13 @@ seconds=${FEMB_FUZZ_SECONDS:-120}
 scale=${FEMB_FUZZ_SCALE:-1}
 fuzz_seed=${FEMB_FUZZ_SEED:-1}
 declare -A runs=([yaml_fuzz]=15000 [part_fuzz]=75000 [scene_fuzz]=30000 [superelement_fuzz]=2000 [matrix_fuzz]=20000)
-missing=()
-for p in clang libclang-rt-14-dev; do
-  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
-done
-if [ ${#missing[@]} -gt 0 ]; then
-  sudo_cmd=""; [ "$(id -u)" -ne 0 ] && sudo_cmd="sudo"
-  $sudo_cmd apt-get update -q
-  DEBIAN_FRONTEND=noninteractive $sudo_cmd apt-get install -y -q --no-install-recommends "${missing[@]}"
-fi
 targets=(yaml_fuzz part_fuzz scene_fuzz superelement_fuzz matrix_fuzz)
-CC=clang CXX=clang++ cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DFEMB_FUZZ=ON \
-  -DFEMB_BUILD_TESTS=OFF >/dev/null
-cmake --build build-fuzz -j "$(nproc)" --target femb_fuzz_targets -- --no-print-directory -s 2>&1 | grep -v "^\[" || true
-for t in "${targets[@]}"; do test -x "build-fuzz/fuzz/$t" || { echo "fuzz: $t did not build"; exit 1; }; done
+source scripts/sanitizer_tree.sh
+cmake --build build-asan -j "$(nproc)" --target femb_fuzz_targets -- --no-print-directory -s 2>&1 | grep -v "^\[" || true
+for t in "${targets[@]}"; do test -x "build-asan/fuzz/$t" || { echo "fuzz: $t did not build"; exit 1; }; done
 
-work=$(pwd)/build-fuzz/work
-rm -rf "$work" && mkdir -p "$work" build-fuzz/artifacts
+work=$(pwd)/build-asan/work
+rm -rf "$work" && mkdir -p "$work" build-asan/artifacts
 build/bin/femb-reduce -q examples/pendulum/rod.yaml -o "$work/seg.h5"
 for t in "${targets[@]}"; do mkdir -p "$work/corpus_$t"; done
 i=0
@@ -67,13 +58,13 @@ export ASAN_OPTIONS=detect_leaks=0 UBSAN_OPTIONS=print_stacktrace=1:halt_on_erro
 status=0
 for t in "${targets[@]}"; do
   start=$(date +%s)
-  if build-fuzz/fuzz/$t "$work/corpus_$t" -seed="$fuzz_seed" -runs=$((runs[$t] * scale)) \
+  if build-asan/fuzz/$t "$work/corpus_$t" -seed="$fuzz_seed" -runs=$((runs[$t] * scale)) \
        -max_total_time="$seconds" -timeout=10 -rss_limit_mb=4096 \
-       -artifact_prefix="build-fuzz/artifacts/$t-" -print_final_stats=1 > "build-fuzz/$t.log" 2>&1; then
-    echo "fuzz: $t: $(grep -m1 'stat::number_of_executed_units' "build-fuzz/$t.log" | awk '{print $2}') inputs" \
+       -artifact_prefix="build-asan/artifacts/$t-" -print_final_stats=1 > "build-asan/$t.log" 2>&1; then
+    echo "fuzz: $t: $(grep -m1 'stat::number_of_executed_units' "build-asan/$t.log" | awk '{print $2}') inputs" \
          "(seed $fuzz_seed) in $(($(date +%s) - start)) s, no failure"
   else
-    echo "fuzz: $t FAILED (input in build-fuzz/artifacts/):"; tail -40 "build-fuzz/$t.log"; status=1
+    echo "fuzz: $t FAILED (input in build-asan/artifacts/):"; tail -40 "build-asan/$t.log"; status=1
   fi
 done
 exit $status

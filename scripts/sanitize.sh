@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Second CI stage: the unit tests built with AddressSanitizer and UndefinedBehaviorSanitizer
-# (build-asan/, gcc -O1), run under ctest. The command-line and example checks are left to the
+# (build-asan/, clang -O1: scripts/sanitizer_tree.sh), run under ctest. The command-line and example checks are left to the
 # optimized build (scripts/test.sh), and so are the longest runs (a 1e5-step energy history, the
 # rigid four-bar's 1e5 steps, 200 s under the sanitizers, the spin-up beam, the full nonlinear
 # leaf; the midpoint scheme's rigid four-bar under gravity and its step-control convergence, 40 s
@@ -9,8 +9,7 @@
 # same paths.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=Sanitize -DCMAKE_CXX_FLAGS_SANITIZE="-O1 -g1" -DCMAKE_C_FLAGS_SANITIZE="-O1 -g1" \
-  -DFEMB_SANITIZE=ON >/dev/null
+source scripts/sanitizer_tree.sh
 targets=$(grep -o '^femb_add_test([^)]*)' tests/CMakeLists.txt | sed 's|.*/||; s|\.cpp)||')
 # One goal (femb_unit_tests: every test executable), so that make compiles nproc sources at once.
 cmake --build build-asan -j "$(nproc)" --target femb_unit_tests -- --no-print-directory -s 2>&1 | grep -v "^\[" || true

@@ -42,10 +42,10 @@ void PrintStack() {
   backtrace_symbols_fd(frames, n, 2);
 }
 
-Superelement Tube(double L, bool stiffened) { return test::TubeSegment(L, 2, stiffened); }
+[[maybe_unused]] Superelement Tube(double L, bool stiffened) { return test::TubeSegment(L, 2, stiffened); }
 
 // A chain of 4 bodies clamped at one end, hanging under gravity with a dead load at its tip.
-SystemModel Chain(const Superelement& se, double L) {
+[[maybe_unused]] SystemModel Chain(const Superelement& se, double L) {
   SystemModel model;
   for (int i = 0; i <= 4; ++i) AddNode(model, "n" + std::to_string(i), Eigen::Vector3d(i * L, 0, 0));
   Clamp(model, 0);
@@ -63,8 +63,8 @@ SystemModel Chain(const Superelement& se, double L) {
 }
 
 // The allocations of each step of a 30-step run from the third step on: their largest number.
-long LargestAllocationsPerStep(const SystemModel& model, double h, const char* kind, long* steps, int threads = 1,
-                               bool adaptive = false, int body_matrices_every = 1) {
+[[maybe_unused]] long LargestAllocationsPerStep(const SystemModel& model, double h, const char* kind, long* steps,
+                                                int threads = 1, bool adaptive = false, int body_matrices_every = 1) {
   DynamicState s = InitialDynamicState(model, InitialState(model), Eigen::VectorXd::Zero(DofMap(model).n_dofs()));
   DynamicOptions options;
   options.step = h;
