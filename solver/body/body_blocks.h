@@ -57,4 +57,12 @@ void TurnColBlocks(Eigen::MatrixXd& X, int blocks, const Blocks& A) {
     }
   }
 }
+
+// X <- Rbar X Rbar^T in place, Rbar = blockdiag(R, ..., R, 1) over the first `blocks` triples: a
+// node matrix turned with the body (its frame's R, or R^T back into the frame).
+inline void TurnNodeBlocks(Eigen::MatrixXd& X, int blocks, const Eigen::Matrix3d& R) {
+  TurnRowBlocks(X, blocks, [&](int) { return R; });
+  const Eigen::Matrix3d Rt = R.transpose();
+  TurnColBlocks(X, blocks, [&](int) { return Rt; });
+}
 }  // namespace femb::body_blocks

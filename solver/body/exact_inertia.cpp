@@ -316,9 +316,7 @@ const Eigen::MatrixXd& SuperelementBody::ExactMass(const Data& data) const {
   Mg += YHZ.transpose();
   Mg.noalias() += s.n3b * Zr;
   // Rbar Mbar Rbar^T block by block.
-  const Eigen::Matrix3d Rt = R.transpose();
-  TurnRowBlocks(Mg, 2 * n_nodes_, [&](int) { return R; });
-  TurnColBlocks(Mg, 2 * n_nodes_, [&](int) { return Rt; });
+  body_blocks::TurnNodeBlocks(Mg, 2 * n_nodes_, R);
   data.has_exact_mass = true;
   return Mg;
 }

@@ -16,6 +16,7 @@ constexpr double kMaxLocalRotation = 2.0;
 
 using body_blocks::TurnBlocksInto;
 using body_blocks::TurnColBlocks;
+using body_blocks::TurnNodeBlocks;
 using body_blocks::TurnRowBlocks;
 
 SuperelementBody::SuperelementBody(const Superelement& se, const SuperelementOptions& options,
@@ -465,9 +466,7 @@ void SuperelementBody::ElasticForce(const Data& d, Eigen::VectorXd* f, Eigen::Ma
   }
   if (options_.full_tangent) AddGeometricTangent(d, Q, Qhat, options_.approximated, Kt);
   // Rbar Kt Rbar^T, block by block.
-  const Eigen::Matrix3d R = frame.R, Rt = frame.R.transpose();
-  TurnRowBlocks(Kt, 2 * n_nodes_, [&](int) { return R; });
-  TurnColBlocks(Kt, 2 * n_nodes_, [&](int) { return Rt; });
+  TurnNodeBlocks(Kt, 2 * n_nodes_, frame.R);
 }
 
 void SuperelementBody::InterfaceConstraint(const Data& d, Eigen::VectorXd* g, Eigen::MatrixXd* G,
@@ -490,8 +489,7 @@ void SuperelementBody::InterfaceConstraint(const Data& d, Eigen::VectorXd* g, Ei
   const Eigen::VectorXd Qhat = d.kin.B.transpose() * Q;
   H->setZero(n, n);
   AddGeometricTangent(d, Q, Qhat, false, *H);
-  TurnRowBlocks(*H, 2 * n_nodes_, [&](int) { return R; });
-  TurnColBlocks(*H, 2 * n_nodes_, [&](int) { return Rt; });
+  TurnNodeBlocks(*H, 2 * n_nodes_, R);
 }
 
 void SuperelementBody::InertiaForce(const Data& d, const BodyVelocity& w, const BodyVelocity& wdot,

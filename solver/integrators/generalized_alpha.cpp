@@ -77,19 +77,6 @@ Assembly AssembleDynamicResidual(const SystemModel& model, const DofMap& dofs, D
   return out;
 }
 
-namespace {
-
-// X = A Y A^T over a body's node triples (the first `blocks` row and column triples; modal rows
-// and columns as they are), into X's storage.
-void TurnNodeBlocks(const Eigen::MatrixXd& Y, int blocks, const Eigen::Matrix3d& A, Eigen::MatrixXd& X) {
-  X = Y;
-  body_blocks::TurnRowBlocks(X, blocks, [&](int) { return A; });
-  const Eigen::Matrix3d At = A.transpose();
-  body_blocks::TurnColBlocks(X, blocks, [&](int) { return At; });
-}
-
-}  // namespace
-
 void AddDynamicMatrices(const SystemModel& model, const DofMap& dofs, const DynamicState& s, double t,
                         BodyWorkspace& work, bool full_inertia_tangent, Assembly& out,
                         BodyThreads* threads, const MatrixCombination* combine, int every) {
@@ -124,14 +111,18 @@ void AddDynamicMatrices(const SystemModel& model, const DofMap& dofs, const Dyna
     const int blocks = 2 * body.n_nodes();
     const Eigen::Matrix3d& R = pass.data.frame.R;
     if (r.age > 0) {
-      TurnNodeBlocks(r.M_frame, blocks, R, r.M);
-      TurnNodeBlocks(r.C_frame, blocks, R, r.C);
+      r.M = r.M_frame;  // storage reused: the same size at every pass
+      r.C = r.C_frame;
+      body_blocks::TurnNodeBlocks(r.M, blocks, R);
+      body_blocks::TurnNodeBlocks(r.C, blocks, R);
     } else {
       body.InertiaForce(pass.data, pass.w, pass.wdot, nullptr, &r.M, &r.C);
       if (r.age == 0) {
         const Eigen::Matrix3d Rt = R.transpose();
-        TurnNodeBlocks(r.M, blocks, Rt, r.M_frame);
-        TurnNodeBlocks(r.C, blocks, Rt, r.C_frame);
+        r.M_frame = r.M;
+        r.C_frame = r.C;
+        body_blocks::TurnNodeBlocks(r.M_frame, blocks, Rt);
+        body_blocks::TurnNodeBlocks(r.C_frame, blocks, Rt);
       }
     }
     if (stiffening) {
