@@ -20,8 +20,8 @@ int DefaultThreads() {
   return std::max(1, int(std::thread::hardware_concurrency()));
 }
 
-BodyThreads::BodyThreads(int threads) {
-  for (int i = 1; i < threads; ++i) helpers_.emplace_back([this] { Helper(); });
+BodyThreads::BodyThreads(int threads) : ranges_(std::make_unique<Range[]>(size_t(std::max(threads, 1)))) {
+  for (int i = 1; i < threads; ++i) helpers_.emplace_back([this, i] { Helper(i); });
 }
 
 BodyThreads::~BodyThreads() {
@@ -33,18 +33,21 @@ BodyThreads::~BodyThreads() {
   for (std::thread& t : helpers_) t.join();
 }
 
-void BodyThreads::Work(Pass& pass) {
-  for (int i = pass.next.fetch_add(1); i < pass.n; i = pass.next.fetch_add(1)) {
-    try {
-      (*pass.f)(i);
-    } catch (...) {
-      (*pass.errors)[size_t(i)] = std::current_exception();
+void BodyThreads::Work(Pass& pass, int thread) {
+  for (int k = 0; k < pass.n_ranges; ++k) {
+    Range& range = pass.ranges[(thread + k) % pass.n_ranges];  // its own range first
+    for (int i = range.next.fetch_add(1); i < range.end; i = range.next.fetch_add(1)) {
+      try {
+        (*pass.f)(i);
+      } catch (...) {
+        (*pass.errors)[size_t(i)] = std::current_exception();
+      }
+      pass.done.fetch_add(1, std::memory_order_release);
     }
-    pass.done.fetch_add(1, std::memory_order_release);
   }
 }
 
-void BodyThreads::Helper() {
+void BodyThreads::Helper(int thread) {
   long seen = 0;
   for (;;) {
     // Passes come every few hundred microseconds in a time step: look for the next one for a
@@ -65,7 +68,7 @@ void BodyThreads::Helper() {
       if (pass) pass->users.fetch_add(1);  // the pass stays alive until users is back to 0
     }
     if (!pass) continue;  // woke after that pass had ended
-    Work(*pass);
+    Work(*pass, thread);
     pass->users.fetch_sub(1, std::memory_order_release);
   }
 }
@@ -80,6 +83,13 @@ void BodyThreads::ForEach(int n, BodyTask f) {
   pass.n = n;
   errors_.assign(size_t(n), nullptr);
   pass.errors = &errors_;
+  const int parts = threads();
+  for (int k = 0; k < parts; ++k) {
+    ranges_[size_t(k)].next.store(int(long(n) * k / parts), std::memory_order_relaxed);
+    ranges_[size_t(k)].end = int(long(n) * (k + 1) / parts);
+  }
+  pass.ranges = ranges_.get();
+  pass.n_ranges = parts;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     pass_ = &pass;
@@ -87,7 +97,7 @@ void BodyThreads::ForEach(int n, BodyTask f) {
     published_.store(generation_, std::memory_order_release);
   }
   wake_.notify_all();
-  Work(pass);
+  Work(pass, 0);
   // Only bodies a helper has begun are left: wait for them, then close the pass to latecomers
   // and wait for the helpers still holding it.
   while (pass.done.load(std::memory_order_acquire) < n) std::this_thread::yield();

@@ -14,6 +14,7 @@
 #include <condition_variable>
 #include <exception>
 #include <functional>
+#include <memory>
 #include <mutex>
 #include <thread>
 #include <vector>
@@ -54,14 +55,25 @@ class BodyThreads {
   void ForEach(int n, BodyTask f);
 
  private:
+  // The bodies of a pass are cut into one contiguous range per thread, each with its own counter:
+  // a thread takes the bodies of its range first, then helps with the others' (a helper that
+  // joins late finds its range taken). So a body is evaluated on the same core pass after pass
+  // and its workspace stays in that core's cache; with one shared counter the bodies changed
+  // threads at random and a pass on 2 threads took 0.72 of its time on 1 instead of 0.5.
+  struct alignas(64) Range {
+    std::atomic<int> next{0};
+    int end = 0;
+  };
   struct Pass {
     const BodyTask* f = nullptr;
     int n = 0;
-    std::atomic<int> next{0}, done{0}, users{0};
+    Range* ranges = nullptr;  ///< threads() of them; the pool's, kept between passes
+    int n_ranges = 0;
+    std::atomic<int> done{0}, users{0};
     std::vector<std::exception_ptr>* errors = nullptr;  ///< per i; the pool's, kept between passes
   };
-  static void Work(Pass& pass);
-  void Helper();
+  static void Work(Pass& pass, int thread);
+  void Helper(int thread);
 
   std::vector<std::thread> helpers_;
   std::mutex mutex_;
@@ -71,6 +83,7 @@ class BodyThreads {
   std::atomic<long> published_{0};  ///< generation_, for helpers looking without the lock
   bool stop_ = false;
   std::vector<std::exception_ptr> errors_;  ///< a pass's (Pass::errors): its storage is reused
+  std::unique_ptr<Range[]> ranges_;          ///< a pass's (Pass::ranges), one per thread
 };
 
 }  // namespace femb
