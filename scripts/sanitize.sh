@@ -1,12 +1,12 @@
 #!/usr/bin/env bash
-# Second CI stage: the unit tests built with AddressSanitizer and UndefinedBehaviorSanitizer
-# (build-asan/, clang -O1: scripts/sanitizer_tree.sh), run under ctest. The command-line and example checks are left to the
-# optimized build (scripts/test.sh), and so are the longest runs (a 1e5-step energy history, the
-# rigid four-bar's 1e5 steps, 200 s under the sanitizers, the spin-up beam, the full nonlinear
-# leaf; the midpoint scheme's rigid four-bar under gravity and its step-control convergence, 40 s
-# each, whose paths the triple pendulum and the generalized-alpha step control take too): the
-# point here is memory and UB errors in the library code, which the other tests exercise on the
-# same paths.
+# Second CI stage: the unit tests built with AddressSanitizer and UndefinedBehaviorSanitizer (build-
+# asan/, clang -O1: scripts/sanitizer_tree.sh), run under ctest. The command-line and example checks
+# are left to the optimized build (scripts/test.sh), and so are the longest runs (a 1e5-step energy
+# history, the rigid four-bar's 1e5 steps, 200 s under the sanitizers, the spin-up beam, the full
+# nonlinear leaf; the midpoint scheme's rigid four-bar under gravity and its step-control
+# convergence, 40 s each, whose paths the triple pendulum and the generalized-alpha step control
+# take too): the point here is memory and UB errors in the library code, which the other tests
+# exercise on the same paths.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 source scripts/sanitizer_tree.sh
