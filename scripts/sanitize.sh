@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# Second CI stage: the unit tests built with AddressSanitizer and UndefinedBehaviorSanitizer (build-
-# asan/, clang -O1: scripts/sanitizer_tree.sh), run under ctest. The command-line and example checks
+# Second CI stage: the unit tests built with AddressSanitizer and UndefinedBehaviorSanitizer
+# (build-asan/, clang -O1: scripts/sanitizer_tree.sh), run under ctest. The command-line and example checks
 # are left to the optimized build (scripts/test.sh), and so are the longest runs (a 1e5-step energy
 # history, the rigid four-bar's 1e5 steps, 200 s under the sanitizers, the spin-up beam, the full
 # nonlinear leaf; the midpoint scheme's rigid four-bar under gravity and its step-control
