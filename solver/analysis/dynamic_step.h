@@ -83,6 +83,19 @@ struct BodyMeasure {
   Eigen::Vector3d linear = Eigen::Vector3d::Zero(), angular = Eigen::Vector3d::Zero();
 };
 
+// Nodes whose coordinates include their own spatial rotation increment (free node, spherical
+// joint to ground, spherical child): the first index of the rotation triple, and of the
+// translation triple when the node is free (-1 otherwise).
+struct RotationNode {
+  int node, rotation, translation;
+};
+
+std::vector<RotationNode> RotationNodes(const SystemModel& model, const DofMap& dofs);
+
+// RotationNodes with unknowns (ApplyIncrement composes their rotation increments, R <- exp(d~)
+// R; every other unknown adds).
+std::vector<RotationNode> RotationTriples(const SystemModel& model, const DofMap& dofs);
+
 // The bodies' storage of a dynamic analysis, kept from one Newton iteration and one step to the
 // next so that evaluating a body reuses its matrices instead of allocating them (issue 14).
 struct BodyWorkspace {
@@ -109,10 +122,15 @@ struct BodyWorkspace {
   Assembly assembly;
   std::vector<Eigen::Matrix<double, 6, 1>> node_acc;
   std::vector<NodeJacobian> dc, dacc;
-  Eigen::VectorXd unused, column, weights, dq, delta;
+  Eigen::VectorXd unused, column, weights, dq, delta, lie_delta;
+  // RotationTriples(model, dofs), set with the weights.
+  std::vector<RotationNode> rotation_triples;
   // ResidualWeights(model, dofs), computed on the first call (they depend on the model only).
   const Eigen::VectorXd& Weights(const SystemModel& model, const DofMap& dofs) {
-    if (weights.size() != dofs.n_dofs()) weights = ResidualWeights(model, dofs);
+    if (weights.size() != dofs.n_dofs()) {
+      weights = ResidualWeights(model, dofs);
+      rotation_triples = RotationTriples(model, dofs);
+    }
     return weights;
   }
 };
@@ -257,14 +275,6 @@ struct StepOutcome {
   bool passes_kept = false;  ///< the workspace's passes hold the bodies' data at the converged state
 };
 
-// Nodes whose coordinates include their own spatial rotation increment (free node, spherical
-// joint to ground, spherical child): the first index of the rotation triple, and of the
-// translation triple when the node is free (-1 otherwise).
-struct RotationNode {
-  int node, rotation, translation;
-};
-
-std::vector<RotationNode> RotationNodes(const SystemModel& model, const DofMap& dofs);
 
 // The velocities of body b's coordinates: the midpoint scheme's node velocities where the state
 // carries them (DynamicState::node_w), J(q) W otherwise.
