@@ -442,6 +442,9 @@ SceneSpec ParseScene(const std::string& text, const std::string& name, const std
       a.body_matrices_every = int(v->Integer());
       if (a.body_matrices_every < 1) v->Fail("body_matrices_every must be a whole number of steps, at least 1");
     }
+    if (auto v = m.Optional("body_matrices_kept")) {
+      a.body_matrices_kept = v->OneOf({"inertia", "all"}) == "all" ? BodyMatricesKeptType::kAll : BodyMatricesKeptType::kInertia;
+    }
     m.CheckNoUnknownKeys();
   }
 

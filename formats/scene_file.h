@@ -42,6 +42,7 @@ struct TimeFunctionSpec {
 /// the CSV header, results.h5's `analysis` attribute).
 enum class AnalysisType { kStatic, kDynamic, kModes };
 enum class IntegratorType { kGeneralizedAlpha, kMidpoint };
+enum class BodyMatricesKeptType { kInertia, kAll };  ///< analysis.body_matrices_kept: inertia | all
 enum class JacobianReuseType { kDefault, kNone, kStep, kSteps };  ///< analysis.jacobian_reuse: none | step | steps (kDefault: unset)
 enum class ProbeQuantity { kPosition, kRotation, kVelocity, kAngularVelocity, kJoint, kReaction, kStress };
 /// Bodies, joints and loads by type (SCENE_FORMAT.md `bodies`, `joints`, `loads`).
@@ -138,6 +139,7 @@ struct SceneAnalysisSpec {
   JacobianReuseType jacobian_reuse = JacobianReuseType::kDefault;  ///< dynamic: which Newton iterations factor anew
   bool gyroscopic_tangent = false;  ///< generalized-alpha: configuration derivative of the quadratic velocity terms in S
   int body_matrices_every = 0;      ///< generalized-alpha: bodies' matrices computed every n-th step (0: unset, the solver's default)
+  BodyMatricesKeptType body_matrices_kept = BodyMatricesKeptType::kAll;  ///< which of them body_matrices_every keeps
 };
 
 struct SceneSpec {

@@ -225,6 +225,9 @@ int main(int argc, char** argv) {
       }
       options.full_inertia_tangent = spec.analysis.gyroscopic_tangent;
       if (spec.analysis.body_matrices_every > 0) options.body_matrices_every = spec.analysis.body_matrices_every;
+      options.body_matrices_kept = spec.analysis.body_matrices_kept == femb::BodyMatricesKeptType::kAll
+                                       ? femb::BodyMatricesKept::kAll
+                                       : femb::BodyMatricesKept::kInertia;
       options.threads = threads;
       options.adaptive = spec.analysis.adaptive_step;
       if (options.adaptive) options.step = 1e-4 * spec.analysis.end_time;  // the first step tried
@@ -261,9 +264,10 @@ int main(int argc, char** argv) {
                     "chosen in %ld, reused in %ld\n", r.factorizations, analysed.c_str(), r.pivoted,
                     r.factorizations - r.pivoted);
         if (r.body_matrices_turned > 0) {
-          std::printf("femb-solve: bodies' inertia matrices computed %ld times, turned with their floating frames %ld times "
-                      "(analysis.body_matrices_every %d)\n", r.body_matrices_computed, r.body_matrices_turned,
-                      options.body_matrices_every);
+          const bool all = options.body_matrices_kept == femb::BodyMatricesKept::kAll;
+          std::printf("femb-solve: bodies' %smatrices computed %ld times, turned with their floating frames %ld times "
+                      "(analysis.body_matrices_every %d, body_matrices_kept %s)\n", all ? "" : "inertia ",
+                      r.body_matrices_computed, r.body_matrices_turned, options.body_matrices_every, all ? "all" : "inertia");
         }
       }
       if (!quiet && spec.analysis.adaptive_step) {

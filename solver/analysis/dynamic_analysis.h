@@ -36,6 +36,12 @@ enum class JacobianReuse {
   kSteps,  ///< kept across steps of the same size; anew after reuse_max_iterations iterations with it
 };
 
+/// Which of a body's matrices DynamicOptions::body_matrices_every keeps between computations.
+enum class BodyMatricesKept {
+  kInertia,  ///< mass and gyroscopic (the inertia force's); the tangents computed every time
+  kAll,      ///< all: also the elastic tangent and the inertia's configuration tangent
+};
+
 struct DynamicOptions;
 JacobianReuse JacobianReuseOf(const DynamicOptions& options);
 
@@ -62,27 +68,33 @@ struct DynamicOptions {
   /// body at omega h = 0.04, at ~4x the assembly time; off by default.
   bool full_inertia_tangent = false;
   int reuse_max_iterations = 6;  ///< kSteps: iterations with one factor before a new one
-  /// Generalized-alpha with a kept factor (kStep, kSteps): each body's inertia matrices (mass
-  /// and gyroscopic: the exact inertia's are a body's most expensive kernel, 15 us of a 30 us
-  /// iteration) are computed at the first matrix pass of every `body_matrices_every`-th step and
-  /// kept in the body's floating frame; the steps between turn them with the frame, Rbar X Rbar^T
-  /// (the inertia force is objective: turning the body turns its matrices exactly so), O(n^2)
-  /// instead of O(n^3). The elastic tangent and the inertia's configuration tangent are computed
-  /// every time: they carry internal forces and accelerations that change fast (keeping them too
-  /// made Newton wander on a stiff 40-mode pendulum at h = 5 ms, tests/tools/solve_cli_test.sh).
-  /// Within a step a second matrix pass (an iteration that did not contract tenfold) computes them
-  /// all. Only Newton's matrix lags: the residual is exact, the motion the same to the tolerance.
-  /// Measured (2026-11-27, one thread, solving time with 1 / 4 / 8 / 16): the 2-body stiffened
-  /// slider-crank at h = 10 us 1.58 / 1.26 / 1.28 / 1.26 s (1.00 / 1.12 / 1.31 / 1.53 iterations
-  /// per step), spin_up_beam 1.43 / 1.21 / 1.24 / 1.25 s, rotating_beam 0.59 / 0.49 / 0.46 /
-  /// 0.44 s, cantilever_transient 0.37 / 0.33 / 0.31 / 0.30 s, spinning_beam 0.256 / 0.267 /
-  /// 0.286 / 0.259 s (2.5 -> 3.3 iterations: its gyroscopic matrix changes fastest), the 10-body
-  /// linear slider-crank 2.62 / 2.32 / 2.32 / 2.45 s. Off (1) by default: Newton's last
-  /// iteration then contracts linearly, so a run agrees with itself across unit systems or
-  /// rounding only to the tolerance (a convergence decision that flips moves it by that much:
-  /// the SI / mm-t-s pendulum of tests/stress/numerical_stress_test.cpp 6e-10 of its swing
-  /// against its 1e-10 bound, one step of 1000 converging one iteration sooner).
+  /// Generalized-alpha with a kept factor (kStep, kSteps): each body's matrices are computed at
+  /// the first matrix pass of every `body_matrices_every`-th step and kept in the body's floating
+  /// frame; the steps between turn them with the frame, Rbar X Rbar^T (the forces are objective:
+  /// turning the body and its motion turns its matrices exactly so), O(n^2) instead of O(n^3).
+  /// Within a step a second matrix pass (an iteration that did not contract tenfold) computes
+  /// them all. Only Newton's matrix lags: the residual is exact, the motion the same to the
+  /// tolerance. Off (1) by default: Newton's last iteration then contracts linearly, so a run
+  /// agrees with itself across unit systems or rounding only to the tolerance (a convergence
+  /// decision that flips moves it by that much: the SI / mm-t-s pendulum of tests/stress/
+  /// numerical_stress_test.cpp 6e-10 of its swing against its 1e-10 bound, one step of 1000
+  /// converging one iteration sooner).
   int body_matrices_every = 1;
+  /// Which matrices body_matrices_every keeps: kAll (default) the whole body matrix, elastic
+  /// tangent with the inertia stiffening and the inertia's configuration tangent included; a kept
+  /// step's matrix pass is then three turns and the scatter. kInertia keeps the mass and
+  /// gyroscopic matrices alone (the exact inertia's are a body's most expensive kernel) and
+  /// computes the tangents every time. The tangents once lagged badly: with the zero-acceleration
+  /// predictor, keeping them made Newton wander on a stiff 40-mode pendulum at h = 5 ms
+  /// (tests/tools/solve_cli_test.sh's rho_inf 0.5 case); with the constant-acceleration predictor
+  /// it takes 1.04 iterations per step either way. Measured 2026-11-28 (one thread, solving time
+  /// best of 2, Newton iterations per step; every 1 / 4 inertia / 4 all / 8 all): slider_crank_2d
+  /// (2 stiffened bodies, h = 10 us) 1.19 / 0.95 / 0.76 / 0.67 s (1.00 its throughout),
+  /// spin_up_beam 0.76 / 0.63 / 0.53 / 0.47 s (1.66 -> 1.87 its), rotating_beam 0.44 / 0.37 /
+  /// 0.33 / 0.33 s (2.71 -> 3.14), spinning_beam 0.194 / 0.197 / 0.170 / 0.163 s (2.27 -> 3.43: its
+  /// gyroscopic matrix changes fastest), cantilever_transient 0.245 / 0.205 / 0.207 / 0.208 s
+  /// (3.33 -> 4.45).
+  BodyMatricesKept body_matrices_kept = BodyMatricesKept::kAll;
   /// Error-controlled steps: `step` is the first step; each later one is chosen so that the
   /// estimated local error of the positions (and the velocities' error times the step) stays
   /// below step_tolerance times the largest node travel so far (at least 1e-3 of the model's

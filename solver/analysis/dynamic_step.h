@@ -106,10 +106,11 @@ struct BodyWorkspace {
     Eigen::MatrixXd d_load, inertia_K;  // scratch (storage kept)
     BodyVelocity wdot;
     Eigen::VectorXd unused;
-    // The inertia force's last computed mass and gyroscopic matrices in the body's floating
-    // frame, Rbar^T X Rbar, and how many matrix passes since have turned them instead
-    // (AddDynamicMatrices, `every`); -1: none kept.
-    Eigen::MatrixXd M_frame, C_frame;
+    // The last computed matrices kept in the body's floating frame, Rbar^T X Rbar (the inertia
+    // force's mass and gyroscopic matrices; with BodyMatricesKept::kAll the whole M, C and K),
+    // and how many matrix passes since have turned them instead (AddDynamicMatrices, `every`);
+    // -1: none kept.
+    Eigen::MatrixXd M_frame, C_frame, K_frame;
     int age = -1;
   };
   std::vector<BodyMatrices> matrices;  // the last matrix pass
@@ -156,12 +157,14 @@ struct MatrixCombination {
 // out.K receives the iteration matrix K + c_C C + c_M M alone, combined body by body before the
 // scatter (one sparse matrix built instead of three and their sum), and out.C, out.M stay empty.
 // every > 1 (Newton's iteration matrix only, DynamicOptions::body_matrices_every): a body whose
-// inertia matrices (mass, gyroscopic) were computed fewer than `every` passes ago takes them
-// turned with its floating frame, Rbar X_frame Rbar^T, instead of computing them (everything
-// else is computed every time); 1: all computed at s.
+// matrices were computed fewer than `every` passes ago takes them turned with its floating
+// frame, Rbar X_frame Rbar^T, instead of computing them: its inertia matrices (mass, gyroscopic)
+// alone with `kept` kInertia (everything else computed every time), all of them with kAll; 1:
+// all computed at s.
 void AddDynamicMatrices(const SystemModel& model, const DofMap& dofs, const DynamicState& s, double t,
                         BodyWorkspace& work, bool full_inertia_tangent, Assembly& out,
-                        BodyThreads* threads = nullptr, const MatrixCombination* combine = nullptr, int every = 1);
+                        BodyThreads* threads = nullptr, const MatrixCombination* combine = nullptr, int every = 1,
+                        BodyMatricesKept kept = BodyMatricesKept::kInertia);
 
 // Residual and (with `matrices`) K, C, M at s, with a workspace of its own.
 Assembly AssembleDynamic(const SystemModel& model, const DofMap& dofs, DynamicState& s, double t, bool matrices,

@@ -79,16 +79,19 @@ Assembly AssembleDynamicResidual(const SystemModel& model, const DofMap& dofs, D
 
 void AddDynamicMatrices(const SystemModel& model, const DofMap& dofs, const DynamicState& s, double t,
                         BodyWorkspace& work, bool full_inertia_tangent, Assembly& out,
-                        BodyThreads* threads, const MatrixCombination* combine, int every) {
+                        BodyThreads* threads, const MatrixCombination* combine, int every, BodyMatricesKept which) {
   const int n_bodies = int(model.bodies.size());
   const std::vector<BodyPass>& passes = work.passes;
   std::vector<BodyWorkspace::BodyMatrices>& results = work.matrices;
   results.resize(static_cast<size_t>(n_bodies));
+  const bool all_kept = which == BodyMatricesKept::kAll;
   // Which bodies turn their kept matrices (decided here, in body order: the same for any number
   // of threads).
   for (int b = 0; b < n_bodies; ++b) {
     BodyWorkspace::BodyMatrices& r = results[size_t(b)];
-    const bool kept = every > 1 && r.age >= 0 && r.age < every - 1 && r.M_frame.rows() == model.bodies[b].n_coordinates();
+    const int n = model.bodies[b].n_coordinates();
+    const bool kept = every > 1 && r.age >= 0 && r.age < every - 1 && r.M_frame.rows() == n &&
+                      (!all_kept || r.K_frame.rows() == n);
     r.age = kept ? r.age + 1 : (every > 1 || r.age >= 0 ? 0 : -1);  // a pass that computes keeps them anew
     ++(kept ? work.matrices_turned : work.matrices_computed);
   }
@@ -97,6 +100,19 @@ void AddDynamicMatrices(const SystemModel& model, const DofMap& dofs, const Dyna
     const BodyPass& pass = passes[size_t(b)];
     BodyWorkspace::BodyMatrices& r = results[size_t(b)];
     const bool stiffening = body.has_inertia_stiffening();
+    const int blocks = 2 * body.n_nodes();
+    const Eigen::Matrix3d& R = pass.data.frame.R;
+    if (all_kept && r.age > 0) {
+      // All of the body's matrices kept (BodyMatricesKept::kAll): turned with the frame.
+      r.K = r.K_frame;  // storage reused: the same size at every pass
+      r.C = r.C_frame;
+      r.M = r.M_frame;
+      body_blocks::TurnNodeBlocks(r.K, blocks, R);
+      body_blocks::TurnNodeBlocks(r.C, blocks, R);
+      body_blocks::TurnNodeBlocks(r.M, blocks, R);
+      if (combine) r.K += combine->c_C * r.C + combine->c_M * r.M;
+      return;
+    }
     Eigen::MatrixXd& d_load = r.d_load;
     body.ElasticForce(pass.data, nullptr, &r.K, stiffening ? &pass.load : nullptr, stiffening ? &d_load : nullptr);
     // The inertia force's mass and gyroscopic matrices (the exact inertia's are a body's most
@@ -104,20 +120,19 @@ void AddDynamicMatrices(const SystemModel& model, const DofMap& dofs, const Dyna
     // turning the whole body and its motion by Q turns every node block of the two matrices,
     // X -> Q X Q^T (tests/solver/analysis/body_matrix_reuse_test.cpp). So X_frame = Rbar^T X Rbar
     // changes only with the deformation and the velocities in the frame, and Rbar X_frame Rbar^T
-    // is the matrix of this pass but for their change since. The elastic tangent and the
-    // inertia's configuration tangent are computed every time: they carry the internal forces
-    // (K2, K3, stiffening) and the accelerations, which change fast (a stiff body's unresolved
-    // modes) and whose lag made Newton wander on a stiff pendulum at h = 5 ms.
-    const int blocks = 2 * body.n_nodes();
-    const Eigen::Matrix3d& R = pass.data.frame.R;
-    if (r.age > 0) {
+    // is the matrix of this pass but for their change since. With kInertia the elastic tangent
+    // and the inertia's configuration tangent are computed every time: they carry the internal
+    // forces (K2, K3, stiffening) and the accelerations. With kAll they are kept and turned too
+    // (above): the internal forces and accelerations are objective as well, so the kept matrix
+    // lags by their change in the frame, as the inertia's does.
+    if (!all_kept && r.age > 0) {
       r.M = r.M_frame;  // storage reused: the same size at every pass
       r.C = r.C_frame;
       body_blocks::TurnNodeBlocks(r.M, blocks, R);
       body_blocks::TurnNodeBlocks(r.C, blocks, R);
     } else {
       body.InertiaForce(pass.data, pass.w, pass.wdot, nullptr, &r.M, &r.C);
-      if (r.age == 0) {
+      if (!all_kept && r.age == 0) {
         const Eigen::Matrix3d Rt = R.transpose();
         r.M_frame = r.M;
         r.C_frame = r.C;
@@ -144,6 +159,15 @@ void AddDynamicMatrices(const SystemModel& model, const DofMap& dofs, const Dyna
     r.K += r.inertia_K;
     r.unused.setZero(body.n_coordinates());
     body.AddModalDamping(pass.w, r.unused, &r.C);
+    if (all_kept && r.age == 0) {
+      const Eigen::Matrix3d Rt = R.transpose();
+      r.K_frame = r.K;
+      r.C_frame = r.C;
+      r.M_frame = r.M;
+      body_blocks::TurnNodeBlocks(r.K_frame, blocks, Rt);
+      body_blocks::TurnNodeBlocks(r.C_frame, blocks, Rt);
+      body_blocks::TurnNodeBlocks(r.M_frame, blocks, Rt);
+    }
     if (combine) r.K += combine->c_C * r.C + combine->c_M * r.M;
   });
   Triplets &K = work.K, &C = work.C, &M = work.M;
@@ -282,7 +306,9 @@ StepOutcome GeneralizedAlphaStep(const SystemModel& model, const DofMap& dofs, c
       const int every = JacobianReuseOf(options) != JacobianReuse::kNone && !matrix.factored_in_step
                             ? std::max(options.body_matrices_every, 1)
                             : 1;
-      if (!built) AddDynamicMatrices(model, dofs, next, t_new, work, options.full_inertia_tangent, a, &threads, &combine, every);
+      if (!built)
+        AddDynamicMatrices(model, dofs, next, t_new, work, options.full_inertia_tangent, a, &threads, &combine, every,
+                           options.body_matrices_kept);
       built = true;
       return a.K;  // K + gamma' C + beta' M
     };

@@ -72,6 +72,16 @@ TEST(SceneFile, BodyMatricesEveryIsAWholeNumberOfSteps) {
   }
 }
 
+TEST(SceneFile, BodyMatricesKeptIsInertiaOrAll) {
+  EXPECT_EQ(ParseScene(kGood, "scene.yaml").analysis.body_matrices_kept, BodyMatricesKeptType::kAll);
+  EXPECT_EQ(ParseScene(kGood, "scene.yaml", {"analysis.body_matrices_kept=inertia"}).analysis.body_matrices_kept,
+            BodyMatricesKeptType::kInertia);
+  EXPECT_EQ(ParseScene(kGood, "scene.yaml", {"analysis.body_matrices_kept=all"}).analysis.body_matrices_kept,
+            BodyMatricesKeptType::kAll);
+  const std::string message = Error(kGood, {"analysis.body_matrices_kept=mass"});
+  EXPECT_NE(message.find("body_matrices_kept"), std::string::npos) << message;
+}
+
 TEST(SceneFile, JacobianReuseTakesItsNamesAndTheOldBooleans) {
   const auto reuse = [](const std::string& value) {
     return ParseScene(kGood, "scene.yaml", {"analysis.jacobian_reuse=" + value}).analysis.jacobian_reuse;
