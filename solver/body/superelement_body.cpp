@@ -137,6 +137,36 @@ Eigen::Matrix<double, 6, 6> SuperelementBody::FrameMatrix(const Eigen::VectorXd&
   return S;
 }
 
+namespace {
+
+// The inverse of a 6 x 6 matrix (the frame matrix S) by Gauss-Jordan elimination with partial
+// pivoting, on fixed-size storage: Eigen's PartialPivLU::inverse goes through its general
+// triangular solves, 3% of a step of the peer slider-crank (perf, 2026-11-28).
+Eigen::Matrix<double, 6, 6> Inverse6(Eigen::Matrix<double, 6, 6> A) {
+  Eigen::Matrix<double, 6, 6> X = Eigen::Matrix<double, 6, 6>::Identity();
+  for (int k = 0; k < 6; ++k) {
+    int p = k;
+    for (int i = k + 1; i < 6; ++i)
+      if (std::abs(A(i, k)) > std::abs(A(p, k))) p = i;
+    if (p != k) {
+      A.row(k).swap(A.row(p));
+      X.row(k).swap(X.row(p));
+    }
+    const double pivot = 1.0 / A(k, k);
+    A.row(k) *= pivot;
+    X.row(k) *= pivot;
+    for (int i = 0; i < 6; ++i) {
+      const double f = A(i, k);
+      if (i == k || f == 0.0) continue;
+      A.row(i) -= f * A.row(k);
+      X.row(i) -= f * X.row(k);
+    }
+  }
+  return X;
+}
+
+}  // namespace
+
 void SuperelementBody::ComputeKinematics(const Eigen::VectorXd& q, Kinematics& k) const {
   const int n = n_coordinates();
   k.Phi_rig.setZero(n, 6);
@@ -162,9 +192,10 @@ void SuperelementBody::ComputeKinematics(const Eigen::VectorXd& q, Kinematics& k
   }
   // S^-1 once (a 6 x 6 LU); Z and the elastic tangent's K4 take fixed-size products with it
   // instead of a triangular solve with n right-hand sides each.
-  k.S_inv = k.S.partialPivLu().inverse();
+  k.S_inv = Inverse6(k.S);
   k.Z.resize(6, n);
-  k.Z.noalias() = k.S_inv * W;
+  using Rows6 = Eigen::Matrix<double, 6, Eigen::Dynamic>;  // fixed rows: the product unrolls over them
+  Eigen::Map<Rows6>(k.Z.data(), 6, n).noalias() = k.S_inv * Eigen::Map<const Rows6>(W.data(), 6, n);
   // T = 1 - Phi_rig Z: node a's translation rows minus (Z_t - r_a~ Z_r), rotation rows minus Z_r
   // (Z_t, Z_r the frame's translation and rotation rows of Z); B = D T: the rotation rows turned.
   k.T.setIdentity(n, n);
@@ -186,9 +217,13 @@ SuperelementBody::Data SuperelementBody::Evaluate(const BodyConfiguration& c, co
 }
 
 void SuperelementBody::Evaluate(const BodyConfiguration& c, const FrameSolution& frame, Data& d) const {
+  LocalCoordinates(c, frame, d.q);
+  EvaluateSolved(c, frame, d);
+}
+
+void SuperelementBody::EvaluateSolved(const BodyConfiguration& c, const FrameSolution& frame, Data& d) const {
   if (&c != &d.c) d.c = c;
   d.frame = frame;
-  LocalCoordinates(d.c, frame, d.q);
   ComputeKinematics(d.q, d.kin);
   if (has_exact_inertia()) {
     if (!d.exact) d.exact.emplace();
@@ -222,8 +257,9 @@ FrameSolution SuperelementBody::SolveFrameFrom(const BodyConfiguration& c, const
 }
 
 FrameSolution SuperelementBody::SolveFrameFrom(const BodyConfiguration& c, const FrameSolution& last,
-                                               Eigen::VectorXd& q) const {
-  const FrameSolution frame = SolveFrame(c, last, q);
+                                               Eigen::VectorXd& q, const Eigen::Matrix<double, 6, 6>* S_inv) const {
+  FrameSolution frame = SolveFrame(c, last, q, S_inv);
+  if (!frame.ok && S_inv) frame = SolveFrame(c, last, q);
   return frame.ok ? frame : SolveFrame(c, GuessFrame(c), q);
 }
 
@@ -233,7 +269,7 @@ FrameSolution SuperelementBody::SolveFrame(const BodyConfiguration& c, const Fra
 }
 
 FrameSolution SuperelementBody::SolveFrame(const BodyConfiguration& c, const FrameSolution& guess,
-                                           Eigen::VectorXd& q) const {
+                                           Eigen::VectorXd& q, const Eigen::Matrix<double, 6, 6>* S_inv) const {
   FrameSolution frame = guess;
   frame.ok = false;
   // Translations relative to the body size, plus the round-off of the absolute positions (a
@@ -254,8 +290,9 @@ FrameSolution SuperelementBody::SolveFrame(const BodyConfiguration& c, const Fra
       for (int k = 0; k < n_nodes_; ++k) frame.ok &= q.segment<3>(6 * k + 3).norm() < kMaxLocalRotation;
       return frame;
     }
-    // d q_loc = -D Phi_rig zeta for a frame variation zeta (frame axes): zeta = S^-1 g.
-    const Eigen::Matrix<double, 6, 1> zeta = FrameMatrix(q).lu().solve(g);
+    // d q_loc = -D Phi_rig zeta for a frame variation zeta (frame axes): zeta = S^-1 g (with
+    // the given S^-1: a chord iteration).
+    const Eigen::Matrix<double, 6, 1> zeta = S_inv ? (*S_inv * g).eval() : FrameMatrix(q).lu().solve(g);
     frame.x += frame.R * zeta.head<3>();
     frame.R = frame.R * ExpSO3(zeta.tail<3>());
   }

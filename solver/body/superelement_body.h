@@ -173,6 +173,9 @@ class SuperelementBody {
   /// The same into `d`, reusing its storage (a body's data kept from one Newton iteration to the
   /// next allocates nothing for the kinematics). `c` may be d.c itself.
   void Evaluate(const BodyConfiguration& c, const FrameSolution& frame, Data& d) const;
+  /// The same when d.q already holds the local coordinates at `frame` (SolveFrameFrom's output
+  /// for this c and frame): they are not computed again.
+  void EvaluateSolved(const BodyConfiguration& c, const FrameSolution& frame, Data& d) const;
   /// The velocity maps of `d` (computed on the first call).
   const BodyVelocityMaps& MapsOf(const Data& d) const;
 
@@ -210,9 +213,15 @@ class SuperelementBody {
   FrameSolution SolveFrame(const BodyConfiguration& c, const FrameSolution& guess) const;
   /// SolveFrame from the last frame, and failing that from GuessFrame (ok = false if both fail).
   FrameSolution SolveFrameFrom(const BodyConfiguration& c, const FrameSolution& last) const;
-  /// The same with `q` as its scratch for the local coordinates (no allocation once sized).
-  FrameSolution SolveFrameFrom(const BodyConfiguration& c, const FrameSolution& last, Eigen::VectorXd& q) const;
-  FrameSolution SolveFrame(const BodyConfiguration& c, const FrameSolution& guess, Eigen::VectorXd& q) const;
+  /// The same with `q` as its scratch for the local coordinates (no allocation once sized). With
+  /// `S_inv` (the inverse frame matrix of a nearby configuration of this body, e.g. its last
+  /// Kinematics::S_inv) the first attempt iterates with it instead of factoring the frame matrix
+  /// at every iterate: S depends on the deformation only, so it converges as fast while it costs
+  /// a 6 x 6 product per iteration; the fallbacks are full Newton.
+  FrameSolution SolveFrameFrom(const BodyConfiguration& c, const FrameSolution& last, Eigen::VectorXd& q,
+                               const Eigen::Matrix<double, 6, 6>* S_inv = nullptr) const;
+  FrameSolution SolveFrame(const BodyConfiguration& c, const FrameSolution& guess, Eigen::VectorXd& q,
+                           const Eigen::Matrix<double, 6, 6>* S_inv = nullptr) const;
 
   /// Local coordinates q_loc (6N + m).
   Eigen::VectorXd LocalCoordinates(const BodyConfiguration& c, const FrameSolution& frame) const;

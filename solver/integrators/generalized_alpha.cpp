@@ -30,13 +30,17 @@ void AssembleDynamicResidual(const SystemModel& model, const DofMap& dofs, Dynam
     r.frame_ok = true;
     BodyConfiguration& c = pass.data.c;  // evaluated in place: the pass's storage is reused
     BodyConfigurationOf(model, s.config, b, c);
-    const FrameSolution frame = body.SolveFrameFrom(c, s.config.frames[b], pass.data.q);
+    // The frame from the last one, iterating with the last pass's S^-1 (the same body a Newton
+    // correction or a step earlier); its local coordinates stay in pass.data.q.
+    const bool kinematics = pass.data.kin.W.cols() == body.n_coordinates();
+    const FrameSolution frame =
+        body.SolveFrameFrom(c, s.config.frames[b], pass.data.q, kinematics ? &pass.data.kin.S_inv : nullptr);
     if (!frame.ok) {
       r.frame_ok = false;
       return;
     }
     s.config.frames[b] = frame;
-    body.Evaluate(c, frame, pass.data);
+    body.EvaluateSolved(c, frame, pass.data);
     GatherBody(model, dofs, s.config, b, s.W, pass.w);
     GatherBodyAcceleration(model, dofs, b, node_acc, s.Wdot, pass.wdot);
     // Inertia stiffening (issue 13): K + K_sigma(a), a from this iterate's frame motion; its
