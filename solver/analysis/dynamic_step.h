@@ -30,9 +30,19 @@ struct Assembly {
   Eigen::VectorXd f_ext;     // nodal loads and gravity, for the work
   SystemMatrix K, C, M;
   double scale = 0.0;
+  // Per unknown: the largest force scale of the bodies acting on it, floored by the loads' and
+  // springs' (the model's `scale` where no body acts: loop multipliers). Newton's test weighs
+  // each unknown's residual by it (ScaledFreeNorm), so that one stiff body's forces set the
+  // tolerance of its own unknowns only.
+  Eigen::VectorXd dof_scale;
   double roundoff = 0.0;  // residual noise from the round-off of absolute positions
   NodeForces node_forces;  // per node, residual sense (for the reactions)
 };
+
+// sqrt(sum_j (w_j r_j / s_j)^2) over the solved unknowns (w: the residual weights, s: an
+// assembly's dof_scale): the residual relative to the forces in balance on each unknown.
+double ScaledFreeNorm(const DofMap& dofs, const Eigen::VectorXd& r, const Eigen::VectorXd& weights,
+                      const Eigen::VectorXd& scale);
 
 // The triplets of an assembly in progress and the node forces for the joints' stiffness.
 struct AssemblyParts {

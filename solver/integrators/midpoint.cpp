@@ -404,7 +404,10 @@ StepOutcome MidpointStep(const SystemModel& model, const DofMap& dofs, const Dyn
       a.residual.tail(n_lambda) = end.tail(n_lambda);
     }
     const double r_norm = FreeNorm(dofs, a.residual, weights);
-    if (r_norm <= std::max(tolerance * a.scale, a.roundoff) && out.iterations > 0 &&
+    // Converged: the residual below the tolerance relative to the forces on each unknown (or
+    // at the round-off of the positions), after at least one correction.
+    const bool small = r_norm <= a.roundoff || ScaledFreeNorm(dofs, a.residual, weights, a.dof_scale) <= tolerance;
+    if (small && out.iterations > 0 &&
         LoopsClosed(model, next.config, tolerance)) {
       out.converged = true;
       next.t = t_new;
