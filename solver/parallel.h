@@ -5,9 +5,10 @@
 // Why not an OpenMP loop: its parallel region ends in a barrier that waits for every thread of
 // the team, including one the operating system has not scheduled yet. With two solver runs on
 // two cores (ctest -j2, a parameter study) that wait is a time slice per region, three regions
-// per step: measured 26x slower than one thread each. Here the calling thread claims bodies from
-// an atomic counter as soon as a pass starts, helpers join when they get a core, and the call
-// waits only for bodies a helper has already begun: a helper that never runs costs nothing.
+// per step: measured 26x slower than one thread each. Here the calling thread claims bodies (from
+// its own range's counter, then the others': BodyThreads::Range) as soon as a pass starts, helpers
+// join when they get a core, and the call waits only for bodies a helper has already begun: a
+// helper that never runs costs nothing.
 #pragma once
 
 #include <atomic>
