@@ -15,7 +15,10 @@ REPEATS runs on one thread; wall = the whole process. Settings varied: the step,
 (analysis.tolerance; the scene default 1e-8) and analysis.body_matrices_every (1: default; the kept
 steps turn all of a body's matrices, analysis.body_matrices_kept: all).
 
-usage: peer_slider_crank.py BIN_DIR [--out DIR] [--repeats 3]
+With --png FILE: error against solve time, femb's rows at tolerance 1e-3 and every 8th step (the
+step varied) and the defaults, with the peer's two reported ranges.
+
+usage: peer_slider_crank.py BIN_DIR [--out DIR] [--repeats 3] [--png FILE]
 """
 import argparse
 import os
@@ -67,6 +70,7 @@ def main():
     ap.add_argument("bin")
     ap.add_argument("--out", default="out/peer_slider_crank")
     ap.add_argument("--repeats", type=int, default=3)
+    ap.add_argument("--png", default="")
     a = ap.parse_args()
     os.environ["OMP_NUM_THREADS"] = os.environ["OPENBLAS_NUM_THREADS"] = "1"
     solve, reduce = os.path.join(a.bin, "femb-solve"), os.path.join(a.bin, "femb-reduce")
@@ -96,6 +100,7 @@ def main():
                                                              "2e-4")]
     rows += [("stiff crank and slider (example)", "stiff.yaml", "1.5e-4", tol, every)
              for tol, every in (("1e-8", "1"), ("1e-3", "8"))]
+    measured = []
     for label, scene, h, tol, every in rows:
         out = os.path.join(a.out, f"{scene[:-5]}_{h}_{tol}_{every}")
         best_solve = best_wall = float("inf")
@@ -110,6 +115,38 @@ def main():
         err = re.search(r"= ([0-9.]+)% of the reference peak", cmp).group(1)
         print(f"{label:34s} {float(h) * 1e6:5.1f} us  {tol:>9s}  {every:>5s}  {m.group(2):>5s}  {m.group(3):>8s}"
               f"  {best_solve:11.3f}  {best_wall:8.3f}  {err}%", flush=True)
+        measured.append((label, h, tol, every, best_solve, float(err)))
+    if a.png:
+        plot(measured, a.png)
+
+
+def plot(measured, png):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(figsize=(7, 4.5))
+    for (tol, every), style, name in ((("1e-3", "8"), "o-", "femb, tolerance 1e-3, body_matrices_every 8"),
+                                      (("1e-8", "1"), "s--", "femb, defaults")):
+        pts = sorted((t, e, h) for label, h, tl, ev, t, e in measured
+                     if label.startswith("rigid") and (tl, ev) == (tol, every))
+        if not pts:
+            continue
+        ax.plot([p[0] for p in pts], [p[1] for p in pts], style, label=name)
+        for t, e, h in pts:
+            ax.annotate(f"{float(h) * 1e6:.0f} us", (t, e), textcoords="offset points", xytext=(4, 4), fontsize=7)
+    for err, lo, hi in ((1.0, 0.04, 0.08), (0.3, 0.09, 0.37)):
+        ax.plot([lo, hi], [err, err], color="tab:red", lw=4, alpha=0.6,
+                label="peer (Exudyn 1.11, ANCF), as issue 14 reported it" if err == 1.0 else None)
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("solve time [s], one thread")
+    ax.set_ylabel("RMS error of the rod midpoint deflection [% of peak]")
+    ax.set_title("planar slider-crank, 3 revolutions: error against run time")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(png, dpi=120)
+    print(f"peer_slider_crank: plot {png}")
 
 
 if __name__ == "__main__":

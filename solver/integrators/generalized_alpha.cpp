@@ -106,14 +106,17 @@ void AddDynamicMatrices(const SystemModel& model, const DofMap& dofs, const Dyna
     const bool stiffening = body.has_inertia_stiffening();
     const int blocks = 2 * body.n_nodes();
     const Eigen::Matrix3d& R = pass.data.frame.R;
+    const Eigen::Matrix3d Rt = R.transpose();
+    // to <- Rbar from Rbar^T, Rbar = blockdiag(Q, ..., Q, 1) (storage reused: the same size at every pass)
+    const auto turned = [blocks](Eigen::MatrixXd& to, const Eigen::MatrixXd& from, const Eigen::Matrix3d& Q) {
+      to = from;
+      body_blocks::TurnNodeBlocks(to, blocks, Q);
+    };
     if (all_kept && r.age > 0) {
       // All of the body's matrices kept (BodyMatricesKept::kAll): turned with the frame.
-      r.K = r.K_frame;  // storage reused: the same size at every pass
-      r.C = r.C_frame;
-      r.M = r.M_frame;
-      body_blocks::TurnNodeBlocks(r.K, blocks, R);
-      body_blocks::TurnNodeBlocks(r.C, blocks, R);
-      body_blocks::TurnNodeBlocks(r.M, blocks, R);
+      turned(r.K, r.K_frame, R);
+      turned(r.C, r.C_frame, R);
+      turned(r.M, r.M_frame, R);
       if (combine) r.K += combine->c_C * r.C + combine->c_M * r.M;
       return;
     }
@@ -130,18 +133,13 @@ void AddDynamicMatrices(const SystemModel& model, const DofMap& dofs, const Dyna
     // (above): the internal forces and accelerations are objective as well, so the kept matrix
     // lags by their change in the frame, as the inertia's does.
     if (!all_kept && r.age > 0) {
-      r.M = r.M_frame;  // storage reused: the same size at every pass
-      r.C = r.C_frame;
-      body_blocks::TurnNodeBlocks(r.M, blocks, R);
-      body_blocks::TurnNodeBlocks(r.C, blocks, R);
+      turned(r.M, r.M_frame, R);
+      turned(r.C, r.C_frame, R);
     } else {
       body.InertiaForce(pass.data, pass.w, pass.wdot, nullptr, &r.M, &r.C);
       if (!all_kept && r.age == 0) {
-        const Eigen::Matrix3d Rt = R.transpose();
-        r.M_frame = r.M;
-        r.C_frame = r.C;
-        body_blocks::TurnNodeBlocks(r.M_frame, blocks, Rt);
-        body_blocks::TurnNodeBlocks(r.C_frame, blocks, Rt);
+        turned(r.M_frame, r.M, Rt);
+        turned(r.C_frame, r.C, Rt);
       }
     }
     if (stiffening) {
@@ -164,13 +162,9 @@ void AddDynamicMatrices(const SystemModel& model, const DofMap& dofs, const Dyna
     r.unused.setZero(body.n_coordinates());
     body.AddModalDamping(pass.w, r.unused, &r.C);
     if (all_kept && r.age == 0) {
-      const Eigen::Matrix3d Rt = R.transpose();
-      r.K_frame = r.K;
-      r.C_frame = r.C;
-      r.M_frame = r.M;
-      body_blocks::TurnNodeBlocks(r.K_frame, blocks, Rt);
-      body_blocks::TurnNodeBlocks(r.C_frame, blocks, Rt);
-      body_blocks::TurnNodeBlocks(r.M_frame, blocks, Rt);
+      turned(r.K_frame, r.K, Rt);
+      turned(r.C_frame, r.C, Rt);
+      turned(r.M_frame, r.M, Rt);
     }
     if (combine) r.K += combine->c_C * r.C + combine->c_M * r.M;
   });
