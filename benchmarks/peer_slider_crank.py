@@ -127,8 +127,8 @@ def plot(measured, png):
     fig, ax = plt.subplots(figsize=(7, 4.5))
     for (tol, every), style, name in ((("1e-3", "8"), "o-", "femb, tolerance 1e-3, body_matrices_every 8"),
                                       (("1e-8", "1"), "s--", "femb, defaults")):
-        pts = sorted((t, e, h) for label, h, tl, ev, t, e in measured
-                     if label.startswith("rigid") and (tl, ev) == (tol, every))
+        pts = sorted(((t, e, h) for label, h, tl, ev, t, e in measured
+                      if label.startswith("rigid") and (tl, ev) == (tol, every)), key=lambda p: -float(p[2]))
         if not pts:
             continue
         ax.plot([p[0] for p in pts], [p[1] for p in pts], style, label=name)
