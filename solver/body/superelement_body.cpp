@@ -190,7 +190,7 @@ void SuperelementBody::ComputeKinematics(const Eigen::VectorXd& q, Kinematics& k
     Wr.noalias() = W.middleCols<3>(6 * a) * r_skew;
     k.S.rightCols<3>() += W.middleCols<3>(6 * a + 3) - Wr;
   }
-  // S^-1 once (a 6 x 6 LU); Z and the elastic tangent's K4 take fixed-size products with it
+  // S^-1 once (Inverse6); Z and the elastic tangent's K4 take fixed-size products with it
   // instead of a triangular solve with n right-hand sides each.
   k.S_inv = Inverse6(k.S);
   k.Z.resize(6, n);
