@@ -57,8 +57,7 @@ void FinishAssembly(const SystemModel& model, const DofMap& dofs, const SystemSt
   ResidualWeights(model, dofs, weights);
   const double applied = std::max((weights.asDiagonal() * springs).norm(), (weights.asDiagonal() * loads).norm());
   out.scale = std::max({out.scale, applied, 1e-300});
-  for (Eigen::Index j = 0; j < out.dof_scale.size(); ++j)
-    out.dof_scale[j] = out.dof_scale[j] > 0.0 ? std::max(out.dof_scale[j], applied) : out.scale;
+  FinishDofScale(applied, out.scale, out.dof_scale);
   out.node_forces.f = parts.node_forces.f;
 }
 
@@ -71,8 +70,7 @@ bool AddBodyTerms(const SystemModel& model, const std::vector<BodyTerms>& terms,
       return false;
     }
     out.scale = std::max(out.scale, r.scale);
-    for (const MapEntry& e : r.map)
-      if (e.coefficient != 0.0) out.dof_scale[e.coordinate] = std::max(out.dof_scale[e.coordinate], r.scale);
+    AddBodyScale(r.map, r.scale, out.dof_scale);
     out.roundoff += r.roundoff;
     AddBodyNodeForces(model, int(b), r.r_b, parts.node_forces);
     const bool matrices = r.K.size() > 0;
@@ -81,16 +79,6 @@ bool AddBodyTerms(const SystemModel& model, const std::vector<BodyTerms>& terms,
     if (matrices) ScatterBody(r.map, nullptr, &r.M, nullptr, &parts.M);
   }
   return true;
-}
-
-double ScaledFreeNorm(const DofMap& dofs, const Eigen::VectorXd& r, const Eigen::VectorXd& weights,
-                      const Eigen::VectorXd& scale) {
-  double s = 0;
-  for (int j : dofs.solved()) {
-    const double x = weights[j] * r[j] / scale[j];
-    s += x * x;
-  }
-  return std::sqrt(s);
 }
 
 Eigen::VectorXd DriveForces(const DofMap& dofs, const Eigen::VectorXd& residual) {

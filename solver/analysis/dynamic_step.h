@@ -39,10 +39,6 @@ struct Assembly {
   NodeForces node_forces;  // per node, residual sense (for the reactions)
 };
 
-// sqrt(sum_j (w_j r_j / s_j)^2) over the solved unknowns (w: the residual weights, s: an
-// assembly's dof_scale): the residual relative to the forces in balance on each unknown.
-double ScaledFreeNorm(const DofMap& dofs, const Eigen::VectorXd& r, const Eigen::VectorXd& weights,
-                      const Eigen::VectorXd& scale);
 
 // The triplets of an assembly in progress and the node forces for the joints' stiffness.
 struct AssemblyParts {

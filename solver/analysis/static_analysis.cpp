@@ -93,7 +93,8 @@ StaticResult SolveStatic(const SystemModel& model, SystemState& state, const Sta
       loads_after = f.loads;
       if (!std::isfinite(r_norm)) break;
       if (it > 0 && LoopsClosed(model, trial, tolerance) &&
-          (r_norm <= std::max(tolerance * std::max(f.force_scale, 1e-300), f.roundoff) || last_step <= 1e-13 * size)) {
+          (r_norm <= f.roundoff || ScaledFreeNorm(dofs, f.residual, weights, f.dof_scale) <= tolerance ||
+           last_step <= 1e-13 * size)) {
         converged = true;
         break;
       }

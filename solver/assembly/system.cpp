@@ -115,6 +115,7 @@ SystemForces AssembleStatic(const SystemModel& model, const DofMap& dofs, System
   SystemForces out;
   const int n = dofs.n_dofs();
   out.residual = Eigen::VectorXd::Zero(n);
+  out.dof_scale = Eigen::VectorXd::Zero(n);
   Triplets tangent;
   NodeForces node_forces = ZeroNodeForces(model);
   Eigen::VectorXd gravity = Eigen::VectorXd::Zero(n);
@@ -143,12 +144,14 @@ SystemForces AssembleStatic(const SystemModel& model, const DofMap& dofs, System
       body.ElasticForce(data, &f, with_tangent ? &K : nullptr);
     }
     out.elastic_energy += body.ElasticEnergy(data);
-    out.force_scale = std::max({out.force_scale, body.ForceNorm(f), body.force_floor()});
+    const double scale = std::max(body.ForceNorm(f), body.force_floor());
+    out.force_scale = std::max(out.force_scale, scale);
     out.roundoff += body.RoundOffForce(c);
     // The weight's configuration derivative in the tangent (S = -dr/dq: minus GravityTangent; the
     // dynamic iteration matrix takes it with the inertia's, generalized_alpha.cpp).
     if (with_tangent && gravity_on && ramp > 0) K -= body.GravityTangent(data, ramp * model.gravity);
     const std::vector<MapEntry> map = BodyMap(model, dofs, state, int(b));
+    AddBodyScale(map, scale, out.dof_scale);
     const Eigen::VectorXd minus_f = -f;
     ScatterBody(map, &minus_f, with_tangent ? &K : nullptr, &out.residual, with_tangent ? &tangent : nullptr);
     AddBodyNodeForces(model, int(b), minus_f, node_forces);
@@ -165,7 +168,9 @@ SystemForces AssembleStatic(const SystemModel& model, const DofMap& dofs, System
   AddSpringDampers(model, state, Eigen::VectorXd(), loads, with_tangent ? &tangent : nullptr, nullptr,
                    &out.elastic_energy, &node_forces);
   out.residual += loads;
-  out.force_scale = std::max(out.force_scale, (ResidualWeights(model, dofs).asDiagonal() * loads).norm());
+  const double applied = (ResidualWeights(model, dofs).asDiagonal() * loads).norm();
+  out.force_scale = std::max(out.force_scale, applied);
+  FinishDofScale(applied, std::max(out.force_scale, 1e-300), out.dof_scale);
   AddLoopConstraints(model, dofs, state, &out.residual, with_tangent ? &tangent : nullptr, &node_forces);
   out.node_forces = node_forces;
   if (with_tangent) {
@@ -261,6 +266,26 @@ void ResidualWeights(const SystemModel& model, const DofMap& dofs, Eigen::Vector
   }
   // The multipliers' rows hold constraint violations, not forces: LoopViolation judges them.
   if (dofs.n_multipliers() > 0) w.tail(dofs.n_multipliers()).setZero();
+}
+
+double ScaledFreeNorm(const DofMap& dofs, const Eigen::VectorXd& r, const Eigen::VectorXd& weights,
+                      const Eigen::VectorXd& scale) {
+  double s = 0;
+  for (int j : dofs.solved()) {
+    const double x = weights[j] * r[j] / scale[j];
+    s += x * x;
+  }
+  return std::sqrt(s);
+}
+
+void AddBodyScale(const std::vector<MapEntry>& map, double scale, Eigen::VectorXd& dof_scale) {
+  for (const MapEntry& e : map)
+    if (e.coefficient != 0.0) dof_scale[e.coordinate] = std::max(dof_scale[e.coordinate], scale);
+}
+
+void FinishDofScale(double applied, double whole, Eigen::VectorXd& dof_scale) {
+  for (Eigen::Index j = 0; j < dof_scale.size(); ++j)
+    dof_scale[j] = dof_scale[j] > 0.0 ? std::max(dof_scale[j], applied) : whole;
 }
 
 double FreeNorm(const DofMap& dofs, const Eigen::VectorXd& r, const Eigen::VectorXd& weights) {

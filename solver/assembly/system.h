@@ -24,6 +24,7 @@ struct SystemForces {
   SystemMatrix tangent;           ///< d(f_int - lambda f_ext)/d(unknowns)
   double elastic_energy = 0.0;
   double force_scale = 0.0;       ///< largest norm of the internal or external force terms
+  Eigen::VectorXd dof_scale;      ///< per unknown: the force scale of the bodies acting on it (ScaledFreeNorm)
   double roundoff = 0.0;          ///< residual noise from the round-off of absolute positions
   NodeForces node_forces;         ///< per node, residual sense (applied minus internal)
   Eigen::VectorXd loads;          ///< the nodal loads alone, over the coordinates (for their work)
@@ -105,5 +106,16 @@ Eigen::VectorXd ResidualWeights(const SystemModel& model, const DofMap& dofs);
 void ResidualWeights(const SystemModel& model, const DofMap& dofs, Eigen::VectorXd& w);
 /// Weighted norm of r over the coordinates solved for.
 double FreeNorm(const DofMap& dofs, const Eigen::VectorXd& r, const Eigen::VectorXd& weights);
+/// sqrt(sum_j (w_j r_j / s_j)^2) over the solved unknowns (w: the residual weights, s: per
+/// unknown, the force scale of the bodies acting on it, SystemForces::dof_scale or
+/// dynamic_internal::Assembly::dof_scale): the residual relative to the forces in balance on each
+/// unknown, Newton's convergence measure.
+double ScaledFreeNorm(const DofMap& dofs, const Eigen::VectorXd& r, const Eigen::VectorXd& weights,
+                      const Eigen::VectorXd& scale);
+/// Adds a body's force scale to the unknowns its map reaches (dof_scale[j] = max(., scale)).
+void AddBodyScale(const std::vector<MapEntry>& map, double scale, Eigen::VectorXd& dof_scale);
+/// Finishes a dof_scale: unknowns a body reaches floored by `applied` (the loads' and springs'
+/// norm), the others (no body: loop multipliers) at the model's scale `whole`.
+void FinishDofScale(double applied, double whole, Eigen::VectorXd& dof_scale);
 
 }  // namespace femb

@@ -5,7 +5,7 @@
 // made 10^4 times stiffer (K scaled; its force floor, 1e-4 of its stiffness, grows with it):
 //  - the scales: the unknowns only the rod bodies act on (the rod's modes, its middle node) are
 //    judged against the rod's forces, 10^4 times and more below the crank's; the crank's modes
-//    against the crank's (the whole model's largest);
+//    against the crank's (the whole model's largest); in the dynamic and in the static assembly;
 //  - the effect: at Newton tolerance 1e-3 against 1e-10, the rod midpoint's path with the stiff
 //    crank. Measured 2.8e-4 m with the test per unknown, 4.4e-4 m with the whole model's scale
 //    (before 2026-11-28), 6e-5 m with the crank as is: the rod's own unknowns are solved as
@@ -20,6 +20,7 @@
 
 #include "solver/analysis/dynamic_analysis.h"
 #include "solver/analysis/dynamic_step.h"
+#include "solver/assembly/system.h"
 #include "tests/test_util.h"
 
 namespace femb {
@@ -75,6 +76,25 @@ TEST(NewtonScale, EachUnknownIsJudgedByTheBodiesActingOnIt) {
   EXPECT_EQ(crank_smallest, a.scale);
   EXPECT_GT(rod_largest, 0.0);
   EXPECT_LT(rod_largest, 1e-4 * a.scale);
+}
+
+TEST(NewtonScale, StaticsJudgesEachUnknownByItsBodiesToo) {
+  // The same scales in a static assembly (AssembleStatic, static_analysis.cpp's test): at rest
+  // the bodies' force floors, the crank's 10^6 times the soft rod's.
+  const SystemModel model = Model(true);
+  const DofMap& dofs = model.dofs();
+  SystemState state = InitialState(model);
+  const SystemForces f = AssembleStatic(model, dofs, state, 1.0, false);
+  ASSERT_TRUE(f.ok) << f.message;
+  ASSERT_EQ(f.dof_scale.size(), dofs.n_dofs());
+  double rod_largest = 0.0, crank_smallest = HUGE_VAL;
+  for (int b = 1; b <= 2; ++b)
+    for (int m = 0; m < model.bodies[size_t(b)].n_modes(); ++m) rod_largest = std::max(rod_largest, f.dof_scale[dofs.mode_dof(b) + m]);
+  for (int m = 0; m < model.bodies[0].n_modes(); ++m) crank_smallest = std::min(crank_smallest, f.dof_scale[dofs.mode_dof(0) + m]);
+  std::printf("[ info ] static scales: the crank's modes %.3e N, the rod's modes at most %.3e N\n", crank_smallest,
+              rod_largest);
+  EXPECT_GT(rod_largest, 0.0);
+  EXPECT_LT(rod_largest, 1e-4 * crank_smallest);
 }
 
 TEST(NewtonScale, AStiffBodyLoosensTheOthersLess) {
