@@ -39,7 +39,6 @@ struct Assembly {
   NodeForces node_forces;  // per node, residual sense (for the reactions)
 };
 
-
 // The triplets of an assembly in progress and the node forces for the joints' stiffness.
 struct AssemblyParts {
   Triplets K, C, M;
@@ -96,11 +95,8 @@ struct RotationNode {
   int node, rotation, translation;
 };
 
+// (ApplyIncrement composes their rotation increments, R <- exp(d~) R; every other unknown adds.)
 std::vector<RotationNode> RotationNodes(const SystemModel& model, const DofMap& dofs);
-
-// RotationNodes with unknowns (ApplyIncrement composes their rotation increments, R <- exp(d~)
-// R; every other unknown adds).
-std::vector<RotationNode> RotationTriples(const SystemModel& model, const DofMap& dofs);
 
 // The bodies' storage of a dynamic analysis, kept from one Newton iteration and one step to the
 // next so that evaluating a body reuses its matrices instead of allocating them (issue 14).
@@ -130,13 +126,13 @@ struct BodyWorkspace {
   std::vector<Eigen::Matrix<double, 6, 1>> node_acc;
   std::vector<NodeJacobian> dc, dacc;
   Eigen::VectorXd unused, column, weights, dq, delta, lie_delta;
-  // RotationTriples(model, dofs), set with the weights.
+  // RotationNodes(model, dofs), set with the weights.
   std::vector<RotationNode> rotation_triples;
   // ResidualWeights(model, dofs), computed on the first call (they depend on the model only).
   const Eigen::VectorXd& Weights(const SystemModel& model, const DofMap& dofs) {
     if (weights.size() != dofs.n_dofs()) {
       weights = ResidualWeights(model, dofs);
-      rotation_triples = RotationTriples(model, dofs);
+      rotation_triples = RotationNodes(model, dofs);
     }
     return weights;
   }
@@ -165,12 +161,12 @@ struct MatrixCombination {
 // every > 1 (Newton's iteration matrix only, DynamicOptions::body_matrices_every): a body whose
 // matrices were computed fewer than `every` passes ago takes them turned with its floating
 // frame, Rbar X_frame Rbar^T, instead of computing them: its inertia matrices (mass, gyroscopic)
-// alone with `kept` kInertia (everything else computed every time), all of them with kAll; 1:
+// alone with `which` kInertia (everything else computed every time), all of them with kAll; 1:
 // all computed at s.
 void AddDynamicMatrices(const SystemModel& model, const DofMap& dofs, const DynamicState& s, double t,
                         BodyWorkspace& work, bool full_inertia_tangent, Assembly& out,
                         BodyThreads* threads = nullptr, const MatrixCombination* combine = nullptr, int every = 1,
-                        BodyMatricesKept kept = BodyMatricesKept::kInertia);
+                        BodyMatricesKept which = BodyMatricesKept::kAll);
 
 // Residual and (with `matrices`) K, C, M at s, with a workspace of its own.
 Assembly AssembleDynamic(const SystemModel& model, const DofMap& dofs, DynamicState& s, double t, bool matrices,
@@ -283,7 +279,6 @@ struct StepOutcome {
   std::unique_ptr<SystemMatrix> singular_matrix;
   bool passes_kept = false;  ///< the workspace's passes hold the bodies' data at the converged state
 };
-
 
 // The velocities of body b's coordinates: the midpoint scheme's node velocities where the state
 // carries them (DynamicState::node_w), J(q) W otherwise.

@@ -241,13 +241,6 @@ Assembly AssembleDynamic(const SystemModel& model, const DofMap& dofs, DynamicSt
   return out;
 }
 
-std::vector<RotationNode> RotationTriples(const SystemModel& model, const DofMap& dofs) {
-  std::vector<RotationNode> triples;
-  for (const RotationNode& n : RotationNodes(model, dofs))
-    if (dofs.node_count(n.node) > 0) triples.push_back(n);
-  return triples;
-}
-
 // One generalized-alpha step of size h from `state` into `next` (Arnold & Bruls 2007).
 // t_new: the time reached, state.t + h, or just below a breakpoint the step lands on (the loads
 // and drives there are their left limits).
