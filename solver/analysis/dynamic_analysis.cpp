@@ -48,12 +48,7 @@ void FinishAssembly(const SystemModel& model, const DofMap& dofs, const SystemSt
   AddSpringDampers(model, config, W, springs, matrices ? &parts.K : nullptr, matrices ? &parts.C : nullptr, nullptr,
                    &parts.node_forces);
   out.residual += springs;
-  if (matrices) {
-    AddJointGeometricStiffness(model, dofs, config, parts.node_forces, parts.K);
-    out.K = ToMatrix(n, parts.K);
-    out.C = ToMatrix(n, parts.C);
-    out.M = ToMatrix(n, parts.M);
-  }
+  if (matrices) AddJointGeometricStiffness(model, dofs, config, parts.node_forces, parts.K);
   ResidualWeights(model, dofs, weights);
   const double applied = std::max((weights.asDiagonal() * springs).norm(), (weights.asDiagonal() * loads).norm());
   out.scale = std::max({out.scale, applied, 1e-300});
@@ -256,7 +251,6 @@ DynamicResult SolveDynamic(const SystemModel& model, DynamicState& state, const 
                            const std::function<void(const DynamicStepReport&, const DynamicState&)>& on_step) {
   DynamicResult result;
   const DofMap& dofs = model.dofs();
-  const std::vector<RotationNode> triples = RotationNodes(model, dofs);
   StepController control(model, dofs, options, state.t);
   double h = options.adaptive ? control.FirstStep() : options.step;
   int cuts = 0;
@@ -308,7 +302,7 @@ DynamicResult SolveDynamic(const SystemModel& model, DynamicState& state, const 
         options.adaptive && control.at_breakpoint() ? std::nextafter(control.boundary(), -HUGE_VAL) : state.t + h;
     const StepOutcome step =
         options.integrator == Integrator::kMidpoint
-            ? MidpointStep(model, dofs, options, triples, state, h, t_new, matrix, threads, next)
+            ? MidpointStep(model, dofs, options, state, h, t_new, matrix, threads, work, next)
             : GeneralizedAlphaStep(model, dofs, options, state, h, t_new, matrix, threads, work, next);
     if (!step.converged && result.steps == 0 && result.newton_cuts == 0 && step.singular_matrix) {
       // The first iteration matrix is singular: the model's, not the step's.

@@ -49,8 +49,8 @@ struct AssemblyParts {
 void StartAssembly(const SystemModel& model, const DofMap& dofs, AssemblyParts& parts, Assembly& out);
 Assembly StartAssembly(const SystemModel& model, const DofMap& dofs, AssemblyParts& parts);
 
-// Nodal loads at t, spring-dampers at velocities W (both on `config`), the joints' geometric
-// stiffness, and the matrices built (when `matrices`).
+// Nodal loads at t, spring-dampers at velocities W (both on `config`), and with `matrices` their
+// and the joints' geometric stiffness into parts.K and parts.C (the caller builds the matrices).
 void FinishAssembly(const SystemModel& model, const DofMap& dofs, const SystemState& config, double t,
                     const Eigen::VectorXd& W, bool matrices, AssemblyParts& parts, Assembly& out);
 
@@ -98,6 +98,55 @@ struct RotationNode {
 // (ApplyIncrement composes their rotation increments, R <- exp(d~) R; every other unknown adds.)
 std::vector<RotationNode> RotationNodes(const SystemModel& model, const DofMap& dofs);
 
+// A map of Newton's increment delta of the midpoint scheme (MidpointKinematics::T, V), as a
+// matrix over the unknowns: the identity times `diagonal` but on the rotation nodes
+// (RotationNodes), whose rotation triple maps onto itself by a 3 x 3 block and a free node's
+// translation triple onto itself and onto the node's rotation triple. Kept as its blocks (per
+// rotation node) and applied to triplets (AddTimesColumns): no sparse matrix is built.
+struct StepColumnMap {
+  double diagonal = 0.0;
+  std::vector<Eigen::Matrix3d> rotation, translation, coupling;  // (r, r), (t, t), (t, r) per rotation node
+};
+
+// The midpoint scheme's kinematics of one iteration (solver/integrators/midpoint.cpp): the step's
+// increment Delta of the coordinates (spatial rotation vectors log(R_n+1 R_n^T) on the rotation
+// triples), the end velocities it implies, the mid configuration, and the first-order maps of the
+// end coordinates' increments (delta, as Newton applies them at n+1) to the mid configuration and
+// to the end velocities.
+struct MidpointKinematics {
+  Eigen::VectorXd delta;  // Delta
+  Eigen::VectorXd W1;     // W_n+1 from the kinematics
+  Eigen::VectorXd half;   // the increment from q_n to q_m
+  SystemState mid;        // q_m
+  StepColumnMap T;        // d q_m / d delta: 1/2 off the rotation nodes
+  StepColumnMap V;        // d W_n+1 / d delta: 2/h off the rotation nodes
+  std::vector<Eigen::Matrix<double, 6, 1>> node_w1;  // every node's velocity at n+1 (EndNodeVelocity)
+};
+
+// One body's storage in a midpoint step (its data at q_n+1 is the BodyWorkspace's pass).
+struct MidpointBody {
+  SuperelementBody::Data d0, dm;  // at q_n (once per step) and at q_m
+  Eigen::Vector3d com0 = Eigen::Vector3d::Zero();  // the centre of mass at q_n
+  Eigen::VectorXd w0, p0, p1, p_mean, wm, w_first, w_second, dw, wdot, s_first, s_second, u, Du;
+  Eigen::MatrixXd d_w, d_p, d_load;
+  InertiaLoadFactors load;
+};
+
+// The midpoint scheme's storage, kept from one iteration and one step to the next (issue 14).
+struct MidpointWorkspace {
+  std::vector<MidpointBody> bodies;
+  MidpointKinematics k;
+  std::vector<char> free_node;       // per body: it has a free node
+  std::vector<double> gravity_work;  // per body
+  // Per unknown: 2 i for the rotation triple of rotation node i, 2 i + 1 for its translation
+  // triple, -1 elsewhere (StepColumnMap's blocks).
+  std::vector<int> triple_of;
+  Eigen::VectorXd rates, D, Dd, unused, end;
+  NodeForces loads;
+  Triplets S, loop_mid, loop_end;  // the iteration matrix's triplets
+  TripletAssembler S_build;
+};
+
 // The bodies' storage of a dynamic analysis, kept from one Newton iteration and one step to the
 // next so that evaluating a body reuses its matrices instead of allocating them (issue 14).
 struct BodyWorkspace {
@@ -128,6 +177,7 @@ struct BodyWorkspace {
   Eigen::VectorXd unused, column, weights, dq, delta, lie_delta;
   // RotationNodes(model, dofs), set with the weights.
   std::vector<RotationNode> rotation_triples;
+  MidpointWorkspace midpoint;  // the midpoint scheme's own (its passes are the ones above)
   // ResidualWeights(model, dofs), computed on the first call (they depend on the model only).
   const Eigen::VectorXd& Weights(const SystemModel& model, const DofMap& dofs) {
     if (weights.size() != dofs.n_dofs()) {
@@ -283,6 +333,7 @@ struct StepOutcome {
 // The velocities of body b's coordinates: the midpoint scheme's node velocities where the state
 // carries them (DynamicState::node_w), J(q) W otherwise.
 Eigen::VectorXd BodyVelocityOf(const SystemModel& model, const DofMap& dofs, const DynamicState& s, int b);
+void BodyVelocityOf(const SystemModel& model, const DofMap& dofs, const DynamicState& s, int b, Eigen::VectorXd& w);
 
 // One generalized-alpha step of size h from `state` into `next` (solver/integrators/
 // generalized_alpha.cpp). t_new: the time reached, state.t + h, or just below a breakpoint the
@@ -294,7 +345,7 @@ StepOutcome GeneralizedAlphaStep(const SystemModel& model, const DofMap& dofs, c
 // One step of the momentum-conserving midpoint scheme (solver/integrators/midpoint.cpp) of size h from `state`
 // into `next`; t_new as for the generalized-alpha step.
 StepOutcome MidpointStep(const SystemModel& model, const DofMap& dofs, const DynamicOptions& options,
-                         const std::vector<RotationNode>& triples, const DynamicState& state, double h, double t_new,
-                         IterationMatrix& matrix, BodyThreads& threads, DynamicState& next);
+                         const DynamicState& state, double h, double t_new, IterationMatrix& matrix,
+                         BodyThreads& threads, BodyWorkspace& work, DynamicState& next);
 
 }  // namespace femb::dynamic_internal

@@ -46,18 +46,23 @@ void SuperelementBody::VelocityMaps(const Data& d, Eigen::MatrixXd* P, Eigen::Ma
 }
 
 Eigen::MatrixXd SuperelementBody::VelocityMapRate(const Eigen::MatrixXd& U, const BodyVelocity& w) const {
+  Eigen::MatrixXd G;
+  VelocityMapRate(U, w, G);
+  return G;
+}
+
+void SuperelementBody::VelocityMapRate(const Eigen::MatrixXd& U, const BodyVelocity& w, Eigen::MatrixXd& G) const {
   const int n = n_coordinates();
-  Eigen::MatrixXd G = Eigen::MatrixXd::Zero(n, n);
+  G.setZero(n, n);
   for (int a = 0; a < n_nodes_; ++a) {
     const Eigen::Vector3d xdot = w.segment<3>(6 * a), omega = w.segment<3>(6 * a + 3);
-    G.middleRows<3>(6 * a) = Skew<double>(xdot) * U;
+    G.middleRows<3>(6 * a).noalias() = Skew<double>(xdot) * U;
     if (options_.cardona_option_b) {
       G.block<3, 3>(6 * a + 3, 6 * a + 3) = Skew<double>(omega);
     } else {
-      G.middleRows<3>(6 * a + 3) = Skew<double>(omega) * U;
+      G.middleRows<3>(6 * a + 3).noalias() = Skew<double>(omega) * U;
     }
   }
-  return G;
 }
 
 Eigen::VectorXd SuperelementBody::QuadraticInertia(const Eigen::MatrixXd& U, const Eigen::MatrixXd& Mg,
@@ -235,21 +240,30 @@ void SuperelementBody::MomentumDerivative(const BodyVelocityMaps& maps, const Bo
 void SuperelementBody::MomentumSourceDerivatives(const BodyVelocityMaps& maps, const BodyVelocity& w,
                                                  const Eigen::VectorXd& p, Eigen::MatrixXd* d_w,
                                                  Eigen::MatrixXd* d_p) const {
+  BodyScratch scratch;
+  MomentumSourceDerivatives(maps, w, p, *d_w, *d_p, scratch);
+}
+
+void SuperelementBody::MomentumSourceDerivatives(const BodyVelocityMaps& maps, const BodyVelocity& w,
+                                                 const Eigen::VectorXd& p, Eigen::MatrixXd& d_w,
+                                                 Eigen::MatrixXd& d_p, BodyScratch& scratch) const {
   const int n = n_coordinates();
   const Eigen::MatrixXd& U = maps.U;
   // s = G(w)^T p + Omega_hat(w) p is bilinear in (w, p).
-  *d_p = VelocityMapRate(U, w).transpose();
-  d_w->setZero(n, n);
+  Eigen::MatrixXd& G = scratch.nn1;
+  VelocityMapRate(U, w, G);
+  d_p = G.transpose();
+  d_w.setZero(n, n);
   for (int a = 0; a < n_nodes_; ++a) {
     const Eigen::Vector3d omega = w.segment<3>(6 * a + 3);
-    d_p->block<3, 3>(6 * a + 3, 6 * a + 3) += Skew<double>(omega);
+    d_p.block<3, 3>(6 * a + 3, 6 * a + 3) += Skew<double>(omega);
     // G(e)^T p = U^T (p_x~ e_x + p_pi~ e_pi) (option A); Omega_hat(e) p = -p_pi~ e_pi.
     const Eigen::Matrix3d px = Skew<double>(Eigen::Vector3d(p.segment<3>(6 * a)));
     const Eigen::Matrix3d pr = Skew<double>(Eigen::Vector3d(p.segment<3>(6 * a + 3)));
-    d_w->middleCols<3>(6 * a) += U.transpose() * px;
+    d_w.middleCols<3>(6 * a).noalias() += U.transpose() * px;
     if (!options_.cardona_option_b) {
-      d_w->middleCols<3>(6 * a + 3) += U.transpose() * pr;
-      d_w->block<3, 3>(6 * a + 3, 6 * a + 3) -= pr;
+      d_w.middleCols<3>(6 * a + 3).noalias() += U.transpose() * pr;
+      d_w.block<3, 3>(6 * a + 3, 6 * a + 3) -= pr;
     }
     // Option B: the node's own G block (p_pi~ e) and Omega_hat(e) p (-p_pi~ e) cancel.
   }
@@ -257,11 +271,21 @@ void SuperelementBody::MomentumSourceDerivatives(const BodyVelocityMaps& maps, c
 
 Eigen::VectorXd SuperelementBody::MomentumSource(const BodyVelocityMaps& maps, const BodyVelocity& w,
                                                  const Eigen::VectorXd& p) const {
-  Eigen::VectorXd out = VelocityMapRate(maps.U, w).transpose() * p;
+  Eigen::VectorXd out;
+  BodyScratch scratch;
+  MomentumSource(maps, w, p, out, scratch);
+  return out;
+}
+
+void SuperelementBody::MomentumSource(const BodyVelocityMaps& maps, const BodyVelocity& w, const Eigen::VectorXd& p,
+                                      Eigen::VectorXd& out, BodyScratch& scratch) const {
+  Eigen::MatrixXd& G = scratch.nn1;
+  VelocityMapRate(maps.U, w, G);
+  out.resize(n_coordinates());
+  out.noalias() = G.transpose() * p;
   for (int a = 0; a < n_nodes_; ++a) {
     out.segment<3>(6 * a + 3) += Eigen::Vector3d(w.segment<3>(6 * a + 3)).cross(Eigen::Vector3d(p.segment<3>(6 * a + 3)));
   }
-  return out;
 }
 
 }  // namespace femb

@@ -378,11 +378,17 @@ class SuperelementBody {
   /// no resultant and its moment about the origin is sum_k p_x,k x xdot_k: this is what makes the
   /// midpoint scheme of dynamic_analysis.h conserve linear and angular momentum exactly.
   Eigen::VectorXd MomentumSource(const BodyVelocityMaps& maps, const BodyVelocity& w, const Eigen::VectorXd& p) const;
+  /// The same into `out` with the temporaries in `scratch` (no allocation once sized).
+  void MomentumSource(const BodyVelocityMaps& maps, const BodyVelocity& w, const Eigen::VectorXd& p,
+                      Eigen::VectorXd& out, BodyScratch& scratch) const;
 
   /// Derivatives of MomentumSource s(q, w, p) with respect to w and to p (both n x n; s is
   /// bilinear in w and p).
   void MomentumSourceDerivatives(const BodyVelocityMaps& maps, const BodyVelocity& w, const Eigen::VectorXd& p,
                                  Eigen::MatrixXd* d_w, Eigen::MatrixXd* d_p) const;
+  /// The same with the temporaries in `scratch` (no allocation once d_w, d_p are sized).
+  void MomentumSourceDerivatives(const BodyVelocityMaps& maps, const BodyVelocity& w, const Eigen::VectorXd& p,
+                                 Eigen::MatrixXd& d_w, Eigen::MatrixXd& d_p, BodyScratch& scratch) const;
 
   /// Linear momentum and angular momentum about the global origin (Noether: sums of the
   /// generalized momenta p = M_g w of the nodes).
@@ -426,6 +432,7 @@ class SuperelementBody {
   void VelocityMaps(const Data& d, Eigen::MatrixXd* P, Eigen::MatrixXd* U) const;
   // G of d(P w) = P G dq at fixed w (n x n), from U and the velocities.
   Eigen::MatrixXd VelocityMapRate(const Eigen::MatrixXd& U, const BodyVelocity& w) const;
+  void VelocityMapRate(const Eigen::MatrixXd& U, const BodyVelocity& w, Eigen::MatrixXd& G) const;
   // The quadratic part of f_in: M_g G w + (Omega_P - Omega_hat) p - G^T p.
   Eigen::VectorXd QuadraticInertia(const Eigen::MatrixXd& U, const Eigen::MatrixXd& Mg, const BodyVelocity& w) const;
   void QuadraticInertia(const Eigen::MatrixXd& U, const Eigen::MatrixXd& Mg, const BodyVelocity& w,

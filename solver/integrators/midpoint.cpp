@@ -52,19 +52,6 @@ std::vector<RotationNode> RotationNodes(const SystemModel& model, const DofMap& 
 
 namespace {
 
-
-// The step's increment Delta of the coordinates (spatial rotation vectors log(R_n+1 R_n^T) on
-// the rotation triples), the end velocities it implies, the mid configuration, and the first-
-// order maps of the end coordinates' increments (delta, as Newton applies them at n+1) to the
-// mid configuration and to the end velocities.
-struct MidpointKinematics {
-  Eigen::VectorXd delta;  // Delta
-  SystemState mid;        // q_m
-  SystemMatrix T;         // d q_m / d delta: 1/2 off the rotation nodes
-  SystemMatrix V;         // d W_n+1 / d delta: 2/h off the rotation nodes
-  std::vector<Eigen::Matrix<double, 6, 1>> node_w1;  // every node's velocity at n+1 (EndNodeVelocity)
-};
-
 // The velocity at n+1 of a node that hangs on joints, from its motion over the step and its
 // velocity at n: xdot_n+1 = 2 (x_n+1 - x_n) / h - xdot_n and, as for a rotation node (Simo & Wong),
 // omega_n+1 = R_n+1 (2 Omega_m - R_n^T omega_n), Omega_m = R_n^T log(R_n+1 R_n^T) / h. This is not
@@ -95,11 +82,46 @@ Eigen::Matrix<double, 6, 1> NodeVelocity(const DynamicState& s, int node) {
   return s.node_w.empty() ? NodeMotion(s.config, node, s.W) : s.node_w[size_t(node)];
 }
 
-MidpointKinematics Midpoint(const SystemModel& model, const DofMap& dofs, const std::vector<RotationNode>& nodes,
-                            const DynamicState& s0, double h, DynamicState& s1) {
-  MidpointKinematics k;
+// The unknowns' places in a StepColumnMap's blocks (MidpointWorkspace::triple_of).
+void TripleOf(const DofMap& dofs, const std::vector<RotationNode>& nodes, std::vector<int>& triple_of) {
+  triple_of.assign(size_t(dofs.n_dofs()), -1);
+  for (size_t i = 0; i < nodes.size(); ++i) {
+    for (int m = 0; m < 3; ++m) {
+      triple_of[size_t(nodes[i].rotation + m)] = int(2 * i);
+      if (nodes[i].translation >= 0) triple_of[size_t(nodes[i].translation + m)] = int(2 * i + 1);
+    }
+  }
+}
+
+// out += scale * A X for the matrix A of the triplets `in`: each entry (i, j, v) spreads over
+// row j of X (one entry off the rotation nodes, three or six on them).
+void AddTimesColumns(const Triplets& in, double scale, const StepColumnMap& X, const std::vector<RotationNode>& nodes,
+                     const std::vector<int>& triple_of, Triplets& out) {
+  for (const Eigen::Triplet<double>& e : in) {
+    const int j = e.col(), t = triple_of[size_t(j)];
+    const double v = scale * e.value();
+    if (t < 0) {
+      out.emplace_back(e.row(), j, v * X.diagonal);
+      continue;
+    }
+    const RotationNode& r = nodes[size_t(t / 2)];
+    if (t % 2 == 0) {
+      const Eigen::Matrix3d& B = X.rotation[size_t(t / 2)];
+      for (int m = 0; m < 3; ++m) out.emplace_back(e.row(), r.rotation + m, v * B(j - r.rotation, m));
+    } else {
+      const Eigen::Matrix3d &B = X.translation[size_t(t / 2)], &Bc = X.coupling[size_t(t / 2)];
+      for (int m = 0; m < 3; ++m) out.emplace_back(e.row(), r.translation + m, v * B(j - r.translation, m));
+      for (int m = 0; m < 3; ++m) out.emplace_back(e.row(), r.rotation + m, v * Bc(j - r.translation, m));
+    }
+  }
+}
+
+// The step's kinematics (MidpointKinematics) at the current end state s1; sets s1's end
+// velocities. Into k (its storage reused).
+void Midpoint(const SystemModel& model, const DofMap& dofs, const std::vector<RotationNode>& nodes,
+              const DynamicState& s0, double h, DynamicState& s1, MidpointKinematics& k) {
   const int n = dofs.n_dofs();
-  k.delta = Eigen::VectorXd::Zero(n);
+  k.delta.setZero(n);
   for (int node = 0; node < model.n_nodes(); ++node) {
     if (dofs.node_count(node) > 0) {
       k.delta.segment(dofs.node_first(node), dofs.node_count(node)) = s1.config.z[node] - s0.config.z[node];
@@ -109,32 +131,33 @@ MidpointKinematics Midpoint(const SystemModel& model, const DofMap& dofs, const 
     k.delta.segment(dofs.mode_dof(int(b)), model.bodies[b].n_modes()) = s1.config.eta[b] - s0.config.eta[b];
   }
   // Every other coordinate: z_n+1 - z_n = h (W_n + W_n+1) / 2, z_m = z_n + Delta / 2.
-  Eigen::VectorXd W1 = 2.0 / h * k.delta - s0.W;
-  Eigen::VectorXd half = 0.5 * k.delta;
-  std::vector<bool> in_block(n, false);
-  Triplets T, V;
-  auto add_block = [](Triplets& t, int row, int col, const Eigen::Matrix3d& block) {
-    for (int i = 0; i < 3; ++i) {
-      for (int j = 0; j < 3; ++j) t.emplace_back(row + i, col + j, block(i, j));
-    }
-  };
-  for (const RotationNode& r : nodes) {
+  Eigen::VectorXd& W1 = k.W1;
+  W1 = 2.0 / h * k.delta - s0.W;
+  k.half = 0.5 * k.delta;
+  k.T.diagonal = 0.5;
+  k.V.diagonal = 2.0 / h;
+  for (StepColumnMap* X : {&k.T, &k.V}) {
+    X->rotation.resize(nodes.size());
+    X->translation.resize(nodes.size());
+    X->coupling.resize(nodes.size());
+  }
+  for (size_t i = 0; i < nodes.size(); ++i) {
+    const RotationNode& r = nodes[i];
     const Eigen::Matrix3d& R0 = s0.config.R[r.node];
     const Eigen::Matrix3d& R1 = s1.config.R[r.node];
     const Eigen::Vector3d dpi = LogSO3(R1 * R0.transpose());
     k.delta.segment<3>(r.rotation) = dpi;
-    half.segment<3>(r.rotation) = 0.5 * dpi;
+    k.half.segment<3>(r.rotation) = 0.5 * dpi;
     const Eigen::Vector3d Omega_m = R0.transpose() * dpi / h;
     const Eigen::Vector3d omega1 = R1 * (2.0 * Omega_m - R0.transpose() * s0.W.segment<3>(r.rotation));
     W1.segment<3>(r.rotation) = omega1;
-    for (int i = 0; i < 3; ++i) in_block[r.rotation + i] = true;
     // An end increment delta (R_n+1 <- exp(delta~) R_n+1) changes Delta_pi by J_l^-1(Delta_pi)
     // delta: the mid rotation exp(Delta_pi~ / 2) R_n by A delta / 2, A = J_l(Delta_pi / 2)
     // J_l^-1(Delta_pi), and omega_n+1 by [2/h R_n+1 R_n^T J_l^-1(Delta_pi) - omega_n+1~] delta.
     const Eigen::Matrix3d Jinv = LeftJacobianInverse<double>(dpi);
     const Eigen::Matrix3d A = LeftJacobianInverse<double>(Eigen::Vector3d(0.5 * dpi)).inverse() * Jinv;
-    add_block(T, r.rotation, r.rotation, 0.5 * A);
-    add_block(V, r.rotation, r.rotation, 2.0 / h * R1 * R0.transpose() * Jinv - Skew<double>(omega1));
+    k.T.rotation[i] = 0.5 * A;
+    k.V.rotation[i] = 2.0 / h * R1 * R0.transpose() * Jinv - Skew<double>(omega1);
     if (r.translation < 0) continue;
     // Free node: the step is the SE(3) exponential of the mean convected twist (V, Omega),
     // V = R^T xdot: x_n+1 = x_n + R_n J_l(h Omega_m) h V_m. A rigid motion of constant twist is
@@ -149,22 +172,14 @@ MidpointKinematics Midpoint(const SystemModel& model, const DofMap& dofs, const 
     // spatial form x_m - x_n = A Delta_x / 2; its change with the end rotation is Delta_x~ / 8
     // to first order.
     const Eigen::Matrix3d J_half = LeftJacobianInverse<double>(Eigen::Vector3d(0.5 * h * Omega_m)).inverse();
-    half.segment<3>(r.translation) = R0 * (J_half * (0.5 * h * V_m));
-    for (int i = 0; i < 3; ++i) in_block[r.translation + i] = true;
-    add_block(T, r.translation, r.translation, 0.5 * A);
-    add_block(T, r.translation, r.rotation, Skew<double>(dx) / 8.0);
+    k.half.segment<3>(r.translation) = R0 * (J_half * (0.5 * h * V_m));
+    k.T.translation[i] = 0.5 * A;
+    k.T.coupling[i] = Skew<double>(dx) / 8.0;
     // xdot_n+1: 2/h R_n+1 J_l^-1(h Omega_m) R_n^T per end translation; per end rotation
     // -xdot_n+1~ (turning R_n+1) + R_n+1 V_m~ R_n^T (through Omega_m), to first order.
-    add_block(V, r.translation, r.translation, 2.0 / h * R1 * Jinv_step * R0.transpose());
-    add_block(V, r.translation, r.rotation, -Skew<double>(xdot1) + R1 * Skew<double>(V_m) * R0.transpose());
+    k.V.translation[i] = 2.0 / h * R1 * Jinv_step * R0.transpose();
+    k.V.coupling[i] = -Skew<double>(xdot1) + R1 * Skew<double>(V_m) * R0.transpose();
   }
-  for (int j = 0; j < n; ++j) {
-    if (in_block[j]) continue;
-    T.emplace_back(j, j, 0.5);
-    V.emplace_back(j, j, 2.0 / h);
-  }
-  k.T = ToMatrix(n, T);
-  k.V = ToMatrix(n, V);
   // End velocities from the kinematics (prescribed coordinates keep their given rates).
   for (int j : dofs.solved()) s1.W[j] = W1[j];
   // Node velocities at n+1 (after W_n+1: free nodes and supports take theirs from it).
@@ -176,8 +191,7 @@ MidpointKinematics Midpoint(const SystemModel& model, const DofMap& dofs, const 
                                                     s1.config.R[node], NodeVelocity(s0, node), h);
   }
   k.mid = s0.config;
-  ApplyIncrement(model, dofs, half, k.mid);
-  return k;
+  ApplyIncrement(model, dofs, k.half, k.mid);
 }
 
 // The node forces f_k (everything a node receives: bodies' inertia, internal and gravity forces,
@@ -192,10 +206,12 @@ MidpointKinematics Midpoint(const SystemModel& model, const DofMap& dofs, const 
 // coordinates and free nodes map exactly and get nothing. The correction is O(h^2) of the forces
 // and is left out of the iteration matrix.
 void AddDiscreteGradientCorrection(const SystemModel& model, const DofMap& dofs, const SystemState& c0,
-                                   const SystemState& c1, const MidpointKinematics& k, double L2, Assembly& out) {
+                                   const SystemState& c1, const MidpointKinematics& k, double L2,
+                                   MidpointWorkspace& w, Assembly& out) {
   if (model.joints.empty()) return;
   const int n = dofs.first_multiplier();
-  Eigen::VectorXd D = Eigen::VectorXd::Zero(n);
+  Eigen::VectorXd& D = w.D;
+  D.setZero(n);
   double gap_work = 0.0;
   for (int node = 0; node < model.n_nodes(); ++node) {
     if (dofs.joint_of(node) < 0) continue;
@@ -206,73 +222,90 @@ void AddDiscreteGradientCorrection(const SystemModel& model, const DofMap& dofs,
     }
     gap_work += gap.dot(out.node_forces.f[node]);
   }
-  const Eigen::VectorXd Dd = D.cwiseProduct(k.delta.head(n));
+  Eigen::VectorXd& Dd = w.Dd;
+  Dd = D.cwiseProduct(k.delta.head(n));
   const double norm = Dd.dot(k.delta.head(n));
   if (!(norm > 0)) return;
   out.residual.head(n) += Dd * (gap_work / norm);
 }
 
 // Residual (applied minus inertia and internal forces, over the coordinates) of the midpoint
-// balance and the matrices at the mid configuration.
-Assembly AssembleMidpoint(const SystemModel& model, const DofMap& dofs, const DynamicState& s0,
-                          const std::vector<Eigen::VectorXd>& p0, double h, MidpointKinematics& k, DynamicState& s1,
-                          double& f_ext_work, BodyThreads* threads = nullptr) {
-  AssemblyParts parts;
-  Assembly out = StartAssembly(model, dofs, parts);
+// balance and the matrices' triplets at the mid configuration (work.parts), into `out`. The
+// momenta at the step's start are in work.midpoint.bodies (MidpointStep).
+void AssembleMidpoint(const SystemModel& model, const DofMap& dofs, const DynamicState& s0, double h,
+                      DynamicState& s1, BodyWorkspace& work, BodyThreads* threads, double& f_ext_work, Assembly& out) {
+  MidpointWorkspace& mw = work.midpoint;
+  MidpointKinematics& k = mw.k;
+  AssemblyParts& parts = work.parts;
+  StartAssembly(model, dofs, parts, out);
   // Each body into its slot (on the threads), then added in body order.
   const int n_bodies = int(model.bodies.size());
-  std::vector<BodyTerms> terms(static_cast<size_t>(n_bodies));
+  work.passes.resize(size_t(n_bodies));
+  work.terms.resize(size_t(n_bodies));
   const double L2 = std::pow(std::max(BoundingDiagonal(model.node_x0), 1e-300), 2);
   // Bodies with a free node (6 own coordinates) keep the momentum-conserving source terms.
-  std::vector<char> free_node(static_cast<size_t>(n_bodies), 0);
+  mw.free_node.assign(size_t(n_bodies), 0);
   for (int b = 0; b < n_bodies; ++b) {
-    for (int node : model.body_nodes[b]) free_node[size_t(b)] |= dofs.free(node);
+    for (int node : model.body_nodes[b]) mw.free_node[size_t(b)] |= dofs.free(node);
   }
-  std::vector<double> gravity_work(static_cast<size_t>(n_bodies), 0.0);
+  mw.gravity_work.assign(size_t(n_bodies), 0.0);
   ForEachBody(threads, n_bodies, [&](int b) {
     const SuperelementBody& body = model.bodies[b];
-    BodyTerms& r = terms[size_t(b)];
-    const BodyConfiguration c1 = BodyConfigurationOf(model, s1.config, int(b));
-    const BodyConfiguration cm = BodyConfigurationOf(model, k.mid, int(b));
-    const FrameSolution f1 = body.SolveFrameFrom(c1, s1.config.frames[b]);
-    const FrameSolution fm = f1.ok ? body.SolveFrameFrom(cm, s0.config.frames[b]) : FrameSolution{};
+    BodyTerms& r = work.terms[size_t(b)];
+    BodyPass& pass = work.passes[size_t(b)];
+    MidpointBody& m = mw.bodies[size_t(b)];
+    SuperelementBody::Data &d1 = pass.data, &dm = m.dm;
+    r.frame_ok = true;
+    BodyConfigurationOf(model, s1.config, b, d1.c);
+    BodyConfigurationOf(model, k.mid, b, dm.c);
+    const FrameSolution f1 = body.SolveFrameFrom(d1.c, s1.config.frames[b], d1.q);
+    const FrameSolution fm = f1.ok ? body.SolveFrameFrom(dm.c, s0.config.frames[b], dm.q) : FrameSolution{};
     if (!f1.ok || !fm.ok) {
       r.frame_ok = false;
       return;
     }
     s1.config.frames[b] = f1;
     k.mid.frames[b] = fm;
-    Eigen::VectorXd w1(body.n_coordinates());
+    // (the local coordinates are the frame solutions', at these frames)
+    body.EvaluateSolved(d1.c, f1, d1);
+    body.EvaluateSolved(dm.c, fm, dm);
+    Eigen::VectorXd& w1 = pass.w;
+    w1.resize(body.n_coordinates());
     for (int a = 0; a < body.n_nodes(); ++a) w1.segment<6>(6 * a) = k.node_w1[size_t(model.body_nodes[b][a])];
     w1.tail(body.n_modes()) = s1.W.segment(dofs.mode_dof(int(b)), body.n_modes());
     // Velocity maps at the end and at the mid configuration, shared by the momentum terms.
-    const SuperelementBody::Data d1 = body.Evaluate(c1, f1), dm = body.Evaluate(cm, fm);
     const BodyVelocityMaps &maps1 = body.MapsOf(d1), &maps_m = body.MapsOf(dm);
-    const Eigen::VectorXd p1 = body.GeneralizedMomentum(maps1, w1);
+    m.p1.resize(body.n_coordinates());
+    m.p1.noalias() = maps1.Mg * w1;
     // Node motion over the step.
-    Eigen::VectorXd wm(body.n_coordinates());
+    Eigen::VectorXd& wm = m.wm;
+    wm.resize(body.n_coordinates());
     for (int a = 0; a < body.n_nodes(); ++a) wm.segment<6>(6 * a) = NodeStep(s0.config, s1.config, model.body_nodes[b][a]) / h;
     wm.tail(body.n_modes()) = (s1.config.eta[b] - s0.config.eta[b]) / h;
-    Eigen::VectorXd f_in, f_int;
+    Eigen::VectorXd &f_in = r.f_in, &f_int = r.f_int, &f_acc = r.f_acc;
     Eigen::MatrixXd &Kb = r.K, &Mb = r.M, &Cb = r.C;
     // M_g at the end of the step: the 2/h^2 term of the iteration matrix is d p_n+1 / h; at
     // the mid configuration it would be off by O(omega h) and leave a 1/h error.
     Mb = maps1.Mg;
-    const Eigen::VectorXd w0 = BodyVelocityOf(model, dofs, s0, int(b));
-    const Eigen::VectorXd f_acc = Mb * (w1 - w0) / h;
+    m.dw = w1 - m.w0;
+    f_acc.resize(body.n_coordinates());
+    f_acc.noalias() = Mb * m.dw;
+    f_acc /= h;
     Cb.setZero(body.n_coordinates(), body.n_coordinates());
     if (body.options().quadratic_velocity_terms) {
       // Source terms with the node motion of each half step, so that their moment matches the
       // change of sum x_k x p_k exactly: x_m is not the mean of x_n and x_n+1.
-      if (free_node[size_t(b)]) {
-        Eigen::VectorXd w_second = wm, w_first = wm;
+      if (mw.free_node[size_t(b)]) {
+        m.w_second = wm;
+        m.w_first = wm;
         for (int a = 0; a < body.n_nodes(); ++a) {
           const int node = model.body_nodes[b][a];
-          w_second.segment<3>(6 * a) = 2.0 * (s1.config.x[node] - k.mid.x[node]) / h;
-          w_first.segment<3>(6 * a) = 2.0 * (k.mid.x[node] - s0.config.x[node]) / h;
+          m.w_second.segment<3>(6 * a) = 2.0 * (s1.config.x[node] - k.mid.x[node]) / h;
+          m.w_first.segment<3>(6 * a) = 2.0 * (k.mid.x[node] - s0.config.x[node]) / h;
         }
-        f_in = (p1 - p0[b]) / h -
-               0.5 * (body.MomentumSource(maps_m, w_second, p1) + body.MomentumSource(maps_m, w_first, p0[b]));
+        body.MomentumSource(maps_m, m.w_second, m.p1, m.s_second, dm.scratch);
+        body.MomentumSource(maps_m, m.w_first, m.p0, m.s_first, dm.scratch);
+        f_in = (m.p1 - m.p0) / h - 0.5 * (m.s_second + m.s_first);
       } else {
         // No free node: every node hangs on joints or supports. The source at the step's mean
         // motion and mean momentum does no work for a rigid body, s(wm, p_m) . wm =
@@ -282,7 +315,9 @@ Assembly AssembleMidpoint(const SystemModel& model, const DofMap& dofs, const Dy
         // no longer matches the change of sum x_k x p_k exactly, so a chain whose root floats
         // free keeps its angular momentum to O(h^2) only (a grounded chain has none to keep).
         // Energy is the invariant a mechanism on joints is judged by.
-        f_in = (p1 - p0[b]) / h - body.MomentumSource(maps_m, wm, 0.5 * (p0[b] + p1));
+        m.p_mean = 0.5 * (m.p0 + m.p1);
+        body.MomentumSource(maps_m, wm, m.p_mean, m.s_first, dm.scratch);
+        f_in = (m.p1 - m.p0) / h - m.s_first;
       }
       // Iteration matrix: with dp_n+1 = (M_g V + D) delta (V = d W_n+1 / d delta ~ 2/h,
       // D = d p / dq at fixed w) and dw_a ~ delta / h,
@@ -290,9 +325,11 @@ Assembly AssembleMidpoint(const SystemModel& model, const DofMap& dofs, const Dy
       // All the 1/h terms are needed (and M_g at n+1, V with its O(omega) part): each is
       // O(omega h) of the leading one, and without them Newton contracts only by ~omega h per
       // iteration, or worse on stiff, lightly inertial directions such as a tube's torsion.
-      Eigen::MatrixXd d_w, d_p;
-      body.MomentumSourceDerivatives(maps_m, wm, 0.5 * (p0[b] + p1), &d_w, &d_p);
-      Cb = body.MomentumDerivative(maps1, w1) - d_w - d_p * Mb;
+      m.p_mean = 0.5 * (m.p0 + m.p1);
+      body.MomentumSourceDerivatives(maps_m, wm, m.p_mean, m.d_w, m.d_p, dm.scratch);
+      body.MomentumDerivative(maps1, w1, Cb, d1.scratch);
+      Cb -= m.d_w;
+      Cb.noalias() -= m.d_p * Mb;
     } else {
       f_in = f_acc;
     }
@@ -300,108 +337,128 @@ Assembly AssembleMidpoint(const SystemModel& model, const DofMap& dofs, const Dy
     if (body.has_inertia_stiffening()) {
       // Inertia stiffening (issue 13) at the mid configuration with the step's mean velocity and
       // acceleration; d wm = delta / h (C / h) and d (w1 - w0) / h = V delta / h (M V / h).
-      const InertiaLoadFactors load = body.InertiaLoads(dm, wm, (w1 - w0) / h, model.gravity);
-      Eigen::MatrixXd d_load;
-      body.ElasticForce(dm, &f_int, &Kb, &load, &d_load);
-      Cb += d_load * load.d_w;
-      Mb += d_load * load.d_wdot;
+      m.wdot = m.dw / h;
+      body.InertiaLoads(dm, wm, m.wdot, model.gravity, m.load);
+      body.ElasticForce(dm, &f_int, &Kb, &m.load, &m.d_load);
+      Cb.noalias() += m.d_load * m.load.d_w;
+      Mb.noalias() += m.d_load * m.load.d_wdot;
     } else {
       body.ElasticForce(dm, &f_int, &Kb);
     }
     Eigen::VectorXd& f_grav = r.f_grav;
-    f_grav = Eigen::VectorXd::Zero(body.n_coordinates());
     if (model.gravity.squaredNorm() > 0) {
-      f_grav = body.GravityForce(dm, model.gravity);
+      body.GravityForce(dm, model.gravity, f_grav);
       // Gravity as a discrete gradient of its potential V = -m g . x_c (Gonzalez): its work over
       // the step's motion u = h wm is exactly V_n - V_n+1, where the force at q_m alone is off
       // by O(h^3) (x_c turns with the frame). The correction lies along D u, D = 1 on node
       // translations and the model's size squared on node rotations.
-      const Eigen::VectorXd u = h * wm;
-      const double dV = -body.mass() * model.gravity.dot(body.CenterOfMass(c1, f1) -
-                                                         body.CenterOfMass(BodyConfigurationOf(model, s0.config, int(b)),
-                                                                           s0.config.frames[b]));
-      Eigen::VectorXd Du = Eigen::VectorXd::Zero(u.size());
+      Eigen::VectorXd &u = m.u, &Du = m.Du;
+      u = h * wm;
+      const double dV = -body.mass() * model.gravity.dot(body.CenterOfMass(d1.q, f1) - m.com0);
+      Du.setZero(u.size());
       for (int a = 0; a < body.n_nodes(); ++a) {
         Du.segment<3>(6 * a) = u.segment<3>(6 * a);
         Du.segment<3>(6 * a + 3) = L2 * u.segment<3>(6 * a + 3);
       }
       const double norm = Du.dot(u);
       if (norm > 0) f_grav += Du * ((-dV - f_grav.dot(u)) / norm);
-      gravity_work[size_t(b)] = -dV;
+      mw.gravity_work[size_t(b)] = -dV;
+    } else {
+      f_grav.setZero(body.n_coordinates());
     }
     // Scale: each term on its own (for a torque-free body the momentum change and the source
     // cancel; M_g (w_n+1 - w_n) / h is the size of the inertia force).
     r.scale = std::max({body.ForceNorm(f_int), body.ForceNorm(f_in), body.ForceNorm(f_grav), body.force_floor(),
                         body.ForceNorm(f_acc)});
-    r.roundoff = body.RoundOffForce(c1);
-    r.map = BodyMap(model, dofs, k.mid, int(b));
+    r.roundoff = body.RoundOffForce(d1.c);
+    BodyMap(model, dofs, k.mid, int(b), r.map);
     r.r_b = f_grav - f_int - f_in;
   });
-  if (!AddBodyTerms(model, terms, parts, out)) return out;
+  if (!AddBodyTerms(model, work.terms, parts, out)) return;
   // Closed loops: the constraint forces -G^T lambda_n+1 at the mid configuration (their work
   // over the step, lambda . G(q_m) Delta, is lambda . (g_n+1 - g_n) = 0 up to O(h^3)); the
   // equations themselves hold at the end of the step (MidpointStep).
   k.mid.lambda = s1.config.lambda;
   AddLoopConstraints(model, dofs, k.mid, &out.residual, nullptr, &parts.node_forces);
   // Loads at the mid time and configuration, spring-dampers at the mean rates Delta / h.
-  FinishAssembly(model, dofs, k.mid, s0.t + 0.5 * h, k.delta / h, true, parts, out);
-  AddDiscreteGradientCorrection(model, dofs, s0.config, s1.config, k, L2, out);
+  mw.rates = k.delta / h;
+  FinishAssembly(model, dofs, k.mid, s0.t + 0.5 * h, mw.rates, true, parts, out);
+  AddDiscreteGradientCorrection(model, dofs, s0.config, s1.config, k, L2, mw, out);
   // The external work of the step, as the forces' discrete gradients do it: gravity's potential
   // change, and the nodal loads (at q_m) times the nodes' motion.
   f_ext_work = 0.0;
-  for (double w : gravity_work) f_ext_work += w;
+  for (double w : mw.gravity_work) f_ext_work += w;
   if (!model.loads.empty()) {
-    NodeForces loads = ZeroNodeForces(model);
-    Eigen::VectorXd unused = Eigen::VectorXd::Zero(dofs.n_dofs());
-    AddNodeLoads(model, k.mid, s0.t + 0.5 * h, unused, nullptr, &loads);
+    mw.loads.f.assign(size_t(model.n_nodes()), Eigen::Matrix<double, 6, 1>::Zero());
+    mw.unused.setZero(dofs.n_dofs());
+    AddNodeLoads(model, k.mid, s0.t + 0.5 * h, mw.unused, nullptr, &mw.loads);
     for (int node = 0; node < model.n_nodes(); ++node) {
-      f_ext_work += NodeStep(s0.config, s1.config, node).dot(loads.f[size_t(node)]);
+      f_ext_work += NodeStep(s0.config, s1.config, node).dot(mw.loads.f[size_t(node)]);
     }
   }
-  return out;
 }
 
 }  // namespace
 
 Eigen::VectorXd BodyVelocityOf(const SystemModel& model, const DofMap& dofs, const DynamicState& s, int b) {
-  if (s.node_w.empty()) return GatherBody(model, dofs, s.config, b, s.W);
-  const SuperelementBody& body = model.bodies[b];
-  Eigen::VectorXd w(body.n_coordinates());
-  for (int a = 0; a < body.n_nodes(); ++a) w.segment<6>(6 * a) = s.node_w[size_t(model.body_nodes[b][a])];
-  w.tail(body.n_modes()) = s.W.segment(dofs.mode_dof(b), body.n_modes());
+  Eigen::VectorXd w;
+  BodyVelocityOf(model, dofs, s, b, w);
   return w;
 }
 
-StepOutcome MidpointStep(const SystemModel& model, const DofMap& dofs, const DynamicOptions& options,
-                         const std::vector<RotationNode>& triples, const DynamicState& state, double h, double t_new,
-                         IterationMatrix& matrix, BodyThreads& threads, DynamicState& next) {
-  next = state;
-  // Momenta at the start of the step.
-  std::vector<Eigen::VectorXd> p0;
-  for (size_t b = 0; b < model.bodies.size(); ++b) {
-    const BodyConfiguration c = BodyConfigurationOf(model, state.config, int(b));
-    p0.push_back(model.bodies[b].GeneralizedMomentum(model.bodies[b].Maps(c, state.config.frames[b]),
-                                                     BodyVelocityOf(model, dofs, state, int(b))));
+void BodyVelocityOf(const SystemModel& model, const DofMap& dofs, const DynamicState& s, int b, Eigen::VectorXd& w) {
+  if (s.node_w.empty()) {
+    GatherBody(model, dofs, s.config, b, s.W, w);
+    return;
   }
+  const SuperelementBody& body = model.bodies[b];
+  w.resize(body.n_coordinates());
+  for (int a = 0; a < body.n_nodes(); ++a) w.segment<6>(6 * a) = s.node_w[size_t(model.body_nodes[b][a])];
+  w.tail(body.n_modes()) = s.W.segment(dofs.mode_dof(b), body.n_modes());
+}
+
+StepOutcome MidpointStep(const SystemModel& model, const DofMap& dofs, const DynamicOptions& options,
+                         const DynamicState& state, double h, double t_new, IterationMatrix& matrix,
+                         BodyThreads& threads, BodyWorkspace& work, DynamicState& next) {
+  next = state;  // storage reused: `next` is the caller's, of the same sizes after the first step
+  const Eigen::VectorXd& weights = work.Weights(model, dofs);
+  const std::vector<RotationNode>& triples = work.rotation_triples;
+  MidpointWorkspace& mw = work.midpoint;
+  MidpointKinematics& k = mw.k;
+  if (mw.triple_of.size() != size_t(dofs.n_dofs())) TripleOf(dofs, triples, mw.triple_of);
+  // Momenta and centres of mass at the start of the step.
+  const int n_bodies = int(model.bodies.size());
+  mw.bodies.resize(size_t(n_bodies));
+  ForEachBody(&threads, n_bodies, [&](int b) {
+    const SuperelementBody& body = model.bodies[b];
+    MidpointBody& m = mw.bodies[size_t(b)];
+    BodyConfigurationOf(model, state.config, b, m.d0.c);
+    body.Evaluate(m.d0.c, state.config.frames[b], m.d0);
+    BodyVelocityOf(model, dofs, state, b, m.w0);
+    m.p0.resize(body.n_coordinates());
+    m.p0.noalias() = body.MapsOf(m.d0).Mg * m.w0;
+    m.com0 = body.CenterOfMass(m.d0.q, state.config.frames[b]);
+  });
   // Predictor: the configuration reached with the current velocity and acceleration.
-  ApplyIncrement(model, dofs, h * state.W + 0.5 * h * h * state.Wdot, next.config);
+  work.dq = h * state.W + 0.5 * h * h * state.Wdot;
+  ApplyIncrement(model, dofs, work.dq, next.config);
   ApplyPrescribed(model, dofs, t_new, next.config, &next.W, &next.Wdot);
   StepOutcome out;
   const double tolerance = std::max(options.tolerance, kRoundOffTolerance);
-  const Eigen::VectorXd weights = ResidualWeights(model, dofs);
   DivergenceTest divergence;
   const int n_lambda = dofs.n_multipliers();
+  Assembly& a = work.assembly;
   matrix.BeginStep();
   for (; out.iterations < options.max_iterations; ++out.iterations) {
-    MidpointKinematics k = Midpoint(model, dofs, triples, state, h, next);
-    double work = 0.0;
-    Assembly a = AssembleMidpoint(model, dofs, state, p0, h, k, next, work, &threads);
+    Midpoint(model, dofs, triples, state, h, next, k);
+    double work_done = 0.0;
+    AssembleMidpoint(model, dofs, state, h, next, work, &threads, work_done, a);
     if (!a.ok || !a.residual.allFinite()) return out;
     if (n_lambda > 0) {
       // The loop equations at the end of the step: residual rows -g(q_n+1).
-      Eigen::VectorXd end = Eigen::VectorXd::Zero(dofs.n_dofs());
-      AddLoopConstraints(model, dofs, next.config, &end, nullptr, nullptr);
-      a.residual.tail(n_lambda) = end.tail(n_lambda);
+      mw.end.setZero(dofs.n_dofs());
+      AddLoopConstraints(model, dofs, next.config, &mw.end, nullptr, nullptr);
+      a.residual.tail(n_lambda) = mw.end.tail(n_lambda);
     }
     const double r_norm = FreeNorm(dofs, a.residual, weights);
     // Converged: the residual below the tolerance relative to the forces on each unknown (or
@@ -421,33 +478,45 @@ StepOutcome MidpointStep(const SystemModel& model, const DofMap& dofs, const Dyn
         next.Wdot = 1.5 * next.a - 0.5 * state.a;
       }
       next.node_w = k.node_w1;
-      next.external_work += work;
+      next.external_work += work_done;
       next.f_ext = a.f_ext;
-      next.f_drive = DriveForces(dofs, a.residual);
+      DriveForces(dofs, a.residual, next.f_drive);
       next.drive_work += next.f_drive.dot(k.delta);
+      // The passes hold each body's data and velocities at the end of the step (the measures').
+      out.passes_kept = true;
       return out;
     }
     if (divergence.Diverged(out.iterations, r_norm)) return out;
-    // Newton's increment delta at n+1: dW_n+1 = V delta, dq_m = T delta, dw_m ~ delta / h.
-    const auto S = [&] {
-      SystemMatrix S = a.K * k.T + (1.0 / h) * (a.C + a.M * k.V);
-      if (n_lambda == 0) return S;
-      // Loops: d(-G_m^T lambda)/d delta = H_m T, its lambda columns G_m^T, the rows G_n+1.
-      Triplets at_mid, at_end;
-      AddLoopConstraints(model, dofs, k.mid, nullptr, &at_mid, nullptr, nullptr, kLoopHessian);
-      S += ToMatrix(dofs.n_dofs(), at_mid) * k.T;
-      at_mid.clear();
-      AddLoopConstraints(model, dofs, k.mid, nullptr, &at_mid, nullptr, nullptr, kLoopColumns);
-      AddLoopConstraints(model, dofs, next.config, nullptr, &at_end, nullptr, nullptr, kLoopRows);
-      at_end.insert(at_end.end(), at_mid.begin(), at_mid.end());
-      return SystemMatrix(S + ToMatrix(dofs.n_dofs(), at_end));
+    // Newton's increment delta at n+1: dW_n+1 = V delta, dq_m = T delta, dw_m ~ delta / h, so
+    // the iteration matrix is K T + (C + M V) / h, built from the assembly's triplets.
+    const SystemMatrix* built = nullptr;
+    const auto S = [&]() -> const SystemMatrix& {
+      if (built) return *built;
+      Triplets& S = mw.S;
+      S.clear();
+      AddTimesColumns(work.parts.K, 1.0, k.T, triples, mw.triple_of, S);
+      for (const Eigen::Triplet<double>& e : work.parts.C) S.emplace_back(e.row(), e.col(), e.value() / h);
+      AddTimesColumns(work.parts.M, 1.0 / h, k.V, triples, mw.triple_of, S);
+      if (n_lambda > 0) {
+        // Loops: d(-G_m^T lambda)/d delta = H_m T, its lambda columns G_m^T, the rows G_n+1.
+        mw.loop_mid.clear();
+        AddLoopConstraints(model, dofs, k.mid, nullptr, &mw.loop_mid, nullptr, nullptr, kLoopHessian);
+        AddTimesColumns(mw.loop_mid, 1.0, k.T, triples, mw.triple_of, S);
+        mw.loop_mid.clear();
+        mw.loop_end.clear();
+        AddLoopConstraints(model, dofs, k.mid, nullptr, &mw.loop_mid, nullptr, nullptr, kLoopColumns);
+        AddLoopConstraints(model, dofs, next.config, nullptr, &mw.loop_end, nullptr, nullptr, kLoopRows);
+        S.insert(S.end(), mw.loop_end.begin(), mw.loop_end.end());
+        S.insert(S.end(), mw.loop_mid.begin(), mw.loop_mid.end());
+      }
+      built = &mw.S_build.Build(dofs.n_dofs(), S);
+      return *built;
     };
-    Eigen::VectorXd delta;
+    Eigen::VectorXd& delta = work.delta;
     if (!matrix.Increment(dofs, options, h, r_norm, S, a.residual, delta, out.singular_matrix)) return out;
     ApplyIncrement(model, dofs, delta, next.config);
   }
   return out;
 }
-
 
 }  // namespace femb::dynamic_internal

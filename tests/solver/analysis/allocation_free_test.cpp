@@ -10,11 +10,12 @@
 // revolute-to-ground (driven) and prismatic-to-ground nodes; revolute joints between nodes;
 // gravity and a dead load; bodies on one thread and on two; fixed and error-controlled steps;
 // the bodies' inertia matrices kept in their frames (body_matrices_every)
-// (but the restart at a breakpoint of a load or drive). Not covered (they may still allocate):
-// the midpoint scheme, closed loops and interface constraints, spring-dampers, follower
-// loads, results recording (femb-solve's output, outside SolveDynamic).
+// (but the restart at a breakpoint of a load or drive); the same for the midpoint scheme but
+// the kept matrices. Not covered (they may still allocate): closed loops and interface
+// constraints, spring-dampers, follower loads, results recording (femb-solve's output, outside
+// SolveDynamic).
 // FEMB_ALLOCATION_TRACE=1 prints the call stack of every allocation counted (to find them);
-// =linear, =stiffened, =threads, =adaptive or =kept: of those cases only.
+// =linear, =stiffened, =threads, =adaptive, =kept or =midpoint: of those cases only.
 #include <execinfo.h>
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -64,7 +65,8 @@ void PrintStack() {
 
 // The allocations of each step of a 30-step run from the third step on: their largest number.
 [[maybe_unused]] long LargestAllocationsPerStep(const SystemModel& model, double h, const char* kind, long* steps,
-                                                int threads = 1, bool adaptive = false, int body_matrices_every = 1) {
+                                                int threads = 1, bool adaptive = false, int body_matrices_every = 1,
+                                                Integrator integrator = Integrator::kGeneralizedAlpha) {
   DynamicState s = InitialDynamicState(model, InitialState(model), Eigen::VectorXd::Zero(DofMap(model).n_dofs()));
   DynamicOptions options;
   options.step = h;
@@ -73,6 +75,7 @@ void PrintStack() {
   options.threads = threads;
   options.adaptive = adaptive;  // from h, at the default step_tolerance
   options.body_matrices_every = body_matrices_every;
+  options.integrator = integrator;
   long last = 0, largest = 0, counted = 0;
   int step = 0;
   const char* trace_kind = std::getenv("FEMB_ALLOCATION_TRACE");
@@ -133,6 +136,41 @@ TEST(AllocationFree, GeneralizedAlphaStepsAllocateNothing) {
   std::printf("[ info ] stiffened slider-crank, body_matrices_every 4: at most %ld allocations in a step (%ld steps counted)\n",
               kept, steps);
   EXPECT_EQ(kept, 0);
+}
+
+TEST(AllocationFree, MidpointStepsAllocateNothing) {
+  // The momentum-conserving midpoint scheme: its kinematics (the column maps T and V), the
+  // momentum terms at both ends and at the mid configuration, the discrete gradients of the
+  // joints and of gravity, the iteration matrix K T + (C + M V) / h from triplets, and the step's
+  // measures from the end state's data. The chain's nodes but the clamped one are free (the
+  // split momentum source); the slider-crank's hang on joints (the mean source, the discrete
+  // gradient of the node Jacobians).
+  for (const bool stiffened : {false, true}) {
+    const double L = 0.25;
+    const Superelement se = Tube(L, stiffened);
+    long steps = 0;
+    const long chain = LargestAllocationsPerStep(Chain(se, L), 1e-3, "midpoint", &steps, 1, false, 1,
+                                                 Integrator::kMidpoint);
+    std::printf("[ info ] midpoint, %s chain of 4 bodies: at most %ld allocations in a step (%ld steps counted)\n",
+                stiffened ? "stiffened" : "linear", chain, steps);
+    EXPECT_EQ(chain, 0);
+    const long crank = LargestAllocationsPerStep(test::SliderCrankModel(Tube(0.15, stiffened), se, 0.15, L), 1e-5,
+                                                 "midpoint", &steps, 1, false, 1, Integrator::kMidpoint);
+    std::printf("[ info ] midpoint, %s slider-crank: at most %ld allocations in a step (%ld steps counted)\n",
+                stiffened ? "stiffened" : "linear", crank, steps);
+    EXPECT_EQ(crank, 0);
+  }
+  const Superelement se = Tube(0.25, true);
+  long steps = 0;
+  const long two = LargestAllocationsPerStep(Chain(se, 0.25), 1e-3, "midpoint", &steps, 2, false, 1, Integrator::kMidpoint);
+  std::printf("[ info ] midpoint, stiffened chain on 2 threads: at most %ld allocations in a step (%ld steps counted)\n",
+              two, steps);
+  EXPECT_EQ(two, 0);
+  const long adaptive = LargestAllocationsPerStep(test::SliderCrankModel(Tube(0.15, true), se, 0.15, 0.25), 1e-5,
+                                                  "midpoint", &steps, 1, true, 1, Integrator::kMidpoint);
+  std::printf("[ info ] midpoint, stiffened slider-crank, step: auto: at most %ld allocations in a step (%ld steps counted)\n",
+              adaptive, steps);
+  EXPECT_EQ(adaptive, 0);
 }
 #endif
 
