@@ -209,7 +209,8 @@ DynamicStepReport MeasureWith(const SystemModel& model, const DofMap& dofs, cons
   r.t = s.t;
   r.external_work = s.external_work;
   if (!model.springs.empty()) {
-    Eigen::VectorXd unused = Eigen::VectorXd::Zero(dofs.n_dofs());
+    thread_local Eigen::VectorXd unused;  // (kept: a step allocates nothing)
+    unused.setZero(dofs.n_dofs());
     AddSpringDampers(model, s.config, s.W, unused, nullptr, nullptr, &r.elastic_energy);  // spring energy
   }
   const int n_bodies = int(model.bodies.size());

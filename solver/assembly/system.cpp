@@ -207,10 +207,14 @@ void AddNodeLoads(const SystemModel& model, const SystemState& state, double t, 
 
 void AddSpringDampers(const SystemModel& model, const SystemState& state, const Eigen::VectorXd& W,
                       Eigen::VectorXd& residual, Triplets* K, Triplets* C, double* energy, NodeForces* node_forces) {
+  // This thread's scratch (kept: a time step allocates nothing once it has its sizes).
+  thread_local std::vector<MapEntry> map;  // the 6 translational components (a, b) -> coordinates
+  thread_local Eigen::VectorXd fv;
+  thread_local Eigen::MatrixXd Km, Cm;
   for (const SpringDamper& s : model.springs) {
     Eigen::Vector3d x[2], v[2];
     const int nodes[2] = {s.node_a, s.node_b};
-    std::vector<MapEntry> map;  // the 6 translational components (a, b) -> coordinates
+    map.clear();
     for (int e = 0; e < 2; ++e) {
       const int k = nodes[e];
       x[e] = k >= 0 ? state.x[k] : s.ground;
@@ -232,8 +236,9 @@ void AddSpringDampers(const SystemModel& model, const SystemState& state, const 
         node_forces->Add(nodes[e], fe);
       }
     }
-    const Eigen::VectorXd fv = f.f;
-    const Eigen::MatrixXd Km = f.K, Cm = f.C;
+    fv = f.f;
+    Km = f.K;
+    Cm = f.C;
     ScatterBody(map, &fv, K ? &Km : nullptr, &residual, K);
     if (C) ScatterBody(map, nullptr, &Cm, nullptr, C);
   }

@@ -1,7 +1,9 @@
 #include "solver/joints/loop_closure.h"
 
 #include <Eigen/Geometry>
+#include <array>
 #include <cmath>
+#include <initializer_list>
 #include <cstdio>
 
 #include "solver/rotation.h"
@@ -25,7 +27,18 @@ void CrossDirections(const Eigen::Vector3d& a, Eigen::Vector3d& b1, Eigen::Vecto
   b2 = a.cross(b1);
 }
 
-std::vector<Equation> Equations(const NodeJoint& j) {
+// A joint's full set of equations (at most 6; fixed storage, no allocation).
+struct EquationSet {
+  std::array<Equation, 6> eq;
+  int n = 0;
+  EquationSet(std::initializer_list<Equation> list) {
+    for (const Equation& e : list) eq[size_t(n++)] = e;
+  }
+  int size() const { return n; }
+  const Equation& operator[](size_t i) const { return eq[i]; }
+};
+
+EquationSet Equations(const NodeJoint& j) {
   const Eigen::Vector3d a = j.axis.normalized();
   Eigen::Vector3d b1, b2;
   CrossDirections(a, b1, b2);
@@ -48,17 +61,16 @@ std::vector<Equation> Equations(const NodeJoint& j) {
 int ConstraintCount(JointType type) {
   NodeJoint j;
   j.type = type;
-  return int(Equations(j).size());
+  return Equations(j).size();
 }
 
 ConstraintBlock EvaluateConstraint(const NodeJoint& j, const Eigen::Vector3d& x_p, const Eigen::Matrix3d& R_p,
                                    const Eigen::Vector3d& x_c, const Eigen::Matrix3d& R_c) {
-  const std::vector<Equation> eqs = Equations(j);
-  const int m = int(eqs.size());
+  const EquationSet eqs = Equations(j);
+  const int m = eqs.size();
   ConstraintBlock out;
   out.g.resize(m);
-  out.G = Eigen::Matrix<double, Eigen::Dynamic, 12>::Zero(m, 12);
-  out.position.resize(size_t(m));
+  out.G.setZero(m, 12);
   const Eigen::Vector3d d = x_c - x_p;
   const Eigen::Matrix3d R_cQ = R_c * j.Q0.transpose();
   for (int i = 0; i < m; ++i) {
@@ -81,12 +93,12 @@ ConstraintBlock EvaluateConstraint(const NodeJoint& j, const Eigen::Vector3d& x_
 
 Eigen::Matrix<double, 12, 12> ConstraintHessian(const NodeJoint& j, const Eigen::Vector3d& x_p,
                                                 const Eigen::Matrix3d& R_p, const Eigen::Vector3d& x_c,
-                                                const Eigen::Matrix3d& R_c, const Eigen::VectorXd& lambda) {
-  const std::vector<Equation> eqs = Equations(j);
+                                                const Eigen::Matrix3d& R_c, const ConstraintValues& lambda) {
+  const EquationSet eqs = Equations(j);
   Eigen::Matrix<double, 12, 12> H = Eigen::Matrix<double, 12, 12>::Zero();
   const Eigen::Vector3d d = x_c - x_p;
   const Eigen::Matrix3d R_cQ = R_c * j.Q0.transpose();
-  for (size_t i = 0; i < eqs.size(); ++i) {
+  for (size_t i = 0; i < size_t(eqs.size()); ++i) {
     const double l = lambda[Eigen::Index(i)];
     if (l == 0.0) continue;
     const Eigen::Vector3d U = R_p * eqs[i].e;
@@ -141,8 +153,8 @@ Eigen::VectorXd CutJointCoordinates(const NodeJoint& j, const Eigen::Vector3d& x
 }
 
 std::string ConstraintName(const NodeJoint& j, int i) {
-  const std::vector<Equation> eqs = Equations(j);
-  if (i < 0 || i >= int(eqs.size())) return "equation " + std::to_string(i);
+  const EquationSet eqs = Equations(j);
+  if (i < 0 || i >= eqs.size()) return "equation " + std::to_string(i);
   const Equation& q = eqs[size_t(i)];
   if (j.type == JointType::kUniversal && !q.position) return "rotation about the normal of the cross";
   const bool axial = j.type != JointType::kRigid && j.type != JointType::kSpherical;

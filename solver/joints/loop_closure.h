@@ -28,6 +28,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <array>
 #include <string>
 #include <vector>
 
@@ -49,10 +50,12 @@ int ConstraintCount(JointType type);
 
 /// A cut joint's full set of equations at a configuration: values g and their derivative with
 /// respect to the nodes' spatial increments, G (m x 12: dx_p, dpi_p, dx_c, dpi_c).
+/// At most 6 equations: fixed-capacity storage, so that evaluating one allocates nothing (issue 14).
+using ConstraintValues = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 6, 1>;
 struct ConstraintBlock {
-  Eigen::VectorXd g;
-  Eigen::Matrix<double, Eigen::Dynamic, 12> G;
-  std::vector<bool> position;  ///< per equation: a position (length), else a rotation (dot product)
+  ConstraintValues g;
+  Eigen::Matrix<double, Eigen::Dynamic, 12, 0, 6, 12> G;
+  std::array<bool, 6> position{};  ///< per equation: a position (length), else a rotation (dot product)
 };
 ConstraintBlock EvaluateConstraint(const NodeJoint& j, const Eigen::Vector3d& x_p, const Eigen::Matrix3d& R_p,
                                    const Eigen::Vector3d& x_c, const Eigen::Matrix3d& R_c);
@@ -60,7 +63,7 @@ ConstraintBlock EvaluateConstraint(const NodeJoint& j, const Eigen::Vector3d& x_
 /// d(G^T lambda)/dq (12 x 12) for multipliers lambda of the full set (m).
 Eigen::Matrix<double, 12, 12> ConstraintHessian(const NodeJoint& j, const Eigen::Vector3d& x_p,
                                                 const Eigen::Matrix3d& R_p, const Eigen::Vector3d& x_c,
-                                                const Eigen::Matrix3d& R_c, const Eigen::VectorXd& lambda);
+                                                const Eigen::Matrix3d& R_c, const ConstraintValues& lambda);
 
 /// A cut revolute, prismatic, cylindrical or universal joint's coordinates as the tree joint
 /// would have them (node_joint.h): s = a . (R_p^T (x_c - x_p) - r0), phi = the angle of

@@ -80,7 +80,7 @@ void AddLoopConstraints(const SystemModel& model, const DofMap& dofs, const Syst
     const int nodes[2] = {j.parent, j.child};
     const ConstraintBlock block = EvaluateConstraint(j, state.x[nodes[0]], state.R[nodes[0]], state.x[nodes[1]], state.R[nodes[1]]);
     const int first = dofs.multiplier_first(int(c)), m = int(cut.equations.size());
-    Eigen::VectorXd l_full = Eigen::VectorXd::Zero(block.g.size());  // dropped equations: none
+    ConstraintValues l_full = ConstraintValues::Zero(block.g.size());  // dropped equations: none
     for (int i = 0; i < m; ++i) l_full[cut.equations[size_t(i)]] = state.lambda[first - dofs.first_multiplier() + i];
     const Eigen::Matrix<double, 12, 1> f = block.G.transpose() * l_full;  // G^T lambda on (parent, child)
     for (int e = 0; e < 2; ++e) {
@@ -244,7 +244,7 @@ std::vector<Eigen::Matrix<double, 6, 1>> CutJointReactions(const SystemModel& mo
   for (const CutJoint& cut : model.cut_joints) {
     const NodeJoint& j = cut.joint;
     const ConstraintBlock block = EvaluateConstraint(j, state.x[j.parent], state.R[j.parent], state.x[j.child], state.R[j.child]);
-    Eigen::VectorXd l_full = Eigen::VectorXd::Zero(block.g.size());
+    ConstraintValues l_full = ConstraintValues::Zero(block.g.size());
     for (size_t i = 0; i < cut.equations.size(); ++i) l_full[cut.equations[i]] = state.lambda[first + long(i)];
     first += int(cut.equations.size());
     out.push_back(-(block.G.rightCols<6>().transpose() * l_full));

@@ -11,11 +11,11 @@
 // gravity and a dead load; bodies on one thread and on two; fixed and error-controlled steps;
 // the bodies' inertia matrices kept in their frames (body_matrices_every)
 // (but the restart at a breakpoint of a load or drive); the same for the midpoint scheme but
-// the kept matrices. Not covered (they may still allocate): closed loops and interface
-// constraints, spring-dampers, follower loads, results recording (femb-solve's output, outside
-// SolveDynamic).
+// the kept matrices; spring-dampers; a closed loop (cut joint). Not covered (they may still
+// allocate): bodies' interface constraints, follower loads, results recording (femb-solve's
+// output, outside SolveDynamic).
 // FEMB_ALLOCATION_TRACE=1 prints the call stack of every allocation counted (to find them);
-// =linear, =stiffened, =threads, =adaptive, =kept or =midpoint: of those cases only.
+// =linear, =stiffened, =threads, =adaptive, =kept, =midpoint, =springs or =loop: of those cases only.
 #include <execinfo.h>
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -60,6 +60,41 @@ void PrintStack() {
   tip.force = Eigen::Vector3d(0, 0, 5.0);
   tip.scale = [](double) { return 1.0; };
   model.loads.push_back(tip);
+  return model;
+}
+
+// The chain closed into a loop through the ground: its tip joined to a clamped node by a cut
+// revolute joint (5 constraint equations, multipliers among the unknowns).
+[[maybe_unused]] SystemModel PinnedChain(const Superelement& se, double L) {
+  SystemModel model = Chain(se, L);
+  const int pin = AddNode(model, "pin", Eigen::Vector3d(4 * L, 0, 0));
+  Clamp(model, pin);
+  CutJoint cut;
+  cut.joint = MakeNodeJoint(JointType::kRevolute, 4, pin, Eigen::Vector3d::UnitZ(), model.node_x0[size_t(pin)],
+                            model.node_R0[size_t(pin)], model.node_x0[4], model.node_R0[4]);
+  cut.name = "pin";
+  for (int i = 0; i < ConstraintCount(JointType::kRevolute); ++i) cut.equations.push_back(i);
+  model.cut_joints.push_back(cut);
+  return model;
+}
+
+// The chain with a spring-damper from its tip to a point above it and one between two of its nodes.
+[[maybe_unused]] SystemModel SprungChain(const Superelement& se, double L) {
+  SystemModel model = Chain(se, L);
+  SpringDamper to_ground;
+  to_ground.node_a = 4;
+  to_ground.ground = Eigen::Vector3d(4 * L, 0.5, 0);
+  to_ground.stiffness = 200.0;
+  to_ground.damping = 2.0;
+  to_ground.free_length = 0.4;
+  model.springs.push_back(to_ground);
+  SpringDamper between;
+  between.node_a = 1;
+  between.node_b = 3;
+  between.stiffness = 50.0;
+  between.damping = 0.5;
+  between.free_length = 2 * L;
+  model.springs.push_back(between);
   return model;
 }
 
@@ -136,6 +171,16 @@ TEST(AllocationFree, GeneralizedAlphaStepsAllocateNothing) {
   std::printf("[ info ] stiffened slider-crank, body_matrices_every 4: at most %ld allocations in a step (%ld steps counted)\n",
               kept, steps);
   EXPECT_EQ(kept, 0);
+  // Spring-dampers (their forces, matrices and energy).
+  const long sprung = LargestAllocationsPerStep(SprungChain(se, 0.25), 1e-3, "springs", &steps);
+  std::printf("[ info ] stiffened chain with 2 spring-dampers: at most %ld allocations in a step (%ld steps counted)\n",
+              sprung, steps);
+  EXPECT_EQ(sprung, 0);
+  // A closed loop (cut joint): its equations, forces and matrix blocks.
+  const long loop = LargestAllocationsPerStep(PinnedChain(se, 0.25), 1e-3, "loop", &steps);
+  std::printf("[ info ] stiffened chain closed by a cut joint: at most %ld allocations in a step (%ld steps counted)\n",
+              loop, steps);
+  EXPECT_EQ(loop, 0);
 }
 
 TEST(AllocationFree, MidpointStepsAllocateNothing) {
@@ -171,6 +216,16 @@ TEST(AllocationFree, MidpointStepsAllocateNothing) {
   std::printf("[ info ] midpoint, stiffened slider-crank, step: auto: at most %ld allocations in a step (%ld steps counted)\n",
               adaptive, steps);
   EXPECT_EQ(adaptive, 0);
+  const long sprung =
+      LargestAllocationsPerStep(SprungChain(se, 0.25), 1e-3, "springs", &steps, 1, false, 1, Integrator::kMidpoint);
+  std::printf("[ info ] midpoint, stiffened chain with 2 spring-dampers: at most %ld allocations in a step (%ld steps counted)\n",
+              sprung, steps);
+  EXPECT_EQ(sprung, 0);
+  const long loop =
+      LargestAllocationsPerStep(PinnedChain(se, 0.25), 1e-3, "loop", &steps, 1, false, 1, Integrator::kMidpoint);
+  std::printf("[ info ] midpoint, stiffened chain closed by a cut joint: at most %ld allocations in a step (%ld steps counted)\n",
+              loop, steps);
+  EXPECT_EQ(loop, 0);
 }
 #endif
 
