@@ -3,10 +3,11 @@
 // assembly of one pass over the bodies and the kept iteration matrix. Not an interface for
 // other code.
 //
-// Storage (issue 14): a generalized-alpha step allocates nothing once the first steps have
-// sized everything (tests/solver/analysis/allocation_free_test.cpp counts it). Everything a step
-// or an iteration needs lives in the BodyWorkspace, in each body's Data (its scratch) or in
-// thread_local scratch of the joint-tree functions, and is written in place: no Eigen object
+// Storage (issue 14): a step of either integrator allocates nothing once the first steps have
+// sized everything (tests/solver/analysis/allocation_free_test.cpp counts it; bodies' interface
+// constraints excepted). Everything a step or an iteration needs lives in the BodyWorkspace
+// (the midpoint scheme's in its MidpointWorkspace), in each body's Data (its scratch) or in
+// thread_local scratch of the joint-tree and force functions, and is written in place: no Eigen object
 // returned by value, no product of dynamic-size blocks assigned without noalias() or a fixed-size
 // holder, no std::function built per call (BodyTask), no std::optional reset that frees.
 #pragma once

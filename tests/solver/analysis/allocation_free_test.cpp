@@ -11,8 +11,8 @@
 // gravity and a dead load; bodies on one thread and on two; fixed and error-controlled steps;
 // the bodies' inertia matrices kept in their frames (body_matrices_every)
 // (but the restart at a breakpoint of a load or drive); the same for the midpoint scheme but
-// the kept matrices; spring-dampers; a closed loop (cut joint). Not covered (they may still
-// allocate): bodies' interface constraints, follower loads, results recording (femb-solve's
+// the kept matrices; spring-dampers, a follower load, a closed loop (cut joint). Not covered
+// (they may still allocate): bodies' interface constraints, results recording (femb-solve's
 // output, outside SolveDynamic).
 // FEMB_ALLOCATION_TRACE=1 prints the call stack of every allocation counted (to find them);
 // =linear, =stiffened, =threads, =adaptive, =kept, =midpoint, =springs or =loop: of those cases only.
@@ -78,9 +78,11 @@ void PrintStack() {
   return model;
 }
 
-// The chain with a spring-damper from its tip to a point above it and one between two of its nodes.
+// The chain with a spring-damper from its tip to a point above it and one between two of its
+// nodes, its tip load a follower load (turning with the node).
 [[maybe_unused]] SystemModel SprungChain(const Superelement& se, double L) {
   SystemModel model = Chain(se, L);
+  model.loads[0].follower = true;
   SpringDamper to_ground;
   to_ground.node_a = 4;
   to_ground.ground = Eigen::Vector3d(4 * L, 0.5, 0);
@@ -171,9 +173,9 @@ TEST(AllocationFree, GeneralizedAlphaStepsAllocateNothing) {
   std::printf("[ info ] stiffened slider-crank, body_matrices_every 4: at most %ld allocations in a step (%ld steps counted)\n",
               kept, steps);
   EXPECT_EQ(kept, 0);
-  // Spring-dampers (their forces, matrices and energy).
+  // Spring-dampers (their forces, matrices and energy) and a follower load.
   const long sprung = LargestAllocationsPerStep(SprungChain(se, 0.25), 1e-3, "springs", &steps);
-  std::printf("[ info ] stiffened chain with 2 spring-dampers: at most %ld allocations in a step (%ld steps counted)\n",
+  std::printf("[ info ] stiffened chain with 2 spring-dampers and a follower load: at most %ld allocations in a step (%ld steps counted)\n",
               sprung, steps);
   EXPECT_EQ(sprung, 0);
   // A closed loop (cut joint): its equations, forces and matrix blocks.
@@ -218,7 +220,7 @@ TEST(AllocationFree, MidpointStepsAllocateNothing) {
   EXPECT_EQ(adaptive, 0);
   const long sprung =
       LargestAllocationsPerStep(SprungChain(se, 0.25), 1e-3, "springs", &steps, 1, false, 1, Integrator::kMidpoint);
-  std::printf("[ info ] midpoint, stiffened chain with 2 spring-dampers: at most %ld allocations in a step (%ld steps counted)\n",
+  std::printf("[ info ] midpoint, stiffened chain with 2 spring-dampers and a follower load: at most %ld allocations in a step (%ld steps counted)\n",
               sprung, steps);
   EXPECT_EQ(sprung, 0);
   const long loop =
