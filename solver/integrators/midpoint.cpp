@@ -230,8 +230,9 @@ void AddDiscreteGradientCorrection(const SystemModel& model, const DofMap& dofs,
 }
 
 // Residual (applied minus inertia and internal forces, over the coordinates) of the midpoint
-// balance and the matrices' triplets at the mid configuration (work.parts), into `out`. The
-// momenta at the step's start are in work.midpoint.bodies (MidpointStep).
+// balance, into `out`; each body's data at both configurations kept for the iteration matrix
+// (MidpointMatrix), which an iteration builds only when it needs one. The momenta at the step's
+// start are in work.midpoint.bodies (MidpointStep).
 void AssembleMidpoint(const SystemModel& model, const DofMap& dofs, const DynamicState& s0, double h,
                       DynamicState& s1, BodyWorkspace& work, BodyThreads* threads, double& f_ext_work, Assembly& out) {
   MidpointWorkspace& mw = work.midpoint;
@@ -283,15 +284,10 @@ void AssembleMidpoint(const SystemModel& model, const DofMap& dofs, const Dynami
     for (int a = 0; a < body.n_nodes(); ++a) wm.segment<6>(6 * a) = NodeStep(s0.config, s1.config, model.body_nodes[b][a]) / h;
     wm.tail(body.n_modes()) = (s1.config.eta[b] - s0.config.eta[b]) / h;
     Eigen::VectorXd &f_in = r.f_in, &f_int = r.f_int, &f_acc = r.f_acc;
-    Eigen::MatrixXd &Kb = r.K, &Mb = r.M, &Cb = r.C;
-    // M_g at the end of the step: the 2/h^2 term of the iteration matrix is d p_n+1 / h; at
-    // the mid configuration it would be off by O(omega h) and leave a 1/h error.
-    Mb = maps1.Mg;
     m.dw = w1 - m.w0;
     f_acc.resize(body.n_coordinates());
-    f_acc.noalias() = Mb * m.dw;
+    f_acc.noalias() = maps1.Mg * m.dw;
     f_acc /= h;
-    Cb.setZero(body.n_coordinates(), body.n_coordinates());
     if (body.options().quadratic_velocity_terms) {
       // Source terms with the node motion of each half step, so that their moment matches the
       // change of sum x_k x p_k exactly: x_m is not the mean of x_n and x_n+1.
@@ -319,31 +315,19 @@ void AssembleMidpoint(const SystemModel& model, const DofMap& dofs, const Dynami
         body.MomentumSource(maps_m, wm, m.p_mean, m.s_first, dm.scratch);
         f_in = (m.p1 - m.p0) / h - m.s_first;
       }
-      // Iteration matrix: with dp_n+1 = (M_g V + D) delta (V = d W_n+1 / d delta ~ 2/h,
-      // D = d p / dq at fixed w) and dw_a ~ delta / h,
-      //   d f_in / d delta = [M_g V + D - d_w s(p_mean) - (d_p s) M_g] / h + O(1).
-      // All the 1/h terms are needed (and M_g at n+1, V with its O(omega) part): each is
-      // O(omega h) of the leading one, and without them Newton contracts only by ~omega h per
-      // iteration, or worse on stiff, lightly inertial directions such as a tube's torsion.
-      m.p_mean = 0.5 * (m.p0 + m.p1);
-      body.MomentumSourceDerivatives(maps_m, wm, m.p_mean, m.d_w, m.d_p, dm.scratch);
-      body.MomentumDerivative(maps1, w1, Cb, d1.scratch);
-      Cb -= m.d_w;
-      Cb.noalias() -= m.d_p * Mb;
     } else {
       f_in = f_acc;
     }
-    body.AddModalDamping(wm, f_in, &Cb);
+    m.p_mean = 0.5 * (m.p0 + m.p1);  // (for the source's derivatives in the matrices)
+    body.AddModalDamping(wm, f_in, nullptr);
     if (body.has_inertia_stiffening()) {
       // Inertia stiffening (issue 13) at the mid configuration with the step's mean velocity and
-      // acceleration; d wm = delta / h (C / h) and d (w1 - w0) / h = V delta / h (M V / h).
+      // acceleration.
       m.wdot = m.dw / h;
       body.InertiaLoads(dm, wm, m.wdot, model.gravity, m.load);
-      body.ElasticForce(dm, &f_int, &Kb, &m.load, &m.d_load);
-      Cb.noalias() += m.d_load * m.load.d_w;
-      Mb.noalias() += m.d_load * m.load.d_wdot;
+      body.ElasticForce(dm, &f_int, nullptr, &m.load);
     } else {
-      body.ElasticForce(dm, &f_int, &Kb);
+      body.ElasticForce(dm, &f_int, nullptr);
     }
     Eigen::VectorXd& f_grav = r.f_grav;
     if (model.gravity.squaredNorm() > 0) {
@@ -382,7 +366,7 @@ void AssembleMidpoint(const SystemModel& model, const DofMap& dofs, const Dynami
   AddLoopConstraints(model, dofs, k.mid, &out.residual, nullptr, &parts.node_forces);
   // Loads at the mid time and configuration, spring-dampers at the mean rates Delta / h.
   mw.rates = k.delta / h;
-  FinishAssembly(model, dofs, k.mid, s0.t + 0.5 * h, mw.rates, true, parts, out);
+  FinishAssembly(model, dofs, k.mid, s0.t + 0.5 * h, mw.rates, false, parts, out);
   AddDiscreteGradientCorrection(model, dofs, s0.config, s1.config, k, L2, mw, out);
   // The external work of the step, as the forces' discrete gradients do it: gravity's potential
   // change, and the nodal loads (at q_m) times the nodes' motion.
@@ -396,6 +380,89 @@ void AssembleMidpoint(const SystemModel& model, const DofMap& dofs, const Dynami
       f_ext_work += NodeStep(s0.config, s1.config, node).dot(mw.loads.f[size_t(node)]);
     }
   }
+}
+
+// The iteration matrix S = K T + (C + M V) / h of the residual pass `a` just made (the same
+// iterate): Newton's increment delta at n+1 moves W_n+1 by V delta, q_m by T delta and the step's
+// motion w_m by ~delta / h. Each body's K, C, M at the pass's data (on the threads, added in body
+// order), the loads', spring-dampers' and joints' blocks, the loops'; built from triplets.
+const SystemMatrix& MidpointMatrix(const SystemModel& model, const DofMap& dofs, const DynamicState& s0, double h,
+                                   const DynamicState& s1, BodyWorkspace& work, BodyThreads* threads,
+                                   const Assembly& a) {
+  MidpointWorkspace& mw = work.midpoint;
+  const MidpointKinematics& k = mw.k;
+  const std::vector<RotationNode>& triples = work.rotation_triples;
+  const int n_bodies = int(model.bodies.size());
+  work.matrices.resize(size_t(n_bodies));
+  ForEachBody(threads, n_bodies, [&](int b) {
+    const SuperelementBody& body = model.bodies[b];
+    const BodyPass& pass = work.passes[size_t(b)];
+    MidpointBody& m = mw.bodies[size_t(b)];
+    BodyWorkspace::BodyMatrices& r = work.matrices[size_t(b)];
+    const bool stiffening = body.has_inertia_stiffening();
+    body.ElasticForce(m.dm, nullptr, &r.K, stiffening ? &m.load : nullptr, stiffening ? &r.d_load : nullptr);
+    // M_g at the end of the step: the 2/h^2 term of the iteration matrix is d p_n+1 / h; at
+    // the mid configuration it would be off by O(omega h) and leave a 1/h error.
+    const BodyVelocityMaps& maps1 = body.MapsOf(pass.data);
+    r.M = maps1.Mg;
+    if (body.options().quadratic_velocity_terms) {
+      // With dp_n+1 = (M_g V + D) delta (V = d W_n+1 / d delta ~ 2/h, D = d p / dq at fixed w)
+      // and dw_a ~ delta / h,
+      //   d f_in / d delta = [M_g V + D - d_w s(p_mean) - (d_p s) M_g] / h + O(1).
+      // All the 1/h terms are needed (and M_g at n+1, V with its O(omega) part): each is
+      // O(omega h) of the leading one, and without them Newton contracts only by ~omega h per
+      // iteration, or worse on stiff, lightly inertial directions such as a tube's torsion.
+      body.MomentumSourceDerivatives(body.MapsOf(m.dm), m.wm, m.p_mean, m.d_w, m.d_p, m.dm.scratch);
+      body.MomentumDerivative(maps1, pass.w, r.C, pass.data.scratch);
+      r.C -= m.d_w;
+      r.C.noalias() -= m.d_p * r.M;
+    } else {
+      r.C.setZero(body.n_coordinates(), body.n_coordinates());
+    }
+    r.unused.setZero(body.n_coordinates());
+    body.AddModalDamping(m.wm, r.unused, &r.C);
+    if (stiffening) {
+      // The inertia loads' velocity and acceleration derivatives: d wm = delta / h (into C / h)
+      // and d (w1 - w0) / h = V delta / h (into M V / h).
+      r.C.noalias() += r.d_load * m.load.d_w;
+      r.M.noalias() += r.d_load * m.load.d_wdot;
+    }
+  });
+  Triplets &K = work.K, &C = work.C, &M = work.M;
+  K.clear();
+  C.clear();
+  M.clear();
+  for (int b = 0; b < n_bodies; ++b) {
+    const BodyWorkspace::BodyMatrices& r = work.matrices[size_t(b)];
+    const std::vector<MapEntry>& map = work.terms[size_t(b)].map;  // the residual pass's, at q_m
+    ScatterBody(map, nullptr, &r.K, nullptr, &K);
+    ScatterBody(map, nullptr, &r.C, nullptr, &C);
+    ScatterBody(map, nullptr, &r.M, nullptr, &M);
+  }
+  // Loads at the mid time and configuration, spring-dampers at the mean rates Delta / h, the
+  // joints' geometric stiffness with the pass's node forces.
+  mw.unused.setZero(dofs.n_dofs());
+  AddNodeLoads(model, k.mid, s0.t + 0.5 * h, mw.unused, &K);
+  AddSpringDampers(model, k.mid, mw.rates, mw.unused, &K, &C, nullptr);
+  AddJointGeometricStiffness(model, dofs, k.mid, a.node_forces, K);
+  Triplets& S = mw.S;
+  S.clear();
+  AddTimesColumns(K, 1.0, k.T, triples, mw.triple_of, S);
+  for (const Eigen::Triplet<double>& e : C) S.emplace_back(e.row(), e.col(), e.value() / h);
+  AddTimesColumns(M, 1.0 / h, k.V, triples, mw.triple_of, S);
+  if (dofs.n_multipliers() > 0) {
+    // Loops: d(-G_m^T lambda)/d delta = H_m T, its lambda columns G_m^T, the rows G_n+1.
+    mw.loop_mid.clear();
+    AddLoopConstraints(model, dofs, k.mid, nullptr, &mw.loop_mid, nullptr, nullptr, kLoopHessian);
+    AddTimesColumns(mw.loop_mid, 1.0, k.T, triples, mw.triple_of, S);
+    mw.loop_mid.clear();
+    mw.loop_end.clear();
+    AddLoopConstraints(model, dofs, k.mid, nullptr, &mw.loop_mid, nullptr, nullptr, kLoopColumns);
+    AddLoopConstraints(model, dofs, s1.config, nullptr, &mw.loop_end, nullptr, nullptr, kLoopRows);
+    S.insert(S.end(), mw.loop_end.begin(), mw.loop_end.end());
+    S.insert(S.end(), mw.loop_mid.begin(), mw.loop_mid.end());
+  }
+  return mw.S_build.Build(dofs.n_dofs(), S);
 }
 
 }  // namespace
@@ -487,29 +554,10 @@ StepOutcome MidpointStep(const SystemModel& model, const DofMap& dofs, const Dyn
       return out;
     }
     if (divergence.Diverged(out.iterations, r_norm)) return out;
-    // Newton's increment delta at n+1: dW_n+1 = V delta, dq_m = T delta, dw_m ~ delta / h, so
-    // the iteration matrix is K T + (C + M V) / h, built from the assembly's triplets.
+    // Newton's increment at n+1, with the iteration matrix built only when it is factored.
     const SystemMatrix* built = nullptr;
     const auto S = [&]() -> const SystemMatrix& {
-      if (built) return *built;
-      Triplets& S = mw.S;
-      S.clear();
-      AddTimesColumns(work.parts.K, 1.0, k.T, triples, mw.triple_of, S);
-      for (const Eigen::Triplet<double>& e : work.parts.C) S.emplace_back(e.row(), e.col(), e.value() / h);
-      AddTimesColumns(work.parts.M, 1.0 / h, k.V, triples, mw.triple_of, S);
-      if (n_lambda > 0) {
-        // Loops: d(-G_m^T lambda)/d delta = H_m T, its lambda columns G_m^T, the rows G_n+1.
-        mw.loop_mid.clear();
-        AddLoopConstraints(model, dofs, k.mid, nullptr, &mw.loop_mid, nullptr, nullptr, kLoopHessian);
-        AddTimesColumns(mw.loop_mid, 1.0, k.T, triples, mw.triple_of, S);
-        mw.loop_mid.clear();
-        mw.loop_end.clear();
-        AddLoopConstraints(model, dofs, k.mid, nullptr, &mw.loop_mid, nullptr, nullptr, kLoopColumns);
-        AddLoopConstraints(model, dofs, next.config, nullptr, &mw.loop_end, nullptr, nullptr, kLoopRows);
-        S.insert(S.end(), mw.loop_end.begin(), mw.loop_end.end());
-        S.insert(S.end(), mw.loop_mid.begin(), mw.loop_mid.end());
-      }
-      built = &mw.S_build.Build(dofs.n_dofs(), S);
+      if (!built) built = &MidpointMatrix(model, dofs, state, h, next, work, &threads, a);
       return *built;
     };
     Eigen::VectorXd& delta = work.delta;
