@@ -33,5 +33,8 @@ echo
 # The solver's hot path against the commit issue 14 measured (9db5b40; builds it once in
 # /tmp, about 10 minutes, then about 2 minutes): not run here, run it by hand:
 #   bash benchmarks/hot_path_vs_base.sh [BASE]
+# The midpoint scheme against its state before the allocation-free rewrite (ab9796a; builds it
+# once in /tmp, about 6 minutes, then about 20 s): by hand too:
+#   bash benchmarks/midpoint_vs_base.sh [BASE]
 # The four-bar coupler's energy with and without geometric stiffening (issue 13; about 40 s).
 /usr/bin/python3 benchmarks/stiffening_energy.py build/bin out/stiffening_energy
