@@ -13,14 +13,9 @@ base=${1:-9db5b40}
 base_dir=${BASE_DIR:-/tmp/femb_base_$base}
 out=${OUT:-/tmp/femb_hot_path}
 export OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1
-if [ ! -x "$base_dir/build/bin/femb-solve" ]; then
-  echo "building $base in $base_dir (once; about 10 minutes)"
-  [ -d "$base_dir" ] || git -C "$here" worktree add -f "$base_dir" "$base" > /dev/null
-  mkdir -p "$base_dir/build"
-  (cd "$base_dir/build" && cmake .. -DCMAKE_BUILD_TYPE=Release > /dev/null &&
-   make -j"$(nproc)" femb-reduce femb-solve solver_scaling_benchmark > /dev/null)
-fi
-[ -x "$here/build/bin/femb-solve" ] || bash "$here/scripts/build.sh" > /dev/null
+# shellcheck source=benchmarks/base_tree.sh
+source "$here/benchmarks/base_tree.sh"
+build_trees femb-reduce femb-solve solver_scaling_benchmark
 mkdir -p "$out"
 # Each tree's slider-crank with its own tools (file formats may differ between commits).
 prepare() {  # tree, dir

@@ -16,14 +16,9 @@ base=${1:-ab9796a}
 base_dir=${BASE_DIR:-/tmp/femb_base_$base}
 out=${OUT:-/tmp/femb_midpoint}
 export OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1
-if [ ! -x "$base_dir/build/bin/femb-solve" ]; then
-  echo "building $base in $base_dir (once; about 10 minutes)"
-  [ -d "$base_dir" ] || git -C "$here" worktree add -f "$base_dir" "$base" > /dev/null
-  mkdir -p "$base_dir/build"
-  (cd "$base_dir/build" && cmake .. -DCMAKE_BUILD_TYPE=Release > /dev/null &&
-   make -j"$(nproc)" femb-reduce femb-solve > /dev/null)
-fi
-[ -x "$here/build/bin/femb-solve" ] || bash "$here/scripts/build.sh" > /dev/null
+# shellcheck source=benchmarks/base_tree.sh
+source "$here/benchmarks/base_tree.sh"
+build_trees femb-reduce femb-solve
 # Each tree's scenes with its own reducer (file formats may differ between commits).
 prepare() {  # tree, dir
   local tree=$1 dir=$2 ex=$1/examples reduce=$1/build/bin/femb-reduce
