@@ -116,6 +116,43 @@ void AddTimesColumns(const Triplets& in, double scale, const StepColumnMap& X, c
   }
 }
 
+// out += B^T (K B T' + M B V' / h) for a body's K and M (local) and map B, T' = T - T_d 1 and
+// V' = V - V_d 1 (StepColumnMap: nonzero on the rotation nodes' triples only): only the map's
+// entries on such coordinates give columns. Every entry is kept, zero or not, so that the
+// triplets come in the same sequence at every iteration (TripletAssembler).
+void AddRotationColumns(const std::vector<MapEntry>& map, const Eigen::MatrixXd& K, const Eigen::MatrixXd& M, double h,
+                        const MidpointKinematics& k, const std::vector<RotationNode>& nodes,
+                        const std::vector<int>& triple_of, Triplets& out) {
+  for (const MapEntry& col : map) {
+    const int t = triple_of[size_t(col.coordinate)];
+    if (t < 0) continue;
+    const size_t i = size_t(t / 2);
+    const RotationNode& r = nodes[i];
+    // Row col.coordinate of T' and V': its own triple's block less the diagonal, and for a free
+    // node's translation the coupling block onto the rotation triple.
+    const bool translation = t % 2 == 1;
+    const int own = translation ? r.translation : r.rotation, c = col.coordinate - own;
+    Eigen::Matrix<double, 1, 6> tr = Eigen::Matrix<double, 1, 6>::Zero(), vr = tr;
+    int first[2] = {own, r.rotation};
+    tr.head<3>() = (translation ? k.T.translation[i] : k.T.rotation[i]).row(c);
+    vr.head<3>() = (translation ? k.V.translation[i] : k.V.rotation[i]).row(c);
+    tr[c] -= k.T.diagonal;
+    vr[c] -= k.V.diagonal;
+    const int blocks = translation ? 2 : 1;
+    if (translation) {
+      tr.tail<3>() = k.T.coupling[i].row(c);
+      vr.tail<3>() = k.V.coupling[i].row(c);
+    }
+    for (const MapEntry& row : map) {
+      const double vk = row.coefficient * col.coefficient * K(row.local, col.local);
+      const double vm = row.coefficient * col.coefficient * M(row.local, col.local) / h;
+      for (int b = 0; b < blocks; ++b) {
+        for (int m = 0; m < 3; ++m) out.emplace_back(row.coordinate, first[b] + m, vk * tr[3 * b + m] + vm * vr[3 * b + m]);
+      }
+    }
+  }
+}
+
 // The step's kinematics (MidpointKinematics) at the current end state s1; sets s1's end
 // velocities. Into k (its storage reused).
 void Midpoint(const SystemModel& model, const DofMap& dofs, const std::vector<RotationNode>& nodes,
@@ -428,28 +465,31 @@ const SystemMatrix& MidpointMatrix(const SystemModel& model, const DofMap& dofs,
       r.M.noalias() += r.d_load * m.load.d_wdot;
     }
   });
-  Triplets &K = work.K, &C = work.C, &M = work.M;
-  K.clear();
-  C.clear();
-  M.clear();
+  // T = T_d 1 + T', V = V_d 1 + V' with T', V' on the rotation nodes' triples only, so a body's
+  // share B^T (K B T + C B / h + M B V / h) is B^T S_b B, S_b = T_d K + C / h + V_d / h M combined
+  // here (one scatter instead of three), plus K and M through T' and V' on the columns of its
+  // rotation-node coordinates (AddRotationColumns).
+  Triplets& S = mw.S;
+  S.clear();
   for (int b = 0; b < n_bodies; ++b) {
-    const BodyWorkspace::BodyMatrices& r = work.matrices[size_t(b)];
+    BodyWorkspace::BodyMatrices& r = work.matrices[size_t(b)];
     const std::vector<MapEntry>& map = work.terms[size_t(b)].map;  // the residual pass's, at q_m
-    ScatterBody(map, nullptr, &r.K, nullptr, &K);
-    ScatterBody(map, nullptr, &r.C, nullptr, &C);
-    ScatterBody(map, nullptr, &r.M, nullptr, &M);
+    Eigen::MatrixXd& S_b = r.inertia_K;  // (GA's scratch name; here the combined body matrix)
+    S_b = k.T.diagonal * r.K + (1.0 / h) * r.C + (k.V.diagonal / h) * r.M;
+    ScatterBody(map, nullptr, &S_b, nullptr, &S);
+    AddRotationColumns(map, r.K, r.M, h, k, triples, mw.triple_of, S);
   }
   // Loads at the mid time and configuration, spring-dampers at the mean rates Delta / h, the
-  // joints' geometric stiffness with the pass's node forces.
+  // joints' geometric stiffness with the pass's node forces: through T and V whole.
+  Triplets &K = work.K, &C = work.C;
+  K.clear();
+  C.clear();
   mw.unused.setZero(dofs.n_dofs());
   AddNodeLoads(model, k.mid, s0.t + 0.5 * h, mw.unused, &K);
   AddSpringDampers(model, k.mid, mw.rates, mw.unused, &K, &C, nullptr);
   AddJointGeometricStiffness(model, dofs, k.mid, a.node_forces, K);
-  Triplets& S = mw.S;
-  S.clear();
   AddTimesColumns(K, 1.0, k.T, triples, mw.triple_of, S);
   for (const Eigen::Triplet<double>& e : C) S.emplace_back(e.row(), e.col(), e.value() / h);
-  AddTimesColumns(M, 1.0 / h, k.V, triples, mw.triple_of, S);
   if (dofs.n_multipliers() > 0) {
     // Loops: d(-G_m^T lambda)/d delta = H_m T, its lambda columns G_m^T, the rows G_n+1.
     mw.loop_mid.clear();
