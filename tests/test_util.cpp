@@ -2,10 +2,16 @@
 
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <sstream>
 
+#include "reducer/fe/beam_model.h"
 #include "reducer/reduce_part.h"
+#include "reducer/reduction/full_modes.h"
 
 namespace femb::test {
 
@@ -119,6 +125,29 @@ Superelement Reduce(const std::string& yaml, const std::vector<std::string>& ove
   ReduceResult r = ReducePart(part, nullptr);
   EXPECT_TRUE(r.ok) << r.message;
   return r.superelement;
+}
+
+Superelement BendingShapesRod(double L) {
+  const std::string beam = StraightBeamYaml(L, 20, "{shape: circle, diameter: 0.02}", "{E: 2.0e9, nu: 0.3, rho: 7800}",
+                                            "[{name: A}, {name: B}]");
+  const FeModel model = BuildBeamModel(ParsePart(beam, "rod.yaml"));
+  Eigen::MatrixXd modes;
+  Eigen::VectorXd lambda;
+  EXPECT_TRUE(FullFreeFreeFrequencies(model, 10, 1.0, &modes, &lambda).ok);
+  const std::filesystem::path path =
+      std::filesystem::temp_directory_path() / ("femb_bending_shapes_" + std::to_string(::getpid()) + ".mtx");
+  {
+    std::ofstream out(path);
+    out.precision(17);
+    out << "%%MatrixMarket matrix array real general\n" << modes.rows() << " 4\n";
+    for (long j = 6; j < 10; ++j)
+      for (long i = 0; i < modes.rows(); ++i) out << modes(i, j) << "\n";
+  }
+  const Superelement se =
+      Reduce(beam + "reduction: {method: general, basis: {file: " + path.string() + "}, floating_frame: mean_axes}\n");
+  std::filesystem::remove(path);
+  EXPECT_EQ(se.interface_constraint.rows(), 2);
+  return se;
 }
 
 }  // namespace femb::test

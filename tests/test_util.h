@@ -30,6 +30,12 @@ SystemModel ClampedOneBodyModel(const Superelement& se, double L, const Eigen::V
 /// stiffening (and with it the exact inertia), reduced in memory.
 Superelement TubeSegment(double L, int elements, bool stiffened);
 
+/// A rod of length L along x (20 beam elements, d = 20 mm, E = 2e9 Pa, rho = 7800, interfaces A
+/// and B at its ends) reduced on its four lowest free-free bending shapes (two per plane) through
+/// femb-reduce's general basis from a Matrix Market file on the beam's DOFs: it cannot stretch or
+/// twist, and carries the interface constraint C q_int = 0 (2 rows; thesis 8.2 case 4).
+Superelement BendingShapesRod(double L);
+
 /// A slider-crank: crank O-A of length Lc (body `crank`, default options) driven at 150 rad/s
 /// about z (revolute to ground, prescribed), a rod of two bodies `rod` of length Lr each hinged to
 /// A (node rod_a) and to the slider node (rod_b), which slides along x (prismatic to ground);

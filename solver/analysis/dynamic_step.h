@@ -4,8 +4,7 @@
 // other code.
 //
 // Storage (issue 14): a step of either integrator allocates nothing once the first steps have
-// sized everything (tests/solver/analysis/allocation_free_test.cpp counts it; bodies' interface
-// constraints excepted). Everything a step or an iteration needs lives in the BodyWorkspace
+// sized everything (tests/solver/analysis/allocation_free_test.cpp counts it). Everything a step or an iteration needs lives in the BodyWorkspace
 // (the midpoint scheme's in its MidpointWorkspace), in each body's Data (its scratch) or in
 // thread_local scratch of the joint-tree and force functions, and is written in place: no Eigen object
 // returned by value, no product of dynamic-size blocks assigned without noalias() or a fixed-size
@@ -136,6 +135,7 @@ struct MidpointBody {
 // The midpoint scheme's storage, kept from one iteration and one step to the next (issue 14).
 struct MidpointWorkspace {
   std::vector<MidpointBody> bodies;
+  BodyDataAtState mid_data;  // &bodies[b].dm, for the bodies' interface constraints at q_m
   MidpointKinematics k;
   std::vector<char> free_node;       // per body: it has a free node
   std::vector<double> gravity_work;  // per body
@@ -152,6 +152,7 @@ struct MidpointWorkspace {
 // next so that evaluating a body reuses its matrices instead of allocating them (issue 14).
 struct BodyWorkspace {
   std::vector<BodyPass> passes;  // the last residual pass; after a converged step, at its state
+  BodyDataAtState pass_data;     // &passes[b].data, for the bodies' interface constraints
   std::vector<BodyTerms> terms;  // the last residual pass's; their maps serve the matrix pass too
   struct BodyMatrices {
     Eigen::MatrixXd K, C, M;

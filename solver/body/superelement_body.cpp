@@ -510,7 +510,10 @@ void SuperelementBody::InterfaceConstraint(const Data& d, Eigen::VectorXd* g, Ei
                                            const Eigen::VectorXd* lambda, Eigen::MatrixXd* H) const {
   const int n = n_coordinates(), r = n_constraints(), nb = 6 * n_nodes_;
   const Eigen::Matrix3d R = d.frame.R, Rt = d.frame.R.transpose();
-  if (g) *g = C_ * d.q.head(nb);
+  if (g) {
+    g->resize(r);
+    g->noalias() = C_ * d.q.head(nb);
+  }
   if (G) {
     // d q_loc = B Rbar^T dq (exact, also with the approximated option: this is a constraint).
     G->resize(r, n);
@@ -521,9 +524,11 @@ void SuperelementBody::InterfaceConstraint(const Data& d, Eigen::VectorXd* g, Ei
   // G^T lambda = Rbar B^T Q with Q = C^T lambda (zero on the modal rows): the elastic force's
   // form with a local force that does not depend on the configuration, so its derivative is
   // K2 + K3 + K4 of that Q (no K1).
-  Eigen::VectorXd Q = Eigen::VectorXd::Zero(n);
-  Q.head(nb) = C_.transpose() * *lambda;
-  const Eigen::VectorXd Qhat = d.kin.B.transpose() * Q;
+  Eigen::VectorXd &Q = d.scratch.v4, &Qhat = d.scratch.v3;  // (AddGeometricTangent takes v1, v2)
+  Q.setZero(n);
+  Q.head(nb).noalias() = C_.transpose() * *lambda;
+  Qhat.resize(n);
+  Qhat.noalias() = d.kin.B.transpose() * Q;
   H->setZero(n, n);
   AddGeometricTangent(d, Q, Qhat, false, *H);
   TurnNodeBlocks(*H, 2 * n_nodes_, R);

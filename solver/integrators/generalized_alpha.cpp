@@ -21,6 +21,8 @@ void AssembleDynamicResidual(const SystemModel& model, const DofMap& dofs, Dynam
   std::vector<BodyTerms>& results = work.terms;
   passes.resize(static_cast<size_t>(n_bodies));
   results.resize(static_cast<size_t>(n_bodies));
+  work.pass_data.resize(size_t(n_bodies));
+  for (int b = 0; b < n_bodies; ++b) work.pass_data[size_t(b)] = &passes[size_t(b)].data;
   NodeAccelerations(model, dofs, s.config, s.W, s.Wdot, work.node_acc);
   const std::vector<Eigen::Matrix<double, 6, 1>>& node_acc = work.node_acc;
   ForEachBody(threads, n_bodies, [&](int b) {
@@ -71,7 +73,7 @@ void AssembleDynamicResidual(const SystemModel& model, const DofMap& dofs, Dynam
   });
   if (!AddBodyTerms(model, results, parts, out)) return;
   FinishAssembly(model, dofs, s.config, t, s.W, false, parts, out);
-  AddLoopConstraints(model, dofs, s.config, &out.residual, nullptr, &out.node_forces);
+  AddLoopConstraints(model, dofs, s.config, &out.residual, nullptr, &out.node_forces, nullptr, kLoopAll, &work.pass_data);
 }
 
 Assembly AssembleDynamicResidual(const SystemModel& model, const DofMap& dofs, DynamicState& s, double t,
@@ -221,7 +223,7 @@ void AddDynamicMatrices(const SystemModel& model, const DofMap& dofs, const Dyna
   unused.setZero(n);
   AddNodeLoads(model, s.config, t, unused, &K);
   AddSpringDampers(model, s.config, s.W, unused, &K, &C, nullptr);
-  AddLoopConstraints(model, dofs, s.config, nullptr, &K, nullptr);
+  AddLoopConstraints(model, dofs, s.config, nullptr, &K, nullptr, nullptr, kLoopAll, &work.pass_data);
   AddJointGeometricStiffness(model, dofs, s.config, out.node_forces, K);
   if (combine) {
     for (const Eigen::Triplet<double>& e : C) K.emplace_back(e.row(), e.col(), combine->c_C * e.value());
@@ -279,7 +281,7 @@ StepOutcome GeneralizedAlphaStep(const SystemModel& model, const DofMap& dofs, c
     // at the round-off of the positions), after at least one correction.
     const bool small = r_norm <= a.roundoff || ScaledFreeNorm(dofs, a.residual, weights, a.dof_scale) <= tolerance;
     if (small && out.iterations > 0 &&
-        LoopsClosed(model, next.config, tolerance)) {
+        LoopsClosed(model, next.config, tolerance, &work.pass_data)) {
       out.converged = true;
       next.a = (alpha_f * state.Wdot + (1 - alpha_f) * next.Wdot - alpha_m * state.a) / (1 - alpha_m);  // (the same relation)
       next.t = t_new;

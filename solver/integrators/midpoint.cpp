@@ -280,6 +280,12 @@ void AssembleMidpoint(const SystemModel& model, const DofMap& dofs, const Dynami
   const int n_bodies = int(model.bodies.size());
   work.passes.resize(size_t(n_bodies));
   work.terms.resize(size_t(n_bodies));
+  work.pass_data.resize(size_t(n_bodies));
+  mw.mid_data.resize(size_t(n_bodies));
+  for (int b = 0; b < n_bodies; ++b) {
+    work.pass_data[size_t(b)] = &work.passes[size_t(b)].data;
+    mw.mid_data[size_t(b)] = &mw.bodies[size_t(b)].dm;
+  }
   const double L2 = std::pow(std::max(BoundingDiagonal(model.node_x0), 1e-300), 2);
   // Bodies with a free node (6 own coordinates) keep the momentum-conserving source terms.
   mw.free_node.assign(size_t(n_bodies), 0);
@@ -400,7 +406,7 @@ void AssembleMidpoint(const SystemModel& model, const DofMap& dofs, const Dynami
   // over the step, lambda . G(q_m) Delta, is lambda . (g_n+1 - g_n) = 0 up to O(h^3)); the
   // equations themselves hold at the end of the step (MidpointStep).
   k.mid.lambda = s1.config.lambda;
-  AddLoopConstraints(model, dofs, k.mid, &out.residual, nullptr, &parts.node_forces);
+  AddLoopConstraints(model, dofs, k.mid, &out.residual, nullptr, &parts.node_forces, nullptr, kLoopAll, &mw.mid_data);
   // Loads at the mid time and configuration, spring-dampers at the mean rates Delta / h.
   mw.rates = k.delta / h;
   FinishAssembly(model, dofs, k.mid, s0.t + 0.5 * h, mw.rates, false, parts, out);
@@ -493,12 +499,12 @@ const SystemMatrix& MidpointMatrix(const SystemModel& model, const DofMap& dofs,
   if (dofs.n_multipliers() > 0) {
     // Loops: d(-G_m^T lambda)/d delta = H_m T, its lambda columns G_m^T, the rows G_n+1.
     mw.loop_mid.clear();
-    AddLoopConstraints(model, dofs, k.mid, nullptr, &mw.loop_mid, nullptr, nullptr, kLoopHessian);
+    AddLoopConstraints(model, dofs, k.mid, nullptr, &mw.loop_mid, nullptr, nullptr, kLoopHessian, &mw.mid_data);
     AddTimesColumns(mw.loop_mid, 1.0, k.T, triples, mw.triple_of, S);
     mw.loop_mid.clear();
     mw.loop_end.clear();
-    AddLoopConstraints(model, dofs, k.mid, nullptr, &mw.loop_mid, nullptr, nullptr, kLoopColumns);
-    AddLoopConstraints(model, dofs, s1.config, nullptr, &mw.loop_end, nullptr, nullptr, kLoopRows);
+    AddLoopConstraints(model, dofs, k.mid, nullptr, &mw.loop_mid, nullptr, nullptr, kLoopColumns, &mw.mid_data);
+    AddLoopConstraints(model, dofs, s1.config, nullptr, &mw.loop_end, nullptr, nullptr, kLoopRows, &work.pass_data);
     S.insert(S.end(), mw.loop_end.begin(), mw.loop_end.end());
     S.insert(S.end(), mw.loop_mid.begin(), mw.loop_mid.end());
   }
@@ -564,7 +570,7 @@ StepOutcome MidpointStep(const SystemModel& model, const DofMap& dofs, const Dyn
     if (n_lambda > 0) {
       // The loop equations at the end of the step: residual rows -g(q_n+1).
       mw.end.setZero(dofs.n_dofs());
-      AddLoopConstraints(model, dofs, next.config, &mw.end, nullptr, nullptr);
+      AddLoopConstraints(model, dofs, next.config, &mw.end, nullptr, nullptr, nullptr, kLoopAll, &work.pass_data);
       a.residual.tail(n_lambda) = mw.end.tail(n_lambda);
     }
     const double r_norm = FreeNorm(dofs, a.residual, weights);
@@ -572,7 +578,7 @@ StepOutcome MidpointStep(const SystemModel& model, const DofMap& dofs, const Dyn
     // at the round-off of the positions), after at least one correction.
     const bool small = r_norm <= a.roundoff || ScaledFreeNorm(dofs, a.residual, weights, a.dof_scale) <= tolerance;
     if (small && out.iterations > 0 &&
-        LoopsClosed(model, next.config, tolerance)) {
+        LoopsClosed(model, next.config, tolerance, &work.pass_data)) {
       out.converged = true;
       next.t = t_new;
       // a: the mean acceleration over the step (t_n+1/2); Wdot: extrapolated to t_n+1 from

@@ -28,28 +28,41 @@ std::optional<SuperelementBody::Data> BodyDataAt(const SystemModel& model, const
   return body.Evaluate(c, frame);
 }
 
+// Body b's data at `state`: the given one, or evaluated into `own`; null when its frame does not
+// converge.
+const SuperelementBody::Data* BodyDataFor(const SystemModel& model, const SystemState& state, int b,
+                                          const BodyDataAtState* data, std::optional<SuperelementBody::Data>& own) {
+  if (data && size_t(b) < data->size() && (*data)[size_t(b)]) return (*data)[size_t(b)];
+  own = BodyDataAt(model, state, b);
+  return own ? &*own : nullptr;
+}
+
 // The bodies' interface constraints (thesis 8.2 case 4): g = C q_int of each constrained body,
 // its Jacobian G through the body's map (BodyMap: node Jacobians, modal coordinates) and
 // d(G^T lambda)/dq, in the same blocks as the cut joints'.
 void AddBodyConstraints(const SystemModel& model, const DofMap& dofs, const SystemState& state, Eigen::VectorXd* residual,
-                        Triplets* tangent, NodeForces* node_forces, Triplets* jacobian, int blocks) {
+                        Triplets* tangent, NodeForces* node_forces, Triplets* jacobian, int blocks,
+                        const BodyDataAtState* data) {
+  // This thread's scratch (kept: with `data`, a time step allocates nothing here).
+  thread_local Eigen::VectorXd lambda, g, minus_f;
+  thread_local Eigen::MatrixXd G, H;
+  thread_local std::vector<MapEntry> map;
   for (size_t b = 0; b < model.bodies.size(); ++b) {
     const SuperelementBody& body = model.bodies[b];
     const int r = body.n_constraints();
     if (r == 0) continue;
-    const std::optional<SuperelementBody::Data> d = BodyDataAt(model, state, int(b));
+    std::optional<SuperelementBody::Data> own;
+    const SuperelementBody::Data* d = BodyDataFor(model, state, int(b), data, own);
     if (!d) continue;
     const int first = dofs.body_multiplier_first(int(b));
-    const Eigen::VectorXd lambda = state.lambda.segment(first - dofs.first_multiplier(), r);
+    lambda = state.lambda.segment(first - dofs.first_multiplier(), r);
     const bool hessian = tangent && (blocks & kLoopHessian) && !lambda.isZero(0.0);
-    Eigen::VectorXd g;
-    Eigen::MatrixXd G, H;
     body.InterfaceConstraint(*d, &g, &G, hessian ? &lambda : nullptr, hessian ? &H : nullptr);
-    const Eigen::VectorXd f = G.transpose() * lambda;  // on the body's coordinates
-    if (node_forces) AddBodyNodeForces(model, int(b), -f, *node_forces);
-    const std::vector<MapEntry> map = BodyMap(model, dofs, state, int(b));
+    minus_f.resize(body.n_coordinates());
+    minus_f.noalias() = -G.transpose() * lambda;  // -G^T lambda on the body's coordinates
+    if (node_forces) AddBodyNodeForces(model, int(b), minus_f, *node_forces);
+    BodyMap(model, dofs, state, int(b), map);
     if (residual) {
-      const Eigen::VectorXd minus_f = -f;
       ScatterBody(map, &minus_f, nullptr, residual, nullptr);
       residual->segment(first, r) -= g;
     }
@@ -73,7 +86,7 @@ void AddBodyConstraints(const SystemModel& model, const DofMap& dofs, const Syst
 
 void AddLoopConstraints(const SystemModel& model, const DofMap& dofs, const SystemState& state,
                         Eigen::VectorXd* residual, Triplets* tangent, NodeForces* node_forces, Triplets* jacobian,
-                        int blocks) {
+                        int blocks, const BodyDataAtState* data) {
   for (size_t c = 0; c < model.cut_joints.size(); ++c) {
     const CutJoint& cut = model.cut_joints[c];
     const NodeJoint& j = cut.joint;
@@ -124,7 +137,7 @@ void AddLoopConstraints(const SystemModel& model, const DofMap& dofs, const Syst
       }
     }
   }
-  AddBodyConstraints(model, dofs, state, residual, tangent, node_forces, jacobian, blocks);
+  AddBodyConstraints(model, dofs, state, residual, tangent, node_forces, jacobian, blocks, data);
 }
 
 namespace {
@@ -207,7 +220,7 @@ std::string LoopSingularity(const SystemModel& model, const SystemState& state) 
          "point: its " + ConstraintName(model.cut_joints[size_t(worst)].joint, equation) + buffer + ")";
 }
 
-double LoopViolation(const SystemModel& model, const SystemState& state, int* worst) {
+double LoopViolation(const SystemModel& model, const SystemState& state, int* worst, const BodyDataAtState* data) {
   double L = BoundingDiagonal(model.node_x0);
   if (!(L > 0)) L = 1.0;
   double largest = 0.0;
@@ -226,8 +239,9 @@ double LoopViolation(const SystemModel& model, const SystemState& state, int* wo
   for (size_t b = 0; b < model.bodies.size(); ++b) {
     const SuperelementBody& body = model.bodies[b];
     if (body.n_constraints() == 0) continue;
-    const std::optional<SuperelementBody::Data> d = BodyDataAt(model, state, int(b));
-    Eigen::VectorXd g;
+    std::optional<SuperelementBody::Data> own;
+    const SuperelementBody::Data* d = BodyDataFor(model, state, int(b), data, own);
+    thread_local Eigen::VectorXd g;  // (kept: no allocation with `data`)
     if (d) body.InterfaceConstraint(*d, &g, nullptr, nullptr, nullptr);  // lengths
     const double v = d ? g.lpNorm<Eigen::Infinity>() : std::numeric_limits<double>::infinity();
     if (v > largest) {
@@ -252,9 +266,9 @@ std::vector<Eigen::Matrix<double, 6, 1>> CutJointReactions(const SystemModel& mo
   return out;
 }
 
-bool LoopsClosed(const SystemModel& model, const SystemState& state, double tolerance) {
+bool LoopsClosed(const SystemModel& model, const SystemState& state, double tolerance, const BodyDataAtState* data) {
   return !model.has_constraints() ||
-         LoopViolation(model, state) <= tolerance * std::max(BoundingDiagonal(model.node_x0), 1e-300);
+         LoopViolation(model, state, nullptr, data) <= tolerance * std::max(BoundingDiagonal(model.node_x0), 1e-300);
 }
 
 }  // namespace femb

@@ -21,15 +21,20 @@ namespace femb {
 /// joints' share of their stiffness). With `tangent`: G in the multipliers' rows, G^T in their
 /// columns and d(G^T lambda)/dq through the node Jacobians -- those of the blocks in `blocks`
 /// (the midpoint scheme takes them from different configurations). With `jacobian`: G and G^T.
+/// With `data` (per body, its data already evaluated at `state`, e.g. by the assembly pass, or
+/// null), the bodies' interface constraints take them instead of solving the body's frame and
+/// evaluating it again; the step then allocates nothing for them.
 enum LoopBlocks { kLoopRows = 1, kLoopColumns = 2, kLoopHessian = 4, kLoopAll = 7 };
+using BodyDataAtState = std::vector<const SuperelementBody::Data*>;
 void AddLoopConstraints(const SystemModel& model, const DofMap& dofs, const SystemState& state,
                         Eigen::VectorXd* residual, Triplets* tangent, NodeForces* node_forces,
-                        Triplets* jacobian = nullptr, int blocks = kLoopAll);
+                        Triplets* jacobian = nullptr, int blocks = kLoopAll, const BodyDataAtState* data = nullptr);
 /// The largest violation of the kept equations: positions in length units, rotations (dot
 /// products) times the model's size L so that both are lengths, and the bodies' interface
 /// constraints (lengths); 0 without any. `worst`: the cut joint with it, or cut_joints.size() + b
 /// for body b's constraint (-1 without any).
-double LoopViolation(const SystemModel& model, const SystemState& state, int* worst = nullptr);
+double LoopViolation(const SystemModel& model, const SystemState& state, int* worst = nullptr,
+                     const BodyDataAtState* data = nullptr);
 /// Per cut joint, the force and moment (global axes, moment about the child node) that the
 /// joint's parent node, or the ground, exerts on its child node through the joint: -G_c^T lambda,
 /// G_c the child's columns of the kept equations. Along a dropped (redundant) direction the
@@ -37,7 +42,8 @@ double LoopViolation(const SystemModel& model, const SystemState& state, int* wo
 std::vector<Eigen::Matrix<double, 6, 1>> CutJointReactions(const SystemModel& model, const SystemState& state);
 /// Newton's test on the loops: no constraints, or LoopViolation <= tolerance times the model's
 /// size (BoundingDiagonal of the nodes), the same relative tolerance as the forces'.
-bool LoopsClosed(const SystemModel& model, const SystemState& state, double tolerance);
+bool LoopsClosed(const SystemModel& model, const SystemState& state, double tolerance,
+                 const BodyDataAtState* data = nullptr);
 
 /// Drops the cut joints' equations that repeat others at the initial state (an over-constrained
 /// mechanism: a planar four-bar of spatial revolute joints has 3 of its 5 closure equations

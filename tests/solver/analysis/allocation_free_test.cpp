@@ -11,11 +11,11 @@
 // gravity and a dead load; bodies on one thread and on two; fixed and error-controlled steps;
 // the bodies' inertia matrices kept in their frames (body_matrices_every)
 // (but the restart at a breakpoint of a load or drive); the same for the midpoint scheme but
-// the kept matrices; spring-dampers, a follower load, a closed loop (cut joint). Not covered
-// (they may still allocate): bodies' interface constraints, results recording (femb-solve's
+// the kept matrices; spring-dampers, a follower load, a closed loop (cut joint), bodies with
+// interface constraints. Not covered (it may still allocate): results recording (femb-solve's
 // output, outside SolveDynamic).
 // FEMB_ALLOCATION_TRACE=1 prints the call stack of every allocation counted (to find them);
-// =linear, =stiffened, =threads, =adaptive, =kept, =midpoint, =springs or =loop: of those cases only.
+// =linear, =stiffened, =threads, =adaptive, =kept, =midpoint, =springs, =loop or =constrained: of those cases only.
 #include <execinfo.h>
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -75,6 +75,25 @@ void PrintStack() {
   cut.name = "pin";
   for (int i = 0; i < ConstraintCount(JointType::kRevolute); ++i) cut.equations.push_back(i);
   model.cut_joints.push_back(cut);
+  return model;
+}
+
+// Two rods on bending shapes alone (interface constraints with multipliers) hanging as a
+// pendulum: revolute to ground at n0, n2 hinged to n1, gravity -y.
+[[maybe_unused]] SystemModel ConstrainedPendulum(const Superelement& se, double L) {
+  SystemModel model;
+  AddNode(model, "n0", Eigen::Vector3d::Zero());
+  AddNode(model, "n1", Eigen::Vector3d(L, 0, 0));
+  AddNode(model, "n2", Eigen::Vector3d(L, 0, 0));
+  AddNode(model, "n3", Eigen::Vector3d(2 * L, 0, 0));
+  for (int b = 0; b < 2; ++b) {
+    model.bodies.emplace_back(se, SuperelementOptions{}, Eigen::Matrix3d::Identity(), Eigen::Vector3d(b * L, 0, 0));
+    model.body_nodes.push_back({2 * b, 2 * b + 1});
+  }
+  RevoluteToGround(model, 0, Eigen::Vector3d::UnitZ());
+  model.joints.push_back(MakeNodeJoint(JointType::kRevolute, 2, 1, Eigen::Vector3d::UnitZ(), model.node_x0[1],
+                                       model.node_R0[1], model.node_x0[2], model.node_R0[2]));
+  model.gravity = Eigen::Vector3d(0, -9.81, 0);
   return model;
 }
 
@@ -183,6 +202,12 @@ TEST(AllocationFree, GeneralizedAlphaStepsAllocateNothing) {
   std::printf("[ info ] stiffened chain closed by a cut joint: at most %ld allocations in a step (%ld steps counted)\n",
               loop, steps);
   EXPECT_EQ(loop, 0);
+  // Bodies with interface constraints (their multipliers; the bodies' data of the pass reused).
+  const long constrained =
+      LargestAllocationsPerStep(ConstrainedPendulum(test::BendingShapesRod(0.5), 0.5), 1e-3, "constrained", &steps);
+  std::printf("[ info ] pendulum of 2 interface-constrained rods: at most %ld allocations in a step (%ld steps counted)\n",
+              constrained, steps);
+  EXPECT_EQ(constrained, 0);
 }
 
 TEST(AllocationFree, MidpointStepsAllocateNothing) {
@@ -228,6 +253,11 @@ TEST(AllocationFree, MidpointStepsAllocateNothing) {
   std::printf("[ info ] midpoint, stiffened chain closed by a cut joint: at most %ld allocations in a step (%ld steps counted)\n",
               loop, steps);
   EXPECT_EQ(loop, 0);
+  const long constrained = LargestAllocationsPerStep(ConstrainedPendulum(test::BendingShapesRod(0.5), 0.5), 1e-3,
+                                                     "constrained", &steps, 1, false, 1, Integrator::kMidpoint);
+  std::printf("[ info ] midpoint, pendulum of 2 interface-constrained rods: at most %ld allocations in a step (%ld steps counted)\n",
+              constrained, steps);
+  EXPECT_EQ(constrained, 0);
 }
 #endif
 

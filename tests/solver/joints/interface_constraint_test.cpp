@@ -8,17 +8,12 @@
 // the constraint by hand), stiffer than beam theory, and so do the linearized modes; a swinging
 // pendulum of two such rods keeps its constraint closed and its energy with the midpoint scheme.
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <Eigen/Dense>
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
-#include <fstream>
 #include <random>
 
-#include "reducer/fe/beam_model.h"
-#include "reducer/reduction/full_modes.h"
 #include "solver/analysis/dynamic_analysis.h"
 #include "solver/analysis/dynamic_step.h"
 #include "solver/analysis/modal_analysis.h"
@@ -30,37 +25,15 @@
 namespace femb {
 namespace {
 
-namespace fs = std::filesystem;
-
 constexpr double kL = 0.5, kE = 2.0e9, kD = 0.02;
 
-// The rod on its four lowest free-free bending shapes (two per plane), through femb-reduce's
-// general basis from a Matrix Market file on the beam's DOFs; or its Craig-Bampton reduction.
+// The rod on its four lowest free-free bending shapes (test::BendingShapesRod), or its
+// Craig-Bampton reduction.
 Superelement Rod(bool bending_only) {
-  const std::string beam =
-      test::StraightBeamYaml(kL, 20, "{shape: circle, diameter: 0.02}",
-                             "{E: 2.0e9, nu: 0.3, rho: 7800}", "[{name: A}, {name: B}]");
-  if (!bending_only)
-    return test::Reduce(beam + "reduction: {internal_modes: 4, floating_frame: mean_axes}\n");
-  const FeModel model = BuildBeamModel(ParsePart(beam, "rod.yaml"));
-  Eigen::MatrixXd modes;
-  Eigen::VectorXd lambda;
-  EXPECT_TRUE(FullFreeFreeFrequencies(model, 10, 1.0, &modes, &lambda).ok);
-  const fs::path path =
-      fs::temp_directory_path() / ("femb_bending_shapes_" + std::to_string(::getpid()) + ".mtx");
-  {
-    std::ofstream out(path);
-    out.precision(17);
-    out << "%%MatrixMarket matrix array real general\n" << modes.rows() << " 4\n";
-    for (long j = 6; j < 10; ++j)
-      for (long i = 0; i < modes.rows(); ++i) out << modes(i, j) << "\n";
-  }
-  const Superelement se =
-      test::Reduce(beam + "reduction: {method: general, basis: {file: " + path.string() +
-                   "}, floating_frame: mean_axes}\n");
-  fs::remove(path);
-  EXPECT_EQ(se.interface_constraint.rows(), 2);
-  return se;
+  if (bending_only) return test::BendingShapesRod(kL);
+  return test::Reduce(test::StraightBeamYaml(kL, 20, "{shape: circle, diameter: 0.02}",
+                                             "{E: 2.0e9, nu: 0.3, rho: 7800}", "[{name: A}, {name: B}]") +
+                      "reduction: {internal_modes: 4, floating_frame: mean_axes}\n");
 }
 
 // Two rods in a chain along x: n0 on a revolute joint to ground about z, n2 hinged to n1 by a
