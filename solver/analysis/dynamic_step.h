@@ -128,7 +128,8 @@ struct MidpointBody {
   SuperelementBody::Data d0, dm;  // at q_n (once per step) and at q_m
   Eigen::Vector3d com0 = Eigen::Vector3d::Zero();  // the centre of mass at q_n
   Eigen::VectorXd w0, p0, p1, p_mean, wm, w_first, w_second, dw, wdot, s_first, s_second, u, Du;
-  Eigen::MatrixXd d_w, d_p, d_load;
+  Eigen::MatrixXd d_w, d_p;
+  Eigen::MatrixXd S_b;  // the body's combined iteration matrix (MidpointMatrix)
   InertiaLoadFactors load;
 };
 

@@ -480,7 +480,7 @@ const SystemMatrix& MidpointMatrix(const SystemModel& model, const DofMap& dofs,
   for (int b = 0; b < n_bodies; ++b) {
     BodyWorkspace::BodyMatrices& r = work.matrices[size_t(b)];
     const std::vector<MapEntry>& map = work.terms[size_t(b)].map;  // the residual pass's, at q_m
-    Eigen::MatrixXd& S_b = r.inertia_K;  // (GA's scratch name; here the combined body matrix)
+    Eigen::MatrixXd& S_b = mw.bodies[size_t(b)].S_b;
     S_b = k.T.diagonal * r.K + (1.0 / h) * r.C + (k.V.diagonal / h) * r.M;
     ScatterBody(map, nullptr, &S_b, nullptr, &S);
     AddRotationColumns(map, r.K, r.M, h, k, triples, mw.triple_of, S);
