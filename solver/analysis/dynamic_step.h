@@ -39,6 +39,14 @@ struct Assembly {
   NodeForces node_forces;  // per node, residual sense (for the reactions)
 };
 
+// Newton's convergence test on an assembly's residual (weighted norm r_norm, FreeNorm): at the
+// round-off of the positions, or below `tolerance` relative to the forces on each unknown
+// (ScaledFreeNorm with the assembly's dof_scale).
+inline bool ResidualSmall(const DofMap& dofs, const Assembly& a, const Eigen::VectorXd& weights, double r_norm,
+                          double tolerance) {
+  return r_norm <= a.roundoff || ScaledFreeNorm(dofs, a.residual, weights, a.dof_scale) <= tolerance;
+}
+
 // The triplets of an assembly in progress and the node forces for the joints' stiffness.
 struct AssemblyParts {
   Triplets K, C, M;
@@ -121,6 +129,7 @@ struct MidpointKinematics {
   StepColumnMap T;        // d q_m / d delta: 1/2 off the rotation nodes
   StepColumnMap V;        // d W_n+1 / d delta: 2/h off the rotation nodes
   std::vector<Eigen::Matrix<double, 6, 1>> node_w1;  // every node's velocity at n+1 (EndNodeVelocity)
+  std::vector<Eigen::Matrix<double, 6, 1>> node_step;  // every node's (x_n+1 - x_n, log(R_n+1 R_n^T))
 };
 
 // One body's storage in a midpoint step (its data at q_n+1 is the BodyWorkspace's pass).
@@ -138,7 +147,9 @@ struct MidpointWorkspace {
   std::vector<MidpointBody> bodies;
   BodyDataAtState mid_data;  // &bodies[b].dm, for the bodies' interface constraints at q_m
   MidpointKinematics k;
-  std::vector<char> free_node;       // per body: it has a free node
+  // Set once for the model: per body, whether it has a free node; the model's size squared.
+  std::vector<char> free_node;
+  double L2 = 0.0;
   std::vector<double> gravity_work;  // per body
   // Per unknown: 2 i for the rotation triple of rotation node i, 2 i + 1 for its translation
   // triple, -1 elsewhere (StepColumnMap's blocks).

@@ -279,8 +279,7 @@ StepOutcome GeneralizedAlphaStep(const SystemModel& model, const DofMap& dofs, c
     const double r_norm = FreeNorm(dofs, a.residual, weights);
     // Converged: the residual below the tolerance relative to the forces on each unknown (or
     // at the round-off of the positions), after at least one correction.
-    const bool small = r_norm <= a.roundoff || ScaledFreeNorm(dofs, a.residual, weights, a.dof_scale) <= tolerance;
-    if (small && out.iterations > 0 &&
+    if (ResidualSmall(dofs, a, weights, r_norm, tolerance) && out.iterations > 0 &&
         LoopsClosed(model, next.config, tolerance, &work.pass_data)) {
       out.converged = true;
       next.a = (alpha_f * state.Wdot + (1 - alpha_f) * next.Wdot - alpha_m * state.a) / (1 - alpha_m);  // (the same relation)

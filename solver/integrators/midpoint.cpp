@@ -61,12 +61,13 @@ namespace {
 // The scheme carries these node velocities from step to step (DynamicState::node_w), as the
 // discrete null space method carries redundant velocities (Betsch & Leyendecker, Int. J. Numer.
 // Meth. Engng 67, 2006). Nodes with their own coordinates (free nodes, supports) keep W's.
-Eigen::Matrix<double, 6, 1> EndNodeVelocity(const Eigen::Vector3d& x0, const Eigen::Matrix3d& R0,
-                                            const Eigen::Vector3d& x1, const Eigen::Matrix3d& R1,
+// `step`: the node's NodeStep.
+Eigen::Matrix<double, 6, 1> EndNodeVelocity(const Eigen::Matrix3d& R0, const Eigen::Matrix3d& R1,
+                                            const Eigen::Matrix<double, 6, 1>& step,
                                             const Eigen::Matrix<double, 6, 1>& w0, double h) {
-  const Eigen::Vector3d Omega_m = R0.transpose() * LogSO3(R1 * R0.transpose()) / h;
+  const Eigen::Vector3d Omega_m = R0.transpose() * step.tail<3>() / h;
   Eigen::Matrix<double, 6, 1> w1;
-  w1 << 2.0 * (x1 - x0) / h - w0.head<3>(), R1 * (2.0 * Omega_m - R0.transpose() * w0.tail<3>());
+  w1 << 2.0 * step.head<3>() / h - w0.head<3>(), R1 * (2.0 * Omega_m - R0.transpose() * w0.tail<3>());
   return w1;
 }
 
@@ -93,26 +94,44 @@ void TripleOf(const DofMap& dofs, const std::vector<RotationNode>& nodes, std::v
   }
 }
 
+// Row j of X as up to 6 entries (columns `cols`, values `vals`), their number returned: X's
+// diagonal off the rotation nodes; on a rotation triple its block's row; on a free node's
+// translation triple its block's row, then the coupling block's row onto the rotation triple.
+int RowOf(const StepColumnMap& X, const std::vector<RotationNode>& nodes, const std::vector<int>& triple_of, int j,
+          int (&cols)[6], double (&vals)[6]) {
+  const int t = triple_of[size_t(j)];
+  if (t < 0) {
+    cols[0] = j;
+    vals[0] = X.diagonal;
+    return 1;
+  }
+  const size_t i = size_t(t / 2);
+  const RotationNode& r = nodes[i];
+  const bool translation = t % 2 == 1;
+  const int own = translation ? r.translation : r.rotation;
+  const Eigen::Matrix3d& B = translation ? X.translation[i] : X.rotation[i];
+  for (int m = 0; m < 3; ++m) {
+    cols[m] = own + m;
+    vals[m] = B(j - own, m);
+  }
+  if (!translation) return 3;
+  for (int m = 0; m < 3; ++m) {
+    cols[3 + m] = r.rotation + m;
+    vals[3 + m] = X.coupling[i](j - own, m);
+  }
+  return 6;
+}
+
 // out += scale * A X for the matrix A of the triplets `in`: each entry (i, j, v) spreads over
-// row j of X (one entry off the rotation nodes, three or six on them).
+// row j of X.
 void AddTimesColumns(const Triplets& in, double scale, const StepColumnMap& X, const std::vector<RotationNode>& nodes,
                      const std::vector<int>& triple_of, Triplets& out) {
+  int cols[6];
+  double vals[6];
   for (const Eigen::Triplet<double>& e : in) {
-    const int j = e.col(), t = triple_of[size_t(j)];
+    const int count = RowOf(X, nodes, triple_of, e.col(), cols, vals);
     const double v = scale * e.value();
-    if (t < 0) {
-      out.emplace_back(e.row(), j, v * X.diagonal);
-      continue;
-    }
-    const RotationNode& r = nodes[size_t(t / 2)];
-    if (t % 2 == 0) {
-      const Eigen::Matrix3d& B = X.rotation[size_t(t / 2)];
-      for (int m = 0; m < 3; ++m) out.emplace_back(e.row(), r.rotation + m, v * B(j - r.rotation, m));
-    } else {
-      const Eigen::Matrix3d &B = X.translation[size_t(t / 2)], &Bc = X.coupling[size_t(t / 2)];
-      for (int m = 0; m < 3; ++m) out.emplace_back(e.row(), r.translation + m, v * B(j - r.translation, m));
-      for (int m = 0; m < 3; ++m) out.emplace_back(e.row(), r.rotation + m, v * Bc(j - r.translation, m));
-    }
+    for (int m = 0; m < count; ++m) out.emplace_back(e.row(), cols[m], v * vals[m]);
   }
 }
 
@@ -123,32 +142,21 @@ void AddTimesColumns(const Triplets& in, double scale, const StepColumnMap& X, c
 void AddRotationColumns(const std::vector<MapEntry>& map, const Eigen::MatrixXd& K, const Eigen::MatrixXd& M, double h,
                         const MidpointKinematics& k, const std::vector<RotationNode>& nodes,
                         const std::vector<int>& triple_of, Triplets& out) {
+  int cols[6];
+  double t_row[6], v_row[6];
   for (const MapEntry& col : map) {
-    const int t = triple_of[size_t(col.coordinate)];
-    if (t < 0) continue;
-    const size_t i = size_t(t / 2);
-    const RotationNode& r = nodes[i];
-    // Row col.coordinate of T' and V': its own triple's block less the diagonal, and for a free
-    // node's translation the coupling block onto the rotation triple.
-    const bool translation = t % 2 == 1;
-    const int own = translation ? r.translation : r.rotation, c = col.coordinate - own;
-    Eigen::Matrix<double, 1, 6> tr = Eigen::Matrix<double, 1, 6>::Zero(), vr = tr;
-    int first[2] = {own, r.rotation};
-    tr.head<3>() = (translation ? k.T.translation[i] : k.T.rotation[i]).row(c);
-    vr.head<3>() = (translation ? k.V.translation[i] : k.V.rotation[i]).row(c);
-    tr[c] -= k.T.diagonal;
-    vr[c] -= k.V.diagonal;
-    const int blocks = translation ? 2 : 1;
-    if (translation) {
-      tr.tail<3>() = k.T.coupling[i].row(c);
-      vr.tail<3>() = k.V.coupling[i].row(c);
+    if (triple_of[size_t(col.coordinate)] < 0) continue;
+    const int count = RowOf(k.T, nodes, triple_of, col.coordinate, cols, t_row);
+    RowOf(k.V, nodes, triple_of, col.coordinate, cols, v_row);
+    for (int m = 0; m < count; ++m) {
+      if (cols[m] != col.coordinate) continue;
+      t_row[m] -= k.T.diagonal;
+      v_row[m] -= k.V.diagonal;
     }
     for (const MapEntry& row : map) {
       const double vk = row.coefficient * col.coefficient * K(row.local, col.local);
       const double vm = row.coefficient * col.coefficient * M(row.local, col.local) / h;
-      for (int b = 0; b < blocks; ++b) {
-        for (int m = 0; m < 3; ++m) out.emplace_back(row.coordinate, first[b] + m, vk * tr[3 * b + m] + vm * vr[3 * b + m]);
-      }
+      for (int m = 0; m < count; ++m) out.emplace_back(row.coordinate, cols[m], vk * t_row[m] + vm * v_row[m]);
     }
   }
 }
@@ -158,6 +166,8 @@ void AddRotationColumns(const std::vector<MapEntry>& map, const Eigen::MatrixXd&
 void Midpoint(const SystemModel& model, const DofMap& dofs, const std::vector<RotationNode>& nodes,
               const DynamicState& s0, double h, DynamicState& s1, MidpointKinematics& k) {
   const int n = dofs.n_dofs();
+  k.node_step.resize(size_t(model.n_nodes()));
+  for (int node = 0; node < model.n_nodes(); ++node) k.node_step[size_t(node)] = NodeStep(s0.config, s1.config, node);
   k.delta.setZero(n);
   for (int node = 0; node < model.n_nodes(); ++node) {
     if (dofs.node_count(node) > 0) {
@@ -182,7 +192,7 @@ void Midpoint(const SystemModel& model, const DofMap& dofs, const std::vector<Ro
     const RotationNode& r = nodes[i];
     const Eigen::Matrix3d& R0 = s0.config.R[r.node];
     const Eigen::Matrix3d& R1 = s1.config.R[r.node];
-    const Eigen::Vector3d dpi = LogSO3(R1 * R0.transpose());
+    const Eigen::Vector3d dpi = k.node_step[size_t(r.node)].tail<3>();
     k.delta.segment<3>(r.rotation) = dpi;
     k.half.segment<3>(r.rotation) = 0.5 * dpi;
     const Eigen::Vector3d Omega_m = R0.transpose() * dpi / h;
@@ -224,8 +234,8 @@ void Midpoint(const SystemModel& model, const DofMap& dofs, const std::vector<Ro
   for (int node = 0; node < model.n_nodes(); ++node) {
     k.node_w1[size_t(node)] = dofs.joint_of(node) < 0
                                   ? NodeMotion(s1.config, node, s1.W)
-                                  : EndNodeVelocity(s0.config.x[node], s0.config.R[node], s1.config.x[node],
-                                                    s1.config.R[node], NodeVelocity(s0, node), h);
+                                  : EndNodeVelocity(s0.config.R[node], s1.config.R[node], k.node_step[size_t(node)],
+                                                    NodeVelocity(s0, node), h);
   }
   k.mid = s0.config;
   ApplyIncrement(model, dofs, k.half, k.mid);
@@ -242,9 +252,8 @@ void Midpoint(const SystemModel& model, const DofMap& dofs, const std::vector<Ro
 // coordinate by how far it moves the nodes (rotations times the model's size L); modal
 // coordinates and free nodes map exactly and get nothing. The correction is O(h^2) of the forces
 // and is left out of the iteration matrix.
-void AddDiscreteGradientCorrection(const SystemModel& model, const DofMap& dofs, const SystemState& c0,
-                                   const SystemState& c1, const MidpointKinematics& k, double L2,
-                                   MidpointWorkspace& w, Assembly& out) {
+void AddDiscreteGradientCorrection(const SystemModel& model, const DofMap& dofs, const MidpointKinematics& k,
+                                   double L2, MidpointWorkspace& w, Assembly& out) {
   if (model.joints.empty()) return;
   const int n = dofs.first_multiplier();
   Eigen::VectorXd& D = w.D;
@@ -252,7 +261,7 @@ void AddDiscreteGradientCorrection(const SystemModel& model, const DofMap& dofs,
   double gap_work = 0.0;
   for (int node = 0; node < model.n_nodes(); ++node) {
     if (dofs.joint_of(node) < 0) continue;
-    Eigen::Matrix<double, 6, 1> gap = NodeStep(c0, c1, node);
+    Eigen::Matrix<double, 6, 1> gap = k.node_step[size_t(node)];
     for (const auto& [col, vec] : k.mid.J[node]) {
       gap -= vec * k.delta[col];
       D[col] += vec.head<3>().squaredNorm() + L2 * vec.tail<3>().squaredNorm();
@@ -271,7 +280,7 @@ void AddDiscreteGradientCorrection(const SystemModel& model, const DofMap& dofs,
 // (MidpointMatrix), which an iteration builds only when it needs one. The momenta at the step's
 // start are in work.midpoint.bodies (MidpointStep).
 void AssembleMidpoint(const SystemModel& model, const DofMap& dofs, const DynamicState& s0, double h,
-                      DynamicState& s1, BodyWorkspace& work, BodyThreads* threads, double& f_ext_work, Assembly& out) {
+                      DynamicState& s1, BodyWorkspace& work, BodyThreads* threads, Assembly& out) {
   MidpointWorkspace& mw = work.midpoint;
   MidpointKinematics& k = mw.k;
   AssemblyParts& parts = work.parts;
@@ -285,12 +294,6 @@ void AssembleMidpoint(const SystemModel& model, const DofMap& dofs, const Dynami
   for (int b = 0; b < n_bodies; ++b) {
     work.pass_data[size_t(b)] = &work.passes[size_t(b)].data;
     mw.mid_data[size_t(b)] = &mw.bodies[size_t(b)].dm;
-  }
-  const double L2 = std::pow(std::max(BoundingDiagonal(model.node_x0), 1e-300), 2);
-  // Bodies with a free node (6 own coordinates) keep the momentum-conserving source terms.
-  mw.free_node.assign(size_t(n_bodies), 0);
-  for (int b = 0; b < n_bodies; ++b) {
-    for (int node : model.body_nodes[b]) mw.free_node[size_t(b)] |= dofs.free(node);
   }
   mw.gravity_work.assign(size_t(n_bodies), 0.0);
   ForEachBody(threads, n_bodies, [&](int b) {
@@ -324,13 +327,14 @@ void AssembleMidpoint(const SystemModel& model, const DofMap& dofs, const Dynami
     // Node motion over the step.
     Eigen::VectorXd& wm = m.wm;
     wm.resize(body.n_coordinates());
-    for (int a = 0; a < body.n_nodes(); ++a) wm.segment<6>(6 * a) = NodeStep(s0.config, s1.config, model.body_nodes[b][a]) / h;
+    for (int a = 0; a < body.n_nodes(); ++a) wm.segment<6>(6 * a) = k.node_step[size_t(model.body_nodes[b][a])] / h;
     wm.tail(body.n_modes()) = (s1.config.eta[b] - s0.config.eta[b]) / h;
     Eigen::VectorXd &f_in = r.f_in, &f_int = r.f_int, &f_acc = r.f_acc;
     m.dw = w1 - m.w0;
     f_acc.resize(body.n_coordinates());
     f_acc.noalias() = maps1.Mg * m.dw;
     f_acc /= h;
+    m.p_mean = 0.5 * (m.p0 + m.p1);  // (also for the source's derivatives in the matrices)
     if (body.options().quadratic_velocity_terms) {
       // Source terms with the node motion of each half step, so that their moment matches the
       // change of sum x_k x p_k exactly: x_m is not the mean of x_n and x_n+1.
@@ -354,14 +358,12 @@ void AssembleMidpoint(const SystemModel& model, const DofMap& dofs, const Dynami
         // no longer matches the change of sum x_k x p_k exactly, so a chain whose root floats
         // free keeps its angular momentum to O(h^2) only (a grounded chain has none to keep).
         // Energy is the invariant a mechanism on joints is judged by.
-        m.p_mean = 0.5 * (m.p0 + m.p1);
         body.MomentumSource(maps_m, wm, m.p_mean, m.s_first, dm.scratch);
         f_in = (m.p1 - m.p0) / h - m.s_first;
       }
     } else {
       f_in = f_acc;
     }
-    m.p_mean = 0.5 * (m.p0 + m.p1);  // (for the source's derivatives in the matrices)
     body.AddModalDamping(wm, f_in, nullptr);
     if (body.has_inertia_stiffening()) {
       // Inertia stiffening (issue 13) at the mid configuration with the step's mean velocity and
@@ -385,7 +387,7 @@ void AssembleMidpoint(const SystemModel& model, const DofMap& dofs, const Dynami
       Du.setZero(u.size());
       for (int a = 0; a < body.n_nodes(); ++a) {
         Du.segment<3>(6 * a) = u.segment<3>(6 * a);
-        Du.segment<3>(6 * a + 3) = L2 * u.segment<3>(6 * a + 3);
+        Du.segment<3>(6 * a + 3) = mw.L2 * u.segment<3>(6 * a + 3);
       }
       const double norm = Du.dot(u);
       if (norm > 0) f_grav += Du * ((-dV - f_grav.dot(u)) / norm);
@@ -410,19 +412,20 @@ void AssembleMidpoint(const SystemModel& model, const DofMap& dofs, const Dynami
   // Loads at the mid time and configuration, spring-dampers at the mean rates Delta / h.
   mw.rates = k.delta / h;
   FinishAssembly(model, dofs, k.mid, s0.t + 0.5 * h, mw.rates, false, parts, out);
-  AddDiscreteGradientCorrection(model, dofs, s0.config, s1.config, k, L2, mw, out);
-  // The external work of the step, as the forces' discrete gradients do it: gravity's potential
-  // change, and the nodal loads (at q_m) times the nodes' motion.
-  f_ext_work = 0.0;
-  for (double w : mw.gravity_work) f_ext_work += w;
-  if (!model.loads.empty()) {
-    mw.loads.f.assign(size_t(model.n_nodes()), Eigen::Matrix<double, 6, 1>::Zero());
-    mw.unused.setZero(dofs.n_dofs());
-    AddNodeLoads(model, k.mid, s0.t + 0.5 * h, mw.unused, nullptr, &mw.loads);
-    for (int node = 0; node < model.n_nodes(); ++node) {
-      f_ext_work += NodeStep(s0.config, s1.config, node).dot(mw.loads.f[size_t(node)]);
-    }
-  }
+  AddDiscreteGradientCorrection(model, dofs, k, mw.L2, mw, out);
+}
+
+// The external work of the step at the iterate just assembled, as the forces' discrete gradients
+// do it: gravity's potential change, and the nodal loads (at q_m) times the nodes' motion.
+double StepExternalWork(const SystemModel& model, const DofMap& dofs, double t_mid, MidpointWorkspace& mw) {
+  double work = 0.0;
+  for (double w : mw.gravity_work) work += w;
+  if (model.loads.empty()) return work;
+  mw.loads.f.assign(size_t(model.n_nodes()), Eigen::Matrix<double, 6, 1>::Zero());
+  mw.unused.setZero(dofs.n_dofs());
+  AddNodeLoads(model, mw.k.mid, t_mid, mw.unused, nullptr, &mw.loads);
+  for (int node = 0; node < model.n_nodes(); ++node) work += mw.k.node_step[size_t(node)].dot(mw.loads.f[size_t(node)]);
+  return work;
 }
 
 // The iteration matrix S = K T + (C + M V) / h of the residual pass `a` just made (the same
@@ -538,7 +541,16 @@ StepOutcome MidpointStep(const SystemModel& model, const DofMap& dofs, const Dyn
   const std::vector<RotationNode>& triples = work.rotation_triples;
   MidpointWorkspace& mw = work.midpoint;
   MidpointKinematics& k = mw.k;
-  if (mw.triple_of.size() != size_t(dofs.n_dofs())) TripleOf(dofs, triples, mw.triple_of);
+  if (mw.triple_of.size() != size_t(dofs.n_dofs())) {
+    // What depends on the model alone.
+    TripleOf(dofs, triples, mw.triple_of);
+    mw.L2 = std::pow(std::max(BoundingDiagonal(model.node_x0), 1e-300), 2);
+    // Bodies with a free node (6 own coordinates) keep the momentum-conserving source terms.
+    mw.free_node.assign(model.bodies.size(), 0);
+    for (size_t b = 0; b < model.bodies.size(); ++b) {
+      for (int node : model.body_nodes[b]) mw.free_node[b] |= dofs.free(node);
+    }
+  }
   // Momenta and centres of mass at the start of the step.
   const int n_bodies = int(model.bodies.size());
   mw.bodies.resize(size_t(n_bodies));
@@ -564,8 +576,7 @@ StepOutcome MidpointStep(const SystemModel& model, const DofMap& dofs, const Dyn
   matrix.BeginStep();
   for (; out.iterations < options.max_iterations; ++out.iterations) {
     Midpoint(model, dofs, triples, state, h, next, k);
-    double work_done = 0.0;
-    AssembleMidpoint(model, dofs, state, h, next, work, &threads, work_done, a);
+    AssembleMidpoint(model, dofs, state, h, next, work, &threads, a);
     if (!a.ok || !a.residual.allFinite()) return out;
     if (n_lambda > 0) {
       // The loop equations at the end of the step: residual rows -g(q_n+1).
@@ -576,8 +587,7 @@ StepOutcome MidpointStep(const SystemModel& model, const DofMap& dofs, const Dyn
     const double r_norm = FreeNorm(dofs, a.residual, weights);
     // Converged: the residual below the tolerance relative to the forces on each unknown (or
     // at the round-off of the positions), after at least one correction.
-    const bool small = r_norm <= a.roundoff || ScaledFreeNorm(dofs, a.residual, weights, a.dof_scale) <= tolerance;
-    if (small && out.iterations > 0 &&
+    if (ResidualSmall(dofs, a, weights, r_norm, tolerance) && out.iterations > 0 &&
         LoopsClosed(model, next.config, tolerance, &work.pass_data)) {
       out.converged = true;
       next.t = t_new;
@@ -591,7 +601,7 @@ StepOutcome MidpointStep(const SystemModel& model, const DofMap& dofs, const Dyn
         next.Wdot = 1.5 * next.a - 0.5 * state.a;
       }
       next.node_w = k.node_w1;
-      next.external_work += work_done;
+      next.external_work += StepExternalWork(model, dofs, state.t + 0.5 * h, mw);
       next.f_ext = a.f_ext;
       DriveForces(dofs, a.residual, next.f_drive);
       next.drive_work += next.f_drive.dot(k.delta);
