@@ -45,12 +45,6 @@ void SuperelementBody::VelocityMaps(const Data& d, Eigen::MatrixXd* P, Eigen::Ma
   U->noalias() = frame.R * Zr;
 }
 
-Eigen::MatrixXd SuperelementBody::VelocityMapRate(const Eigen::MatrixXd& U, const BodyVelocity& w) const {
-  Eigen::MatrixXd G;
-  VelocityMapRate(U, w, G);
-  return G;
-}
-
 void SuperelementBody::VelocityMapRate(const Eigen::MatrixXd& U, const BodyVelocity& w, Eigen::MatrixXd& G) const {
   const int n = n_coordinates();
   G.setZero(n, n);

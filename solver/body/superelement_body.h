@@ -430,8 +430,7 @@ class SuperelementBody {
   Eigen::Matrix<double, 6, 6> FrameMatrix(const Eigen::VectorXd& q_loc) const;
   // P (system velocities -> local velocities) and the frame's angular velocity map U (3 x n).
   void VelocityMaps(const Data& d, Eigen::MatrixXd* P, Eigen::MatrixXd* U) const;
-  // G of d(P w) = P G dq at fixed w (n x n), from U and the velocities.
-  Eigen::MatrixXd VelocityMapRate(const Eigen::MatrixXd& U, const BodyVelocity& w) const;
+  // G of d(P w) = P G dq at fixed w (n x n, into G), from U and the velocities.
   void VelocityMapRate(const Eigen::MatrixXd& U, const BodyVelocity& w, Eigen::MatrixXd& G) const;
   // The quadratic part of f_in: M_g G w + (Omega_P - Omega_hat) p - G^T p.
   Eigen::VectorXd QuadraticInertia(const Eigen::MatrixXd& U, const Eigen::MatrixXd& Mg, const BodyVelocity& w) const;
