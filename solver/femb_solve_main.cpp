@@ -210,6 +210,10 @@ int main(int argc, char** argv) {
                                              : std::vector<Eigen::Matrix<double, 6, 1>>();
       recorder.Record(0.0, state.config, state.W, r0.kinetic_energy, r0.elastic_energy, 0.0, r0.linear_momentum,
                       r0.angular_momentum, spec.reactions ? &reactions0 : nullptr, &state.Wdot);
+      // Reactions from the output state's consistent accelerations and multipliers (with loops, or
+      // the midpoint scheme), not from the integrator's own (WithConsistentAccelerations).
+      const bool consistent = spec.reactions && (scene.model.dofs().n_multipliers() > 0 ||
+                                                 spec.analysis.integrator == femb::IntegratorType::kMidpoint);
       femb::DynamicOptions options;
       options.step = spec.analysis.step;
       options.end_time = spec.analysis.end_time;
@@ -239,6 +243,7 @@ int main(int argc, char** argv) {
         for (double t : f.Breakpoints()) options.breakpoints.push_back(t);
       }
       recorder.RecordStepSize(0.0);
+      femb::DynamicState output_state;
       const femb::DynamicResult r = femb::SolveDynamic(
           scene.model, state, options, [&](const femb::DynamicStepReport& s, const femb::DynamicState& st) {
             ++step_count;
@@ -247,10 +252,11 @@ int main(int argc, char** argv) {
             // output_step picks the output steps (adaptive steps land on its times); else every
             // output_every-th step.
             if (spec.analysis.output_step > 0 ? s.output : step_count % spec.analysis.output_every == 0) {
-              const auto reactions = spec.reactions ? femb::DynamicReactions(scene.model, st)
+              const femb::DynamicState& out = consistent ? (output_state = femb::WithConsistentAccelerations(scene.model, st)) : st;
+              const auto reactions = spec.reactions ? femb::DynamicReactions(scene.model, out)
                                                     : std::vector<Eigen::Matrix<double, 6, 1>>();
-              recorder.Record(s.t, st.config, st.W, s.kinetic_energy, s.elastic_energy, s.external_work,
-                              s.linear_momentum, s.angular_momentum, spec.reactions ? &reactions : nullptr, &st.Wdot);
+              recorder.Record(s.t, out.config, out.W, s.kinetic_energy, s.elastic_energy, s.external_work,
+                              s.linear_momentum, s.angular_momentum, spec.reactions ? &reactions : nullptr, &out.Wdot);
               recorder.RecordStepSize(s.h);
             }
             progress(s.t, false);

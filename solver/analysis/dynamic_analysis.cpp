@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <functional>
+#include <limits>
 
 #include "solver/analysis/dynamic_step.h"
 #include "solver/analysis/singularity.h"
@@ -93,27 +94,23 @@ void DriveForces(const DofMap& dofs, const Eigen::VectorXd& residual, Eigen::Vec
 using namespace dynamic_internal;
 
 
-std::vector<Eigen::Matrix<double, 6, 1>> DynamicReactions(const SystemModel& model, const DynamicState& state) {
-  const DofMap& dofs = model.dofs();
-  DynamicState s = state;
-  const Assembly a = AssembleDynamic(model, dofs, s, s.t, false);
-  if (!a.ok) return std::vector<Eigen::Matrix<double, 6, 1>>(model.n_nodes(), Eigen::Matrix<double, 6, 1>::Zero());
-  return JointReactions(model, dofs, s.config, a.node_forces);
-}
-
 namespace {
 
 // The free accelerations from M_g Wdot = f_ext - f_int - f_gyro at s (prescribed ones as set),
-// a = Wdot, and the external and drive forces there: the start of an integration.
+// a = Wdot, and the external and drive forces there: the start of an integration, and its
+// restart at a breakpoint. The residual is taken with the free accelerations zero, so that it is
+// the right-hand side whatever accelerations s held (a restart holds the integrator's): with
+// them in, it would be solved for the change of the accelerations and taken as the accelerations.
 void ConsistentAccelerations(const SystemModel& model, const DofMap& dofs, DynamicState& s) {
-  const Assembly b = AssembleDynamic(model, dofs, s, s.t, true);
   for (int j : dofs.solved()) s.Wdot[j] = 0.0;
-  Eigen::VectorXd rhs = b.residual - b.M * s.Wdot;
+  const Assembly b = AssembleDynamic(model, dofs, s, s.t, true);
+  Eigen::VectorXd rhs = b.residual;  // f - M Wdot_p - G^T lambda
   SystemMatrix M = b.M;
   if (dofs.n_multipliers() > 0) {
-    // Closed loops: [M G^T; G 0] [Wdot; d lambda] = [r; -Gdot W] (the constraints' second time
-    // derivative), with Gdot W = d^2 g / dt^2 along q(t) = q + t W (no coordinate acceleration),
-    // by central differences over a step that moves the model by 1e-4 of its size.
+    // Closed loops: [M G^T; G 0] [Wdot_f; d lambda] = [r; -Gdot W] (the constraints' second time
+    // derivative, G Wdot + Gdot W = 0), with Gdot W = d^2 g / dt^2 along q(t) = q + t W (no
+    // coordinate acceleration), by central differences over a step that moves the model by 1e-4
+    // of its size.
     Triplets G;
     AddLoopConstraints(model, dofs, s.config, nullptr, nullptr, nullptr, &G);
     M = b.M + ToMatrix(dofs.n_dofs(), G);
@@ -121,6 +118,8 @@ void ConsistentAccelerations(const SystemModel& model, const DofMap& dofs, Dynam
     double speed = 0.0;
     for (int k = 0; k < model.n_nodes(); ++k) speed = std::max(speed, NodeMotion(s.config, k, s.W).head<3>().norm() +
                                                                          L * NodeMotion(s.config, k, s.W).tail<3>().norm());
+    const int m = dofs.n_multipliers();
+    rhs.tail(m).setZero();
     if (speed > 0) {
       const double eps = 1e-4 * L / speed;
       const auto g_at = [&](double e) {
@@ -129,14 +128,15 @@ void ConsistentAccelerations(const SystemModel& model, const DofMap& dofs, Dynam
         Eigen::VectorXd r = Eigen::VectorXd::Zero(dofs.n_dofs());
         q.lambda.setZero();
         AddLoopConstraints(model, dofs, q, &r, nullptr, nullptr);
-        return Eigen::VectorXd(-r.tail(dofs.n_multipliers()));  // g
+        return Eigen::VectorXd(-r.tail(m));  // g
       };
-      rhs.tail(dofs.n_multipliers()) = -(g_at(eps) - 2 * g_at(0.0) + g_at(-eps)) / (eps * eps);
-    } else {
-      rhs.tail(dofs.n_multipliers()).setZero();
+      rhs.tail(m) -= (g_at(eps) - 2 * g_at(0.0) + g_at(-eps)) / (eps * eps);
     }
   }
-  const Eigen::VectorXd free_acc = SolveFree(dofs, M, rhs);
+  const Eigen::VectorXd free_acc = SolveFree(dofs, M, rhs);  // zero on the prescribed coordinates
+  // The drives' forces with the accelerations and multipliers found: -(r - M Wdot_f - G^T d lambda)
+  // on the prescribed rows.
+  s.f_drive = DriveForces(dofs, b.residual - M * free_acc);
   for (int j : dofs.solved()) s.Wdot[j] = free_acc[j];
   if (dofs.n_multipliers() > 0) {
     s.config.lambda += free_acc.tail(dofs.n_multipliers());
@@ -144,12 +144,23 @@ void ConsistentAccelerations(const SystemModel& model, const DofMap& dofs, Dynam
   }
   s.a = s.Wdot;
   s.f_ext = b.f_ext;
-  Eigen::VectorXd added = Eigen::VectorXd::Zero(dofs.n_dofs());
-  for (int j : dofs.solved()) added[j] = s.Wdot[j];
-  s.f_drive = DriveForces(dofs, b.residual - b.M * added);
 }
 
 }  // namespace
+
+DynamicState WithConsistentAccelerations(const SystemModel& model, const DynamicState& state) {
+  DynamicState s = state;
+  if (model.dofs().n_multipliers() > 0 || !state.node_w.empty()) ConsistentAccelerations(model, model.dofs(), s);
+  return s;
+}
+
+std::vector<Eigen::Matrix<double, 6, 1>> DynamicReactions(const SystemModel& model, const DynamicState& state) {
+  const DofMap& dofs = model.dofs();
+  DynamicState s = state;
+  const Assembly a = AssembleDynamic(model, dofs, s, s.t, false);
+  if (!a.ok) return std::vector<Eigen::Matrix<double, 6, 1>>(model.n_nodes(), Eigen::Matrix<double, 6, 1>::Zero());
+  return JointReactions(model, dofs, s.config, a.node_forces);
+}
 
 DynamicState InitialDynamicState(const SystemModel& model, const SystemState& config, const Eigen::VectorXd& W,
                                  double t0) {
@@ -241,6 +252,14 @@ DynamicStepReport MeasureWith(const SystemModel& model, const DofMap& dofs, cons
   }
   return r;
 }
+// The kinetic energy of velocities at the noise of the positions' round-off over a step h (the
+// energy watchdog's floor in SolveDynamic).
+double EnergyNoise(double mass, const SystemState& config, double h) {
+  double x = 0.0;
+  for (const Eigen::Vector3d& xk : config.x) x = std::max(x, xk.norm());
+  const double v = 100.0 * std::numeric_limits<double>::epsilon() * x / h;
+  return 0.5 * mass * v * v;
+}
 }  // namespace
 
 DynamicStepReport Measure(const SystemModel& model, DynamicState& s) {
@@ -272,10 +291,18 @@ DynamicResult SolveDynamic(const SystemModel& model, DynamicState& state, const 
   // too long for the stiffest modes (generalized-alpha with rho_inf near 1 on stiff modes; the
   // midpoint scheme's elastic force is not an exact discrete gradient). Above 5% of the energy
   // scale (the largest of T + U and the works so far) it is said once; above 25% the run stops.
+  // The energy scale has a floor: the kinetic energy of velocities at the noise of the
+  // positions' round-off over a step, E_noise = m |v_noise|^2 / 2 with v_noise = 100 eps |x|_max
+  // / h (m the bodies' mass, |x|_max the largest node distance from the origin), so that a start
+  // from rest is not judged on noise: the spin-up of a four-bar (0.45 kg, 0.4 m) at h = 2 us held
+  // 2e-21 J of kinetic energy after its first step, all of it noise (the drive's work was
+  // 3e-26 J), and 1e-20 J after ten; E_noise is 4e-18 J there, and 1e-25 J at h = 1 ms.
   constexpr double kEnergyWarn = 0.05, kEnergyStop = 0.25;
   const DynamicStepReport start = Measure(model, state);
   const double E0 = start.kinetic_energy + start.elastic_energy;
   double energy_scale = std::abs(E0);
+  double model_mass = 0.0;
+  for (const SuperelementBody& body : model.bodies) model_mass += std::max(body.mass(), 0.0);
   bool warned = false;
   if (const std::string w = RoundOffToleranceWarning(options.tolerance); !w.empty()) result.warnings.push_back(w);
   const auto count_factorizations = [&] {
@@ -396,7 +423,8 @@ DynamicResult SolveDynamic(const SystemModel& model, DynamicState& state, const 
     r.output = output;
     if (on_step) on_step(r, state);
     const double energy = r.kinetic_energy + r.elastic_energy;
-    energy_scale = std::max({energy_scale, std::abs(energy), std::abs(state.external_work), std::abs(state.drive_work)});
+    energy_scale = std::max({energy_scale, std::abs(energy), std::abs(state.external_work), std::abs(state.drive_work),
+                             EnergyNoise(model_mass, state.config, h) / kEnergyWarn});
     const double growth = energy - state.external_work - state.drive_work - E0;
     // Judged from the 10th step on: over the first few steps of a smooth start (a spin-up
     // drive, energy ~ t^6) the trapezoidal work of the drives is off by tens of percent of an

@@ -62,6 +62,7 @@ SuperelementBody::SuperelementBody(const Superelement& se, const SuperelementOpt
   modal_weight_ = std::sqrt(std::max(mass, 0.0));
   force_weights_.tail(n_modes_).setConstant(modal_weight_);
   k_max_ = (force_weights_.asDiagonal() * K_ * force_weights_.asDiagonal()).cwiseAbs().maxCoeff();
+  m_max_ = (force_weights_.asDiagonal() * M_ * force_weights_.asDiagonal()).cwiseAbs().maxCoeff();
   force_floor_ = 1e-4 * k_max_ * length;
   // A file's polynomial is the modal derivatives' cubic force (option polynomial_force) or,
   // without derivatives, the geometric stiffening's quadratic force (option geometric_stiffening).
@@ -245,10 +246,11 @@ FrameSolution SuperelementBody::GuessFrame(const BodyConfiguration& c) const {
   return frame;
 }
 
-double SuperelementBody::RoundOffForce(const BodyConfiguration& c) const {
+double SuperelementBody::RoundOffForce(const BodyConfiguration& c, double inertia_factor) const {
   double x = 0.0;
   for (const Eigen::Vector3d& xk : c.x) x = std::max(x, xk.norm());
-  return 16.0 * std::sqrt(double(n_coordinates())) * std::numeric_limits<double>::epsilon() * k_max_ * x;
+  return std::numeric_limits<double>::epsilon() * x *
+         (16.0 * std::sqrt(double(n_coordinates())) * k_max_ + 2.0 * inertia_factor * m_max_);
 }
 
 FrameSolution SuperelementBody::SolveFrameFrom(const BodyConfiguration& c, const FrameSolution& last) const {

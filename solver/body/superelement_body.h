@@ -196,9 +196,16 @@ class SuperelementBody {
   /// The weight of the modal forces in ForceNorm: sqrt of the body's mass.
   double ModalForceWeight() const { return modal_weight_; }
   /// The residual noise that the round-off of absolute node positions of magnitude |x| causes
-  /// in the elastic force (ForceNorm units): 16 sqrt(n) eps max|D K D| |x|. Far from the origin (1e4 m) it exceeds a
-  /// relative Newton tolerance; the analyses accept a residual below it.
-  double RoundOffForce(const BodyConfiguration& c) const;
+  /// in the elastic force and, in a time step whose iteration matrix takes the mass times
+  /// `inertia_factor` (generalized-alpha beta', the midpoint scheme 2 / h^2: the accelerations
+  /// are position differences over h^2), in the inertia force (ForceNorm units):
+  /// eps |x| (16 sqrt(n) max|D K D| + 2 inertia_factor max|D M D|): the inertia's share is the
+  /// round-off of the position differences in the two momenta of a step (16 sqrt(n) there let
+  /// the midpoint scheme stop short of its invariants at Newton tolerance 1e-12).
+  /// Far from the origin (1e4 m), or
+  /// with steps of microseconds, it exceeds a relative Newton tolerance; the analyses accept a
+  /// residual below it.
+  double RoundOffForce(const BodyConfiguration& c, double inertia_factor = 0.0) const;
 
   /// Undeformed configuration at the placement, and its floating frame.
   BodyConfiguration InitialConfiguration() const;
@@ -497,6 +504,7 @@ class SuperelementBody {
   FrameSolution initial_frame_;
   double force_floor_ = 0.0;
   double k_max_ = 0.0;  ///< max|D K D|, D = diag(force_weights_): force per length
+  double m_max_ = 0.0;  ///< max|D M D|: force per acceleration
   Eigen::VectorXd force_weights_;  ///< see ForceNorm
   double modal_weight_ = 1.0;
 };

@@ -67,7 +67,7 @@ void AssembleDynamicResidual(const SystemModel& model, const DofMap& dofs, Dynam
     r.f_quadratic = f_in - f_acc;
     r.scale = std::max({body.ForceNorm(f_int), body.ForceNorm(f_in), body.ForceNorm(r.f_grav), body.force_floor(),
                         body.ForceNorm(f_acc), body.ForceNorm(r.f_quadratic)});
-    r.roundoff = body.RoundOffForce(c);
+    r.roundoff = body.RoundOffForce(c, work.inertia_factor);
     BodyMap(model, dofs, s.config, b, r.map);
     r.r_b = r.f_grav - f_int - f_in;
   });
@@ -261,12 +261,23 @@ StepOutcome GeneralizedAlphaStep(const SystemModel& model, const DofMap& dofs, c
   // rod bodies, h = 150 us, tolerance 1e-4): 1.79 -> 1.17 Newton iterations per step. The
   // converged state does not depend on the predictor (to the tolerance) since the configuration
   // is q_n o exp(Delta q) below.
-  next.a = (state.Wdot - alpha_m * state.a) / (1 - alpha_m);
-  next.W = state.W + h * (1 - gamma) * state.a + h * gamma * next.a;
-  work.dq = h * (state.W + h * (0.5 - beta) * state.a + h * beta * next.a);
+  //
+  // The acceleration-like a_n stands for Wdot at t_n + (alpha_m - alpha_f) h_n, a time that moves
+  // with the step (a_n - Wdot_n = (alpha_m - alpha_f) h_n Wdot' + O(h^2)). A step of another
+  // size takes it there by a_n* = Wdot_n + (h / h_n) (a_n - Wdot_n): kept as it was, it is off by
+  // O(h - h_n), which the constrained directions (index-3 loops, where the positions are fixed
+  // by the constraints) answer with an oscillation of the accelerations and multipliers: spikes
+  // in the reactions after every change of step of error-controlled runs.
+  Eigen::VectorXd& a_n = work.a_n;
+  a_n = state.a;
+  if (state.h_last > 0 && h != state.h_last) a_n = state.Wdot + (h / state.h_last) * (state.a - state.Wdot);
+  next.a = (state.Wdot - alpha_m * a_n) / (1 - alpha_m);
+  next.W = state.W + h * (1 - gamma) * a_n + h * gamma * next.a;
+  work.dq = h * (state.W + h * (0.5 - beta) * a_n + h * beta * next.a);
   ApplyIncrement(model, dofs, work.dq, next.config);
   ApplyPrescribed(model, dofs, t_new, next.config, &next.W, &next.Wdot);
   const double gamma_p = gamma / (beta * h), beta_p = (1 - alpha_m) / (beta * h * h * (1 - alpha_f));
+  work.inertia_factor = beta_p;
   StepOutcome out;
   const double tolerance = std::max(options.tolerance, kRoundOffTolerance);
   const Eigen::VectorXd& weights = work.Weights(model, dofs);
@@ -282,7 +293,7 @@ StepOutcome GeneralizedAlphaStep(const SystemModel& model, const DofMap& dofs, c
     if (ResidualSmall(dofs, a, weights, r_norm, tolerance) && out.iterations > 0 &&
         LoopsClosed(model, next.config, tolerance, &work.pass_data)) {
       out.converged = true;
-      next.a = (alpha_f * state.Wdot + (1 - alpha_f) * next.Wdot - alpha_m * state.a) / (1 - alpha_m);  // (the same relation)
+      next.a = (alpha_f * state.Wdot + (1 - alpha_f) * next.Wdot - alpha_m * a_n) / (1 - alpha_m);  // (the same relation)
       next.t = t_new;
       // External work by the trapezoidal rule on the increment h (W_n + W_n+1) / 2.
       next.external_work += 0.5 * (state.f_ext + a.f_ext).dot(h * 0.5 * (state.W + next.W));

@@ -399,7 +399,7 @@ void AssembleMidpoint(const SystemModel& model, const DofMap& dofs, const Dynami
     // cancel; M_g (w_n+1 - w_n) / h is the size of the inertia force).
     r.scale = std::max({body.ForceNorm(f_int), body.ForceNorm(f_in), body.ForceNorm(f_grav), body.force_floor(),
                         body.ForceNorm(f_acc)});
-    r.roundoff = body.RoundOffForce(d1.c);
+    r.roundoff = body.RoundOffForce(d1.c, work.inertia_factor);
     BodyMap(model, dofs, k.mid, int(b), r.map);
     r.r_b = f_grav - f_int - f_in;
   });
@@ -566,6 +566,7 @@ StepOutcome MidpointStep(const SystemModel& model, const DofMap& dofs, const Dyn
   });
   // Predictor: the configuration reached with the current velocity and acceleration.
   work.dq = h * state.W + 0.5 * h * h * state.Wdot;
+  work.inertia_factor = 2.0 / (h * h);  // S_b = K / 2 + C / h + 2 M / h^2
   ApplyIncrement(model, dofs, work.dq, next.config);
   ApplyPrescribed(model, dofs, t_new, next.config, &next.W, &next.Wdot);
   StepOutcome out;
