@@ -57,9 +57,14 @@ void RecordModeShapes(const femb::Scene& scene, const femb::SystemState& state, 
 
 constexpr const char* kUsage = R"(usage: femb-solve SCENE.yaml [-o OUTDIR] [--set key=value]... [--threads N] [--quiet]
 
-Simulates a scene of superelements in absolute interface coordinates (see formats/SCENE_FORMAT.md):
-static (load stepping in pseudo-time, Newton with the full tangent, step cutting) or dynamic
-(Lie-group generalized-alpha, Newton, step cutting).
+Simulates a scene of superelements and rigid bodies in absolute interface coordinates (see
+formats/SCENE_FORMAT.md), with joints along a tree and closed loops cut into constraint equations:
+  analysis.type: static   load stepping in pseudo-time, Newton with the full tangent, step cutting
+  analysis.type: dynamic  analysis.integrator: generalized_alpha (numerical damping rho_inf) or
+                          midpoint (momentum-conserving, no damping); analysis.step: a fixed step
+                          (cut where Newton fails, with a warning) or auto (error-controlled by
+                          analysis.step_tolerance; the steps are listed in results.h5 /steps)
+  analysis.type: modes    linearized eigenfrequencies about the initial or the static state
 
 options:
   -o, --output OUTDIR   output folder (default: out/<scene name>): results.h5 and probes.csv
@@ -249,6 +254,7 @@ int main(int argc, char** argv) {
             ++step_count;
             total_iterations += s.iterations;
             rejected = s.rejected;
+            recorder.RecordStep(s.t, s.h);
             // output_step picks the output steps (adaptive steps land on its times); else every
             // output_every-th step.
             if (spec.analysis.output_step > 0 ? s.output : step_count % spec.analysis.output_every == 0) {
@@ -279,6 +285,11 @@ int main(int argc, char** argv) {
       if (!quiet && spec.analysis.adaptive_step) {
         std::printf("femb-solve: %ld steps rejected (%ld by the error test, %ld by Newton)\n",
                     r.rejected_by_error + r.newton_cuts, r.rejected_by_error, r.newton_cuts);
+        if (r.steps > 0) {
+          std::printf("femb-solve: steps: smallest %.3g s (ending at t = %.6g), largest %.3g s, mean %.3g s; every step "
+                      "in results.h5 /steps\n", r.smallest_step, r.smallest_step_time, r.largest_step,
+                      spec.analysis.end_time / double(r.steps));
+        }
       }
       recorder.StepCounts(r.steps, r.rejected_by_error, r.newton_cuts);
     }

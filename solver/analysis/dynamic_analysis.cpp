@@ -301,6 +301,7 @@ DynamicResult SolveDynamic(const SystemModel& model, DynamicState& state, const 
   const DynamicStepReport start = Measure(model, state);
   const double E0 = start.kinetic_energy + start.elastic_energy;
   double energy_scale = std::abs(E0);
+  double first_cut_time = -1.0;  // fixed steps: where Newton first needed a shorter step
   double model_mass = 0.0;
   for (const SuperelementBody& body : model.bodies) model_mass += std::max(body.mass(), 0.0);
   bool warned = false;
@@ -405,6 +406,9 @@ DynamicResult SolveDynamic(const SystemModel& model, DynamicState& state, const 
       }
     }
     next.h_last = h;
+    if (result.steps == 0 || h < result.smallest_step) result.smallest_step = h, result.smallest_step_time = next.t;
+    result.largest_step = std::max(result.largest_step, h);
+    if (cuts > 0 && first_cut_time < 0) first_cut_time = state.t;
     state = next;
     if (options.adaptive && control.at_breakpoint()) {
       // A load or drive jumps or kinks here: restart from the state with the accelerations of the
@@ -451,6 +455,16 @@ DynamicResult SolveDynamic(const SystemModel& model, DynamicState& state, const 
     }
   }
   count_factorizations();
+  if (!options.adaptive && first_cut_time >= 0) {
+    // A fixed step that Newton could not take was replaced: said once, with the step used.
+    char buffer[400];
+    std::snprintf(buffer, sizeof buffer,
+                  "Newton did not converge with analysis.step %.3g from t = %.6g on (%ld cuts): steps there were "
+                  "shortened, to %.3g at the least (at t = %.6g); the results are those of the shorter steps. Give "
+                  "a step Newton takes, or `step: auto`",
+                  options.step, first_cut_time, result.newton_cuts, result.smallest_step, result.smallest_step_time);
+    result.warnings.push_back(buffer);
+  }
   result.ok = true;
   return result;
 }

@@ -152,6 +152,8 @@ struct DynamicResult {
   long steps = 0;
   long rejected_by_error = 0;  ///< adaptive steps: tried and rejected by the error test
   long newton_cuts = 0;        ///< steps cut because Newton diverged
+  double smallest_step = 0.0, largest_step = 0.0;  ///< of the steps taken (0 when none)
+  double smallest_step_time = 0.0;                 ///< where the smallest one ended
   long newton_iterations = 0;
   long factorizations = 0;  ///< of the iteration matrix
   long pattern_analyses = 0;  ///< of its sparsity pattern (once unless the pattern changes)

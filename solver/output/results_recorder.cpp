@@ -398,6 +398,11 @@ void ResultsRecorder::Finish(const std::string& status) {
     if (step_size_.size() == time_.size()) {
       w.Vector("/step_size", Eigen::Map<const Eigen::VectorXd>(step_size_.data(), long(step_size_.size())));
     }
+    if (!all_steps_t_.empty()) {
+      w.CreateGroup("/steps");
+      w.Vector("/steps/time", Eigen::Map<const Eigen::VectorXd>(all_steps_t_.data(), long(all_steps_t_.size())));
+      w.Vector("/steps/size", Eigen::Map<const Eigen::VectorXd>(all_steps_h_.data(), long(all_steps_h_.size())));
+    }
     if (!model.cut_joints.empty()) {
       w.CreateGroup("/loops");
       std::vector<std::string> names;

@@ -34,6 +34,12 @@ class ResultsRecorder {
   /// The step that reached the last recorded state (dynamic analyses; 0 for the initial state):
   /// /step_size in results.h5.
   void RecordStepSize(double h) { step_size_.push_back(h); }
+  /// Every step taken (dynamic analyses): the time it reached and its size, /steps/time and
+  /// /steps/size in results.h5.
+  void RecordStep(double t, double h) {
+    all_steps_t_.push_back(t);
+    all_steps_h_.push_back(h);
+  }
   /// Steps taken and rejected over the run: attributes of results.h5.
   void StepCounts(long taken, long rejected_by_error, long newton_cuts) {
     steps_taken_ = taken, rejected_by_error_ = rejected_by_error, newton_cuts_ = newton_cuts;
@@ -54,7 +60,7 @@ class ResultsRecorder {
   int animation_every_ = 1;  ///< one animation frame per this many output steps (spec, or auto)
   double frame_interval_ = 0;  ///< > 0: one animation frame per this much time (auto, with step: auto)
   double next_frame_time_ = 0;
-  std::vector<double> step_size_;
+  std::vector<double> step_size_, all_steps_t_, all_steps_h_;
   long steps_taken_ = -1, rejected_by_error_ = 0, newton_cuts_ = 0;
   std::string directory_, csv_path_, h5_path_, csv_tmp_;
   std::ofstream csv_;

@@ -262,6 +262,7 @@ assert float(rows[0]['kinetic_energy']) > 0, rows[0]['kinetic_energy']" && ok ||
 # must fall below min_step stops with exit 3, results kept.
 "$bin/femb-solve" "$work/pend/rate.yaml" -o "$work/pend_auto" --set analysis.end_time=0.2 --set analysis.step=auto \
   --set analysis.output_step=0.01 --threads 1 > "$work/auto.txt" && grep -q "steps rejected (.* by the error test" "$work/auto.txt" \
+  && grep -q "steps: smallest .* s (ending at t = .*), largest .* s, mean .* s; every step in results.h5 /steps" "$work/auto.txt" \
   && ok || fail "step: auto: $(tail -3 "$work/auto.txt")"
 $py - "$work/pend_auto" <<'PY' && ok || fail "step: auto: results.h5"
 import sys, h5py, numpy as np
@@ -270,7 +271,16 @@ t, h = f["time"][:], f["step_size"][:]
 assert len(t) == 21 and np.abs(t - 0.01 * np.arange(21)).max() < 1e-15, t
 assert f.attrs["steps"] > 20 and f.attrs["rejected_steps_error"] >= 0 and f.attrs["rejected_steps_newton"] >= 0
 assert h[0] == 0 and (h[1:] > 0).all() and (h[1:] <= 0.01 + 1e-15).all(), h
+# Every step taken: as many as the attribute says, each ending where the next begins, to 0.2 s.
+ts, hs = f["steps/time"][:], f["steps/size"][:]
+assert len(ts) == f.attrs["steps"] == len(hs), (len(ts), f.attrs["steps"])
+assert abs(ts[-1] - 0.2) < 1e-12 and np.abs(np.diff(ts) - hs[1:]).max() < 1e-12 and abs(ts[0] - hs[0]) < 1e-15
 PY
+# A fixed step Newton cannot take is cut: said once as a warning, even with -q, with the step used.
+"$bin/femb-solve" -q "$work/pend/rate.yaml" -o "$work/pend_big" --set analysis.step=0.5 --set analysis.end_time=1 \
+  > "$work/big.txt" 2>&1; code=$?
+[ $code = 0 ] && [ "$(grep -c "^femb-solve: warning: Newton did not converge with analysis.step 0.5 from t = .* on (.* cuts): steps there were shortened, to .* at the least" "$work/big.txt")" = 1 ] \
+  && ok || fail "fixed step cut by Newton: exit $code $(cat "$work/big.txt")"
 "$bin/femb-solve" -q "$work/pend/rate.yaml" -o "$work/pend_auto_bad" --set analysis.step=auto --set analysis.min_step=0.1 \
   --set analysis.max_step=0.01 2> "$work/err.txt"; [ $? = 2 ] && grep -q "analysis.min_step.*min_step 0.1 is above max_step 0.01" "$work/err.txt" \
   && [ $(wc -l < "$work/err.txt") = 1 ] && ok || fail "min_step > max_step: $(cat "$work/err.txt")"
