@@ -250,7 +250,7 @@ double SuperelementBody::RoundOffForce(const BodyConfiguration& c, double inerti
   double x = 0.0;
   for (const Eigen::Vector3d& xk : c.x) x = std::max(x, xk.norm());
   return std::numeric_limits<double>::epsilon() * x *
-         (16.0 * std::sqrt(double(n_coordinates())) * k_max_ + 2.0 * inertia_factor * m_max_);
+         (16.0 * std::sqrt(double(n_coordinates())) * k_max_ + 4.0 * inertia_factor * m_max_);
 }
 
 FrameSolution SuperelementBody::SolveFrameFrom(const BodyConfiguration& c, const FrameSolution& last) const {

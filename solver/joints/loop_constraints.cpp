@@ -164,9 +164,13 @@ std::vector<double> EquationRemainders(const SystemModel& model, const DofMap& d
   }
   std::vector<Eigen::VectorXd> basis;
   std::vector<double> remainder(size_t(m), 0.0);
+  // A row at the round-off of the others is zero: normalized, it would look independent of
+  // every row (a planar loop in a tilted plane: its out-of-plane translation's row was 3e-17 and
+  // was kept instead of an in-plane one, leaving [M G^T; G 0] singular).
+  const double largest = m > 0 && n > 0 ? G.rowwise().norm().maxCoeff() : 0.0;
   for (int i = 0; i < m; ++i) {
     const double size = G.row(i).norm();
-    if (size == 0.0) continue;
+    if (size <= tolerance * largest) continue;
     Eigen::VectorXd v = G.row(i).transpose() / size;
     for (int pass = 0; pass < 2; ++pass)
       for (const Eigen::VectorXd& q : basis) v -= q.dot(v) * q;
