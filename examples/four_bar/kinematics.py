@@ -6,10 +6,10 @@ point B from the crank angle (make_scenes.coupler_point: the intersection of |C 
 Then the ground reactions against the momentum balance: with no other load, the forces of the
 ground at A (the driven tree joint's support reaction) and at D (the cut joint's, from its
 multipliers) add up to the rate of the links' linear momentum, d/dt of results.h5's
-/energy/linear_momentum by central differences between equally spaced outputs. Checked from
-t = 2 ms on (the first 100 steps: index-3 generalized-alpha starts with an oscillation of the
-multipliers, damped by rho_inf, 4e-3 of the peak reaction at the first step; printed too).
-Exit 1 above 1e-5 of the largest reaction.
+/energy/linear_momentum by central differences between equally spaced outputs, from the second
+output on (the reactions come from each output state's consistent accelerations and multipliers,
+not index-3 generalized-alpha's, which start with an oscillation damped by rho_inf). Exit 1 above
+5e-5 of the largest reaction.
 
 usage: kinematics.py RUN_DIR [TOL]
 """
@@ -55,13 +55,13 @@ def main():
     gap = np.max(np.abs(force[1:-1] - rate), axis=1) / peak
     dt = np.diff(t)
     uniform = np.abs(dt[1:] - dt[:-1]) < 1e-9 * dt[1:]
-    checked = uniform & (t[1:-1] >= 2e-3)
-    balance, start = np.max(gap[checked]), np.max(gap[~checked & uniform])
+    early = t[1:-1] < 2e-3
+    balance, start = np.max(gap[uniform]), np.max(gap[uniform & early])
     same = np.max(np.abs(cut[:, 0:2] - ground[:, 2:4])) / peak  # the probes.csv round-off
     print(f"ground reactions at A (tree) and D (cut joint): peak {peak:.4g} N; their sum against the rate of the linear "
-          f"momentum {balance:.2e} of the peak from t = 2 ms (tolerance 1e-5; {start:.1e} in the first 2 ms); "
+          f"momentum {balance:.2e} of the peak from the second output on (tolerance 5e-5; {start:.1e} in the first 2 ms); "
           f"/loops/reaction against the D probe {same:.1e}")
-    sys.exit(0 if max(error, angle_error) <= tol and balance <= 1e-5 and same <= 1e-9 else 1)
+    sys.exit(0 if max(error, angle_error) <= tol and balance <= 5e-5 and same <= 1e-9 else 1)
 
 
 if __name__ == "__main__":
