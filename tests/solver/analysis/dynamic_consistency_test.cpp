@@ -145,6 +145,16 @@ DynamicOptions Options(Integrator integrator, double end_time) {
   return o;
 }
 
+// Error-controlled steps over the 0.2 s run, landing on the spin-up's end (a breakpoint).
+DynamicOptions ErrorControlled(Integrator integrator, double tolerance) {
+  DynamicOptions o = Options(integrator, 0.2);
+  o.adaptive = true;
+  o.step = 2e-5;
+  o.step_tolerance = tolerance;
+  o.breakpoints = {0.1};
+  return o;
+}
+
 class TiltedFourBarTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
@@ -182,11 +192,7 @@ void RestartLeavesASmoothRunUnchanged(const Scene& scene, Integrator integrator)
   }());
   ASSERT_TRUE(reference.result.ok) << reference.result.message;
   for (double tolerance : {1e-4, 1e-5, 1e-6}) {
-    DynamicOptions o = Options(integrator, 0.2);
-    o.adaptive = true;
-    o.step = 2e-5;
-    o.step_tolerance = tolerance;
-    o.breakpoints = {0.1};
+    DynamicOptions o = ErrorControlled(integrator, tolerance);
     const Reactions restarted = Simulate(scene, o);
     o.breakpoints.clear();
     const Reactions smooth = Simulate(scene, o);
@@ -239,12 +245,7 @@ TEST(DynamicConsistency, RigidTiltedFourBarReactionsFollowAFixedStepRunAtEveryTo
     ASSERT_TRUE(reference.result.ok) << reference.result.message;
     EXPECT_TRUE(reference.result.warnings.empty()) << reference.result.warnings.front();
     for (double tolerance : {1e-4, 1e-5, 1e-6}) {
-      DynamicOptions o = Options(integrator, 0.2);
-      o.adaptive = true;
-      o.step = 2e-5;
-      o.step_tolerance = tolerance;
-      o.breakpoints = {0.1};
-      const Reactions run = Simulate(scene, o);
+      const Reactions run = Simulate(scene, ErrorControlled(integrator, tolerance));
       ASSERT_TRUE(run.result.ok) << run.result.message;
       const double before = run.Error(reference, 0, 0.1 - 1e-9), after = run.Error(reference, 0.1 + 1e-9, 0.2);
       std::printf("[ info ] rigid links, %s, step_tolerance %.0e (%ld steps): ground reactions against the fixed 5 us "
