@@ -103,6 +103,8 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
     report("mesh+assembly", clock.Seconds(), detail);
   }
 
+  // What needs only the mesh and the mass is refused before the factorization and eigen solve.
+  CheckFloatingFrame(part.reduction.floating_frame, part.reduction.where_floating_frame, model);
   const bool keep_mesh = part.reduction.keep_mesh.value_or(model.n_dofs() <= ReductionSpec::kKeepMeshMaxDofs);
   if (!keep_mesh && part.reduction.stresses.value_or(false)) {
     throw InputError(part.reduction.where_stresses + ": reduction.stresses: true needs the mesh, which is not kept for "

@@ -2,10 +2,46 @@
 
 #include <Eigen/Dense>
 #include <cstdio>
+#include <optional>
 
 #include "formats/input_error.h"
+#include "reducer/reduction/craig_bampton.h"
 
 namespace femb {
+
+namespace {
+
+// N(x_c) of the center_of_mass frame, or the refusal naming `where`.
+std::optional<SparseMatrix> CenterOfMassInterpolation(const std::string& where, const FeModel& model,
+                                                      const Eigen::Vector3d& c) {
+  if (!model.interpolate_at) {
+    throw InputError(where + ": floating_frame center_of_mass interpolates the field at the centre of mass, and this "
+                     "model's mesh has no volume cells to interpolate in (an imported surface or line mesh): use "
+                     "floating_frame: mean_axes");
+  }
+  std::optional<SparseMatrix> interpolation = model.interpolate_at(c);
+  if (!interpolation) {
+    char buffer[160];
+    std::snprintf(buffer, sizeof buffer, "(%.6g, %.6g, %.6g)", c.x(), c.y(), c.z());
+    throw InputError(where + ": floating_frame center_of_mass: the centre of mass " + buffer +
+                     " lies outside the material; use floating_frame: mean_axes");
+  }
+  return interpolation;
+}
+
+}  // namespace
+
+void CheckFloatingFrame(const std::string& type, const std::string& where, const FeModel& model) {
+  if (type != "center_of_mass") return;
+  // The centre of mass from the rigid fields R (translations, rotations about the part origin):
+  // R^T M R = [m 1, -S~; S~, J], the first moment S = m c from its (translation, rotation) block.
+  const Eigen::MatrixXd R = RigidFields(model);
+  const Eigen::MatrixXd M_rig = R.transpose() * (model.M * R);
+  const double m = M_rig(0, 0);
+  if (!(m > 0)) return;  // (a massless model is refused elsewhere, with its own message)
+  const Eigen::Vector3d c = Eigen::Vector3d(-M_rig(2, 4), -M_rig(0, 5), -M_rig(1, 3)) / m;
+  CenterOfMassInterpolation(where, model, c);
+}
 
 FloatingFrame ComputeFloatingFrame(const std::string& type, const std::string& where,
                                    const Superelement& se, const FeModel& model,
@@ -17,18 +53,7 @@ FloatingFrame ComputeFloatingFrame(const std::string& type, const std::string& w
   frame.Phi_CB = Eigen::MatrixXd::Zero(6, n_r);
 
   if (type == "center_of_mass") {
-    if (!model.interpolate_at) {
-      throw InputError(where + ": floating_frame center_of_mass interpolates the field at the centre of mass, and this "
-                       "model's mesh has no volume cells to interpolate in (an imported surface or line mesh): use "
-                       "floating_frame: mean_axes");
-    }
-    auto interpolation = model.interpolate_at(c);
-    if (!interpolation) {
-      char buffer[160];
-      std::snprintf(buffer, sizeof buffer, "(%.6g, %.6g, %.6g)", c.x(), c.y(), c.z());
-      throw InputError(where + ": floating_frame center_of_mass: the centre of mass " + buffer +
-                       " lies outside the material; use floating_frame: mean_axes");
-    }
+    const std::optional<SparseMatrix> interpolation = CenterOfMassInterpolation(where, model, c);
     frame.origin = c;
     frame.Phi_CB = (*interpolation) * shapes;
   } else if (type == "mean_axes") {

@@ -24,4 +24,9 @@ FloatingFrame ComputeFloatingFrame(const std::string& type, const std::string& w
                                    const Superelement& se, const FeModel& model,
                                    const Eigen::MatrixXd& shapes);
 
+/// The refusals of `type` that need only the model's mesh and mass, before any reduction work:
+/// center_of_mass without volume cells or with the centre of mass (from the full M and the rigid
+/// fields) outside the material. Throws the same InputError as ComputeFloatingFrame.
+void CheckFloatingFrame(const std::string& type, const std::string& where, const FeModel& model);
+
 }  // namespace femb
