@@ -215,10 +215,6 @@ int main(int argc, char** argv) {
                                              : std::vector<Eigen::Matrix<double, 6, 1>>();
       recorder.Record(0.0, state.config, state.W, r0.kinetic_energy, r0.elastic_energy, 0.0, r0.linear_momentum,
                       r0.angular_momentum, spec.reactions ? &reactions0 : nullptr, &state.Wdot);
-      // Reactions from the output state's consistent accelerations and multipliers (with loops, or
-      // the midpoint scheme), not from the integrator's own (WithConsistentAccelerations).
-      const bool consistent = spec.reactions && (scene.model.dofs().n_multipliers() > 0 ||
-                                                 spec.analysis.integrator == femb::IntegratorType::kMidpoint);
       femb::DynamicOptions options;
       options.step = spec.analysis.step;
       options.end_time = spec.analysis.end_time;
@@ -258,7 +254,10 @@ int main(int argc, char** argv) {
             // output_step picks the output steps (adaptive steps land on its times); else every
             // output_every-th step.
             if (spec.analysis.output_step > 0 ? s.output : step_count % spec.analysis.output_every == 0) {
-              const femb::DynamicState& out = consistent ? (output_state = femb::WithConsistentAccelerations(scene.model, st)) : st;
+              // Reactions from the output state's consistent accelerations and multipliers, not
+              // from the integrator's own (WithConsistentAccelerations).
+              const femb::DynamicState& out =
+                  spec.reactions ? (output_state = femb::WithConsistentAccelerations(scene.model, st)) : st;
               const auto reactions = spec.reactions ? femb::DynamicReactions(scene.model, out)
                                                     : std::vector<Eigen::Matrix<double, 6, 1>>();
               recorder.Record(s.t, out.config, out.W, s.kinetic_energy, s.elastic_energy, s.external_work,

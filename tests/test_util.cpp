@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -118,6 +119,12 @@ SystemModel SliderCrankModel(const Superelement& crank, const Superelement& rod,
                                        model.node_x0[b], model.node_R0[b]));
   model.gravity = Eigen::Vector3d(0, -9.81, 0);
   return model;
+}
+
+std::string Number(double x) {
+  char buffer[40];
+  std::snprintf(buffer, sizeof buffer, "%.17g", x);
+  return buffer;
 }
 
 Superelement Reduce(const std::string& yaml, const std::vector<std::string>& overrides) {

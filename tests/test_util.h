@@ -10,6 +10,9 @@
 
 namespace femb::test {
 
+/// x with 17 significant digits (round-trips through YAML).
+std::string Number(double x);
+
 /// A straight beam part along x from 0 to L with interfaces at the named ends ("A" at x = 0,
 /// "B" at x = L), `extra` appended to the YAML (e.g. a reduction block).
 std::string StraightBeamYaml(double L, int elements, const std::string& section,

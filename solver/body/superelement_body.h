@@ -202,10 +202,9 @@ class SuperelementBody {
   /// eps |x| (16 sqrt(n) max|D K D| + 4 inertia_factor max|D M D|): the inertia's share is the
   /// round-off of the position differences in the momenta of a step (measured: the midpoint
   /// scheme's residual on a rigid four-bar at h = 5 us stalls at 1.25 times eps |x| 2 beta' |M|;
-  /// 16 sqrt(n) there let it stop short of its invariants at Newton tolerance 1e-12).
-  /// Far from the origin (1e4 m), or
-  /// with steps of microseconds, it exceeds a relative Newton tolerance; the analyses accept a
-  /// residual below it.
+  /// 16 sqrt(n) there let it stop short of its invariants at Newton tolerance 1e-12). Far from
+  /// the origin (1e4 m), or with steps of microseconds, it exceeds a relative Newton tolerance;
+  /// the analyses accept a residual below it.
   double RoundOffForce(const BodyConfiguration& c, double inertia_factor = 0.0) const;
 
   /// Undeformed configuration at the placement, and its floating frame.

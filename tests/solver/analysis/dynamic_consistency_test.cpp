@@ -26,11 +26,7 @@
 namespace femb {
 namespace {
 
-std::string Number(double x) {
-  char buffer[40];
-  std::snprintf(buffer, sizeof buffer, "%.17g", x);
-  return buffer;
-}
+using test::Number;
 
 std::string Vector(const Eigen::Vector3d& v) { return "[" + Number(v.x()) + ", " + Number(v.y()) + ", " + Number(v.z()) + "]"; }
 

@@ -143,11 +143,7 @@ TEST(LoopClosure, StaticTangentWithCutJointsMatchesFiniteDifferences) {
   }
 }
 
-std::string Number(double x) {
-  char buffer[40];
-  std::snprintf(buffer, sizeof buffer, "%.17g", x);
-  return buffer;
-}
+using test::Number;
 
 std::string Point(const Eigen::Vector2d& p) { return "[" + Number(p.x()) + ", " + Number(p.y()) + ", 0]"; }
 
