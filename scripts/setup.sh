@@ -4,7 +4,7 @@
 # arguments are installed too (scripts/sanitizer_tree.sh: clang for the sanitizer tree).
 set -euo pipefail
 packages=(cmake g++ make pkg-config libeigen3-dev libspectra-dev libsuitesparse-dev libmetis-dev
-  libhdf5-dev libgmsh-dev gmsh libyaml-cpp-dev nlohmann-json3-dev libgtest-dev libopenblas-dev
+  libhdf5-dev zlib1g-dev libgmsh-dev gmsh libyaml-cpp-dev nlohmann-json3-dev libgtest-dev libopenblas-dev
   python3-h5py python3-numpy python3-scipy python3-meshio python3-matplotlib calculix-ccx "$@")
 missing=()
 for p in "${packages[@]}"; do
