@@ -454,6 +454,21 @@ SceneSpec ParseScene(const std::string& text, const std::string& name, const std
     if (auto v = m.Optional("animation_every")) scene.animation_every = int(v->NonNegativeInteger());
     if (auto v = m.Optional("reactions")) scene.reactions = scene.reactions || v->Bool();
     if (auto v = m.Optional("stresses")) scene.stresses = v->Bool();
+    if (auto exclude = m.Optional("stress_exclude")) {
+      YamlMap em = exclude->Map();
+      scene.stress_exclude.where = exclude->Where();
+      const YamlValue distance = em.Required("distance");
+      scene.stress_exclude.distance = distance.Number();
+      if (!(scene.stress_exclude.distance >= 0)) distance.Fail("stress_exclude.distance must be >= 0 (a length)");
+      if (auto list = em.Optional("interfaces")) {
+        for (const YamlValue& item : list->List()) {
+          const std::string name = item.String();
+          if (name.find('.') == std::string::npos) item.Fail("stress_exclude.interfaces: '" + name + "' is not <body>.<interface>");
+          scene.stress_exclude.interfaces.push_back(name);
+        }
+      }
+      em.CheckNoUnknownKeys();
+    }
     if (auto probes = m.Optional("probes")) {
       for (const YamlValue& item : probes->List()) {
         YamlMap pm = item.Map();
@@ -462,30 +477,46 @@ SceneSpec ParseScene(const std::string& text, const std::string& name, const std
         p.name = pm.Required("name").String();
         const auto body = pm.Optional("body");
         if (body) {
-          // A stress probe: a body and a point, quantities [stress] only.
+          // A point probe: a body and a point.
           p.body = body->String();
           p.point = pm.Required("point").Vector3();
-          if (pm.Optional("node")) item.Fail("probe '" + p.name + "': give either node (node quantities) or body and point (stress), not both");
+          if (pm.Optional("node")) item.Fail("probe '" + p.name + "': give either node (node quantities) or body and point (point quantities), not both");
         } else {
           p.node = check_node(pm.Required("node"));
         }
         YamlValue q = pm.Required("quantities");
+        static const ProbeQuantity node_quantities[] = {
+            ProbeQuantity::kPosition,     ProbeQuantity::kRotation,            ProbeQuantity::kVelocity,
+            ProbeQuantity::kAngularVelocity, ProbeQuantity::kAcceleration,     ProbeQuantity::kAngularAcceleration,
+            ProbeQuantity::kJoint,        ProbeQuantity::kReaction,            ProbeQuantity::kEffort};
+        static const ProbeQuantity point_quantities[] = {ProbeQuantity::kPosition, ProbeQuantity::kVelocity,
+                                                         ProbeQuantity::kAcceleration, ProbeQuantity::kDeformation,
+                                                         ProbeQuantity::kStress};
+        const auto names = [](const auto& list) {
+          std::string out;
+          for (ProbeQuantity x : list) out += std::string(out.empty() ? "" : ", ") + Name(x);
+          return out;
+        };
         for (const YamlValue& qi : q.List()) {
           const std::string s = qi.String();
-          static const ProbeQuantity all[] = {ProbeQuantity::kPosition, ProbeQuantity::kRotation, ProbeQuantity::kVelocity,
-                                              ProbeQuantity::kAngularVelocity, ProbeQuantity::kJoint,
-                                              ProbeQuantity::kReaction, ProbeQuantity::kStress};
-          const ProbeQuantity* found = std::find_if(std::begin(all), std::end(all), [&](ProbeQuantity x) { return s == Name(x); });
-          if (found == std::end(all)) {
-            qi.Fail("unknown probe quantity '" + s +
-                    "' (known: position, rotation, velocity, angular_velocity, joint, reaction; stress with body and point)");
+          const auto known = [&](const auto& list) {
+            return std::find_if(std::begin(list), std::end(list), [&](ProbeQuantity x) { return s == Name(x); });
+          };
+          const auto in_node = known(node_quantities);
+          const auto in_point = known(point_quantities);
+          if (in_node == std::end(node_quantities) && in_point == std::end(point_quantities)) {
+            qi.Fail("unknown probe quantity '" + s + "' (node probes: " + names(node_quantities) +
+                    "; point probes, with body and point: " + names(point_quantities) + ")");
           }
-          if ((s == "stress") != body.has_value()) {
-            qi.Fail(s == "stress" ? "probe quantity 'stress' needs body and point (e.g. {name: s, body: rod0, point: [x, y, z], quantities: [stress]})"
-                                  : "probe quantity '" + s + "' is a node quantity: give node, not body and point");
+          if (body && in_point == std::end(point_quantities)) {
+            qi.Fail("probe quantity '" + s + "' is a node quantity: give node, not body and point (point probes: " +
+                    names(point_quantities) + ")");
           }
-          if (s == "reaction") scene.reactions = true;
-          p.quantities.push_back(*found);
+          if (!body && in_node == std::end(node_quantities)) {
+            qi.Fail("probe quantity '" + s + "' needs body and point (e.g. {name: s, body: rod0, point: [x, y, z], quantities: [" + s + "]})");
+          }
+          if (s == "reaction" || s == "effort") scene.reactions = true;
+          p.quantities.push_back(body ? *in_point : *in_node);
         }
         pm.CheckNoUnknownKeys();
         scene.probes.push_back(p);
@@ -543,6 +574,10 @@ const char* Name(ProbeQuantity quantity) {
     case ProbeQuantity::kJoint: return "joint";
     case ProbeQuantity::kReaction: return "reaction";
     case ProbeQuantity::kStress: return "stress";
+    case ProbeQuantity::kAcceleration: return "acceleration";
+    case ProbeQuantity::kAngularAcceleration: return "angular_acceleration";
+    case ProbeQuantity::kDeformation: return "deformation";
+    case ProbeQuantity::kEffort: return "effort";
   }
   return "?";
 }

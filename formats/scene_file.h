@@ -44,7 +44,10 @@ enum class AnalysisType { kStatic, kDynamic, kModes };
 enum class IntegratorType { kGeneralizedAlpha, kMidpoint };
 enum class BodyMatricesKeptType { kInertia, kAll };  ///< analysis.body_matrices_kept: inertia | all
 enum class JacobianReuseType { kDefault, kNone, kStep, kSteps };  ///< analysis.jacobian_reuse: none | step | steps (kDefault: unset)
-enum class ProbeQuantity { kPosition, kRotation, kVelocity, kAngularVelocity, kJoint, kReaction, kStress };
+enum class ProbeQuantity {
+  kPosition, kRotation, kVelocity, kAngularVelocity, kJoint, kReaction, kStress,
+  kAcceleration, kAngularAcceleration, kDeformation, kEffort
+};
 /// Bodies, joints and loads by type (SCENE_FORMAT.md `bodies`, `joints`, `loads`).
 enum class SceneBodyType { kSuperelement, kRigid };
 enum class SceneJointType { kClamp, kRigid, kSpherical, kRevolute, kPrismatic, kCylindrical, kUniversal };
@@ -107,11 +110,26 @@ struct SceneLoadSpec {
 struct SceneProbeSpec {
   std::string name;
   std::string node;
-  /// A stress probe (quantity `stress`, issue 17) names a body and a point instead of a node: the
-  /// body's stress point nearest to `point` (scene coordinates at the initial placement).
+  /// A point probe names a body and a point instead of a node (`point`: scene coordinates at the
+  /// initial placement): position, velocity, acceleration and deformation of the material point
+  /// there (interpolated from the file's mesh and mode shapes), stress at the body's stress
+  /// point nearest to it.
   std::string body;
   Eigen::Vector3d point = Eigen::Vector3d::Zero();
-  std::vector<ProbeQuantity> quantities;  ///< node quantities, or kStress alone (body and point)
+  /// Node probes: position, rotation, velocity, angular_velocity, acceleration,
+  /// angular_acceleration, joint, reaction, effort; point probes: position, velocity,
+  /// acceleration, deformation, stress.
+  std::vector<ProbeQuantity> quantities;
+  std::string where;
+};
+
+/// outputs.stress_exclude: the mesh nodes left out of each body's largest von Mises stress
+/// (results.h5 max_von_mises; the animation's fields keep them): those within `distance` of
+/// the nodes the named interfaces' couplings tie (`interfaces`: "<body>.<interface>"; empty:
+/// every interface of every body).
+struct StressExcludeSpec {
+  double distance = -1.0;  ///< < 0: nothing excluded
+  std::vector<std::string> interfaces;
   std::string where;
 };
 
@@ -164,6 +182,7 @@ struct SceneSpec {
   /// body's largest von Mises stress and where it is per output step in results.h5. Off by
   /// default (no cost); stress probes work without it.
   bool stresses = false;
+  StressExcludeSpec stress_exclude;
   /// Initial velocity (spatial) of named nodes: (linear, angular).
   std::map<std::string, std::pair<Eigen::Vector3d, Eigen::Vector3d>> initial_velocities;
   /// Initial joint rates of named nodes that have a joint (revolute: angular rate, ...).

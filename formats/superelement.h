@@ -57,6 +57,9 @@ struct Visualization {
   std::string cell_type;        ///< "line2", "tet4", "tet10", "hex8", "hex20"
   int dofs_per_node = 6;        ///< 6 (u, theta) for beams, 3 (u) for solids
   Eigen::MatrixXd shapes;       ///< (n_nodes * dofs_per_node) x n_reduced, node-major
+  /// Per interface: the mesh nodes its coupling ties (a beam's interface: its own node); empty
+  /// in files written before they were stored.
+  std::vector<std::vector<int>> interface_nodes;
 };
 
 /// Optional (issue 17): the stress that each reduced coordinate causes at stress points of the

@@ -146,6 +146,16 @@ void WriteContent(const Superelement& se, h5::Writer& w) {
     w.Matrix("/visualization/nodes", v.nodes);
     w.IntMatrix("/visualization/cells", v.cells);
     w.Matrix("/visualization/shapes", v.shapes);
+    if (!v.interface_nodes.empty()) {
+      // Ragged: the sets one after the other, and where each starts (N + 1 offsets).
+      std::vector<int> flat, offsets{0};
+      for (const std::vector<int>& set : v.interface_nodes) {
+        flat.insert(flat.end(), set.begin(), set.end());
+        offsets.push_back(int(flat.size()));
+      }
+      w.IntVector("/visualization/interface_nodes", flat);
+      w.IntVector("/visualization/interface_node_offsets", offsets);
+    }
   }
   if (se.stress) {
     const ModalStress& st = *se.stress;
@@ -346,6 +356,25 @@ Superelement ReadSuperelementFile(const std::string& path, const SuperelementRea
     v.cells = r.IntMatrix("/visualization/cells");
     RequireShape(r, "/visualization/shapes", v.nodes.rows() * v.dofs_per_node, n);
     v.shapes = r.Matrix("/visualization/shapes");
+    if (r.Exists("/visualization/interface_nodes")) {
+      const Eigen::VectorXi flat = r.IntVector("/visualization/interface_nodes");
+      const Eigen::VectorXi offsets = r.IntVector("/visualization/interface_node_offsets");
+      if (offsets.size() != long(se.interfaces.size()) + 1 || offsets[0] != 0 || offsets[offsets.size() - 1] != flat.size()) {
+        throw InputError(path + ": /visualization/interface_node_offsets: expected " + std::to_string(se.interfaces.size() + 1) +
+                         " offsets from 0 to " + std::to_string(flat.size()));
+      }
+      for (long k = 0; k + 1 < offsets.size(); ++k) {
+        if (offsets[k + 1] < offsets[k]) throw InputError(path + ": /visualization/interface_node_offsets: decreasing at " + std::to_string(k));
+        std::vector<int> set(flat.data() + offsets[k], flat.data() + offsets[k + 1]);
+        for (int node : set) {
+          if (node < 0 || node >= v.nodes.rows()) {
+            throw InputError(path + ": /visualization/interface_nodes: node " + std::to_string(node) + " of interface '" +
+                             se.interfaces[size_t(k)].name + "' is not a node of /visualization/nodes");
+          }
+        }
+        v.interface_nodes.push_back(std::move(set));
+      }
+    }
     if (options.stress && r.Exists("/stress")) {
       ModalStress st;
       st.method = r.StringAttribute("/stress", "method");

@@ -73,9 +73,8 @@ std::vector<std::pair<int, int>> DerivativePairs(const PartSpec& part, int n_int
   return pairs;
 }
 
-SolidType SolidTypeOf(const std::string& name) {
-  for (SolidType t : {SolidType::kTet4, SolidType::kTet10, SolidType::kHex8, SolidType::kHex20})
-    if (SolidTypeName(t) == name) return t;
+SolidType SolidCellType(const std::string& name) {
+  if (const std::optional<SolidType> t = SolidTypeOf(name)) return *t;
   throw InputError("no solid element type '" + name + "'");
 }
 
@@ -137,7 +136,7 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
   auto make_nonlinear = [&] {
     if (nonlinear) return;
     if (part.type == "solid") {
-      nonlinear = std::make_unique<SvkSolidMesh>(SolidTypeOf(model.cell_type), model.nodes, model.cells, part.material);
+      nonlinear = std::make_unique<SvkSolidMesh>(SolidCellType(model.cell_type), model.nodes, model.cells, part.material);
     } else {
       nonlinear = std::make_unique<VonKarmanBeams>(part);
       to_model_dofs.resize(model.n_dofs(), model.n_dofs());
@@ -373,6 +372,7 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
     v.cell_type = model.cell_type;
     v.dofs_per_node = model.dofs_per_node;
     v.shapes = model.mesh_map.size() ? Eigen::MatrixXd(model.mesh_map * cb.shapes) : cb.shapes;
+    v.interface_nodes = model.interface_node_sets;
     se.visualization = std::move(v);
   }
   prov.femb_version = FEMB_VERSION;
@@ -392,7 +392,7 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
     // beams: the von Karman axial term), as the body's polynomial force does; the inertia load
     // cases' stresses are linear.
     auto stresses_of = [&](const Eigen::MatrixXd& fields, bool quadratic) {
-      return part.type == "solid" ? SolidModalStress(SolidTypeOf(model.cell_type), model.nodes, model.cells, part.material, fields,
+      return part.type == "solid" ? SolidModalStress(SolidCellType(model.cell_type), model.nodes, model.cells, part.material, fields,
                                                      quadratic)
                                   : BeamModalStress(part, fields, quadratic);
     };

@@ -98,6 +98,7 @@ FeModel BuildBeamModel(const PartSpec& part) {
   for (const InterfaceSpec& i : part.interfaces) {
     model.interface_names.push_back(i.name);
     model.interface_positions.push_back(spec.points[i.point]);
+    model.interface_node_sets.push_back({i.point});
     std::vector<FullDof> dofs;
     for (int c = 0; c < 6; ++c) dofs.push_back({6 * i.point + c});
     model.interface_dofs.push_back(dofs);

@@ -35,6 +35,9 @@ struct FeModel {
   /// coordinates are q_k = W_k u, a weighted rigid fit of the node set. interface_weights[k] is
   /// W_k (6 x n_dofs) for those and has no rows for DOF interfaces (or is absent for beams).
   std::vector<SparseMatrix> interface_weights;
+  /// Per interface: the mesh nodes its coupling ties (RBE2 and RBE3 sets; a beam's interface is
+  /// its own node), in the numbering of `nodes`.
+  std::vector<std::vector<int>> interface_node_sets;
 
   /// (u, theta) of the material point at `x` as a 6 x n_dofs matrix acting on full DOF vectors;
   /// nullopt when `x` lies outside the material.

@@ -99,7 +99,7 @@ FeModel BuildImportedModel(const PartSpec& part, const ProgressFn& progress) {
     model.interface_names.push_back(part.interfaces[k].name);
     model.interface_positions.push_back(interface_nodes.positions[k]);
   }
-
+  model.interface_node_sets = sets;
   // Model DOFs: the imported DOFs of nodes in no RBE2 set (file order), then 6 per RBE2
   // interface. T (imported -> model): u_s = u_k + theta_k x (x_s - x_k) = u_k - (x_s - x_k)~ theta_k,
   // theta_s = theta_k.

@@ -11,13 +11,9 @@
 #include <vector>
 
 #include "formats/part_file.h"
+#include "formats/solid_shape.h"
 
 namespace femb {
-
-enum class SolidType { kTet4, kTet10, kHex8, kHex20 };
-
-int SolidNodeCount(SolidType type);
-std::string SolidTypeName(SolidType type);  ///< "tet4", ...
 
 struct SolidElementMatrices {
   Eigen::MatrixXd K, M;  ///< (3 n) x (3 n)
@@ -42,9 +38,6 @@ std::vector<SolidPoint> SolidElementPoints(SolidType type, const Eigen::MatrixXd
 /// The strain-displacement matrix (6 x 3n; xx, yy, zz, yz, xz, xy with engineering shear
 /// strains) of shape-function gradients dN/dX (n x 3).
 Eigen::MatrixXd SolidStrainMatrix(const Eigen::MatrixXd& dNdX);
-
-/// Shape functions (n) and their derivatives (n x 3) at a reference point.
-void SolidShapeFunctions(SolidType type, const Eigen::Vector3d& xi, Eigen::VectorXd* N, Eigen::MatrixXd* dN);
 
 /// Reference-element quadrature (points, weights).
 void SolidQuadrature(SolidType type, std::vector<Eigen::Vector3d>* points, std::vector<double>* weights);

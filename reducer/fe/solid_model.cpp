@@ -22,29 +22,9 @@ Eigen::Matrix3d SkewOf(const Eigen::Vector3d& a) {
   return m;
 }
 
-// Reference coordinates of x in element e, or false when outside (tolerance tol).
+// Reference coordinates of x in element e, or false when outside (1e-9).
 bool Locate(const SolidMesh& mesh, int e, const Eigen::Vector3d& x, Eigen::Vector3d* xi) {
-  const int n = SolidNodeCount(mesh.type);
-  Eigen::MatrixXd X(n, 3);
-  for (int a = 0; a < n; ++a) X.row(a) = mesh.nodes.row(mesh.cells(e, a));
-  const bool tet = mesh.type == SolidType::kTet4 || mesh.type == SolidType::kTet10;
-  Eigen::Vector3d p = tet ? Eigen::Vector3d(0.25, 0.25, 0.25) : Eigen::Vector3d::Zero();
-  Eigen::VectorXd N;
-  Eigen::MatrixXd dN;
-  for (int it = 0; it < 20; ++it) {
-    SolidShapeFunctions(mesh.type, p, &N, &dN);
-    const Eigen::Vector3d r = X.transpose() * N - x;
-    const Eigen::Matrix3d J = X.transpose() * dN;
-    if (std::abs(J.determinant()) < 1e-300) return false;
-    const Eigen::Vector3d d = J.lu().solve(r);
-    p -= d;
-    if (d.norm() < 1e-12) break;
-  }
-  const double tol = 1e-9;
-  const bool inside = tet ? (p.minCoeff() >= -tol && p.sum() <= 1 + tol)
-                          : (p.cwiseAbs().maxCoeff() <= 1 + tol);
-  *xi = p;
-  return inside;
+  return LocateInCell(mesh.type, mesh.nodes, mesh.cells, e, x, xi);
 }
 
 }  // namespace
@@ -402,6 +382,7 @@ FeModel BuildSolidModel(const PartSpec& part, const ProgressFn& progress) {
     model.interface_names.push_back(part.interfaces[k].name);
     model.interface_positions.push_back(interface_nodes.positions[k]);
   }
+  model.interface_node_sets = sets;
   // RBE3 (distributing): the interface motion is the least-squares rigid fit of its node set,
   //   u_k = u_c + theta x (x_k - c),  u_c = mean(u_i),  theta = A^-1 sum r_i x u_i,
   //   A = sum (|r_i|^2 1 - r_i r_i^T), r_i = x_i - c,

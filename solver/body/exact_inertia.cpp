@@ -42,6 +42,40 @@ const SuperelementBody::ExactData& SuperelementBody::ExactProducts(const Data& d
   return d;
 }
 
+void SuperelementBody::SubtractRateTerms(const Eigen::VectorXd& q, const Eigen::Vector3d& Om, const Eigen::VectorXd& Rw,
+                                         const Eigen::VectorXd& qd, Eigen::VectorXd& r) const {
+  // c = Omega^ Rbar^T w + [Omega x udot_k; (d/dt J_l(theta_k)) thetadot_k] (header, "Exact inertia").
+  for (int a = 0; a < 2 * n_nodes_; ++a) r.segment<3>(3 * a) -= Om.cross(Eigen::Vector3d(Rw.segment<3>(3 * a)));
+  for (int k = 0; k < n_nodes_; ++k) {
+    r.segment<3>(6 * k) -= Om.cross(Eigen::Vector3d(qd.segment<3>(6 * k)));
+    r.segment<3>(6 * k + 3) -= LeftJacobianRate(Eigen::Vector3d(q.segment<3>(6 * k + 3)), Eigen::Vector3d(qd.segment<3>(6 * k + 3)));
+  }
+}
+
+SuperelementBody::LocalMotion SuperelementBody::LocalRates(const Data& data, const BodyVelocity& w,
+                                                           const BodyVelocity* wdot) const {
+  const int blocks = 2 * n_nodes_;
+  const Eigen::Matrix3d Rt = data.frame.R.transpose();
+  Eigen::VectorXd Rw;
+  TurnBlocksInto(Rt, w, blocks, Rw);
+  LocalMotion out;
+  const Eigen::Matrix<double, 6, 1> xi = data.kin.Z * Rw;
+  out.V = xi.head<3>();
+  out.Omega = xi.tail<3>();
+  out.qdot = data.kin.B * Rw;
+  out.qddot.setZero(out.qdot.size());
+  if (wdot) {
+    Eigen::VectorXd r;
+    TurnBlocksInto(Rt, *wdot, blocks, r);
+    SubtractRateTerms(data.q, out.Omega, Rw, out.qdot, r);
+    const Eigen::Matrix<double, 6, 1> xidot = data.kin.Z * r;
+    out.Vdot = xidot.head<3>();
+    out.Omegadot = xidot.tail<3>();
+    out.qddot = data.kin.B * r;
+  }
+  return out;
+}
+
 Eigen::VectorXd SuperelementBody::ExactInertiaForce(const Data& data, const BodyVelocity& w,
                                                     const BodyVelocity& wdot, Eigen::VectorXd* f_acc) const {
   Eigen::VectorXd f;
@@ -71,12 +105,7 @@ void SuperelementBody::ExactInertiaForce(const Data& data, const BodyVelocity& w
   Eigen::VectorXd& r = s.r;
   TurnBlocksInto(Rt, wdot, blocks, r);
   if (f_acc) ExactMassTimesTurned(data, r, *f_acc);
-  for (int a = 0; a < blocks; ++a) r.segment<3>(3 * a) -= Om.cross(Eigen::Vector3d(Rw.segment<3>(3 * a)));
-  for (int k = 0; k < n_nodes_; ++k) {
-    r.segment<3>(6 * k) -= Om.cross(Eigen::Vector3d(qd.segment<3>(6 * k)));
-    r.segment<3>(6 * k + 3) -=
-        LeftJacobianRate(Eigen::Vector3d(data.q.segment<3>(6 * k + 3)), Eigen::Vector3d(qd.segment<3>(6 * k + 3)));
-  }
+  SubtractRateTerms(data.q, Om, Rw, qd, r);
   Eigen::Vector3d Omd;
   Omd.noalias() = Z.bottomRows<3>() * r;
   Eigen::VectorXd &y = s.y, &yd = s.yd;

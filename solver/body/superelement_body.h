@@ -322,6 +322,21 @@ class SuperelementBody {
   /// Z_r the rotation rows of Z, H = [Gamma_a q], (X_q)_ab = q^T Xi_ab q.
   bool has_exact_inertia() const { return !Gamma_.empty(); }
 
+  /// The floating frame's motion and the rates of the local coordinates at `d` (thesis 3.17 and
+  /// its derivative, see "Exact inertia" above): xi = (V, Omega) = Z Rbar^T w, the frame origin's
+  /// velocity and the frame's angular velocity in frame axes; qdot_loc = B Rbar^T w; with `wdot`
+  /// also xidot = (Vdot, Omegadot) = Z r and qddot_loc = B r, r = Rbar^T wdot - c (zero
+  /// without). A material point at s = X + Phi(X) q_loc from the frame origin (frame axes) then
+  /// moves with x = x_j + R_j s, v = R_j (V + Omega x s + Phi qdot_loc) and
+  /// a = R_j (Vdot + Omega x V + Omegadot x s + Omega x (Omega x s) + 2 Omega x Phi qdot_loc
+  /// + Phi qddot_loc).
+  struct LocalMotion {
+    Eigen::Vector3d V = Eigen::Vector3d::Zero(), Omega = Eigen::Vector3d::Zero();
+    Eigen::Vector3d Vdot = Eigen::Vector3d::Zero(), Omegadot = Eigen::Vector3d::Zero();
+    Eigen::VectorXd qdot, qddot;
+  };
+  LocalMotion LocalRates(const Data& d, const BodyVelocity& w, const BodyVelocity* wdot) const;
+
   /// Inertia force from the corotational kinetic energy T = v^T M v / 2, v = P w (thesis 3.22,
   /// 4.9; DESIGN.md "Inertia"), P = blockdiag(R_j^T ... , 1) (option A) or with R_k^T on the
   /// angular rows (option B). With G defined by d(P w) = P G dq and Omega_P, Omega_hat the
@@ -468,6 +483,9 @@ class SuperelementBody {
   Eigen::MatrixXd ExactInertiaConfigurationTangent(const Data& d, const BodyVelocity& w,
                                                    const BodyVelocity& wdot) const;
   BodyConfiguration Perturbed(const BodyConfiguration& c, int i, double sign, double* step) const;
+  // r -= c(Omega, Rbar^T w, qdot_loc) at local coordinates q (LocalRates, ExactInertiaForce).
+  void SubtractRateTerms(const Eigen::VectorXd& q, const Eigen::Vector3d& Om, const Eigen::VectorXd& Rw,
+                         const Eigen::VectorXd& qd, Eigen::VectorXd& r) const;
   std::vector<Eigen::MatrixXd> Gamma_;  ///< the file's inertia invariants Gamma_a (3), or none
   // The invariants stacked for one matrix-vector product each: [Gamma_0; Gamma_1; Gamma_2]
   // (3n x n) and Xi_ab at row block 3 a + b (9n x n, Xi_ba = Xi_ab^T); Phi_rig0^T M (6 x n).

@@ -7,6 +7,7 @@
 #include <charconv>
 #include <cstdio>
 #include <filesystem>
+#include <optional>
 #include <stdexcept>
 #include <thread>
 
@@ -127,6 +128,11 @@ ResultsRecorder::ResultsRecorder(const Scene& scene, const std::string& director
         // The stress point's von Mises stress and tensor (part axes, issue 17).
         static const char* components[7] = {"von_mises", "xx", "yy", "zz", "yz", "xz", "xy"};
         for (const char* c : components) csv_ << "," << p.name << ".stress." << c;
+      } else if (q == ProbeQuantity::kEffort) {
+        // The generalized force of each prescribed coordinate of the node's joint.
+        for (int c : scene.effort_coordinates[size_t(&p - scene.spec.probes.data())]) {
+          csv_ << "," << p.name << ".effort." << scene.model.prescribed[size_t(c)].coordinate;
+        }
       } else if (q == ProbeQuantity::kReaction) {
         static const char* components[6] = {"fx", "fy", "fz", "mx", "my", "mz"};
         for (const char* c : components) csv_ << "," << p.name << ".reaction." << c;
@@ -246,15 +252,21 @@ void ResultsRecorder::Record(double t, const SystemState& state, const Eigen::Ve
   // The inertia load factors of body b's frame (SuperelementBody::InertiaLoads) when its modal
   // stresses include the inertia load cases: d'Alembert with gravity (static analyses: gravity
   // as ramped by the analysis, no motion).
+  // The velocities and accelerations over the unknowns (zero in static analyses) and the node
+  // accelerations, made when first asked for.
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(dofs.n_dofs());
+  const Eigen::VectorXd& V = W.size() == dofs.n_dofs() ? W : zero;
+  const Eigen::VectorXd& A = accelerations && accelerations->size() == dofs.n_dofs() ? *accelerations : zero;
   std::vector<Eigen::Matrix<double, 6, 1>> node_acc;
+  const auto node_accelerations = [&]() -> const std::vector<Eigen::Matrix<double, 6, 1>>& {
+    if (node_acc.empty()) node_acc = NodeAccelerations(model, dofs, state, V, A);
+    return node_acc;
+  };
   auto inertia = [&](size_t b) -> const Eigen::VectorXd* {
     if (!scene_.stresses[b] || scene_.stresses[b]->inertia_modes.size() == 0) return nullptr;
     if (has_factors_[b]) return &factors_[b];
     const bool dynamic = scene_.spec.analysis.type == AnalysisType::kDynamic;
-    const Eigen::VectorXd zero = Eigen::VectorXd::Zero(dofs.n_dofs());
-    const Eigen::VectorXd& V = W.size() == dofs.n_dofs() ? W : zero;
-    const Eigen::VectorXd& A = accelerations && accelerations->size() == dofs.n_dofs() ? *accelerations : zero;
-    if (node_acc.empty()) node_acc = NodeAccelerations(model, dofs, state, V, A);
+    node_accelerations();
     double g = dynamic ? 1.0 : 0.0;
     if (!dynamic && model.static_gravity_end > 0) g = std::min(t / model.static_gravity_end, 1.0);
     factors_[b] = model.bodies[b]
@@ -278,8 +290,15 @@ void ResultsRecorder::Record(double t, const SystemState& state, const Eigen::Ve
       Eigen::MatrixXd stress;
       Eigen::VectorXd von_mises;
       NodeStresses(*scene_.stresses[b], stress_coordinates(b), n_mesh, &stress, &von_mises, inertia(b));
+      // The largest von Mises stress, without the nodes outputs.stress_exclude leaves out.
+      const std::vector<char>& excluded = scene_.stress_excluded[b];
       Eigen::Index worst = 0;
-      max_von_mises_[b].push_back(von_mises.size() ? von_mises.maxCoeff(&worst) : 0.0);
+      double largest = -1.0;
+      for (Eigen::Index i = 0; i < von_mises.size(); ++i) {
+        if (!excluded.empty() && excluded[size_t(i)]) continue;
+        if (von_mises[i] > largest) largest = von_mises[i], worst = i;
+      }
+      max_von_mises_[b].push_back(std::max(largest, 0.0));
       max_von_mises_node_[b].push_back(int(worst));
       if (frame_fields) {
         Eigen::MatrixXf f(n_mesh, 4);
@@ -328,13 +347,52 @@ void ResultsRecorder::Record(double t, const SystemState& state, const Eigen::Ve
     csv_.put(',');
     Put(csv_, v);
   };
+  // Per body with point probes: its frame's motion and the local coordinates' rates
+  // (SuperelementBody::LocalRates), made when first asked for.
+  std::vector<std::optional<SuperelementBody::LocalMotion>> motion(model.bodies.size());
+  const auto motion_of = [&](int b) -> const SuperelementBody::LocalMotion& {
+    if (!motion[size_t(b)]) {
+      const SuperelementBody& body = model.bodies[size_t(b)];
+      const SuperelementBody::Data d = body.Evaluate(BodyConfigurationOf(model, state, b), state.frames[size_t(b)]);
+      const Eigen::VectorXd wdot = GatherBodyAcceleration(model, dofs, b, node_accelerations(), A);
+      motion[size_t(b)] = body.LocalRates(d, GatherBody(model, dofs, state, b, V), &wdot);
+    }
+    return *motion[size_t(b)];
+  };
+  const auto put3 = [&](const Eigen::Vector3d& v) {
+    for (int i = 0; i < 3; ++i) put(v[i]);
+  };
   for (size_t pi = 0; pi < scene_.spec.probes.size(); ++pi) {
     const SceneProbeSpec& p = scene_.spec.probes[pi];
-    if (!p.body.empty()) {  // a stress probe: its stress point
-      const auto [b, point] = scene_.stress_probes[pi];
-      const Eigen::Matrix<double, 6, 1> s = PointStress(*scene_.stresses[size_t(b)], point, stress_coordinates(size_t(b)), inertia(size_t(b)));
-      put(VonMises(s));
-      for (int i = 0; i < 6; ++i) put(s[i]);
+    if (!p.body.empty()) {  // a point probe
+      const Scene::PointProbe& point = scene_.point_probes[pi];
+      for (const ProbeQuantity q : p.quantities) {
+        if (q == ProbeQuantity::kStress) {  // at its stress point
+          const auto [b, at] = scene_.stress_probes[pi];
+          const Eigen::Matrix<double, 6, 1> s = PointStress(*scene_.stresses[size_t(b)], at, stress_coordinates(size_t(b)), inertia(size_t(b)));
+          put(VonMises(s));
+          for (int i = 0; i < 6; ++i) put(s[i]);
+          continue;
+        }
+        // The material point: s = s0 + u from the frame origin in frame axes, u = shape q_loc
+        // (SuperelementBody::LocalRates for its velocity and acceleration).
+        const int b = point.body;
+        const FrameSolution& frame = state.frames[size_t(b)];
+        const Eigen::Vector3d u = point.shape * q_loc_[size_t(b)];
+        const Eigen::Vector3d r = point.s0 + u;
+        if (q == ProbeQuantity::kPosition) put3(scene_.origin + frame.x + frame.R * r);
+        if (q == ProbeQuantity::kDeformation) put3(frame.R * u);
+        if (q == ProbeQuantity::kVelocity) {
+          const SuperelementBody::LocalMotion& m = motion_of(b);
+          put3(frame.R * (m.V + m.Omega.cross(r) + point.shape * m.qdot));
+        }
+        if (q == ProbeQuantity::kAcceleration) {
+          const SuperelementBody::LocalMotion& m = motion_of(b);
+          const Eigen::Vector3d ud = point.shape * m.qdot, udd = point.shape * m.qddot;
+          put3(frame.R * (m.Vdot + m.Omega.cross(m.V) + m.Omegadot.cross(r) + m.Omega.cross(m.Omega.cross(r)) +
+                          2.0 * m.Omega.cross(ud) + udd));
+        }
+      }
       continue;
     }
     const int k = scene_.node_index.at(p.node);
@@ -343,6 +401,19 @@ void ResultsRecorder::Record(double t, const SystemState& state, const Eigen::Ve
       if (q == ProbeQuantity::kRotation) for (int i = 0; i < 4; ++i) put(quat[4 * k + i]);
       if (q == ProbeQuantity::kVelocity) for (int i = 0; i < 3; ++i) put(vel[3 * k + i]);
       if (q == ProbeQuantity::kAngularVelocity) for (int i = 0; i < 3; ++i) put(ang[3 * k + i]);
+      if (q == ProbeQuantity::kAcceleration) put3(node_accelerations()[size_t(k)].head<3>());
+      if (q == ProbeQuantity::kAngularAcceleration) put3(node_accelerations()[size_t(k)].tail<3>());
+      if (q == ProbeQuantity::kEffort) {
+        // The generalized force of each prescribed coordinate: B^T of what the joint exerts on
+        // the node (its reaction: force, moment about the node), B the coordinate's motion of the
+        // node (NodeJoint: a revolute's moment about its axis, a prismatic's force along it).
+        const NodeJoint& j = model.joints[size_t(dofs.joint_of(k))];
+        const ParentNode parent = ParentOf(state, j.parent);
+        const JointMaps maps = ComputeJointMaps(j, parent.x, parent.R, state.x[k], state.z[k]);
+        Eigen::Matrix<double, 6, 1> r;
+        for (int i = 0; i < 6; ++i) r[i] = reaction(k, i);
+        for (int c : scene_.effort_coordinates[pi]) put(maps.B.col(model.prescribed[size_t(c)].coordinate).dot(r));
+      }
       if (q == ProbeQuantity::kJoint) {
         const int c = pi < probe_cut_.size() ? probe_cut_[pi] : -1;
         if (c < 0) {

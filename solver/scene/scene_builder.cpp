@@ -1,12 +1,14 @@
 #include "solver/scene/scene_builder.h"
 
-#include <cstdio>
 #include <Eigen/Dense>
+#include <algorithm>
+#include <cstdio>
 #include <filesystem>
 #include <memory>
 
 #include "formats/input_error.h"
 #include "formats/part_file.h"
+#include "formats/solid_shape.h"
 #include "formats/superelement_checks.h"
 #include "formats/superelement_file.h"
 #include "solver/rotation.h"
@@ -65,6 +67,165 @@ void RequireJointGap(const SceneJointSpec& j, const Eigen::Vector3d& x_p, const 
 
 }  // namespace
 
+namespace {
+
+// Point probes: the material point of the body at the probe's point (scene coordinates at the
+// initial placement, i.e. part axes through the body's placement), interpolated in the cell of
+// the file's mesh that holds it or, within the mesh size outside every cell, at the nearest mesh
+// node; the stress at the body's stress point nearest to it. Effort probes: the prescribed
+// coordinates of the node's joint.
+void ResolveProbes(const SceneSpec& spec, const DofMap& dofs, Scene& scene) {
+  const SystemModel& model = scene.model;
+  for (const SceneProbeSpec& p : spec.probes) {
+    scene.stress_probes.emplace_back(-1, -1);
+    scene.point_probes.emplace_back();
+    scene.effort_coordinates.emplace_back();
+    const auto has = [&](ProbeQuantity q) { return std::count(p.quantities.begin(), p.quantities.end(), q) > 0; };
+    if (p.body.empty()) {
+      if (!has(ProbeQuantity::kEffort)) continue;
+      const int k = scene.node_index.at(p.node);
+      for (size_t i = 0; i < model.prescribed.size(); ++i) {
+        if (model.prescribed[i].node == k) scene.effort_coordinates.back().push_back(int(i));
+      }
+      if (scene.effort_coordinates.back().empty()) {
+        throw InputError(p.where + ": probe '" + p.name + "': node '" + p.node +
+                         "' has no prescribed joint coordinate (effort is the force or torque that keeps a prescribed motion)");
+      }
+      continue;
+    }
+    int b = 0;
+    while (b < int(spec.bodies.size()) && spec.bodies[size_t(b)].name != p.body) ++b;
+    if (b == int(spec.bodies.size())) {
+      throw InputError(p.where + ": probe '" + p.name + "': no body '" + p.body + "' in the scene");
+    }
+    const SceneBodySpec& body = spec.bodies[size_t(b)];
+    const Eigen::Vector3d X = ExpSO3(body.rotation).transpose() * (p.point - body.position);
+    char buffer[300];
+    if (has(ProbeQuantity::kPosition) || has(ProbeQuantity::kVelocity) || has(ProbeQuantity::kAcceleration) ||
+        has(ProbeQuantity::kDeformation)) {
+      Scene::PointProbe& probe = scene.point_probes.back();
+      probe.body = b;
+      probe.s0 = X - scene.mesh_origin[size_t(b)];
+      const int n = model.bodies[size_t(b)].n_coordinates();
+      probe.shape = Eigen::MatrixXd::Zero(3, n);
+      if (body.type != SceneBodyType::kRigid) {
+        if (!scene.meshes[size_t(b)]) {
+          throw InputError(p.where + ": probe '" + p.name + "': body '" + p.body + "' has no mesh in " + body.superelement +
+                           " (reduce it with reduction.keep_mesh: true)");
+        }
+        const Visualization& mesh = *scene.meshes[size_t(b)];
+        const MeshPoint at = LocateInMesh(mesh.nodes, mesh.cells, mesh.cell_type, X);
+        if (at.cell < 0 && at.distance > at.size) {
+          std::snprintf(buffer, sizeof buffer,
+                        "point (%.6g, %.6g, %.6g) lies outside body '%s': %.3g from its nearest mesh node, more than the mesh size there (%.3g)",
+                        p.point.x(), p.point.y(), p.point.z(), p.body.c_str(), at.distance, at.size);
+          throw InputError(p.where + ": probe '" + p.name + "': " + buffer);
+        }
+        // u(X) = sum_a N_a u_a; a node with rotations (beams, shells) carries its section
+        // rigidly: u + theta x (X - X_node).
+        const int per = mesh.dofs_per_node;
+        for (size_t a = 0; a < at.nodes.size(); ++a) {
+          probe.shape += at.weights[a] * mesh.shapes.middleRows(long(per) * at.nodes[a], 3);
+          if (per == 6) {
+            const Eigen::Vector3d arm = X - mesh.nodes.row(at.nodes[a]).transpose();
+            probe.shape -= at.weights[a] * Skew(arm) * mesh.shapes.middleRows(long(per) * at.nodes[a] + 3, 3);
+          }
+        }
+        if (at.cell >= 0) {
+          std::snprintf(buffer, sizeof buffer, "probe '%s': point of body '%s' in cell %d of its mesh", p.name.c_str(),
+                        p.body.c_str(), at.cell);
+        } else {
+          std::snprintf(buffer, sizeof buffer, "probe '%s': body '%s' at its mesh node %d (%.6g, %.6g, %.6g) in part axes, %.3g from the given point",
+                        p.name.c_str(), p.body.c_str(), at.nearest, mesh.nodes(at.nearest, 0), mesh.nodes(at.nearest, 1),
+                        mesh.nodes(at.nearest, 2), at.distance);
+        }
+        scene.notes.push_back(buffer);
+      }
+    }
+    if (!has(ProbeQuantity::kStress)) continue;
+    if (!scene.stresses[size_t(b)]) {
+      throw InputError(p.where + ": probe '" + p.name + "': body '" + p.body + "' has no modal stresses" +
+                       (body.type == SceneBodyType::kRigid ? std::string(" (a rigid body)")
+                                             : " in " + body.superelement + " (reduce it with the mesh kept: reduction.keep_mesh, reduction.stresses)"));
+    }
+    const ModalStress& st = *scene.stresses[size_t(b)];
+    if (st.n_points() == 0) {
+      throw InputError(p.where + ": probe '" + p.name + "': body '" + p.body + "' has no stress points (beams of "
+                       "'general' sections have section forces only)");
+    }
+    Eigen::Index nearest = 0;
+    (st.points.rowwise() - X.transpose()).rowwise().squaredNorm().minCoeff(&nearest);
+    scene.stress_probes.back() = {b, int(nearest)};
+    std::snprintf(buffer, sizeof buffer, "probe '%s': stress point %ld of body '%s' at (%.6g, %.6g, %.6g) in part axes, %.3g from the given point",
+                  p.name.c_str(), long(nearest), p.body.c_str(), st.points(nearest, 0), st.points(nearest, 1),
+                  st.points(nearest, 2), (st.points.row(nearest).transpose() - X).norm());
+    scene.notes.push_back(buffer);
+  }
+}
+
+// outputs.stress_exclude: per body with stresses, the mesh nodes within the distance of the
+// nodes the named interfaces' couplings tie.
+void ResolveStressExclusion(const SceneSpec& spec, Scene& scene) {
+  const StressExcludeSpec& ex = spec.stress_exclude;
+  scene.stress_excluded.assign(scene.stresses.size(), {});
+  if (ex.distance < 0) return;
+  // "<body>.<interface>" named, or every interface of every body.
+  std::vector<std::vector<int>> chosen(spec.bodies.size());  // per body: its interfaces
+  for (const std::string& name : ex.interfaces) {
+    const size_t dot = name.find('.');
+    const std::string body_name = name.substr(0, dot), interface = name.substr(dot + 1);
+    size_t b = 0;
+    while (b < spec.bodies.size() && spec.bodies[b].name != body_name) ++b;
+    if (b == spec.bodies.size()) throw InputError(ex.where + ": stress_exclude.interfaces: no body '" + body_name + "' in the scene");
+    int k = -1;
+    const auto& names = scene.interface_names[b];
+    for (size_t i = 0; i < names.size(); ++i)
+      if (names[i] == interface) k = int(i);
+    if (k < 0) {
+      std::string known;
+      for (const std::string& n : names) known += (known.empty() ? "" : ", ") + n;
+      throw InputError(ex.where + ": stress_exclude.interfaces: body '" + body_name + "' has no interface '" + interface +
+                       "' (it has: " + known + ")");
+    }
+    chosen[b].push_back(k);
+  }
+  for (size_t b = 0; b < spec.bodies.size(); ++b) {
+    if (!scene.stresses[b] || !scene.meshes[b]) continue;
+    if (ex.interfaces.empty()) {
+      for (size_t k = 0; k < scene.interface_names[b].size(); ++k) chosen[b].push_back(int(k));
+    }
+    if (chosen[b].empty()) continue;
+    const Visualization& mesh = *scene.meshes[b];
+    // The nodes the chosen couplings tie (files without the sets: the interface points).
+    std::vector<Eigen::Vector3d> seeds;
+    for (int k : chosen[b]) {
+      if (size_t(k) < mesh.interface_nodes.size()) {
+        for (int node : mesh.interface_nodes[size_t(k)]) seeds.push_back(mesh.nodes.row(node).transpose());
+      } else {
+        seeds.push_back(scene.interface_points[b][size_t(k)]);
+      }
+    }
+    std::vector<char>& out = scene.stress_excluded[b];
+    out.assign(size_t(mesh.nodes.rows()), 0);
+    long count = 0;
+    for (long i = 0; i < mesh.nodes.rows(); ++i) {
+      const Eigen::Vector3d x = mesh.nodes.row(i).transpose();
+      for (const Eigen::Vector3d& s : seeds) {
+        if ((x - s).squaredNorm() <= ex.distance * ex.distance) {
+          out[size_t(i)] = 1, ++count;
+          break;
+        }
+      }
+    }
+    char buffer[200];
+    std::snprintf(buffer, sizeof buffer, "body '%s': %ld of %ld mesh nodes within %.3g of its couplings left out of its largest von Mises stress",
+                  spec.bodies[b].name.c_str(), count, long(mesh.nodes.rows()), ex.distance);
+    scene.notes.push_back(buffer);
+  }
+}
+
+}  // namespace
+
 Scene BuildScene(const SceneSpec& spec) {
   Scene scene;
   scene.spec = spec;
@@ -107,6 +268,8 @@ Scene BuildScene(const SceneSpec& spec) {
       scene.meshes.emplace_back();
       scene.stresses.emplace_back();
       scene.mesh_origin.push_back(b.center_of_mass);
+      scene.interface_names.push_back({"com"});
+      scene.interface_points.push_back({b.center_of_mass});
       scene.stick_nodes.push_back({com});
       for (const auto& [point, node] : b.nodes) {
         if (point == "com") continue;
@@ -134,10 +297,14 @@ Scene BuildScene(const SceneSpec& spec) {
     Superelement se;
     try {
       SuperelementReadOptions options;
-      bool stress_probe = false;
-      for (const SceneProbeSpec& p : spec.probes) stress_probe |= p.body == b.name;
+      bool stress_probe = false, point_probe = false;
+      for (const SceneProbeSpec& p : spec.probes) {
+        if (p.body != b.name) continue;
+        point_probe = true;
+        stress_probe |= std::count(p.quantities.begin(), p.quantities.end(), ProbeQuantity::kStress) > 0;
+      }
       options.stress = spec.stresses || stress_probe;
-      options.visualization = spec.animation || options.stress;
+      options.visualization = spec.animation || options.stress || point_probe;
       se = ReadSuperelementFile(file.string(), options);
       RequireValidSuperelement(se, file.string());
     } catch (const InputError& e) {
@@ -232,6 +399,12 @@ Scene BuildScene(const SceneSpec& spec) {
     model.body_names.push_back(b.name);
     scene.meshes.push_back(se.visualization);
     scene.mesh_origin.push_back(se.floating_frame.origin);
+    scene.interface_names.emplace_back();
+    scene.interface_points.emplace_back();
+    for (const InterfaceNode& node : se.interfaces) {
+      scene.interface_names.back().push_back(node.name);
+      scene.interface_points.back().push_back(node.position);
+    }
     scene.stick_nodes.push_back(se.visualization ? std::vector<int>() : nodes);
   }
   // The joint tree (issue 15). Every node has at most one holder: a parent node or the ground
@@ -421,37 +594,8 @@ Scene BuildScene(const SceneSpec& spec) {
     }
     for (size_t i = 0; i < rates.size(); ++i) scene.initial_velocity[dofs.node_first(k) + int(i)] = rates[i];
   }
-  // Stress probes: the body's stress point nearest to the given point (scene coordinates at the
-  // initial placement, i.e. part axes through the body's placement).
-  for (const SceneProbeSpec& p : spec.probes) {
-    scene.stress_probes.emplace_back(-1, -1);
-    if (p.body.empty()) continue;
-    int b = 0;
-    while (b < int(spec.bodies.size()) && spec.bodies[size_t(b)].name != p.body) ++b;
-    if (b == int(spec.bodies.size())) {
-      throw InputError(p.where + ": probe '" + p.name + "': no body '" + p.body + "' in the scene");
-    }
-    const SceneBodySpec& body = spec.bodies[size_t(b)];
-    if (!scene.stresses[size_t(b)]) {
-      throw InputError(p.where + ": probe '" + p.name + "': body '" + p.body + "' has no modal stresses" +
-                       (body.type == SceneBodyType::kRigid ? std::string(" (a rigid body)")
-                                             : " in " + body.superelement + " (reduce it with the mesh kept: reduction.keep_mesh, reduction.stresses)"));
-    }
-    const ModalStress& st = *scene.stresses[size_t(b)];
-    if (st.n_points() == 0) {
-      throw InputError(p.where + ": probe '" + p.name + "': body '" + p.body + "' has no stress points (beams of "
-                       "'general' sections have section forces only)");
-    }
-    const Eigen::Vector3d X = ExpSO3(body.rotation).transpose() * (p.point - body.position);
-    Eigen::Index nearest = 0;
-    (st.points.rowwise() - X.transpose()).rowwise().squaredNorm().minCoeff(&nearest);
-    scene.stress_probes.back() = {b, int(nearest)};
-    char buffer[200];
-    std::snprintf(buffer, sizeof buffer, "probe '%s': stress point %ld of body '%s' at (%.6g, %.6g, %.6g) in part axes, %.3g from the given point",
-                  p.name.c_str(), long(nearest), p.body.c_str(), st.points(nearest, 0), st.points(nearest, 1),
-                  st.points(nearest, 2), (st.points.row(nearest).transpose() - X).norm());
-    scene.notes.push_back(buffer);
-  }
+  ResolveProbes(spec, dofs, scene);
+  ResolveStressExclusion(spec, scene);
   return scene;
 }
 

@@ -33,6 +33,23 @@ struct Scene {
   /// Per probe: for a stress probe the body and its stress point nearest to the probe's point
   /// (-1, -1 for node probes).
   std::vector<std::pair<int, int>> stress_probes;
+  /// Per probe: for a point probe's position, velocity, acceleration and deformation the body
+  /// (-1: none), the point from the body's floating frame origin in part axes (undeformed) and
+  /// its displacement field, u(X) = shape q_loc (3 x the body's coordinates; zero for a rigid body).
+  struct PointProbe {
+    int body = -1;
+    Eigen::Vector3d s0 = Eigen::Vector3d::Zero();
+    Eigen::MatrixXd shape;
+  };
+  std::vector<PointProbe> point_probes;
+  /// Per probe: for an effort probe the prescribed coordinates of its node (SystemModel::prescribed).
+  std::vector<std::vector<int>> effort_coordinates;
+  /// Per body: its interfaces' names and points (part axes), as in its file.
+  std::vector<std::vector<std::string>> interface_names;
+  std::vector<std::vector<Eigen::Vector3d>> interface_points;
+  /// Per body with stresses and outputs.stress_exclude: per mesh node 1 when it is left out of
+  /// the body's largest von Mises stress (empty: none).
+  std::vector<std::vector<char>> stress_excluded;
   /// Per body without a mesh (rigid bodies, superelements reduced without keeping theirs): the
   /// scene nodes the animation joins by lines from the first one (a rigid body: its centre of
   /// mass to each of its points; a superelement: its first interface to the others).

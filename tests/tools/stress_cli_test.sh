@@ -196,7 +196,7 @@ expect() {  # label, expected message, sed on the scene, [part file override]
 }
 expect "unknown body" "probe 'top': no body 'nobar' in the scene" 's/body: bar, point/body: nobar, point/'
 expect "stress on a node" "probe quantity 'stress' needs body and point" 's/quantities: \[position\]/quantities: [stress]/'
-expect "node quantity on a body" "probe quantity 'position' is a node quantity" 's/quantities: \[stress\]/quantities: [position]/'
+expect "node quantity on a body" "probe quantity 'rotation' is a node quantity" 's/quantities: \[stress\]/quantities: [rotation]/'
 "$bin/femb-reduce" -q "$work/bar.yaml" -o "$work/bar_plain.h5" --set reduction.stresses=false || fail "reduce without stresses"
 expect "file without stresses" "body 'bar' has no modal stresses in bar_plain.h5" 's/bar.h5/bar_plain.h5/'
 
