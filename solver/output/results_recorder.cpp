@@ -120,22 +120,27 @@ ResultsRecorder::ResultsRecorder(const Scene& scene, const std::string& director
   csv_ << "time";
   static const char* xyz[3] = {"x", "y", "z"};
   static const char* wxyz[4] = {"w", "x", "y", "z"};
+  // Every probe column: in probes.csv's header and results.h5's /probes/names.
+  const auto column = [&](const std::string& name) {
+    csv_ << "," << name;
+    probe_columns_.push_back(name);
+  };
   for (const SceneProbeSpec& p : scene.spec.probes) {
     for (const ProbeQuantity q : p.quantities) {
       if (q == ProbeQuantity::kRotation) {
-        for (const char* c : wxyz) csv_ << "," << p.name << "." << Name(q) << "." << c;
+        for (const char* c : wxyz) column(p.name + "." + Name(q) + "." + c);
       } else if (q == ProbeQuantity::kStress) {
         // The stress point's von Mises stress and tensor (part axes, issue 17).
         static const char* components[7] = {"von_mises", "xx", "yy", "zz", "yz", "xz", "xy"};
-        for (const char* c : components) csv_ << "," << p.name << ".stress." << c;
+        for (const char* c : components) column(p.name + ".stress." + c);
       } else if (q == ProbeQuantity::kEffort) {
         // The generalized force of each prescribed coordinate of the node's joint.
         for (int c : scene.effort_coordinates[size_t(&p - scene.spec.probes.data())]) {
-          csv_ << "," << p.name << ".effort." << scene.model.prescribed[size_t(c)].coordinate;
+          column(p.name + ".effort." + std::to_string(scene.model.prescribed[size_t(c)].coordinate));
         }
       } else if (q == ProbeQuantity::kReaction) {
         static const char* components[6] = {"fx", "fy", "fz", "mx", "my", "mz"};
-        for (const char* c : components) csv_ << "," << p.name << ".reaction." << c;
+        for (const char* c : components) column(p.name + ".reaction." + c);
       } else if (q == ProbeQuantity::kJoint) {
         // The node's joint coordinates (revolute: angle; prismatic: travel; cylindrical: both).
         // To the ground or between nodes: the joint's coordinates (a revolute joint's angle
@@ -161,13 +166,14 @@ ResultsRecorder::ResultsRecorder(const Scene& scene, const std::string& director
           throw InputError(p.where + ": probe '" + p.name + "': node '" + p.node +
                            "' has no revolute, prismatic, cylindrical or universal joint coordinate");
         }
-        for (int i = 0; i < d; ++i) csv_ << "," << p.name << ".joint." << i;
+        for (int i = 0; i < d; ++i) column(p.name + ".joint." + std::to_string(i));
       } else {
-        for (const char* c : xyz) csv_ << "," << p.name << "." << Name(q) << "." << c;
+        for (const char* c : xyz) column(p.name + "." + Name(q) + "." + c);
       }
     }
   }
   csv_ << ",kinetic_energy,elastic_energy,external_work\n";
+  probe_values_.width = int(probe_columns_.size());
 }
 
 void ResultsRecorder::Record(double t, const SystemState& state, const Eigen::VectorXd& W, double kinetic,
@@ -343,9 +349,12 @@ void ResultsRecorder::Record(double t, const SystemState& state, const Eigen::Ve
   }
 
   Put(csv_, t);
+  double* const probe_row = probe_values_.Append();
+  int probe_column = 0;
   const auto put = [&](double v) {
     csv_.put(',');
     Put(csv_, v);
+    if (probe_column < probe_values_.width) probe_row[probe_column++] = v;
   };
   // Per body with point probes: its frame's motion and the local coordinates' rates
   // (SuperelementBody::LocalRates), made when first asked for.
@@ -469,6 +478,12 @@ void ResultsRecorder::Finish(const std::string& status) {
     w.Attribute("/", "status", status);
     w.Attribute("/", "units", scene_.spec.units);
     w.Vector("/time", Eigen::Map<const Eigen::VectorXd>(time_.data(), long(time_.size())));
+    if (probe_values_.width > 0) {
+      // probes.csv's columns in full precision (the CSV keeps 10 significant digits).
+      w.CreateGroup("/probes");
+      w.Strings("/probes/names", probe_columns_);
+      w.Matrix("/probes/values", probe_values_.Matrix());
+    }
     if (steps_taken_ >= 0) {
       w.Attribute("/", "steps", steps_taken_);
       w.Attribute("/", "rejected_steps_error", rejected_by_error_);

@@ -81,6 +81,9 @@ class ResultsRecorder {
     long ChunkRows() const { return std::max(1L, 8192L / std::max(width, 1)); }
   };
   Rows loop_reactions_;  ///< per output step, 6 per cut joint (with reactions)
+  // probes.csv's probe columns in full precision: results.h5 /probes/names and /probes/values.
+  std::vector<std::string> probe_columns_;
+  Rows probe_values_;
   // Per probe: the cut joint whose coordinates a `joint` probe shows (its node has none of its
   // own), or -1; and their last values (angles unwrapped to be continuous).
   std::vector<int> probe_cut_;
