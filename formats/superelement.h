@@ -142,6 +142,10 @@ struct Superelement {
   MassProperties mass_properties;
   long n_full_dofs = 0;
   Eigen::VectorXd full_free_free_frequencies_hz;  ///< optional (empty when not computed)
+  /// The interfaces whose rigid (RBE2) couplings the unreduced model above includes: their node
+  /// sets move rigidly, so its free-free frequencies are those of the part with those faces
+  /// stiffened, not of the bare part (RBE3 couplings add no stiffness). Empty: none.
+  std::vector<std::string> full_rigid_couplings;
   long n_modal_derivatives = 0;
   /// The reduced coordinates (i, j) whose shapes each modal derivative differentiates:
   /// theta = -K_ii^-1 (dK/dq_j) phi_i before deflation (n_modal_derivatives pairs).

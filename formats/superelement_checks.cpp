@@ -161,7 +161,9 @@ SuperelementChecks CheckSuperelement(const Superelement& se) {
   a.checks.push_back({"floating_frame", frame_error <= 1e-8 && amplified <= 1e-8 && projector_norm <= 1e6,
                       Sci("max|Phi_CB Phi_rig0 - 1| = %.3g", frame_error) +
                           Sci(", ||K Phi_rig0 Phi_CB|| / ||K|| = %.3g", amplified) +
-                          Sci(", ||1 - Phi_rig0 Phi_CB||_M = %.3g", projector_norm),
+                          Sci(", ||1 - Phi_rig0 Phi_CB||_M = %.3g", projector_norm) +
+                          " (the elastic projector's norm in the mass metric: 1 for mean axes, about the part's "
+                          "aspect ratio for a centre-of-mass or interface frame; fails above 1e6)",
                       "/floating_frame/Phi_CB"});
 
   double orientation_error = 0.0;

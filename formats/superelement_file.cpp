@@ -134,6 +134,7 @@ void WriteContent(const Superelement& se, h5::Writer& w) {
 
   w.CreateGroup("/full_model");
   w.Attribute("/full_model", "n_dofs", se.n_full_dofs);
+  if (!se.full_rigid_couplings.empty()) w.Strings("/full_model/rigid_couplings", se.full_rigid_couplings);
   if (se.full_free_free_frequencies_hz.size() > 0) {
     w.Vector("/full_model/free_free_frequencies_hz", se.full_free_free_frequencies_hz);
   }
@@ -344,6 +345,7 @@ Superelement ReadSuperelementFile(const std::string& path, const SuperelementRea
   se.mass_properties.inertia_com = r.Matrix("/mass_properties/inertia_com");
 
   se.n_full_dofs = r.IntAttribute("/full_model", "n_dofs");
+  if (r.Exists("/full_model/rigid_couplings")) se.full_rigid_couplings = r.Strings("/full_model/rigid_couplings");
   if (r.Exists("/full_model/free_free_frequencies_hz")) {
     se.full_free_free_frequencies_hz = r.Vector("/full_model/free_free_frequencies_hz");
   }

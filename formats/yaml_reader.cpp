@@ -9,7 +9,12 @@
 namespace femb {
 
 std::string YamlValue::Where() const {
-  if (source_->overridden.count(path_)) return "--set " + path_;
+  // Set on the command line: the value itself, or inside a mapping or list item set whole.
+  for (size_t i = 0; i <= path_.size(); ++i) {
+    if ((i == path_.size() || path_[i] == '.' || path_[i] == '[') && source_->overridden.count(path_.substr(0, i))) {
+      return "--set " + path_;
+    }
+  }
   // yaml-cpp counts lines from 0.
   std::string where = source_->file;
   if (node_.Mark().line >= 0) where += ":" + std::to_string(node_.Mark().line + 1);
@@ -194,7 +199,6 @@ void YamlDocument::Set(const std::string& assignment) {
       at = close + 1 < part.size() ? close + 1 : std::string::npos;
     }
   }
-  if (steps.back().second >= 0) throw InputError("--set " + assignment + ": the key path must end with a key");
   // yaml-cpp nodes are handles: walk down by reassigning node references.
   std::vector<YAML::Node> chain{root_};
   std::string walked;
@@ -228,6 +232,23 @@ void YamlDocument::Set(const std::string& assignment) {
       next = chain.back()[name];
     }
     chain.push_back(next);
+  }
+  const long last = steps.back().second;
+  if (last >= 0) {
+    // A whole list item: replaced, or appended at the index one past the last.
+    YAML::Node list = chain.back();
+    if (!list.IsSequence()) throw InputError("--set " + assignment + ": '" + walked + "' is not a list in " + file());
+    if (last > long(list.size())) {
+      throw InputError("--set " + assignment + ": '" + walked + "' has no item " + std::to_string(last) + " in " + file() +
+                       " (it has " + std::to_string(list.size()) + "; [" + std::to_string(list.size()) + "] appends one)");
+    }
+    if (last == long(list.size())) {
+      list.push_back(value);
+    } else {
+      list[std::size_t(last)] = value;
+    }
+    source_->overridden.insert(key);
+    return;
   }
   if (!chain.back().IsMap() && chain.back().IsDefined() && !chain.back().IsNull()) {
     throw InputError("--set " + assignment + ": '" + walked + "' is not a mapping in " + file());

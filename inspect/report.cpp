@@ -126,6 +126,12 @@ std::string TextSummary(const Superelement& se, const SuperelementAnalysis& a, c
   s += F("\nFree-free frequencies [Hz] (%d rigid-body):\n", a.rigid_body_mode_count);
   const Eigen::VectorXd& full = se.full_free_free_frequencies_hz;
   if (full.size()) {
+    if (!se.full_rigid_couplings.empty()) {
+      std::string rigid;
+      for (const std::string& name : se.full_rigid_couplings) rigid += (rigid.empty() ? "" : ", ") + name;
+      s += "  full: the unreduced model with the RBE2 couplings of " + rigid +
+           " (their node sets rigid: stiffer than the bare part; RBE3 couplings add no stiffness)\n";
+    }
     s += "     #        reduced           full     rel. error\n";
   } else {
     s += "     #        reduced   (no full-model frequencies stored: femb-reduce --full-modes K)\n";
@@ -191,6 +197,7 @@ nlohmann::json JsonSummary(const Superelement& se, const SuperelementAnalysis& a
   j["free_free_frequencies_hz"] = ToJson(a.free_free_frequencies_hz);
   if (se.full_free_free_frequencies_hz.size()) {
     j["full_free_free_frequencies_hz"] = ToJson(se.full_free_free_frequencies_hz);
+    j["full_rigid_couplings"] = se.full_rigid_couplings;
   }
   j["rigid_body_mode_count"] = a.rigid_body_mode_count;
   nlohmann::json checks = nlohmann::json::object();

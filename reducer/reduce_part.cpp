@@ -284,6 +284,9 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
   se.internal_frequencies_hz.resize(cb.lambda.size());
   for (int k = 0; k < cb.lambda.size(); ++k) se.internal_frequencies_hz[k] = FrequencyHz(cb.lambda[k]);
   se.n_full_dofs = model.n_dofs();
+  for (const InterfaceSpec& i : part.interfaces) {
+    if (part.type != "beam" && i.coupling == "rbe2") se.full_rigid_couplings.push_back(i.name);
+  }
   se.n_modal_derivatives = long(cb.derivative_pairs.size());
   se.modal_derivative_pairs = cb.derivative_pairs;
   se.mass_properties = ComputeMassProperties(se);
@@ -432,8 +435,12 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
       return result;
     }
     se.full_free_free_frequencies_hz = full.frequencies_hz;
-    std::snprintf(detail, sizeof detail, "%d free-free frequencies of the full model, %ld linear solves",
-                  int(full.frequencies_hz.size()), full.linear_solves);
+    std::string rigid;
+    for (const std::string& name : se.full_rigid_couplings) rigid += (rigid.empty() ? "" : ", ") + name;
+    std::snprintf(detail, sizeof detail, "%d free-free frequencies of the full model%s, %ld linear solves",
+                  int(full.frequencies_hz.size()),
+                  rigid.empty() ? "" : (" with the RBE2 couplings of " + rigid + " (their node sets rigid)").c_str(),
+                  full.linear_solves);
     report("full modes", clock.Seconds(), detail);
   }
   result.ok = true;

@@ -65,6 +65,11 @@ formats/SCENE_FORMAT.md), with joints along a tree and closed loops cut into con
                           (cut where Newton fails, with a warning) or auto (error-controlled by
                           analysis.step_tolerance; the steps are listed in results.h5 /steps)
   analysis.type: modes    linearized eigenfrequencies about the initial or the static state
+  outputs                 probes at nodes (position, rotation, velocity, acceleration, joint,
+                          reaction, effort of a prescribed joint) and at any point of a body
+                          (position, velocity, acceleration, deformation, stress); stresses
+                          (largest von Mises per body, stress_exclude near couplings); a ParaView
+                          animation
 
 options:
   -o, --output OUTDIR   output folder (default: out/<scene name>): results.h5 and probes.csv
@@ -295,6 +300,9 @@ int main(int argc, char** argv) {
     const double solve_end = Seconds(wall);
     recorder.Finish(status);
     progress(spec.analysis.end_time, true);
+    if (!quiet) {
+      for (const std::string& line : recorder.StressSummary()) std::printf("femb-solve: %s\n", line.c_str());
+    }
     if (!ok) {
       std::fprintf(stderr, "femb-solve: %s: numerical failure: %s; results up to it are in %s\n", scene_path.c_str(),
                    status.c_str(), output.c_str());

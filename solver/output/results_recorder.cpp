@@ -13,6 +13,7 @@
 
 #include "formats/hdf5_file.h"
 #include "formats/input_error.h"
+#include "formats/part_file.h"
 #include "formats/vtk_cells.h"
 
 namespace femb {
@@ -448,6 +449,25 @@ void ResultsRecorder::Record(double t, const SystemState& state, const Eigen::Ve
   put(elastic);
   put(external_work);
   csv_.put('\n');
+}
+
+std::vector<std::string> ResultsRecorder::StressSummary() const {
+  std::vector<std::string> lines;
+  for (size_t b = 0; b < max_von_mises_.size(); ++b) {
+    const std::vector<double>& v = max_von_mises_[b];
+    if (v.empty() || !scene_.meshes[b]) continue;
+    const size_t s = size_t(std::max_element(v.begin(), v.end()) - v.begin());
+    const int node = max_von_mises_node_[b][s];
+    const Eigen::Vector3d X = scene_.meshes[b]->nodes.row(node).transpose();
+    const bool excluded = b < scene_.stress_excluded.size() && !scene_.stress_excluded[b].empty();
+    char buffer[300];
+    std::snprintf(buffer, sizeof buffer,
+                  "body '%s': largest von Mises stress %.4g %s at t = %.6g, mesh node %d at (%.6g, %.6g, %.6g) in part axes%s",
+                  scene_.body_names[b].c_str(), v[s], UnitSystem(scene_.spec.units, "units").stress.c_str(), time_[s], node,
+                  X.x(), X.y(), X.z(), excluded ? " (outside outputs.stress_exclude)" : "");
+    lines.push_back(buffer);
+  }
+  return lines;
 }
 
 bool ResultsRecorder::JointNode(int k) const {

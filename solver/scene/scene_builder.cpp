@@ -74,7 +74,7 @@ namespace {
 // the file's mesh that holds it or, within the mesh size outside every cell, at the nearest mesh
 // node; the stress at the body's stress point nearest to it. Effort probes: the prescribed
 // coordinates of the node's joint.
-void ResolveProbes(const SceneSpec& spec, const DofMap& dofs, Scene& scene) {
+void ResolveProbes(const SceneSpec& spec, Scene& scene) {
   const SystemModel& model = scene.model;
   for (const SceneProbeSpec& p : spec.probes) {
     scene.stress_probes.emplace_back(-1, -1);
@@ -594,7 +594,7 @@ Scene BuildScene(const SceneSpec& spec) {
     }
     for (size_t i = 0; i < rates.size(); ++i) scene.initial_velocity[dofs.node_first(k) + int(i)] = rates[i];
   }
-  ResolveProbes(spec, dofs, scene);
+  ResolveProbes(spec, scene);
   ResolveStressExclusion(spec, scene);
   return scene;
 }

@@ -54,6 +54,29 @@ TEST(PartFile, SetOverridesKeys) {
   EXPECT_NE(ParsePart(kGood, "part.yaml").text_hash, p.text_hash);
 }
 
+// A whole list item: replaced by index, or appended one past the last; an error inside it names
+// the --set that put it there.
+TEST(PartFile, SetReplacesOrAppendsAWholeListItem) {
+  const PartSpec replaced = ParsePart(kGood, "part.yaml", {"interfaces[1]={name: C, point: B}"});
+  ASSERT_EQ(replaced.interfaces.size(), 2u);
+  EXPECT_EQ(replaced.interfaces[1].name, "C");
+  EXPECT_EQ(replaced.interfaces[1].point, ParsePart(kGood, "part.yaml").interfaces[1].point);
+  // A point in the middle: the segment replaced by two, a third interface appended.
+  const PartSpec appended = ParsePart(kGood, "part.yaml",
+                                      {"beam.points.M=[0.15, 0, 0]", "beam.segments[0]={from: A, to: M, elements: 5}",
+                                       "beam.segments[1]={from: M, to: B, elements: 5}", "interfaces[2]={name: C, point: M}"});
+  ASSERT_EQ(appended.interfaces.size(), 3u);
+  EXPECT_EQ(appended.interfaces[2].name, "C");
+  EXPECT_EQ(appended.beam.segments.size(), 2u);
+  const std::string beyond = Error(kGood, {"interfaces[5]={name: C}"});
+  EXPECT_NE(beyond.find("--set interfaces[5]={name: C}: 'interfaces' has no item 5 in part.yaml (it has 2; [2] appends one)"),
+            std::string::npos) << beyond;
+  const std::string inside = Error(kGood, {"interfaces[1]={name: C, point: Q}"});
+  EXPECT_NE(inside.find("--set interfaces[1].point: interface point 'Q' not found"), std::string::npos) << inside;
+  const std::string not_list = Error(kGood, {"reduction[0]=3"});
+  EXPECT_NE(not_list.find("'reduction' is not a list"), std::string::npos) << not_list;
+}
+
 TEST(PartFile, BadInputNamesFileLineAndKey) {
   struct Case {
     std::string text, expected;
