@@ -115,7 +115,7 @@ void Writer::CompressedFloatMatrices(std::vector<FloatData>& data, int threads) 
     for (size_t i = next++; i < data.size(); i = next++) {
       const auto& v = data[i].value;
       const size_t n = size_t(v.size()), bytes = n * sizeof(float);
-      if (n == 0 || bytes >= (size_t(1) << 32)) continue;
+      if (!data[i].compress || n == 0 || bytes >= (size_t(1) << 32)) continue;
       shuffled.resize(bytes);
       const unsigned char* raw = reinterpret_cast<const unsigned char*>(v.data());
       for (size_t k = 0; k < n; ++k) {
@@ -137,7 +137,8 @@ void Writer::CompressedFloatMatrices(std::vector<FloatData>& data, int threads) 
   for (size_t i = 0; i < data.size(); ++i) {
     const auto& v = data[i].value;
     if (packed[i].empty()) {
-      WriteData(data[i].name, {hsize_t(v.rows()), hsize_t(v.cols())}, H5T_IEEE_F32LE, H5T_NATIVE_FLOAT, v.data(), true);
+      WriteData(data[i].name, {hsize_t(v.rows()), hsize_t(v.cols())}, H5T_IEEE_F32LE, H5T_NATIVE_FLOAT, v.data(),
+                data[i].compress);
       continue;
     }
     const hsize_t shape[2] = {hsize_t(v.rows()), hsize_t(v.cols())};

@@ -52,6 +52,7 @@ class Writer {
   struct FloatData {
     std::string name;
     Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> value;
+    bool compress = true;  ///< false: stored contiguous as it is (data that deflate shrinks little)
   };
   void CompressedFloatMatrices(std::vector<FloatData>& data, int threads);
   void Scalar(const std::string& name, double value);

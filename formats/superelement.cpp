@@ -153,7 +153,7 @@ Eigen::Matrix<double, 6, 1> PointStress(const ModalStress& modal, int p, const E
 }
 
 void NodeStresses(const ModalStress& modal, const Eigen::VectorXd& q, long n_nodes, Eigen::MatrixXd* stress,
-                  Eigen::VectorXd* von_mises, const Eigen::VectorXd* inertia) {
+                  Eigen::VectorXd* von_mises, const Eigen::VectorXd* inertia, Eigen::VectorXf* scratch) {
   stress->setZero(n_nodes, 6);
   von_mises->setConstant(n_nodes, -1.0);
   // The field in single precision, the precision of the modes themselves (a sum of n terms adds
@@ -162,7 +162,11 @@ void NodeStresses(const ModalStress& modal, const Eigen::VectorXd& q, long n_nod
   // largest per node in double precision.
   const bool with_inertia = inertia && modal.inertia_modes.size() > 0;
   const bool quadratic = modal.gradients.size() > 0 || modal.element_quadratic.size() > 0;
-  Eigen::VectorXf all = modal.modes * q.cast<float>();
+  // (`scratch`: the field's storage kept by the caller from call to call; a field-sized
+  // temporary per call cost page faults at every output step.)
+  Eigen::VectorXf own;
+  Eigen::VectorXf& all = scratch ? *scratch : own;
+  all.noalias() = modal.modes * q.cast<float>();
   if (with_inertia) all.noalias() += modal.inertia_modes * inertia->cast<float>();
   for (int p = 0; p < modal.n_points(); ++p) {
     Eigen::Matrix<double, 6, 1> s = all.segment<6>(6 * p).cast<double>();

@@ -215,7 +215,7 @@ Eigen::Vector3d PrincipalStresses(const Eigen::Matrix<double, 6, 1>& s);
 /// `inertia`: the 12 inertia load factors of the body's frame, for the inertia load cases'
 /// stresses (ModalStress::inertia_modes; ignored when the file has none or when null).
 void NodeStresses(const ModalStress& modal, const Eigen::VectorXd& q, long n_nodes, Eigen::MatrixXd* stress,
-                  Eigen::VectorXd* von_mises, const Eigen::VectorXd* inertia = nullptr);
+                  Eigen::VectorXd* von_mises, const Eigen::VectorXd* inertia = nullptr, Eigen::VectorXf* scratch = nullptr);
 /// The stress (6 components) at stress point p of local coordinates q (and inertia factors).
 Eigen::Matrix<double, 6, 1> PointStress(const ModalStress& modal, int p, const Eigen::VectorXd& q,
                                         const Eigen::VectorXd* inertia = nullptr);

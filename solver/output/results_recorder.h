@@ -112,6 +112,10 @@ class ResultsRecorder {
   std::vector<std::vector<double>> max_von_mises_;
   std::vector<std::vector<int>> max_von_mises_node_;
   std::vector<std::vector<Eigen::MatrixXf>> frame_stress_;
+  // NodeStresses' outputs and field, kept from one output step to the next (no page faults).
+  Eigen::MatrixXd stress_scratch_;
+  Eigen::VectorXd von_mises_scratch_;
+  Eigen::VectorXf field_scratch_;
   void WriteAnimation();
   bool JointNode(int k) const;
 };
