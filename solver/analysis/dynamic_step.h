@@ -329,11 +329,20 @@ struct IterationMatrix {
 // cantilever_transient, left-node frames, h = 0.5 ms) took residual excursions of 30x, landed
 // on a root that raised the energy by 5 J in one step, and which root it was depended on the
 // round-off of the linear solver. The step is cut instead (the caller halves it).
+// With closed loops the reference is the first iterate whose loops are closed (`closed`): a
+// predictor that opens them (a drive accelerating from the start moves its joint, the loop's
+// other links do not follow) has a residual that the first correction, closing the loop, may
+// double before Newton converges; measured on a rigid four-bar whose crank starts at
+// -1000 rad/s^2: every step from 100 us down to 12.5 us was cut at t = 0.
 struct DivergenceTest {
   double first = 0.0;
-  bool Diverged(int iteration, double r) {
-    if (iteration == 0) first = r;
-    return iteration > 0 && r > first;
+  bool has_first = false;
+  bool Diverged(double r, bool closed = true) {
+    if (!has_first) {
+      if (closed) first = r, has_first = true;
+      return false;
+    }
+    return r > first;
   }
 };
 

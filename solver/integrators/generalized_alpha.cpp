@@ -303,7 +303,9 @@ StepOutcome GeneralizedAlphaStep(const SystemModel& model, const DofMap& dofs, c
       out.passes_kept = true;
       return out;
     }
-    if (divergence.Diverged(out.iterations, r_norm)) return out;
+    if (divergence.Diverged(r_norm, !model.has_constraints() || LoopsClosed(model, next.config, tolerance, &work.pass_data))) {
+      return out;
+    }
     bool built = false;
     const auto S = [&]() -> const SystemMatrix& {
       const MatrixCombination combine{gamma_p, beta_p};

@@ -610,7 +610,9 @@ StepOutcome MidpointStep(const SystemModel& model, const DofMap& dofs, const Dyn
       out.passes_kept = true;
       return out;
     }
-    if (divergence.Diverged(out.iterations, r_norm)) return out;
+    if (divergence.Diverged(r_norm, !model.has_constraints() || LoopsClosed(model, next.config, tolerance, &work.pass_data))) {
+      return out;
+    }
     // Newton's increment at n+1, with the iteration matrix built only when it is factored.
     const SystemMatrix* built = nullptr;
     const auto S = [&]() -> const SystemMatrix& {

@@ -11,6 +11,7 @@
 #include "formats/solid_shape.h"
 #include "formats/superelement_checks.h"
 #include "formats/superelement_file.h"
+#include "solver/joints/loop_constraints.h"
 #include "solver/rotation.h"
 
 namespace femb {
@@ -222,6 +223,39 @@ void ResolveStressExclusion(const SceneSpec& spec, Scene& scene) {
                   spec.bodies[b].name.c_str(), count, long(mesh.nodes.rows()), ex.distance);
     scene.notes.push_back(buffer);
   }
+}
+
+// A drive whose function is not 0 at t = 0 moves its joint away from the placement at the start.
+// Along a tree the rest follows; in a closed loop the mechanism would have to be assembled anew
+// there, which Newton's first step cannot do from the placement (it stopped with "Newton
+// diverged at t = 0"): refused with the joint, its start value and the gap it opens.
+void RequireLoopsClosedAtStart(const SceneSpec& spec, const SystemModel& model, const DofMap& dofs) {
+  if (model.cut_joints.empty()) return;
+  std::string moved;
+  for (const SystemModel::Prescribed& p : model.prescribed) {
+    const double start = p.value(0.0);
+    if (start == 0.0) continue;
+    for (const SceneJointSpec& j : spec.joints) {
+      if (j.node == model.node_names[size_t(p.node)] && !j.prescribed.empty()) {
+        char buffer[300];
+        std::snprintf(buffer, sizeof buffer, "%s: prescribed '%s' of node '%s' is %.6g at t = 0", j.where.c_str(),
+                      j.prescribed.c_str(), j.node.c_str(), start);
+        moved += std::string(moved.empty() ? "" : "; ") + buffer;
+      }
+    }
+  }
+  if (moved.empty()) return;
+  SystemState state = InitialState(model);
+  ApplyPrescribed(model, dofs, 0.0, state, nullptr, nullptr);
+  int worst = -1;
+  const double gap = LoopViolation(model, state, &worst);
+  if (gap <= 1e-9 * std::max(BoundingDiagonal(model.node_x0), 1e-300)) return;
+  char buffer[200];
+  std::snprintf(buffer, sizeof buffer, ", which opens the loop closed by %s by %.3g at the start",
+                worst >= 0 && size_t(worst) < model.cut_joints.size() ? model.cut_joints[size_t(worst)].name.c_str() : "a cut joint",
+                gap);
+  throw InputError(moved + buffer + " (the scene places the mechanism at 0): place the bodies at the drive's start "
+                   "position, or give the function an offset so that it is 0 at t = 0");
 }
 
 }  // namespace
@@ -521,6 +555,7 @@ Scene BuildScene(const SceneSpec& spec) {
     throw InputError(spec.file + ": joints: " + e.what());
   }
   const DofMap& dofs = *dofs_ptr;
+  RequireLoopsClosedAtStart(spec, model, dofs);
   for (const SceneLoadSpec& l : spec.loads) {
     if (l.type == SceneLoadType::kGravity) {
       model.gravity += l.g;
