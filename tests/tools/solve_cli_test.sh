@@ -415,6 +415,8 @@ sed 's/{name: b3, superelement: segment.h5/{name: b3, options: {geometric_stiffe
 # The exact inertia asked for from a file without the invariants: one line, exit 2; a corrupted
 # invariant: the load gate names the dataset and the check.
 expect "inertia invariants not in the file" 2 "options.inertia is exact but" 's/{name: b3, superelement: segment.h5/{name: b3, options: {inertia: exact}, superelement: segment.h5/'
+# Under the midpoint integrator (corotational inertia only) the exact inertia is refused, not ignored.
+expect "exact inertia under the midpoint scheme" 2 "options.inertia: exact is not available with the midpoint integrator" 's/{name: b3, superelement: segment.h5/{name: b3, options: {inertia: exact}, superelement: segment_gs.h5/; s/type: static/type: dynamic\n  integrator: midpoint\n  step: 0.01/'
 expect "bad inertia option" 2 "options.inertia: expected exact or corotational (exact: the file's inertia invariants), got 'lumped'" 's/{name: b3, superelement: segment.h5/{name: b3, options: {inertia: lumped}, superelement: segment.h5/'
 cp "$work/segment_gs.h5" "$work/bad_gamma.h5"
 $py -c "import h5py; f=h5py.File('$work/bad_gamma.h5','r+'); a=f['/reduced/inertia_invariants/Gamma'][...]; a[0,1]+=1.0; f['/reduced/inertia_invariants/Gamma'][...]=a"
