@@ -170,6 +170,9 @@ void ResolveStressExclusion(const SceneSpec& spec, Scene& scene) {
   const StressExcludeSpec& ex = spec.stress_exclude;
   scene.stress_excluded.assign(scene.stresses.size(), {});
   if (ex.distance < 0) return;
+  if (!spec.stresses) {
+    scene.notes.push_back(ex.where + ": has no effect without outputs.stresses: true");
+  }
   // "<body>.<interface>" named, or every interface of every body.
   std::vector<std::vector<int>> chosen(spec.bodies.size());  // per body: its interfaces
   for (const std::string& name : ex.interfaces) {
