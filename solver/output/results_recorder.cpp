@@ -363,7 +363,10 @@ void ResultsRecorder::Record(double t, const SystemState& state, const Eigen::Ve
   const auto motion_of = [&](int b) -> const SuperelementBody::LocalMotion& {
     if (!motion[size_t(b)]) {
       const SuperelementBody& body = model.bodies[size_t(b)];
-      const SuperelementBody::Data d = body.Evaluate(BodyConfigurationOf(model, state, b), state.frames[size_t(b)]);
+      // The local coordinates at this frame are q_loc_ already: not solved for again.
+      SuperelementBody::Data d;
+      d.q = q_loc_[size_t(b)];
+      body.EvaluateSolved(BodyConfigurationOf(model, state, b), state.frames[size_t(b)], d);
       const Eigen::VectorXd wdot = GatherBodyAcceleration(model, dofs, b, node_accelerations(), A);
       motion[size_t(b)] = body.LocalRates(d, GatherBody(model, dofs, state, b, V), &wdot);
     }
