@@ -5,6 +5,23 @@
 
 namespace femb {
 
+std::string DynamicsSummary(const Superelement& se) {
+  if (se.n_reduced_dofs() <= 6) return "rigid (one interface, no modes): the rigid body's exact inertia";
+  std::string s = se.inertia_gamma.empty()
+                      ? "corotational inertia only (no inertia invariants: an older femb-reduce wrote the file; a "
+                        "spinning part's centrifugal load on its deformation is then a fifth too high)"
+                      : "exact inertia (inertia invariants)";
+  if (se.polynomial && se.polynomial->cubic()) {
+    s += "; large deformation inside (modal derivatives, cubic internal force)";
+    if (!se.inertia_stiffness.empty()) s += " and the inertia loads' geometric stiffening";
+  } else if (!se.inertia_stiffness.empty()) {
+    s += "; geometric stiffening of the inertia loads and the basis's own stress";
+  } else {
+    s += "; no geometric stiffening: linear inside (a rotating or highly loaded part misses its stress stiffening)";
+  }
+  return s;
+}
+
 std::string ReducedCoordinateLabel(const Superelement& se, int i) {
   static const char* kComponents[6] = {"u_x", "u_y", "u_z", "theta_x", "theta_y", "theta_z"};
   if (i < 0 || i >= se.n_interface_dofs() + se.n_internal_modes() + int(se.n_modal_derivatives)) {

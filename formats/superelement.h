@@ -181,6 +181,13 @@ struct Superelement {
   int n_reduced_dofs() const { return int(K.rows()); }
 };
 
+/// What femb-solve's generalized-alpha integrator can do with the file's body, in one line:
+/// its inertia (exact, from the inertia invariants, or corotational only) and its geometric
+/// stiffening (inertia load cases, the basis's own stress, the cubic force of modal derivatives,
+/// or none: linear inside), e.g. "exact inertia; geometric stiffening of the inertia loads and
+/// the basis's stress".
+std::string DynamicsSummary(const Superelement& se);
+
 /// Label of reduced coordinate i, e.g. "A.u_x", "B.theta_z", "mode 3 (512.4 Hz)",
 /// "derivative 2 (B.u_y x mode 1)".
 std::string ReducedCoordinateLabel(const Superelement& se, int i);

@@ -88,6 +88,7 @@ std::string TextSummary(const Superelement& se, const SuperelementAnalysis& a, c
     s += F("  inertia invariants: Gamma (3) and Xi (6), %d x %d each (exact kinetic energy in the floating frame)\n",
            se.n_reduced_dofs(), se.n_reduced_dofs());
   }
+  s += "  in dynamics: " + DynamicsSummary(se) + "\n";
   if (!p.stage_seconds.empty()) {
     s += "  reduction time:";
     for (const auto& [stage, sec] : p.stage_seconds) s += F(" %s %.3g s;", stage.c_str(), sec);

@@ -102,6 +102,7 @@ int main(int argc, char** argv) {
       return 3;
     }
     progress("checks", check_clock.Seconds(), std::to_string(checks.checks.size()) + " checks passed");
+    progress("dynamics", 0.0, femb::DynamicsSummary(result.superelement));
     femb::Stopwatch write_clock;
     femb::WriteSuperelementFile(result.superelement, output);
     progress("write", write_clock.Seconds(), output);

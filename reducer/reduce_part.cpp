@@ -306,12 +306,12 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
     se.K = 0.5 * (se.K + se.K.transpose()).eval();
   }
   // The inertia invariants for the exact kinetic energy of the reduced field in the floating
-  // frame (SuperelementBody, "Exact inertia"): with the geometric stiffening (below), and for the
-  // free-interface and general bases of femb's own parts, which have no stiffening. Without them
-  // the solver takes the corotational inertia (thesis 3.22), whose centrifugal load on a spinning
-  // part is a fifth too high (a free bar spinning at 200 rad/s: +21.3% stretch with the
-  // free-interface basis, +0.33% with the invariants).
-  if (stiffening || (part.type != "imported" && (free_interface || general) && se.n_reduced_dofs() > 6)) {
+  // frame (SuperelementBody, "Exact inertia"), for every basis and every kind of part: they need
+  // only M, the DOFs' vector components and the basis. Without them the solver takes the
+  // corotational inertia (thesis 3.22), whose centrifugal load on a spinning part is a fifth too
+  // high (a free bar spinning at 200 rad/s: +21.3% stretch with the free-interface basis, +0.43%
+  // with the invariants).
+  if (se.n_reduced_dofs() > 6) {
     InertiaInvariants(model, cb.shapes, &se.inertia_gamma, &se.inertia_xi);
   }
   const bool derivatives = se.n_modal_derivatives > 0;

@@ -123,6 +123,20 @@ int main(int argc, char** argv) {
                   spec.analysis.type == femb::AnalysisType::kDynamic
                       ? (", " + std::to_string(threads) + (threads == 1 ? " thread" : " threads")).c_str()
                       : "");
+      // Which inertia and stiffening the flexible bodies use (the notes below say why when a
+      // body does without the exact inertia or the stiffening).
+      int flexible = 0, exact = 0, stiffened = 0;
+      for (const femb::SuperelementBody& body : scene.model.bodies) {
+        if (body.n_coordinates() <= 6) continue;
+        ++flexible;
+        exact += body.has_exact_inertia();
+        stiffened += body.options().geometric_stiffening && body.has_inertia_stiffening();
+      }
+      if (flexible > 0) {
+        std::printf("femb-solve: %d flexible bodies: %d with the exact inertia, %d with the corotational one; %d "
+                    "with geometric stiffening, %d linear inside\n",
+                    flexible, exact, flexible - exact, stiffened, flexible - stiffened);
+      }
       // One note per file, not per body.
       std::set<std::string> said;
       for (const std::string& note : scene.notes) {

@@ -20,6 +20,7 @@ n, out, step, modes, options = rod.parse_args(sys.argv)
 here = os.path.dirname(os.path.abspath(__file__))
 L = rod.write_segment(out, n, modes)
 stiffening.apply(os.path.join(out, f"rod_{n}.yaml"), stiffened)
+options = stiffening.body_options(stiffened, options)
 names = rod.node_names(n)
 bodies = "\n".join(
     f"  - {{name: rod{i}, superelement: rod_{n}.h5, placement: {{position: [{0.15 + i * L!r}, 0, 0]}}, "

@@ -52,6 +52,10 @@ struct FeModel {
   /// DOF, for the rigid-body fields. Empty for femb's own models.
   std::vector<Eigen::Vector3d> dof_point;
   std::vector<int> dof_component;
+  /// Imported models: the node each model DOF belongs to (the imported node's index, or
+  /// n_nodes + k for the six DOFs of RBE2 interface k): the DOFs of one node and kind
+  /// (translation, rotation) are the components of one vector.
+  std::vector<int> dof_node;
   /// Imported models: the imported DOFs (the matrices' rows) = full_map * model DOFs.
   SparseMatrix full_map;
 

@@ -111,6 +111,7 @@ FeModel BuildImportedModel(const PartSpec& part, const ProgressFn& progress) {
       model_of[size_t(r)] = n_model++;
       model.dof_point.push_back(geometry.nodes.row(full_node[size_t(r)]).transpose());
       model.dof_component.push_back(im.component[size_t(r)]);
+      model.dof_node.push_back(int(full_node[size_t(r)]));
     }
   }
   std::vector<int> base(part.interfaces.size(), -1);
@@ -120,6 +121,7 @@ FeModel BuildImportedModel(const PartSpec& part, const ProgressFn& progress) {
     for (int c = 0; c < 6; ++c) {
       model.dof_point.push_back(model.interface_positions[k]);
       model.dof_component.push_back(c);
+      model.dof_node.push_back(int(geometry.nodes.rows() + long(k)));
     }
     n_model += 6;
   }

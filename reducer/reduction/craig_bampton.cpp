@@ -8,6 +8,7 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <unordered_map>
 
 #include "reducer/linalg/dense_products.h"
 #include "reducer/linalg/generalized_eigen.h"
@@ -145,15 +146,41 @@ Eigen::MatrixXd InertiaFields(const FeModel& model) {
 void InertiaInvariants(const FeModel& model, const Eigen::MatrixXd& shapes, std::vector<Eigen::MatrixXd>* gamma,
                        std::vector<Eigen::MatrixXd>* xi) {
   const long n = shapes.rows();
-  // Every model DOF belongs to a triple of vector components in part axes (beams: 6 per node;
-  // solids: 3 per free mesh node, then 6 per RBE2 interface), so S_a acts triple by triple.
   std::array<Eigen::MatrixXd, 3> turned;
+  std::array<Eigen::Matrix3d, 3> S;  // S_a v = e_a x v
   for (int a = 0; a < 3; ++a) {
     const Eigen::Vector3d e = Eigen::Vector3d::Unit(a);
-    Eigen::Matrix3d S;  // S v = e x v
-    S << 0, -e.z(), e.y(), e.z(), 0, -e.x(), -e.y(), e.x(), 0;
-    turned[size_t(a)].resize(n, shapes.cols());
-    for (long t = 0; t + 2 < n; t += 3) turned[size_t(a)].middleRows(t, 3) = S * shapes.middleRows(t, 3);
+    S[size_t(a)] << 0, -e.z(), e.y(), e.z(), 0, -e.x(), -e.y(), e.x(), 0;
+    turned[size_t(a)] = Eigen::MatrixXd::Zero(n, shapes.cols());
+  }
+  if (model.dof_node.empty()) {
+    // femb's own models: every DOF belongs to a triple of vector components in part axes
+    // (beams: 6 per node; solids: 3 per free mesh node, then 6 per RBE2 interface).
+    for (int a = 0; a < 3; ++a)
+      for (long t = 0; t + 2 < n; t += 3) turned[size_t(a)].middleRows(t, 3) = S[size_t(a)] * shapes.middleRows(t, 3);
+  } else {
+    // Imported models: the DOFs of one node and kind (translation, rotation) are the components
+    // of one vector, in any order and possibly incomplete (a missing component is zero: a node
+    // with two translations in a planar model, a shell's five rotations).
+    std::unordered_map<int, std::array<int, 6>> component_dof;
+    for (long d = 0; d < n; ++d) {
+      auto [it, added] = component_dof.try_emplace(model.dof_node[size_t(d)]);
+      if (added) it->second.fill(-1);
+      it->second[size_t(model.dof_component[size_t(d)])] = int(d);
+    }
+    for (long d = 0; d < n; ++d) {
+      const int c = model.dof_component[size_t(d)];
+      const int kind = c / 3;
+      const std::array<int, 6>& dofs = component_dof.at(model.dof_node[size_t(d)]);
+      for (int j = 0; j < 3; ++j) {
+        const int from = dofs[size_t(3 * kind + j)];
+        if (from < 0) continue;
+        for (int a = 0; a < 3; ++a) {
+          const double s = S[size_t(a)](c % 3, j);
+          if (s != 0.0) turned[size_t(a)].row(d) += s * shapes.row(from);
+        }
+      }
+    }
   }
   gamma->clear();
   xi->clear();

@@ -129,6 +129,20 @@ TEST(ImportedModel, BeamWithRotationalDofsRoundTrips) {
   EXPECT_LT(f, 1e-8);
   EXPECT_LT(Relative(imported.K, native.K), 1e-8);
   EXPECT_LT(Relative(imported.M, native.M), 1e-8);
+  // The inertia invariants on 6 DOFs per node (the rotations turn with the frame as the
+  // translations do), to 1e-8 of each kind's largest.
+  ASSERT_EQ(imported.inertia_gamma.size(), 3u);
+  ASSERT_EQ(imported.inertia_xi.size(), 6u);
+  for (const auto& [got, want] : {std::pair(&imported.inertia_gamma, &native.inertia_gamma),
+                                  std::pair(&imported.inertia_xi, &native.inertia_xi)}) {
+    double scale = 0.0, error = 0.0;
+    for (size_t k = 0; k < want->size(); ++k) {
+      scale = std::max(scale, (*want)[k].cwiseAbs().maxCoeff());
+      error = std::max(error, ((*got)[k] - (*want)[k]).cwiseAbs().maxCoeff());
+    }
+    std::printf("[ info ] beam: inertia invariants %.2e\n", error / scale);
+    EXPECT_LT(error, 1e-8 * scale);
+  }
   EXPECT_EQ(imported.visualization->cell_type, "line2");
   fs::remove_all(dir);
 }

@@ -51,7 +51,9 @@ BodyMatrices MatricesAt(const SuperelementBody& body, const BodyConfiguration& c
 TEST(BodyMatrices, TurnWithTheBody) {
   const Eigen::Matrix3d Q = ExpSO3(Eigen::Vector3d(0.7, -0.4, 1.1));
   for (const bool stiffened : {false, true}) {
-    const SuperelementBody body(Tube(0.5, stiffened), SuperelementOptions{});
+    SuperelementOptions options;
+    options.exact_inertia = stiffened;  // linear with the corotational inertia, stiffened with the exact one
+    const SuperelementBody body(Tube(0.5, stiffened), options);
     ASSERT_EQ(body.has_exact_inertia(), stiffened);
     const int n = body.n_coordinates(), N = body.n_nodes();
     // A deformed, turned body with node velocities and accelerations of a few m/s, rad/s.

@@ -94,9 +94,16 @@ TEST(FlexibleDynamics, FreeSpinningFlexibleBodyConservesEnergyAndMomentum) {
   struct Errors {
     double dE = 0, dH = 0, dL = 0, max_elastic = 0;
   };
+  // As femb-solve builds them: the midpoint scheme's body has the corotational inertia.
+  SystemModel corotational = model;
+  SuperelementOptions corotational_options;
+  corotational_options.exact_inertia = false;
+  corotational.bodies.clear();
+  corotational.bodies.emplace_back(se, corotational_options);
   auto run = [&](int steps_per_turn, Integrator integrator) {
-    DynamicState s = InitialDynamicState(model, InitialState(model), W);
-    const DynamicStepReport r0 = Measure(model, s);
+    const SystemModel& used = integrator == Integrator::kMidpoint ? corotational : model;
+    DynamicState s = InitialDynamicState(used, InitialState(used), W);
+    const DynamicStepReport r0 = Measure(used, s);
     DynamicOptions options;
     options.step = period / steps_per_turn;
     options.end_time = 5 * period;
@@ -104,7 +111,7 @@ TEST(FlexibleDynamics, FreeSpinningFlexibleBodyConservesEnergyAndMomentum) {
     options.integrator = integrator;
     Errors e;
     const double E0 = r0.kinetic_energy + r0.elastic_energy;
-    EXPECT_TRUE(SolveDynamic(model, s, options, [&](const DynamicStepReport& r, const DynamicState&) {
+    EXPECT_TRUE(SolveDynamic(used, s, options, [&](const DynamicStepReport& r, const DynamicState&) {
                   e.dE = std::max(e.dE, std::abs(r.kinetic_energy + r.elastic_energy - E0) / E0);
                   e.dH = std::max(e.dH, (r.angular_momentum - r0.angular_momentum).norm() / r0.angular_momentum.norm());
                   e.dL = std::max(e.dL, r.linear_momentum.norm());

@@ -37,8 +37,9 @@ Superelement Rod(int modes, bool stiffened = false) {
 }
 
 void AddRod(SystemModel& model, const Superelement& se, int a, int b) {
-  model.bodies.emplace_back(se, SuperelementOptions{}, Eigen::Matrix3d::Identity(),
-                            model.node_x0[size_t(a)]);
+  SuperelementOptions options;
+  options.exact_inertia = !se.inertia_stiffness.empty();  // as Rod says: the exact inertia with the stiffening
+  model.bodies.emplace_back(se, options, Eigen::Matrix3d::Identity(), model.node_x0[size_t(a)]);
   model.body_nodes.push_back({a, b});
 }
 

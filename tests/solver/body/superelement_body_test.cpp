@@ -273,6 +273,7 @@ TEST(SuperelementBody, MomentumDerivativesMatchFiniteDifferences) {
   for (bool option_b : {false, true}) {
     SuperelementOptions options;
     options.cardona_option_b = option_b;
+    options.exact_inertia = false;  // the corotational inertia's momentum (thesis 3.22) is what is checked
     const SuperelementBody body(Tee(), options);
     const BodyConfiguration c = Deformed(body, 0.1, 5);
     const FrameSolution frame = body.SolveFrame(c, body.GuessFrame(c));
@@ -332,57 +333,64 @@ TEST(SuperelementBody, MomentumDerivativesMatchFiniteDifferences) {
 
 TEST(SuperelementBody, InertiaForceIsTheLagrangianDerivativeAlongAMotion) {
   // Along a smooth motion q(t), d/dt (dT/dw) - (dT/dq) = f_in and the power balance
-  // dT/dt = w . f_in holds for the exact inertia force. Check the power balance with central
-  // differences in time on a rigid-deformable motion of the Tee.
-  const SuperelementBody body(Tee(), {});
-  const BodyConfiguration c0 = Deformed(body, 0.1, 21);
-  const int n = body.n_coordinates();
-  std::mt19937 rng(9);
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
-  Eigen::VectorXd w0(n), acc(n);
-  for (int i = 0; i < n; ++i) {
-    w0[i] = u(rng);
-    acc[i] = u(rng);
-  }
-  // q(t) = q0 o exp(t w0 + t^2/2 acc) (node-wise), w(t) = w0 + t acc to first order; use the
-  // exact velocity of this curve through the discrete derivative of positions and rotations.
-  auto config = [&](double t) { return Perturb(c0, t * w0 + 0.5 * t * t * acc, 1.0); };
-  auto velocity = [&](double t) {
-    const double h = 1e-6;
-    const BodyConfiguration a = config(t - h), b = config(t + h);
-    Eigen::VectorXd w(n);
-    for (int k = 0; k < body.n_nodes(); ++k) {
-      w.segment<3>(6 * k) = (b.x[k] - a.x[k]) / (2 * h);
-      w.segment<3>(6 * k + 3) = LogSO3(b.R[k] * a.R[k].transpose()) / (2 * h);
+  // dT/dt = w . f_in holds for the inertia force, corotational (thesis 3.22) and exact. Check the
+  // power balance with central differences in time on a rigid-deformable motion of the Tee; the
+  // momentum form of the midpoint integrator with the corotational inertia.
+  for (const bool exact : {false, true}) {
+    SuperelementOptions options;
+    options.exact_inertia = exact;
+    const SuperelementBody body(Tee(), options);
+    ASSERT_EQ(body.has_exact_inertia(), exact);
+    const BodyConfiguration c0 = Deformed(body, 0.1, 21);
+    const int n = body.n_coordinates();
+    std::mt19937 rng(9);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    Eigen::VectorXd w0(n), acc(n);
+    for (int i = 0; i < n; ++i) {
+      w0[i] = u(rng);
+      acc[i] = u(rng);
     }
-    w.tail(body.n_modes()) = (b.eta - a.eta) / (2 * h);
-    return w;
-  };
-  auto energy = [&](double t) {
+    // q(t) = q0 o exp(t w0 + t^2/2 acc) (node-wise), w(t) = w0 + t acc to first order; use the
+    // exact velocity of this curve through the discrete derivative of positions and rotations.
+    auto config = [&](double t) { return Perturb(c0, t * w0 + 0.5 * t * t * acc, 1.0); };
+    auto velocity = [&](double t) {
+      const double h = 1e-6;
+      const BodyConfiguration a = config(t - h), b = config(t + h);
+      Eigen::VectorXd w(n);
+      for (int k = 0; k < body.n_nodes(); ++k) {
+        w.segment<3>(6 * k) = (b.x[k] - a.x[k]) / (2 * h);
+        w.segment<3>(6 * k + 3) = LogSO3(b.R[k] * a.R[k].transpose()) / (2 * h);
+      }
+      w.tail(body.n_modes()) = (b.eta - a.eta) / (2 * h);
+      return w;
+    };
+    auto energy = [&](double t) {
+      const BodyConfiguration c = config(t);
+      return body.KineticEnergy(c, body.SolveFrame(c, body.GuessFrame(c)), velocity(t));
+    };
+    const double t = 0.01, dt = 1e-4;
+    const double power_fd = (energy(t + dt) - energy(t - dt)) / (2 * dt);
     const BodyConfiguration c = config(t);
-    return body.KineticEnergy(c, body.SolveFrame(c, body.GuessFrame(c)), velocity(t));
-  };
-  const double t = 0.01, dt = 1e-4;
-  const double power_fd = (energy(t + dt) - energy(t - dt)) / (2 * dt);
-  const BodyConfiguration c = config(t);
-  const Eigen::VectorXd w = velocity(t);
-  const Eigen::VectorXd wdot = (velocity(t + dt) - velocity(t - dt)) / (2 * dt);
-  Eigen::VectorXd f_in;
-  body.InertiaForce(c, body.SolveFrame(c, body.GuessFrame(c)), w, wdot, &f_in, nullptr, nullptr);
-  EXPECT_NEAR(w.dot(f_in), power_fd, 1e-5 * std::abs(power_fd));
+    const Eigen::VectorXd w = velocity(t);
+    const Eigen::VectorXd wdot = (velocity(t + dt) - velocity(t - dt)) / (2 * dt);
+    Eigen::VectorXd f_in;
+    body.InertiaForce(c, body.SolveFrame(c, body.GuessFrame(c)), w, wdot, &f_in, nullptr, nullptr);
+    EXPECT_NEAR(w.dot(f_in), power_fd, 1e-5 * std::abs(power_fd)) << (exact ? "exact" : "corotational");
+    if (exact) continue;
 
-  // Momentum form used by the midpoint integrator: f_in = dp/dt - s(q, w, p), p = M_g w,
-  // s = MomentumSource; dp/dt by central differences along the same motion.
-  auto momentum = [&](double time) {
-    const BodyConfiguration ct = config(time);
-    return body.GeneralizedMomentum(body.Maps(ct, body.SolveFrame(ct, body.GuessFrame(ct))), velocity(time));
-  };
-  const Eigen::VectorXd pdot = (momentum(t + dt) - momentum(t - dt)) / (2 * dt);
-  const FrameSolution frame = body.SolveFrame(c, body.GuessFrame(c));
-  const BodyVelocityMaps maps = body.Maps(c, frame);
-  const Eigen::VectorXd balance = pdot - body.MomentumSource(maps, w, body.GeneralizedMomentum(maps, w));
-  EXPECT_LT((balance - f_in).norm(), 1e-5 * f_in.norm()) << "f_in " << f_in.transpose() << "\nbalance "
-                                                           << balance.transpose();
+    // Momentum form used by the midpoint integrator: f_in = dp/dt - s(q, w, p), p = M_g w,
+    // s = MomentumSource; dp/dt by central differences along the same motion.
+    auto momentum = [&](double time) {
+      const BodyConfiguration ct = config(time);
+      return body.GeneralizedMomentum(body.Maps(ct, body.SolveFrame(ct, body.GuessFrame(ct))), velocity(time));
+    };
+    const Eigen::VectorXd pdot = (momentum(t + dt) - momentum(t - dt)) / (2 * dt);
+    const FrameSolution frame = body.SolveFrame(c, body.GuessFrame(c));
+    const BodyVelocityMaps maps = body.Maps(c, frame);
+    const Eigen::VectorXd balance = pdot - body.MomentumSource(maps, w, body.GeneralizedMomentum(maps, w));
+    EXPECT_LT((balance - f_in).norm(), 1e-5 * f_in.norm()) << "f_in " << f_in.transpose() << "\nbalance "
+                                                             << balance.transpose();
+  }
 }
 
 }  // namespace

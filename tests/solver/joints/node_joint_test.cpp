@@ -161,9 +161,12 @@ void DoublePendulum(JointType second, const Eigen::Vector3d& spin, Integrator in
   AddNode(model, "n1", Eigen::Vector3d(L, 0, 0));
   AddNode(model, "n2", Eigen::Vector3d(L, 0, 0));
   AddNode(model, "n3", Eigen::Vector3d(2 * L, 0, 0));
-  model.bodies.emplace_back(se, SuperelementOptions{}, Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero());
+  // As femb-solve builds them: the midpoint scheme's bodies have the corotational inertia.
+  SuperelementOptions options;
+  options.exact_inertia = integrator != Integrator::kMidpoint;
+  model.bodies.emplace_back(se, options, Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero());
   model.body_nodes.push_back({0, 1});
-  model.bodies.emplace_back(se, SuperelementOptions{}, Eigen::Matrix3d::Identity(), Eigen::Vector3d(L, 0, 0));
+  model.bodies.emplace_back(se, options, Eigen::Matrix3d::Identity(), Eigen::Vector3d(L, 0, 0));
   model.body_nodes.push_back({2, 3});
   RevoluteToGround(model, 0, Eigen::Vector3d::UnitZ());
   model.joints.push_back(MakeNodeJoint(second, 2, 1, Eigen::Vector3d::UnitZ(), model.node_x0[1], model.node_R0[1],
