@@ -291,6 +291,13 @@ PartSpec ParsePart(const std::string& text, const std::string& name,
   if (part.type != "imported") {
     part.material = ParseMaterial(root.Required("material"));
     if (part.check_units) CheckMaterialUnits(part, root.Required("material"));
+  } else if (auto material = root.Optional("material")) {
+    // Optional: the matrices carry the material; given, it lets femb's own elements on the
+    // imported mesh's solid cells build the geometric stiffening.
+    part.material = ParseMaterial(*material);
+    if (part.check_units) CheckMaterialUnits(part, *material);
+  } else {
+    part.has_material = false;
   }
   if (part.type == "imported") {
     // The matrices carry the material; the geometry file gives the node coordinates (and ids).
@@ -449,8 +456,9 @@ PartSpec ParsePart(const std::string& text, const std::string& name,
     }
     if (auto v = m.Optional("geometric_stiffening")) {
       part.reduction.geometric_stiffening = v->Bool();
-      if (*part.reduction.geometric_stiffening && part.type == "imported") {
-        v->Fail("geometric stiffening needs femb's own elements (the stress of each field); imported matrices do not have them");
+      if (*part.reduction.geometric_stiffening && part.type == "imported" && !part.has_material) {
+        v->Fail("geometric stiffening of imported matrices needs the part's material: (E, nu, rho; femb's own elements "
+                "on the imported mesh's solid cells give the stress of each field)");
       }
     }
     if (auto v = m.Optional("full_modes")) part.reduction.full_modes = int(v->NonNegativeInteger());

@@ -116,6 +116,12 @@ struct ReductionSpec {
   bool GeometricStiffening(const std::string& part_type) const {
     return geometric_stiffening.value_or(method == "craig_bampton" && part_type != "imported");
   }
+  /// Imported parts with a material: the stiffening is built on femb's own elements over the
+  /// imported mesh's solid cells; its default there is on.
+  bool GeometricStiffening(const std::string& part_type, bool has_material) const {
+    if (part_type == "imported") return geometric_stiffening.value_or(has_material && method == "craig_bampton");
+    return GeometricStiffening(part_type);
+  }
   /// Store the mesh and mode shapes (visualization group); unset: only for models up to
   /// kKeepMeshMaxDofs DOFs (the shapes take n_dofs x n_reduced doubles).
   std::optional<bool> keep_mesh;
@@ -145,6 +151,9 @@ struct PartSpec {
   std::string type;       ///< "beam", "solid" or "imported"
   Units units;
   MaterialSpec material;
+  /// Imported parts: `material:` given (optional there), for femb's own elements on the imported
+  /// mesh's solid cells: the geometric stiffening. Always true for beams and solids.
+  bool has_material = true;
   BeamSpec beam;
   SolidSpec solid;          ///< solid; imported: file and where only
   MatricesSpec matrices;    ///< imported

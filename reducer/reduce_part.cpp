@@ -28,6 +28,12 @@ namespace femb {
 
 namespace {
 
+// Imported parts with geometric stiffening: how far femb's own elements (the part's material on
+// the imported mesh) may differ from the imported stiffness, relative on the reduced K. Another
+// code's element formulation differs by 1e-6 .. 1e-4 (CalculiX's TET10: 6e-6 in frequency); a
+// wrong modulus or Poisson ratio by percent.
+constexpr double kImportedStiffnessMismatch = 1e-3;
+
 // The deformation shapes of reduction.method general: a Matrix Market file (ReadShapeMatrix), or
 // an HDF5 file (.h5, .hdf5) with the dataset /shapes, one row per DOF and one column per shape
 // (h5py: f["shapes"] = V).
@@ -135,7 +141,7 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
   // and the geometric stiffening.
   auto make_nonlinear = [&] {
     if (nonlinear) return;
-    if (part.type == "solid") {
+    if (part.type == "solid" || part.type == "imported") {
       nonlinear = std::make_unique<SvkSolidMesh>(SolidCellType(model.cell_type), model.nodes, model.cells, part.material);
     } else {
       nonlinear = std::make_unique<VonKarmanBeams>(part);
@@ -167,7 +173,26 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
   // Geometric stiffening (issue 13): the unit inertia load cases are solved on the same factor.
   // A basis without deformation (one interface node, no internal modes: the six rigid motions)
   // has nothing to stiffen, and its exact and corotational kinetic energies are the same.
-  const bool stiffening = part.reduction.GeometricStiffening(part.type) && n_b + m > 6;
+  bool stiffening = part.reduction.GeometricStiffening(part.type, part.has_material) && n_b + m > 6;
+  if (stiffening && part.type == "imported") {
+    // femb's own Green-Lagrange solid elements on the imported mesh with the part's material:
+    // only where every cell is a solid femb knows and every DOF a translation.
+    std::string why;
+    const std::string& cell = model.cell_type;
+    if (cell != "tet4" && cell != "tet10" && cell != "hex8" && cell != "hex20") {
+      why = "its mesh has " + cell + " cells (femb's solid elements: tet4, tet10, hex8, hex20)";
+    } else {
+      for (size_t d = 0; d < model.dof_component.size() && why.empty(); ++d)
+        if (model.dof_component[d] >= 3 && model.dof_node[d] < model.n_nodes()) why = "its matrices have rotational DOFs";
+    }
+    if (!why.empty()) {
+      if (part.reduction.geometric_stiffening.value_or(false)) {
+        throw InputError(part.file + ": reduction.geometric_stiffening: the imported part cannot have it: " + why);
+      }
+      if (progress) progress("stiffening", 0.0, "none: " + why + "; the body is linear inside");
+      stiffening = false;
+    }
+  }
   if (part.reduction.geometric_stiffening.value_or(false) && !stiffening) {
     if (progress) progress("stiffening", 0.0, "none stored: the basis is the six rigid motions (one interface node, no internal modes)");
   }
@@ -329,7 +354,7 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
     Stopwatch tensors;
     const Eigen::MatrixXd mesh_shapes = to_model_dofs * cb.shapes;
     const auto completion = InterfaceRotationCompletion(model.nodes, mesh_shapes, model.interface_positions,
-                                                        se.floating_frame.origin, part.type == "solid" ? 3 : 6);
+                                                        se.floating_frame.origin, part.type == "beam" ? 6 : 3);
     PolynomialRequest poly_request;
     poly_request.cubic = derivatives;
     if (stiffening) {
@@ -339,11 +364,23 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
       stress_fields = to_model_dofs * u;
       poly_request.stress_fields = &stress_fields;
     }
-    ReducedPolynomial poly = part.type == "solid"
+    ReducedPolynomial poly = part.type != "beam"
                                  ? ReduceSvk(static_cast<const SvkSolidMesh&>(*nonlinear), mesh_shapes, completion, poly_request)
                                  : ReduceVonKarman(static_cast<const VonKarmanBeams&>(*nonlinear), mesh_shapes, completion, poly_request);
     const double mismatch = (poly.K - cb.K).norm() / cb.K.norm();
-    if (mismatch > 1e-8) {
+    if (part.type == "imported" && mismatch > kImportedStiffnessMismatch) {
+      // femb's elements with the part's material on the imported mesh must be the imported
+      // stiffness (up to element formulation): else their stresses, hence the geometric
+      // stiffness, belong to another material or model.
+      char text[400];
+      std::snprintf(text, sizeof text,
+                    "%s: material: femb's elements on the imported mesh with this material differ from the imported "
+                    "stiffness by %.2g (reduced K, relative; at most %.0e): give the material the matrices were made "
+                    "with, or reduction.geometric_stiffening: false",
+                    part.file.c_str(), mismatch, kImportedStiffnessMismatch);
+      throw InputError(text);
+    }
+    if (part.type != "imported" && mismatch > 1e-8) {
       result.message = "the polynomial internal force's linear part differs from K_r by " + std::to_string(mismatch);
       return result;
     }

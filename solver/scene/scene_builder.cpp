@@ -378,7 +378,8 @@ Scene BuildScene(const SceneSpec& spec) {
       // (rotating_beam example: one body without it 43-59% off, with it 2.2%).
       scene.notes.push_back("body '" + b.name + "': " + file.string() + " has no geometric stiffening; the body is "
                             "linear inside, so a rotating or highly loaded part misses its stress stiffening (" +
-                            (imported ? "an imported part has none: split it into several bodies to recover it"
+                            (imported ? "an imported part of solid cells gets it from the part's material:, others can be split "
+                                                   "into several bodies"
                                       : "re-reduce it with reduction.geometric_stiffening: true to add it") +
                             ")");
     }

@@ -230,8 +230,15 @@ grep -q "B: 1 nodes by plane" "$work/imported.log" && grep -q "rigid-body residu
 "$bin/femb-inspect" "$work/rod_imported.h5" --json | $py -c "import json,sys; assert json.load(sys.stdin)['geometric_stiffening'] is False" \
   && ok || fail "imported part has geometric stiffening"
 "$bin/femb-reduce" "$work/rod_mm/imported.yaml" -o "$work/rod_imported_gs.h5" --set reduction.geometric_stiffening=true 2> "$work/err.txt"; code=$?
-[ $code = 2 ] && grep -q "geometric stiffening needs femb's own elements" "$work/err.txt" && [ ! -e "$work/rod_imported_gs.h5" ] && ok \
+[ $code = 2 ] && grep -q "geometric stiffening of imported matrices needs the part's material" "$work/err.txt" && [ ! -e "$work/rod_imported_gs.h5" ] && ok \
   || fail "imported with stiffening: exit $code $(cat "$work/err.txt")"
+# With a material the stiffening comes from femb's solid elements on the imported mesh: a beam
+# mesh has none (one line, exit 2).
+"$bin/femb-reduce" "$work/rod_mm/imported.yaml" -o "$work/rod_imported_gs.h5" --set reduction.geometric_stiffening=true \
+  --set "material={E: 2.1e11, nu: 0.3, rho: 7850}" 2> "$work/err.txt"; code=$?
+[ $code = 2 ] && grep -q "reduction.geometric_stiffening: the imported part cannot have it: its mesh has line2 cells" "$work/err.txt" \
+  && [ "$(wc -l < "$work/err.txt")" = 1 ] && [ ! -e "$work/rod_imported_gs.h5" ] && ok \
+  || fail "imported beam with a material and stiffening: exit $code $(cat "$work/err.txt")"
 "$bin/femb-inspect" "$work/rod_imported.h5" --vtu "$work/rod_vtu" > /dev/null && [ -f "$work/rod_vtu/beam_rod_006.vtu" ] && ok \
   || fail "inspect --vtu imported"
 $py - "$work/beam_rod.h5" "$work/rod_imported.h5" <<'PY' && ok || fail "imported frequencies differ from native"

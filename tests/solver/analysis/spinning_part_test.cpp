@@ -221,26 +221,47 @@ TEST(SpinningPart, EveryPartStretchesAsTheUnreducedModel) {
   }
 }
 
-// femb's own part (without its geometric stiffening, which an imported part does not have) and
-// the imported one spinning and tumbling for 2 ms: the end points' positions agree to 1e-8 of
-// the bar's length at every step, with generalized-alpha (exact inertia) and the midpoint scheme
-// (corotational).
+// femb's own part and the imported one spinning and tumbling for 2 ms: the end points' positions
+// agree to 1e-8 of the bar's length at every step, with generalized-alpha (exact inertia) and
+// the midpoint scheme (corotational); linear inside, and with the geometric stiffening (the
+// imported part's from femb's elements on its mesh with the part's material).
 TEST(SpinningPart, ImportedPartMovesAsFembsOwn) {
   const Files files;
-  const Superelement native = files.Reduce("native.yaml", {"reduction.geometric_stiffening=false"});
-  const Superelement imported = files.Reduce("imported.yaml");
-  for (const Integrator integrator : {Integrator::kGeneralizedAlpha, Integrator::kMidpoint}) {
-    const auto a = Spin(native, integrator, 2e-3, 1e-5, true), b = Spin(imported, integrator, 2e-3, 1e-5, true);
-    ASSERT_EQ(a.size(), b.size());
-    double worst = 0.0, stretch = 0.0;
-    for (size_t i = 0; i < a.size(); ++i) {
-      for (int k = 0; k < 2; ++k) worst = std::max(worst, (a[i][size_t(k)] - b[i][size_t(k)]).norm());
-      stretch = std::max(stretch, std::abs((a[i][1] - a[i][0]).norm() - 1.0));
+  for (const bool stiffened : {false, true}) {
+    const std::string on = stiffened ? "true" : "false";
+    const Superelement native = files.Reduce("native.yaml", {"reduction.geometric_stiffening=" + on});
+    const Superelement imported =
+        files.Reduce("imported.yaml", {"reduction.geometric_stiffening=" + on, "material={E: 2.1e11, nu: 0.3, rho: 7850}"});
+    ASSERT_EQ(imported.inertia_stiffness.empty(), !stiffened);
+    for (const Integrator integrator : {Integrator::kGeneralizedAlpha, Integrator::kMidpoint}) {
+      const auto a = Spin(native, integrator, 2e-3, 1e-5, true), b = Spin(imported, integrator, 2e-3, 1e-5, true);
+      ASSERT_EQ(a.size(), b.size());
+      double worst = 0.0, stretch = 0.0;
+      for (size_t i = 0; i < a.size(); ++i) {
+        for (int k = 0; k < 2; ++k) worst = std::max(worst, (a[i][size_t(k)] - b[i][size_t(k)]).norm());
+        stretch = std::max(stretch, std::abs((a[i][1] - a[i][0]).norm() - 1.0));
+      }
+      std::printf("[ info ] %s, %s: imported against femb's own part: largest position difference %.2e m (largest stretch "
+                  "%.2e m)\n",
+                  stiffened ? "stiffened" : "linear", integrator == Integrator::kMidpoint ? "midpoint" : "generalized-alpha",
+                  worst, stretch);
+      EXPECT_LT(worst, 1e-8);
     }
-    std::printf("[ info ] %s: imported against femb's own part: largest position difference %.2e m (largest stretch %.2e m)\n",
-                integrator == Integrator::kMidpoint ? "midpoint" : "generalized-alpha", worst, stretch);
-    EXPECT_LT(worst, 1e-8);
   }
+}
+
+// The imported part's stiffening needs its material, and the material the matrices were made
+// with: one line each.
+TEST(SpinningPart, ImportedStiffeningRefusesAMissingOrWrongMaterial) {
+  const Files files;
+  const std::string missing = test::ThrownMessage([&] { files.Reduce("imported.yaml", {"reduction.geometric_stiffening=true"}); });
+  EXPECT_NE(missing.find("geometric stiffening of imported matrices needs the part's material"), std::string::npos) << missing;
+  const std::string wrong =
+      test::ThrownMessage([&] { files.Reduce("imported.yaml", {"material={E: 2.0e11, nu: 0.3, rho: 7850}"}); });
+  EXPECT_NE(wrong.find("imported.yaml: material: femb's elements on the imported mesh with this material differ from the "
+                       "imported stiffness by 0.048"),
+            std::string::npos)
+      << wrong;
 }
 
 }  // namespace
