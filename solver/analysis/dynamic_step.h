@@ -139,6 +139,7 @@ struct MidpointBody {
   Eigen::VectorXd w0, p0, p1, p_mean, wm, w_first, w_second, dw, wdot, s_first, s_second, u, Du;
   Eigen::MatrixXd d_w, d_p;
   Eigen::MatrixXd S_b;  // the body's combined iteration matrix (MidpointMatrix)
+  SuperelementBody::Data side;  // the exact inertia: MomentumConfigurationTangent's perturbed data
   InertiaLoadFactors load;
 };
 

@@ -282,4 +282,13 @@ void SuperelementBody::MomentumSource(const BodyVelocityMaps& maps, const BodyVe
   }
 }
 
+void SuperelementBody::MomentumSource(const Data& d, const BodyVelocity& w, const Eigen::VectorXd& p,
+                                      Eigen::VectorXd& out) const {
+  MomentumSource(MapsOf(d), w, p, out, d.scratch);
+  if (!has_exact_inertia()) return;
+  Eigen::VectorXd& c = d.scratch.v3;
+  ExactMomentumSource(d, w, c);
+  out += c;
+}
+
 }  // namespace femb

@@ -179,6 +179,63 @@ void SuperelementBody::ExactMassTimesTurned(const Data& data, const Eigen::Vecto
   TurnBlocksInto(data.frame.R, out, 2 * n_nodes_, out);
 }
 
+void SuperelementBody::ExactMomentumSource(const Data& data, const BodyVelocity& w, Eigen::VectorXd& out) const {
+  // T(q, w) = T_hat(q_loc, Rbar^T w) (T is invariant under rigid motions), so at fixed w
+  // dT/dq = G^T p (the frame's turning, as for the corotational inertia) + Rbar B^T g with
+  // g = dT_hat/dq_loc at fixed w_hat = Rbar^T w. T_hat = T_L(xi(q_loc), q_loc, qdot(q_loc)) with
+  // xi = Z w_hat, qdot = B w_hat (header, "Exact inertia"): w_hat = Phi_rig(q) xi + D^-1(q) qdot
+  // with Phi_CB qdot = 0, differentiated at fixed w_hat, gives delta xi = -Z a, delta qdot = -B a,
+  // a = (d Phi_rig) xi + (d D^-1) qdot, so
+  //   g = dT_L/dq|explicit - (a's coefficients of p_hat),  p_hat = Z^T pi_xi + B^T pi_q = Rbar^T p:
+  //   dT_L/dq|explicit = sum_a Omega_a Gamma_a^T y + sum_ab Omega_a Omega_b Xi_ab q,
+  //   node k's translation rows: a = Omega x delta u_k        -> p_hat_t,k x Omega,
+  //   node k's rotation rows:    a = (dJ_l(theta_k)) thetadot -> d/dtheta [p_hat_r,k^T J_l thetadot_k].
+  const int blocks = 2 * n_nodes_;
+  const ExactData& d = *data.exact;
+  ExactScratch& s = data.exact_scratch;
+  const Eigen::MatrixXd& Z = data.kin.Z;
+  const Eigen::MatrixXd& B = data.kin.B;
+  Eigen::VectorXd& Rw = s.Rw;
+  TurnBlocksInto(data.frame.R.transpose(), w, blocks, Rw);
+  Eigen::Matrix<double, 6, 1> xi;
+  xi.noalias() = Z * Rw;
+  const Eigen::Vector3d Om = xi.tail<3>();
+  Eigen::VectorXd &qd = s.qd, &y = s.y, &pi_q = s.pi_q;
+  qd.noalias() = B * Rw;
+  y.noalias() = Phi_rig0_ * xi;
+  y += qd;
+  pi_q.noalias() = M_ * y;
+  s.t1.noalias() = d.H * Om;
+  pi_q += s.t1;
+  Eigen::Matrix<double, 6, 1> pi_xi;
+  pi_xi.noalias() = Phi_rig0_.transpose() * pi_q;
+  Eigen::Vector3d Hty;
+  Hty.noalias() = d.H.transpose() * y;
+  pi_xi.tail<3>() += Hty + d.Xq * Om;
+  Eigen::VectorXd &p_hat = s.p_hat, &g = s.g;
+  p_hat.noalias() = Z.transpose() * pi_xi;
+  s.t1.noalias() = B.transpose() * pi_q;
+  p_hat += s.t1;
+  g.setZero(n_coordinates());
+  for (int a = 0; a < 3; ++a) {
+    s.t1.noalias() = Gamma_[size_t(a)].transpose() * y;
+    g += Om[a] * s.t1;
+    for (int b = 0; b < 3; ++b) g += Om[a] * Om[b] * d.XQ.col(3 * a + b);
+  }
+  for (int k = 0; k < n_nodes_; ++k) {
+    g.segment<3>(6 * k) -= Eigen::Vector3d(p_hat.segment<3>(6 * k)).cross(Om);
+    // d/dtheta [p^T J_l(theta) v] = -(d/dtheta [J_l^-1(theta)^T J_l^T p])^T J_l v (d J_l =
+    // -J_l d(J_l^-1) J_l), with J_l^T p and J_l v held.
+    const Eigen::Matrix3d J = data.kin.Jinv[size_t(k)].inverse();
+    const Eigen::Vector3d theta = data.q.segment<3>(6 * k + 3);
+    const Eigen::Vector3d Jtp = J.transpose() * Eigen::Vector3d(p_hat.segment<3>(6 * k + 3));
+    const Eigen::Vector3d Jv = J * Eigen::Vector3d(qd.segment<3>(6 * k + 3));
+    g.segment<3>(6 * k + 3) += LeftJacobianInverseTransposeDerivative(theta, Jtp).transpose() * Jv;
+  }
+  out.noalias() = B.transpose() * g;
+  TurnBlocksInto(data.frame.R, out, blocks, out);
+}
+
 void SuperelementBody::ExactGyroscopic(const Data& data, const BodyVelocity& w, Eigen::MatrixXd& G) const {
   // ExactInertiaForce is A(q) wdot + g(q, w), g quadratic in w with no wdot: its derivative by
   // w is that of g. Forward mode by hand: every quantity of the force that depends on w carries
@@ -364,6 +421,65 @@ Eigen::MatrixXd SuperelementBody::ExactInertiaConfigurationTangent(const Data& d
     tangent.col(i) = (f_plus - f_minus) / (2 * step);
   }
   return tangent;
+}
+
+void SuperelementBody::AddLocalSourceVelocityDerivative(const Data& d, const BodyVelocity& w, Eigen::MatrixXd& d_w) const {
+  if (!has_exact_inertia()) return;
+  Eigen::VectorXd &wp = d.scratch.v2, &plus = d.scratch.v3, &minus = d.scratch.v4;
+  wp = w;
+  for (int i = 0; i < n_coordinates(); ++i) {
+    wp[i] = w[i] + 1.0;
+    ExactMomentumSource(d, wp, plus);
+    wp[i] = w[i] - 1.0;
+    ExactMomentumSource(d, wp, minus);
+    wp[i] = w[i];
+    d_w.col(i) += 0.5 * (plus - minus);
+  }
+}
+
+void SuperelementBody::MomentumConfigurationTangent(const Data& d, const BodyVelocity& w, Data& side,
+                                                    Eigen::MatrixXd& D) const {
+  if (!has_exact_inertia()) {
+    MomentumDerivative(MapsOf(d), w, D, d.scratch);
+    return;
+  }
+  // Central differences, steps as Perturbed's, the configuration perturbed in place.
+  const int n = n_coordinates();
+  D.resize(n, n);
+  double size = 0.0;
+  for (const Eigen::Vector3d& X : X_) size = std::max(size, X.norm());
+  const double length = 1e-7 * std::max(size, 1e-3);
+  const double modal = length * std::sqrt(std::max(M_(0, 0), 1e-300));
+  side.c = d.c;
+  BodyConfiguration& c = side.c;
+  for (int i = 0; i < n; ++i) {
+    const int a = i / 6, k = i % 6;
+    const bool node = i < 6 * n_nodes_;
+    const double step = !node ? modal : k < 3 ? length : 1e-7;
+    for (const double sign : {1.0, -1.0}) {
+      if (!node) {
+        c.eta[i - 6 * n_nodes_] = d.c.eta[i - 6 * n_nodes_] + sign * step;
+      } else if (k < 3) {
+        c.x[a][k] = d.c.x[a][k] + sign * step;
+      } else {
+        c.R[a] = ExpSO3(sign * step * Eigen::Vector3d::Unit(k - 3)) * d.c.R[a];
+      }
+      EvaluateSolved(c, SolveFrameFrom(c, d.frame, side.q), side);  // (the frame solve leaves q_loc in side.q)
+      if (sign > 0) {
+        D.col(i) = MassTimes(side, w);
+      } else {
+        D.col(i) -= MassTimes(side, w);
+      }
+    }
+    D.col(i) /= 2 * step;
+    if (!node) {
+      c.eta[i - 6 * n_nodes_] = d.c.eta[i - 6 * n_nodes_];
+    } else if (k < 3) {
+      c.x[a][k] = d.c.x[a][k];
+    } else {
+      c.R[a] = d.c.R[a];
+    }
+  }
 }
 
 }  // namespace femb

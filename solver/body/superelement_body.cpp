@@ -78,6 +78,9 @@ SuperelementBody::SuperelementBody(const Superelement& se, const SuperelementOpt
     }
   }
   if (options_.exact_inertia && se.inertia_gamma.size() == 3 && se.inertia_xi.size() == 6) {
+    // Cardona's options are two forms of the corotational inertia; the exact kinetic energy has
+    // one, whose frame-turning terms (the maps and sources of the midpoint scheme) are option A's.
+    options_.cardona_option_b = false;
     Gamma_ = se.inertia_gamma;
     Gamma_stack_.resize(3 * n, n);
     for (int a = 0; a < 3; ++a) Gamma_stack_.middleRows(a * n, n) = Gamma_[size_t(a)];

@@ -99,7 +99,7 @@ struct BodyScratch {
 
 /// The exact inertia's temporaries (ExactInertiaForce, ExactGyroscopic), as BodyScratch.
 struct ExactScratch {
-  Eigen::VectorXd Rw, qd, r, y, yd, pi_q, pi_q_dot, f_q, t1, t2, S_ab;
+  Eigen::VectorXd Rw, qd, r, y, yd, pi_q, pi_q_dot, f_q, t1, t2, S_ab, p_hat, g;
   Eigen::MatrixXd Hd, dxi, dv, dOm, dqd, dr, dOmd, dy, G_Om, Gty, base, df_q, G_skew, GtP, dh, dhd, dpi_xi, PH, df_xi,
       PG, dpi_v, dpi_w, t3, t4, t5, t6, t7, t8;
   Eigen::RowVectorXd row, row2;
@@ -372,6 +372,8 @@ class SuperelementBody {
 
   /// M_g w, into d.scratch.v1 (the exact inertia: without forming M_g).
   const Eigen::VectorXd& MassTimes(const Data& d, const BodyVelocity& w) const;
+  /// The mass matrix d^2 T / dw^2 at `d`: the exact one or the corotational M_g (MapsOf).
+  const Eigen::MatrixXd& Mass(const Data& d) const { return has_exact_inertia() ? ExactMass(d) : MapsOf(d).Mg; }
   /// Kinetic energy v^T M v / 2.
   double KineticEnergy(const Data& d, const BodyVelocity& w) const;
   double KineticEnergy(const BodyConfiguration& c, const FrameSolution& frame, const BodyVelocity& w) const {
@@ -403,7 +405,26 @@ class SuperelementBody {
   /// The same into `out` with the temporaries in `scratch` (no allocation once sized).
   void MomentumSource(const BodyVelocityMaps& maps, const BodyVelocity& w, const Eigen::VectorXd& p,
                       Eigen::VectorXd& out, BodyScratch& scratch) const;
+  /// The whole source at `d` for the body's own kinetic energy: with the exact inertia
+  ///   s = G^T p + Omega_hat p + Rbar B^T g,
+  /// g = dT/dq_loc at fixed frame-axes velocities Rbar^T w (the local coordinates' own share:
+  /// the invariants' explicit terms and the turning of the maps Z, B with q_loc; see
+  /// ExactMomentumSource), which, orthogonal to every rigid motion, adds no resultant and no
+  /// moment: the midpoint scheme keeps conserving momentum. Here p is the exact momentum
+  /// MassTimes(d, w) for the G^T p part only where the caller passes it so; the local term
+  /// takes the momentum of w at d itself. Without the exact inertia: MomentumSource(MapsOf(d)).
+  void MomentumSource(const Data& d, const BodyVelocity& w, const Eigen::VectorXd& p, Eigen::VectorXd& out) const;
 
+  /// d p / d q at fixed w of the body's own momentum p = MassTimes(d, w) (the midpoint scheme's
+  /// iteration matrix): MomentumDerivative for the corotational inertia; for the exact one by
+  /// central differences with the frame re-solved (its local coordinates' share turns the
+  /// torsion of a spinning bar, whose inertia is small, as much as the frame's: without it
+  /// Newton stalled there). `side`: the perturbed configurations' data (storage reused).
+  void MomentumConfigurationTangent(const Data& d, const BodyVelocity& w, Data& side, Eigen::MatrixXd& D) const;
+  /// With the exact inertia: adds to `d_w` the derivative of the source's local term (the
+  /// MomentumSource at `d` beyond G^T p + Omega_hat p) with respect to w, by central
+  /// differences that are exact up to round-off (the term is quadratic in w).
+  void AddLocalSourceVelocityDerivative(const Data& d, const BodyVelocity& w, Eigen::MatrixXd& d_w) const;
   /// Derivatives of MomentumSource s(q, w, p) with respect to w and to p (both n x n; s is
   /// bilinear in w and p).
   void MomentumSourceDerivatives(const BodyVelocityMaps& maps, const BodyVelocity& w, const Eigen::VectorXd& p,
@@ -480,6 +501,8 @@ class SuperelementBody {
   // d f_in / d w of the exact inertia force (forward mode, exact).
   void ExactGyroscopic(const Data& d, const BodyVelocity& w, Eigen::MatrixXd& G) const;
   void ExactMassTimesTurned(const Data& data, const Eigen::VectorXd& r, Eigen::VectorXd& out) const;
+  // c = Rbar B^T g, g = dT/dq_loc at fixed Rbar^T w (MomentumSource(const Data&, ...)), into out.
+  void ExactMomentumSource(const Data& data, const BodyVelocity& w, Eigen::VectorXd& out) const;
   Eigen::MatrixXd ExactInertiaConfigurationTangent(const Data& d, const BodyVelocity& w,
                                                    const BodyVelocity& wdot) const;
   BodyConfiguration Perturbed(const BodyConfiguration& c, int i, double sign, double* step) const;

@@ -321,9 +321,15 @@ void AssembleMidpoint(const SystemModel& model, const DofMap& dofs, const Dynami
     for (int a = 0; a < body.n_nodes(); ++a) w1.segment<6>(6 * a) = k.node_w1[size_t(model.body_nodes[b][a])];
     w1.tail(body.n_modes()) = s1.W.segment(dofs.mode_dof(int(b)), body.n_modes());
     // Velocity maps at the end and at the mid configuration, shared by the momentum terms.
-    const BodyVelocityMaps &maps1 = body.MapsOf(d1), &maps_m = body.MapsOf(dm);
+    const BodyVelocityMaps& maps1 = body.MapsOf(d1);
+    // The momenta of the body's kinetic energy, p = dT/dw (the exact inertia's or M_g w).
+    const bool exact = body.has_exact_inertia();
     m.p1.resize(body.n_coordinates());
-    m.p1.noalias() = maps1.Mg * w1;
+    if (exact) {
+      m.p1 = body.MassTimes(d1, w1);
+    } else {
+      m.p1.noalias() = maps1.Mg * w1;
+    }
     // Node motion over the step.
     Eigen::VectorXd& wm = m.wm;
     wm.resize(body.n_coordinates());
@@ -332,7 +338,11 @@ void AssembleMidpoint(const SystemModel& model, const DofMap& dofs, const Dynami
     Eigen::VectorXd &f_in = r.f_in, &f_int = r.f_int, &f_acc = r.f_acc;
     m.dw = w1 - m.w0;
     f_acc.resize(body.n_coordinates());
-    f_acc.noalias() = maps1.Mg * m.dw;
+    if (exact) {
+      f_acc = body.MassTimes(d1, m.dw);
+    } else {
+      f_acc.noalias() = maps1.Mg * m.dw;
+    }
     f_acc /= h;
     m.p_mean = 0.5 * (m.p0 + m.p1);  // (also for the source's derivatives in the matrices)
     if (body.options().quadratic_velocity_terms) {
@@ -346,8 +356,8 @@ void AssembleMidpoint(const SystemModel& model, const DofMap& dofs, const Dynami
           m.w_second.segment<3>(6 * a) = 2.0 * (s1.config.x[node] - k.mid.x[node]) / h;
           m.w_first.segment<3>(6 * a) = 2.0 * (k.mid.x[node] - s0.config.x[node]) / h;
         }
-        body.MomentumSource(maps_m, m.w_second, m.p1, m.s_second, dm.scratch);
-        body.MomentumSource(maps_m, m.w_first, m.p0, m.s_first, dm.scratch);
+        body.MomentumSource(dm, m.w_second, m.p1, m.s_second);
+        body.MomentumSource(dm, m.w_first, m.p0, m.s_first);
         f_in = (m.p1 - m.p0) / h - 0.5 * (m.s_second + m.s_first);
       } else {
         // No free node: every node hangs on joints or supports. The source at the step's mean
@@ -358,7 +368,7 @@ void AssembleMidpoint(const SystemModel& model, const DofMap& dofs, const Dynami
         // no longer matches the change of sum x_k x p_k exactly, so a chain whose root floats
         // free keeps its angular momentum to O(h^2) only (a grounded chain has none to keep).
         // Energy is the invariant a mechanism on joints is judged by.
-        body.MomentumSource(maps_m, wm, m.p_mean, m.s_first, dm.scratch);
+        body.MomentumSource(dm, wm, m.p_mean, m.s_first);
         f_in = (m.p1 - m.p0) / h - m.s_first;
       }
     } else {
@@ -449,8 +459,7 @@ const SystemMatrix& MidpointMatrix(const SystemModel& model, const DofMap& dofs,
     body.ElasticForce(m.dm, nullptr, &r.K, stiffening ? &m.load : nullptr, stiffening ? &r.d_load : nullptr);
     // M_g at the end of the step: the 2/h^2 term of the iteration matrix is d p_n+1 / h; at
     // the mid configuration it would be off by O(omega h) and leave a 1/h error.
-    const BodyVelocityMaps& maps1 = body.MapsOf(pass.data);
-    r.M = maps1.Mg;
+    r.M = body.Mass(pass.data);
     if (body.options().quadratic_velocity_terms) {
       // With dp_n+1 = (M_g V + D) delta (V = d W_n+1 / d delta ~ 2/h, D = d p / dq at fixed w)
       // and dw_a ~ delta / h,
@@ -458,8 +467,11 @@ const SystemMatrix& MidpointMatrix(const SystemModel& model, const DofMap& dofs,
       // All the 1/h terms are needed (and M_g at n+1, V with its O(omega) part): each is
       // O(omega h) of the leading one, and without them Newton contracts only by ~omega h per
       // iteration, or worse on stiff, lightly inertial directions such as a tube's torsion.
+      // The exact inertia: d p_n+1 / dq by differences (MomentumConfigurationTangent); the
+      // source's local term's derivatives, O(omega h) of the rest, are left to the iterations.
       body.MomentumSourceDerivatives(body.MapsOf(m.dm), m.wm, m.p_mean, m.d_w, m.d_p, m.dm.scratch);
-      body.MomentumDerivative(maps1, pass.w, r.C, pass.data.scratch);
+      body.AddLocalSourceVelocityDerivative(m.dm, m.wm, m.d_w);
+      body.MomentumConfigurationTangent(pass.data, pass.w, m.side, r.C);
       r.C -= m.d_w;
       r.C.noalias() -= m.d_p * r.M;
     } else {
@@ -561,7 +573,11 @@ StepOutcome MidpointStep(const SystemModel& model, const DofMap& dofs, const Dyn
     body.Evaluate(m.d0.c, state.config.frames[b], m.d0);
     BodyVelocityOf(model, dofs, state, b, m.w0);
     m.p0.resize(body.n_coordinates());
-    m.p0.noalias() = body.MapsOf(m.d0).Mg * m.w0;
+    if (body.has_exact_inertia()) {
+      m.p0 = body.MassTimes(m.d0, m.w0);
+    } else {
+      m.p0.noalias() = body.MapsOf(m.d0).Mg * m.w0;
+    }
     m.com0 = body.CenterOfMass(m.d0.q, state.config.frames[b]);
   });
   // Predictor: the configuration reached with the current velocity and acceleration.

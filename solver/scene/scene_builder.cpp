@@ -378,27 +378,20 @@ Scene BuildScene(const SceneSpec& spec) {
       // (rotating_beam example: one body without it 43-59% off, with it 2.2%).
       scene.notes.push_back("body '" + b.name + "': " + file.string() + " has no geometric stiffening; the body is "
                             "linear inside, so a rotating or highly loaded part misses its stress stiffening (" +
-                            (imported ? "an imported part of solid cells gets it from the part's material:, others can be split "
-                                                   "into several bodies"
+                            (imported ? "an imported part of solid cells gets it from the part's material:, others "
+                                        "can be split into several bodies"
                                       : "re-reduce it with reduction.geometric_stiffening: true to add it") +
                             ")");
     }
-    // The exact kinetic energy (issue 13) likewise: the file's inertia invariants unless switched
-    // off, or under the midpoint integrator, whose conservation is the corotational energy's.
-    options.exact_inertia = b.exact_inertia.value_or(!midpoint);
-    if (b.exact_inertia.value_or(false) && midpoint) {
-      // The midpoint scheme's momenta and their discrete gradient are the corotational inertia's
-      // (thesis 3.22): an exact inertia asked for there would be ignored.
-      throw InputError(b.where + ": body '" + b.name + "': options.inertia: exact is not available with the midpoint "
-                       "integrator (its momentum form is the corotational inertia's); use analysis.integrator: "
-                       "generalized_alpha for the exact inertia");
-    }
+    // The exact kinetic energy: the file's inertia invariants unless switched off, with either
+    // integrator (the midpoint scheme takes its momenta and source, MomentumSource).
+    options.exact_inertia = b.exact_inertia.value_or(true);
     if (b.exact_inertia.value_or(false) && se.inertia_gamma.empty()) {
       throw InputError(b.where + ": body '" + b.name + "': options.inertia is exact but " + file.string() +
                        " has no inertia invariants (an older femb-reduce wrote it: reduce the part again, "
                        "femb-reduce stores them for every part)");
     }
-    if (!midpoint && !b.exact_inertia.has_value() && se.inertia_gamma.empty() && se.n_reduced_dofs() > 6) {
+    if (!b.exact_inertia.has_value() && se.inertia_gamma.empty() && se.n_reduced_dofs() > 6) {
       scene.notes.push_back("body '" + b.name + "': " + file.string() + " has no inertia invariants (an older "
                             "femb-reduce wrote it): the corotational inertia (thesis 3.22) approximates the "
                             "centrifugal and Coriolis coupling of the deformation (a spinning bar stretched 21% too "
@@ -408,11 +401,6 @@ Scene BuildScene(const SceneSpec& spec) {
       scene.notes.push_back("body '" + b.name + "': the midpoint integrator keeps the body linear inside, whose energy it "
                             "conserves exactly: the file's geometric stiffening is not used (generalized_alpha uses it; "
                             "options.geometric_stiffening: true forces it)");
-    }
-    if (midpoint && !b.exact_inertia.has_value() && !se.inertia_gamma.empty()) {
-      scene.notes.push_back("body '" + b.name + "': the midpoint integrator uses the corotational inertia (thesis "
-                            "3.22), whose energy it conserves exactly, not the file's exact one (generalized_alpha "
-                            "does: a spinning part's centrifugal load is a fifth too high with the corotational one)");
     }
     std::vector<int> nodes;
     for (const auto& [iname, _] : b.nodes) {

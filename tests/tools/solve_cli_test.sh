@@ -424,8 +424,11 @@ sed 's/{name: b3, superelement: segment.h5/{name: b3, superelement: old.h5/; s/t
 "$bin/femb-solve" "$work/old.yaml" -o "$work/old_out" > "$work/old_log.txt" 2>&1 \
   && grep -q "note: body 'b3': .*old.h5 has no inertia invariants (an older femb-reduce wrote it): the corotational inertia" "$work/old_log.txt" \
   && ! grep -q "note: body 'b2': .*inertia invariants" "$work/old_log.txt" && ok || fail "old file without invariants: $(cat "$work/old_log.txt")"
-# Under the midpoint integrator (corotational inertia only) the exact inertia is refused, not ignored.
-expect "exact inertia under the midpoint scheme" 2 "options.inertia: exact is not available with the midpoint integrator" 's/{name: b3, superelement: segment.h5/{name: b3, options: {inertia: exact}, superelement: segment_gs.h5/; s/type: static/type: dynamic\n  integrator: midpoint\n  step: 0.01/'
+# The midpoint integrator takes the exact inertia too (its momenta and source are the exact
+# kinetic energy's): no note about the corotational one.
+sed 's/{name: b3, superelement: segment.h5/{name: b3, options: {inertia: exact}, superelement: segment_gs.h5/; s/type: static/type: dynamic\n  integrator: midpoint\n  step: 0.01\n  end_time: 0.02/' "$work/scene.yaml" > "$work/mid_exact.yaml"
+"$bin/femb-solve" "$work/mid_exact.yaml" -o "$work/mid_exact_out" > "$work/mid_exact_log.txt" 2>&1 \
+  && ! grep -q "note: .*corotational" "$work/mid_exact_log.txt" && grep -q "10 flexible bodies: 10 with the exact inertia" "$work/mid_exact_log.txt" && ok || fail "exact inertia under the midpoint scheme: $(cat "$work/mid_exact_log.txt")"
 expect "bad inertia option" 2 "options.inertia: expected exact or corotational (exact: the file's inertia invariants), got 'lumped'" 's/{name: b3, superelement: segment.h5/{name: b3, options: {inertia: lumped}, superelement: segment.h5/'
 cp "$work/segment_gs.h5" "$work/bad_gamma.h5"
 $py -c "import h5py; f=h5py.File('$work/bad_gamma.h5','r+'); a=f['/reduced/inertia_invariants/Gamma'][...]; a[0,1]+=1.0; f['/reduced/inertia_invariants/Gamma'][...]=a"

@@ -282,10 +282,10 @@ TEST(GeometricStiffening, RigidBasisReducesAndStoresNone) {
   EXPECT_FALSE(r.superelement.polynomial.has_value());
 }
 
-// The midpoint integrator conserves the energy of linear bodies with the corotational inertia
-// exactly (its elastic force is no exact discrete gradient of the stiffened energy). So a
-// stiffened file is used linear with the corotational inertia there unless the body asks (with
-// a note either way), and with its stiffening and exact inertia under generalized-alpha.
+// The midpoint integrator's elastic force is no exact discrete gradient of the stiffened energy.
+// So a stiffened file is used linear there unless the body asks (with a note either way), and
+// with its stiffening under generalized-alpha; both take the file's exact inertia unless the
+// body asks for the corotational one.
 TEST(GeometricStiffening, MidpointUsesAStiffenedFileLinearUnlessAsked) {
   const std::string dir = ::testing::TempDir() + "stiffening_midpoint";
   std::filesystem::create_directories(dir);
@@ -306,12 +306,14 @@ TEST(GeometricStiffening, MidpointUsesAStiffenedFileLinearUnlessAsked) {
   EXPECT_TRUE(alpha.model.bodies[0].options().geometric_stiffening);
   const Scene midpoint = scene("midpoint", "");
   EXPECT_FALSE(midpoint.model.bodies[0].options().geometric_stiffening);
-  EXPECT_FALSE(midpoint.model.bodies[0].options().exact_inertia);
-  EXPECT_TRUE(alpha.model.bodies[0].options().exact_inertia);
+  EXPECT_TRUE(midpoint.model.bodies[0].has_exact_inertia());
+  EXPECT_TRUE(alpha.model.bodies[0].has_exact_inertia());
   EXPECT_TRUE(noted(midpoint, "the file's geometric stiffening is not used"));
   const Scene forced = scene("midpoint", ", options: {geometric_stiffening: true}");
   EXPECT_TRUE(forced.model.bodies[0].options().geometric_stiffening);
-  EXPECT_TRUE(noted(forced, "the midpoint integrator uses the corotational inertia"));
+  EXPECT_FALSE(noted(forced, "corotational"));
+  const Scene corotational = scene("midpoint", ", options: {inertia: corotational}");
+  EXPECT_FALSE(corotational.model.bodies[0].has_exact_inertia());
 }
 
 }  // namespace
