@@ -461,7 +461,10 @@ PartSpec ParsePart(const std::string& text, const std::string& name,
                 "on the imported mesh's solid cells give the stress of each field)");
       }
     }
-    if (auto v = m.Optional("full_modes")) part.reduction.full_modes = int(v->NonNegativeInteger());
+    if (auto v = m.Optional("full_modes")) {
+      part.reduction.full_modes = int(v->NonNegativeInteger());
+      part.reduction.full_modes_given = true;
+    }
     if (auto v = m.Optional("memory_limit_gb")) part.reduction.memory_limit_gb = v->PositiveNumber();
     if (auto v = m.Optional("modal_derivatives")) {
       ModalDerivativeSpec& d = part.reduction.modal_derivatives;

@@ -130,7 +130,12 @@ struct ReductionSpec {
   /// whenever the mesh is kept. true without the mesh is an error.
   std::optional<bool> stresses;
   std::string where_stresses;
-  int full_modes = 0;     ///< K lowest nonzero free-free frequencies of the full model
+  /// K lowest nonzero free-free frequencies of the full model, compared with the reduced
+  /// model's in the summary. Unset: up to 12 (at most the reduced model's flexible count) for
+  /// models up to kFullModesMaxDofs DOFs, none above; 0: none.
+  int full_modes = 0;
+  bool full_modes_given = false;
+  static constexpr long kFullModesMaxDofs = 200000;
   double memory_limit_gb = 0;  ///< refuse when the Cholesky factor would exceed it (0: MemAvailable)
   std::string where_floating_frame;
 };
