@@ -446,8 +446,9 @@ PartSpec ParsePart(const std::string& text, const std::string& name,
     if (auto v = m.Optional("keep_mesh")) part.reduction.keep_mesh = v->Bool();
     if (auto v = m.Optional("stresses")) {
       part.reduction.stresses = v->Bool();
-      if (*part.reduction.stresses && part.type == "imported") {
-        v->Fail("stresses need femb's own elements and material; imported matrices do not have them");
+      if (*part.reduction.stresses && part.type == "imported" && !part.has_material) {
+        v->Fail("stresses of imported matrices need the part's material: (femb's own elements on the imported mesh's "
+                "solid cells recover them)");
       }
       part.reduction.where_stresses = v->Where();
       if (*part.reduction.stresses && part.reduction.keep_mesh == false) {

@@ -432,15 +432,32 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
   prov.n_elements = model.n_elements();
   report("frame+mass", clock.Seconds(), "floating frame " + se.floating_frame.type +
                                              (keep_mesh ? ", mesh and mode shapes kept" : ", mesh and mode shapes not kept (reduction.keep_mesh)"));
-  // Imported matrices have no elements to recover stresses from (the part file refuses true).
-  if (keep_mesh && part.reduction.stresses.value_or(part.type != "imported")) {
+  // Imported matrices: femb's solid elements on the imported mesh with the part's material (the
+  // same conditions as the stiffening's; the part file refuses true without a material).
+  bool stresses = keep_mesh && part.reduction.stresses.value_or(part.type != "imported" || part.has_material);
+  if (stresses && part.type == "imported") {
+    const std::string& cell = model.cell_type;
+    const bool solid_cells = cell == "tet4" || cell == "tet10" || cell == "hex8" || cell == "hex20";
+    bool rotations = false;
+    for (size_t d = 0; d < model.dof_component.size(); ++d)
+      rotations |= model.dof_component[d] >= 3 && model.dof_node[d] < model.n_nodes();
+    if (!solid_cells || rotations) {
+      const std::string why = !solid_cells ? "its mesh has " + cell + " cells" : "its matrices have rotational DOFs";
+      if (part.reduction.stresses.value_or(false)) {
+        throw InputError(part.file + ": reduction.stresses: the imported part cannot have them: " + why +
+                         " (femb's solid elements: tet4, tet10, hex8, hex20)");
+      }
+      stresses = false;
+    }
+  }
+  if (stresses) {
     Stopwatch stress_clock;
     const Visualization& v = *se.visualization;
     // With modal derivatives the stress keeps the strain's quadratic part (solids: Green-Lagrange;
     // beams: the von Karman axial term), as the body's polynomial force does; the inertia load
     // cases' stresses are linear.
     auto stresses_of = [&](const Eigen::MatrixXd& fields, bool quadratic) {
-      return part.type == "solid" ? SolidModalStress(SolidCellType(model.cell_type), model.nodes, model.cells, part.material, fields,
+      return part.type != "beam" ? SolidModalStress(SolidCellType(model.cell_type), model.nodes, model.cells, part.material, fields,
                                                      quadratic)
                                   : BeamModalStress(part, fields, quadratic);
     };

@@ -204,8 +204,8 @@ TEST(ImportedModel, BadMatricesAreOneLineEach) {
   // A grounded spring on one DOF: the body no longer floats.
   std::snprintf(line, sizeof line, "1 1 %.17g", 2 * k11);
   expect(reduce(test::Replace(sti, first, line), dof), "the stiffness resists a rigid-body motion");
-  // Keys the imported matrices cannot honour.
-  expect(reduce(sti, dof, "reduction: {stresses: true}\n"), "stresses need femb's own elements");
+  // Keys the imported matrices cannot honour (stresses: not without the part's material).
+  expect(reduce(sti, dof, "reduction: {stresses: true}\n"), "stresses of imported matrices need the part's material");
   expect(reduce(sti, dof, "reduction: {modal_derivatives: true}\n"), "modal derivatives need femb's own elements");
   WriteText(dir / "missing.yaml", "name: bar\ntype: imported\ngeometry: {file: bar.inp}\n"
                                   "matrices: {format: calculix, stiffness: nothere.sti, mass: bar.mas, dofs: bar.dof}\n"

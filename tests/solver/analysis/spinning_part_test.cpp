@@ -238,6 +238,18 @@ TEST(SpinningPart, ImportedPartMovesAsFembsOwn) {
     const Superelement imported =
         files.Reduce("imported.yaml", {"reduction.geometric_stiffening=" + on, "material={E: 2.1e11, nu: 0.3, rho: 7850}"});
     ASSERT_EQ(imported.inertia_stiffness.empty(), !stiffened);
+    // With the material, the imported part also recovers stresses with femb's elements: the same
+    // modal stresses as the own part's (single precision; up to the signs of the fixed-interface
+    // modes), and the inertia load cases' with the stiffening.
+    ASSERT_TRUE(imported.stress.has_value());
+    ASSERT_TRUE(native.stress.has_value());
+    const float scale = native.stress->modes.cwiseAbs().maxCoeff();
+    EXPECT_LT((imported.stress->modes.cwiseAbs() - native.stress->modes.cwiseAbs()).cwiseAbs().maxCoeff(), 1e-6f * scale);
+    ASSERT_EQ(imported.stress->inertia_modes.size(), native.stress->inertia_modes.size());
+    if (stiffened) {
+      const float inertia_scale = native.stress->inertia_modes.cwiseAbs().maxCoeff();
+      EXPECT_LT((imported.stress->inertia_modes - native.stress->inertia_modes).cwiseAbs().maxCoeff(), 1e-6f * inertia_scale);
+    }
     for (const Integrator integrator : {Integrator::kGeneralizedAlpha, Integrator::kMidpoint}) {
       const auto a = Spin(native, integrator, 2e-3, 1e-5, true), b = Spin(imported, integrator, 2e-3, 1e-5, true);
       ASSERT_EQ(a.size(), b.size());
