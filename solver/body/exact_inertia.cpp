@@ -425,6 +425,7 @@ Eigen::MatrixXd SuperelementBody::ExactInertiaConfigurationTangent(const Data& d
 
 void SuperelementBody::AddLocalSourceVelocityDerivative(const Data& d, const BodyVelocity& w, Eigen::MatrixXd& d_w) const {
   if (!has_exact_inertia()) return;
+  // c(w) = Q(w, w): c(w + e) - c(w - e) = 4 Q(w, e) = 2 (dc/dw) e for any step e.
   Eigen::VectorXd &wp = d.scratch.v2, &plus = d.scratch.v3, &minus = d.scratch.v4;
   wp = w;
   for (int i = 0; i < n_coordinates(); ++i) {
@@ -443,43 +444,38 @@ void SuperelementBody::MomentumConfigurationTangent(const Data& d, const BodyVel
     MomentumDerivative(MapsOf(d), w, D, d.scratch);
     return;
   }
-  // Central differences, steps as Perturbed's, the configuration perturbed in place.
-  const int n = n_coordinates();
-  D.resize(n, n);
+  // p = Rbar p_hat(q_loc, Rbar^T w): the frame's turning of p is MomentumDerivative's with the
+  // exact mass (dp = -p~ U dq + M_e G dq, option A), the local coordinates' share
+  // Rbar (d p_hat / d q_loc) B Rbar^T (delta q_loc = B Rbar^T dq), the first factor by central
+  // differences in q_loc at the frame of d (no frame solve; steps as Perturbed's).
+  const int n = n_coordinates(), blocks = 2 * n_nodes_;
+  BodyVelocityMaps& maps = side.maps;
+  maps = MapsOf(d);
+  maps.Mg = ExactMass(d);
+  MomentumDerivative(maps, w, D, side.scratch);
   double size = 0.0;
   for (const Eigen::Vector3d& X : X_) size = std::max(size, X.norm());
   const double length = 1e-7 * std::max(size, 1e-3);
   const double modal = length * std::sqrt(std::max(M_(0, 0), 1e-300));
+  Eigen::MatrixXd &P = side.exact_scratch.t3, &BR = side.exact_scratch.t4;
+  P.resize(n, n);
   side.c = d.c;
-  BodyConfiguration& c = side.c;
+  side.q = d.q;
   for (int i = 0; i < n; ++i) {
-    const int a = i / 6, k = i % 6;
-    const bool node = i < 6 * n_nodes_;
-    const double step = !node ? modal : k < 3 ? length : 1e-7;
-    for (const double sign : {1.0, -1.0}) {
-      if (!node) {
-        c.eta[i - 6 * n_nodes_] = d.c.eta[i - 6 * n_nodes_] + sign * step;
-      } else if (k < 3) {
-        c.x[a][k] = d.c.x[a][k] + sign * step;
-      } else {
-        c.R[a] = ExpSO3(sign * step * Eigen::Vector3d::Unit(k - 3)) * d.c.R[a];
-      }
-      EvaluateSolved(c, SolveFrameFrom(c, d.frame, side.q), side);  // (the frame solve leaves q_loc in side.q)
-      if (sign > 0) {
-        D.col(i) = MassTimes(side, w);
-      } else {
-        D.col(i) -= MassTimes(side, w);
-      }
-    }
-    D.col(i) /= 2 * step;
-    if (!node) {
-      c.eta[i - 6 * n_nodes_] = d.c.eta[i - 6 * n_nodes_];
-    } else if (k < 3) {
-      c.x[a][k] = d.c.x[a][k];
-    } else {
-      c.R[a] = d.c.R[a];
-    }
+    const double step = i >= 6 * n_nodes_ ? modal : i % 6 < 3 ? length : 1e-7;
+    side.q[i] = d.q[i] + step;
+    EvaluateSolved(side.c, d.frame, side);
+    P.col(i) = MassTimes(side, w);
+    side.q[i] = d.q[i] - step;
+    EvaluateSolved(side.c, d.frame, side);
+    P.col(i) -= MassTimes(side, w);
+    P.col(i) /= 2 * step;
+    side.q[i] = d.q[i];
   }
+  BR = d.kin.B;
+  const Eigen::Matrix3d Rt = d.frame.R.transpose();
+  TurnColBlocks(BR, blocks, [&](int) { return Rt; });
+  D.noalias() += P.lazyProduct(BR);  // (no blocking workspace on the heap)
 }
 
 }  // namespace femb

@@ -416,10 +416,11 @@ class SuperelementBody {
   void MomentumSource(const Data& d, const BodyVelocity& w, const Eigen::VectorXd& p, Eigen::VectorXd& out) const;
 
   /// d p / d q at fixed w of the body's own momentum p = MassTimes(d, w) (the midpoint scheme's
-  /// iteration matrix): MomentumDerivative for the corotational inertia; for the exact one by
-  /// central differences with the frame re-solved (its local coordinates' share turns the
-  /// torsion of a spinning bar, whose inertia is small, as much as the frame's: without it
-  /// Newton stalled there). `side`: the perturbed configurations' data (storage reused).
+  /// iteration matrix): MomentumDerivative for the corotational inertia; for the exact one the
+  /// frame's turning as MomentumDerivative with the exact mass plus the local coordinates' share
+  /// Rbar (d p_hat / d q_loc) B Rbar^T, the middle factor by central differences in q_loc (that
+  /// share turns the torsion of a spinning bar, whose inertia is small, as much as the frame's:
+  /// without it Newton stalled there). `side`: the perturbed data (storage reused).
   void MomentumConfigurationTangent(const Data& d, const BodyVelocity& w, Data& side, Eigen::MatrixXd& D) const;
   /// With the exact inertia: adds to `d_w` the derivative of the source's local term (the
   /// MomentumSource at `d` beyond G^T p + Omega_hat p) with respect to w, by central
