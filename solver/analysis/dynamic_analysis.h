@@ -14,6 +14,7 @@
 // steps") and kept below step_tolerance of the model's motion; steps land on the kinks and jumps of the loads and drives and on output times.
 #pragma once
 
+#include <array>
 #include <functional>
 #include <optional>
 #include <string>
@@ -121,6 +122,11 @@ struct DynamicState {
   Eigen::VectorXd W;     ///< velocities over the unknowns
   Eigen::VectorXd Wdot;  ///< accelerations
   Eigen::VectorXd a;     ///< generalized-alpha acceleration-like variable
+  /// Generalized-alpha: the increments Delta q of the last steps (oldest first) and their steps,
+  /// for the velocities' share of a change of step size; none kept at a start or a restart.
+  std::array<Eigen::VectorXd, 3> increments;
+  std::array<double, 3> increment_steps{};
+  int increments_kept = 0;
   double t = 0.0;
   double external_work = 0.0;
   Eigen::VectorXd f_ext;  ///< external forces (nodal loads, gravity) at t, for the work
