@@ -11,7 +11,6 @@
 // holder, no std::function built per call (BodyTask), no std::optional reset that frees.
 #pragma once
 
-#include <Eigen/Cholesky>
 #include <Eigen/Core>
 #include <functional>
 #include <memory>
@@ -191,13 +190,8 @@ struct BodyWorkspace {
   std::vector<Eigen::Matrix<double, 6, 1>> node_acc;
   std::vector<NodeJacobian> dc, dacc;
   Eigen::VectorXd unused, column, weights, dq, delta, lie_delta, a_n;
-  // Generalized-alpha's loops in the stabilized index-2 form (generalized_alpha.cpp): the
-  // constraint Jacobian's entries at the iterate, its position rows -g, and the correction
-  // G^T mu with (G G^T) mu = -g - G delta; the step's velocities W_n and their change.
-  Triplets loop_jacobian;
-  Eigen::VectorXd loop_g, loop_rhs, loop_mu, loop_correction, W_n, velocity_change;
-  Eigen::MatrixXd loop_GGt;
-  Eigen::LDLT<Eigen::MatrixXd> loop_ldlt;
+  // Generalized-alpha: the step's velocities W_n and their change at a change of step size.
+  Eigen::VectorXd W_n, velocity_change;
   // The factor of the mass in the step's iteration matrix (RoundOffForce; 0 outside a step).
   double inertia_factor = 0.0;
   // RotationNodes(model, dofs), set with the weights.

@@ -1,7 +1,6 @@
 // The generalized-alpha integrator (Chung & Hulbert 1993 on the Lie group of the nodes, Arnold &
-// Bruls 2007; closed loops in the stabilized index-2 form of Arnold, Bruls & Cardona 2016): its
-// step, and the dynamic residual and iteration matrix it assembles (shared with the consistent
-// start and the reactions).
+// Bruls 2007; index 3 with closed loops): its step, and the dynamic residual and iteration
+// matrix it assembles (shared with the consistent start and the reactions).
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
@@ -246,82 +245,21 @@ Assembly AssembleDynamic(const SystemModel& model, const DofMap& dofs, DynamicSt
 
 namespace {
 
-// Closed loops in the stabilized index-2 form (Gear, Gupta & Leimkuhler 1985; for
-// generalized-alpha Arnold, Bruls & Cardona 2016): a step keeps the velocity constraint G W = 0
-// as well as the positions' g = 0, the latter through a correction G^T mu of the positions
-// alone (velocities and accelerations follow the integrator's formulas). In the index-3 form
-// (g = 0 only) the constrained directions' velocities and accelerations carry what the step's
-// history leaves in them: a change of step size sets them oscillating, and through the mass
-// coupling they drive the flexible bodies' stiff modes. Newton keeps its matrix: the
-// multipliers' rows G delta = -g become G delta = -G W / gamma' (the velocity after the
-// correction, W + gamma' delta, satisfies the constraint), and after each correction the
-// positions move by G^T mu, (G G^T) mu = -g - G delta, on the coordinates solved for. The
-// coupling of that move into the dynamic rows (K G^T mu) is left to the next iteration.
-//
-// The multipliers' rows of `residual` hold -g (AddLoopConstraints): kept in work.loop_g, the
-// rows take -G W / gamma' instead; work.loop_jacobian gets G at the iterate, by column.
-void StabilizedLoopRows(const SystemModel& model, const DofMap& dofs, const DynamicState& s, double gamma_p,
-                        BodyWorkspace& work, Eigen::VectorXd& residual) {
-  const int m = dofs.n_multipliers(), first = dofs.first_multiplier();
-  work.loop_g = residual.tail(m);
-  Triplets& G = work.loop_jacobian;
-  G.clear();
-  AddLoopConstraints(model, dofs, s.config, nullptr, nullptr, nullptr, &G, kLoopRows, &work.pass_data);
-  // G's entries on the coordinates (its rows; the transposed copies dropped), by column.
-  G.erase(std::remove_if(G.begin(), G.end(),
-                         [&](const Eigen::Triplet<double>& e) { return e.row() < first || e.col() >= first; }),
-          G.end());
-  std::sort(G.begin(), G.end(),
-            [](const Eigen::Triplet<double>& x, const Eigen::Triplet<double>& y) { return x.col() < y.col(); });
-  auto rows = residual.tail(m);
-  rows.setZero();
-  for (const Eigen::Triplet<double>& e : G) rows[e.row() - first] -= e.value() * s.W[e.col()];
-  rows /= gamma_p;
-}
-
-// The move G^T mu with (G G^T) mu = work.loop_rhs - G v (on entry work.loop_rhs holds the
-// right-hand side; G = work.loop_jacobian on the coordinates solved for) into
-// work.loop_correction: G (v + G^T mu) = work.loop_rhs. The positions' correction with v =
-// delta and work.loop_rhs = -g; with v a velocity change and work.loop_rhs = 0, v +
-// work.loop_correction is its share in the constraints' null space.
-void LoopProjection(const DofMap& dofs, const Eigen::VectorXd& v, BodyWorkspace& work) {
-  const int m = dofs.n_multipliers(), first = dofs.first_multiplier();
-  const Triplets& G = work.loop_jacobian;
-  work.loop_GGt.setZero(m, m);
-  for (size_t k = 0; k < G.size();) {
-    size_t end = k;
-    while (end < G.size() && G[end].col() == G[k].col()) ++end;
-    if (!dofs.prescribed(G[k].col())) {
-      for (size_t a = k; a < end; ++a) {
-        work.loop_rhs[G[a].row() - first] -= G[a].value() * v[G[a].col()];
-        for (size_t b = k; b < end; ++b)
-          work.loop_GGt(G[a].row() - first, G[b].row() - first) += G[a].value() * G[b].value();
-      }
-    }
-    k = end;
-  }
-  work.loop_ldlt.compute(work.loop_GGt);
-  work.loop_mu = work.loop_rhs;
-  work.loop_ldlt.solveInPlace(work.loop_mu);
-  work.loop_correction.setZero(dofs.n_dofs());
-  for (const Eigen::Triplet<double>& e : G)
-    if (!dofs.prescribed(e.col())) work.loop_correction[e.col()] += e.value() * work.loop_mu[e.row() - first];
-}
-
-// The velocities' share of a change of step size from h_n (the last step) to h. Generalized-alpha
-// carries a velocity that is the motion's own up to c_v h_n^2 q3 (q3 the motion's third
-// derivative, c_v = 1/6 - beta - (alpha_m - alpha_f) / 2: with that offset the position update
-// is exact for a cubic motion, as a_n is with its (alpha_m - alpha_f) h_n q3). In the directions
-// that stiff elastic forces hold (the axial direction of a flexible link, its static modes), as
-// in constrained ones, the step balances that offset through its positions: kept at h_n^2 after
-// a change of step, it sets their forces off by an amount locked to the step sequence. On a
-// spinning stiff spring (omega h = 11), steps of 0.4/0.3/0.3 ms put the spring force 5e-4 of its
-// peak off where equal steps stay within 2.4e-5; moved, 4e-5. The offset is moved to c_v h^2 q3
-// with q3 from the third divided difference of the last three steps' increments (positions: the
-// accelerations and velocities of stiff directions are no estimate of it, and a correction from
-// them grows without bound on random steps), in the loops' null space when there are loops
-// (the constrained directions' velocities are the constraint's). Into `W` (holding W_n);
-// nothing without three steps kept.
+// The velocities' share of a change of step size from h_n (the last step) to h, beside a_n's
+// (below). Generalized-alpha carries a velocity that is the motion's own up to c_v h_n^2 q3 (q3
+// the motion's third derivative, c_v = 1/6 - beta - (alpha_m - alpha_f) / 2: with that offset the
+// position update is exact for a cubic motion, as it is with a_n's (alpha_m - alpha_f) h_n q3).
+// In the directions that stiff elastic forces hold (the axial direction of a flexible link, its
+// static modes), as in the loops' constrained ones, the step balances the offset through the
+// positions: kept at h_n^2 after a change of step, it sets their forces off by an amount locked
+// to the step sequence. On a spinning stiff spring (omega h = 11), steps of 0.4/0.3/0.3 ms put
+// the spring force 5e-4 of its peak off where equal steps stay within 2.4e-5 (moved: 4e-5); the
+// tilted four-bar's ground reactions with a flexible coupler, 4.0e-3 against 1.5e-4 (moved:
+// 1.4e-4), and under step: auto 0.3-1.6% (moved: 2-4e-4). The offset is moved to c_v h^2 q3 with
+// q3 from the third divided difference of the last three steps' increments: positions, since the
+// accelerations and velocities of stiff directions are no estimate of it (a correction from them
+// grew without bound on random step sequences). Into `W` (holding W_n); nothing without three
+// steps kept.
 void RescaleVelocityOffset(const DofMap& dofs, const DynamicState& s, double h, double c_v, BodyWorkspace& work,
                            Eigen::VectorXd& W) {
   if (s.increments_kept < 3 || s.h_last <= 0 || h == s.h_last) return;
@@ -334,11 +272,6 @@ void RescaleVelocityOffset(const DofMap& dofs, const DynamicState& s, double h, 
     if (dofs.multiplier(i)) continue;
     const double d0 = d[0][i] / hs[0], d1 = d[1][i] / hs[1], d2 = d[2][i] / hs[2];
     dv[i] = f * ((d2 - d1) / (hs[1] + hs[2]) - (d1 - d0) / (hs[0] + hs[1]));
-  }
-  if (dofs.n_multipliers() > 0 && !work.loop_jacobian.empty()) {
-    work.loop_rhs.setZero(dofs.n_multipliers());
-    LoopProjection(dofs, dv, work);
-    dv += work.loop_correction;
   }
   W += dv;
 }
@@ -397,7 +330,6 @@ StepOutcome GeneralizedAlphaStep(const SystemModel& model, const DofMap& dofs, c
   for (; out.iterations < options.max_iterations; ++out.iterations) {
     AssembleDynamicResidual(model, dofs, next, t_new, work, &threads, a);
     if (!a.ok || !a.residual.allFinite()) return out;
-    if (dofs.n_multipliers() > 0) StabilizedLoopRows(model, dofs, next, gamma_p, work, a.residual);
     const double r_norm = FreeNorm(dofs, a.residual, weights);
     // Converged: the residual below the tolerance relative to the forces on each unknown (or
     // at the round-off of the positions), after at least one correction.
@@ -448,14 +380,9 @@ StepOutcome GeneralizedAlphaStep(const SystemModel& model, const DofMap& dofs, c
     // log(exp(Delta q~) R_n R_n+1^T), not by composing the corrections, exp(delta~) R_n+1, which
     // would make the converged state depend on the path Newton took (the predictor) by the
     // corrections' commutators. Every other unknown adds.
+    work.dq += delta;
     Eigen::VectorXd& lie_delta = work.lie_delta;
     lie_delta = delta;
-    if (dofs.n_multipliers() > 0) {
-      work.loop_rhs = work.loop_g;
-      LoopProjection(dofs, delta, work);
-      lie_delta += work.loop_correction;
-    }
-    work.dq += lie_delta;
     for (const RotationNode& n : work.rotation_triples) {
       const Eigen::Matrix3d target = ExpSO3(Eigen::Vector3d(work.dq.segment<3>(n.rotation))) * state.config.R[size_t(n.node)];
       lie_delta.segment<3>(n.rotation) = LogSO3(Eigen::Matrix3d(target * next.config.R[size_t(n.node)].transpose()));

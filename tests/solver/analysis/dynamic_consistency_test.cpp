@@ -202,11 +202,10 @@ void RestartLeavesASmoothRunUnchanged(const Scene& scene, Integrator integrator)
                 integrator == Integrator::kMidpoint ? "midpoint" : "generalized-alpha", tolerance, restarted.steps,
                 before, after, smooth.steps, smooth_after);
     // Every ground-reaction component within 1e-3 of its peak of the fixed 5 us run, before the
-    // breakpoint and after it (measured 2.1e-4 to 3.7e-4; 0.3-1.6% with the loop in the index-3
-    // form and the velocities' offset kept at a change of step, generalized_alpha.cpp), and the
-    // restart adds nothing: the restarted run follows the one without the breakpoint to 1e-4 of
-    // the peak (measured: the same run; 2.9e-3 off when the restart dropped the variables'
-    // offsets).
+    // breakpoint and after it (measured 1.7e-4 to 3.9e-4; 0.3-1.6% with the velocities' offset
+    // kept at a change of step, generalized_alpha.cpp), and the restart adds nothing: its error
+    // after the breakpoint within 1e-4 of the run's without the breakpoint (measured: within
+    // 5e-6; 2.0e-3 against 1.8e-4 at 1e-5 when the restart dropped a_n's offset).
     EXPECT_LT(std::max(before, after), 1e-3);
     EXPECT_LT(after, smooth_after + 1e-4);
   }
@@ -228,9 +227,9 @@ TEST_F(TiltedFourBarTest, RestartAtTheBreakpointLeavesASmoothRunUnchangedGeneral
 // 1e3), a largest step of 0.4 ms lands on the 1 ms outputs in steps of 0.4, 0.3 and 0.3 ms,
 // and the reactions must follow the fixed 5 us run as closely as equal steps of 1/3 ms do. The
 // coupler's stiff directions (its axial stiffness, omega h about 10) balance generalized-alpha's
-// velocity offset c_v h^2 q3 through their forces: kept at the last step's h^2 (and the loop in
-// the index-3 form), the reactions were 4.0e-3 of their peak off with the changing steps
-// against 1.5e-4 with equal ones, the same with the coupler's loop cut open.
+// velocity offset c_v h^2 q3 through their forces: kept at the last step's h^2, the reactions
+// were 4.0e-3 of their peak off with the changing steps against 1.5e-4 with equal ones (and
+// 1.6e-3 against 4.5e-5 with the loop cut open: the loop is not the cause).
 TEST_F(TiltedFourBarTest, StepsChangingAtEveryStepFollowTheFixedStepRunAsEqualStepsDo) {
   DynamicOptions fixed = Options(Integrator::kGeneralizedAlpha, 0.2);
   fixed.step = 5e-6;
