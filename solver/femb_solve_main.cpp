@@ -1,5 +1,6 @@
 // femb-solve: simulate a scene of superelements (static or dynamic).
 #include <chrono>
+#include <csignal>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -16,6 +17,7 @@
 #include "solver/analysis/static_analysis.h"
 #include "solver/output/results_recorder.h"
 #include "solver/parallel.h"
+#include "solver/stop_request.h"
 #include "solver/scene/scene_builder.h"
 
 namespace {
@@ -82,7 +84,9 @@ options:
   -h, --help            this text
 
 exit codes: 0 success, 2 bad input (one line names the file, line and key), 3 numerical failure
-(the results up to the failure are kept in OUTDIR).
+(the results up to the failure are kept in OUTDIR), 130 / 143 stopped by SIGINT (Ctrl-C) /
+SIGTERM: the step under way is finished and the results up to it are written to OUTDIR (a
+second signal ends the run at once, writing nothing).
 )";
 
 }  // namespace
@@ -109,6 +113,7 @@ int main(int argc, char** argv) {
     }
     threads = int(t);
   }
+  femb::InstallStopHandlers();
   try {
     const auto wall = std::chrono::steady_clock::now();
     const femb::SceneSpec spec = femb::ReadSceneFile(scene_path, overrides);
@@ -146,6 +151,8 @@ int main(int argc, char** argv) {
     }
     std::string status = "completed";
     bool ok = true;
+    int stopped = 0;           // the signal that stopped the analysis, or 0
+    double stopped_at = 0.0;   // the time (static: load factor) it stopped at
     long total_iterations = 0;
     long step_count = 0;
     long rejected = 0;  // steps rejected so far (step: auto)
@@ -213,8 +220,10 @@ int main(int argc, char** argv) {
       auto reactions0 = static_reactions(0.0, state);
       recorder.Record(0.0, state, Eigen::VectorXd(), 0.0, 0.0, 0.0, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(),
                       spec.reactions ? &reactions0 : nullptr);
+      femb::StaticOptions static_options = StaticOptionsOf(spec.analysis);
+      static_options.stop = &femb::StopRequest();
       const femb::StaticResult r = femb::SolveStatic(
-          scene.model, state, StaticOptionsOf(spec.analysis), [&](const femb::StaticStepReport& s, const femb::SystemState& st) {
+          scene.model, state, static_options, [&](const femb::StaticStepReport& s, const femb::SystemState& st) {
             ++step_count;
             total_iterations += s.iterations;
             if (step_count % spec.analysis.output_every == 0) {
@@ -226,6 +235,8 @@ int main(int argc, char** argv) {
           });
       ok = r.ok;
       if (!ok) status = r.message;
+      stopped = r.stopped;
+      stopped_at = r.steps.empty() ? 0.0 : r.steps.back().lambda;
       for (const std::string& w : r.warnings) std::printf("femb-solve: warning: %s\n", w.c_str());
     } else {
       femb::DynamicState state = femb::InitialDynamicState(scene.model, femb::InitialState(scene.model), scene.initial_velocity);
@@ -253,6 +264,7 @@ int main(int argc, char** argv) {
                                        ? femb::BodyMatricesKept::kAll
                                        : femb::BodyMatricesKept::kInertia;
       options.threads = threads;
+      options.stop = &femb::StopRequest();
       options.adaptive = spec.analysis.adaptive_step;
       if (options.adaptive) options.step = 1e-4 * spec.analysis.end_time;  // the first step tried
       options.step_tolerance = spec.analysis.step_tolerance;
@@ -287,6 +299,8 @@ int main(int argc, char** argv) {
           });
       ok = r.ok;
       if (!ok) status = r.message;
+      stopped = r.stopped;
+      stopped_at = state.t;
       for (const std::string& w : r.warnings) std::printf("femb-solve: warning: %s\n", w.c_str());
       if (!quiet) {
         const std::string analysed = r.pattern_analyses == 1 ? "once" : std::to_string(r.pattern_analyses) + " times";
@@ -312,10 +326,23 @@ int main(int argc, char** argv) {
       recorder.StepCounts(r.steps, r.rejected_by_error, r.newton_cuts);
     }
     const double solve_end = Seconds(wall);
+    const char* signal_name = stopped == SIGINT ? "SIGINT" : stopped == SIGTERM ? "SIGTERM" : "a signal";
+    if (stopped) {
+      char buffer[200];
+      std::snprintf(buffer, sizeof buffer, "stopped by %s at %s %.6g of %.6g", signal_name,
+                    spec.analysis.type == femb::AnalysisType::kStatic ? "load factor" : "t =", stopped_at,
+                    spec.analysis.end_time);
+      status = buffer;
+    }
     recorder.Finish(status);
-    progress(spec.analysis.end_time, true);
+    if (!stopped) progress(spec.analysis.end_time, true);
     if (!quiet) {
       for (const std::string& line : recorder.StressSummary()) std::printf("femb-solve: %s\n", line.c_str());
+    }
+    if (stopped) {
+      std::fprintf(stderr, "femb-solve: %s: %s; results up to it are in %s\n", scene_path.c_str(), status.c_str(),
+                   output.c_str());
+      return 128 + stopped;
     }
     if (!ok) {
       std::fprintf(stderr, "femb-solve: %s: numerical failure: %s; results up to it are in %s\n", scene_path.c_str(),

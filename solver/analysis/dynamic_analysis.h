@@ -14,7 +14,7 @@
 // steps") and kept below step_tolerance of the model's motion; steps land on the kinks and jumps of the loads and drives and on output times.
 #pragma once
 
-#include <array>
+#include <atomic>
 #include <functional>
 #include <optional>
 #include <string>
@@ -47,6 +47,10 @@ struct DynamicOptions;
 JacobianReuse JacobianReuseOf(const DynamicOptions& options);
 
 struct DynamicOptions {
+  /// A stop request, read after each step: when it holds a nonzero value the run stops there,
+  /// with what it computed (DynamicResult::stopped). femb-solve points it at the signal number of
+  /// a SIGINT or SIGTERM (solver/stop_request.h).
+  const std::atomic<int>* stop = nullptr;
   Integrator integrator = Integrator::kGeneralizedAlpha;
   double step = 1e-3;         ///< time step h [time]
   double end_time = 1.0;
@@ -122,11 +126,6 @@ struct DynamicState {
   Eigen::VectorXd W;     ///< velocities over the unknowns
   Eigen::VectorXd Wdot;  ///< accelerations
   Eigen::VectorXd a;     ///< generalized-alpha acceleration-like variable
-  /// Generalized-alpha: the increments Delta q of the last steps (oldest first) and their steps,
-  /// for the velocities' share of a change of step size; none kept at a start or a restart.
-  std::array<Eigen::VectorXd, 3> increments;
-  std::array<double, 3> increment_steps{};
-  int increments_kept = 0;
   double t = 0.0;
   double external_work = 0.0;
   Eigen::VectorXd f_ext;  ///< external forces (nodal loads, gravity) at t, for the work
@@ -154,6 +153,7 @@ struct DynamicStepReport {
 struct DynamicResult {
   bool ok = false;
   std::string message;
+  int stopped = 0;  ///< the stop request's value when the run stopped on it (ok, before end_time), else 0
   std::vector<std::string> warnings;  ///< said once each (energy growth below the stop limit)
   long steps = 0;
   long rejected_by_error = 0;  ///< adaptive steps: tried and rejected by the error test

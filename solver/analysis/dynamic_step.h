@@ -190,8 +190,6 @@ struct BodyWorkspace {
   std::vector<Eigen::Matrix<double, 6, 1>> node_acc;
   std::vector<NodeJacobian> dc, dacc;
   Eigen::VectorXd unused, column, weights, dq, delta, lie_delta, a_n;
-  // Generalized-alpha: the step's velocities W_n and their change at a change of step size.
-  Eigen::VectorXd W_n, velocity_change;
   // The factor of the mass in the step's iteration matrix (RoundOffForce; 0 outside a step).
   double inertia_factor = 0.0;
   // RotationNodes(model, dofs), set with the weights.

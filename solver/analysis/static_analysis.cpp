@@ -166,6 +166,10 @@ StaticResult SolveStatic(const SystemModel& model, SystemState& state, const Sta
     StaticStepReport report{lambda, it, r_norm, energy, work};
     result.steps.push_back(report);
     if (on_step) on_step(report, state);
+    if (options.stop && options.stop->load() != 0) {
+      result.stopped = options.stop->load();
+      break;
+    }
     // Grow back towards the nominal step after easy steps.
     if (it <= 4 && cuts > 0) {
       step = std::min(nominal, 2.0 * step);

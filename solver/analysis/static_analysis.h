@@ -2,6 +2,7 @@
 // with the full tangent at each step, step cutting on divergence (thesis 4.2).
 #pragma once
 
+#include <atomic>
 #include <functional>
 #include <string>
 #include <vector>
@@ -11,6 +12,9 @@
 namespace femb {
 
 struct StaticOptions {
+  /// A stop request, read after each converged step: nonzero stops the run there
+  /// (StaticResult::stopped; femb-solve: solver/stop_request.h).
+  const std::atomic<int>* stop = nullptr;
   double end_time = 1.0;      ///< pseudo-time at the end; loads are scaled by their functions of it
   int steps = 10;             ///< equal pseudo-time steps to end_time
   int max_iterations = 25;    ///< Newton iterations per step
@@ -29,6 +33,7 @@ struct StaticStepReport {
 struct StaticResult {
   bool ok = false;
   std::string message;                  ///< why it stopped early
+  int stopped = 0;                      ///< the stop request's value when it stopped on it (ok), else 0
   /// Said once each: the tangent's determinant changed sign (a limit or bifurcation point), a
   /// tolerance below the round-off floor.
   std::vector<std::string> warnings;

@@ -243,41 +243,6 @@ Assembly AssembleDynamic(const SystemModel& model, const DofMap& dofs, DynamicSt
   return out;
 }
 
-namespace {
-
-// The velocities' share of a change of step size from h_n (the last step) to h, beside a_n's
-// (below). Generalized-alpha carries a velocity that is the motion's own up to c_v h_n^2 q3 (q3
-// the motion's third derivative, c_v = 1/6 - beta - (alpha_m - alpha_f) / 2: with that offset the
-// position update is exact for a cubic motion, as it is with a_n's (alpha_m - alpha_f) h_n q3).
-// In the directions that stiff elastic forces hold (the axial direction of a flexible link, its
-// static modes), as in the loops' constrained ones, the step balances the offset through the
-// positions: kept at h_n^2 after a change of step, it sets their forces off by an amount locked
-// to the step sequence. On a spinning stiff spring (omega h = 11), steps of 0.4/0.3/0.3 ms put
-// the spring force 5e-4 of its peak off where equal steps stay within 2.4e-5 (moved: 4e-5); the
-// tilted four-bar's ground reactions with a flexible coupler, 4.0e-3 against 1.5e-4 (moved:
-// 1.4e-4), and under step: auto 0.3-1.6% (moved: 2-4e-4). The offset is moved to c_v h^2 q3 with
-// q3 from the third divided difference of the last three steps' increments: positions, since the
-// accelerations and velocities of stiff directions are no estimate of it (a correction from them
-// grew without bound on random step sequences). Into `W` (holding W_n); nothing without three
-// steps kept.
-void RescaleVelocityOffset(const DofMap& dofs, const DynamicState& s, double h, double c_v, BodyWorkspace& work,
-                           Eigen::VectorXd& W) {
-  if (s.increments_kept < 3 || s.h_last <= 0 || h == s.h_last) return;
-  const auto& d = s.increments;
-  const auto& hs = s.increment_steps;  // oldest first; hs[2] = h_last
-  const double f = 6 * c_v * (h * h - s.h_last * s.h_last) / (hs[0] + hs[1] + hs[2]);
-  Eigen::VectorXd& dv = work.velocity_change;
-  dv.setZero(dofs.n_dofs());
-  for (int i : dofs.solved()) {
-    if (dofs.multiplier(i)) continue;
-    const double d0 = d[0][i] / hs[0], d1 = d[1][i] / hs[1], d2 = d[2][i] / hs[2];
-    dv[i] = f * ((d2 - d1) / (hs[1] + hs[2]) - (d1 - d0) / (hs[0] + hs[1]));
-  }
-  W += dv;
-}
-
-}  // namespace
-
 // One generalized-alpha step of size h from `state` into `next` (Arnold & Bruls 2007).
 // t_new: the time reached, state.t + h, or just below a breakpoint the step lands on (the loads
 // and drives there are their left limits).
@@ -306,17 +271,9 @@ StepOutcome GeneralizedAlphaStep(const SystemModel& model, const DofMap& dofs, c
   Eigen::VectorXd& a_n = work.a_n;
   a_n = state.a;
   if (state.h_last > 0 && h != state.h_last) a_n = state.Wdot + (h / state.h_last) * (state.a - state.Wdot);
-  Eigen::VectorXd& W_n = work.W_n;
-  W_n = state.W;
-  work.velocity_change.resize(dofs.n_dofs());  // sized on the first step (it is needed at a change of step)
-  // Error-controlled steps only: there the estimate keeps c_q h^3 q3 within the tolerance, so
-  // that the change is of the local error's size; a fixed step changes only where Newton cut it,
-  // where q3 from steps too long for the motion is no estimate (a pendulum at 0.5 s steps
-  // diverged with it).
-  if (options.adaptive) RescaleVelocityOffset(dofs, state, h, 1.0 / 6 - beta - 0.5 * (alpha_m - alpha_f), work, W_n);
   next.a = (state.Wdot - alpha_m * a_n) / (1 - alpha_m);
-  next.W = W_n + h * (1 - gamma) * a_n + h * gamma * next.a;
-  work.dq = h * (W_n + h * (0.5 - beta) * a_n + h * beta * next.a);
+  next.W = state.W + h * (1 - gamma) * a_n + h * gamma * next.a;
+  work.dq = h * (state.W + h * (0.5 - beta) * a_n + h * beta * next.a);
   ApplyIncrement(model, dofs, work.dq, next.config);
   ApplyPrescribed(model, dofs, t_new, next.config, &next.W, &next.Wdot);
   const double gamma_p = gamma / (beta * h), beta_p = (1 - alpha_m) / (beta * h * h * (1 - alpha_f));
@@ -337,15 +294,6 @@ StepOutcome GeneralizedAlphaStep(const SystemModel& model, const DofMap& dofs, c
         LoopsClosed(model, next.config, tolerance, &work.pass_data)) {
       out.converged = true;
       next.a = (alpha_f * state.Wdot + (1 - alpha_f) * next.Wdot - alpha_m * a_n) / (1 - alpha_m);  // (the same relation)
-      // The step's increment, for the velocity offset's next rescaling (newest last; all three
-      // sized on the first step, so that no later step allocates).
-      for (Eigen::VectorXd& v : next.increments)
-        if (v.size() != work.dq.size()) v.setZero(work.dq.size());
-      next.increments[0].swap(next.increments[1]);
-      next.increments[1].swap(next.increments[2]);
-      next.increments[2] = work.dq;
-      next.increment_steps = {state.increment_steps[1], state.increment_steps[2], h};
-      next.increments_kept = std::min(state.increments_kept + 1, 3);
       next.t = t_new;
       // External work by the trapezoidal rule on the increment h (W_n + W_n+1) / 2.
       next.external_work += 0.5 * (state.f_ext + a.f_ext).dot(h * 0.5 * (state.W + next.W));

@@ -281,6 +281,33 @@ PY
   > "$work/big.txt" 2>&1; code=$?
 [ $code = 0 ] && [ "$(grep -c "^femb-solve: warning: Newton did not converge with analysis.step 0.5 from t = .* on (.* cuts): steps there were shortened, to .* at the least" "$work/big.txt")" = 1 ] \
   && ok || fail "fixed step cut by Newton: exit $code $(cat "$work/big.txt")"
+# Clean stops: SIGTERM (a batch system's time limit) and SIGINT (Ctrl-C) finish the step under
+# way, write every result up to it and exit with 128 + the signal (143, 130); results.h5's status
+# says where the run stopped; no temporary file is left.
+$py - "$bin" "$work/pend/rate.yaml" "$work" <<'PY' && ok || fail "clean stops on SIGTERM and SIGINT"
+import glob, h5py, signal, subprocess, sys
+bin_dir, scene, work = sys.argv[1:4]
+for sig, code, name in ((signal.SIGTERM, 143, "SIGTERM"), (signal.SIGINT, 130, "SIGINT")):
+    out = f"{work}/pend_{name}"
+    p = subprocess.Popen([bin_dir + "/femb-solve", scene, "-o", out, "--set", "analysis.end_time=1000"],
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    for line in p.stdout:  # the first progress line: the analysis runs
+        if line.startswith("femb-solve: t = "):
+            break
+    p.send_signal(sig)
+    stdout, stderr = p.communicate(timeout=120)
+    assert p.returncode == code, (name, p.returncode, stderr)
+    assert f"stopped by {name} at t = " in stderr and f"results up to it are in {out}" in stderr, stderr
+    with h5py.File(out + "/results.h5") as f:
+        status = f.attrs["status"]
+        status = status.decode() if isinstance(status, bytes) else str(status)
+        t = f["time"][:]
+    assert status.startswith(f"stopped by {name} at t = "), status
+    assert 0 < t[-1] < 1000 and f"at t = {t[-1]:.6g} of 1000" in status, (t[-1], status)
+    rows = open(out + "/probes.csv").read().splitlines()
+    assert len(rows) == len(t) + 1, (len(rows), len(t))
+    assert not glob.glob(out + "/*.tmp*"), glob.glob(out + "/*")
+PY
 "$bin/femb-solve" -q "$work/pend/rate.yaml" -o "$work/pend_auto_bad" --set analysis.step=auto --set analysis.min_step=0.1 \
   --set analysis.max_step=0.01 2> "$work/err.txt"; [ $? = 2 ] && grep -q "analysis.min_step.*min_step 0.1 is above max_step 0.01" "$work/err.txt" \
   && [ $(wc -l < "$work/err.txt") = 1 ] && ok || fail "min_step > max_step: $(cat "$work/err.txt")"
