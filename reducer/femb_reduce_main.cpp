@@ -90,6 +90,7 @@ int main(int argc, char** argv) {
                    part_path.c_str(), result.message.c_str());
       return 3;
     }
+    for (const std::string& w : result.warnings) std::printf("femb-reduce: warning: %s: %s\n", part_path.c_str(), w.c_str());
     // The file's contract (formats/superelement_checks.h): a model that fails it is not written.
     femb::Stopwatch check_clock;
     const femb::SuperelementChecks checks = femb::CheckSuperelement(result.superelement);

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "formats/part_file.h"
 #include "formats/superelement.h"
@@ -13,6 +14,7 @@ struct ReduceResult {
   bool ok = false;
   std::string message;  ///< numerical failure, when !ok
   bool too_big = false;  ///< refused: the factor would not fit in memory (message says how much)
+  std::vector<std::string> warnings;  ///< said by femb-reduce, also with -q
   Superelement superelement;
 };
 

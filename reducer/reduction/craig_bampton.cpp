@@ -368,13 +368,21 @@ CraigBamptonResult CraigBamptonReduce(const FeModel& model, int internal_modes,
   };
   const Eigen::MatrixXd C = Eigen::MatrixXd(Wt.transpose());
   long passes = 0;
-  const EigenResult eig =
-      n_i <= dense_limit || 2 * internal_modes + 1 > n_i - n_c
-          ? LowestConstrainedEigenpairs(K.ii, M.ii, C, internal_modes, 0.0, solve, dense_limit)
-          : BlockLanczosEigenpairs(K.ii, M.ii, C, internal_modes, 0.0, constrained_solve, kLanczosBlock, kLanczosTolerance, &passes);
+  // One mode more than kept (when there is one): its frequency tells whether the cut splits
+  // equal modes.
+  const int nev = internal_modes > 0 && internal_modes + 1 <= n_i - n_c ? internal_modes + 1 : internal_modes;
+  EigenResult eig =
+      n_i <= dense_limit || 2 * nev + 1 > n_i - n_c
+          ? LowestConstrainedEigenpairs(K.ii, M.ii, C, nev, 0.0, solve, dense_limit)
+          : BlockLanczosEigenpairs(K.ii, M.ii, C, nev, 0.0, constrained_solve, kLanczosBlock, kLanczosTolerance, &passes);
   if (!eig.ok) {
     r.message = "fixed-interface eigen solve failed: " + eig.message;
     return r;
+  }
+  if (nev > internal_modes) {
+    r.next_lambda = eig.lambda[internal_modes];
+    eig.lambda.conservativeResize(internal_modes);
+    eig.vectors.conservativeResize(Eigen::NoChange, internal_modes);
   }
   r.lambda = eig.lambda;
   r.eigen_linear_solves = eig.linear_solves;

@@ -40,6 +40,10 @@ struct CraigBamptonResult {
   std::string message;        ///< why it failed (numerical), when !ok
   Eigen::MatrixXd K, M;       ///< reduced, n_r x n_r
   Eigen::VectorXd lambda;     ///< internal eigenvalues omega^2, ascending
+  /// The eigenvalue after the last internal mode kept, solved for to tell whether the cut splits
+  /// a group of equal frequencies (a round or square section, a symmetric part); 0 when none is
+  /// left to solve for.
+  double next_lambda = 0.0;
   Eigen::MatrixXd shapes;     ///< n_full x n_r: full DOF field of each reduced coordinate
   FactorizationInfo factorization;
   long eigen_linear_solves = 0;
