@@ -32,6 +32,14 @@ Superelement Tee() {
       "reduction: {internal_modes: 2, floating_frame: mean_axes, geometric_stiffening: false}\n");
 }
 
+// n entries uniform in [-1, 1], drawn in order from `rng`.
+Eigen::VectorXd Uniform(int n, std::mt19937& rng) {
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  Eigen::VectorXd v(n);
+  for (int i = 0; i < n; ++i) v[i] = u(rng);
+  return v;
+}
+
 // A deformed configuration: large rigid rotation and translation, plus node perturbations of
 // the given size (displacements relative to the body size, rotations in rad).
 BodyConfiguration Deformed(const SuperelementBody& body, double size, unsigned seed) {
@@ -279,9 +287,7 @@ TEST(SuperelementBody, MomentumDerivativesMatchFiniteDifferences) {
     const FrameSolution frame = body.SolveFrame(c, body.GuessFrame(c));
     const int n = body.n_coordinates();
     std::mt19937 rng(3);
-    std::uniform_real_distribution<double> u(-1.0, 1.0);
-    Eigen::VectorXd w(n);
-    for (int i = 0; i < n; ++i) w[i] = u(rng);
+    const Eigen::VectorXd w = Uniform(n, rng);
     const Eigen::MatrixXd D = body.MomentumDerivative(body.Maps(c, frame), w);
     Eigen::MatrixXd fd(n, n);
     const double eps = 1e-6;
@@ -295,8 +301,7 @@ TEST(SuperelementBody, MomentumDerivativesMatchFiniteDifferences) {
 
     // MomentumSource derivatives in w and p (bilinear: central differences are exact up to
     // round-off).
-    Eigen::VectorXd p(n);
-    for (int i = 0; i < n; ++i) p[i] = u(rng);
+    const Eigen::VectorXd p = Uniform(n, rng);
     Eigen::MatrixXd d_w, d_p, fd_w(n, n), fd_p(n, n);
     const BodyVelocityMaps maps = body.Maps(c, frame);
     body.MomentumSourceDerivatives(body.Maps(c, frame), w, p, &d_w, &d_p);
@@ -311,8 +316,7 @@ TEST(SuperelementBody, MomentumDerivativesMatchFiniteDifferences) {
     // Configuration derivative of the inertia force: d(M_g wdot)/dq (analytic) against central
     // differences of f_in at w = 0 (where f_in = M_g wdot exactly), and the full derivative
     // (quadratic terms by differences inside the body) against differences of f_in.
-    Eigen::VectorXd wdot(n);
-    for (int i = 0; i < n; ++i) wdot[i] = u(rng);
+    const Eigen::VectorXd wdot = Uniform(n, rng);
     const Eigen::VectorXd zero = Eigen::VectorXd::Zero(n);
     for (bool full : {false, true}) {
       const Eigen::MatrixXd K_in = body.InertiaConfigurationTangent(c, frame, full ? w : zero, wdot, full);
@@ -342,9 +346,7 @@ TEST(SuperelementBody, ExactMomentumConfigurationTangentMatchesFiniteDifferences
   const FrameSolution frame = body.SolveFrame(c, body.GuessFrame(c));
   const int n = body.n_coordinates();
   std::mt19937 rng(3);
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
-  Eigen::VectorXd w(n);
-  for (int i = 0; i < n; ++i) w[i] = u(rng);
+  const Eigen::VectorXd w = Uniform(n, rng);
   const SuperelementBody::Data d = body.Evaluate(c, frame);
   SuperelementBody::Data side;
   Eigen::MatrixXd D;
