@@ -207,6 +207,17 @@ void Writer::Attribute(const std::string& object, const std::string& name, long 
   }
 }
 
+void Writer::CopyFrom(const std::string& source, const std::vector<std::string>& names) {
+  const hid_t id = H5Fopen(source.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  if (id < 0) throw InputError(source + ": cannot open HDF5 file to copy from");
+  const Handle from = Own(id);
+  for (const std::string& name : names) {
+    if (H5Ocopy(from.id(), name.c_str(), file_.id(), name.c_str(), H5P_DEFAULT, H5P_DEFAULT) < 0) {
+      throw InputError(path_ + ": cannot copy " + name + " from " + source);
+    }
+  }
+}
+
 void Writer::Close() {
   if (file_.id() >= 0 && H5Fflush(file_.id(), H5F_SCOPE_GLOBAL) < 0) {
     throw InputError(path_ + ": cannot flush HDF5 file");

@@ -60,6 +60,9 @@ class Writer {
   /// Attributes on an existing object ("/" for the root).
   void Attribute(const std::string& object, const std::string& name, const std::string& value);
   void Attribute(const std::string& object, const std::string& name, long value);
+  /// Copies the objects `names` (datasets, with their storage and filters as they are: no
+  /// decompression) from the HDF5 file `source` to the same names in this file.
+  void CopyFrom(const std::string& source, const std::vector<std::string>& names);
   void Close();
 
  private:

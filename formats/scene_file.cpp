@@ -454,6 +454,11 @@ SceneSpec ParseScene(const std::string& text, const std::string& name, const std
     if (auto v = m.Optional("animation_every")) scene.animation_every = int(v->NonNegativeInteger());
     if (auto v = m.Optional("reactions")) scene.reactions = scene.reactions || v->Bool();
     if (auto v = m.Optional("stresses")) scene.stresses = v->Bool();
+    if (auto v = m.Optional("flush_every")) {
+      scene.flush_every = v->Number();
+      if (!(scene.flush_every >= 0)) v->Fail("flush_every must be >= 0 (seconds of wall time between writes)");
+    }
+    if (auto v = m.Optional("flush_every_steps")) scene.flush_every_steps = long(v->NonNegativeInteger());
     if (auto exclude = m.Optional("stress_exclude")) {
       YamlMap em = exclude->Map();
       scene.stress_exclude.where = exclude->Where();

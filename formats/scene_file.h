@@ -183,6 +183,10 @@ struct SceneSpec {
   /// default (no cost); stress probes work without it.
   bool stresses = false;
   StressExcludeSpec stress_exclude;
+  /// Results written during the run (outputs.flush_every, seconds of wall time; 0: at every
+  /// output step) and every this many output steps (outputs.flush_every_steps; 0: off).
+  double flush_every = 10.0;
+  long flush_every_steps = 0;
   /// Initial velocity (spatial) of named nodes: (linear, angular).
   std::map<std::string, std::pair<Eigen::Vector3d, Eigen::Vector3d>> initial_velocities;
   /// Initial joint rates of named nodes that have a joint (revolute: angular rate, ...).

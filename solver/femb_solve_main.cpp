@@ -74,7 +74,9 @@ formats/SCENE_FORMAT.md), with joints along a tree and closed loops cut into con
                           animation
 
 options:
-  -o, --output OUTDIR   output folder (default: out/<scene name>): results.h5 and probes.csv
+  -o, --output OUTDIR   output folder (default: out/<scene name>): results.h5, probes.csv and the
+                        animation, written at the start, every outputs.flush_every seconds
+                        (default 10) and at the end (a killed run keeps what was last written)
   --set key=value       override a scene key, e.g. --set analysis.step=5e-4
                         --set analysis.end_time=0.5 (repeatable)
   --threads N           threads for the bodies' forces and matrices in dynamic analysis
@@ -156,6 +158,15 @@ int main(int argc, char** argv) {
     long total_iterations = 0;
     long step_count = 0;
     long rejected = 0;  // steps rejected so far (step: auto)
+    // Results on disk during the run: results.h5's status says how far it got.
+    const bool is_static = spec.analysis.type == femb::AnalysisType::kStatic;
+    auto flush = [&](double t, bool force) {
+      if (!force && !recorder.FlushDue()) return;
+      char running[160];
+      std::snprintf(running, sizeof running, "running: %s %.6g of %.6g (written during the run)",
+                    is_static ? "load factor" : "t =", t, spec.analysis.end_time);
+      recorder.Flush(running);
+    };
     double last_print = -1.0;
     auto progress = [&](double t, bool force) {
       if (quiet) return;
@@ -220,6 +231,7 @@ int main(int argc, char** argv) {
       auto reactions0 = static_reactions(0.0, state);
       recorder.Record(0.0, state, Eigen::VectorXd(), 0.0, 0.0, 0.0, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(),
                       spec.reactions ? &reactions0 : nullptr);
+      flush(0.0, true);
       femb::StaticOptions static_options = StaticOptionsOf(spec.analysis);
       static_options.stop = &femb::StopRequest();
       const femb::StaticResult r = femb::SolveStatic(
@@ -230,6 +242,7 @@ int main(int argc, char** argv) {
               const auto reactions = static_reactions(s.lambda, st);
               recorder.Record(s.lambda, st, Eigen::VectorXd(), 0.0, s.elastic_energy, s.external_work, Eigen::Vector3d::Zero(),
                               Eigen::Vector3d::Zero(), spec.reactions ? &reactions : nullptr);
+              flush(s.lambda, false);
             }
             progress(s.lambda, false);
           });
@@ -245,6 +258,8 @@ int main(int argc, char** argv) {
                                              : std::vector<Eigen::Matrix<double, 6, 1>>();
       recorder.Record(0.0, state.config, state.W, r0.kinetic_energy, r0.elastic_energy, 0.0, r0.linear_momentum,
                       r0.angular_momentum, spec.reactions ? &reactions0 : nullptr, &state.Wdot);
+      recorder.RecordStepSize(0.0);
+      flush(0.0, true);
       femb::DynamicOptions options;
       options.step = spec.analysis.step;
       options.end_time = spec.analysis.end_time;
@@ -274,7 +289,6 @@ int main(int argc, char** argv) {
       for (const auto& [name, f] : spec.functions) {
         for (double t : f.Breakpoints()) options.breakpoints.push_back(t);
       }
-      recorder.RecordStepSize(0.0);
       femb::DynamicState output_state;
       const femb::DynamicResult r = femb::SolveDynamic(
           scene.model, state, options, [&](const femb::DynamicStepReport& s, const femb::DynamicState& st) {
@@ -294,6 +308,7 @@ int main(int argc, char** argv) {
               recorder.Record(s.t, out.config, out.W, s.kinetic_energy, s.elastic_energy, s.external_work,
                               s.linear_momentum, s.angular_momentum, spec.reactions ? &reactions : nullptr, &out.Wdot);
               recorder.RecordStepSize(s.h);
+              flush(s.t, false);
             }
             progress(s.t, false);
           });
@@ -348,6 +363,11 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "femb-solve: %s: numerical failure: %s; results up to it are in %s\n", scene_path.c_str(),
                    status.c_str(), output.c_str());
       return 3;
+    }
+    if (!quiet && recorder.flushes() > 0) {
+      const std::string times = recorder.flushes() == 1 ? "once" : std::to_string(recorder.flushes()) + " times";
+      std::printf("femb-solve: results written %s during the run (outputs.flush_every %g s), %.3f s in all\n",
+                  times.c_str(), spec.flush_every, recorder.flush_seconds());
     }
     if (!quiet) {
       // The phases: reading (scene, superelement files, model), the analysis with its per-step

@@ -71,6 +71,8 @@ Eigen::MatrixXd ResultsRecorder::Rows::Matrix() const {
 
 ResultsRecorder::ResultsRecorder(const Scene& scene, const std::string& directory)
     : scene_(scene), dofs_(scene.model.dofs()), directory_(directory) {
+  flush_every_ = scene.spec.flush_every;
+  flush_every_steps_ = scene.spec.flush_every_steps;
   // Animation frames: as asked, or about kAutoFrames per run (the output steps the analysis will
   // take: load steps, or time steps over output_every).
   constexpr double kAutoFrames = 500;
@@ -202,6 +204,7 @@ void ResultsRecorder::Record(double t, const SystemState& state, const Eigen::Ve
     Eigen::Vector3d::Map(ang + 3 * k) = v.tail<3>();
   }
   time_.push_back(t);
+  ++outputs_since_flush_;
   kinetic_.push_back(kinetic);
   elastic_.push_back(elastic);
   work_.push_back(external_work);
@@ -483,12 +486,42 @@ bool ResultsRecorder::JointNode(int k) const {
   return false;
 }
 
+bool ResultsRecorder::FlushDue() const {
+  if (flush_every_steps_ > 0 && outputs_since_flush_ >= flush_every_steps_) return true;
+  const double since = std::chrono::duration<double>(std::chrono::steady_clock::now() - last_flush_).count();
+  return outputs_since_flush_ > 0 && since >= std::max(flush_every_, 30.0 * last_flush_cost_);
+}
+
+void ResultsRecorder::Flush(const std::string& status) {
+  const auto start = std::chrono::steady_clock::now();
+  WriteResults(status);
+  // probes.csv: the stream so far, copied whole to a temporary name and renamed.
+  csv_.flush();
+  if (!csv_) throw InputError(csv_tmp_ + ": cannot write");
+  const std::string copy = csv_path_ + ".tmp.copy." + std::to_string(::getpid());
+  std::error_code ec;
+  std::filesystem::copy_file(csv_tmp_, copy, std::filesystem::copy_options::overwrite_existing, ec);
+  if (!ec) std::filesystem::rename(copy, csv_path_, ec);
+  if (ec) throw InputError(csv_path_ + ": cannot write (" + ec.message() + ")");
+  WriteAnimationPart();
+  last_flush_ = std::chrono::steady_clock::now();
+  last_flush_cost_ = std::chrono::duration<double>(last_flush_ - start).count();
+  flush_seconds_ += last_flush_cost_;
+  ++flushes_;
+  outputs_since_flush_ = 0;
+}
+
 void ResultsRecorder::Finish(const std::string& status) {
   csv_.close();
   std::error_code ec;
   std::filesystem::rename(csv_tmp_, csv_path_, ec);
   if (ec) throw InputError(csv_path_ + ": cannot rename into place (" + ec.message() + ")");
+  WriteResults(status);
+  FinishAnimation();
+}
 
+void ResultsRecorder::WriteResults(const std::string& status) {
+  std::error_code ec;
   const std::string tmp = h5_path_ + ".tmp." + std::to_string(::getpid());
   {
     const SystemModel& model = scene_.model;
@@ -576,16 +609,17 @@ void ResultsRecorder::Finish(const std::string& status) {
   }
   std::filesystem::rename(tmp, h5_path_, ec);
   if (ec) throw InputError(h5_path_ + ": cannot rename into place (" + ec.message() + ")");
-  WriteAnimation();
 }
 
-void ResultsRecorder::WriteAnimation() {
-  // One unstructured grid per output step holding every body (nodes concatenated, cell data
-  // 'body' = body index): a temporal collection that ParaView and meshio read. Bodies with a
-  // mesh show it; the others (rigid bodies, superelements reduced without their mesh) a stick
-  // figure of lines from their first node to the others. One cell type: a uniform topology;
-  // several (beams and solids, sticks): XDMF's Mixed topology.
-  if (!scene_.spec.animation || frame_time_.empty()) return;
+const ResultsRecorder::AnimationGrid& ResultsRecorder::Grid() {
+  // One unstructured grid per frame holding every body (nodes concatenated, cell data 'body' =
+  // body index): a temporal collection that ParaView and meshio read. Bodies with a mesh show
+  // it; the others (rigid bodies, superelements reduced without their mesh) a stick figure of
+  // lines from their first node to the others. One cell type: a uniform topology; several
+  // (beams and solids, sticks): XDMF's Mixed topology.
+  if (grid_) return *grid_;
+  grid_ = std::make_unique<AnimationGrid>();
+  AnimationGrid& g = *grid_;
   struct Block {
     std::string cell_type;  // "line2", "tet10", ...
     Eigen::MatrixXi cells;  // VTK/XDMF node order, body-local node indices
@@ -605,136 +639,205 @@ void ResultsRecorder::WriteAnimation() {
       body_nodes[b] = m;
     }
   }
-  bool uniform = true;
-  for (const Block& block : blocks) uniform &= block.cell_type == blocks.front().cell_type;
-  long n_nodes = 0, n_cells = 0;
-  for (size_t b = 0; b < blocks.size(); ++b) n_nodes += body_nodes[b], n_cells += blocks[b].cells.rows();
-  if (n_nodes == 0 || n_cells == 0) return;
+  for (const Block& block : blocks) g.uniform &= block.cell_type == blocks.front().cell_type;
+  for (size_t b = 0; b < blocks.size(); ++b) g.n_nodes += body_nodes[b], g.n_cells += blocks[b].cells.rows();
+  if (g.n_nodes == 0 || g.n_cells == 0) return g;
   // Topology: uniform, n_cells x per_cell; mixed, one flat list of (XDMF type, [count,] nodes...).
-  const int per_cell = uniform ? int(blocks.front().cells.cols()) : 0;
-  std::vector<int> flat;
-  Eigen::MatrixXd body(n_cells, 1);
+  g.per_cell = g.uniform ? int(blocks.front().cells.cols()) : 0;
+  g.body.resize(g.n_cells, 1);
   long node_offset = 0, cell_offset = 0;
   for (size_t b = 0; b < blocks.size(); ++b) {
     const Block& block = blocks[b];
     const int code = XdmfMixedCode(block.cell_type);
     for (long c = 0; c < block.cells.rows(); ++c) {
-      if (!uniform) {
-        flat.push_back(code);
-        if (code == 2) flat.push_back(int(block.cells.cols()));  // polyline: its node count
+      if (!g.uniform) {
+        g.flat.push_back(code);
+        if (code == 2) g.flat.push_back(int(block.cells.cols()));  // polyline: its node count
       }
-      for (long i = 0; i < block.cells.cols(); ++i) flat.push_back(block.cells(c, i) + int(node_offset));
+      for (long i = 0; i < block.cells.cols(); ++i) g.flat.push_back(block.cells(c, i) + int(node_offset));
     }
-    body.middleRows(cell_offset, block.cells.rows()).setConstant(double(b));
+    g.body.middleRows(cell_offset, block.cells.rows()).setConstant(double(b));
     node_offset += body_nodes[b];
     cell_offset += block.cells.rows();
   }
-  const Eigen::MatrixXi cells = uniform ? Eigen::MatrixXi(Eigen::Map<Eigen::Matrix<int, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(
-                                              flat.data(), n_cells, per_cell))
-                                        : Eigen::MatrixXi();
-  const std::string cell_type = uniform ? blocks.front().cell_type : "mixed";
-  const std::filesystem::path dir(directory_);
-  const std::string h5 = (dir / "animation.h5").string(), xdmf = (dir / "animation.xdmf").string();
-  const std::string pid = std::to_string(::getpid());
-  {
-    h5::Writer w(h5 + ".tmp." + pid, /*v110=*/true);
-    Eigen::MatrixXf x0;
-    if (uniform) {
-      w.IntMatrix("/cells", cells);
-    } else {
-      w.IntVector("/cells", flat);
-    }
-    w.Matrix("/body", body);
-    // Rounded where the bits carry nothing a picture shows, so that they compress (shuffle and
-    // deflate): the positions, the displacement and the deformation to multiples of 2^-22 of the
-    // largest coordinate of the run (2.4e-7 m in a 1 m scene, where single precision resolves
-    // 6e-8; the displacement is then the exact difference of the stored positions), the
-    // principal stresses to 2^-12 of the frame's largest (colour maps show 256 levels), the von
-    // Mises stress as it is (results.h5's maximum is its largest to 1e-7). The positions and the
-    // von Mises stress are stored uncompressed: deflate shrank them by 1.5x and 1.2x only, at
-    // half the writing time of a solid cantilever's animation.
-    float largest = 0.0f;
-    for (const auto& frame : mesh_positions_) {
-      for (const Eigen::MatrixXf& x : frame) largest = std::max(largest, x.size() ? x.cwiseAbs().maxCoeff() : 0.0f);
-    }
-    const float geometry_step = Resolution(largest, 22);
-    const auto round = [](const Eigen::MatrixXf& v, float step) -> Eigen::MatrixXf {
-      return step > 0 ? Eigen::MatrixXf((v / step).array().round() * step) : v;
-    };
-    // The frames' datasets compressed in batches of 32 frames on the machine's cores.
-    const int threads = int(std::clamp(std::thread::hardware_concurrency(), 1u, 8u));
-    std::vector<h5::Writer::FloatData> batch;
-    for (size_t s = 0; s < frame_time_.size(); ++s) {
-      Eigen::MatrixXf x(n_nodes, 3), d(n_nodes, 3);
-      long offset = 0;
-      for (size_t b = 0; b < blocks.size(); ++b) {
-        x.middleRows(offset, mesh_positions_[s][b].rows()) = mesh_positions_[s][b];
-        d.middleRows(offset, mesh_deformations_[s][b].rows()) = mesh_deformations_[s][b];
-        offset += mesh_positions_[s][b].rows();
-      }
-      x = round(x, geometry_step);
-      if (s == 0) x0 = x;
-      const std::string index = std::to_string(s);
-      batch.push_back({"/x_" + index, x, false});
-      batch.push_back({"/deformation_" + index, round(d, geometry_step)});
-      batch.push_back({"/displacement_" + index, x - x0});
-      if (s < frame_stress_.size()) {
-        Eigen::MatrixXf f(n_nodes, 4);
-        offset = 0;
-        for (size_t b = 0; b < blocks.size(); ++b) {
-          f.middleRows(offset, frame_stress_[s][b].rows()) = frame_stress_[s][b];
-          offset += frame_stress_[s][b].rows();
-        }
-        batch.push_back({"/von_mises_" + index, f.leftCols(1), false});
-        batch.push_back({"/principal_stress_" + index, round(f.rightCols(3), Resolution(f.rightCols(3).cwiseAbs().maxCoeff(), 12))});
-      }
-      if (s % 32 == 31 || s + 1 == frame_time_.size()) {
-        w.CompressedFloatMatrices(batch, threads);
-        batch.clear();
-      }
-    }
-    w.Close();
+  if (g.uniform) {
+    g.cells = Eigen::Map<Eigen::Matrix<int, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(g.flat.data(), g.n_cells, g.per_cell);
+    g.flat.clear();
   }
-  const std::string topology = uniform ? XdmfTopology(cell_type) : "Mixed";
-  std::ofstream out(xdmf + ".tmp." + pid);
+  g.cell_type = g.uniform ? blocks.front().cell_type : "mixed";
+  return g;
+}
+
+void ResultsRecorder::WriteMesh(h5::Writer& w) {
+  const AnimationGrid& g = Grid();
+  if (g.uniform) {
+    w.IntMatrix("/cells", g.cells);
+  } else {
+    w.IntVector("/cells", g.flat);
+  }
+  w.Matrix("/body", g.body);
+}
+
+void ResultsRecorder::WriteFrames(h5::Writer& w, const std::string& file) {
+  const AnimationGrid& g = Grid();
+  // Rounded where the bits carry nothing a picture shows, so that they compress (shuffle and
+  // deflate): the positions, the displacement and the deformation to multiples of 2^-22 of the
+  // largest coordinate so far (2.4e-7 m in a 1 m scene, where single precision resolves 6e-8;
+  // within one write the displacement is then the exact difference of the stored positions),
+  // the principal stresses to 2^-12 of the frame's largest (colour maps show 256 levels), the
+  // von Mises stress as it is (results.h5's maximum is its largest to 1e-7). The positions and
+  // the von Mises stress are stored uncompressed: deflate shrank them by 1.5x and 1.2x only, at
+  // half the writing time of a solid cantilever's animation.
+  for (const auto& frame : mesh_positions_) {
+    for (const Eigen::MatrixXf& x : frame) geometry_largest_ = std::max(geometry_largest_, x.size() ? x.cwiseAbs().maxCoeff() : 0.0f);
+  }
+  const float geometry_step = Resolution(geometry_largest_, 22);
+  const auto round = [](const Eigen::MatrixXf& v, float step) -> Eigen::MatrixXf {
+    return step > 0 ? Eigen::MatrixXf((v / step).array().round() * step) : v;
+  };
+  // The frames' datasets compressed in batches of 32 frames on the machine's cores.
+  const int threads = int(std::clamp(std::thread::hardware_concurrency(), 1u, 8u));
+  std::vector<h5::Writer::FloatData> batch;
+  const size_t pending = mesh_positions_.size();
+  for (size_t p = 0; p < pending; ++p) {
+    const size_t s = frames_written_ + p;
+    Eigen::MatrixXf x(g.n_nodes, 3), d(g.n_nodes, 3);
+    long offset = 0;
+    for (size_t b = 0; b < mesh_positions_[p].size(); ++b) {
+      x.middleRows(offset, mesh_positions_[p][b].rows()) = mesh_positions_[p][b];
+      d.middleRows(offset, mesh_deformations_[p][b].rows()) = mesh_deformations_[p][b];
+      offset += mesh_positions_[p][b].rows();
+    }
+    x = round(x, geometry_step);
+    if (s == 0) x0_ = x;
+    const std::string index = std::to_string(s);
+    batch.push_back({"/x_" + index, x, false});
+    batch.push_back({"/deformation_" + index, round(d, geometry_step)});
+    batch.push_back({"/displacement_" + index, x - x0_});
+    const bool stress = p < frame_stress_.size();
+    if (stress) {
+      Eigen::MatrixXf f(g.n_nodes, 4);
+      offset = 0;
+      for (size_t b = 0; b < frame_stress_[p].size(); ++b) {
+        f.middleRows(offset, frame_stress_[p][b].rows()) = frame_stress_[p][b];
+        offset += frame_stress_[p][b].rows();
+      }
+      batch.push_back({"/von_mises_" + index, f.leftCols(1), false});
+      batch.push_back({"/principal_stress_" + index, round(f.rightCols(3), Resolution(f.rightCols(3).cwiseAbs().maxCoeff(), 12))});
+    }
+    frame_file_.push_back(file);
+    frame_stress_fields_.push_back(stress);
+    if (p % 32 == 31 || p + 1 == pending) {
+      w.CompressedFloatMatrices(batch, threads);
+      batch.clear();
+    }
+  }
+  frames_written_ += pending;
+  mesh_positions_.clear();
+  mesh_deformations_.clear();
+  frame_stress_.clear();
+}
+
+void ResultsRecorder::WriteXdmf(const std::string& mesh_file) {
+  const AnimationGrid& g = Grid();
+  const std::string topology = g.uniform ? XdmfTopology(g.cell_type) : "Mixed";
+  const std::string xdmf = (std::filesystem::path(directory_) / "animation.xdmf").string();
+  const std::string tmp = xdmf + ".tmp." + std::to_string(::getpid());
+  std::ofstream out(tmp);
   out << "<?xml version=\"1.0\" ?>\n<Xdmf Version=\"3.0\">\n <Domain>\n"
       << "  <Grid Name=\"" << scene_.spec.name << "\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
-  for (size_t s = 0; s < frame_time_.size(); ++s) {
+  const long n_nodes = g.n_nodes;
+  for (size_t s = 0; s < frames_written_; ++s) {
+    const std::string& file = frame_file_[s];
     out << "   <Grid Name=\"step " << s << "\" GridType=\"Uniform\">\n"
         << "    <Time Value=\"" << Num(frame_time_[s]) << "\"/>\n"
-        << "    <Topology TopologyType=\"" << topology << "\" NumberOfElements=\"" << n_cells << "\"";
-    if (cell_type == "line2") out << " NodesPerElement=\"2\"";
-    out << ">\n     <DataItem Dimensions=\"" << (uniform ? std::to_string(n_cells) + " " + std::to_string(per_cell)
-                                                  : std::to_string(flat.size()))
-        << "\" NumberType=\"Int\" Precision=\"4\" Format=\"HDF\">animation.h5:/cells</DataItem>\n    </Topology>\n"
+        << "    <Topology TopologyType=\"" << topology << "\" NumberOfElements=\"" << g.n_cells << "\"";
+    if (g.cell_type == "line2") out << " NodesPerElement=\"2\"";
+    out << ">\n     <DataItem Dimensions=\""
+        << (g.uniform ? std::to_string(g.n_cells) + " " + std::to_string(g.per_cell) : std::to_string(g.flat.size()))
+        << "\" NumberType=\"Int\" Precision=\"4\" Format=\"HDF\">" << mesh_file << ":/cells</DataItem>\n    </Topology>\n"
         << "    <Geometry GeometryType=\"XYZ\">\n     <DataItem Dimensions=\"" << n_nodes
-        << " 3\" NumberType=\"Float\" Precision=\"4\" Format=\"HDF\">animation.h5:/x_" << s
+        << " 3\" NumberType=\"Float\" Precision=\"4\" Format=\"HDF\">" << file << ":/x_" << s
         << "</DataItem>\n    </Geometry>\n"
         << "    <Attribute Name=\"body\" AttributeType=\"Scalar\" Center=\"Cell\">\n     <DataItem Dimensions=\""
-        << n_cells << " 1\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">animation.h5:/body</DataItem>\n"
+        << g.n_cells << " 1\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">" << mesh_file << ":/body</DataItem>\n"
         << "    </Attribute>\n"
         << "    <Attribute Name=\"deformation\" AttributeType=\"Vector\" Center=\"Node\">\n     <DataItem Dimensions=\""
-        << n_nodes << " 3\" NumberType=\"Float\" Precision=\"4\" Format=\"HDF\">animation.h5:/deformation_" << s
+        << n_nodes << " 3\" NumberType=\"Float\" Precision=\"4\" Format=\"HDF\">" << file << ":/deformation_" << s
         << "</DataItem>\n    </Attribute>\n"
         << "    <Attribute Name=\"displacement\" AttributeType=\"Vector\" Center=\"Node\">\n     <DataItem Dimensions=\""
-        << n_nodes << " 3\" NumberType=\"Float\" Precision=\"4\" Format=\"HDF\">animation.h5:/displacement_" << s
+        << n_nodes << " 3\" NumberType=\"Float\" Precision=\"4\" Format=\"HDF\">" << file << ":/displacement_" << s
         << "</DataItem>\n    </Attribute>\n";
-    if (s < frame_stress_.size()) {
+    if (frame_stress_fields_[s]) {
       out << "    <Attribute Name=\"von_mises\" AttributeType=\"Scalar\" Center=\"Node\">\n     <DataItem Dimensions=\""
-          << n_nodes << " 1\" NumberType=\"Float\" Precision=\"4\" Format=\"HDF\">animation.h5:/von_mises_" << s
+          << n_nodes << " 1\" NumberType=\"Float\" Precision=\"4\" Format=\"HDF\">" << file << ":/von_mises_" << s
           << "</DataItem>\n    </Attribute>\n"
           << "    <Attribute Name=\"principal_stress\" AttributeType=\"Vector\" Center=\"Node\">\n     <DataItem Dimensions=\""
-          << n_nodes << " 3\" NumberType=\"Float\" Precision=\"4\" Format=\"HDF\">animation.h5:/principal_stress_" << s
+          << n_nodes << " 3\" NumberType=\"Float\" Precision=\"4\" Format=\"HDF\">" << file << ":/principal_stress_" << s
           << "</DataItem>\n    </Attribute>\n";
     }
     out << "   </Grid>\n";
   }
   out << "  </Grid>\n </Domain>\n</Xdmf>\n";
   out.close();
+  if (!out) throw InputError(tmp + ": cannot write");
   std::error_code ec;
-  std::filesystem::rename(h5 + ".tmp." + pid, h5, ec);
-  if (!ec) std::filesystem::rename(xdmf + ".tmp." + pid, xdmf, ec);
+  std::filesystem::rename(tmp, xdmf, ec);
   if (ec) throw InputError(xdmf + ": cannot rename into place (" + ec.message() + ")");
+}
+
+void ResultsRecorder::WriteAnimationPart() {
+  if (!scene_.spec.animation || mesh_positions_.empty() || Grid().n_cells == 0) return;
+  const std::filesystem::path dir(directory_);
+  char name[64];
+  std::snprintf(name, sizeof name, "animation.part-%04zu.h5", animation_parts_.size());
+  const std::string path = (dir / name).string(), tmp = path + ".tmp." + std::to_string(::getpid());
+  {
+    h5::Writer w(tmp, /*v110=*/true);
+    if (animation_parts_.empty()) WriteMesh(w);
+    WriteFrames(w, name);
+    w.Close();
+  }
+  std::error_code ec;
+  std::filesystem::rename(tmp, path, ec);
+  if (ec) throw InputError(path + ": cannot rename into place (" + ec.message() + ")");
+  if (animation_parts_.empty()) std::filesystem::remove(dir / "animation.h5", ec);  // an earlier run's
+  animation_parts_.push_back(name);
+  WriteXdmf(animation_parts_.front());
+}
+
+void ResultsRecorder::FinishAnimation() {
+  if (!scene_.spec.animation || frame_time_.empty() || Grid().n_cells == 0) return;
+  // animation.h5: the mesh, the frames of the part files written during the run (copied as they
+  // are stored) and the frames since.
+  const std::filesystem::path dir(directory_);
+  const std::string h5 = (dir / "animation.h5").string(), tmp = h5 + ".tmp." + std::to_string(::getpid());
+  {
+    h5::Writer w(tmp, /*v110=*/true);
+    WriteMesh(w);
+    for (const std::string& part : animation_parts_) {
+      std::vector<std::string> names;
+      for (size_t s = 0; s < frames_written_; ++s) {
+        if (frame_file_[s] != part) continue;
+        const std::string index = std::to_string(s);
+        for (const char* field : {"/x_", "/deformation_", "/displacement_"}) names.push_back(field + index);
+        if (frame_stress_fields_[s]) names.insert(names.end(), {"/von_mises_" + index, "/principal_stress_" + index});
+      }
+      w.CopyFrom((dir / part).string(), names);
+    }
+    WriteFrames(w, "animation.h5");
+    w.Close();
+  }
+  std::error_code ec;
+  std::filesystem::rename(tmp, h5, ec);
+  if (ec) throw InputError(h5 + ": cannot rename into place (" + ec.message() + ")");
+  std::fill(frame_file_.begin(), frame_file_.end(), "animation.h5");
+  WriteXdmf("animation.h5");
+  // The part files, now in animation.h5 (and an earlier run's left by a kill).
+  for (const auto& entry : std::filesystem::directory_iterator(dir, ec)) {
+    const std::string file = entry.path().filename().string();
+    if (file.rfind("animation.part-", 0) == 0) std::filesystem::remove(entry.path(), ec);
+  }
 }
 
 }  // namespace femb

@@ -1,18 +1,26 @@
 // Results of a simulation: an HDF5 file with every node's motion, the modal coordinates and
 // floating frames of every body and the energies per output step, and a CSV of the requested
-// probes that always ends with kinetic_energy,elastic_energy,external_work. Both are written
-// to temporary names and renamed by Finish(), which is also called after a numerical failure
-// so the results up to it are kept. Layout: formats/SCENE_FORMAT.md. When the superelement
-// files hold meshes and mode shapes, animation.xdmf + animation.h5 give the deformed meshes of
-// every output step for ParaView: x(X) = x_j + R_j (X - X_j + u(X)), u = shapes * q_loc.
+// probes that always ends with kinetic_energy,elastic_energy,external_work. Layout:
+// formats/SCENE_FORMAT.md. When the superelement files hold meshes and mode shapes,
+// animation.xdmf + animation.h5 give the deformed meshes of every output step for ParaView:
+// x(X) = x_j + R_j (X - X_j + u(X)), u = shapes * q_loc.
+//
+// Written during the run (Flush, every outputs.flush_every seconds) and at its end (Finish, also
+// after a numerical failure or a stop): each file whole under a temporary name, then renamed, so
+// that a reader, or a run killed at any moment, finds complete files holding every output step
+// up to the last write. During the run the animation's frames go to part files written once
+// each (animation.part-N.h5, referenced by animation.xdmf); Finish gathers them into
+// animation.h5.
 #pragma once
 
 #include <algorithm>
+#include <chrono>
 #include <fstream>
 #include <memory>
 #include <string>
 #include <vector>
 
+#include "formats/hdf5_file.h"
 #include "solver/scene/scene_builder.h"
 
 namespace femb {
@@ -44,9 +52,20 @@ class ResultsRecorder {
   void StepCounts(long taken, long rejected_by_error, long newton_cuts) {
     steps_taken_ = taken, rejected_by_error_ = rejected_by_error, newton_cuts_ = newton_cuts;
   }
-  /// Writes results.h5 and renames both files into place. `status` is stored ("completed" or the
-  /// failure message).
+  /// Whether a write during the run is due: outputs.flush_every seconds of wall time since the
+  /// last one (and at least 30 times that write's duration: the writing stays within about 3% of
+  /// the run as results.h5 grows), or outputs.flush_every_steps output steps.
+  bool FlushDue() const;
+  /// Writes results.h5 (its `status` says the run goes on, e.g. "running: t = 0.5 of 2"),
+  /// probes.csv and the animation's frames since the last write (a new part file) under their
+  /// final names.
+  void Flush(const std::string& status);
+  /// Writes results.h5, probes.csv and animation.h5 in their final form. `status` is stored
+  /// ("completed", the failure message, or where a signal stopped the run).
   void Finish(const std::string& status);
+  /// Writes during the run so far: their number and their wall time in seconds.
+  long flushes() const { return flushes_; }
+  double flush_seconds() const { return flush_seconds_; }
   const std::string& csv_path() const { return csv_path_; }
   const std::string& h5_path() const { return h5_path_; }
   long steps() const { return long(time_.size()); }
@@ -116,7 +135,38 @@ class ResultsRecorder {
   Eigen::MatrixXd stress_scratch_;
   Eigen::VectorXd von_mises_scratch_;
   Eigen::VectorXf field_scratch_;
-  void WriteAnimation();
+  // Writing during the run (Flush).
+  double flush_every_ = 10.0;
+  long flush_every_steps_ = 0, outputs_since_flush_ = 0, flushes_ = 0;
+  std::chrono::steady_clock::time_point last_flush_ = std::chrono::steady_clock::now();
+  double last_flush_cost_ = 0.0, flush_seconds_ = 0.0;
+  // The animation's grid (every body's mesh or stick figure; built at the first frame written)
+  // and where each frame is: frame_time_ holds every frame's time, mesh_positions_,
+  // mesh_deformations_ and frame_stress_ the frames not yet written (from frames_written_ on).
+  struct AnimationGrid {
+    bool uniform = true;
+    std::string cell_type;  ///< "line2", "tet10", ... or "mixed"
+    int per_cell = 0;       ///< nodes per cell (uniform)
+    long n_nodes = 0, n_cells = 0;
+    Eigen::MatrixXi cells;  ///< uniform: n_cells x per_cell
+    std::vector<int> flat;  ///< mixed: (XDMF type, [count,] nodes...) per cell
+    Eigen::MatrixXd body;   ///< per cell, its body's index
+  };
+  std::unique_ptr<AnimationGrid> grid_;
+  size_t frames_written_ = 0;
+  std::vector<std::string> frame_file_;  ///< per written frame, the file (in directory_) holding it
+  std::vector<char> frame_stress_fields_;  ///< per written frame, whether it has stress fields
+  std::vector<std::string> animation_parts_;  ///< part files written during the run
+  float geometry_largest_ = 0.0f;  ///< the largest coordinate of the frames written so far
+  Eigen::MatrixXf x0_;             ///< the first frame's stored positions (displacement = x - x0)
+  const AnimationGrid& Grid();
+  /// Writes the pending frames into `w` (the file `file` in directory_) and forgets them.
+  void WriteFrames(h5::Writer& w, const std::string& file);
+  void WriteMesh(h5::Writer& w);
+  void WriteXdmf(const std::string& mesh_file);
+  void WriteAnimationPart();
+  void FinishAnimation();
+  void WriteResults(const std::string& status);
   bool JointNode(int k) const;
 };
 
