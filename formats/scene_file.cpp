@@ -359,6 +359,16 @@ SceneSpec ParseScene(const std::string& text, const std::string& name, const std
     }
   }
 
+  if (auto initial = root.Optional("initial_state")) {
+    YamlMap m = initial->Map();
+    const YamlValue from = m.Required("from");
+    scene.initial_state.from = from.String();
+    scene.initial_state.where = initial->Where();
+    if (auto t = m.Optional("time")) scene.initial_state.time = t->Number();
+    m.CheckNoUnknownKeys();
+    if (scene.initial_state.from.empty()) from.Fail("initial_state.from: give the folder of a femb-solve run");
+  }
+
   if (auto initial = root.Optional("initial_velocity")) {
     for (const auto& [node, value] : initial->Map().Entries()) {
       YamlMap m = value.Map();

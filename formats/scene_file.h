@@ -187,6 +187,13 @@ struct SceneSpec {
   /// output step) and every this many output steps (outputs.flush_every_steps; 0: off).
   double flush_every = 10.0;
   long flush_every_steps = 0;
+  /// initial_state: start from the state another run reached (its folder's checkpoint.h5; a
+  /// relative folder is relative to the scene file's), at `time` (unset: a dynamic run's state
+  /// at its own time, a static one's at 0).
+  struct InitialStateSpec {
+    std::string from, where;
+    std::optional<double> time;
+  } initial_state;
   /// Initial velocity (spatial) of named nodes: (linear, angular).
   std::map<std::string, std::pair<Eigen::Vector3d, Eigen::Vector3d>> initial_velocities;
   /// Initial joint rates of named nodes that have a joint (revolute: angular rate, ...).

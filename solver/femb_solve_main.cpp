@@ -4,7 +4,9 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
+#include <optional>
 #include <set>
 #include <string>
 #include <vector>
@@ -15,6 +17,7 @@
 #include "solver/analysis/dynamic_analysis.h"
 #include "solver/analysis/modal_analysis.h"
 #include "solver/analysis/static_analysis.h"
+#include "solver/output/checkpoint.h"
 #include "solver/output/results_recorder.h"
 #include "solver/parallel.h"
 #include "solver/stop_request.h"
@@ -121,7 +124,37 @@ int main(int argc, char** argv) {
     const femb::SceneSpec spec = femb::ReadSceneFile(scene_path, overrides);
     const femb::Scene scene = femb::BuildScene(spec);
     if (output.empty()) output = "out/" + spec.name;
+    // initial_state: the state another run reached, read (and checked against this model)
+    // before anything is written.
+    std::optional<femb::DynamicState> from;
+    double t0 = 0.0;
+    if (!spec.initial_state.from.empty()) {
+      const femb::SceneSpec::InitialStateSpec& is = spec.initial_state;
+      if (spec.analysis.type == femb::AnalysisType::kStatic) {
+        throw femb::InputError(is.where + ": initial_state: a static analysis starts from the model's placement (give it "
+                               "to a dynamic or modes analysis)");
+      }
+      if (!spec.initial_velocities.empty() || !spec.initial_joint_rates.empty()) {
+        throw femb::InputError(is.where + ": initial_state: the velocities are the state's; leave out initial_velocity");
+      }
+      std::filesystem::path dir(is.from);
+      if (dir.is_relative()) dir = std::filesystem::path(spec.file).parent_path() / dir;
+      std::string kind;
+      from = femb::ReadCheckpoint(dir.string(), scene, &kind);
+      t0 = is.time ? *is.time : kind == "dynamic" ? from->t : 0.0;
+      if (spec.analysis.type == femb::AnalysisType::kDynamic && !(spec.analysis.end_time > t0)) {
+        char buffer[200];
+        std::snprintf(buffer, sizeof buffer, ": analysis.end_time %.6g is not after the initial state's time %.6g",
+                      spec.analysis.end_time, t0);
+        throw femb::InputError(is.where + buffer);
+      }
+      if (!quiet) {
+        std::printf("femb-solve: initial state: the %s state of %s at t = %.6g, started at t = %.6g\n", kind.c_str(),
+                    dir.string().c_str(), from->t, t0);
+      }
+    }
     femb::ResultsRecorder recorder(scene, output);
+    const std::string signature = femb::ModelSignature(scene);
     const femb::DofMap& dofs = scene.model.dofs();
     const double read_seconds = Seconds(wall);  // scene, superelement files, model
     if (!quiet) {
@@ -160,12 +193,21 @@ int main(int argc, char** argv) {
     long rejected = 0;  // steps rejected so far (step: auto)
     // Results on disk during the run: results.h5's status says how far it got.
     const bool is_static = spec.analysis.type == femb::AnalysisType::kStatic;
-    auto flush = [&](double t, bool force) {
+    const char* kind = is_static ? "static" : "dynamic";
+    auto flush = [&](const femb::DynamicState& state, bool force) {
       if (!force && !recorder.FlushDue()) return;
       char running[160];
       std::snprintf(running, sizeof running, "running: %s %.6g of %.6g (written during the run)",
-                    is_static ? "load factor" : "t =", t, spec.analysis.end_time);
+                    is_static ? "load factor" : "t =", state.t, spec.analysis.end_time);
       recorder.Flush(running);
+      femb::WriteCheckpoint(output, scene, signature, state, kind);
+    };
+    // A static state as a checkpoint's: the configuration at load factor t, at rest.
+    auto at_rest = [](const femb::SystemState& config, double t) {
+      femb::DynamicState s;
+      s.config = config;
+      s.t = t;
+      return s;
     };
     double last_print = -1.0;
     auto progress = [&](double t, bool force) {
@@ -185,9 +227,9 @@ int main(int argc, char** argv) {
       std::fflush(stdout);
     };
     if (spec.analysis.type == femb::AnalysisType::kModes) {
-      femb::SystemState state = femb::InitialState(scene.model);
-      double load_time = 0.0;
-      if (spec.analysis.modes_about_static) {
+      femb::SystemState state = from ? from->config : femb::InitialState(scene.model);
+      double load_time = t0;
+      if (spec.analysis.modes_about_static && !from) {
         const femb::StaticResult r = femb::SolveStatic(scene.model, state, StaticOptionsOf(spec.analysis));
         if (!r.ok) {
           recorder.Finish(r.message);
@@ -231,7 +273,7 @@ int main(int argc, char** argv) {
       auto reactions0 = static_reactions(0.0, state);
       recorder.Record(0.0, state, Eigen::VectorXd(), 0.0, 0.0, 0.0, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(),
                       spec.reactions ? &reactions0 : nullptr);
-      flush(0.0, true);
+      flush(at_rest(state, 0.0), true);
       femb::StaticOptions static_options = StaticOptionsOf(spec.analysis);
       static_options.stop = &femb::StopRequest();
       const femb::StaticResult r = femb::SolveStatic(
@@ -242,7 +284,7 @@ int main(int argc, char** argv) {
               const auto reactions = static_reactions(s.lambda, st);
               recorder.Record(s.lambda, st, Eigen::VectorXd(), 0.0, s.elastic_energy, s.external_work, Eigen::Vector3d::Zero(),
                               Eigen::Vector3d::Zero(), spec.reactions ? &reactions : nullptr);
-              flush(s.lambda, false);
+              if (recorder.FlushDue()) flush(at_rest(st, s.lambda), true);
             }
             progress(s.lambda, false);
           });
@@ -250,16 +292,19 @@ int main(int argc, char** argv) {
       if (!ok) status = r.message;
       stopped = r.stopped;
       stopped_at = r.steps.empty() ? 0.0 : r.steps.back().lambda;
+      femb::WriteCheckpoint(output, scene, signature, at_rest(state, r.steps.empty() ? 0.0 : r.steps.back().lambda), kind);
       for (const std::string& w : r.warnings) std::printf("femb-solve: warning: %s\n", w.c_str());
     } else {
-      femb::DynamicState state = femb::InitialDynamicState(scene.model, femb::InitialState(scene.model), scene.initial_velocity);
+      femb::DynamicState state =
+          from ? femb::InitialDynamicState(scene.model, from->config, from->W.size() ? from->W : scene.initial_velocity, t0)
+               : femb::InitialDynamicState(scene.model, femb::InitialState(scene.model), scene.initial_velocity);
       const femb::DynamicStepReport r0 = femb::Measure(scene.model, state);
       const auto reactions0 = spec.reactions ? femb::DynamicReactions(scene.model, state)
                                              : std::vector<Eigen::Matrix<double, 6, 1>>();
-      recorder.Record(0.0, state.config, state.W, r0.kinetic_energy, r0.elastic_energy, 0.0, r0.linear_momentum,
+      recorder.Record(state.t, state.config, state.W, r0.kinetic_energy, r0.elastic_energy, 0.0, r0.linear_momentum,
                       r0.angular_momentum, spec.reactions ? &reactions0 : nullptr, &state.Wdot);
       recorder.RecordStepSize(0.0);
-      flush(0.0, true);
+      flush(state, true);
       femb::DynamicOptions options;
       options.step = spec.analysis.step;
       options.end_time = spec.analysis.end_time;
@@ -308,7 +353,7 @@ int main(int argc, char** argv) {
               recorder.Record(s.t, out.config, out.W, s.kinetic_energy, s.elastic_energy, s.external_work,
                               s.linear_momentum, s.angular_momentum, spec.reactions ? &reactions : nullptr, &out.Wdot);
               recorder.RecordStepSize(s.h);
-              flush(s.t, false);
+              flush(st, false);
             }
             progress(s.t, false);
           });
@@ -316,6 +361,7 @@ int main(int argc, char** argv) {
       if (!ok) status = r.message;
       stopped = r.stopped;
       stopped_at = state.t;
+      femb::WriteCheckpoint(output, scene, signature, state, kind);
       for (const std::string& w : r.warnings) std::printf("femb-solve: warning: %s\n", w.c_str());
       if (!quiet) {
         const std::string analysed = r.pattern_analyses == 1 ? "once" : std::to_string(r.pattern_analyses) + " times";

@@ -489,7 +489,7 @@ bool ResultsRecorder::JointNode(int k) const {
 bool ResultsRecorder::FlushDue() const {
   if (flush_every_steps_ > 0 && outputs_since_flush_ >= flush_every_steps_) return true;
   const double since = std::chrono::duration<double>(std::chrono::steady_clock::now() - last_flush_).count();
-  return outputs_since_flush_ > 0 && since >= std::max(flush_every_, 30.0 * last_flush_cost_);
+  return outputs_since_flush_ > 0 && since >= std::max(flush_every_, 50.0 * last_flush_cost_);
 }
 
 void ResultsRecorder::Flush(const std::string& status) {

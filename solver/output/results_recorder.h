@@ -53,7 +53,7 @@ class ResultsRecorder {
     steps_taken_ = taken, rejected_by_error_ = rejected_by_error, newton_cuts_ = newton_cuts;
   }
   /// Whether a write during the run is due: outputs.flush_every seconds of wall time since the
-  /// last one (and at least 30 times that write's duration: the writing stays within about 3% of
+  /// last one (and at least 50 times that write's duration: the writing stays within about 2% of
   /// the run as results.h5 grows), or outputs.flush_every_steps output steps.
   bool FlushDue() const;
   /// Writes results.h5 (its `status` says the run goes on, e.g. "running: t = 0.5 of 2"),
