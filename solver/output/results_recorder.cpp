@@ -494,8 +494,9 @@ bool ResultsRecorder::FlushDue() const {
 
 void ResultsRecorder::Flush(const std::string& status) {
   const auto start = std::chrono::steady_clock::now();
-  WriteResults(status);
-  // probes.csv: the stream so far, copied whole to a temporary name and renamed.
+  // probes.csv (the stream so far, copied whole to a temporary name and renamed) before
+  // results.h5: killed between the two renames, probes.csv holds the newer steps and results.h5
+  // those of the write before.
   csv_.flush();
   if (!csv_) throw InputError(csv_tmp_ + ": cannot write");
   const std::string copy = csv_path_ + ".tmp.copy." + std::to_string(::getpid());
@@ -503,6 +504,7 @@ void ResultsRecorder::Flush(const std::string& status) {
   std::filesystem::copy_file(csv_tmp_, copy, std::filesystem::copy_options::overwrite_existing, ec);
   if (!ec) std::filesystem::rename(copy, csv_path_, ec);
   if (ec) throw InputError(csv_path_ + ": cannot write (" + ec.message() + ")");
+  WriteResults(status);
   WriteAnimationPart();
   last_flush_ = std::chrono::steady_clock::now();
   last_flush_cost_ = std::chrono::duration<double>(last_flush_ - start).count();
