@@ -270,8 +270,10 @@ DynamicStepReport Measure(const SystemModel& model, DynamicState& s) {
 DynamicResult SolveDynamic(const SystemModel& model, DynamicState& state, const DynamicOptions& options,
                            const std::function<void(const DynamicStepReport&, const DynamicState&)>& on_step) {
   DynamicResult result;
+  const DynamicResume* resume = options.resume;
+  if (resume) state = resume->state;
   const DofMap& dofs = model.dofs();
-  StepController control(model, dofs, options, state.t);
+  StepController control(model, dofs, options, resume ? resume->t_start : state.t);
   double h = options.adaptive ? control.FirstStep() : options.step;
   int cuts = 0;
   bool after_rejection = false;
@@ -284,7 +286,7 @@ DynamicResult SolveDynamic(const SystemModel& model, DynamicState& state, const 
   // remainder below 1% of a step is merged into the last one.
   double t_base = state.t;
   long n_nominal = 0;
-  const double t_output0 = state.t;
+  const double t_output0 = resume ? resume->t_start : state.t;
   double last_output = 0;
   // Energy balance E = T + U - W_loads - W_drives: constant for a conservative system, falling
   // with damping (modal, dampers, generalized-alpha's rho_inf < 1). Growth is numerical: a step
@@ -298,14 +300,67 @@ DynamicResult SolveDynamic(const SystemModel& model, DynamicState& state, const 
   // 2e-21 J of kinetic energy after its first step, all of it noise (the drive's work was
   // 3e-26 J), and 1e-20 J after ten; E_noise is 4e-18 J there, and 1e-25 J at h = 1 ms.
   constexpr double kEnergyWarn = 0.05, kEnergyStop = 0.25;
-  const DynamicStepReport start = Measure(model, state);
-  const double E0 = start.kinetic_energy + start.elastic_energy;
-  double energy_scale = std::abs(E0);
+  const DynamicStepReport start = resume ? DynamicStepReport() : Measure(model, state);
+  const double E0 = resume ? resume->E0 : start.kinetic_energy + start.elastic_energy;
+  double energy_scale = resume ? resume->energy_scale : std::abs(E0);
   double first_cut_time = -1.0;  // fixed steps: where Newton first needed a shorter step
   double model_mass = 0.0;
   for (const SuperelementBody& body : model.bodies) model_mass += std::max(body.mass(), 0.0);
   bool warned = false;
   if (const std::string w = RoundOffToleranceWarning(options.tolerance); !w.empty()) result.warnings.push_back(w);
+  const int n_bodies = int(model.bodies.size());
+  if (resume) {
+    // The loop's variables, the step controller, the pivot order, the bodies' last frame
+    // matrices and kept matrices as the saved run had them after its last step.
+    h = resume->h, cuts = resume->cuts, t_base = resume->t_base, n_nominal = resume->n_nominal;
+    last_output = resume->last_output, first_cut_time = resume->first_cut_time, warned = resume->warned;
+    result = resume->result;
+    control.Restore(*resume);
+    if (!matrix.solver.Restore(resume->factor)) {
+      result.message = "the saved state's iteration matrix pivots could not be restored";
+      return result;
+    }
+    matrix.factorizations = resume->factorizations;
+    work.matrices_computed = resume->matrices_computed, work.matrices_turned = resume->matrices_turned;
+    work.passes.resize(size_t(n_bodies));
+    work.matrices.resize(size_t(n_bodies));
+    for (int b = 0; b < n_bodies; ++b) {
+      if (size_t(b) < resume->has_frame_S_inv.size() && resume->has_frame_S_inv[size_t(b)]) {
+        work.passes[size_t(b)].data.kin.S_inv = resume->frame_S_inv[size_t(b)];
+        work.passes[size_t(b)].data.kin.W.resize(6, model.bodies[size_t(b)].n_coordinates());
+      }
+      if (size_t(b) < resume->kept_age.size()) {
+        BodyWorkspace::BodyMatrices& m = work.matrices[size_t(b)];
+        m.M_frame = resume->kept_M[size_t(b)], m.C_frame = resume->kept_C[size_t(b)];
+        m.K_frame = resume->kept_K[size_t(b)], m.age = resume->kept_age[size_t(b)];
+      }
+    }
+  }
+  // What the next step starts from (DynamicStepReport::capture, called in on_step).
+  const std::function<void(DynamicResume&)> capture = [&](DynamicResume& r) {
+    r.state = state;
+    r.t_start = t_output0, r.h = h, r.t_base = t_base, r.last_output = last_output, r.E0 = E0;
+    r.energy_scale = energy_scale, r.first_cut_time = first_cut_time, r.n_nominal = n_nominal, r.cuts = cuts;
+    r.warned = warned;
+    r.result = result;
+    control.Save(r);
+    matrix.solver.Save(r.factor);
+    r.factorizations = matrix.factorizations;
+    r.matrices_computed = work.matrices_computed, r.matrices_turned = work.matrices_turned;
+    r.frame_S_inv.assign(size_t(n_bodies), Eigen::Matrix<double, 6, 6>::Zero());
+    r.has_frame_S_inv.assign(size_t(n_bodies), 0);
+    for (int b = 0; b < n_bodies && size_t(b) < work.passes.size(); ++b) {
+      const SuperelementBody::Kinematics& kin = work.passes[size_t(b)].data.kin;
+      if (kin.W.cols() != model.bodies[size_t(b)].n_coordinates()) continue;
+      r.frame_S_inv[size_t(b)] = kin.S_inv;
+      r.has_frame_S_inv[size_t(b)] = 1;
+    }
+    r.kept_M.clear(), r.kept_C.clear(), r.kept_K.clear(), r.kept_age.clear();
+    for (const BodyWorkspace::BodyMatrices& m : work.matrices) {
+      r.kept_M.push_back(m.M_frame), r.kept_C.push_back(m.C_frame), r.kept_K.push_back(m.K_frame);
+      r.kept_age.push_back(m.age);
+    }
+  };
   const auto count_factorizations = [&] {
     result.factorizations = matrix.factorizations;
     result.pattern_analyses = matrix.solver.analyses();
@@ -433,11 +488,7 @@ DynamicResult SolveDynamic(const SystemModel& model, DynamicState& state, const 
     r.iterations = step.iterations;
     r.rejected = result.rejected_by_error + result.newton_cuts;
     r.output = output;
-    if (on_step) on_step(r, state);
-    if (options.stop && options.stop->load() != 0) {
-      result.stopped = options.stop->load();
-      break;
-    }
+    r.capture = &capture;
     const double energy = r.kinetic_energy + r.elastic_energy;
     energy_scale = std::max({energy_scale, std::abs(energy), std::abs(state.external_work), std::abs(state.drive_work),
                              EnergyNoise(model_mass, state.config, h) / kEnergyWarn});
@@ -446,6 +497,7 @@ DynamicResult SolveDynamic(const SystemModel& model, DynamicState& state, const 
     // drive, energy ~ t^6) the trapezoidal work of the drives is off by tens of percent of an
     // energy that is itself round-off (a one-body spin-up stopped at t = 0.01 with 2.4e-16 J of
     // 4.1e-16 J); the rule's error falls as 1/n^2 of the steps taken.
+    std::string unstable;  // the energy watchdog's stop
     if (result.steps >= 10 && energy_scale > 0 && growth > kEnergyWarn * energy_scale) {
       char buffer[400];
       std::snprintf(buffer, sizeof buffer,
@@ -454,16 +506,26 @@ DynamicResult SolveDynamic(const SystemModel& model, DynamicState& state, const 
                     growth, 100 * growth / energy_scale, energy_scale, state.t, h,
                     options.adaptive ? "step_tolerance" : "step",
                     options.integrator == Integrator::kGeneralizedAlpha ? " or analysis.rho_inf" : "");
-      if (growth > kEnergyStop * energy_scale) return fail(buffer);
-      if (!warned) result.warnings.push_back(buffer);
-      warned = true;
+      if (growth > kEnergyStop * energy_scale) {
+        unstable = buffer;
+      } else {
+        if (!warned) result.warnings.push_back(buffer);
+        warned = true;
+      }
     }
+    // The next step's size, then the report: what on_step captures is what the next step starts from.
     if (options.adaptive) {
       h = control.Accept(state, h, error, after_rejection);
       after_rejection = false;
     } else if (cuts > 0 && step.iterations <= 4) {
       h = std::min(options.step, 2 * h);
       --cuts;
+    }
+    if (on_step) on_step(r, state);
+    if (!unstable.empty()) return fail(unstable);
+    if (options.stop && options.stop->load() != 0) {
+      result.stopped = options.stop->load();
+      break;
     }
   }
   count_factorizations();

@@ -20,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "solver/assembly/free_solver.h"
 #include "solver/assembly/system.h"
 
 namespace femb {
@@ -45,6 +46,7 @@ enum class BodyMatricesKept {
 
 struct DynamicOptions;
 JacobianReuse JacobianReuseOf(const DynamicOptions& options);
+struct DynamicResume;
 
 struct DynamicOptions {
   /// A stop request, read after each step: when it holds a nonzero value the run stops there,
@@ -114,6 +116,10 @@ struct DynamicOptions {
   /// Threads for the bodies' forces and matrices (generalized-alpha; solver/parallel.h). The
   /// results are the same bits for any number.
   int threads = 1;
+  /// Continue a run from what DynamicStepReport::capture saved (the state given to SolveDynamic
+  /// is then replaced by the saved one): the steps that follow are those of the run it was
+  /// saved from, to the bit.
+  const DynamicResume* resume = nullptr;
 };
 
 inline JacobianReuse JacobianReuseOf(const DynamicOptions& options) {
@@ -140,6 +146,8 @@ struct DynamicState {
 };
 
 struct DynamicStepReport {
+  /// Saves what the run carries into its next step (DynamicResume); valid during on_step.
+  const std::function<void(DynamicResume&)>* capture = nullptr;
   double t = 0.0;
   double h = 0.0;
   int iterations = 0;
@@ -166,6 +174,37 @@ struct DynamicResult {
   long pivoted = 0;           ///< factorizations that chose their pivots anew (the others reused them)
   long body_matrices_computed = 0;  ///< bodies' inertia matrices computed (body_matrices_every), all bodies
   long body_matrices_turned = 0;    ///< and turned with their frames instead
+};
+
+/// What SolveDynamic carries from one step to the next besides the state: a run resumed from it
+/// (DynamicOptions::resume) takes the steps the uninterrupted run takes, to the bit. The pivot
+/// order of the iteration matrix's factor is kept (FactorMemory), not the factor: a factor kept
+/// across steps (JacobianReuse::kSteps) is computed anew at the first step, so that run continues
+/// to the Newton tolerance instead.
+struct DynamicResume {
+  DynamicState state;
+  double t_start = 0.0;  ///< the run's first time (its output times and step limits count from it)
+  double h = 0.0;        ///< the next step to try
+  double t_base = 0.0, last_output = 0.0, E0 = 0.0, energy_scale = 0.0, first_cut_time = -1.0;
+  long n_nominal = 0;
+  int cuts = 0;
+  bool warned = false;
+  /// The result so far: steps, rejections, step sizes, iterations, factorizations, warnings.
+  DynamicResult result;
+  /// The step controller's memory (step: auto): the largest node travel, the last error ratio,
+  /// the last accepted step's jerk.
+  double travel = 0.0, last_error = 0.0;
+  Eigen::VectorXd last_jerk;
+  bool has_last_jerk = false;
+  FactorMemory factor;
+  long factorizations = 0;
+  /// Per body: the inverse frame matrix of its last evaluation (the next frame solve iterates
+  /// with it; empty: none), and with body_matrices_every its kept matrices and their age.
+  std::vector<Eigen::Matrix<double, 6, 6>> frame_S_inv;
+  std::vector<char> has_frame_S_inv;
+  std::vector<Eigen::MatrixXd> kept_M, kept_C, kept_K;
+  std::vector<int> kept_age;
+  long matrices_computed = 0, matrices_turned = 0;
 };
 
 /// Initial state: configuration and velocities given; accelerations from M_g wdot = f_ext -

@@ -65,6 +65,13 @@ class StepController {
   double Accept(const DynamicState& s1, double h, double E, bool after_rejection);
   /// The factor for a step retried after a rejection with error ratio E (or with no history).
   static double Factor(double E);
+  /// What Accept keeps for the next steps, into or from a DynamicResume.
+  void Save(DynamicResume& r) const {
+    r.travel = D_, r.last_error = E_prev_, r.last_jerk = jerk_prev_, r.has_last_jerk = has_jerk_prev_;
+  }
+  void Restore(const DynamicResume& r) {
+    D_ = r.travel, E_prev_ = r.last_error, jerk_prev_ = r.last_jerk, has_jerk_prev_ = r.has_last_jerk;
+  }
 
  private:
   const DynamicOptions& options_;

@@ -16,6 +16,7 @@ struct FreeSolver::Klu {
   // The free block of S in compressed columns; the pattern `symbolic` was analysed for.
   std::vector<int> outer, inner, analysed_outer, analysed_inner;
   std::vector<double> values;
+  std::vector<double> pivot_values;  // the values of the last full factorization (FactorMemory)
   // The pivot ratio (min / max |u_ii|) of the last full factorization.
   double rcond = 0.0;
   Klu() {
@@ -32,6 +33,7 @@ struct FreeSolver::Klu {
     if (numeric) klu_free_numeric(&numeric, &common);
     numeric = klu_factor(outer.data(), inner.data(), values.data(), symbolic, &common);
     if (!numeric) return false;
+    pivot_values.assign(values.begin(), values.end());
     klu_rcond(symbolic, numeric, &common);
     rcond = common.rcond;
     return rcond > 0.0;
@@ -40,6 +42,33 @@ struct FreeSolver::Klu {
 
 FreeSolver::FreeSolver() : klu_(std::make_unique<Klu>()) {}
 FreeSolver::~FreeSolver() = default;
+
+void FreeSolver::Save(FactorMemory& memory) const {
+  const Klu& k = *klu_;
+  memory.outer = k.symbolic ? k.analysed_outer : std::vector<int>();
+  memory.inner = k.symbolic ? k.analysed_inner : std::vector<int>();
+  memory.pivot_values = k.numeric ? k.pivot_values : std::vector<double>();
+  memory.analysed = analysed_, memory.full = full_, memory.refactored = refactored_;
+}
+
+bool FreeSolver::Restore(const FactorMemory& memory) {
+  Klu& k = *klu_;
+  k.Clear();
+  k.symbolic = nullptr, k.numeric = nullptr;
+  valid_ = false;
+  analysed_ = memory.analysed, full_ = memory.full, refactored_ = memory.refactored;
+  if (memory.outer.empty()) return true;
+  const int n = int(memory.outer.size()) - 1;
+  if (n < 0 || memory.outer.back() != int(memory.inner.size())) return false;
+  k.outer = k.analysed_outer = memory.outer;
+  k.inner = k.analysed_inner = memory.inner;
+  k.symbolic = klu_analyze(n, k.outer.data(), k.inner.data(), &k.common);
+  if (!k.symbolic) return false;
+  if (memory.pivot_values.empty()) return true;
+  if (memory.pivot_values.size() != memory.inner.size()) return false;
+  k.values = memory.pivot_values;
+  return k.FactorAnew();
+}
 
 bool FreeSolver::Factor(const DofMap& dofs, const SystemMatrix& S) {
   valid_ = false;

@@ -23,6 +23,15 @@ Eigen::VectorXd SolveFree(const DofMap& dofs, const SystemMatrix& S, const Eigen
 /// pivot order (klu_refactor); otherwise it pivots anew (klu_factor). Factor returns false when
 /// the matrix is singular: a zero pivot or a condition estimate of the matrix scaled to unit
 /// diagonal (D S D) above 1e15.
+/// What a FreeSolver keeps from one factorization to the next: the pattern it analysed, the
+/// (scaled) values of the last factorization that chose its pivots, and its counts. Restored, a
+/// solver chooses the same pivots and refactors as the one it was saved from (a resumed run).
+struct FactorMemory {
+  std::vector<int> outer, inner;
+  std::vector<double> pivot_values;
+  long analysed = 0, full = 0, refactored = 0;
+};
+
 class FreeSolver {
  public:
   FreeSolver();
@@ -40,6 +49,10 @@ class FreeSolver {
   long analyses() const { return analysed_; }
   long full_factorizations() const { return full_; }
   long refactorizations() const { return refactored_; }
+  /// The pivot order's source (FactorMemory). Restore leaves no valid factor: the next Factor
+  /// refactors with the restored pivots as the saved solver would have.
+  void Save(FactorMemory& memory) const;
+  bool Restore(const FactorMemory& memory);
 
  private:
   struct Klu;

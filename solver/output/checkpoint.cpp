@@ -52,6 +52,68 @@ Eigen::MatrixXd Rows9(const std::vector<Eigen::Matrix3d>& v) {
   return out;
 }
 
+
+// Numbers (counts too: exact as doubles below 2^53) of the resume group, by name.
+void WriteExactState(h5::Writer& w, const std::string& g, const DynamicState& s) {
+  const SystemState& c = s.config;
+  w.CreateGroup(g);
+  w.Vector(g + "/joint_coordinates", Flat(c.z));
+  w.Matrix(g + "/node_position", Rows3(c.x));
+  w.Matrix(g + "/node_rotation", Rows9(c.R));
+  w.Vector(g + "/modal_coordinates", Flat(c.eta));
+  std::vector<Eigen::Vector3d> fx;
+  std::vector<Eigen::Matrix3d> fR;
+  std::vector<int> iterations;
+  for (const FrameSolution& f : c.frames) fx.push_back(f.x), fR.push_back(f.R), iterations.push_back(f.iterations);
+  w.Matrix(g + "/frame_position", Rows3(fx));
+  w.Matrix(g + "/frame_rotation", Rows9(fR));
+  w.IntVector(g + "/frame_iterations", iterations);
+  w.Vector(g + "/multipliers", c.lambda);
+  w.Vector(g + "/velocities", s.W);
+  w.Vector(g + "/accelerations", s.Wdot);
+  w.Vector(g + "/algorithmic_accelerations", s.a);
+  w.Vector(g + "/external_forces", s.f_ext);
+  w.Vector(g + "/drive_forces", s.f_drive);
+  Eigen::MatrixXd node_w(long(s.node_w.size()), 6);
+  for (size_t k = 0; k < s.node_w.size(); ++k) node_w.row(long(k)) = s.node_w[k].transpose();
+  w.Matrix(g + "/node_velocities", node_w);
+  w.Vector(g + "/numbers", (Eigen::VectorXd(4) << s.t, s.external_work, s.drive_work, s.h_last).finished());
+}
+
+void WriteResume(h5::Writer& w, const DynamicResume& r) {
+  w.CreateGroup("/resume");
+  WriteExactState(w, "/resume/state", r.state);
+  const DynamicResult& x = r.result;
+  w.Vector("/resume/numbers",
+           (Eigen::VectorXd(28) << r.t_start, r.h, r.t_base, r.last_output, r.E0, r.energy_scale, r.first_cut_time,
+            double(r.n_nominal), double(r.cuts), double(r.warned), r.travel, r.last_error, double(r.has_last_jerk),
+            double(r.factorizations), double(r.matrices_computed), double(r.matrices_turned), double(x.steps),
+            double(x.rejected_by_error), double(x.newton_cuts), x.smallest_step, x.largest_step, x.smallest_step_time,
+            double(x.newton_iterations), double(x.factorizations), double(x.pattern_analyses), double(x.pivoted),
+            double(x.body_matrices_computed), double(x.body_matrices_turned))
+               .finished());
+  w.Strings("/resume/warnings", x.warnings);
+  w.Vector("/resume/last_jerk", r.last_jerk);
+  w.IntVector("/resume/factor_outer", r.factor.outer);
+  w.IntVector("/resume/factor_inner", r.factor.inner);
+  w.Vector("/resume/factor_pivot_values",
+           Eigen::Map<const Eigen::VectorXd>(r.factor.pivot_values.data(), long(r.factor.pivot_values.size())));
+  w.Vector("/resume/factor_counts",
+           Eigen::Vector3d(double(r.factor.analysed), double(r.factor.full), double(r.factor.refactored)));
+  Eigen::MatrixXd S_inv(long(r.frame_S_inv.size()), 36);
+  for (size_t b = 0; b < r.frame_S_inv.size(); ++b) S_inv.row(long(b)) = Eigen::Map<const Eigen::Matrix<double, 1, 36>>(r.frame_S_inv[b].data());
+  w.Matrix("/resume/frame_S_inv", S_inv);
+  w.IntVector("/resume/has_frame_S_inv", std::vector<int>(r.has_frame_S_inv.begin(), r.has_frame_S_inv.end()));
+  w.IntVector("/resume/kept_age", r.kept_age);
+  for (size_t b = 0; b < r.kept_age.size(); ++b) {
+    const std::string g = "/resume/kept_" + std::to_string(b);
+    w.CreateGroup(g);
+    w.Matrix(g + "/M", r.kept_M[b]);
+    w.Matrix(g + "/C", r.kept_C[b]);
+    w.Matrix(g + "/K", r.kept_K[b]);
+  }
+}
+
 }  // namespace
 
 std::string ModelSignature(const Scene& scene) {
@@ -78,10 +140,10 @@ std::string ModelSignature(const Scene& scene) {
 }
 
 void WriteCheckpoint(const std::string& directory, const Scene& scene, const std::string& signature,
-                     const DynamicState& state, const std::string& analysis) {
+                     const DynamicState& state, const std::string& analysis, const DynamicResume* resume,
+                     const std::function<void(h5::Writer&)>& extra) {
   const std::string path = (std::filesystem::path(directory) / "checkpoint.h5").string();
   const std::string tmp = path + ".tmp." + std::to_string(::getpid());
-  const SystemState& c = state.config;
   {
     h5::Writer w(tmp);
     w.Attribute("/", "format", kFormat);
@@ -89,25 +151,19 @@ void WriteCheckpoint(const std::string& directory, const Scene& scene, const std
     w.Attribute("/", "scene", scene.spec.file);
     w.Attribute("/", "analysis", analysis);
     w.Attribute("/", "model", signature);
-    w.Scalar("/time", state.t);
-    w.Vector("/joint_coordinates", Flat(c.z));
-    w.Matrix("/node_position", Rows3(c.x));
-    w.Matrix("/node_rotation", Rows9(c.R));
-    w.Vector("/modal_coordinates", Flat(c.eta));
-    std::vector<Eigen::Vector3d> fx;
-    std::vector<Eigen::Matrix3d> fR;
-    for (const FrameSolution& f : c.frames) fx.push_back(f.x), fR.push_back(f.R);
-    w.Matrix("/frame_position", Rows3(fx));
-    w.Matrix("/frame_rotation", Rows9(fR));
-    w.Vector("/multipliers", c.lambda);
+    // A static state has no velocities: zero.
+    DynamicState full;
+    const DynamicState* s = &state;
     const long n = scene.model.dofs().n_dofs();
-    const auto or_zero = [n](const Eigen::VectorXd& v) { return v.size() == n ? v : Eigen::VectorXd(Eigen::VectorXd::Zero(n)); };
-    w.Vector("/velocities", or_zero(state.W));
-    w.Vector("/accelerations", or_zero(state.Wdot));
-    w.Vector("/algorithmic_accelerations", or_zero(state.a));
-    w.Scalar("/external_work", state.external_work);
-    w.Scalar("/drive_work", state.drive_work);
-    w.Scalar("/step", state.h_last);
+    if (state.W.size() != n || state.Wdot.size() != n || state.a.size() != n) {
+      full = state;
+      for (Eigen::VectorXd* v : {&full.W, &full.Wdot, &full.a})
+        if (v->size() != n) v->setZero(n);
+      s = &full;
+    }
+    WriteExactState(w, "/state", *s);
+    if (resume) WriteResume(w, *resume);
+    if (extra) extra(w);
     w.Close();
   }
   std::error_code ec;
@@ -115,12 +171,16 @@ void WriteCheckpoint(const std::string& directory, const Scene& scene, const std
   if (ec) throw InputError(path + ": cannot rename into place (" + ec.message() + ")");
 }
 
-DynamicState ReadCheckpoint(const std::string& directory, const Scene& scene, std::string* analysis) {
+namespace {
+
+// The checkpoint of `directory`, checked: a femb checkpoint of a version this femb reads,
+// written for `scene`'s model (else one line naming the first difference).
+h5::Reader OpenCheckpoint(const std::string& directory, const Scene& scene) {
   const std::string path = (std::filesystem::path(directory) / "checkpoint.h5").string();
   if (!std::filesystem::exists(path)) {
     throw InputError(path + ": no checkpoint (a folder femb-solve wrote its results to holds one)");
   }
-  const h5::Reader r(path);
+  h5::Reader r(path);
   if (!r.HasAttribute("/", "format") || r.StringAttribute("/", "format") != kFormat) {
     throw InputError(path + ": not a femb checkpoint (attribute format is not " + kFormat + ")");
   }
@@ -128,7 +188,6 @@ DynamicState ReadCheckpoint(const std::string& directory, const Scene& scene, st
   if (version.substr(0, version.find('.')) != std::string(kVersion).substr(0, 1)) {
     throw InputError(path + ": checkpoint format_version " + version + ", this femb reads " + kVersion);
   }
-  // The same model: the first line that differs.
   std::istringstream theirs(r.StringAttribute("/", "model")), ours(ModelSignature(scene));
   std::string a, b;
   while (true) {
@@ -139,57 +198,127 @@ DynamicState ReadCheckpoint(const std::string& directory, const Scene& scene, st
                        scene.spec.file + " has '" + (more_b ? b : "(nothing)") + "'");
     }
   }
-  const SystemModel& model = scene.model;
+  return r;
+}
+
+// The state of group g, to the bit, with its node Jacobians; sizes checked against the model.
+DynamicState ReadState(const h5::Reader& r, const std::string& g, const SystemModel& model) {
   const DofMap& dofs = model.dofs();
   DynamicState s;
   s.config = InitialState(model);
   SystemState& c = s.config;
   const auto need = [&](const std::string& name, long rows, long cols) {
-    const std::vector<hsize_t> shape = r.Shape(name);
-    const bool ok = cols == 0 ? shape.size() == 1 && long(shape[0]) == rows
-                              : shape.size() == 2 && long(shape[0]) == rows && long(shape[1]) == cols;
-    if (!ok) throw InputError(path + ": dataset " + name + " does not have the model's size");
+    const std::vector<hsize_t> shape = r.Shape(g + name);
+    const bool ok = cols < 0 ? shape.size() == 1 && long(shape[0]) == rows
+                             : shape.size() == 2 && long(shape[0]) == rows && long(shape[1]) == cols;
+    if (!ok) throw InputError(r.path() + ": dataset " + g + name + " does not have the model's size");
   };
   long nz = 0, neta = 0;
   for (const Eigen::VectorXd& z : c.z) nz += z.size();
   for (const Eigen::VectorXd& e : c.eta) neta += e.size();
   const long n_nodes = model.n_nodes(), n_bodies = long(model.bodies.size()), n = dofs.n_dofs();
-  need("/joint_coordinates", nz, 0);
+  need("/joint_coordinates", nz, -1);
   need("/node_position", n_nodes, 3);
   need("/node_rotation", n_nodes, 9);
-  need("/modal_coordinates", neta, 0);
+  need("/modal_coordinates", neta, -1);
   need("/frame_position", n_bodies, 3);
   need("/frame_rotation", n_bodies, 9);
-  need("/velocities", n, 0);
-  const Eigen::VectorXd z = r.Vector("/joint_coordinates"), eta = r.Vector("/modal_coordinates");
-  const Eigen::MatrixXd x = r.Matrix("/node_position"), R = r.Matrix("/node_rotation");
-  const Eigen::MatrixXd fx = r.Matrix("/frame_position"), fR = r.Matrix("/frame_rotation");
+  need("/frame_iterations", n_bodies, -1);
+  need("/multipliers", dofs.n_multipliers(), -1);
+  for (const char* v : {"/velocities", "/accelerations", "/algorithmic_accelerations"}) need(v, n, -1);
+  need("/numbers", 4, -1);
+  const Eigen::VectorXd z = r.Vector(g + "/joint_coordinates"), eta = r.Vector(g + "/modal_coordinates");
+  const Eigen::MatrixXd x = r.Matrix(g + "/node_position"), R = r.Matrix(g + "/node_rotation");
+  const Eigen::MatrixXd fx = r.Matrix(g + "/frame_position"), fR = r.Matrix(g + "/frame_rotation");
+  const Eigen::VectorXi iterations = r.IntVector(g + "/frame_iterations");
   long at = 0;
   for (Eigen::VectorXd& zk : c.z) zk = z.segment(at, zk.size()), at += zk.size();
   at = 0;
   for (Eigen::VectorXd& e : c.eta) e = eta.segment(at, e.size()), at += e.size();
-  for (long k = 0; k < n_nodes; ++k) {
-    c.x[size_t(k)] = x.row(k).transpose();
-    c.R[size_t(k)] = Eigen::Map<const Eigen::Matrix3d>(Eigen::Matrix<double, 1, 9>(R.row(k)).data());
-  }
+  const auto rotation = [](const Eigen::MatrixXd& m, long i) {
+    const Eigen::Matrix<double, 1, 9> row = m.row(i);
+    return Eigen::Matrix3d(Eigen::Map<const Eigen::Matrix3d>(row.data()));
+  };
+  for (long k = 0; k < n_nodes; ++k) c.x[size_t(k)] = x.row(k).transpose(), c.R[size_t(k)] = rotation(R, k);
   for (long b = 0; b < n_bodies; ++b) {
-    c.frames[size_t(b)].x = fx.row(b).transpose();
-    c.frames[size_t(b)].R = Eigen::Map<const Eigen::Matrix3d>(Eigen::Matrix<double, 1, 9>(fR.row(b)).data());
-    c.frames[size_t(b)].ok = true;
+    FrameSolution& f = c.frames[size_t(b)];
+    f.x = fx.row(b).transpose(), f.R = rotation(fR, b), f.iterations = iterations[b], f.ok = true;
   }
-  c.lambda = r.Vector("/multipliers");
-  if (c.lambda.size() != dofs.n_multipliers()) throw InputError(path + ": dataset /multipliers does not have the model's size");
-  s.W = r.Vector("/velocities");
-  s.Wdot = r.Vector("/accelerations");
-  s.a = r.Vector("/algorithmic_accelerations");
-  if (s.Wdot.size() != n || s.a.size() != n) throw InputError(path + ": accelerations do not have the model's size");
-  s.t = r.Scalar("/time");
-  s.external_work = r.Scalar("/external_work");
-  s.drive_work = r.Scalar("/drive_work");
-  s.h_last = r.Scalar("/step");
+  c.lambda = r.Vector(g + "/multipliers");
+  s.W = r.Vector(g + "/velocities");
+  s.Wdot = r.Vector(g + "/accelerations");
+  s.a = r.Vector(g + "/algorithmic_accelerations");
+  s.f_ext = r.Vector(g + "/external_forces");
+  s.f_drive = r.Vector(g + "/drive_forces");
+  const Eigen::MatrixXd node_w = r.Matrix(g + "/node_velocities");
+  if (node_w.cols() != 6 || (node_w.rows() != 0 && node_w.rows() != n_nodes)) {
+    throw InputError(r.path() + ": dataset " + g + "/node_velocities does not have the model's size");
+  }
+  for (long k = 0; k < node_w.rows(); ++k) s.node_w.push_back(node_w.row(k).transpose());
+  const Eigen::VectorXd numbers = r.Vector(g + "/numbers");
+  s.t = numbers[0], s.external_work = numbers[1], s.drive_work = numbers[2], s.h_last = numbers[3];
   UpdateKinematics(model, dofs, c);
-  if (analysis) *analysis = r.StringAttribute("/", "analysis");
   return s;
+}
+
+}  // namespace
+
+DynamicState ReadCheckpoint(const std::string& directory, const Scene& scene, std::string* analysis) {
+  const h5::Reader r = OpenCheckpoint(directory, scene);
+  if (analysis) *analysis = r.StringAttribute("/", "analysis");
+  return ReadState(r, "/state", scene.model);
+}
+
+bool ReadResume(const std::string& directory, const Scene& scene, DynamicResume& resume) {
+  const h5::Reader r = OpenCheckpoint(directory, scene);
+  if (!r.Exists("/resume")) return false;
+  const SystemModel& model = scene.model;
+  resume.state = ReadState(r, "/state", model);
+  const Eigen::VectorXd x = r.Vector("/resume/numbers");
+  if (x.size() != 28) throw InputError(r.path() + ": dataset /resume/numbers has " + std::to_string(x.size()) + " values, not 28");
+  resume.t_start = x[0], resume.h = x[1], resume.t_base = x[2], resume.last_output = x[3], resume.E0 = x[4];
+  resume.energy_scale = x[5], resume.first_cut_time = x[6], resume.n_nominal = long(x[7]), resume.cuts = int(x[8]);
+  resume.warned = x[9] != 0, resume.travel = x[10], resume.last_error = x[11], resume.has_last_jerk = x[12] != 0;
+  resume.factorizations = long(x[13]), resume.matrices_computed = long(x[14]), resume.matrices_turned = long(x[15]);
+  DynamicResult& result = resume.result;
+  result.steps = long(x[16]), result.rejected_by_error = long(x[17]), result.newton_cuts = long(x[18]);
+  result.smallest_step = x[19], result.largest_step = x[20], result.smallest_step_time = x[21];
+  result.newton_iterations = long(x[22]), result.factorizations = long(x[23]), result.pattern_analyses = long(x[24]);
+  result.pivoted = long(x[25]), result.body_matrices_computed = long(x[26]), result.body_matrices_turned = long(x[27]);
+  result.warnings = r.Strings("/resume/warnings");
+  resume.last_jerk = r.Vector("/resume/last_jerk");
+  const Eigen::VectorXi outer = r.IntVector("/resume/factor_outer"), inner = r.IntVector("/resume/factor_inner");
+  resume.factor.outer.assign(outer.data(), outer.data() + outer.size());
+  resume.factor.inner.assign(inner.data(), inner.data() + inner.size());
+  const Eigen::VectorXd pivots = r.Vector("/resume/factor_pivot_values");
+  resume.factor.pivot_values.assign(pivots.data(), pivots.data() + pivots.size());
+  const Eigen::VectorXd counts = r.Vector("/resume/factor_counts");
+  if (counts.size() != 3) throw InputError(r.path() + ": dataset /resume/factor_counts must hold 3 values");
+  resume.factor.analysed = long(counts[0]), resume.factor.full = long(counts[1]), resume.factor.refactored = long(counts[2]);
+  const long n_bodies = long(model.bodies.size());
+  const Eigen::MatrixXd S_inv = r.Matrix("/resume/frame_S_inv");
+  const Eigen::VectorXi has = r.IntVector("/resume/has_frame_S_inv");
+  if (S_inv.rows() != n_bodies || S_inv.cols() != 36 || has.size() != n_bodies) {
+    throw InputError(r.path() + ": /resume/frame_S_inv does not have the model's size");
+  }
+  resume.frame_S_inv.resize(size_t(n_bodies));
+  resume.has_frame_S_inv.resize(size_t(n_bodies));
+  for (long b = 0; b < n_bodies; ++b) {
+    const Eigen::Matrix<double, 1, 36> row = S_inv.row(b);
+    resume.frame_S_inv[size_t(b)] = Eigen::Map<const Eigen::Matrix<double, 6, 6>>(row.data());
+    resume.has_frame_S_inv[size_t(b)] = char(has[b] != 0);
+  }
+  const Eigen::VectorXi age = r.IntVector("/resume/kept_age");
+  if (age.size() != 0 && age.size() != n_bodies) throw InputError(r.path() + ": /resume/kept_age does not have the model's size");
+  resume.kept_age.assign(age.data(), age.data() + age.size());
+  resume.kept_M.clear(), resume.kept_C.clear(), resume.kept_K.clear();
+  for (long b = 0; b < age.size(); ++b) {
+    const std::string g = "/resume/kept_" + std::to_string(b);
+    resume.kept_M.push_back(r.Matrix(g + "/M"));
+    resume.kept_C.push_back(r.Matrix(g + "/C"));
+    resume.kept_K.push_back(r.Matrix(g + "/K"));
+  }
+  return true;
 }
 
 }  // namespace femb

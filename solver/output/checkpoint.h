@@ -7,7 +7,10 @@
 // bodies (superelement files compared by content), nodes, joints and cut joints.
 #pragma once
 
+#include <functional>
 #include <string>
+
+#include "formats/hdf5_file.h"
 
 #include "solver/analysis/dynamic_analysis.h"
 #include "solver/scene/scene_builder.h"
@@ -19,14 +22,21 @@ namespace femb {
 std::string ModelSignature(const Scene& scene);
 
 /// Writes `state` (analysis "static" or "dynamic"; a static state has no velocities) as
-/// `directory`/checkpoint.h5. `signature`: ModelSignature(scene), computed once per run.
+/// `directory`/checkpoint.h5. `signature`: ModelSignature(scene), computed once per run. With
+/// `resume` (captured at `state`) the file also holds what a dynamic run carries into its next
+/// step (group /resume), and `extra` adds the caller's own groups (the results so far).
 void WriteCheckpoint(const std::string& directory, const Scene& scene, const std::string& signature,
-                     const DynamicState& state, const std::string& analysis);
+                     const DynamicState& state, const std::string& analysis, const DynamicResume* resume = nullptr,
+                     const std::function<void(h5::Writer&)>& extra = nullptr);
 
 /// The state in `directory`/checkpoint.h5 for `scene`'s model, with its node Jacobians. Throws
 /// InputError (one line naming the file) when there is none, it is not a femb checkpoint, is
 /// truncated, or belongs to another model (the first difference named). `analysis`: the kind
 /// of run that wrote it.
 DynamicState ReadCheckpoint(const std::string& directory, const Scene& scene, std::string* analysis = nullptr);
+
+/// The checkpoint's /resume group (ReadCheckpoint's checks first), the state included, to the
+/// bit; false when the checkpoint has none (a static run's, or one written before the first step).
+bool ReadResume(const std::string& directory, const Scene& scene, DynamicResume& resume);
 
 }  // namespace femb

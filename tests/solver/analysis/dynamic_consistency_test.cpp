@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
+#include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -19,6 +20,7 @@
 #include "formats/superelement_file.h"
 #include "solver/analysis/dynamic_analysis.h"
 #include "solver/joints/loop_constraints.h"
+#include "solver/output/checkpoint.h"
 #include "solver/rotation.h"
 #include "solver/scene/scene_builder.h"
 #include "test_util.h"
@@ -362,6 +364,111 @@ TEST(DynamicConsistency, DriveAcceleratingAtTheStartRunsAndAnOpenStartIsRefused)
   EXPECT_NE(message.find("joints[0]: prescribed 'crank' of node 'A' is 1 at t = 0, which opens the loop closed by"),
             std::string::npos) << message;
   EXPECT_NE(message.find("give the function an offset so that it is 0 at t = 0"), std::string::npos) << message;
+}
+
+}  // namespace
+}  // namespace femb
+
+namespace femb {
+namespace {
+
+// Every step of a run: its time and state (positions, modal coordinates, velocities,
+// accelerations, generalized-alpha's algorithmic accelerations), to compare runs to the bit.
+struct StepTrace {
+  std::vector<double> t;
+  std::vector<Eigen::VectorXd> values;
+  void Add(const DynamicState& s) {
+    Eigen::VectorXd v(3 * long(s.config.x.size()) + 3 * s.W.size());
+    long at = 0;
+    for (const Eigen::Vector3d& x : s.config.x) v.segment<3>(at) = x, at += 3;
+    v.segment(at, s.W.size()) = s.W, at += s.W.size();
+    v.segment(at, s.Wdot.size()) = s.Wdot, at += s.Wdot.size();
+    v.segment(at, s.a.size()) = s.a.size() == s.W.size() ? s.a : Eigen::VectorXd::Zero(s.W.size());
+    for (const Eigen::VectorXd& eta : s.config.eta) v.conservativeResize(v.size() + eta.size()), v.tail(eta.size()) = eta;
+    t.push_back(s.t);
+    values.push_back(v);
+  }
+};
+
+// A run stopped after its first step at or past t_stop, with what it carries into its next step
+// saved (DynamicStepReport::capture) and written to a checkpoint file, and resumed from the file
+// in a new SolveDynamic: its steps are
+// those of the uninterrupted run, to the bit (times, positions, velocities, accelerations, modal
+// coordinates), and so are its step counts.
+void ResumedRunTakesTheSameSteps(const Scene& scene, DynamicOptions o, double t_stop) {
+  const SystemModel& model = scene.model;
+  const auto start = [&] { return InitialDynamicState(model, InitialState(model), scene.initial_velocity); };
+  StepTrace whole, resumed;
+  DynamicState s = start();
+  const DynamicResult all = SolveDynamic(model, s, o, [&](const DynamicStepReport&, const DynamicState& st) { whole.Add(st); });
+  ASSERT_TRUE(all.ok) << all.message;
+  std::atomic<int> stop{0};
+  DynamicResume saved;
+  DynamicOptions first = o;
+  first.stop = &stop;
+  s = start();
+  const DynamicResult part = SolveDynamic(model, s, first, [&](const DynamicStepReport& r, const DynamicState& st) {
+    if (st.t >= t_stop && stop.load() == 0) {
+      (*r.capture)(saved);
+      stop = 1;
+    }
+  });
+  ASSERT_TRUE(part.ok && part.stopped == 1) << part.message;
+  // Through the checkpoint file, as femb-solve --restart reads it.
+  const std::string dir = ::testing::TempDir() + "resume_checkpoint";
+  std::filesystem::create_directories(dir);
+  WriteCheckpoint(dir, scene, ModelSignature(scene), saved.state, "dynamic", &saved);
+  DynamicResume read;
+  ASSERT_TRUE(ReadResume(dir, scene, read));
+  DynamicOptions second = o;
+  second.resume = &read;
+  DynamicState fresh = start();
+  const DynamicResult rest =
+      SolveDynamic(model, fresh, second, [&](const DynamicStepReport&, const DynamicState& st) { resumed.Add(st); });
+  ASSERT_TRUE(rest.ok) << rest.message;
+  const size_t skip = whole.t.size() - resumed.t.size();
+  ASSERT_GT(resumed.t.size(), 10u);
+  ASSERT_EQ(whole.t[skip - 1], saved.state.t);
+  size_t differ = 0;
+  double largest = 0.0;
+  for (size_t i = 0; i < resumed.t.size(); ++i) {
+    const Eigen::VectorXd d = resumed.values[i] - whole.values[skip + i];
+    differ += resumed.t[i] != whole.t[skip + i] || d.cwiseAbs().maxCoeff() != 0.0;
+    largest = std::max(largest, d.cwiseAbs().maxCoeff());
+  }
+  std::printf("[ info ] resumed at t = %.6g: %zu steps after it, %zu differ (largest difference %.3g)\n",
+              saved.state.t, resumed.t.size(), differ, largest);
+  EXPECT_EQ(differ, 0u);
+  EXPECT_EQ(rest.steps, all.steps);
+  EXPECT_EQ(rest.rejected_by_error, all.rejected_by_error);
+  EXPECT_EQ(rest.newton_iterations, all.newton_iterations);
+  EXPECT_EQ(rest.factorizations, all.factorizations);
+  EXPECT_EQ(rest.pivoted, all.pivoted);
+}
+
+TEST_F(TiltedFourBarTest, ResumedRunTakesTheSameStepsGeneralizedAlpha) {
+  DynamicOptions o = Options(Integrator::kGeneralizedAlpha, 0.15);
+  o.step = 2e-4;
+  ResumedRunTakesTheSameSteps(*scene_, o, 0.06);
+}
+
+TEST_F(TiltedFourBarTest, ResumedRunTakesTheSameStepsGeneralizedAlphaErrorControlledKeptMatrices) {
+  DynamicOptions o = ErrorControlled(Integrator::kGeneralizedAlpha, 1e-5);
+  o.end_time = 0.15;
+  o.body_matrices_every = 3;
+  ResumedRunTakesTheSameSteps(*scene_, o, 0.06);
+}
+
+TEST_F(TiltedFourBarTest, ResumedRunTakesTheSameStepsMidpoint) {
+  DynamicOptions o = Options(Integrator::kMidpoint, 0.15);
+  o.step = 2e-4;
+  ResumedRunTakesTheSameSteps(*scene_, o, 0.06);
+}
+
+TEST_F(TiltedFourBarTest, ResumedRunTakesTheSameStepsMidpointErrorControlled) {
+  DynamicOptions o = ErrorControlled(Integrator::kMidpoint, 1e-5);
+  o.end_time = 0.15;
+  ResumedRunTakesTheSameSteps(*scene_, o, 0.06);
 }
 
 }  // namespace
