@@ -104,6 +104,8 @@ int main(int argc, char** argv) {
   cli.Value({"-o", "--output"}, [&](const std::string& v) { output = v; });
   cli.Value({"--set"}, [&](const std::string& v) { overrides.push_back(v); });
   cli.Switch({"-q", "--quiet"}, [&] { quiet = true; });
+  std::string restart;
+  cli.Value({"--restart"}, [&](const std::string& v) { restart = v; });
   int threads = femb::DefaultThreads();
   std::string threads_text;
   cli.Value({"--threads"}, [&](const std::string& v) { threads_text = v; });
@@ -123,7 +125,36 @@ int main(int argc, char** argv) {
     const auto wall = std::chrono::steady_clock::now();
     const femb::SceneSpec spec = femb::ReadSceneFile(scene_path, overrides);
     const femb::Scene scene = femb::BuildScene(spec);
+    if (!restart.empty()) {
+      if (!output.empty() && std::filesystem::path(output) != std::filesystem::path(restart)) {
+        throw femb::InputError("--restart " + restart + " continues the run in that folder; leave out -o " + output);
+      }
+      output = restart;
+    }
     if (output.empty()) output = "out/" + spec.name;
+    // --restart: what the stopped run carries into its next step, read and checked before
+    // anything is written.
+    std::optional<femb::DynamicResume> resume;
+    if (!restart.empty()) {
+      const std::string checkpoint = (std::filesystem::path(restart) / "checkpoint.h5").string();
+      if (spec.analysis.type != femb::AnalysisType::kDynamic) {
+        throw femb::InputError("--restart " + restart + ": continues dynamic analyses only (start one from a static run's "
+                               "state with initial_state)");
+      }
+      if (!spec.initial_state.from.empty()) throw femb::InputError(spec.initial_state.where + ": initial_state and --restart: give one");
+      resume.emplace();
+      if (!femb::ReadResume(restart, scene, *resume)) {
+        throw femb::InputError(checkpoint + ": holds no dynamic run to continue (a static run's state, or one written "
+                               "before the first step: start anew, or from it with initial_state)");
+      }
+      if (!(spec.analysis.end_time > resume->state.t + 1e-12 * std::abs(spec.analysis.end_time))) {
+        char buffer[300];
+        std::snprintf(buffer, sizeof buffer,
+                      ": the run reached t = %.9g; analysis.end_time %.9g is not later (--set analysis.end_time=... "
+                      "extends it)", resume->state.t, spec.analysis.end_time);
+        throw femb::InputError(checkpoint + buffer);
+      }
+    }
     // initial_state: the state another run reached, read (and checked against this model)
     // before anything is written.
     std::optional<femb::DynamicState> from;
@@ -155,6 +186,20 @@ int main(int argc, char** argv) {
     }
     femb::ResultsRecorder recorder(scene, output);
     const std::string signature = femb::ModelSignature(scene);
+    long step_count = 0;
+    long total_iterations = 0;
+    if (resume) {
+      const femb::h5::Reader checkpoint((std::filesystem::path(restart) / "checkpoint.h5").string());
+      recorder.Resume(checkpoint);
+      recorder.ResumedAt(resume->state.t);
+      const Eigen::VectorXd run = checkpoint.Vector("/run/counts");
+      if (run.size() != 2) throw femb::InputError(checkpoint.path() + ": /run/counts must hold 2 values");
+      step_count = long(run[0]), total_iterations = long(run[1]);
+      if (!quiet) {
+        std::printf("femb-solve: restart: %s at t = %.6g (%ld steps, %ld output steps), to t = %.6g\n", restart.c_str(),
+                    resume->state.t, step_count, recorder.steps(), spec.analysis.end_time);
+      }
+    }
     const femb::DofMap& dofs = scene.model.dofs();
     const double read_seconds = Seconds(wall);  // scene, superelement files, model
     if (!quiet) {
@@ -188,19 +233,39 @@ int main(int argc, char** argv) {
     bool ok = true;
     int stopped = 0;           // the signal that stopped the analysis, or 0
     double stopped_at = 0.0;   // the time (static: load factor) it stopped at
-    long total_iterations = 0;
-    long step_count = 0;
     long rejected = 0;  // steps rejected so far (step: auto)
     // Results on disk during the run: results.h5's status says how far it got.
     const bool is_static = spec.analysis.type == femb::AnalysisType::kStatic;
     const char* kind = is_static ? "static" : "dynamic";
-    auto flush = [&](const femb::DynamicState& state, bool force) {
+    // What a restart continues from: the run's state and what it carries into its next step
+    // (captured at each write during the run and at the last step), with the results' mark and
+    // this program's counts at that state.
+    std::optional<femb::DynamicResume> saved;
+    femb::DynamicState final_state;  // the state the analysis ended in (static: at rest)
+    femb::ResultsRecorder::Mark mark;
+    long saved_steps = 0, saved_iterations = 0;
+    const auto take = [&](const femb::DynamicStepReport& report) {
+      if (!saved) saved.emplace();
+      (*report.capture)(*saved);
+      mark = recorder.TakeMark();
+      saved_steps = step_count, saved_iterations = total_iterations;
+    };
+    const auto write_checkpoint = [&](const femb::DynamicState& state) {
+      if (!saved) return femb::WriteCheckpoint(output, scene, signature, state, kind);
+      femb::WriteCheckpoint(output, scene, signature, saved->state, kind, &*saved, [&](femb::h5::Writer& w) {
+        recorder.WriteMark(w, mark);
+        w.CreateGroup("/run");
+        w.Vector("/run/counts", Eigen::Vector2d(double(saved_steps), double(saved_iterations)));
+      });
+    };
+    auto flush = [&](const femb::DynamicState& state, bool force, const femb::DynamicStepReport* report = nullptr) {
       if (!force && !recorder.FlushDue()) return;
       char running[160];
       std::snprintf(running, sizeof running, "running: %s %.6g of %.6g (written during the run)",
                     is_static ? "load factor" : "t =", state.t, spec.analysis.end_time);
+      if (report) take(*report);
       recorder.Flush(running);
-      femb::WriteCheckpoint(output, scene, signature, state, kind);
+      write_checkpoint(state);
     };
     // A static state as a checkpoint's: the configuration at load factor t, at rest.
     auto at_rest = [](const femb::SystemState& config, double t) {
@@ -292,19 +357,22 @@ int main(int argc, char** argv) {
       if (!ok) status = r.message;
       stopped = r.stopped;
       stopped_at = r.steps.empty() ? 0.0 : r.steps.back().lambda;
-      femb::WriteCheckpoint(output, scene, signature, at_rest(state, r.steps.empty() ? 0.0 : r.steps.back().lambda), kind);
+      final_state = at_rest(state, stopped_at);
       for (const std::string& w : r.warnings) std::printf("femb-solve: warning: %s\n", w.c_str());
     } else {
       femb::DynamicState state =
-          from ? femb::InitialDynamicState(scene.model, from->config, from->W.size() ? from->W : scene.initial_velocity, t0)
-               : femb::InitialDynamicState(scene.model, femb::InitialState(scene.model), scene.initial_velocity);
-      const femb::DynamicStepReport r0 = femb::Measure(scene.model, state);
-      const auto reactions0 = spec.reactions ? femb::DynamicReactions(scene.model, state)
-                                             : std::vector<Eigen::Matrix<double, 6, 1>>();
-      recorder.Record(state.t, state.config, state.W, r0.kinetic_energy, r0.elastic_energy, 0.0, r0.linear_momentum,
-                      r0.angular_momentum, spec.reactions ? &reactions0 : nullptr, &state.Wdot);
-      recorder.RecordStepSize(0.0);
-      flush(state, true);
+          resume ? resume->state
+          : from ? femb::InitialDynamicState(scene.model, from->config, from->W.size() ? from->W : scene.initial_velocity, t0)
+                 : femb::InitialDynamicState(scene.model, femb::InitialState(scene.model), scene.initial_velocity);
+      if (!resume) {
+        const femb::DynamicStepReport r0 = femb::Measure(scene.model, state);
+        const auto reactions0 = spec.reactions ? femb::DynamicReactions(scene.model, state)
+                                               : std::vector<Eigen::Matrix<double, 6, 1>>();
+        recorder.Record(state.t, state.config, state.W, r0.kinetic_energy, r0.elastic_energy, 0.0, r0.linear_momentum,
+                        r0.angular_momentum, spec.reactions ? &reactions0 : nullptr, &state.Wdot);
+        recorder.RecordStepSize(0.0);
+        flush(state, true);
+      }
       femb::DynamicOptions options;
       options.step = spec.analysis.step;
       options.end_time = spec.analysis.end_time;
@@ -325,6 +393,7 @@ int main(int argc, char** argv) {
                                        : femb::BodyMatricesKept::kInertia;
       options.threads = threads;
       options.stop = &femb::StopRequest();
+      if (resume) options.resume = &*resume;
       options.adaptive = spec.analysis.adaptive_step;
       if (options.adaptive) options.step = 1e-4 * spec.analysis.end_time;  // the first step tried
       options.step_tolerance = spec.analysis.step_tolerance;
@@ -353,15 +422,16 @@ int main(int argc, char** argv) {
               recorder.Record(s.t, out.config, out.W, s.kinetic_energy, s.elastic_energy, s.external_work,
                               s.linear_momentum, s.angular_momentum, spec.reactions ? &reactions : nullptr, &out.Wdot);
               recorder.RecordStepSize(s.h);
-              flush(st, false);
+              flush(st, false, &s);
             }
+            if (s.last) take(s);
             progress(s.t, false);
           });
       ok = r.ok;
       if (!ok) status = r.message;
       stopped = r.stopped;
       stopped_at = state.t;
-      femb::WriteCheckpoint(output, scene, signature, state, kind);
+      final_state = state;
       for (const std::string& w : r.warnings) std::printf("femb-solve: warning: %s\n", w.c_str());
       if (!quiet) {
         const std::string analysed = r.pattern_analyses == 1 ? "once" : std::to_string(r.pattern_analyses) + " times";
@@ -396,6 +466,8 @@ int main(int argc, char** argv) {
       status = buffer;
     }
     recorder.Finish(status);
+    // The checkpoint after the results it refers to (a kill between the two leaves the older one).
+    write_checkpoint(final_state);
     if (!stopped) progress(spec.analysis.end_time, true);
     if (!quiet) {
       for (const std::string& line : recorder.StressSummary()) std::printf("femb-solve: %s\n", line.c_str());

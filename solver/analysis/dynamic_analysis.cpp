@@ -336,9 +336,13 @@ DynamicResult SolveDynamic(const SystemModel& model, DynamicState& state, const 
       }
     }
   }
-  // What the next step starts from (DynamicStepReport::capture, called in on_step).
+  // What the next step starts from (DynamicStepReport::capture, called in on_step). A fixed step's
+  // time is t_base + n h, rounded to end_time at the end for the report: the state goes on from
+  // the unrounded one (grid_time), as in a longer run.
+  double grid_time = state.t;
   const std::function<void(DynamicResume&)> capture = [&](DynamicResume& r) {
     r.state = state;
+    if (!options.adaptive) r.state.t = grid_time;
     r.t_start = t_output0, r.h = h, r.t_base = t_base, r.last_output = last_output, r.E0 = E0;
     r.energy_scale = energy_scale, r.first_cut_time = first_cut_time, r.n_nominal = n_nominal, r.cuts = cuts;
     r.warned = warned;
@@ -374,12 +378,15 @@ DynamicResult SolveDynamic(const SystemModel& model, DynamicState& state, const 
     count_factorizations();
     return result;
   };
-  while (state.t < options.end_time - 1e-12 * std::max(std::abs(options.end_time), options.step)) {
+  const auto before_end = [&] { return state.t < options.end_time - 1e-12 * std::max(std::abs(options.end_time), options.step); };
+  while (before_end()) {
     if (options.adaptive) {
       h = control.Fit(state.t, h);
     } else {
+      // The last step: the rest of the time, unless that is the nominal step to round-off (then
+      // the step stays nominal: a run extended from this end takes the steps a longer run takes).
       const double remaining = options.end_time - state.t;
-      if (remaining <= 1.01 * h) h = remaining;
+      if (remaining <= 1.01 * h && !(h == options.step && std::abs(remaining - h) <= 1e-9 * h)) h = remaining;
     }
     matrix.with_this_factor = 0;  // a step may use the kept factor for reuse_max_iterations iterations
     const double t_new =
@@ -452,6 +459,7 @@ DynamicResult SolveDynamic(const SystemModel& model, DynamicState& state, const 
         t_base = next.t;
         n_nominal = 0;
       }
+      grid_time = next.t;  // a run continued from here goes on from the unrounded time
       if (options.end_time - next.t < 1e-9 * h) next.t = options.end_time;
       if (options.output_step > 0) {
         // The first step at or after each output time.
@@ -521,10 +529,14 @@ DynamicResult SolveDynamic(const SystemModel& model, DynamicState& state, const 
       h = std::min(options.step, 2 * h);
       --cuts;
     }
+    // A stop requested by now ends the run after this report (one requested during it, after the
+    // next step): the report says which step is the last.
+    const int stop = options.stop ? options.stop->load() : 0;
+    r.last = !before_end() || stop != 0;
     if (on_step) on_step(r, state);
     if (!unstable.empty()) return fail(unstable);
-    if (options.stop && options.stop->load() != 0) {
-      result.stopped = options.stop->load();
+    if (stop != 0) {
+      result.stopped = stop;
       break;
     }
   }

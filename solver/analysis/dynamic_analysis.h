@@ -148,6 +148,8 @@ struct DynamicState {
 struct DynamicStepReport {
   /// Saves what the run carries into its next step (DynamicResume); valid during on_step.
   const std::function<void(DynamicResume&)>* capture = nullptr;
+  /// The run's last step: it reached end_time, or a stop was requested before this report.
+  bool last = false;
   double t = 0.0;
   double h = 0.0;
   int iterations = 0;

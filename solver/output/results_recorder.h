@@ -29,6 +29,10 @@ class ResultsRecorder {
  public:
   /// Creates `directory` if needed; opens results.h5 (at Finish) and probes.csv (streamed).
   ResultsRecorder(const Scene& scene, const std::string& directory);
+  /// Without Finish (an input error before or during the run): the temporary CSV is removed.
+  ~ResultsRecorder();
+  ResultsRecorder(const ResultsRecorder&) = delete;
+  ResultsRecorder& operator=(const ResultsRecorder&) = delete;
   /// Records one output step. W: velocities over the unknowns (zero for static analyses);
   /// momentum: linear and angular (about the origin) momentum of all bodies (dynamic analyses).
   /// `reactions`: per node (force, moment; JointReactions), recorded when the scene asks for them.
@@ -63,6 +67,26 @@ class ResultsRecorder {
   /// Writes results.h5, probes.csv and animation.h5 in their final form. `status` is stored
   /// ("completed", the failure message, or where a signal stopped the run).
   void Finish(const std::string& status);
+  /// What a restart needs of the results so far (femb-solve --restart), taken when the run's
+  /// state is saved (DynamicStepReport::capture): the output steps, steps and animation frames
+  /// recorded up to that state, and the probes' unwrapping of angles.
+  struct Mark {
+    long outputs = 0, steps = 0, frames = 0;
+    double next_frame_time = 0.0;
+    std::vector<Eigen::VectorXd> probe_last;
+  };
+  Mark TakeMark() const;
+  /// Writes `mark` with where the animation's frames are (group /recorder of a checkpoint; after
+  /// Flush or Finish, when every frame up to the mark is in a file).
+  void WriteMark(h5::Writer& w, const Mark& mark) const;
+  /// Continues the results already in the output folder from a checkpoint's /recorder group: the
+  /// series of results.h5 and the rows of probes.csv up to its mark (later ones, written after
+  /// the checkpoint's state, are dropped), and the animation's frames. One line (InputError)
+  /// when the folder's files do not hold them or the scene's outputs differ from the run's.
+  void Resume(const h5::Reader& checkpoint);
+  /// The continued run's time t: a last recorded time that the run's end rounded to end_time (a
+  /// fixed step's t_base + n h, within round-off) takes t, as the longer run records it.
+  void ResumedAt(double t);
   /// Writes during the run so far: their number and their wall time in seconds.
   long flushes() const { return flushes_; }
   double flush_seconds() const { return flush_seconds_; }
@@ -100,6 +124,8 @@ class ResultsRecorder {
     std::vector<std::unique_ptr<double[]>> chunks;
     double* Append();                ///< the new row, zero-filled
     Eigen::MatrixXd Matrix() const;  ///< count x width
+    /// Appends the first n rows of m (its width checked; `what` names it in the error).
+    void Load(const Eigen::MatrixXd& m, long n, const std::string& what);
    private:
     long ChunkRows() const { return std::max(1L, 8192L / std::max(width, 1)); }
   };

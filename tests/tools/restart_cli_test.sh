@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
-# Starting an analysis from the state another run reached (initial_state: {from: OUTDIR}, the
-# folder's checkpoint.h5): a dynamic run from a static equilibrium starts at rest, a dynamic
-# run continues another's, modes about a saved static state; bad checkpoints are one line,
-# exit 2, and nothing in the output folder is touched.
+# The state a run reached (OUTDIR/checkpoint.h5): another analysis started from it
+# (initial_state: {from: OUTDIR}: a dynamic run from a static equilibrium starts at rest, a
+# dynamic run continues another's, modes about a saved static state), and a stopped or killed
+# run continued in its folder to the bit (--restart OUTDIR); bad checkpoints are one line, exit
+# 2, and nothing in the output folder is touched.
 # Usage: restart_cli_test.sh BIN_DIR SOURCE_DIR
 set -u
 bin=$1
@@ -112,6 +113,91 @@ printf '%s\n' "name: bar_static2" "$model" "analysis: {type: static, end_time: 1
 check_bad "initial_state in a static analysis" "$work/bad4.yaml" "initial_state: a static analysis starts from the model's placement"
 echo "initial_state: {from: half}" | cat "$work/tip.yaml" - | sed 's/end_time: 0.1,/end_time: 0.04,/' > "$work/bad5.yaml"
 check_bad "end_time before the state's time" "$work/bad5.yaml" "analysis.end_time 0.04 is not after the initial state's time 0.05"
+
+# --restart: a run stopped by SIGTERM, or killed by SIGKILL after a write during the run, and
+# continued in its folder ends with probes.csv and results.h5 identical to the bit to the
+# uninterrupted run's: the four-bar with a flexible coupler in 2 superelements and a cut joint,
+# generalized-alpha (fixed steps; step: auto with body_matrices_every 3) and the midpoint scheme
+# (fixed steps; step: auto), reactions on. A finished run extended to a later end time equals the
+# run to that time directly.
+mkdir -p "$work/fb"
+$py "$src/examples/four_bar/make_scenes.py" "$work/fb" > /dev/null && "$bin/femb-reduce" -q "$work/fb/coupler_2.yaml" -o "$work/fb/coupler_2.h5" \
+  || fail "four-bar scenes"
+$py - "$bin" "$work/fb" <<'PY' && ok || fail "--restart after SIGTERM and SIGKILL, and extending a finished run"
+import os, signal, subprocess, sys, time
+import h5py, numpy as np
+bin_dir, fb = sys.argv[1:3]
+base = [bin_dir + "/femb-solve", fb + "/flexible.yaml", "-q", "--threads", "1", "--set", "analysis.end_time=0.05",
+        "--set", "outputs.reactions=true", "--set", "outputs.flush_every_steps=300"]
+
+def datasets(path):
+    out = {}
+    with h5py.File(path, "r") as f:
+        f.visititems(lambda name, obj: out.__setitem__(name, obj[()]) if isinstance(obj, h5py.Dataset) else None)
+        out["@"] = {k: f.attrs[k] for k in f.attrs}
+    return out
+
+def same(a, b):
+    da, db = datasets(a + "/results.h5"), datasets(b + "/results.h5")
+    assert set(da) == set(db), set(da) ^ set(db)
+    for k in da:
+        if k == "@":
+            assert {k: str(v) for k, v in da[k].items()} == {k: str(v) for k, v in db[k].items()}, (da[k], db[k])
+        elif da[k].dtype.kind == "O":
+            assert list(da[k]) == list(db[k]), k
+        else:
+            assert da[k].shape == db[k].shape and np.array_equal(da[k], db[k]), (k, da[k].shape, db[k].shape)
+    assert open(a + "/probes.csv").read() == open(b + "/probes.csv").read()
+
+def has_resume(out):
+    try:
+        with h5py.File(out + "/checkpoint.h5", "r") as f:
+            return "resume" in f
+    except (OSError, KeyError):
+        return False
+
+cases = [("generalized-alpha", [], signal.SIGTERM),
+         ("generalized-alpha, step: auto, body_matrices_every 3",
+          ["--set", "analysis.step=auto", "--set", "analysis.body_matrices_every=3"], signal.SIGKILL),
+         ("midpoint", ["--set", "analysis.integrator=midpoint"], signal.SIGKILL),
+         ("midpoint, step: auto", ["--set", "analysis.integrator=midpoint", "--set", "analysis.step=auto"], signal.SIGTERM)]
+for k, (name, extra, sig) in enumerate(cases):
+    whole, part = f"{fb}/whole{k}", f"{fb}/part{k}"
+    subprocess.run(base + extra + ["-o", whole], check=True)
+    p = subprocess.Popen(base + extra + ["-o", part])
+    while not has_resume(part) and p.poll() is None:
+        time.sleep(0.01)
+    p.send_signal(sig)
+    p.wait()
+    with h5py.File(part + "/checkpoint.h5", "r") as f:
+        t_stop = f["state/numbers"][0]
+    assert p.returncode in (-signal.SIGKILL, 143), (name, p.returncode)
+    assert t_stop < 0.05, (name, t_stop)
+    subprocess.run(base + extra + ["--restart", part], check=True)
+    same(whole, part)
+    print(f"{name}: stopped by {signal.Signals(sig).name} with its state at t = {t_stop:.6g}, restarted: identical")
+# A finished run extended: to 0.03 s, then on to 0.05 s.
+subprocess.run(base + ["-o", fb + "/short", "--set", "analysis.end_time=0.03"], check=True)
+subprocess.run(base + ["--restart", fb + "/short"], check=True)
+same(fb + "/whole0", fb + "/short")
+print("extended from 0.03 s to 0.05 s: identical to the run to 0.05 s")
+PY
+# --restart's bad input: one line, exit 2, the folder left as it was.
+check_restart_bad() {  # label, folder, expected message part, extra args...
+  local label=$1 dir=$2 message=$3
+  shift 3
+  local before
+  before=$(cd "$dir" 2>/dev/null && md5sum * 2>/dev/null)
+  "$bin/femb-solve" -q "$work/fb/flexible.yaml" --restart "$dir" "$@" 2> "$work/err.txt"; local code=$?
+  [ $code = 2 ] && [ "$(wc -l < "$work/err.txt")" = 1 ] && grep -q "$message" "$work/err.txt" \
+    && [ "$(cd "$dir" 2>/dev/null && md5sum * 2>/dev/null)" = "$before" ] && ok || fail "$label: exit $code, $(cat "$work/err.txt")"
+}
+check_restart_bad "restart without a checkpoint" "$work/nowhere" "nowhere/checkpoint.h5: no checkpoint"
+check_restart_bad "restart from another model's checkpoint" "$work/half" "written for another model"
+check_restart_bad "restart of a finished run to its own end" "$work/fb/short" "the run reached t = 0.05.*not later" --set analysis.end_time=0.05
+cp -r "$work/fb/short" "$work/fb/cut"
+head -c 5000 "$work/fb/short/checkpoint.h5" > "$work/fb/cut/checkpoint.h5"
+check_restart_bad "restart from a truncated checkpoint" "$work/fb/cut" "cut/checkpoint.h5"
 
 echo "restart_cli_test: $passed passed, $failed failed"
 [ "$failed" = 0 ]
