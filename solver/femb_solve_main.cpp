@@ -60,7 +60,7 @@ void RecordModeShapes(const femb::Scene& scene, const femb::SystemState& state, 
   }
 }
 
-constexpr const char* kUsage = R"(usage: femb-solve SCENE.yaml [-o OUTDIR] [--set key=value]... [--threads N] [--quiet]
+constexpr const char* kUsage = R"(usage: femb-solve SCENE.yaml [-o OUTDIR | --restart OUTDIR] [--set key=value]... [--threads N] [--quiet]
 
 Simulates a scene of superelements and rigid bodies in absolute interface coordinates (see
 formats/SCENE_FORMAT.md), with joints along a tree and closed loops cut into constraint equations:
@@ -79,7 +79,12 @@ formats/SCENE_FORMAT.md), with joints along a tree and closed loops cut into con
 options:
   -o, --output OUTDIR   output folder (default: out/<scene name>): results.h5, probes.csv and the
                         animation, written at the start, every outputs.flush_every seconds
-                        (default 10) and at the end (a killed run keeps what was last written)
+                        (default 10) and at the end (a killed run keeps what was last written),
+                        with checkpoint.h5, the state reached
+  --restart OUTDIR      continue the dynamic run whose results are in OUTDIR from its
+                        checkpoint (stopped by a signal, killed, or finished: then with a later
+                        --set analysis.end_time=...), into the same files: the results equal the
+                        uninterrupted run's to the bit
   --set key=value       override a scene key, e.g. --set analysis.step=5e-4
                         --set analysis.end_time=0.5 (repeatable)
   --threads N           threads for the bodies' forces and matrices in dynamic analysis
@@ -91,7 +96,7 @@ options:
 exit codes: 0 success, 2 bad input (one line names the file, line and key), 3 numerical failure
 (the results up to the failure are kept in OUTDIR), 130 / 143 stopped by SIGINT (Ctrl-C) /
 SIGTERM: the step under way is finished and the results up to it are written to OUTDIR (a
-second signal ends the run at once, writing nothing).
+second signal ends the run at once, writing nothing); continue it with --restart OUTDIR.
 )";
 
 }  // namespace
