@@ -146,7 +146,6 @@ int main(int argc, char** argv) {
         throw femb::InputError("--restart " + restart + ": continues dynamic analyses only (start one from a static run's "
                                "state with initial_state)");
       }
-      if (!spec.initial_state.from.empty()) throw femb::InputError(spec.initial_state.where + ": initial_state and --restart: give one");
       resume.emplace();
       if (!femb::ReadResume(restart, scene, *resume)) {
         throw femb::InputError(checkpoint + ": holds no dynamic run to continue (a static run's state, or one written "
@@ -164,7 +163,7 @@ int main(int argc, char** argv) {
     // before anything is written.
     std::optional<femb::DynamicState> from;
     double t0 = 0.0;
-    if (!spec.initial_state.from.empty()) {
+    if (!spec.initial_state.from.empty() && !resume) {  // a restarted run began from it already
       const femb::SceneSpec::InitialStateSpec& is = spec.initial_state;
       if (spec.analysis.type == femb::AnalysisType::kStatic) {
         throw femb::InputError(is.where + ": initial_state: a static analysis starts from the model's placement (give it "

@@ -657,8 +657,14 @@ void ResultsRecorder::ResumedAt(double t) {
 
 bool ResultsRecorder::FlushDue() const {
   if (flush_every_steps_ > 0 && outputs_since_flush_ >= flush_every_steps_) return true;
-  const double since = std::chrono::duration<double>(std::chrono::steady_clock::now() - last_flush_).count();
-  return outputs_since_flush_ > 0 && since >= std::max(flush_every_, 50.0 * last_flush_cost_);
+  if (outputs_since_flush_ == 0) return false;
+  const auto now = std::chrono::steady_clock::now();
+  if (std::chrono::duration<double>(now - last_flush_).count() < flush_every_) return false;
+  // The writes' budget: all of them within 2% of the wall time so far, the next one predicted
+  // from the last (results.h5 is rewritten whole: its cost grows with the output steps).
+  const double elapsed = std::chrono::duration<double>(now - started_).count();
+  const double next = last_flush_cost_ * double(time_.size()) / double(std::max(outputs_at_last_flush_, 1L));
+  return flush_seconds_ + next <= 0.02 * elapsed;
 }
 
 void ResultsRecorder::Flush(const std::string& status) {
@@ -677,6 +683,7 @@ void ResultsRecorder::Flush(const std::string& status) {
   WriteAnimationPart();
   last_flush_ = std::chrono::steady_clock::now();
   last_flush_cost_ = std::chrono::duration<double>(last_flush_ - start).count();
+  outputs_at_last_flush_ = long(time_.size());
   flush_seconds_ += last_flush_cost_;
   ++flushes_;
   outputs_since_flush_ = 0;

@@ -57,8 +57,9 @@ class ResultsRecorder {
     steps_taken_ = taken, rejected_by_error_ = rejected_by_error, newton_cuts_ = newton_cuts;
   }
   /// Whether a write during the run is due: outputs.flush_every seconds of wall time since the
-  /// last one (and at least 50 times that write's duration: the writing stays within about 2% of
-  /// the run as results.h5 grows), or outputs.flush_every_steps output steps.
+  /// last one, unless the writes (the next one predicted from the last, as results.h5 grows)
+  /// would then have taken more than 2% of the wall time so far; or outputs.flush_every_steps
+  /// output steps.
   bool FlushDue() const;
   /// Writes results.h5 (its `status` says the run goes on, e.g. "running: t = 0.5 of 2"),
   /// probes.csv and the animation's frames since the last write (a new part file) under their
@@ -164,7 +165,8 @@ class ResultsRecorder {
   // Writing during the run (Flush).
   double flush_every_ = 10.0;
   long flush_every_steps_ = 0, outputs_since_flush_ = 0, flushes_ = 0;
-  std::chrono::steady_clock::time_point last_flush_ = std::chrono::steady_clock::now();
+  long outputs_at_last_flush_ = 0;
+  std::chrono::steady_clock::time_point started_ = std::chrono::steady_clock::now(), last_flush_ = started_;
   double last_flush_cost_ = 0.0, flush_seconds_ = 0.0;
   // The animation's grid (every body's mesh or stick figure; built at the first frame written)
   // and where each frame is: frame_time_ holds every frame's time, mesh_positions_,

@@ -46,6 +46,12 @@ assert abs(s["tippositiony"][0] - st["tippositiony"][-1]) == 0  # the static run
 assert np.abs(d["tipaccelerationy"]).max() > 0.5 * 9.81, d["tipaccelerationy"]
 PY
 
+# A run started from another's state, stopped and restarted, equals the run in one go (the
+# restart continues its own state: initial_state is not read again).
+"$bin/femb-solve" -q "$work/settled.yaml" -o "$work/settled_half" --set analysis.end_time=0.01 \
+  && "$bin/femb-solve" -q "$work/settled.yaml" --restart "$work/settled_half" \
+  && cmp -s "$work/settled/probes.csv" "$work/settled_half/probes.csv" && ok || fail "restart of a run started with initial_state"
+
 # Modes about the saved static state equal modes_about_static (the same static solve).
 printf '%s\n' "name: bar_modes" "$model" "loads:" "  - {type: gravity, g: [0, -9.81, 0]}" \
   "analysis: {type: modes, count: 4, end_time: 1, steps: 4, about: static}" > "$work/modes.yaml"
