@@ -38,3 +38,6 @@ echo
 #   bash benchmarks/midpoint_vs_base.sh [BASE]
 # The four-bar coupler's energy with and without geometric stiffening (issue 13; about 40 s).
 /usr/bin/python3 benchmarks/stiffening_energy.py build/bin out/stiffening_energy
+echo
+# What writing the results during the run costs (the 10-body slider-crank, about 4 minutes).
+/usr/bin/python3 benchmarks/flush_cost.py build/bin

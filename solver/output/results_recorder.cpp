@@ -661,9 +661,14 @@ bool ResultsRecorder::FlushDue() const {
   const auto now = std::chrono::steady_clock::now();
   if (std::chrono::duration<double>(now - last_flush_).count() < flush_every_) return false;
   // The writes' budget: all of them within 2% of the wall time so far, the next one predicted
-  // from the last (results.h5 is rewritten whole: its cost grows with the output steps).
+  // from the last: probes.csv and results.h5 are rewritten whole (their cost grows with the
+  // output steps), an animation part holds the frames since the last write.
   const double elapsed = std::chrono::duration<double>(now - started_).count();
-  const double next = last_flush_cost_ * double(time_.size()) / double(std::max(outputs_at_last_flush_, 1L));
+  // The growth extrapolated from a write of at least a quarter of the output steps (a smaller
+  // one's cost is mostly fixed: files created, datasets opened).
+  const double n = double(time_.size()), n_last = double(std::max(outputs_at_last_flush_, 1L));
+  const double grows = n_last >= 0.25 * n ? n / n_last : 1.0;
+  const double next = last_growing_cost_ * grows + (last_flush_cost_ - last_growing_cost_);
   return flush_seconds_ + next <= 0.02 * elapsed;
 }
 
@@ -680,9 +685,11 @@ void ResultsRecorder::Flush(const std::string& status) {
   if (!ec) std::filesystem::rename(copy, csv_path_, ec);
   if (ec) throw InputError(csv_path_ + ": cannot write (" + ec.message() + ")");
   WriteResults(status);
+  const auto grown = std::chrono::steady_clock::now();
   WriteAnimationPart();
   last_flush_ = std::chrono::steady_clock::now();
   last_flush_cost_ = std::chrono::duration<double>(last_flush_ - start).count();
+  last_growing_cost_ = std::chrono::duration<double>(grown - start).count();
   outputs_at_last_flush_ = long(time_.size());
   flush_seconds_ += last_flush_cost_;
   ++flushes_;

@@ -167,7 +167,7 @@ class ResultsRecorder {
   long flush_every_steps_ = 0, outputs_since_flush_ = 0, flushes_ = 0;
   long outputs_at_last_flush_ = 0;
   std::chrono::steady_clock::time_point started_ = std::chrono::steady_clock::now(), last_flush_ = started_;
-  double last_flush_cost_ = 0.0, flush_seconds_ = 0.0;
+  double last_flush_cost_ = 0.0, last_growing_cost_ = 0.0, flush_seconds_ = 0.0;
   // The animation's grid (every body's mesh or stick figure; built at the first frame written)
   // and where each frame is: frame_time_ holds every frame's time, mesh_positions_,
   // mesh_deformations_ and frame_stress_ the frames not yet written (from frames_written_ on).
