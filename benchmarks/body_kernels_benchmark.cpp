@@ -1,7 +1,7 @@
 // One body's kernels, timed call by call: the work of a Newton iteration of generalized-alpha on
 // one superelement (a tube segment with 2 interface nodes and 2 internal modes, 14 coordinates;
 // more modes with an argument), linear and with the geometric stiffening and exact inertia
-// (issue 13's cost ratio), split into the passes femb-solve makes: the body data (Evaluate:
+// (the stiffening's cost ratio), split into the passes femb-solve makes: the body data (Evaluate:
 // local coordinates and kinematics), the residual pass (elastic, inertia and gravity forces, the
 // inertia load factors) and the matrix pass (tangent, mass and gyroscopic matrices,
 // configuration tangent of the inertia force). Prints microseconds per call and heap

@@ -1,12 +1,12 @@
 #!/usr/bin/env bash
-# The solver's hot path against an earlier commit of femb, same machine, same run (issue 14):
+# The solver's hot path against an earlier commit of femb, same machine, same run:
 # builds BASE in a git worktree (kept in $BASE_DIR for the next run), then, interleaved and
 # twice each (the lower time counts):
 #   - the 10-body 2D slider-crank (examples/slider_crank_2d, 10 linear rod bodies, h = 10 us,
 #     12 600 steps) with each commit's femb-reduce and femb-solve, on 1 thread and on 2;
 #     prints wall times, ratios and the largest difference of the rod midpoint's position;
 #   - each commit's solver_scaling_benchmark (its own table: ms per body-step, allocations).
-# Usage: bash benchmarks/hot_path_vs_base.sh [BASE]    (default 9db5b40, the state issue 14 measured)
+# Usage: bash benchmarks/hot_path_vs_base.sh [BASE]    (default 9db5b40, the state before the allocation-free hot path)
 set -euo pipefail
 here=$(cd "$(dirname "$0")/.." && pwd)
 base=${1:-9db5b40}

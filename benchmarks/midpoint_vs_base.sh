@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The momentum-conserving midpoint scheme against an earlier commit of femb, same machine, same
-# run (issue 14): builds BASE in a git worktree (kept in $BASE_DIR for the next run), then runs
+# run: builds BASE in a git worktree (kept in $BASE_DIR for the next run), then runs
 # seven scenes with `analysis.integrator: midpoint` on one thread, interleaved, three times each
 # (the lowest solving time counts, femb-solve's own split of its time): the tumbling tee
 # (free flexible body), the planar and the spatial slider-crank (chains of joints, stiffened rod

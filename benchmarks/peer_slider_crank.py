@@ -1,7 +1,7 @@
 #!/usr/bin/python3
-"""Time to accuracy on the planar slider-crank as issue 14 compared it with its open peer (Exudyn
+"""Time to accuracy on the planar slider-crank as it was compared with its open peer (Exudyn
 1.11, ANCF cables: 1% RMS in 0.04-0.08 s of solve time, 0.3% in 0.09-0.37 s; the peer's numbers
-as the issue measured them, not rerun here).
+as measured side by side, not rerun here).
 
 The model as a multibody user would build it for that comparison: a rigid crank (0.15 m, 0.371 kg,
 driven at 150 rad/s) and a rigid slider (0.0334 kg), the flexible rod (0.3 m, d = 6 mm, steel) in 2
@@ -136,7 +136,7 @@ def plot(measured, png):
             ax.annotate(f"{float(h) * 1e6:.0f} us", (t, e), textcoords="offset points", xytext=(4, 4), fontsize=7)
     for err, lo, hi in ((1.0, 0.04, 0.08), (0.3, 0.09, 0.37)):
         ax.plot([lo, hi], [err, err], color="tab:red", lw=4, alpha=0.6,
-                label="peer (Exudyn 1.11, ANCF), as issue 14 reported it" if err == 1.0 else None)
+                label="peer (Exudyn 1.11, ANCF), as reported side by side" if err == 1.0 else None)
     ax.set_xscale("log")
     ax.set_yscale("log")
     ax.set_xlabel("solve time [s], one thread")

@@ -1,4 +1,4 @@
-// Rotating clamped cantilever in ONE body (issue 13 study): the first flapwise and in-plane
+// Rotating clamped cantilever in ONE body (a geometric stiffening study): the first flapwise and in-plane
 // frequency about the steadily rotating state, measured from a free vibration, against an
 // independent converged 1-D rotating-beam model and Southwell's closed form, with and without
 // geometric stiffening, for an interface frame (at the hub) and a centre-of-mass frame. "1 body":

@@ -26,17 +26,17 @@ echo
 # the examples' references exist in build/example_out, e.g. after ctest; else they are run first).
 /usr/bin/python3 benchmarks/step_control.py build/bin
 echo
-# Time to accuracy on the slider-crank issue 14 compared with its peer: rigid crank and slider,
+# Time to accuracy on the slider-crank compared with its peer: rigid crank and slider,
 # the rod in 2 stiffened bodies; steps, Newton tolerances, body_matrices_every (about 30 s).
 /usr/bin/python3 benchmarks/peer_slider_crank.py build/bin --out out/peer_slider_crank
 echo
-# The solver's hot path against the commit issue 14 measured (9db5b40; builds it once in
+# The solver's hot path against the commit before the allocation-free hot path (9db5b40; builds it once in
 # /tmp, about 10 minutes, then about 2 minutes): not run here, run it by hand:
 #   bash benchmarks/hot_path_vs_base.sh [BASE]
 # The midpoint scheme against its state before the allocation-free rewrite (ab9796a; builds it
 # once in /tmp, about 6 minutes, then about 20 s): by hand too:
 #   bash benchmarks/midpoint_vs_base.sh [BASE]
-# The four-bar coupler's energy with and without geometric stiffening (issue 13; about 40 s).
+# The four-bar coupler's energy with and without geometric stiffening (about 40 s).
 /usr/bin/python3 benchmarks/stiffening_energy.py build/bin out/stiffening_energy
 echo
 # What writing the results during the run costs (the 10-body slider-crank, about 4 minutes).

@@ -1,10 +1,10 @@
 // Solver scaling: a chain of N flexible bodies (tube segments, 2 internal modes each) clamped
 // at one end and falling under gravity; time per dynamic step and Newton iterations per step
 // for N = 1, 10, 100, 1000, linear bodies and bodies with the geometric stiffening and exact
-// inertia (reduction.geometric_stiffening, issue 13: the cost ratio per body-step), on one
-// thread and on all the processors (bodies in parallel, issue 14: the speed-up, same bits).
+// inertia (reduction.geometric_stiffening: the cost ratio per body-step), on one
+// thread and on all the processors (bodies in parallel: the speed-up, same bits).
 // Prints what it measured on this run, with the heap allocations per body-step (malloc, which
-// Eigen and operator new call, wrapped in this program around glibc's: issue 14 asks for none
+// Eigen and operator new call, wrapped in this program around glibc's: a step should make none
 // inside a step).
 // Usage: solver_scaling_benchmark [BODIES STEPS [linear|stiffened]]: one chain, for profiling.
 #include <atomic>

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Run time against error with fixed and error-controlled steps (issue 14, `step: auto`) on every
+"""Run time against error with fixed and error-controlled steps (`step: auto`) on every
 dynamic seed case, each with its recommended model (and the few-body stiffened model where the
 example has one): the example's fixed step, then `analysis.step=auto` at three step tolerances.
 The error is the example's own measure against the example's own reference (RMS over the

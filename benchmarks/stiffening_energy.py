@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Energy of the four-bar's coupler with and without geometric stiffening (issue 13).
+"""Energy of the four-bar's coupler with and without geometric stiffening.
 
 The four-bar of examples/four_bar (crank driven at 100 rad/s, coupler 0.35 m of 6 mm steel rod in
 2 superelements) run for 3 revolutions with the coupler linear and with its geometric stiffening,

@@ -46,7 +46,7 @@ struct BeamSpec {
   BeamSectionSpec section;
 };
 
-/// Nodes picked by geometry (issue 16): the mesh nodes on a surface (cylinder, sphere, plane)
+/// Nodes picked by geometry: the mesh nodes on a surface (cylinder, sphere, plane)
 /// within `tolerance`, or inside a box. reducer/mesh/node_selection.h applies it.
 struct NodeSelectionSpec {
   std::string shape;  ///< "cylinder", "sphere", "box" or "plane"
@@ -107,7 +107,7 @@ struct ReductionSpec {
   std::string where_basis;
   ModalDerivativeSpec modal_derivatives;
   std::string floating_frame = "center_of_mass";
-  /// Geometric stiffening (issue 13): the geometric stiffness of the basis vectors' stresses and
+  /// Geometric stiffening: the geometric stiffness of the basis vectors' stresses and
   /// of the 12 unit inertia load cases, and the inertia invariants of the exact kinetic energy,
   /// stored for femb-solve. Unset: on wherever it can be built (GeometricStiffening below).
   std::optional<bool> geometric_stiffening;
@@ -126,7 +126,7 @@ struct ReductionSpec {
   /// kKeepMeshMaxDofs DOFs (the shapes take n_dofs x n_reduced doubles).
   std::optional<bool> keep_mesh;
   static constexpr long kKeepMeshMaxDofs = 200000;
-  /// Modal stresses (issue 17, reducer/reduction/modal_stress.h) beside the kept mesh; unset: on
+  /// Modal stresses (reducer/reduction/modal_stress.h) beside the kept mesh; unset: on
   /// whenever the mesh is kept. true without the mesh is an error.
   std::optional<bool> stresses;
   std::string where_stresses;
@@ -140,7 +140,7 @@ struct ReductionSpec {
   std::string where_floating_frame;
 };
 
-/// Imported matrices (issue 16, `type: imported`): K and M of a model assembled by another FE
+/// Imported matrices (`type: imported`): K and M of a model assembled by another FE
 /// code, with the node coordinates from `geometry.file` (SolidSpec::file).
 struct MatricesSpec {
   std::string format;     ///< "calculix", "abaqus" or "matrix_market"

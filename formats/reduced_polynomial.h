@@ -1,4 +1,4 @@
-// The reduced polynomial internal force of a superelement with modal derivatives (issue 6):
+// The reduced polynomial internal force of a superelement with modal derivatives:
 // with Green-Lagrange strains the strain energy is exactly quartic in the reduced coordinates q,
 //   W(q) = q^T K q / 2 + q^T A z(q) + z(q)^T B z(q),
 // z_p = m_p q_j q_k over the pairs p = (j, k), j <= k, ordered (0,0), (0,1), ..., (0,n-1), (1,1),
@@ -11,7 +11,7 @@
 
 namespace femb {
 
-// Without modal derivatives, the geometric stiffening of issue 13 stores the quadratic part A
+// Without modal derivatives, the geometric stiffening stores the quadratic part A
 // only (B empty, 0 x 0). A holds the third-order tensor of the geometric stiffness of each basis
 // vector's stress: K_sigma,j = Phi^T G(sigma(phi_j)) Phi has entries (k, l) = 2 A(j, p(k, l)),
 // and (A z)_i = q^T K_sigma,i q / 2 is the force that the deformation's quadratic strain exerts
@@ -69,7 +69,7 @@ Eigen::MatrixXd CondensedTangent(const Eigen::MatrixXd& K, const PolynomialStiff
                                  const Eigen::VectorXd& eps);
 
 /// The temporaries of the condensed polynomial's functions below, kept by the caller from call
-/// to call so that they allocate nothing once sized (a body's Data; issue 14). Contents mean
+/// to call so that they allocate nothing once sized (a body's Data). Contents mean
 /// nothing between calls.
 struct PolynomialScratch {
   Eigen::VectorXd z, Az, RAz, Ate, u;

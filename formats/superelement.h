@@ -62,7 +62,7 @@ struct Visualization {
   std::vector<std::vector<int>> interface_nodes;
 };
 
-/// Optional (issue 17): the stress that each reduced coordinate causes at stress points of the
+/// Optional: the stress that each reduced coordinate causes at stress points of the
 /// kept mesh. Linear: sigma(point p) = sum_i q_i modes.block(6 p, i, 6, 1) for local coordinates
 /// q (the rigid-body modes cause none). Components (xx, yy, zz, yz, xz, xy), Cauchy = linear
 /// stress, part axes, [stress per unit of the coordinate]. Solids: one point per mesh node (the
@@ -153,11 +153,11 @@ struct Superelement {
   /// With modal derivatives: the quadratic and cubic coefficients of the reduced Green-Lagrange
   /// internal force (reduced_polynomial.h); the solver then uses it in place of K q.
   std::optional<PolynomialStiffness> polynomial;
-  /// Geometric stiffening from rigid-body inertia loads (issue 13; SuperelementBody::InertiaLoads):
+  /// Geometric stiffening from rigid-body inertia loads (SuperelementBody::InertiaLoads):
   /// K_sigma,k = Phi^T G(sigma_k) Phi (n x n, symmetric) of the stress sigma_k of unit inertia
   /// load case k (kInertiaLoadCases) with the interfaces held; empty when not computed.
   std::vector<Eigen::MatrixXd> inertia_stiffness;
-  /// Inertia invariants of the floating frame formulation (issue 13; the SID of Wallrapp): with
+  /// Inertia invariants of the floating frame formulation (the SID of Wallrapp): with
   /// S_a the skew matrix of e_a on every translation and rotation triple of the full model (it
   /// turns a displacement field with the frame), Phi the full basis and M the full mass matrix,
   ///   inertia_gamma[a] = Gamma_a  = Phi^T M S_a Phi          (a = x, y, z)

@@ -295,7 +295,7 @@ Superelement ReadSuperelementFile(const std::string& path, const SuperelementRea
     const long P = n * (n + 1) / 2;
     RequireShape(r, "/reduced/polynomial/A", n, P);
     se.polynomial = PolynomialStiffness{r.Matrix("/reduced/polynomial/A"), Eigen::MatrixXd(), Eigen::MatrixXd()};
-    // B is absent when the file holds the quadratic part only (geometric stiffening, issue 13).
+    // B is absent when the file holds the quadratic part only (geometric stiffening).
     if (r.Exists("/reduced/polynomial/B")) {
       RequireShape(r, "/reduced/polynomial/B", P, P);
       se.polynomial->B = r.Matrix("/reduced/polynomial/B");

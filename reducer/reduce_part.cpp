@@ -171,7 +171,7 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
       return out;
     };
   }
-  // Geometric stiffening (issue 13): the unit inertia load cases are solved on the same factor.
+  // Geometric stiffening: the unit inertia load cases are solved on the same factor.
   // A basis without deformation (one interface node, no internal modes: the six rigid motions)
   // has nothing to stiffen, and its exact and corotational kinetic energies are the same.
   bool stiffening = part.reduction.GeometricStiffening(part.type, part.has_material) && n_b + m > 6;

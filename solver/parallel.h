@@ -1,4 +1,4 @@
-// Bodies in parallel (issue 14 item 2). A body's forces and matrices depend on its own
+// Bodies in parallel. A body's forces and matrices depend on its own
 // configuration only, so the solver evaluates them on several threads into per-body slots and
 // adds the slots into the system in body order: the same bits for any number of threads.
 //
@@ -27,7 +27,7 @@ int DefaultThreads();
 
 /// A callable f(i) passed by reference, without a copy: what ForEach runs. Unlike a
 /// std::function it never allocates (a lambda capturing more than two references would), so a
-/// pass allocates nothing (issue 14). The callable must outlive the pass.
+/// pass allocates nothing. The callable must outlive the pass.
 class BodyTask {
  public:
   template <class F>

@@ -1,4 +1,4 @@
-// The independent reference of the rotating-beam checks (issue 13): the lowest bending
+// The independent reference of the rotating-beam checks: the lowest bending
 // eigenvalue omega^2 of a straight Euler-Bernoulli beam rotating steadily about an axis through
 // its root, perpendicular to it, from a 1-D model of cubic Hermite elements (converged: 200
 // elements agree with 400 to 1e-7):

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# A rod on bending modes alone (thesis 8.2, case 4; issue 16): exports the rod's matrices,
+# A rod on bending modes alone (thesis 8.2, case 4): exports the rod's matrices,
 # computes its four lowest free-free bending modes (make_shapes.py), reduces the rod on them
 # (bending.yaml: its stretch and twist become the superelement's interface constraint) and with
 # Craig-Bampton modes (rod.yaml), spins both up in one scene and compares (compare.py).

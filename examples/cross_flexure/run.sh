@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Cross-flexure pivot (thesis fig. 8.2, issue 6): two crossing steel leaves under a bending
+# Cross-flexure pivot (thesis fig. 8.2): two crossing steel leaves under a bending
 # moment up to 0.6 N m (0.63 rad). Each leaf in 1 or 3 solid bodies with modal derivatives, or 1
 # or 10 linear bodies; reference: the full Green-Lagrange model of both leaves with the rotor
 # turned by prescribed angles (build/bin/cross_flexure_reference). Prints rotation errors and

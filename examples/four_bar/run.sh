@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Closed loops (issue 15) end to end: a crank-rocker four-bar with every link rigid (one loop,
+# Closed loops end to end: a crank-rocker four-bar with every link rigid (one loop,
 # closed by a cut joint with constraint equations), the same with the coupler flexible in 2
 # superelements and rigid crank and rocker, and the same with every link a superelement (a
 # tree: no cut joint); then the slider-crank of examples/slider_crank_2d with a rigid crank and

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Imported matrices (issue 16): exports the crank's TET10 mesh with femb-reduce --export-matrices,
+# Imported matrices: exports the crank's TET10 mesh with femb-reduce --export-matrices,
 # has CalculiX 2.20 assemble it (job.inp: *FREQUENCY, SOLVER=MATRIXSTORAGE), reduces CalculiX's
 # matrices with the bores picked by geometry (part.yaml) and femb's own assembly of the same mesh
 # (native.yaml), spins both up in one scene and compares (compare.py).

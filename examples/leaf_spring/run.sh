@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Clamped-guided leaf spring (issue 6): one solid superelement with modal derivatives (the
+# Clamped-guided leaf spring: one solid superelement with modal derivatives (the
 # Green-Lagrange polynomial internal force) vs the same body linear inside, against CalculiX
 # NLGEOM on the same mesh (ccx_reference.py; femb's own full Newton agrees with it, see
 # tests/solver/analysis/leaf_spring_test.cpp). Prints the errors over the stroke, plots them.
@@ -25,7 +25,7 @@ fi
 start=$SECONDS
 /usr/bin/python3 "$here/ccx_reference.py" "$here/leaf.h5" "$out/ccx"
 echo "leaf_spring: CalculiX reference in $((SECONDS - start)) s"
-# Tolerance: the issue's 2% over the stroke for the body with modal derivatives (measured 0.06%);
+# Tolerance: 2% over the stroke for the body with modal derivatives (measured 0.06%);
 # the linear body is shown, with no tolerance: it has no shortening at all.
 /usr/bin/python3 "$here/compare.py" "$out/ccx/ccx.csv" "1 body, modal derivatives=$out/modal_derivatives@0.02" \
   "1 body, linear inside=$out/linear" --png "$out/leaf_spring.png"

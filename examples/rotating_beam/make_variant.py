@@ -3,7 +3,7 @@
 mass): OUTDIR/seg.yaml and OUTDIR/scene.yaml. Probes `hinge` (joint angle and rate) and `tip`.
 
 usage: make_variant.py OUTDIR N [STEP] [END_TIME] [--stiffening]
---stiffening: the segment with reduction.geometric_stiffening (issue 13); without it, linear (explicitly).
+--stiffening: the segment with reduction.geometric_stiffening; without it, linear (explicitly).
 """
 import os
 import sys

@@ -22,7 +22,7 @@ variant reference_20_bodies 20 2.5e-5
 "$bin/femb-solve" -q "$here/scene.yaml" -o "$out/10_bodies" || exit 3
 variant 2_bodies 2
 variant 1_body 1
-# The same with the geometric stiffening inside the bodies (reduction.geometric_stiffening, issue 13).
+# The same with the geometric stiffening inside the bodies (reduction.geometric_stiffening).
 variant 2_bodies_stiffened 2 1e-4 --stiffening
 variant 1_body_stiffened 1 1e-4 --stiffening
 # RMS over time of the deflection error, relative to the reference's peak (11.0 mm); tolerances a

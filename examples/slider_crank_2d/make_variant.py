@@ -3,7 +3,7 @@
 length 0.3/N) and OUTDIR/scene.yaml (crank, N rod segments chained through shared nodes, slider).
 
 usage: make_variant.py N OUTDIR [STEP] [MODES] [OPTIONS] [--stiffening]
---stiffening: the rod segment with reduction.geometric_stiffening (issue 13); without it, linear (explicitly).
+--stiffening: the rod segment with reduction.geometric_stiffening; without it, linear (explicitly).
 OPTIONS: a YAML flow map of the rod bodies' options, e.g. '{transformations: approximated}'.
 N must be even (the rod midpoint is then a node, probe rod_mid). Probes: crank (joint),
 rod_a, rod_mid, rod_b (position), slider (position, joint).

@@ -29,14 +29,14 @@ for n in 2 4 10 20; do
   "$bin/femb-reduce" -q "$dir/rod_$n.yaml" -o "$dir/rod_$n.h5"
   run "$(basename "$dir")" "$dir/scene.yaml"
 done
-# Error-controlled steps at the default step_tolerance (issue 14): the same tolerances as with
+# Error-controlled steps at the default step_tolerance: the same tolerances as with
 # the fixed 10 us steps, with about a quarter of the steps.
 run 10_bodies_auto "$out/10_bodies/scene.yaml" --set analysis.step=auto
 run 2_bodies_auto "$here/scene.yaml" --set analysis.step=auto
 # Tolerances (RMS error over the whole history, fraction of the reference peak): linear bodies
 # converge with their number (the rod's axial force, up to ~12% of its buckling load, changes
 # its bending only through the bodies' relative rotations); measured 7.1%, 1.7%, 0.21%; the 2
-# stiffened bodies (the geometric stiffness of that force inside them, issue 13) 0.05%.
+# stiffened bodies (the geometric stiffness of that force inside them) 0.05%.
 /usr/bin/python3 "$here/deflection.py" "$out/reference_20_bodies" "2 bodies (stiffened)=$out/2_bodies@0.003" \
   "2 bodies, linear=$out/2_bodies_linear@0.10" "4 bodies, linear=$out/4_bodies@0.03" "10 bodies, linear=$out/10_bodies@0.005" \
   "10 bodies, linear, step: auto=$out/10_bodies_auto@0.005" "2 bodies (stiffened), step: auto=$out/2_bodies_auto@0.003" \

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Stress in the slider-crank's rod (issue 17): how the recovered stress converges with the
+"""Stress in the slider-crank's rod: how the recovered stress converges with the
 number of bodies, beside the midpoint deflection. For the rod in 2, 4 and 10 linear bodies, 2
 bodies with geometric stiffening (whose files add the inertia load cases' stresses) and the
 20-body reference, all at h = 10 us, three crank revolutions with outputs.stresses and a stress

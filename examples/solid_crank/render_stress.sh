@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The crank's stress picture (issue 17): reduce the solid crank (run.sh's part file), solve the
+# The crank's stress picture: reduce the solid crank (run.sh's part file), solve the
 # static side load of stress_scene.yaml with stress recovery, compare the web's recovered stress
 # with beam theory, and render von Mises on the deformed mesh with ParaView (pvpython under
 # xvfb-run) into docs/results/solid_crank_von_mises.png. Installs paraview and xvfb (Debian) when

@@ -3,7 +3,7 @@
 prescribed by spin_up with final speed OMEGA, Ts = 15 s; probes `hub` and `tip`).
 
 usage: make_variant.py OUTDIR N [STEP] [OMEGA] [--stiffening]
---stiffening: the segment with reduction.geometric_stiffening (issue 13); without it, linear (explicitly).
+--stiffening: the segment with reduction.geometric_stiffening; without it, linear (explicitly).
 """
 import os
 import sys

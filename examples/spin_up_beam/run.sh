@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Spin-up beam (Kane, Ryan & Banerjee 1987; issue 5 case 7): 10 m beam clamped to a hub whose angle
+# Spin-up beam (Kane, Ryan & Banerjee 1987): 10 m beam clamped to a hub whose angle
 # is prescribed (spin_up to omega_s over Ts = 15 s), 20 s simulated. Runs the 10-body model
 # (scene.yaml) at omega_s = 4 and 6 rad/s and 4 bodies at 4 rad/s, against 20-body references at
 # half the step; checks the tip deflection in the hub frame with the tolerances below; plots.
@@ -20,7 +20,7 @@ variant() {  # name, bodies, step, omega, [--stiffening]
 variant 4_bodies_w4 4 0.01 4
 variant reference_w4 20 0.005 4
 variant reference_w6 20 0.005 6
-# One and two bodies with the geometric stiffening inside them (reduction.geometric_stiffening, issue 13).
+# One and two bodies with the geometric stiffening inside them (reduction.geometric_stiffening).
 variant 1_body_w6_stiffened 1 0.01 6 --stiffening
 variant 2_bodies_w6_stiffened 2 0.01 6 --stiffening
 # RMS over time of the hub-frame tip deflection error, relative to the reference's peak (0.40 m

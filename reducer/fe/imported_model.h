@@ -1,4 +1,4 @@
-// Imported FE matrices (issue 16, part type 'imported'): a model assembled by another FE code
+// Imported FE matrices (part type 'imported'): a model assembled by another FE code
 // reduced by femb. The stiffness and mass come from files, the node coordinates (and node labels)
 // from the geometry file through meshio; interfaces are named node sets of that file or nodes
 // picked by geometry, tied by RBE2 or RBE3 as for femb's own solids.

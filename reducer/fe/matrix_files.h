@@ -1,4 +1,4 @@
-// FE matrix files of other codes (issue 16): readers with every check femb makes on load, and
+// FE matrix files of other codes: readers with every check femb makes on load, and
 // the writer of femb-reduce --export-matrices. Formats (symmetric; one triangle or both, both
 // then checked to 1e-8 of the largest entry):
 //   calculix       *FREQUENCY, SOLVER=MATRIXSTORAGE (CalculiX 2.20): job.sti and job.mas hold

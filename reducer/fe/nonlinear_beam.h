@@ -1,4 +1,4 @@
-// Moderate-rotation (von Karman) beams (issue 6): the beam part's elements (timoshenko_beam.h)
+// Moderate-rotation (von Karman) beams: the beam part's elements (timoshenko_beam.h)
 // with the axial strain u' + (v'^2 + w'^2) / 2 in element axes, the other strains (torsion,
 // curvatures, shear) linear. The axial strain enters as its element mean (assumed constant
 // membrane strain): pointwise, u' (constant per element) cannot balance v'^2 / 2 (quadratic), and

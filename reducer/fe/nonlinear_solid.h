@@ -1,4 +1,4 @@
-// Geometrically nonlinear solids (issue 6): total Lagrangian, Green-Lagrange strain, St. Venant-
+// Geometrically nonlinear solids: total Lagrangian, Green-Lagrange strain, St. Venant-
 // Kirchhoff material on the same elements and quadrature as the linear model.
 //   G = grad_X u,  F = 1 + G,  E = (G + G^T + G^T G) / 2,  S = D E (Voigt, engineering shear),
 //   W = int E : S / 2 dV,  f_a = int F S grad N_a dV,

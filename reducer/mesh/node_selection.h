@@ -1,4 +1,4 @@
-// Interface node sets picked by geometry (part key interfaces[k].select, issue 16): the mesh
+// Interface node sets picked by geometry (part key interfaces[k].select): the mesh
 // nodes whose distance to a surface is at most the tolerance,
 //   cylinder  | |(x - p) x a| - r | <= tol  (and -tol <= (x - p).a <= length + tol when bounded)
 //   sphere    | |x - c| - r | <= tol

@@ -439,7 +439,7 @@ CraigBamptonResult CraigBamptonReduce(const FeModel& model, int internal_modes,
     clock.Restart();
   }
   if (inertia_fields && inertia_fields->cols() > 0) {
-    // Inertia load cases (issue 13): D'Alembert loads -M A_k on the interior, interfaces held;
+    // Inertia load cases: D'Alembert loads -M A_k on the interior, interfaces held;
     // the part in the span of the internal modes and derivatives is removed (M_ii inner
     // product), since the basis carries it through its own coordinates.
     const Eigen::MatrixXd MA = model.M * *inertia_fields;

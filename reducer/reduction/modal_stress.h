@@ -1,4 +1,4 @@
-// Modal stresses (issue 17): the linear stress that each reduced basis vector causes in the part,
+// Modal stresses: the linear stress that each reduced basis vector causes in the part,
 // for stress recovery in femb-solve (sigma(t) = sum_i q_loc,i(t) sigma_i) and for femb-inspect.
 //
 // Solids: sigma = D B u at every quadrature point of every element (the element's own rule,

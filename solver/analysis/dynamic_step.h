@@ -3,7 +3,7 @@
 // assembly of one pass over the bodies and the kept iteration matrix. Not an interface for
 // other code.
 //
-// Storage (issue 14): a step of either integrator allocates nothing once the first steps have
+// Storage: a step of either integrator allocates nothing once the first steps have
 // sized everything (tests/solver/analysis/allocation_free_test.cpp counts it). Everything a step or an iteration needs lives in the BodyWorkspace
 // (the midpoint scheme's in its MidpointWorkspace), in each body's Data (its scratch) or in
 // thread_local scratch of the joint-tree and force functions, and is written in place: no Eigen object
@@ -143,7 +143,7 @@ struct MidpointBody {
   InertiaLoadFactors load;
 };
 
-// The midpoint scheme's storage, kept from one iteration and one step to the next (issue 14).
+// The midpoint scheme's storage, kept from one iteration and one step to the next.
 struct MidpointWorkspace {
   std::vector<MidpointBody> bodies;
   BodyDataAtState mid_data;  // &bodies[b].dm, for the bodies' interface constraints at q_m
@@ -162,7 +162,7 @@ struct MidpointWorkspace {
 };
 
 // The bodies' storage of a dynamic analysis, kept from one Newton iteration and one step to the
-// next so that evaluating a body reuses its matrices instead of allocating them (issue 14).
+// next so that evaluating a body reuses its matrices instead of allocating them.
 struct BodyWorkspace {
   std::vector<BodyPass> passes;  // the last residual pass; after a converged step, at its state
   BodyDataAtState pass_data;     // &passes[b].data, for the bodies' interface constraints

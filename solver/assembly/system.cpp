@@ -136,7 +136,7 @@ SystemForces AssembleStatic(const SystemModel& model, const DofMap& dofs, System
     const bool gravity_on = model.static_gravity_end > 0 && model.gravity.squaredNorm() > 0;
     const double ramp = gravity_on ? std::min(lambda / model.static_gravity_end, 1.0) : 0.0;
     if (gravity_on && body.has_inertia_stiffening()) {
-      // The stress of the body's own weight stiffens it (issue 13: load factors -R_j^T g at rest).
+      // The stress of the body's own weight stiffens it (load factors -R_j^T g at rest).
       const Eigen::VectorXd zero = Eigen::VectorXd::Zero(body.n_coordinates());
       const InertiaLoadFactors load = body.InertiaLoads(data, zero, zero, ramp * model.gravity);
       body.ElasticForce(data, &f, with_tangent ? &K : nullptr, &load);

@@ -8,7 +8,7 @@
 // convective accelerations. Supports are joints like any other, to the ground (kGround): the
 // fixed parent at the origin with world axes and no coordinates. A clamp is a rigid joint to
 // the ground, a pin a spherical one, a revolute to the ground turns the node about its fixed
-// axis: R = exp(phi a~) R0. One representation for every joint (issue 14 item 0).
+// axis: R = exp(phi a~) R0. One representation for every joint.
 // Unknowns: every node's coordinates, the modal coordinates of every body, then the cut
 // joints' multipliers and those of the bodies' interface constraints (thesis 8.2 case 4)
 // (DofMap::first_multiplier; solver/joints/loop_constraints.h). A joint

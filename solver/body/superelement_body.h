@@ -44,7 +44,7 @@ struct SuperelementOptions {
   /// With modal derivatives in the file: the local internal force is its cubic polynomial
   /// (formats/reduced_polynomial.h, Green-Lagrange inside the body) instead of K q_loc.
   bool polynomial_force = true;
-  /// Geometric stiffening from the file (issue 13): the quadratic Green-Lagrange force of a file
+  /// Geometric stiffening from the file: the quadratic Green-Lagrange force of a file
   /// without modal derivatives and the inertia load cases' geometric stiffness. false: ignored.
   bool geometric_stiffening = true;
   /// With the file's inertia invariants (formats/superelement.h inertia_gamma, inertia_xi): the
@@ -89,7 +89,7 @@ struct BodyVelocityMaps {
 
 /// Scratch storage of a body's kernels at one configuration (SuperelementBody::Data::scratch):
 /// the temporaries of the forces and matrices, kept with the data from one Newton iteration to
-/// the next so that evaluating a body allocates nothing once they have their sizes (issue 14).
+/// the next so that evaluating a body allocates nothing once they have their sizes.
 /// Their contents mean nothing between calls. One matrix per shape and use in an iteration (a
 /// resize to another number of entries would allocate): n x n, n x 6 (or 6 x n), n x 3 (3 x n).
 struct BodyScratch {
@@ -140,7 +140,7 @@ class SuperelementBody {
   };
   /// Everything one configuration of the body determines, computed once (Evaluate) and passed to
   /// every force, matrix and energy evaluated there: an assembly pass evaluates each body's
-  /// kinematics once instead of once per term (issue 14: the model / data split).
+  /// kinematics once instead of once per term (the model / data split).
   struct Data {
     BodyConfiguration c;
     FrameSolution frame;
@@ -265,7 +265,7 @@ class SuperelementBody {
   /// True when the body uses the geometric stiffness of inertia load cases (file and option).
   bool has_inertia_stiffening() const { return !K_sigma_.empty(); }
 
-  /// Stiffening from rigid-body inertia loads (issue 13; Wallrapp's standard input data, the SID
+  /// Stiffening from rigid-body inertia loads (Wallrapp's standard input data, the SID
   /// of Simpack; Cardona 2000 for the superelement setting). The reducer stored
   /// K_sigma,k = Phi^T G(sigma_k) Phi for the stress sigma_k of the k-th unit inertia field with
   /// the interfaces held; the body's local stiffness is K + sum_k a_k K_sigma,k with a_k the

@@ -45,7 +45,7 @@ void AssembleDynamicResidual(const SystemModel& model, const DofMap& dofs, Dynam
     body.EvaluateSolved(c, frame, pass.data);
     GatherBody(model, dofs, s.config, b, s.W, pass.w);
     GatherBodyAcceleration(model, dofs, b, node_acc, s.Wdot, pass.wdot);
-    // Inertia stiffening (issue 13): K + K_sigma(a), a from this iterate's frame motion; its
+    // Inertia stiffening: K + K_sigma(a), a from this iterate's frame motion; its
     // velocity and acceleration derivatives go into C and M of the iteration matrix.
     const bool stiffening = body.has_inertia_stiffening();
     if (stiffening) {

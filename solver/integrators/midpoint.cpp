@@ -32,7 +32,7 @@ namespace femb::dynamic_internal {
 // spinning tube: 6e-6 against generalized-alpha's 2e-3). No numerical damping.
 //
 // Chains of joints (nodes that are functions of other nodes' coordinates) get three more
-// pieces, so that a chain or loop of rigid bodies keeps its energy exactly too (issue 15):
+// pieces, so that a chain or loop of rigid bodies keeps its energy exactly too:
 // such nodes carry their own velocities (EndNodeVelocity), the node Jacobians at q_m and gravity
 // are discrete gradients (AddDiscreteGradientCorrection, the gravity term in AssembleMidpoint),
 // and bodies without a free node take the source at the mean motion. See each for why.
@@ -376,7 +376,7 @@ void AssembleMidpoint(const SystemModel& model, const DofMap& dofs, const Dynami
     }
     body.AddModalDamping(wm, f_in, nullptr);
     if (body.has_inertia_stiffening()) {
-      // Inertia stiffening (issue 13) at the mid configuration with the step's mean velocity and
+      // Inertia stiffening at the mid configuration with the step's mean velocity and
       // acceleration.
       m.wdot = m.dw / h;
       body.InertiaLoads(dm, wm, m.wdot, model.gravity, m.load);

@@ -1,4 +1,4 @@
-// Joints that close kinematic loops (issue 15). The tree joints of the scene make child nodes
+// Joints that close kinematic loops. The tree joints of the scene make child nodes
 // functions of parent nodes (node_joint.h) and need no multipliers; a joint that would close a
 // loop of that tree (a node with two parents, a cycle) is cut: its child keeps its own
 // coordinates and the joint becomes algebraic equations g(q) = 0 with Lagrange multipliers
@@ -50,7 +50,7 @@ int ConstraintCount(JointType type);
 
 /// A cut joint's full set of equations at a configuration: values g and their derivative with
 /// respect to the nodes' spatial increments, G (m x 12: dx_p, dpi_p, dx_c, dpi_c).
-/// At most 6 equations: fixed-capacity storage, so that evaluating one allocates nothing (issue 14).
+/// At most 6 equations: fixed-capacity storage, so that evaluating one allocates nothing.
 using ConstraintValues = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 6, 1>;
 struct ConstraintBlock {
   ConstraintValues g;

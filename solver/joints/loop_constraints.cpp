@@ -1,4 +1,4 @@
-// The cut joints' constraint equations in the system (issue 15): their assembly into the
+// The cut joints' constraint equations in the system: their assembly into the
 // residual and the iteration matrix, the rank test that drops redundant equations and names a
 // dead point, and the loops' violation and reactions. The equations of one joint are in
 // solver/joints/loop_closure.h.

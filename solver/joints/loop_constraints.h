@@ -1,4 +1,4 @@
-// Closed loops in the system (issue 15): the cut joints' constraint equations with Lagrange
+// Closed loops in the system: the cut joints' constraint equations with Lagrange
 // multipliers, assembled into the residual and the iteration matrix, and the same for the
 // interface constraints of bodies whose basis moves fewer directions (thesis 8.2 case 4); the rank test that drops
 // redundant equations and names a dead point; the loops' violation and reactions. The

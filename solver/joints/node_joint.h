@@ -54,7 +54,7 @@ void PlaceChild(const NodeJoint& j, const Eigen::Vector3d& x_p, const Eigen::Mat
                 Eigen::Vector3d* x_c, Eigen::Matrix3d* R_c);
 
 /// At most 3 joint coordinates (spherical): the joints' small matrices and vectors have a fixed
-/// largest size and live on the stack (no heap allocation in a time step, issue 14).
+/// largest size and live on the stack (no heap allocation in a time step).
 inline constexpr int kMaxJointCoordinates = 3;
 using JointColumns = Eigen::Matrix<double, 6, Eigen::Dynamic, 0, 6, kMaxJointCoordinates>;
 using JointVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxJointCoordinates, 1>;

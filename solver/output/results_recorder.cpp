@@ -144,7 +144,7 @@ ResultsRecorder::ResultsRecorder(const Scene& scene, const std::string& director
       if (q == ProbeQuantity::kRotation) {
         for (const char* c : wxyz) column(p.name + "." + Name(q) + "." + c);
       } else if (q == ProbeQuantity::kStress) {
-        // The stress point's von Mises stress and tensor (part axes, issue 17).
+        // The stress point's von Mises stress and tensor (part axes).
         static const char* components[7] = {"von_mises", "xx", "yy", "zz", "yz", "xz", "xy"};
         for (const char* c : components) column(p.name + ".stress." + c);
       } else if (q == ProbeQuantity::kEffort) {

@@ -359,7 +359,7 @@ Scene BuildScene(const SceneSpec& spec) {
     options.cardona_option_b = b.option_b;
     options.polynomial_force = b.polynomial_force;
     options.modal_damping = b.modal_damping;
-    // Geometric stiffening (issue 13): what the file has, unless switched off; asked for
+    // Geometric stiffening: what the file has, unless switched off; asked for
     // explicitly from a file without it is an error, otherwise a note. The midpoint integrator
     // conserves the energy of linear bodies with the corotational inertia (thesis 3.22) exactly;
     // its elastic force is no exact discrete gradient of the stiffened energy, and the
@@ -453,7 +453,7 @@ Scene BuildScene(const SceneSpec& spec) {
     }
     scene.stick_nodes.push_back(se.visualization ? std::vector<int>() : nodes);
   }
-  // The joint tree (issue 15). Every node has at most one holder: a parent node or the ground
+  // The joint tree. Every node has at most one holder: a parent node or the ground
   // (kGround), which it hangs on through a tree joint. The rigid bodies' offsets
   // and then the scene's joints -- prescribed ones first, then in the scene's order -- go into
   // the tree while they can; a joint that would give its node a second holder or close a cycle

@@ -27,7 +27,7 @@ struct Scene {
   /// floating frame origin they refer to (part axes).
   std::vector<std::optional<Visualization>> meshes;
   std::vector<Eigen::Vector3d> mesh_origin;
-  /// Per body: its file's modal stresses (issue 17), loaded when the scene asks for stresses
+  /// Per body: its file's modal stresses, loaded when the scene asks for stresses
   /// (outputs.stresses or a stress probe on the body).
   std::vector<std::optional<ModalStress>> stresses;
   /// Per probe: for a stress probe the body and its stress point nearest to the probe's point

@@ -1,4 +1,4 @@
-// libFuzzer target: the readers of imported FE matrices (issue 16) on arbitrary files. The first
+// libFuzzer target: the readers of imported FE matrices on arbitrary files. The first
 // byte picks the reader (CalculiX .sti/.mas/.dof, Abaqus matrix-input .mtx pair, Matrix Market
 // pair with its DOF CSV, or a Matrix Market shapes file); the rest is cut at 0x01 bytes into the
 // files it reads, written under FEMB_FUZZ_DIR. Seed corpus: a beam part's exported matrices in

@@ -1,4 +1,4 @@
-// Numerical stress tests (issue 12): each case states its reference and its pass criterion; the
+// Numerical stress tests: each case states its reference and its pass criterion; the
 // README's "Numerical stress tests" table summarizes them. Scenes are built from text and
 // superelements reduced in memory, then solved through the library as femb-solve does.
 #include <gtest/gtest.h>

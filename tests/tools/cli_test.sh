@@ -36,7 +36,7 @@ full = j["full_free_free_frequencies_hz"]; assert len(full) == 16
 # reduced frequencies are Rayleigh-Ritz upper bounds of the full ones
 for r, f in zip(ff[6:10], full[6:10]):
     assert r >= f * (1 - 1e-9) and r < 1.01 * f, (r, f)
-# Geometric stiffening is on by default for femb's own Craig-Bampton parts (issue 13).
+# Geometric stiffening is on by default for femb's own Craig-Bampton parts.
 assert j["geometric_stiffening"] is True
 PY
   grep -q "stiffening .* 12 inertia load case geometric stiffnesses" "$work/$ex.log" && ok || fail "$ex: no stiffening progress line"
@@ -47,7 +47,7 @@ rows=$("$bin/femb-inspect" "$work/beam_rod.h5" --dump K --format csv | wc -l)
 [ "$rows" = 16 ] && ok || fail "--dump K csv rows $rows"
 "$bin/femb-inspect" "$work/beam_rod.h5" --dump PhiCB | sed -n 3p | grep -qx "6 16" && ok || fail "--dump PhiCB mtx"
 # --vtu: beam mode shapes as VTU line meshes with displacement, rotation and the modal stress
-# (von Mises, tensor; issue 17); without a stored
+# (von Mises, tensor); without a stored
 # mesh it is a clear error.
 "$bin/femb-inspect" "$work/beam_rod.h5" --vtu "$work/vtu" > /dev/null && [ "$(ls "$work/vtu" | wc -l)" = 16 ] && ok || fail "--vtu beam"
 # A cut inside a pair of equal modes (a round section's two bending planes at 728.342 Hz) is said
@@ -217,7 +217,7 @@ expect_input_error "region held by no interface" "a mesh region of 3 nodes aroun
 expect_input_error "too many modes" "exceeds the 54 interior DOFs" "$good" --set reduction.internal_modes=500
 expect_input_error "bad --set" "--set reduction.floating_frame: unknown floating frame 'centroid'" "$good" --set reduction.floating_frame=centroid
 
-# Imported matrices (issue 16): a native part exported with --export-matrices and read back as a
+# Imported matrices: a native part exported with --export-matrices and read back as a
 # part of type 'imported' gives the same frequencies; the file inspects and draws like any other.
 "$bin/femb-reduce" -q "$src/examples/beam_rod/part.yaml" --export-matrices "$work/rod_mm" --matrix-format matrix_market \
   && [ -f "$work/rod_mm/beam_rod_K.mtx" ] && [ -f "$work/rod_mm/beam_rod.inp" ] && ok || fail "export matrices"
@@ -255,7 +255,7 @@ a = h5py.File(sys.argv[1])["reduced/internal_frequencies_hz"][()]
 b = h5py.File(sys.argv[2])["reduced/internal_frequencies_hz"][()]
 assert np.abs(b / a - 1).max() < 1e-8, (a, b)
 PY
-# Thesis 8.2 case 4 (issue 16): the native rod on four of its free-free bending modes, computed
+# Thesis 8.2 case 4: the native rod on four of its free-free bending modes, computed
 # here from the exported matrices (rows: the beam's nodes, 6 DOFs each), which cannot stretch or
 # twist it. femb-reduce names the two constrained directions, femb-inspect shows and checks them,
 # and femb-solve holds them: pulled by 20 kN and twisted by 2 N m, the rod's tip does not move

@@ -222,7 +222,7 @@ r = pos[names.index("n10")] - pos[names.index("n0")]
 assert np.abs(R[:3] + F).max() < 1e-6 * 1e4, R
 assert np.abs(R[3:] + np.cross(r, F)).max() < 1e-6 * 1e4, (R[3:], -np.cross(r, F))
 PY
-# The energy watchdog (issue 12's case): the stiff rod with 40 modes (30 elements) at h = 5 ms
+# The energy watchdog: the stiff rod with 40 modes (30 elements) at h = 5 ms
 # gains energy with rho_inf 0.8-1.0 and once ended "completed" with 4x the kinetic energy; now
 # it stops with exit 3 and says why, results kept. rho_inf 0.5 damps the unresolved modes.
 sed 's/internal_modes: 2/internal_modes: 40/; s/elements: 6/elements: 30/' "$work/pend/rod.yaml" > "$work/pend/rod40.yaml"
@@ -417,7 +417,7 @@ expect() {  # name, exit code, expected text, scene text transformation (sed)
 expect "unknown joint type" 2 "bad.yaml:18: joints[0].type: unknown joint type 'weld'" 's/type: clamp/type: weld/'
 expect "unknown node" 2 "node 'n42' is not a node of any body" 's/node: n10, force/node: n42, force/'
 expect "unknown body type" 2 "unknown body type 'rigid_blob'" 's/{name: b0, /{name: b0, type: rigid_blob, /'
-# Loops (issue 15): a rigid body on two supports, a cycle of rigid joints: the joint that closes
+# Loops: a rigid body on two supports, a cycle of rigid joints: the joint that closes
 # each loop is cut (constraint equations with multipliers) and the log names it.
 sed 's/^joints:/joints:\n  - {type: spherical, node: n9}\n  - {type: spherical, node: n10}/; s/{name: b9, superelement: segment.h5, placement: {position: \[0.9, 0, 0\]}, nodes: {A: n9, B: n10}}/{name: b9, type: rigid, mass: 1, inertia: [1, 1, 1], points: {A: [0, 0, 0], B: [0.1, 0, 0]}, placement: {position: [0.9, 0, 0]}, nodes: {A: n9, B: n10}}/; s/  - {type: force, node: n10, force/  - {type: force, node: n8, force/' "$work/scene.yaml" > "$work/loop.yaml"
 "$bin/femb-solve" "$work/loop.yaml" -o "$work/loop_out" > "$work/loop_log.txt" 2>&1 \
@@ -433,7 +433,7 @@ expect "node placed twice" 2 "node 'n1' is placed at" 's/position: \[0.1, 0, 0\]
 # Wrong version superelement file.
 cp "$work/segment.h5" "$work/v2.h5"
 $py -c "import h5py; f=h5py.File('$work/v2.h5','r+'); f.attrs['format_version_major']=2" 
-# Geometric stiffening asked for explicitly from a file without it (issue 13): one line, exit 2.
+# Geometric stiffening asked for explicitly from a file without it: one line, exit 2.
 expect "stiffening not in the file" 2 "options.geometric_stiffening is true but" 's/{name: b3, superelement: segment.h5/{name: b3, options: {geometric_stiffening: true}, superelement: segment.h5/'
 "$bin/femb-reduce" -q "$work/segment.yaml" -o "$work/segment_gs.h5" --set reduction.geometric_stiffening=true || fail "reduce with stiffening"
 sed 's/{name: b3, superelement: segment.h5/{name: b3, options: {geometric_stiffening: true}, superelement: segment_gs.h5/' "$work/scene.yaml" > "$work/gs.yaml"
@@ -475,7 +475,7 @@ sed 's/^joints:/joints:\n  - {type: rigid, node: n3, parent: n5}\n  - {type: rig
 "$bin/femb-solve" "$work/cycle.yaml" -o "$work/cycle_out" > "$work/cycle_log.txt" 2>&1 \
   && grep -q "rigid joint of node 'n7' on node 'n3' closes a loop: the other joints already hold it; its 6 equations repeat theirs" "$work/cycle_log.txt" \
   && ok || fail "cycle of rigid joints: $(cat "$work/cycle_log.txt")"
-# A node with two joints: the second is cut (issue 15).
+# A node with two joints: the second is cut.
 sed 's/^joints:/joints:\n  - {type: rigid, node: n3, parent: n5}\n  - {type: rigid, node: n3, parent: n7}/' "$work/scene.yaml" > "$work/two.yaml"
 "$bin/femb-solve" "$work/two.yaml" -o "$work/two_out" > "$work/two_log.txt" 2>&1 \
   && grep -q "rigid joint of node 'n3' on node 'n7' closes a loop: 6 constraint equations" "$work/two_log.txt" \

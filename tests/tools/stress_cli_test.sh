@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Stress recovery end to end (issue 17): femb-reduce stores modal stresses, femb-inspect --vtu
+# Stress recovery end to end: femb-reduce stores modal stresses, femb-inspect --vtu
 # shows them per mode, femb-solve recovers them (probe, results.h5 maximum, animation fields),
 # and bad stress requests get one line and exit 2.
 # Usage: stress_cli_test.sh BIN_DIR SOURCE_DIR
@@ -91,7 +91,7 @@ assert "von_mises" not in open(sys.argv[1] + "/animation.xdmf").read()
 assert "top.stress.xx" in open(sys.argv[1] + "/probes.csv").readline()
 PY
 
-# A rotating bar (issue 17 item 3): the same bar with geometric stiffening, spun up to 100 rad/s
+# A rotating bar: the same bar with geometric stiffening, spun up to 100 rad/s
 # about z through its root in 0.05 s, held 0.05 s. On its axis the stress is the centrifugal
 # axial stress rho Omega^2 (L^2 - x^2) / 2 (closed form); with the inertia load cases' stresses
 # (ModalStress::inertia_modes) its mean over the hold is within 1% of it at x = L/4, L/2, 3L/4
@@ -134,7 +134,7 @@ assert all(abs(r - 1) < 0.01 for r in with_cases), with_cases
 assert abs(without[0] - 1) > 0.1 and abs(without[2] - 1) > 0.1, without
 PY
 
-# A sagging wire (issue 17: the stress of a body with modal derivatives keeps the strain's
+# A sagging wire (the stress of a body with modal derivatives keeps the strain's
 # quadratic part): a 1 m steel beam of 2 mm diameter clamped at both ends, in ONE body with
 # modal derivatives of all pairs, under 10 g (sag about 20 diameters: a membrane). Reference:
 # axial equilibrium of the von Karman beam, N' = 0 - the normal force (the mean of the top and

@@ -1,4 +1,4 @@
-// Imported FE matrices (issue 16): a native part exported by femb-reduce's exporter in each
+// Imported FE matrices: a native part exported by femb-reduce's exporter in each
 // matrix format and read back as a part of type 'imported' reduces to the same superelement
 // (frequencies and reduced matrices to 1e-8); a beam with rotational DOFs too; CalculiX's own
 // assembly of the same mesh agrees within the element-quadrature difference; bad matrices are

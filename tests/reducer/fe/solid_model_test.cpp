@@ -241,7 +241,7 @@ TEST(SolidModel, MissingNodeSetIsNamed) {
             std::string::npos) << message;
 }
 
-// Interfaces picked by geometry (issue 16) take the same nodes as the named sets of the same
+// Interfaces picked by geometry take the same nodes as the named sets of the same
 // mesh: the reduced matrices agree to round-off. Tube 50/30 mm x 0.3 m: the bore (cylinder of
 // radius 30 mm, bounded to the tube's length), the bottom face (plane z = 0) and the top face
 // (a box around z = 0.3); also a sphere cap on a box's corner.

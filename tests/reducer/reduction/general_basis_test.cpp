@@ -1,4 +1,4 @@
-// General deformation bases (thesis 8.2, issue 16 item 3): the pseudo-inverse route gives back
+// General deformation bases (thesis 8.2): the pseudo-inverse route gives back
 // Craig-Bampton when handed its basis (case m = M = 6N: Guyan; m = 6N < M: with its modes); a
 // free-interface basis reproduces the full model's free-free frequencies it contains exactly and
 // converges as modes are added; too few shapes to move every interface direction (m < 6N) are

@@ -1,4 +1,4 @@
-// Modal stresses (issue 17): the stress of a reduced static solution, sum_i q_i sigma_i, against
+// Modal stresses: the stress of a reduced static solution, sum_i q_i sigma_i, against
 // beam theory; rigid-body motions cause none; the superelement file keeps them.
 #include "reducer/reduction/modal_stress.h"
 
@@ -50,7 +50,7 @@ int NearestPoint(const ModalStress& s, const Eigen::Vector3d& x) {
 
 // Reference: Euler-Bernoulli beam theory, sigma_xx = M c / I with M = F (L - x) of a tip force F
 // along y; the RBE2 couplings at the ends disturb the field only near them (Saint-Venant), so the
-// stations x = 0.25 ... 0.75 see the beam's stress. Tolerance 2% (issue 17), measured 1e-6 on
+// stations x = 0.25 ... 0.75 see the beam's stress. Tolerance 2%, measured 1e-6 on
 // HEX20 (quadratic elements represent the linear bending stress exactly) and 0.2% on TET10.
 void ExpectBendingStress(const Superelement& se, double tolerance) {
   ASSERT_TRUE(se.stress.has_value());

@@ -1,4 +1,4 @@
-// Issue 14: no heap allocation inside a time step or a Newton iteration. This program replaces
+// No heap allocation inside a time step or a Newton iteration. This program replaces
 // malloc, calloc and realloc (benchmarks/allocation_count.h: every operator new and every Eigen
 // allocation goes through them) and counts the allocations between the ends of consecutive
 // steps of SolveDynamic: the predictor, every Newton iteration (residual, iteration matrix,

@@ -1,5 +1,5 @@
-// The exact kinetic energy of the reduced field in the floating frame (issue 13,
-// SuperelementBody "Exact inertia"), checked against independent references:
+// The exact kinetic energy of the reduced field in the floating frame
+// (SuperelementBody "Exact inertia"), checked against independent references:
 //  - the force is the Lagrangian derivative of T: dT/dt along a trajectory equals w . f_in
 //    (Richardson-extrapolated central differences), and its velocity and acceleration
 //    derivatives (the iteration matrix) match finite differences;

@@ -1,4 +1,4 @@
-// Geometric stiffening inside a body (issue 13), checked against independent references:
+// Geometric stiffening inside a body, checked against independent references:
 //  - the inertia load factors and the stiffening force's tangent and load derivatives against
 //    finite differences, and the factors of a rigid rotation against their closed form;
 //  - the stored tensors (basis stress, inertia load case) against closed-form integrals;

@@ -1,4 +1,4 @@
-// Issue 6's validation: a clamped-guided steel leaf (50 x 10 x 0.5 mm, HEX20) pushed across its
+// Modal derivatives validated: a clamped-guided steel leaf (50 x 10 x 0.5 mm, HEX20) pushed across its
 // thickness by a force at the guided end, which slides freely along the leaf and does not rotate.
 // One superelement with modal derivatives (femb-solve's static analysis, polynomial internal
 // force) against femb's full nonlinear model of the same mesh (Green-Lagrange, Newton:

@@ -83,7 +83,7 @@ TEST(RigidBodyDynamics, TorqueFreeMotionConservesEnergyAndMomentumAtSecondOrder)
   // revolution since the step's rotation comes from its total increment (2026-11-28; 1.35e-3 with
   // Newton's corrections composed, which made the state depend on Newton's path), and the
   // energy error 3.0e-5 at 200 (4.7e-5 before).
-  // (The target 1e-4 at 100 steps/rev needs a conserving scheme; see the notes.)
+  // (The target 1e-4 at 100 steps/rev needs a conserving scheme; see the notes.)
   const double omega_h = omega0.norm() * period / 100;
   EXPECT_LT(coarse.momentum_error, omega_h * omega_h / 2);
   // Energy: below 1e-4 from 200 steps per revolution on (3e-4 at 100, printed above).
@@ -106,7 +106,7 @@ TEST(RigidBodyDynamics, MidpointSchemeConservesEnergyAndMomentumExactly) {
     const Eigen::Vector3d omega0(1.0, 2.0, 3.0);
     const double period = 2 * M_PI / omega0.norm();
     const Eigen::Vector3d none = Eigen::Vector3d::Zero();
-    // Default Newton tolerance (1e-9 relative residual): the bound is 1e-4 at 100 steps
+    // Default Newton tolerance (1e-9 relative residual): the bound is 1e-4 at 100 steps
     // per revolution over 1000 steps; the errors are those of the Newton iterations, far below.
     const FlightErrors coarse = FreeFlight(se, omega0, period / 100, 1000, 1.0, none, Integrator::kMidpoint);
     const FlightErrors fine = FreeFlight(se, omega0, period / 200, 2000, 1.0, none, Integrator::kMidpoint);

@@ -1,4 +1,4 @@
-// The system assembly (issue 14 item 0: unit tests for it): the numbering of the unknowns
+// The system assembly (unit tests for it): the numbering of the unknowns
 // (nodes on every kind of support, joint children, modal coordinates, the multipliers of cut
 // joints and of body constraints, prescribed coordinates), increments that keep each support's
 // motion exact (a revolute node turns about its fixed axis by the sum of its increments), the
@@ -114,7 +114,7 @@ TEST(System, DofMapNumbersNodesModesAndMultipliers) {
             std::find(order.begin(), order.end(), 2) - order.begin());
 }
 
-// Issue 14 item 0: the model owns its numbering (SystemModel::dofs()): made once and shared by
+// The model owns its numbering (SystemModel::dofs()): made once and shared by
 // the analyses, made anew when the structure changes, and valid after the model is gone (the
 // map holds no reference into the model, which a Scene moves). Supports are joints to the
 // ground: a second support of a node replaces the first.

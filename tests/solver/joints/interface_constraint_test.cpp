@@ -1,4 +1,4 @@
-// Thesis 8.2 case 4 in femb-solve (issue 16): a rod reduced on four free-free bending shapes,
+// Thesis 8.2 case 4 in femb-solve: a rod reduced on four free-free bending shapes,
 // which cannot stretch or twist it, carries the interface constraint C q_int = 0 that femb-solve
 // enforces with Lagrange multipliers. Checked: the constraint's Jacobian and the multipliers'
 // geometric stiffness in the static tangent against central finite differences (a chain of two

@@ -1,4 +1,4 @@
-// Closed loops (issue 15): cut joints imposed by constraint equations with Lagrange multipliers.
+// Closed loops: cut joints imposed by constraint equations with Lagrange multipliers.
 // The constraint Jacobian and the multipliers' geometric stiffness in the static tangent of every
 // joint type against central finite differences of the residual (multipliers nonzero, the cut
 // joint's parent hanging on a tree joint); a rigid four-bar driven at constant crank speed
@@ -343,7 +343,7 @@ Swing SwingUnderGravity(double h, bool open = false) {
   return run;
 }
 
-// Issue 15: energy with gravity and no drive to 1e-6 over 10 periods (midpoint).
+// Energy with gravity and no drive to 1e-6 over 10 periods (midpoint).
 TEST(LoopClosure, RigidFourBarUnderGravityKeepsItsEnergyWithTheMidpointScheme) {
   for (const double h : {2e-3, 1e-3}) {
     const Swing run = SwingUnderGravity(h);

@@ -1,7 +1,7 @@
 // Joints between nodes: the static tangent of a system with every joint type (including the
 // joints' geometric stiffness) against central finite differences of the residual, exact
 // constraint satisfaction, the convective terms through the energy balance of a flexible
-// double pendulum, and supports as joints to the ground (issue 14 item 0).
+// double pendulum, and supports as joints to the ground.
 #include "solver/joints/node_joint.h"
 
 #include <gtest/gtest.h>
@@ -214,7 +214,7 @@ void DoublePendulum(JointType second, const Eigen::Vector3d& spin, Integrator in
   EXPECT_GT(drift_coarse / drift_fine, 3.0);  // second order: the error is the integrator's
 }
 
-// Issue 14 item 0: a support is a joint to the ground (kGround: the fixed parent at the origin,
+// A support is a joint to the ground (kGround: the fixed parent at the origin,
 // world axes). Each type's node Jacobian is the motion basis supports had before (revolute
 // [0; a], prismatic [a; 0], cylindrical both, pin [0; 1], universal [0; a1], [0; a2]), and a
 // flexible rod hanging on it moves exactly as on the same joint to a clamped node at the joint
