@@ -35,8 +35,8 @@ namespace femb {
 // bound of the true quartic z^T B z, whose excess (membrane strain the basis cannot carry) would
 // lock a bending-only basis; the full polynomial stays with modal derivatives. W >= 0, so a
 // stiffened body conserves energy like a linear one (the geometric stiffness form
-// K q + J^T (A^T q) used before 2026-11-27 is not a gradient, and pumped a four-bar coupler's
-// bending until the run stopped: benchmarks/stiffening_energy.py).
+// K q + J^T (A^T q) is not a gradient, and pumps a four-bar coupler's bending until the run
+// stops: benchmarks/stiffening_energy.py).
 struct PolynomialStiffness {
   Eigen::MatrixXd A, B;
   /// Without B: a root R of K^+, the pseudo-inverse of the reduced stiffness, K^+ = R^T R (rank

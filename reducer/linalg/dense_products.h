@@ -3,8 +3,7 @@
 // explicitly: OpenBLAS picks its kernels for the processor at run time and runs them on its
 // threads.
 //
-// Why explicit calls and not EIGEN_USE_BLAS (which the reducer was compiled with until
-// 2026-11-27): that macro redefines Eigen's product templates, so a program linking the reducer
+// Why explicit calls and not EIGEN_USE_BLAS: that macro redefines Eigen's product templates, so a program linking the reducer
 // and the solver (every test program, the solver benchmarks) had them compiled two ways under
 // the same names, a one-definition violation, and the solver's small products ran in whichever
 // the linker kept. The solver is built for Eigen's own kernels: femb-solve with EIGEN_USE_BLAS

@@ -94,13 +94,8 @@ struct DynamicOptions {
   /// computes the tangents every time. The tangents once lagged badly: with the zero-acceleration
   /// predictor, keeping them made Newton wander on a stiff 40-mode pendulum at h = 5 ms
   /// (tests/tools/solve_cli_test.sh's rho_inf 0.5 case); with the constant-acceleration predictor
-  /// it takes 1.04 iterations per step either way. Measured 2026-11-28 (one thread, solving time
-  /// best of 2, Newton iterations per step; every 1 / 4 inertia / 4 all / 8 all): slider_crank_2d
-  /// (2 stiffened bodies, h = 10 us) 1.19 / 0.95 / 0.76 / 0.67 s (1.00 its throughout),
-  /// spin_up_beam 0.76 / 0.63 / 0.53 / 0.47 s (1.66 -> 1.87 its), rotating_beam 0.44 / 0.37 /
-  /// 0.33 / 0.33 s (2.71 -> 3.14), spinning_beam 0.194 / 0.197 / 0.170 / 0.163 s (2.27 -> 3.43: its
-  /// gyroscopic matrix changes fastest), cantilever_transient 0.245 / 0.205 / 0.207 / 0.208 s
-  /// (3.33 -> 4.45).
+  /// it takes 1.04 iterations per step either way. What each setting saves on the seed examples
+  /// (and the Newton iterations it adds) is measured in the README ("Analyses").
   BodyMatricesKept body_matrices_kept = BodyMatricesKept::kAll;
   /// Error-controlled steps: `step` is the first step; each later one is chosen so that the
   /// estimated local error of the positions (and the velocities' error times the step) stays

@@ -145,7 +145,7 @@ namespace {
 
 // The inverse of a 6 x 6 matrix (the frame matrix S) by Gauss-Jordan elimination with partial
 // pivoting, on fixed-size storage: Eigen's PartialPivLU::inverse goes through its general
-// triangular solves, 3% of a step of the peer slider-crank (perf, 2026-11-28).
+// triangular solves, 3% of a step of the peer slider-crank (perf).
 Eigen::Matrix<double, 6, 6> Inverse6(Eigen::Matrix<double, 6, 6> A) {
   Eigen::Matrix<double, 6, 6> X = Eigen::Matrix<double, 6, 6>::Identity();
   for (int k = 0; k < 6; ++k) {

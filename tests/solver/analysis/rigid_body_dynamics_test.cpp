@@ -80,9 +80,9 @@ TEST(RigidBodyDynamics, TorqueFreeMotionConservesEnergyAndMomentumAtSecondOrder)
               coarse.energy_error, coarse.momentum_error, fine.energy_error, fine.momentum_error);
   // Generalized-alpha is not an energy-momentum scheme: the spatial angular momentum vector
   // oscillates with amplitude ~ (omega h)^2 / 2, bounded: measured 1.84e-3 at 100 steps per
-  // revolution since the step's rotation comes from its total increment (2026-11-28; 1.35e-3 with
-  // Newton's corrections composed, which made the state depend on Newton's path), and the
-  // energy error 3.0e-5 at 200 (4.7e-5 before).
+  // revolution with the step's rotation from its total increment (1.35e-3 with Newton's
+  // corrections composed, which makes the state depend on Newton's path), and the energy error
+  // 3.0e-5 at 200 (4.7e-5 composed).
   // (The target 1e-4 at 100 steps/rev needs a conserving scheme; see the notes.)
   const double omega_h = omega0.norm() * period / 100;
   EXPECT_LT(coarse.momentum_error, omega_h * omega_h / 2);
