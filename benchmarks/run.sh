@@ -41,3 +41,6 @@ echo
 echo
 # What writing the results during the run costs (the 10-body slider-crank, about 4 minutes).
 /usr/bin/python3 benchmarks/flush_cost.py build/bin
+echo
+# What stress output costs: the solid cantilever with outputs.stresses off and on (about 15 s).
+/usr/bin/python3 benchmarks/stress_output.py build/bin

@@ -3,9 +3,11 @@
 #include <zlib.h>
 
 #include <algorithm>
-#include <atomic>
+#include <array>
+#include <cmath>
+#include <cstdint>
 #include <cstring>
-#include <thread>
+#include <memory>
 
 #include "formats/input_error.h"
 
@@ -104,56 +106,118 @@ void Writer::FloatMatrix(const std::string& name, const Eigen::MatrixXf& value, 
             true);
 }
 
-void Writer::CompressedFloatMatrices(std::vector<FloatData>& data, int threads) {
-  // Each dataset one chunk, filtered here as HDF5's pipeline would (shuffle: the bytes of equal
-  // significance together; then zlib at level 1) and written with H5Dwrite_chunk. A chunk that
-  // does not shrink, or one of 4 GB or more, goes through HDF5's own pipeline.
-  std::vector<std::vector<unsigned char>> packed(data.size());
-  std::atomic<size_t> next{0};
-  const auto work = [&] {
-    std::vector<unsigned char> shuffled;
-    for (size_t i = next++; i < data.size(); i = next++) {
-      const auto& v = data[i].value;
-      const size_t n = size_t(v.size()), bytes = n * sizeof(float);
-      if (!data[i].compress || n == 0 || bytes >= (size_t(1) << 32)) continue;
-      shuffled.resize(bytes);
-      const unsigned char* raw = reinterpret_cast<const unsigned char*>(v.data());
+namespace {
+
+// Shannon entropy of the bytes [begin, end) in bits per byte: what Huffman coding of them alone
+// would approach (8: nothing to gain).
+// Estimated from at most 4096 bytes spread evenly over the range (enough to tell a plane of
+// nearly random bytes; counted into four tables, as a run of equal bytes into one would wait on
+// each increment).
+double ByteEntropy(const unsigned char* begin, const unsigned char* end) {
+  const size_t size = size_t(end - begin), stride = std::max<size_t>(1, size / 4096);
+  std::array<std::array<uint32_t, 256>, 4> count{};
+  size_t n = 0;
+  for (size_t i = 0; i < size; i += stride, ++n) ++count[n & 3][begin[i]];
+  double h = 0.0;
+  for (int v = 0; v < 256; ++v) {
+    const uint32_t c = count[0][v] + count[1][v] + count[2][v] + count[3][v];
+    if (c > 0) h -= double(c) / double(n) * std::log2(double(c) / double(n));
+  }
+  return h;
+}
+
+// One zlib stream (what HDF5's deflate filter reads) of `data`, made of `planes` equal byte
+// planes (shuffled floats: the sign and exponent bytes, then the mantissa's): each plane its own
+// deflate blocks, at level 1, or stored where its bytes are nearly random (entropy above 7.3
+// bits a byte, which deflate shrinks by less than 10% at the most of its time: the low mantissa
+// bytes of a rounded field). Returns the stream's size (0: zlib failed).
+// `out` must hold DeflateBound(data.size(), planes) bytes.
+size_t DeflateBound(size_t bytes, size_t planes) { return compressBound(uLong(bytes)) + 64 * planes; }
+size_t DeflatePlanes(const std::vector<unsigned char>& data, size_t planes, unsigned char* out) {
+  z_stream z{};
+  if (deflateInit(&z, 1) != Z_OK) return 0;
+  const size_t capacity = DeflateBound(data.size(), planes);
+  z.next_out = out;
+  z.avail_out = uInt(capacity);
+  const size_t plane = data.size() / planes;
+  bool ok = true;
+  for (size_t k = 0; k < planes && ok; ++k) {
+    const unsigned char* begin = data.data() + k * plane;
+    const int level = ByteEntropy(begin, begin + plane) > 7.3 ? 0 : 1;
+    ok = deflateParams(&z, level, Z_DEFAULT_STRATEGY) == Z_OK;
+    z.next_in = const_cast<unsigned char*>(begin);
+    z.avail_in = uInt(plane);
+    ok = ok && deflate(&z, k + 1 == planes ? Z_FINISH : Z_BLOCK) == (k + 1 == planes ? Z_STREAM_END : Z_OK);
+  }
+  const size_t size = ok ? capacity - z.avail_out : 0;
+  deflateEnd(&z);
+  return size;
+}
+
+}  // namespace
+
+size_t PackedFloats::stored_bytes() const {
+  size_t n = 0;
+  for (const Chunk& c : chunks) n += c.bytes.size();
+  return n;
+}
+
+PackedFloats PackFloats(std::string name, const float* data, long rows, long cols) {
+  PackedFloats p;
+  p.name = std::move(name);
+  p.rows = hsize_t(std::max(rows, 0L)), p.cols = hsize_t(std::max(cols, 0L));
+  if (p.rows == 0 || p.cols == 0) return p;
+  // Chunks of equal length, each at most 2^20 rows (4 MB; HDF5's limit is 4 GB).
+  const hsize_t limit = hsize_t(1) << 20, per_column = (p.rows + limit - 1) / limit;
+  p.chunk_rows = (p.rows + per_column - 1) / per_column;
+  const size_t bytes = size_t(p.chunk_rows) * sizeof(float);
+  std::vector<unsigned char> shuffled(bytes);
+  const std::unique_ptr<unsigned char[]> deflated(new unsigned char[DeflateBound(bytes, sizeof(float))]);
+  for (hsize_t c = 0; c < p.cols; ++c) {
+    for (hsize_t r0 = 0; r0 < p.rows; r0 += p.chunk_rows) {
+      // The chunk's values, the last one zero-padded to the chunk's length (HDF5 stores whole
+      // chunks), shuffled as HDF5's shuffle filter does.
+      const size_t n = size_t(std::min(p.chunk_rows, p.rows - r0)), m = size_t(p.chunk_rows);
+      const unsigned char* raw = reinterpret_cast<const unsigned char*>(data + c * p.rows + r0);
       for (size_t k = 0; k < n; ++k) {
-        for (size_t b = 0; b < sizeof(float); ++b) shuffled[b * n + k] = raw[k * sizeof(float) + b];
+        for (size_t b = 0; b < sizeof(float); ++b) shuffled[b * m + k] = raw[k * sizeof(float) + b];
       }
-      uLongf size = compressBound(uLong(bytes));
-      packed[i].resize(size);
-      if (compress2(packed[i].data(), &size, shuffled.data(), uLong(bytes), 1) != Z_OK || size >= bytes) {
-        packed[i].clear();
+      for (size_t b = 0; b < sizeof(float); ++b) std::fill(shuffled.begin() + long(b * m + n), shuffled.begin() + long((b + 1) * m), 0);
+      PackedFloats::Chunk chunk;
+      chunk.row = r0, chunk.col = c;
+      const size_t size = DeflatePlanes(shuffled, sizeof(float), deflated.get());
+      if (size > 0 && size < bytes) {
+        chunk.bytes.assign(deflated.get(), deflated.get() + size);
       } else {
-        packed[i].resize(size);
+        chunk.raw = true;
+        chunk.bytes.assign(m * sizeof(float), 0);
+        std::memcpy(chunk.bytes.data(), raw, n * sizeof(float));
       }
+      p.chunks.push_back(std::move(chunk));
     }
-  };
-  std::vector<std::thread> pool;
-  for (int t = 1; t < threads; ++t) pool.emplace_back(work);
-  work();
-  for (std::thread& t : pool) t.join();
-  for (size_t i = 0; i < data.size(); ++i) {
-    const auto& v = data[i].value;
-    if (packed[i].empty()) {
-      WriteData(data[i].name, {hsize_t(v.rows()), hsize_t(v.cols())}, H5T_IEEE_F32LE, H5T_NATIVE_FLOAT, v.data(),
-                data[i].compress);
-      continue;
+  }
+  return p;
+}
+
+void Writer::Packed(const PackedFloats& data) {
+  const hsize_t shape[2] = {data.rows, data.cols};
+  Handle space = Own(H5Screate_simple(2, shape, nullptr));
+  Handle create = Own(H5Pcreate(H5P_DATASET_CREATE));
+  Handle set;
+  const hsize_t chunk[2] = {data.chunk_rows, 1};
+  if (data.rows == 0 || data.cols == 0) {
+    set = Own(H5Dcreate2(file_.id(), data.name.c_str(), H5T_IEEE_F32LE, space.id(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT));
+  } else if (H5Pset_chunk(create.id(), 2, chunk) >= 0 && H5Pset_shuffle(create.id()) >= 0 &&
+             H5Pset_deflate(create.id(), 1) >= 0) {
+    set = Own(H5Dcreate2(file_.id(), data.name.c_str(), H5T_IEEE_F32LE, space.id(), H5P_DEFAULT, create.id(), H5P_DEFAULT));
+  }
+  if (set.id() < 0) throw InputError(path_ + ": cannot write dataset " + data.name);
+  for (const PackedFloats::Chunk& c : data.chunks) {
+    // Filter mask: bit i set skips filter i (0 shuffle, 1 deflate) when the chunk is read.
+    const hsize_t origin[2] = {c.row, c.col};
+    if (H5Dwrite_chunk(set.id(), H5P_DEFAULT, c.raw ? 0x3u : 0u, origin, c.bytes.size(), c.bytes.data()) < 0) {
+      throw InputError(path_ + ": cannot write dataset " + data.name);
     }
-    const hsize_t shape[2] = {hsize_t(v.rows()), hsize_t(v.cols())};
-    Handle space = Own(H5Screate_simple(2, shape, nullptr));
-    Handle create = Own(H5Pcreate(H5P_DATASET_CREATE));
-    Handle set;
-    if (H5Pset_chunk(create.id(), 2, shape) >= 0 && H5Pset_shuffle(create.id()) >= 0 && H5Pset_deflate(create.id(), 1) >= 0) {
-      set = Own(H5Dcreate2(file_.id(), data[i].name.c_str(), H5T_IEEE_F32LE, space.id(), H5P_DEFAULT, create.id(),
-                           H5P_DEFAULT));
-    }
-    const hsize_t origin[2] = {0, 0};
-    if (set.id() < 0 || H5Dwrite_chunk(set.id(), H5P_DEFAULT, 0, origin, packed[i].size(), packed[i].data()) < 0) {
-      throw InputError(path_ + ": cannot write dataset " + data[i].name);
-    }
-    std::vector<unsigned char>().swap(packed[i]);
   }
 }
 
@@ -288,6 +352,18 @@ Eigen::MatrixXd Reader::Matrix(const std::string& name) const {
   if (shape.size() != 2) Fail("dataset " + name + " must be 2-dimensional, got rank " + std::to_string(shape.size()));
   return Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(
       data.data(), Eigen::Index(shape[0]), Eigen::Index(shape[1]));
+}
+
+Eigen::MatrixXf Reader::FloatMatrix(const std::string& name) const {
+  const std::vector<hsize_t> shape = Shape(name);
+  if (shape.size() != 2) Fail("dataset " + name + " must be 2-dimensional, got rank " + std::to_string(shape.size()));
+  const Eigen::Index rows = Eigen::Index(shape[0]), cols = Eigen::Index(shape[1]);
+  Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> m(rows, cols);
+  Handle set = Own(H5Dopen2(file_.id(), name.c_str(), H5P_DEFAULT));
+  if (m.size() > 0 && H5Dread(set.id(), H5T_NATIVE_FLOAT, H5S_ALL, H5S_ALL, H5P_DEFAULT, m.data()) < 0) {
+    Fail("cannot read dataset " + name + " (truncated file or not numeric)");
+  }
+  return m;
 }
 
 Eigen::VectorXd Reader::Vector(const std::string& name) const {

@@ -129,6 +129,22 @@ Eigen::Vector3d PrincipalStresses(const Eigen::Matrix<double, 6, 1>& s) {
   return Eigen::Vector3d(l1, 3.0 * m - l1 - l3, l3);
 }
 
+Eigen::Vector2d ExtremePrincipalStresses(const Eigen::Matrix<double, 6, 1>& s) {
+  // PrincipalStresses' roots m + 2 p cos(phi) and m + 2 p cos(phi + 2 pi / 3) = m - p (cos(phi) +
+  // sqrt(3) sin(phi)), phi in [0, pi / 3]. acos, which loses half the digits near a double root,
+  // stays in double precision; the sine and cosine of phi, well conditioned, in single.
+  const double m = (s[0] + s[1] + s[2]) / 3.0;
+  const double b0 = s[0] - m, b1 = s[1] - m, b2 = s[2] - m;
+  const double p2 = (b0 * b0 + b1 * b1 + b2 * b2 + 2.0 * (s[3] * s[3] + s[4] * s[4] + s[5] * s[5])) / 6.0;
+  if (p2 <= 1e-300) return Eigen::Vector2d::Constant(m);
+  const double p = std::sqrt(p2);
+  const double det = b0 * (b1 * b2 - s[3] * s[3]) - s[5] * (s[5] * b2 - s[3] * s[4]) + s[4] * (s[5] * s[3] - b1 * s[4]);
+  const double phi = std::acos(std::clamp(det / (2.0 * p2 * p), -1.0, 1.0)) / 3.0;
+  float sine = 0.0f, cosine = 0.0f;
+  sincosf(float(phi), &sine, &cosine);
+  return Eigen::Vector2d(m + 2.0 * p * double(cosine), m - p * (double(cosine) + std::sqrt(3.0) * double(sine)));
+}
+
 namespace {
 
 // D E_quad of St. Venant-Kirchhoff at point p: E_quad = H^T H / 2 with H = sum_i q_i H_i

@@ -215,6 +215,10 @@ namespace femb {
 double VonMises(const Eigen::Matrix<double, 6, 1>& s);
 /// Principal stresses of (xx, yy, zz, yz, xz, xy), largest first.
 Eigen::Vector3d PrincipalStresses(const Eigen::Matrix<double, 6, 1>& s);
+/// The largest and the smallest principal stress, to about 1e-7 of the deviator's size (the
+/// closed form of PrincipalStresses with the last trigonometry in single precision: the
+/// animation's fields, stored to 2^-12 of a frame's largest).
+Eigen::Vector2d ExtremePrincipalStresses(const Eigen::Matrix<double, 6, 1>& s);
 /// The stress field of local coordinates q at the mesh nodes: per node the 6 components (xx, yy,
 /// zz, yz, xz, xy; part axes) of its stress point with the largest von Mises stress (solids: its
 /// only point; beams: the most stressed fibre of the sections at the node) in `stress`

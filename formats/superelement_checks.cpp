@@ -17,67 +17,64 @@ std::string Sci(const char* fmt, double v) {
 }
 
 // The first entry of A that is NaN or infinite, as "(row, col) = value"; empty when all are finite.
-std::string FirstNonFinite(const Eigen::MatrixXd& A) {
+template <typename Derived>
+std::string FirstNonFinite(const Eigen::DenseBase<Derived>& A) {
+  if (A.allFinite()) return "";
   for (Eigen::Index j = 0; j < A.cols(); ++j)
     for (Eigen::Index i = 0; i < A.rows(); ++i)
       if (!std::isfinite(A(i, j))) {
         char buffer[96];
-        std::snprintf(buffer, sizeof buffer, "entry (%ld, %ld) is %g", long(i), long(j), A(i, j));
+        std::snprintf(buffer, sizeof buffer, "entry (%ld, %ld) is %g", long(i), long(j), double(A(i, j)));
         return buffer;
       }
   return "";
 }
 
 Check Finite(const Superelement& se) {
-  std::vector<std::pair<std::string, Eigen::MatrixXd>> datasets = {
-      {"/reduced/K", se.K},
-      {"/reduced/M", se.M},
-      {"/reduced/internal_frequencies_hz", se.internal_frequencies_hz},
-      {"/floating_frame/Phi_CB", se.floating_frame.Phi_CB},
-      {"/floating_frame/origin", se.floating_frame.origin},
-      {"/floating_frame/orientation", se.floating_frame.orientation},
-      {"/mass_properties/mass", Eigen::MatrixXd::Constant(1, 1, se.mass_properties.mass)},
-      {"/mass_properties/center_of_mass", se.mass_properties.center_of_mass},
-      {"/mass_properties/inertia_com", se.mass_properties.inertia_com}};
+  // Each dataset where it is (no copy: the stresses and shapes of a solid part are large).
+  std::string name, bad;
+  const auto check = [&](const std::string& dataset, const auto& A) {
+    if (!bad.empty()) return;
+    bad = FirstNonFinite(A);
+    if (!bad.empty()) name = dataset;
+  };
+  check("/reduced/K", se.K);
+  check("/reduced/M", se.M);
+  check("/reduced/internal_frequencies_hz", se.internal_frequencies_hz);
+  check("/floating_frame/Phi_CB", se.floating_frame.Phi_CB);
+  check("/floating_frame/origin", se.floating_frame.origin);
+  check("/floating_frame/orientation", se.floating_frame.orientation);
+  check("/mass_properties/mass", Eigen::MatrixXd::Constant(1, 1, se.mass_properties.mass));
+  check("/mass_properties/center_of_mass", se.mass_properties.center_of_mass);
+  check("/mass_properties/inertia_com", se.mass_properties.inertia_com);
   Eigen::MatrixXd positions(se.interfaces.size(), 3), orientations(se.interfaces.size(), 9);
   for (size_t k = 0; k < se.interfaces.size(); ++k) {
     positions.row(Eigen::Index(k)) = se.interfaces[k].position.transpose();
     orientations.row(Eigen::Index(k)) = Eigen::Map<const Eigen::Matrix<double, 1, 9>>(se.interfaces[k].orientation.data());
   }
-  datasets.emplace_back("/interfaces/positions", positions);
-  datasets.emplace_back("/interfaces/orientations", orientations);
-  if (se.floating_frame.cardona_weights.size() > 0) {
-    datasets.emplace_back("/floating_frame/cardona_weights", se.floating_frame.cardona_weights);
-  }
+  check("/interfaces/positions", positions);
+  check("/interfaces/orientations", orientations);
+  if (se.floating_frame.cardona_weights.size() > 0) check("/floating_frame/cardona_weights", se.floating_frame.cardona_weights);
   if (se.polynomial) {
-    datasets.emplace_back("/reduced/polynomial/A", se.polynomial->A);
-    datasets.emplace_back("/reduced/polynomial/B", se.polynomial->B);
+    check("/reduced/polynomial/A", se.polynomial->A);
+    check("/reduced/polynomial/B", se.polynomial->B);
   }
-  for (const Eigen::MatrixXd& K_sigma : se.inertia_stiffness) {
-    datasets.emplace_back("/reduced/geometric_stiffness/inertia", K_sigma);
-  }
-  if (se.interface_constraint.rows() > 0) datasets.emplace_back("/reduced/interface_constraint", se.interface_constraint);
-  for (const Eigen::MatrixXd& G : se.inertia_gamma) datasets.emplace_back("/reduced/inertia_invariants/Gamma", G);
-  for (const Eigen::MatrixXd& X : se.inertia_xi) datasets.emplace_back("/reduced/inertia_invariants/Xi", X);
+  for (const Eigen::MatrixXd& K_sigma : se.inertia_stiffness) check("/reduced/geometric_stiffness/inertia", K_sigma);
+  if (se.interface_constraint.rows() > 0) check("/reduced/interface_constraint", se.interface_constraint);
+  for (const Eigen::MatrixXd& G : se.inertia_gamma) check("/reduced/inertia_invariants/Gamma", G);
+  for (const Eigen::MatrixXd& X : se.inertia_xi) check("/reduced/inertia_invariants/Xi", X);
   if (se.visualization) {
-    datasets.emplace_back("/visualization/nodes", se.visualization->nodes);
-    datasets.emplace_back("/visualization/shapes", se.visualization->shapes);
+    check("/visualization/nodes", se.visualization->nodes);
+    check("/visualization/shapes", se.visualization->shapes);
   }
   if (se.stress) {
-    datasets.emplace_back("/stress/modes", se.stress->modes.cast<double>());
-    if (se.stress->inertia_modes.size() > 0) datasets.emplace_back("/stress/inertia_modes", se.stress->inertia_modes.cast<double>());
-    if (se.stress->gradients.size() > 0) datasets.emplace_back("/stress/gradients", se.stress->gradients.cast<double>());
-    if (se.stress->element_quadratic.size() > 0) {
-      datasets.emplace_back("/stress/element_quadratic", se.stress->element_quadratic.cast<double>());
-    }
-    if (se.stress->section_forces.size() > 0) {
-      datasets.emplace_back("/stress/section_forces", se.stress->section_forces.cast<double>());
-    }
+    check("/stress/modes", se.stress->modes);
+    check("/stress/inertia_modes", se.stress->inertia_modes);
+    check("/stress/gradients", se.stress->gradients);
+    check("/stress/element_quadratic", se.stress->element_quadratic);
+    check("/stress/section_forces", se.stress->section_forces);
   }
-  for (const auto& [name, A] : datasets) {
-    const std::string bad = FirstNonFinite(A);
-    if (!bad.empty()) return {"finite", false, name + " " + bad, name};
-  }
+  if (!bad.empty()) return {"finite", false, name + " " + bad, name};
   return {"finite", true, "every number of the datasets is finite", ""};
 }
 

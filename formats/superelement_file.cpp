@@ -393,18 +393,18 @@ Superelement ReadSuperelementFile(const std::string& path, const SuperelementRea
         }
       }
       RequireShape(r, "/stress/modes", 6 * np, n);
-      st.modes = r.Matrix("/stress/modes").cast<float>();
+      st.modes = r.FloatMatrix("/stress/modes");
       if (r.Exists("/stress/section_forces")) {
         RequireShape(r, "/stress/section_forces", 12 * v.cells.rows(), n);
         RequireShape(r, "/stress/element_axes", v.cells.rows(), 9);
-        st.section_forces = r.Matrix("/stress/section_forces").cast<float>();
+        st.section_forces = r.FloatMatrix("/stress/section_forces");
         st.element_axes = r.Matrix("/stress/element_axes");
       }
       if (r.Exists("/stress/element_quadratic")) {
         RequireShape(r, "/stress/element_quadratic", v.cells.rows(), n * (n + 1) / 2);
         RequireShape(r, "/stress/point_element", np, -1);
         RequireShape(r, "/stress/element_axes", v.cells.rows(), 9);
-        st.element_quadratic = r.Matrix("/stress/element_quadratic").cast<float>();
+        st.element_quadratic = r.FloatMatrix("/stress/element_quadratic");
         st.element_axes = r.Matrix("/stress/element_axes");
         st.point_element = r.IntVector("/stress/point_element");
         for (long p = 0; p < np; ++p) {
@@ -418,7 +418,7 @@ Superelement ReadSuperelementFile(const std::string& path, const SuperelementRea
         RequireShape(r, "/stress/material", 2, -1);
         if (r.Exists("/stress/gradients")) {
           RequireShape(r, "/stress/gradients", 9 * np, n);
-          st.gradients = r.Matrix("/stress/gradients").cast<float>();
+          st.gradients = r.FloatMatrix("/stress/gradients");
         }
         const Eigen::VectorXd material = r.Vector("/stress/material");
         st.E = material[0];
@@ -429,10 +429,10 @@ Superelement ReadSuperelementFile(const std::string& path, const SuperelementRea
       }
       if (r.Exists("/stress/inertia_modes")) {
         RequireShape(r, "/stress/inertia_modes", 6 * np, kInertiaLoadCaseCount);
-        st.inertia_modes = r.Matrix("/stress/inertia_modes").cast<float>();
+        st.inertia_modes = r.FloatMatrix("/stress/inertia_modes");
         if (r.Exists("/stress/inertia_section_forces")) {
           RequireShape(r, "/stress/inertia_section_forces", 12 * v.cells.rows(), kInertiaLoadCaseCount);
-          st.inertia_section_forces = r.Matrix("/stress/inertia_section_forces").cast<float>();
+          st.inertia_section_forces = r.FloatMatrix("/stress/inertia_section_forces");
         }
       }
       se.stress = std::move(st);

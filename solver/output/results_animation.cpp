@@ -6,10 +6,15 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
+#include <exception>
 #include <filesystem>
 #include <fstream>
+#include <mutex>
+#include <numeric>
 #include <stdexcept>
 #include <string>
 #include <thread>
@@ -17,6 +22,7 @@
 
 #include "formats/hdf5_file.h"
 #include "formats/input_error.h"
+#include "formats/superelement.h"
 #include "formats/vtk_cells.h"
 
 namespace femb {
@@ -27,6 +33,36 @@ namespace {
 float Resolution(float largest, int bits) {
   if (!(largest > 0) || !std::isfinite(largest)) return 0.0f;
   return std::ldexp(1.0f, std::ilogb(largest) + 1 - bits);
+}
+// The nodes in the order of their Morton code (the bits of the three coordinates, quantized to
+// 2^21 steps of the mesh's bounding box, interleaved): a curve through space that keeps
+// neighbours mostly next to each other, so that a field's consecutive values are alike.
+std::vector<int> MortonOrder(const Eigen::MatrixXd& nodes) {
+  const long n = nodes.rows();
+  std::vector<int> order(static_cast<size_t>(n));
+  std::iota(order.begin(), order.end(), 0);
+  if (n == 0) return order;
+  const Eigen::RowVector3d low = nodes.colwise().minCoeff(), span = nodes.colwise().maxCoeff() - low;
+  const auto spread = [](uint64_t v) {  // the 21 bits of v to every third bit
+    v &= 0x1fffff;
+    v = (v | v << 32) & 0x1f00000000ffffULL;
+    v = (v | v << 16) & 0x1f0000ff0000ffULL;
+    v = (v | v << 8) & 0x100f00f00f00f00fULL;
+    v = (v | v << 4) & 0x10c30c30c30c30c3ULL;
+    v = (v | v << 2) & 0x1249249249249249ULL;
+    return v;
+  };
+  std::vector<uint64_t> code(static_cast<size_t>(n));
+  for (long i = 0; i < n; ++i) {
+    uint64_t c = 0;
+    for (int k = 0; k < 3; ++k) {
+      const double f = span[k] > 0 ? (nodes(i, k) - low[k]) / span[k] : 0.0;
+      c |= spread(uint64_t(std::clamp(f, 0.0, 1.0) * double((1 << 21) - 1))) << k;
+    }
+    code[size_t(i)] = c;
+  }
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return code[size_t(a)] < code[size_t(b)]; });
+  return order;
 }
 std::string Num(double v) {
   char buffer[32];
@@ -50,10 +86,23 @@ const ResultsRecorder::AnimationGrid& ResultsRecorder::Grid() {
   };
   std::vector<Block> blocks;
   std::vector<long> body_nodes(scene_.meshes.size(), 0);
+  g.node_of.resize(scene_.meshes.size());
   for (size_t b = 0; b < scene_.meshes.size(); ++b) {
     if (scene_.meshes[b]) {
-      blocks.push_back({scene_.meshes[b]->cell_type, ToVtkOrder(scene_.meshes[b]->cell_type, scene_.meshes[b]->cells)});
-      body_nodes[b] = scene_.meshes[b]->nodes.rows();
+      const Visualization& mesh = *scene_.meshes[b];
+      Eigen::MatrixXi cells = ToVtkOrder(mesh.cell_type, mesh.cells);
+      std::vector<int>& order = g.node_of[b];
+      if (mesh.cell_type == "line2" || mesh.cell_type == "line3") {
+        order.resize(size_t(mesh.nodes.rows()));
+        std::iota(order.begin(), order.end(), 0);
+      } else {
+        order = MortonOrder(mesh.nodes);
+        std::vector<int> rank(order.size());
+        for (size_t j = 0; j < order.size(); ++j) rank[size_t(order[j])] = int(j);
+        for (Eigen::Index i = 0; i < cells.size(); ++i) cells.data()[i] = rank[size_t(cells.data()[i])];
+      }
+      blocks.push_back({mesh.cell_type, cells});
+      body_nodes[b] = mesh.nodes.rows();
     } else {
       // Lines from the first node to the others; a body of one node: a line of length zero.
       const long m = long(scene_.stick_nodes[b].size());
@@ -61,10 +110,17 @@ const ResultsRecorder::AnimationGrid& ResultsRecorder::Grid() {
       for (long i = 1; i < m; ++i) lines.row(i - 1) << 0, int(i);
       blocks.push_back({"line2", lines});
       body_nodes[b] = m;
+      g.node_of[b].resize(size_t(m));
+      std::iota(g.node_of[b].begin(), g.node_of[b].end(), 0);
     }
   }
+  for (size_t b = 0; b < blocks.size(); ++b) {
+    g.offset.push_back(g.n_nodes);
+    g.node.insert(g.node.end(), g.node_of[b].begin(), g.node_of[b].end());
+    g.n_nodes += body_nodes[b];
+  }
   for (const Block& block : blocks) g.uniform &= block.cell_type == blocks.front().cell_type;
-  for (size_t b = 0; b < blocks.size(); ++b) g.n_nodes += body_nodes[b], g.n_cells += blocks[b].cells.rows();
+  for (size_t b = 0; b < blocks.size(); ++b) g.n_cells += blocks[b].cells.rows();
   if (g.n_nodes == 0 || g.n_cells == 0) return g;
   // Topology: uniform, n_cells x per_cell; mixed, one flat list of (XDMF type, [count,] nodes...).
   g.per_cell = g.uniform ? int(blocks.front().cells.cols()) : 0;
@@ -100,66 +156,142 @@ void ResultsRecorder::WriteMesh(h5::Writer& w) {
     w.IntVector("/cells", g.flat);
   }
   w.Matrix("/body", g.body);
+  w.IntVector("/node", g.node);
+}
+
+// A thread's storage for MakeFields, kept from frame to frame.
+struct ResultsRecorder::FieldWorkspace {
+  Eigen::MatrixXf x, d, displacement, stress;  // grid fields, column-major (a column a chunk)
+  Eigen::VectorXd u, von_mises;
+  Eigen::MatrixXd tensor;
+  Eigen::VectorXf scratch;
+};
+
+ResultsRecorder::PackedFrame ResultsRecorder::MakeFields(const PendingOutput& job, FieldWorkspace& ws) {
+  const bool fields = job.frame >= 0, stresses = scene_.spec.stresses;
+  const AnimationGrid* g = fields ? grid_.get() : nullptr;
+  PackedFrame out;
+  out.stress = fields && stresses;
+  if (fields) {
+    ws.x.resize(g->n_nodes, 3), ws.d.resize(g->n_nodes, 3);
+    if (out.stress) ws.stress.setZero(g->n_nodes, 3);  // von Mises, largest and smallest principal
+  }
+  for (size_t b = 0; b < scene_.meshes.size(); ++b) {
+    const long offset = fields ? g->offset[b] : 0;
+    const std::vector<int>* order = fields ? &g->node_of[b] : nullptr;
+    const auto& mesh = scene_.meshes[b];
+    if (fields && mesh) {
+      // x = x_j + R_j (X - X_j + Phi q_loc); the deformation field is the elastic part R_j Phi
+      // q_loc in global axes (what ParaView should colour by: no rigid motion of the body in it).
+      ws.u.noalias() = mesh->shapes * job.q_loc[b];
+      const Eigen::Matrix3d& R = job.frame_R[b];
+      const Eigen::Vector3d x0 = scene_.origin + job.frame_x[b];
+      for (size_t j = 0; j < order->size(); ++j) {
+        const int i = (*order)[j];
+        const Eigen::Vector3d X = mesh->nodes.row(i).transpose() - scene_.mesh_origin[b];
+        const Eigen::Vector3d ui = R * ws.u.segment<3>(long(mesh->dofs_per_node) * i);
+        ws.x.row(offset + long(j)) = (x0 + R * X + ui).transpose().cast<float>();
+        ws.d.row(offset + long(j)) = ui.transpose().cast<float>();
+      }
+    } else if (fields) {
+      ws.x.middleRows(offset, job.sticks[b].rows()) = job.sticks[b];
+      ws.d.middleRows(offset, job.sticks[b].rows()).setZero();  // no deformation field
+    }
+    if (!stresses || !scene_.stresses[b]) continue;
+    const long n_mesh = mesh ? long(mesh->nodes.rows()) : long(scene_.stick_nodes[b].size());
+    NodeStresses(*scene_.stresses[b], job.q_stress[b], n_mesh, &ws.tensor, &ws.von_mises,
+                 job.factors[b].size() > 0 ? &job.factors[b] : nullptr, &ws.scratch);
+    // The largest von Mises stress, without the nodes outputs.stress_exclude leaves out.
+    const std::vector<char>& excluded = scene_.stress_excluded[b];
+    Eigen::Index worst = 0;
+    double largest = -1.0;
+    for (Eigen::Index i = 0; i < ws.von_mises.size(); ++i) {
+      if (!excluded.empty() && excluded[size_t(i)]) continue;
+      if (ws.von_mises[i] > largest) largest = ws.von_mises[i], worst = i;
+    }
+    max_von_mises_[b][size_t(job.output)] = std::max(largest, 0.0);
+    max_von_mises_node_[b][size_t(job.output)] = int(worst);
+    if (!fields) continue;
+    for (size_t j = 0; j < order->size(); ++j) {
+      const int i = (*order)[j];
+      const Eigen::Vector2d p = ExtremePrincipalStresses(ws.tensor.row(i).transpose());
+      ws.stress.row(offset + long(j)) << float(ws.von_mises[i]), float(p[0]), float(p[1]);
+    }
+  }
+  if (!fields) return out;
+  // Rounded where the bits carry nothing a picture shows, so that they compress (shuffle and
+  // deflate): the positions, the displacement and the deformation to multiples of 2^-22 of the
+  // frame's largest coordinate (2.4e-7 m in a 1 m scene, where single precision resolves 6e-8;
+  // the displacement is then the exact difference of the stored positions), the von Mises stress
+  // to 2^-21 of the frame's largest (results.h5 holds the largest in double precision), the
+  // principal stresses to 2^-12 of the frame's largest (colour maps show 256 levels).
+  const auto round = [](auto&& v, float step) {
+    if (step > 0) v = (v / step).array().round() * step;
+  };
+  const float geometry = Resolution(ws.x.size() ? ws.x.cwiseAbs().maxCoeff() : 0.0f, 22);
+  round(ws.x, geometry);
+  round(ws.d, geometry);
+  if (job.frame == 0) x0_ = ws.x;  // (frame 0 is made alone, before the others)
+  ws.displacement = ws.x - x0_;
+  const std::string index = std::to_string(job.frame);
+  const auto pack = [&](const std::string& name, const float* data, long cols) {
+    out.fields.push_back(h5::PackFloats(name + index, data, g->n_nodes, cols));
+  };
+  pack("/x_", ws.x.data(), 3);
+  pack("/deformation_", ws.d.data(), 3);
+  pack("/displacement_", ws.displacement.data(), 3);
+  if (out.stress) {
+    round(ws.stress.col(0), Resolution(ws.stress.col(0).maxCoeff(), 21));
+    round(ws.stress.rightCols(2), Resolution(ws.stress.rightCols(2).cwiseAbs().maxCoeff(), 12));
+    pack("/von_mises_", ws.stress.col(0).data(), 1);
+    pack("/max_principal_", ws.stress.col(1).data(), 1);
+    pack("/min_principal_", ws.stress.col(2).data(), 1);
+  }
+  return out;
+}
+
+void ResultsRecorder::MakePending() {
+  if (pending_.empty()) return;
+  if (scene_.spec.animation) Grid();  // (built here, read by the threads)
+  // Each output step made by one thread, the steps spread over the machine's cores; frame 0
+  // first, alone (the others' displacement is from its positions).
+  std::vector<PackedFrame> made(pending_.size());
+  size_t first = 0;
+  FieldWorkspace ws;
+  if (pending_.front().frame == 0) made[first++] = MakeFields(pending_.front(), ws);
+  const int threads = int(std::clamp(std::thread::hardware_concurrency(), 1u, 8u));
+  std::atomic<size_t> next{first};
+  std::exception_ptr failure;
+  std::mutex failure_mutex;
+  const auto work = [&](FieldWorkspace& own) {
+    try {
+      for (size_t i = next++; i < pending_.size(); i = next++) made[i] = MakeFields(pending_[i], own);
+    } catch (...) {
+      const std::lock_guard<std::mutex> lock(failure_mutex);
+      if (!failure) failure = std::current_exception();
+      next = pending_.size();
+    }
+  };
+  std::vector<FieldWorkspace> spaces(size_t(threads - 1));
+  std::vector<std::thread> pool;
+  for (int t = 1; t < threads; ++t) pool.emplace_back(work, std::ref(spaces[size_t(t - 1)]));
+  work(ws);
+  for (std::thread& t : pool) t.join();
+  if (failure) std::rethrow_exception(failure);
+  for (size_t i = 0; i < pending_.size(); ++i) {
+    if (pending_[i].frame >= 0 && Grid().n_cells > 0) packed_frames_.push_back(std::move(made[i]));
+  }
+  pending_.clear();
 }
 
 void ResultsRecorder::WriteFrames(h5::Writer& w, const std::string& file) {
-  const AnimationGrid& g = Grid();
-  // Rounded where the bits carry nothing a picture shows, so that they compress (shuffle and
-  // deflate): the positions, the displacement and the deformation to multiples of 2^-22 of the
-  // largest coordinate so far (2.4e-7 m in a 1 m scene, where single precision resolves 6e-8;
-  // within one write the displacement is then the exact difference of the stored positions),
-  // the principal stresses to 2^-12 of the frame's largest (colour maps show 256 levels), the
-  // von Mises stress as it is (results.h5's maximum is its largest to 1e-7). The positions and
-  // the von Mises stress are stored uncompressed: deflate shrank them by 1.5x and 1.2x only, at
-  // half the writing time of a solid cantilever's animation.
-  for (const auto& frame : mesh_positions_) {
-    for (const Eigen::MatrixXf& x : frame) geometry_largest_ = std::max(geometry_largest_, x.size() ? x.cwiseAbs().maxCoeff() : 0.0f);
-  }
-  const float geometry_step = Resolution(geometry_largest_, 22);
-  const auto round = [](const Eigen::MatrixXf& v, float step) -> Eigen::MatrixXf {
-    return step > 0 ? Eigen::MatrixXf((v / step).array().round() * step) : v;
-  };
-  // The frames' datasets compressed in batches of 32 frames on the machine's cores.
-  const int threads = int(std::clamp(std::thread::hardware_concurrency(), 1u, 8u));
-  std::vector<h5::Writer::FloatData> batch;
-  const size_t pending = mesh_positions_.size();
-  for (size_t p = 0; p < pending; ++p) {
-    const size_t s = frames_written_ + p;
-    Eigen::MatrixXf x(g.n_nodes, 3), d(g.n_nodes, 3);
-    long offset = 0;
-    for (size_t b = 0; b < mesh_positions_[p].size(); ++b) {
-      x.middleRows(offset, mesh_positions_[p][b].rows()) = mesh_positions_[p][b];
-      d.middleRows(offset, mesh_deformations_[p][b].rows()) = mesh_deformations_[p][b];
-      offset += mesh_positions_[p][b].rows();
-    }
-    x = round(x, geometry_step);
-    if (s == 0) x0_ = x;
-    const std::string index = std::to_string(s);
-    batch.push_back({"/x_" + index, x, false});
-    batch.push_back({"/deformation_" + index, round(d, geometry_step)});
-    batch.push_back({"/displacement_" + index, x - x0_});
-    const bool stress = p < frame_stress_.size();
-    if (stress) {
-      Eigen::MatrixXf f(g.n_nodes, 4);
-      offset = 0;
-      for (size_t b = 0; b < frame_stress_[p].size(); ++b) {
-        f.middleRows(offset, frame_stress_[p][b].rows()) = frame_stress_[p][b];
-        offset += frame_stress_[p][b].rows();
-      }
-      batch.push_back({"/von_mises_" + index, f.leftCols(1), false});
-      batch.push_back({"/principal_stress_" + index, round(f.rightCols(3), Resolution(f.rightCols(3).cwiseAbs().maxCoeff(), 12))});
-    }
+  for (PackedFrame& frame : packed_frames_) {
+    for (const h5::PackedFloats& field : frame.fields) w.Packed(field);
     frame_file_.push_back(file);
-    frame_stress_fields_.push_back(stress);
-    if (p % 32 == 31 || p + 1 == pending) {
-      w.CompressedFloatMatrices(batch, threads);
-      batch.clear();
-    }
+    frame_stress_fields_.push_back(frame.stress);
   }
-  frames_written_ += pending;
-  mesh_positions_.clear();
-  mesh_deformations_.clear();
-  frame_stress_.clear();
+  frames_written_ += packed_frames_.size();
+  packed_frames_.clear();
 }
 
 void ResultsRecorder::WriteXdmf(const std::string& mesh_file) {
@@ -186,6 +318,9 @@ void ResultsRecorder::WriteXdmf(const std::string& mesh_file) {
         << "    <Attribute Name=\"body\" AttributeType=\"Scalar\" Center=\"Cell\">\n     <DataItem Dimensions=\""
         << g.n_cells << " 1\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">" << mesh_file << ":/body</DataItem>\n"
         << "    </Attribute>\n"
+        << "    <Attribute Name=\"node\" AttributeType=\"Scalar\" Center=\"Node\">\n     <DataItem Dimensions=\""
+        << n_nodes << " 1\" NumberType=\"Int\" Precision=\"4\" Format=\"HDF\">" << mesh_file << ":/node</DataItem>\n"
+        << "    </Attribute>\n"
         << "    <Attribute Name=\"deformation\" AttributeType=\"Vector\" Center=\"Node\">\n     <DataItem Dimensions=\""
         << n_nodes << " 3\" NumberType=\"Float\" Precision=\"4\" Format=\"HDF\">" << file << ":/deformation_" << s
         << "</DataItem>\n    </Attribute>\n"
@@ -193,12 +328,11 @@ void ResultsRecorder::WriteXdmf(const std::string& mesh_file) {
         << n_nodes << " 3\" NumberType=\"Float\" Precision=\"4\" Format=\"HDF\">" << file << ":/displacement_" << s
         << "</DataItem>\n    </Attribute>\n";
     if (frame_stress_fields_[s]) {
-      out << "    <Attribute Name=\"von_mises\" AttributeType=\"Scalar\" Center=\"Node\">\n     <DataItem Dimensions=\""
-          << n_nodes << " 1\" NumberType=\"Float\" Precision=\"4\" Format=\"HDF\">" << file << ":/von_mises_" << s
-          << "</DataItem>\n    </Attribute>\n"
-          << "    <Attribute Name=\"principal_stress\" AttributeType=\"Vector\" Center=\"Node\">\n     <DataItem Dimensions=\""
-          << n_nodes << " 3\" NumberType=\"Float\" Precision=\"4\" Format=\"HDF\">" << file << ":/principal_stress_" << s
-          << "</DataItem>\n    </Attribute>\n";
+      for (const char* field : {"von_mises", "max_principal", "min_principal"}) {
+        out << "    <Attribute Name=\"" << field << "\" AttributeType=\"Scalar\" Center=\"Node\">\n     <DataItem Dimensions=\""
+            << n_nodes << " 1\" NumberType=\"Float\" Precision=\"4\" Format=\"HDF\">" << file << ":/" << field << "_" << s
+            << "</DataItem>\n    </Attribute>\n";
+      }
     }
     out << "   </Grid>\n";
   }
@@ -211,7 +345,7 @@ void ResultsRecorder::WriteXdmf(const std::string& mesh_file) {
 }
 
 void ResultsRecorder::WriteAnimationPart() {
-  if (!scene_.spec.animation || mesh_positions_.empty() || Grid().n_cells == 0) return;
+  if (!scene_.spec.animation || packed_frames_.empty() || Grid().n_cells == 0) return;
   const std::filesystem::path dir(directory_);
   char name[64];
   std::snprintf(name, sizeof name, "animation.part-%04zu.h5", animation_parts_.size());
@@ -253,7 +387,9 @@ void ResultsRecorder::FinishAnimation() {
         if (frame_file_[s] != part) continue;
         const std::string index = std::to_string(s);
         for (const char* field : {"/x_", "/deformation_", "/displacement_"}) names.push_back(field + index);
-        if (frame_stress_fields_[s]) names.insert(names.end(), {"/von_mises_" + index, "/principal_stress_" + index});
+        if (frame_stress_fields_[s]) {
+          for (const char* field : {"/von_mises_", "/max_principal_", "/min_principal_"}) names.push_back(field + index);
+        }
       }
       w.CopyFrom((dir / part).string(), names);
     }

@@ -271,70 +271,35 @@ void ResultsRecorder::Record(double t, const SystemState& state, const Eigen::Ve
     has_factors_[b] = 1;
     return &factors_[b];
   };
-  if (scene_.spec.stresses) {
-    const bool frame_fields = frame && scene_.spec.animation;  // the animation's node fields
-    max_von_mises_.resize(model.bodies.size());
-    max_von_mises_node_.resize(model.bodies.size());
-    std::vector<Eigen::MatrixXf> fields;
-    for (size_t b = 0; b < model.bodies.size(); ++b) {
-      const long n_mesh = scene_.meshes[b] ? long(scene_.meshes[b]->nodes.rows()) : long(scene_.stick_nodes[b].size());
-      if (!scene_.stresses[b]) {
-        if (frame_fields) fields.push_back(Eigen::MatrixXf::Zero(n_mesh, 4));
-        continue;
-      }
-      Eigen::MatrixXd& stress = stress_scratch_;
-      Eigen::VectorXd& von_mises = von_mises_scratch_;
-      NodeStresses(*scene_.stresses[b], stress_coordinates(b), n_mesh, &stress, &von_mises, inertia(b), &field_scratch_);
-      // The largest von Mises stress, without the nodes outputs.stress_exclude leaves out.
-      const std::vector<char>& excluded = scene_.stress_excluded[b];
-      Eigen::Index worst = 0;
-      double largest = -1.0;
-      for (Eigen::Index i = 0; i < von_mises.size(); ++i) {
-        if (!excluded.empty() && excluded[size_t(i)]) continue;
-        if (von_mises[i] > largest) largest = von_mises[i], worst = i;
-      }
-      max_von_mises_[b].push_back(std::max(largest, 0.0));
-      max_von_mises_node_[b].push_back(int(worst));
-      if (frame_fields) {
-        Eigen::MatrixXf f(n_mesh, 4);
-        for (long i = 0; i < n_mesh; ++i) {
-          f(i, 0) = float(von_mises[i]);
-          f.block<1, 3>(i, 1) = PrincipalStresses(stress.row(i).transpose()).transpose().cast<float>();
-        }
-        fields.push_back(f);
-      }
-    }
-    if (frame_fields) frame_stress_.push_back(std::move(fields));
-  }
-  if (scene_.spec.animation && frame) {
-    std::vector<Eigen::MatrixXf> meshes, deformations;
-    for (size_t b = 0; b < model.bodies.size(); ++b) {
-      const auto& mesh = scene_.meshes[b];
-      if (!mesh) {
-        // Stick figure: the positions of its nodes (no deformation field: zero).
+  // The stresses and the animation's node fields are made when written (MakePending), from what
+  // they need of this output step.
+  const bool frame_fields = frame && scene_.spec.animation;
+  if (scene_.spec.stresses || frame_fields) {
+    const size_t n_bodies = model.bodies.size();
+    PendingOutput job;
+    job.output = long(time_.size()) - 1;
+    job.frame = frame_fields ? long(frame_time_.size()) : -1;
+    job.frame_x.resize(n_bodies), job.frame_R.resize(n_bodies), job.q_loc.resize(n_bodies), job.sticks.resize(n_bodies);
+    job.q_stress.resize(n_bodies), job.factors.resize(n_bodies);
+    if (scene_.spec.stresses) max_von_mises_.resize(n_bodies), max_von_mises_node_.resize(n_bodies);
+    for (size_t b = 0; b < n_bodies; ++b) {
+      job.frame_x[b] = state.frames[b].x, job.frame_R[b] = state.frames[b].R;
+      if (frame_fields && scene_.meshes[b]) job.q_loc[b] = local(b);
+      if (frame_fields && !scene_.meshes[b]) {
+        // A stick figure: the positions of its nodes.
         const std::vector<int>& sticks = scene_.stick_nodes[b];
-        Eigen::MatrixXf x(long(sticks.size()), 3);
-        for (size_t i = 0; i < sticks.size(); ++i) x.row(long(i)) = (scene_.origin + state.x[sticks[i]]).transpose().cast<float>();
-        meshes.push_back(x);
-        deformations.push_back(Eigen::MatrixXf::Zero(x.rows(), 3));
-        continue;
+        job.sticks[b].resize(long(sticks.size()), 3);
+        for (size_t i = 0; i < sticks.size(); ++i) job.sticks[b].row(long(i)) = (scene_.origin + state.x[sticks[i]]).transpose().cast<float>();
       }
-      const Eigen::VectorXd u = mesh->shapes * local(b);
-      // x = x_j + R_j (X - X_j + Phi q_loc); the deformation field is the elastic part R_j Phi q_loc
-      // in global axes (what ParaView should colour by: no rigid motion of the body in it).
-      Eigen::MatrixXf x(mesh->nodes.rows(), 3), d(mesh->nodes.rows(), 3);
-      for (int i = 0; i < mesh->nodes.rows(); ++i) {
-        const Eigen::Vector3d X = mesh->nodes.row(i).transpose() - scene_.mesh_origin[b];
-        const Eigen::Vector3d ui = state.frames[b].R * u.segment<3>(mesh->dofs_per_node * i);
-        x.row(i) = (scene_.origin + state.frames[b].x + state.frames[b].R * X + ui).transpose().cast<float>();
-        d.row(i) = ui.transpose().cast<float>();
+      if (scene_.spec.stresses && scene_.stresses[b]) {
+        job.q_stress[b] = stress_coordinates(b);
+        if (const Eigen::VectorXd* a = inertia(b)) job.factors[b] = *a;
+        max_von_mises_[b].push_back(0.0);
+        max_von_mises_node_[b].push_back(0);
       }
-      meshes.push_back(x);
-      deformations.push_back(d);
     }
-    frame_time_.push_back(time_.back());
-    mesh_positions_.push_back(meshes);
-    mesh_deformations_.push_back(deformations);
+    if (frame_fields) frame_time_.push_back(time_.back());
+    pending_.push_back(std::move(job));
   }
 
   Put(csv_, t);
@@ -497,6 +462,8 @@ bool ResultsRecorder::FlushDue() const {
 
 void ResultsRecorder::Flush(const std::string& status) {
   const auto start = std::chrono::steady_clock::now();
+  MakePending();
+  const auto made = std::chrono::steady_clock::now();
   // probes.csv (the stream so far, copied whole to a temporary name and renamed) before
   // results.h5: killed between the two renames, probes.csv holds the newer steps and results.h5
   // those of the write before.
@@ -512,7 +479,7 @@ void ResultsRecorder::Flush(const std::string& status) {
   WriteAnimationPart();
   last_flush_ = std::chrono::steady_clock::now();
   last_flush_cost_ = std::chrono::duration<double>(last_flush_ - start).count();
-  last_growing_cost_ = std::chrono::duration<double>(grown - start).count();
+  last_growing_cost_ = std::chrono::duration<double>(grown - made).count();
   outputs_at_last_flush_ = long(time_.size());
   flush_seconds_ += last_flush_cost_;
   ++flushes_;
@@ -520,6 +487,7 @@ void ResultsRecorder::Flush(const std::string& status) {
 }
 
 void ResultsRecorder::Finish(const std::string& status) {
+  MakePending();
   csv_.close();
   std::error_code ec;
   std::filesystem::rename(csv_tmp_, csv_path_, ec);

@@ -147,21 +147,37 @@ class ResultsRecorder {
   std::vector<Eigen::VectorXd> q_loc_, q_stress_, factors_;
   std::vector<char> has_stress_coordinates_, has_factors_;
   std::vector<char> joint_node_;  ///< JointNode(k), per node
-  // Per animation frame (every animation_every-th output step): its time, and per body with a
-  // mesh the deformed node positions (single precision: a solid part's mesh is large).
+  // Per animation frame (every animation_every-th output step): its time.
   std::vector<double> frame_time_;
-  std::vector<std::vector<Eigen::MatrixXf>> mesh_positions_;
-  std::vector<std::vector<Eigen::MatrixXf>> mesh_deformations_;  ///< R_j Phi q_loc per frame and body
   // Stress recovery (outputs.stresses): per body with modal stresses, per output step the largest
-  // von Mises stress and its mesh node; per frame and body the node fields (von Mises, the three
-  // principal stresses; zero for bodies without stresses).
+  // von Mises stress and its mesh node.
   std::vector<std::vector<double>> max_von_mises_;
   std::vector<std::vector<int>> max_von_mises_node_;
-  std::vector<std::vector<Eigen::MatrixXf>> frame_stress_;
-  // NodeStresses' outputs and field, kept from one output step to the next (no page faults).
-  Eigen::MatrixXd stress_scratch_;
-  Eigen::VectorXd von_mises_scratch_;
-  Eigen::VectorXf field_scratch_;
+  // The fields of an output step (the largest stresses; on animation frames the node fields:
+  // positions, deformation, displacement, stresses) are made when written, on the machine's
+  // cores (MakePending): Record keeps what they need, a few numbers per body.
+  struct PendingOutput {
+    long output = 0;  ///< the output step's index
+    long frame = -1;  ///< its animation frame's index, or -1
+    std::vector<Eigen::Vector3d> frame_x;  ///< per body, its floating frame (global, relative to origin)
+    std::vector<Eigen::Matrix3d> frame_R;
+    std::vector<Eigen::VectorXd> q_loc;     ///< per body with a mesh (frames)
+    std::vector<Eigen::MatrixXf> sticks;    ///< per body without a mesh: its stick nodes' positions (frames)
+    std::vector<Eigen::VectorXd> q_stress;  ///< per body with stresses: StressCoordinates
+    std::vector<Eigen::VectorXd> factors;   ///< and its inertia load factors (empty: none)
+  };
+  std::vector<PendingOutput> pending_;
+  // A frame made and packed (compressed), waiting for its file.
+  struct PackedFrame {
+    std::vector<h5::PackedFloats> fields;
+    bool stress = false;
+  };
+  std::vector<PackedFrame> packed_frames_;
+  struct FieldWorkspace;  // one per thread (results_animation.cpp)
+  /// Makes the pending output steps' fields (the largest stresses into max_von_mises_, the frames
+  /// into packed_frames_) and forgets them.
+  void MakePending();
+  PackedFrame MakeFields(const PendingOutput& job, FieldWorkspace& ws);
   // Writing during the run (Flush).
   double flush_every_ = 10.0;
   long flush_every_steps_ = 0, outputs_since_flush_ = 0, flushes_ = 0;
@@ -169,8 +185,8 @@ class ResultsRecorder {
   std::chrono::steady_clock::time_point started_ = std::chrono::steady_clock::now(), last_flush_ = started_;
   double last_flush_cost_ = 0.0, last_growing_cost_ = 0.0, flush_seconds_ = 0.0;
   // The animation's grid (every body's mesh or stick figure; built at the first frame written)
-  // and where each frame is: frame_time_ holds every frame's time, mesh_positions_,
-  // mesh_deformations_ and frame_stress_ the frames not yet written (from frames_written_ on).
+  // and where each frame is: frame_time_ holds every frame's time, pending_ and packed_frames_
+  // the frames not yet written (from frames_written_ on).
   struct AnimationGrid {
     bool uniform = true;
     std::string cell_type;  ///< "line2", "tet10", ... or "mixed"
@@ -179,16 +195,20 @@ class ResultsRecorder {
     Eigen::MatrixXi cells;  ///< uniform: n_cells x per_cell
     std::vector<int> flat;  ///< mixed: (XDMF type, [count,] nodes...) per cell
     Eigen::MatrixXd body;   ///< per cell, its body's index
+    std::vector<long> offset;  ///< per body, its first node in the grid
+    /// Per body, the mesh node (or stick node) at each of its grid nodes: solid and shell meshes
+    /// in spatial (Morton) order, which neighbours' values compress better in; lines in order.
+    std::vector<std::vector<int>> node_of;
+    std::vector<int> node;  ///< per grid node, its node in its body's mesh (the field `node`)
   };
   std::unique_ptr<AnimationGrid> grid_;
   size_t frames_written_ = 0;
   std::vector<std::string> frame_file_;  ///< per written frame, the file (in directory_) holding it
   std::vector<char> frame_stress_fields_;  ///< per written frame, whether it has stress fields
   std::vector<std::string> animation_parts_;  ///< part files written during the run
-  float geometry_largest_ = 0.0f;  ///< the largest coordinate of the frames written so far
-  Eigen::MatrixXf x0_;             ///< the first frame's stored positions (displacement = x - x0)
+  Eigen::MatrixXf x0_;  ///< the first frame's stored positions (displacement = x - x0)
   const AnimationGrid& Grid();
-  /// Writes the pending frames into `w` (the file `file` in directory_) and forgets them.
+  /// Writes the packed frames into `w` (the file `file` in directory_) and forgets them.
   void WriteFrames(h5::Writer& w, const std::string& file);
   void WriteMesh(h5::Writer& w);
   void WriteXdmf(const std::string& mesh_file);

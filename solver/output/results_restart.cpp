@@ -68,7 +68,6 @@ void ResultsRecorder::WriteMark(h5::Writer& w, const Mark& mark) const {
   w.IntVector("/recorder/frame_file", file_of);
   w.IntVector("/recorder/frame_stress", stress);
   w.Strings("/recorder/animation_parts", animation_parts_);
-  w.Vector("/recorder/geometry_largest", Eigen::VectorXd::Constant(1, double(geometry_largest_)));
   w.Matrix("/recorder/x0", x0_.cast<double>());
 }
 
@@ -168,7 +167,6 @@ void ResultsRecorder::Resume(const h5::Reader& checkpoint) {
   }
   frames_written_ = size_t(n_frames);
   animation_parts_ = checkpoint.Strings("/recorder/animation_parts");
-  geometry_largest_ = float(checkpoint.Vector("/recorder/geometry_largest")[0]);
   x0_ = checkpoint.Matrix("/recorder/x0").cast<float>();
   outputs_since_flush_ = 0;
 }

@@ -6,8 +6,11 @@
 
 #include <Eigen/Geometry>
 #include <filesystem>
+#include <cstring>
 #include <functional>
 #include <fstream>
+#include <random>
+#include <thread>
 
 #include "formats/hdf5_file.h"
 #include "test_util.h"
@@ -69,32 +72,60 @@ TEST(SuperelementFile, RoundTripKeepsEverything) {
   fs::remove(path);
 }
 
-// The animation's compressed frames (h5::Writer::CompressedFloatMatrices: shuffle and deflate
-// done on two threads, written as raw chunks) read back exactly through HDF5's own filter
-// pipeline, as FloatMatrix's; a smooth field shrinks, random bits that do not compress are
-// stored as they are, and an empty matrix is written too.
-TEST(Hdf5Writer, CompressedFramesReadBackExactly) {
+// The animation's compressed frames (h5::PackFloats on two threads: a column a chunk, shuffled
+// and deflated; h5::Writer::Packed writes the chunks as they are) read back exactly through
+// HDF5's own filter pipeline, as FloatMatrix's: a smooth field shrinks, random bits that do not
+// compress are stored unfiltered, a column longer than 2^20 rows is split into equal chunks
+// (the last one padded), and an empty matrix is written too.
+TEST(Hdf5Writer, PackedFramesReadBackExactly) {
   const std::string path = TempPath("compressed.h5");
-  std::vector<h5::Writer::FloatData> data;
-  Eigen::MatrixXf smooth(5000, 3), noise = Eigen::MatrixXf::Random(700, 3), empty(0, 3);
+  Eigen::MatrixXf smooth(5000, 3), noise(700, 3), empty(0, 3);
+  Eigen::MatrixXf tall(1300000, 1);
   for (int i = 0; i < smooth.rows(); ++i) smooth.row(i) << std::round(1e4f * std::sin(1e-3f * i)) / 1024.0f, 0.5f, float(i % 7);
-  data.push_back({"/smooth", smooth});
-  data.push_back({"/noise", noise});
-  data.push_back({"/empty", empty});
+  // Random bits in every byte (finite numbers: exponent field 1..254).
+  std::mt19937 random(5);
+  for (Eigen::Index i = 0; i < noise.size(); ++i) {
+    const uint32_t u = random(), bits = (u & 0x807fffffu) | ((1u + (u >> 7) % 254u) << 23);
+    std::memcpy(noise.data() + i, &bits, sizeof bits);
+  }
+  for (int i = 0; i < tall.rows(); ++i) tall(i, 0) = float(i % 1000) / 8.0f;
+  // Between the two: numbers in [1, 2) with random mantissas, whose sign and exponent bytes
+  // deflate and whose low mantissa bytes are stored as they are, in one stream.
+  Eigen::MatrixXf mixed(4000, 2);
+  for (Eigen::Index i = 0; i < mixed.size(); ++i) {
+    const uint32_t bits = 0x3f800000u | (uint32_t(random()) & 0x007fffffu);
+    std::memcpy(mixed.data() + i, &bits, sizeof bits);
+  }
+  std::vector<h5::PackedFloats> packed(5);
+  packed[4] = h5::PackFloats("/mixed", mixed.data(), mixed.rows(), mixed.cols());
+  for (const auto& c : packed[4].chunks) EXPECT_FALSE(c.raw);
+  EXPECT_LT(packed[4].stored_bytes(), mixed.size() * sizeof(float) * 0.8);
+  std::thread other([&] { packed[1] = h5::PackFloats("/noise", noise.data(), noise.rows(), noise.cols()); });
+  packed[0] = h5::PackFloats("/smooth", smooth.data(), smooth.rows(), smooth.cols());
+  packed[2] = h5::PackFloats("/empty", empty.data(), empty.rows(), empty.cols());
+  packed[3] = h5::PackFloats("/tall", tall.data(), tall.rows(), tall.cols());
+  other.join();
+  EXPECT_EQ(packed[0].chunks.size(), 3u);
+  for (const auto& c : packed[1].chunks) EXPECT_TRUE(c.raw);
+  EXPECT_EQ(packed[3].chunks.size(), 2u);
+  EXPECT_EQ(packed[3].chunk_rows, 650000u);
   {
     h5::Writer w(path, /*v110=*/true);
-    w.CompressedFloatMatrices(data, 2);
+    for (const auto& p : packed) w.Packed(p);
     w.FloatMatrix("/plain", smooth);
     w.Close();
   }
   h5::Reader r(path);
   EXPECT_EQ(r.Matrix("/smooth"), smooth.cast<double>());
   EXPECT_EQ(r.Matrix("/noise"), noise.cast<double>());
+  EXPECT_EQ(r.Matrix("/tall"), tall.cast<double>());
+  EXPECT_EQ(r.Matrix("/mixed"), mixed.cast<double>());
   EXPECT_EQ(r.Matrix("/plain"), smooth.cast<double>());
   EXPECT_EQ(r.Shape("/empty"), (std::vector<hsize_t>{0, 3}));
   const hid_t file = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
   const hid_t set = H5Dopen2(file, "/smooth", H5P_DEFAULT);
   EXPECT_LT(H5Dget_storage_size(set), smooth.size() * sizeof(float) / 3);
+  EXPECT_EQ(H5Dget_storage_size(set), packed[0].stored_bytes());
   H5Dclose(set);
   H5Fclose(file);
   fs::remove(path);

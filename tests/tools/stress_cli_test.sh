@@ -70,17 +70,31 @@ assert g["max_von_mises_point"][2][0] < 0.05 and m[2] > 0.9 * abs(ref) * 2, (g["
 reader = meshio.xdmf.TimeSeriesReader(sys.argv[1] + "/animation.xdmf")
 points, cells = reader.read_points_cells()
 _, data, _ = reader.read_data(2)
-vm_field, principal = data["von_mises"].ravel(), data["principal_stress"]
+vm_field, largest, smallest = (data[k].ravel() for k in ("von_mises", "max_principal", "min_principal"))
 assert abs(vm_field.max() - m[2]) < 1e-6 * m[2], (vm_field.max(), m[2])
-assert (principal[:, 0] >= principal[:, 1]).all() and (principal[:, 1] >= principal[:, 2]).all()
-# Stored compactly: the rounded fields shuffled and deflated (the positions and the von Mises
-# stress, which deflate shrinks little, as they are); the principal stresses rounded to multiples
-# of the power of two 2^-12 of the frame's largest
+assert (largest >= smallest).all()
+# The principal stresses bound the von Mises stress: sigma_vm <= sigma_1 - sigma_3 (Tresca), and
+# sigma_vm >= (sigma_1 - sigma_3) sqrt(3) / 2 (to the fields' rounding)
+tresca = largest - smallest
+assert (vm_field <= tresca * (1 + 1e-3) + 1e-3 * m[2]).all() and (vm_field >= 0.866 * tresca - 1e-3 * m[2]).all()
+# Stored compactly: every field rounded, a column a chunk, shuffled and deflated; the principal
+# stresses rounded to multiples of the power of two 2^-12 of the frame's largest
 a = h5py.File(sys.argv[1] + "/animation.h5")
-assert all(a[k].compression == "gzip" and a[k].shuffle for k in ("displacement_2", "deformation_2", "principal_stress_2"))
-assert a["x_2"].compression is None and a["von_mises_2"].compression is None
+for k in ("x_2", "displacement_2", "deformation_2", "von_mises_2", "max_principal_2", "min_principal_2"):
+    assert a[k].compression == "gzip" and a[k].shuffle and a[k].chunks[1] == 1, k
+principal = np.concatenate([largest, smallest])
 step = 2.0 ** (np.floor(np.log2(np.abs(principal).max())) + 1 - 12)
 assert np.abs(principal / step - np.round(principal / step)).max() < 1e-6, step
+# The node field 'node' maps the animation's nodes (in spatial order) to the part's mesh nodes:
+# at the mesh node results.h5 names, the field holds the largest von Mises stress, and the first
+# frame's positions are the mesh's.
+node = a["node"][...].ravel()
+assert sorted(node) == list(range(len(node)))
+k = int(np.where(node == g["max_von_mises_node"][2])[0][0])
+vm2 = a["von_mises_2"][...].ravel()
+assert vm2[k] == vm2.max(), (vm2[k], vm2.max())
+nodes = h5py.File(sys.argv[1] + "/../bar.h5", "r")["visualization/nodes"][...]
+assert np.abs(a["x_0"][...] - nodes[node]).max() < 1e-6
 PY
 # Without outputs.stresses: no fields, no maxima (the probe still works).
 "$bin/femb-solve" -q "$work/scene.yaml" -o "$work/plain" --set outputs.stresses=false && $py - "$work/plain" <<'PY' \
