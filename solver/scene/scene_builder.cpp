@@ -2,8 +2,10 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <limits>
 #include <memory>
 
 #include "formats/input_error.h"
@@ -75,6 +77,48 @@ namespace {
 // the file's mesh that holds it or, within the mesh size outside every cell, at the nearest mesh
 // node; the stress at the body's stress point nearest to it. Effort probes: the prescribed
 // coordinates of the node's joint.
+// A point of a beam body (2-node elements, 6 coordinates per node): the section of the element
+// whose axis passes nearest, at the point's projection on it (clamped to the element's ends),
+// carried rigidly: u(X) = u_axis(s) + theta(s) x r, r from the axis point to X. Along the element
+// (s in [0, 1], length L, axis e, P = 1 - e e^T) the axial displacement and the twist are linear
+// in the end nodes' values, the transverse displacement is Hermite's cubic through the nodes'
+// displacements and slopes theta x e,
+//   u_perp(s) = P (H1 u_a + H3 u_b) + L (H2 theta_a + H4 theta_b) x e,
+//   H1 = 1 - 3s^2 + 2s^3, H2 = s - 2s^2 + s^3, H3 = 3s^2 - 2s^3, H4 = s^3 - s^2,
+// and the bending rotation is e x du_perp/dx: exact for Euler-Bernoulli elements; a Timoshenko
+// element's shear deflection inside the element, which the nodes' rotations do not carry, is
+// left out (at the nodes it is exact). Returns the 3 x n map from the body's coordinates, as
+// `shape` of Scene::PointProbe; `cell`, `s` and `distance` (from the axis) say where.
+Eigen::MatrixXd BeamPointShape(const Visualization& mesh, const Eigen::Vector3d& X, int* cell, double* s_out, double* distance,
+                               double* length) {
+  *cell = -1;
+  *distance = std::numeric_limits<double>::infinity();
+  for (int c = 0; c < mesh.cells.rows(); ++c) {
+    const Eigen::Vector3d a = mesh.nodes.row(mesh.cells(c, 0)).transpose(), d = mesh.nodes.row(mesh.cells(c, 1)).transpose() - a;
+    const double L2 = d.squaredNorm();
+    if (!(L2 > 0)) continue;
+    const double s = std::clamp((X - a).dot(d) / L2, 0.0, 1.0), away = (X - a - s * d).norm();
+    if (away < *distance) *cell = c, *s_out = s, *distance = away, *length = std::sqrt(L2);
+  }
+  const int n = int(mesh.shapes.cols());
+  if (*cell < 0) return Eigen::MatrixXd::Zero(3, n);
+  const int a = mesh.cells(*cell, 0), b = mesh.cells(*cell, 1);
+  const Eigen::Vector3d Xa = mesh.nodes.row(a).transpose(), Xb = mesh.nodes.row(b).transpose();
+  const double L = *length, s = *s_out;
+  const Eigen::Vector3d e = (Xb - Xa) / L;
+  const Eigen::Matrix3d E = e * e.transpose(), P = Eigen::Matrix3d::Identity() - E, C = -Skew(e);  // C theta = theta x e
+  const auto rows = [&](int node, int at) { return mesh.shapes.middleRows(6L * node + at, 3); };
+  const Eigen::MatrixXd Ua = rows(a, 0), Ta = rows(a, 3), Ub = rows(b, 0), Tb = rows(b, 3);
+  const double H1 = 1 - 3 * s * s + 2 * s * s * s, H2 = s - 2 * s * s + s * s * s, H3 = 3 * s * s - 2 * s * s * s,
+               H4 = s * s * s - s * s;
+  const double D1 = -6 * s + 6 * s * s, D2 = 1 - 4 * s + 3 * s * s, D3 = 6 * s - 6 * s * s, D4 = 3 * s * s - 2 * s;  // dH/ds
+  const Eigen::MatrixXd u_axis = E * ((1 - s) * Ua + s * Ub) + P * (H1 * Ua + H3 * Ub) + L * C * (H2 * Ta + H4 * Tb);
+  const Eigen::MatrixXd slope = P * (D1 * Ua + D3 * Ub) / L + C * (D2 * Ta + D4 * Tb);  // du_perp / dx
+  const Eigen::MatrixXd theta = E * ((1 - s) * Ta + s * Tb) + Skew(e) * slope;
+  const Eigen::Vector3d r = X - (Xa + s * L * e);
+  return u_axis - Skew(r) * theta;
+}
+
 void ResolveProbes(const SceneSpec& spec, Scene& scene) {
   const SystemModel& model = scene.model;
   for (const SceneProbeSpec& p : spec.probes) {
@@ -115,30 +159,44 @@ void ResolveProbes(const SceneSpec& spec, Scene& scene) {
                            " (reduce it with reduction.keep_mesh: true)");
         }
         const Visualization& mesh = *scene.meshes[size_t(b)];
-        const MeshPoint at = LocateInMesh(mesh.nodes, mesh.cells, mesh.cell_type, X);
-        if (at.cell < 0 && at.distance > at.size) {
-          std::snprintf(buffer, sizeof buffer,
-                        "point (%.6g, %.6g, %.6g) lies outside body '%s': %.3g from its nearest mesh node, more than the mesh size there (%.3g)",
-                        p.point.x(), p.point.y(), p.point.z(), p.body.c_str(), at.distance, at.size);
-          throw InputError(p.where + ": probe '" + p.name + "': " + buffer);
-        }
-        // u(X) = sum_a N_a u_a; a node with rotations (beams, shells) carries its section
-        // rigidly: u + theta x (X - X_node).
-        const int per = mesh.dofs_per_node;
-        for (size_t a = 0; a < at.nodes.size(); ++a) {
-          probe.shape += at.weights[a] * mesh.shapes.middleRows(long(per) * at.nodes[a], 3);
-          if (per == 6) {
-            const Eigen::Vector3d arm = X - mesh.nodes.row(at.nodes[a]).transpose();
-            probe.shape -= at.weights[a] * Skew(arm) * mesh.shapes.middleRows(long(per) * at.nodes[a] + 3, 3);
+        if (mesh.cell_type == "line2" && mesh.dofs_per_node == 6 && mesh.cells.cols() == 2) {
+          int cell = -1;
+          double s = 0, distance = 0, length = 0;
+          probe.shape = BeamPointShape(mesh, X, &cell, &s, &distance, &length);
+          if (cell < 0 || distance > length) {
+            std::snprintf(buffer, sizeof buffer,
+                          "point (%.6g, %.6g, %.6g) lies outside body '%s': %.3g from the axis of its nearest beam element, more than the element's length (%.3g)",
+                          p.point.x(), p.point.y(), p.point.z(), p.body.c_str(), distance, length);
+            throw InputError(p.where + ": probe '" + p.name + "': " + buffer);
           }
-        }
-        if (at.cell >= 0) {
-          std::snprintf(buffer, sizeof buffer, "probe '%s': point of body '%s' in cell %d of its mesh", p.name.c_str(),
-                        p.body.c_str(), at.cell);
+          std::snprintf(buffer, sizeof buffer, "probe '%s': point of body '%s' on beam element %d of its mesh, at %.4g of its length, %.3g from its axis",
+                        p.name.c_str(), p.body.c_str(), cell, s, distance);
         } else {
-          std::snprintf(buffer, sizeof buffer, "probe '%s': body '%s' at its mesh node %d (%.6g, %.6g, %.6g) in part axes, %.3g from the given point",
-                        p.name.c_str(), p.body.c_str(), at.nearest, mesh.nodes(at.nearest, 0), mesh.nodes(at.nearest, 1),
-                        mesh.nodes(at.nearest, 2), at.distance);
+          const MeshPoint at = LocateInMesh(mesh.nodes, mesh.cells, mesh.cell_type, X);
+          if (at.cell < 0 && at.distance > at.size) {
+            std::snprintf(buffer, sizeof buffer,
+                          "point (%.6g, %.6g, %.6g) lies outside body '%s': %.3g from its nearest mesh node, more than the mesh size there (%.3g)",
+                          p.point.x(), p.point.y(), p.point.z(), p.body.c_str(), at.distance, at.size);
+            throw InputError(p.where + ": probe '" + p.name + "': " + buffer);
+          }
+          // u(X) = sum_a N_a u_a; a node with rotations (beams, shells) carries its section
+          // rigidly: u + theta x (X - X_node).
+          const int per = mesh.dofs_per_node;
+          for (size_t a = 0; a < at.nodes.size(); ++a) {
+            probe.shape += at.weights[a] * mesh.shapes.middleRows(long(per) * at.nodes[a], 3);
+            if (per == 6) {
+              const Eigen::Vector3d arm = X - mesh.nodes.row(at.nodes[a]).transpose();
+              probe.shape -= at.weights[a] * Skew(arm) * mesh.shapes.middleRows(long(per) * at.nodes[a] + 3, 3);
+            }
+          }
+          if (at.cell >= 0) {
+            std::snprintf(buffer, sizeof buffer, "probe '%s': point of body '%s' in cell %d of its mesh", p.name.c_str(),
+                          p.body.c_str(), at.cell);
+          } else {
+            std::snprintf(buffer, sizeof buffer, "probe '%s': body '%s' at its mesh node %d (%.6g, %.6g, %.6g) in part axes, %.3g from the given point",
+                          p.name.c_str(), p.body.c_str(), at.nearest, mesh.nodes(at.nearest, 0), mesh.nodes(at.nearest, 1),
+                          mesh.nodes(at.nearest, 2), at.distance);
+          }
         }
         scene.notes.push_back(buffer);
       }
