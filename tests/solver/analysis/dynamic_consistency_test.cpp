@@ -306,6 +306,8 @@ TEST(DynamicConsistency, AbruptStartReactionsBalanceTheMomentumRateFromTheSecond
 // round-off from the positions over h^2 was not in its round-off floor, so that a correction at
 // the noise looked like divergence), and generalized-alpha's energy watchdog at 2 us (a relative
 // test on energies of 1e-20 J, the velocities' noise). The crank-pin force converges with the step.
+// No warning, but the midpoint scheme's at the steps that leave the coupler's highest reduced
+// mode (11.65 kHz, omega = 7.32e4 rad/s) unresolved, omega h > 1: 100 us and 20 us.
 TEST_F(TiltedFourBarTest, EveryStepFrom100usDownTo1usConverges) {
   for (Integrator integrator : {Integrator::kGeneralizedAlpha, Integrator::kMidpoint}) {
     std::vector<Reactions> runs;
@@ -315,7 +317,14 @@ TEST_F(TiltedFourBarTest, EveryStepFrom100usDownTo1usConverges) {
       o.step = h;
       runs.push_back(Simulate(*scene_, o));
       ASSERT_TRUE(runs.back().result.ok) << runs.back().result.message << " at step " << h;
-      EXPECT_TRUE(runs.back().result.warnings.empty()) << runs.back().result.warnings.front() << " at step " << h;
+      std::vector<std::string> warnings = runs.back().result.warnings;
+      if (integrator == Integrator::kMidpoint && h > 1.5e-5) {
+        ASSERT_EQ(warnings.size(), 1u) << "at step " << h;
+        EXPECT_NE(warnings[0].find("highest mode, 1.165e+04 Hz"), std::string::npos) << warnings[0];
+        EXPECT_NE(warnings[0].find("omega h = " + std::string(h > 5e-5 ? "7.32" : "1.46")), std::string::npos) << warnings[0];
+        warnings.clear();
+      }
+      EXPECT_TRUE(warnings.empty()) << warnings.front() << " at step " << h;
       EXPECT_EQ(runs.back().result.newton_cuts, 0) << "at step " << h;
     }
     std::printf("[ info ] %s, ground reactions against the 1 us run (of each component's peak):",
