@@ -24,6 +24,7 @@
 #include "formats/input_error.h"
 #include "formats/superelement.h"
 #include "formats/vtk_cells.h"
+#include "solver/parallel.h"
 
 namespace femb {
 namespace {
@@ -259,7 +260,7 @@ void ResultsRecorder::MakePending() {
   size_t first = 0;
   FieldWorkspace ws;
   if (pending_.front().frame == 0) made[first++] = MakeFields(pending_.front(), ws);
-  const int threads = int(std::clamp(std::thread::hardware_concurrency(), 1u, 8u));
+  const int threads = std::clamp(DefaultThreads(), 1, 8);  // the processors this process may use
   std::atomic<size_t> next{first};
   std::exception_ptr failure;
   std::mutex failure_mutex;
