@@ -109,40 +109,48 @@ double VonMises(const Eigen::Matrix<double, 6, 1>& s) {
   return std::sqrt(0.5 * (a * a + b * b + c * c) + 3.0 * (s[3] * s[3] + s[4] * s[4] + s[5] * s[5]));
 }
 
-Eigen::Vector3d PrincipalStresses(const Eigen::Matrix<double, 6, 1>& s) {
-  // The closed form of a symmetric 3 x 3 eigenproblem (Smith 1961): with the mean stress m and
-  // the deviator B = S - m 1 scaled by p = sqrt(|B|_F^2 / 6), the roots are
-  // m + 2 p cos(phi + 2 pi k / 3), cos(3 phi) = det(B / p) / 2. Near a double root acos loses half
-  // the digits: the roots are then right to about 1e-8 of p (the animation stores them in single
-  // precision), at a tenth of the iterative solver's cost (the animation's stress fields took
-  // a third of a solid cantilever's run).
-  const double m = (s[0] + s[1] + s[2]) / 3.0;
-  const double b0 = s[0] - m, b1 = s[1] - m, b2 = s[2] - m;
+namespace {
+
+// The closed form of a symmetric 3 x 3 eigenproblem (Smith 1961): with the mean stress m and the
+// deviator B = S - m 1 scaled by p = sqrt(|B|_F^2 / 6), the roots are m + 2 p cos(phi + 2 pi k /
+// 3), cos(3 phi) = det(B / p) / 2, phi in [0, pi / 3]; p = 0 for a hydrostatic state. Near a
+// double root acos loses half the digits: the roots are then right to about 1e-8 of p.
+struct PrincipalAngle {
+  double m = 0.0, p = 0.0, phi = 0.0;
+};
+PrincipalAngle PrincipalAngleOf(const Eigen::Matrix<double, 6, 1>& s) {
+  PrincipalAngle a;
+  a.m = (s[0] + s[1] + s[2]) / 3.0;
+  const double b0 = s[0] - a.m, b1 = s[1] - a.m, b2 = s[2] - a.m;
   const double p2 = (b0 * b0 + b1 * b1 + b2 * b2 + 2.0 * (s[3] * s[3] + s[4] * s[4] + s[5] * s[5])) / 6.0;
-  if (p2 <= 1e-300) return Eigen::Vector3d::Constant(m);
-  const double p = std::sqrt(p2);
+  if (p2 <= 1e-300) return a;
+  a.p = std::sqrt(p2);
   // det(B) / p^3 / 2 for B = [b0 s5 s4; s5 b1 s3; s4 s3 b2].
   const double det = b0 * (b1 * b2 - s[3] * s[3]) - s[5] * (s[5] * b2 - s[3] * s[4]) + s[4] * (s[5] * s[3] - b1 * s[4]);
-  const double r = std::clamp(det / (2.0 * p2 * p), -1.0, 1.0);
-  const double phi = std::acos(r) / 3.0;
-  const double l1 = m + 2.0 * p * std::cos(phi), l3 = m + 2.0 * p * std::cos(phi + 2.0 * M_PI / 3.0);
-  return Eigen::Vector3d(l1, 3.0 * m - l1 - l3, l3);
+  a.phi = std::acos(std::clamp(det / (2.0 * p2 * a.p), -1.0, 1.0)) / 3.0;
+  return a;
+}
+
+}  // namespace
+
+Eigen::Vector3d PrincipalStresses(const Eigen::Matrix<double, 6, 1>& s) {
+  // At a tenth of the iterative solver's cost (the animation's stress fields took a third of a
+  // solid cantilever's run); to 1e-8 of p, the animation stores them in single precision.
+  const PrincipalAngle a = PrincipalAngleOf(s);
+  if (a.p == 0.0) return Eigen::Vector3d::Constant(a.m);
+  const double l1 = a.m + 2.0 * a.p * std::cos(a.phi), l3 = a.m + 2.0 * a.p * std::cos(a.phi + 2.0 * M_PI / 3.0);
+  return Eigen::Vector3d(l1, 3.0 * a.m - l1 - l3, l3);
 }
 
 Eigen::Vector2d ExtremePrincipalStresses(const Eigen::Matrix<double, 6, 1>& s) {
   // PrincipalStresses' roots m + 2 p cos(phi) and m + 2 p cos(phi + 2 pi / 3) = m - p (cos(phi) +
-  // sqrt(3) sin(phi)), phi in [0, pi / 3]. acos, which loses half the digits near a double root,
-  // stays in double precision; the sine and cosine of phi, well conditioned, in single.
-  const double m = (s[0] + s[1] + s[2]) / 3.0;
-  const double b0 = s[0] - m, b1 = s[1] - m, b2 = s[2] - m;
-  const double p2 = (b0 * b0 + b1 * b1 + b2 * b2 + 2.0 * (s[3] * s[3] + s[4] * s[4] + s[5] * s[5])) / 6.0;
-  if (p2 <= 1e-300) return Eigen::Vector2d::Constant(m);
-  const double p = std::sqrt(p2);
-  const double det = b0 * (b1 * b2 - s[3] * s[3]) - s[5] * (s[5] * b2 - s[3] * s[4]) + s[4] * (s[5] * s[3] - b1 * s[4]);
-  const double phi = std::acos(std::clamp(det / (2.0 * p2 * p), -1.0, 1.0)) / 3.0;
+  // sqrt(3) sin(phi)). acos, which loses half the digits near a double root, stays in double
+  // precision (PrincipalAngleOf); the sine and cosine of phi, well conditioned, in single.
+  const PrincipalAngle a = PrincipalAngleOf(s);
+  if (a.p == 0.0) return Eigen::Vector2d::Constant(a.m);
   float sine = 0.0f, cosine = 0.0f;
-  sincosf(float(phi), &sine, &cosine);
-  return Eigen::Vector2d(m + 2.0 * p * double(cosine), m - p * (double(cosine) + std::sqrt(3.0) * double(sine)));
+  sincosf(float(a.phi), &sine, &cosine);
+  return Eigen::Vector2d(a.m + 2.0 * a.p * double(cosine), a.m - a.p * (double(cosine) + std::sqrt(3.0) * double(sine)));
 }
 
 namespace {

@@ -186,12 +186,12 @@ ResultsRecorder::PackedFrame ResultsRecorder::MakeFields(const PendingOutput& jo
       // q_loc in global axes (what ParaView should colour by: no rigid motion of the body in it).
       ws.u.noalias() = mesh->shapes * job.q_loc[b];
       const Eigen::Matrix3d& R = job.frame_R[b];
-      const Eigen::Vector3d x0 = scene_.origin + job.frame_x[b];
+      const Eigen::Vector3d frame_origin = scene_.origin + job.frame_x[b];
       for (size_t j = 0; j < order->size(); ++j) {
         const int i = (*order)[j];
         const Eigen::Vector3d X = mesh->nodes.row(i).transpose() - scene_.mesh_origin[b];
         const Eigen::Vector3d ui = R * ws.u.segment<3>(long(mesh->dofs_per_node) * i);
-        ws.x.row(offset + long(j)) = (x0 + R * X + ui).transpose().cast<float>();
+        ws.x.row(offset + long(j)) = (frame_origin + R * X + ui).transpose().cast<float>();
         ws.d.row(offset + long(j)) = ui.transpose().cast<float>();
       }
     } else if (fields) {
