@@ -14,7 +14,9 @@ std::string Part(int elements) {
   return "name: bench\ntype: beam\nmaterial: {E: 2.0e11, nu: 0.3, rho: 7870}\n"
          "section: {shape: circle, diameter: 0.006}\n"
          "beam:\n  points: {A: [0, 0, 0], B: [0.3, 0, 0]}\n"
-         "  segments: [{from: A, to: B, elements: " + std::to_string(elements) + "}]\n"
+         "  segments: [{from: A, to: B, elements: " +
+         std::to_string(elements) +
+         "}]\n"
          "interfaces: [{name: A}, {name: B}]\n";
 }
 
@@ -32,9 +34,9 @@ int main() {
   std::printf("%9s %9s | %10s %10s %10s %10s %10s %10s | %10s | %s\n", "elements", "DOFs", "assembly", "factorize",
               "static", "eigen", "projection", "full modes", "total [s]", "max rel. error, flexible modes 1-4");
   for (int elements : {10, 100, 1000, 10000, 50000}) {
-    const femb::PartSpec part = femb::ParsePart(Part(elements), "bench.yaml",
-                                                {"reduction.internal_modes=10", "reduction.full_modes=4",
-                                                 "reduction.keep_mesh=false"});
+    const femb::PartSpec part =
+        femb::ParsePart(Part(elements), "bench.yaml",
+                        {"reduction.internal_modes=10", "reduction.full_modes=4", "reduction.keep_mesh=false"});
     femb::Stopwatch clock;
     const femb::ReduceResult r = femb::ReducePart(part, nullptr);
     const double total = clock.Seconds();
@@ -43,7 +45,8 @@ int main() {
       return 3;
     }
     double t[6] = {0, 0, 0, 0, 0, 0};
-    const char* names[6] = {"mesh+assembly", "factorize K_ii", "static modes", "eigen solve", "projection", "full modes"};
+    const char* names[6] = {"mesh+assembly", "factorize K_ii", "static modes",
+                            "eigen solve",   "projection",     "full modes"};
     for (const auto& [stage, sec] : r.superelement.provenance.stage_seconds) {
       for (int i = 0; i < 6; ++i) {
         if (stage == names[i]) t[i] = sec;
@@ -61,17 +64,19 @@ int main() {
   for (int k = 1; k <= 8; ++k) std::printf("   mode %d", k);
   std::printf("\n");
   for (int m : {0, 2, 4, 8, 16, 32}) {
-    const femb::PartSpec part = femb::ParsePart(Part(200), "bench.yaml",
-                                                {"reduction.internal_modes=" + std::to_string(m),
-                                                 "reduction.full_modes=8", "reduction.keep_mesh=false"});
+    const femb::PartSpec part = femb::ParsePart(
+        Part(200), "bench.yaml",
+        {"reduction.internal_modes=" + std::to_string(m), "reduction.full_modes=8", "reduction.keep_mesh=false"});
     femb::Stopwatch clock;
     const femb::ReduceResult r = femb::ReducePart(part, nullptr);
     const double total = clock.Seconds();
     const Eigen::VectorXd f = ReducedFrequencies(r.superelement), full = r.superelement.full_free_free_frequencies_hz;
     std::printf("%6d %10.4f |", m, total);
     for (int k = 6; k < 14; ++k) {
-      if (k < f.size()) std::printf(" %8.1e", std::abs(f[k] - full[k]) / full[k]);
-      else std::printf(" %8s", "-");
+      if (k < f.size())
+        std::printf(" %8.1e", std::abs(f[k] - full[k]) / full[k]);
+      else
+        std::printf(" %8s", "-");
     }
     std::printf("\n");
   }

@@ -24,7 +24,6 @@
 #include "solver/body/superelement_body.h"
 #include "solver/rotation.h"
 
-
 namespace {
 
 struct Timing {
@@ -53,9 +52,10 @@ std::vector<Timing> MeasureInterleaved(int repeats, const std::vector<std::funct
 int main(int argc, char** argv) {
   const int modes = argc > 1 ? std::max(0, std::atoi(argv[1])) : 2;
   const int repeats = argc > 2 ? std::max(1, std::atoi(argv[2])) : 2000;
-  std::printf("One body's kernels: tube segment, 2 interface nodes, %d internal modes; microseconds per call "
-              "(best of 9 interleaved rounds of %d), heap allocations per call\n\n",
-              modes, repeats);
+  std::printf(
+      "One body's kernels: tube segment, 2 interface nodes, %d internal modes; microseconds per call "
+      "(best of 9 interleaved rounds of %d), heap allocations per call\n\n",
+      modes, repeats);
   std::printf("%-48s %10s %7s %12s %7s %12s %7s %7s %7s\n", "kernel", "linear us", "allocs", "exact in. us", "allocs",
               "stiffened us", "allocs", "ratio", "ratio");
   std::printf("%-48s %10s %7s %12s %7s %12s %7s %7s %7s\n", "", "", "", "", "", "", "", "st/lin", "st/ex");
@@ -87,7 +87,8 @@ int main(int argc, char** argv) {
         "section: {shape: tube, outer_radius: 0.01, wall: 0.001}\n"
         "beam:\n  points: {A: [0, 0, 0], B: [0.5, 0, 0]}\n"
         "  segments: [{from: A, to: B, elements: 8}]\n"
-        "interfaces: [{name: A}, {name: B}]\nreduction: {internal_modes: " + std::to_string(modes) +
+        "interfaces: [{name: A}, {name: B}]\nreduction: {internal_modes: " +
+            std::to_string(modes) +
             ", keep_mesh: false, geometric_stiffening: " + std::string(stiffening ? "true" : "false") + "}\n",
         "bench.yaml");
     const femb::ReduceResult reduced = femb::ReducePart(part, nullptr);
@@ -157,8 +158,8 @@ int main(int argc, char** argv) {
     rows[kind].push_back({names[0], k[0]});
     rows[kind].push_back({names[1], k[1]});
     for (int stage = 1; stage <= 4; ++stage)
-      rows[kind].push_back({names[size_t(stage + 1)],
-                            {k[stage + 1].us - k[stage].us, k[stage + 1].allocations - k[stage].allocations}});
+      rows[kind].push_back(
+          {names[size_t(stage + 1)], {k[stage + 1].us - k[stage].us, k[stage + 1].allocations - k[stage].allocations}});
     rows[kind].push_back({names[6], k[5]});
   }
   if (sink == 12345.678) std::printf(" ");

@@ -118,8 +118,8 @@ int Run(int argc, char** argv) {
       // there can land on another equilibrium (seen at 0.05 rad steps: the rotor 1.4 mm lower).
       const Eigen::VectorXd guess =
           previous_step > 0 ? Eigen::VectorXd(u + (step_size / previous_step) * (u - u_previous)) : u;
-      const NonlinearStaticResult step = SolveNonlinearStatic(solid, T, prescribed, values, Eigen::VectorXd::Zero(n), 1,
-                                                              1e-9, 30, &guess);
+      const NonlinearStaticResult step =
+          SolveNonlinearStatic(solid, T, prescribed, values, Eigen::VectorXd::Zero(n), 1, 1e-9, 30, &guess);
       u_previous = u;
       previous_step = step_size;
       if (!step.converged) {
@@ -141,9 +141,10 @@ int Run(int argc, char** argv) {
       moment += (x - c).cross(Eigen::Vector3d(f.segment<3>(3 * i))).y();
     }
     // The moment the internal forces exert on the rotor is -M; the applied moment balances it.
-    std::printf("cross_flexure_reference: theta %.4f rad: moment %.6g N m, centre shift (%.4f, %.4f) mm, %d Newton "
-                "iterations, %.1f s\n",
-                theta, moment, 1e3 * t.x(), 1e3 * t.z(), iterations, clock.Seconds());
+    std::printf(
+        "cross_flexure_reference: theta %.4f rad: moment %.6g N m, centre shift (%.4f, %.4f) mm, %d Newton "
+        "iterations, %.1f s\n",
+        theta, moment, 1e3 * t.x(), 1e3 * t.z(), iterations, clock.Seconds());
     out << theta << "," << moment << "," << t.x() << "," << t.z() << "\n";
   }
   out.close();

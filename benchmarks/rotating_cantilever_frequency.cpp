@@ -31,8 +31,8 @@ Superelement Tube(bool stiffening, const std::string& frame) {
       "section: {shape: tube, outer_radius: 0.01, wall: 0.001}\n"
       "beam:\n  theory: euler_bernoulli\n  points: {A: [0, 0, 0], B: [1, 0, 0]}\n"
       "  segments: [{from: A, to: B, elements: 40}]\ninterfaces: [{name: A}, {name: B}]\n"
-      "reduction: {internal_modes: 4, geometric_stiffening: " + std::string(stiffening ? "true" : "false") +
-      ", floating_frame: '" + frame + "'}\n";
+      "reduction: {internal_modes: 4, geometric_stiffening: " +
+      std::string(stiffening ? "true" : "false") + ", floating_frame: '" + frame + "'}\n";
   ReduceResult r = ReducePart(ParsePart(yaml, "tube.yaml", {}), nullptr);
   if (!r.ok) std::printf("reduction failed: %s\n", r.message.c_str());
   return r.superelement;
@@ -76,11 +76,12 @@ double MeasuredOmega(const Superelement& se, double Omega, bool in_plane, double
   options.end_time = 40 * period;
   options.rho_inf = 0.5;
   std::vector<double> t, d;
-  const DynamicResult result = SolveDynamic(model, s, options, [&](const DynamicStepReport& rep, const DynamicState& st) {
-    const Eigen::Vector3d rel = st.config.R[0].transpose() * (st.config.x[1] - st.config.x[0]);
-    t.push_back(rep.t);
-    d.push_back(in_plane ? rel.y() : rel.z());
-  });
+  const DynamicResult result =
+      SolveDynamic(model, s, options, [&](const DynamicStepReport& rep, const DynamicState& st) {
+        const Eigen::Vector3d rel = st.config.R[0].transpose() * (st.config.x[1] - st.config.x[0]);
+        t.push_back(rep.t);
+        d.push_back(in_plane ? rel.y() : rel.z());
+      });
   if (!result.ok) std::printf("  (run stopped: %s)\n", result.message.c_str());
   if (d.size() < 100) return 0.0;
   double mean = 0.0;

@@ -25,14 +25,22 @@ void SilenceHdf5() {
 
 herr_t CloseAny(hid_t id) {
   switch (H5Iget_type(id)) {
-    case H5I_FILE: return H5Fclose(id);
-    case H5I_GROUP: return H5Gclose(id);
-    case H5I_DATASET: return H5Dclose(id);
-    case H5I_DATASPACE: return H5Sclose(id);
-    case H5I_DATATYPE: return H5Tclose(id);
-    case H5I_ATTR: return H5Aclose(id);
-    case H5I_GENPROP_LST: return H5Pclose(id);
-    default: return -1;
+    case H5I_FILE:
+      return H5Fclose(id);
+    case H5I_GROUP:
+      return H5Gclose(id);
+    case H5I_DATASET:
+      return H5Dclose(id);
+    case H5I_DATASPACE:
+      return H5Sclose(id);
+    case H5I_DATATYPE:
+      return H5Tclose(id);
+    case H5I_ATTR:
+      return H5Aclose(id);
+    case H5I_GENPROP_LST:
+      return H5Pclose(id);
+    default:
+      return -1;
   }
 }
 
@@ -69,23 +77,23 @@ void Writer::CreateGroup(const std::string& group) {
   if (g.id() < 0) throw InputError(path_ + ": cannot create group " + group);
 }
 
-void Writer::WriteData(const std::string& name, const std::vector<hsize_t>& shape, hid_t file_type,
-                       hid_t memory_type, const void* data, bool compress) {
-  Handle space = Own(shape.empty() ? H5Screate(H5S_SCALAR)
-                                   : H5Screate_simple(int(shape.size()), shape.data(), nullptr));
+void Writer::WriteData(const std::string& name, const std::vector<hsize_t>& shape, hid_t file_type, hid_t memory_type,
+                       const void* data, bool compress) {
+  Handle space =
+      Own(shape.empty() ? H5Screate(H5S_SCALAR) : H5Screate_simple(int(shape.size()), shape.data(), nullptr));
   Handle create = Own(H5Pcreate(H5P_DATASET_CREATE));
   if (compress && shape.size() == 2 && shape[0] > 0 && shape[1] > 0 && H5Zfilter_avail(H5Z_FILTER_DEFLATE) > 0) {
     // Chunks of about 1 MB of rows: deflate level 1 (level 4 made the files 3% smaller at twice
     // the time).
-    const hsize_t chunk[2] = {std::min<hsize_t>(shape[0], std::max<hsize_t>(1, (hsize_t(1) << 18) / shape[1])), shape[1]};
-    if (H5Pset_chunk(create.id(), 2, chunk) < 0 || H5Pset_shuffle(create.id()) < 0 || H5Pset_deflate(create.id(), 1) < 0) {
+    const hsize_t chunk[2] = {std::min<hsize_t>(shape[0], std::max<hsize_t>(1, (hsize_t(1) << 18) / shape[1])),
+                              shape[1]};
+    if (H5Pset_chunk(create.id(), 2, chunk) < 0 || H5Pset_shuffle(create.id()) < 0 ||
+        H5Pset_deflate(create.id(), 1) < 0) {
       throw InputError(path_ + ": cannot set the compression of dataset " + name);
     }
   }
-  Handle set = Own(H5Dcreate2(file_.id(), name.c_str(), file_type, space.id(), H5P_DEFAULT,
-                              create.id(), H5P_DEFAULT));
-  if (set.id() < 0 ||
-      H5Dwrite(set.id(), memory_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data) < 0) {
+  Handle set = Own(H5Dcreate2(file_.id(), name.c_str(), file_type, space.id(), H5P_DEFAULT, create.id(), H5P_DEFAULT));
+  if (set.id() < 0 || H5Dwrite(set.id(), memory_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data) < 0) {
     throw InputError(path_ + ": cannot write dataset " + name);
   }
 }
@@ -184,7 +192,8 @@ PackedFloats PackFloats(std::string name, const float* data, long rows, long col
       for (size_t k = 0; k < n; ++k) {
         for (size_t b = 0; b < sizeof(float); ++b) shuffled[b * m + k] = raw[k * sizeof(float) + b];
       }
-      for (size_t b = 0; b < sizeof(float); ++b) std::fill(shuffled.begin() + long(b * m + n), shuffled.begin() + long((b + 1) * m), 0);
+      for (size_t b = 0; b < sizeof(float); ++b)
+        std::fill(shuffled.begin() + long(b * m + n), shuffled.begin() + long((b + 1) * m), 0);
       PackedFloats::Chunk chunk;
       chunk.row = r0, chunk.col = c;
       const size_t size = DeflatePlanes(shuffled, sizeof(float), deflated.get());
@@ -208,10 +217,12 @@ void Writer::Packed(const PackedFloats& data) {
   Handle set;
   const hsize_t chunk[2] = {data.chunk_rows, 1};
   if (data.rows == 0 || data.cols == 0) {
-    set = Own(H5Dcreate2(file_.id(), data.name.c_str(), H5T_IEEE_F32LE, space.id(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT));
+    set = Own(
+        H5Dcreate2(file_.id(), data.name.c_str(), H5T_IEEE_F32LE, space.id(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT));
   } else if (H5Pset_chunk(create.id(), 2, chunk) >= 0 && H5Pset_shuffle(create.id()) >= 0 &&
              H5Pset_deflate(create.id(), 1) >= 0) {
-    set = Own(H5Dcreate2(file_.id(), data.name.c_str(), H5T_IEEE_F32LE, space.id(), H5P_DEFAULT, create.id(), H5P_DEFAULT));
+    set = Own(
+        H5Dcreate2(file_.id(), data.name.c_str(), H5T_IEEE_F32LE, space.id(), H5P_DEFAULT, create.id(), H5P_DEFAULT));
   }
   if (set.id() < 0) throw InputError(path_ + ": cannot write dataset " + data.name);
   for (const PackedFloats::Chunk& c : data.chunks) {
@@ -240,25 +251,22 @@ void Writer::Strings(const std::string& name, const std::vector<std::string>& va
   H5Tset_cset(type.id(), H5T_CSET_UTF8);
   hsize_t n = value.size();
   Handle space = Own(H5Screate_simple(1, &n, nullptr));
-  Handle set = Own(H5Dcreate2(file_.id(), name.c_str(), type.id(), space.id(), H5P_DEFAULT,
-                              H5P_DEFAULT, H5P_DEFAULT));
+  Handle set = Own(H5Dcreate2(file_.id(), name.c_str(), type.id(), space.id(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT));
   std::vector<const char*> pointers;
   for (const auto& s : value) pointers.push_back(s.c_str());
-  if (set.id() < 0 ||
-      (n > 0 && H5Dwrite(set.id(), type.id(), H5S_ALL, H5S_ALL, H5P_DEFAULT, pointers.data()) < 0)) {
+  if (set.id() < 0 || (n > 0 && H5Dwrite(set.id(), type.id(), H5S_ALL, H5S_ALL, H5P_DEFAULT, pointers.data()) < 0)) {
     throw InputError(path_ + ": cannot write dataset " + name);
   }
 }
 
-void Writer::Attribute(const std::string& object, const std::string& name,
-                       const std::string& value) {
+void Writer::Attribute(const std::string& object, const std::string& name, const std::string& value) {
   Handle type = Own(H5Tcopy(H5T_C_S1));
   H5Tset_size(type.id(), value.size() + 1);
   H5Tset_strpad(type.id(), H5T_STR_NULLTERM);
   H5Tset_cset(type.id(), H5T_CSET_UTF8);
   Handle space = Own(H5Screate(H5S_SCALAR));
-  Handle attr = Own(H5Acreate_by_name(file_.id(), object.c_str(), name.c_str(), type.id(),
-                                      space.id(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT));
+  Handle attr = Own(H5Acreate_by_name(file_.id(), object.c_str(), name.c_str(), type.id(), space.id(), H5P_DEFAULT,
+                                      H5P_DEFAULT, H5P_DEFAULT));
   if (attr.id() < 0 || H5Awrite(attr.id(), type.id(), value.c_str()) < 0) {
     throw InputError(path_ + ": cannot write attribute " + object + "@" + name);
   }
@@ -266,8 +274,8 @@ void Writer::Attribute(const std::string& object, const std::string& name,
 
 void Writer::Attribute(const std::string& object, const std::string& name, long value) {
   Handle space = Own(H5Screate(H5S_SCALAR));
-  Handle attr = Own(H5Acreate_by_name(file_.id(), object.c_str(), name.c_str(), H5T_STD_I64LE,
-                                      space.id(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT));
+  Handle attr = Own(H5Acreate_by_name(file_.id(), object.c_str(), name.c_str(), H5T_STD_I64LE, space.id(), H5P_DEFAULT,
+                                      H5P_DEFAULT, H5P_DEFAULT));
   if (attr.id() < 0 || H5Awrite(attr.id(), H5T_NATIVE_LONG, &value) < 0) {
     throw InputError(path_ + ": cannot write attribute " + object + "@" + name);
   }
@@ -334,15 +342,13 @@ std::vector<hsize_t> Reader::Shape(const std::string& name) const {
   return shape;
 }
 
-std::vector<double> Reader::ReadDoubles(const std::string& name,
-                                        std::vector<hsize_t>* shape) const {
+std::vector<double> Reader::ReadDoubles(const std::string& name, std::vector<hsize_t>* shape) const {
   *shape = Shape(name);
   Handle set = Own(H5Dopen2(file_.id(), name.c_str(), H5P_DEFAULT));
   size_t count = 1;
   for (hsize_t d : *shape) count *= d;
   std::vector<double> data(count);
-  if (count > 0 && H5Dread(set.id(), H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT,
-                           data.data()) < 0) {
+  if (count > 0 && H5Dread(set.id(), H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, data.data()) < 0) {
     Fail("cannot read dataset " + name + " (truncated file or not numeric)");
   }
   return data;
@@ -387,8 +393,7 @@ Eigen::MatrixXi Reader::IntMatrix(const std::string& name) const {
   if (shape.size() != 2) Fail("dataset " + name + " must be 2-dimensional");
   Eigen::Matrix<int, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> m(shape[0], shape[1]);
   Handle set = Own(H5Dopen2(file_.id(), name.c_str(), H5P_DEFAULT));
-  if (m.size() > 0 &&
-      H5Dread(set.id(), H5T_NATIVE_INT, H5S_ALL, H5S_ALL, H5P_DEFAULT, m.data()) < 0) {
+  if (m.size() > 0 && H5Dread(set.id(), H5T_NATIVE_INT, H5S_ALL, H5S_ALL, H5P_DEFAULT, m.data()) < 0) {
     Fail("cannot read dataset " + name);
   }
   return m;
@@ -413,8 +418,7 @@ std::vector<std::string> Reader::Strings(const std::string& name) const {
   H5Tset_size(type.id(), H5T_VARIABLE);
   H5Tset_cset(type.id(), H5T_CSET_UTF8);
   std::vector<char*> pointers(shape[0], nullptr);
-  if (shape[0] > 0 &&
-      H5Dread(set.id(), type.id(), H5S_ALL, H5S_ALL, H5P_DEFAULT, pointers.data()) < 0) {
+  if (shape[0] > 0 && H5Dread(set.id(), type.id(), H5S_ALL, H5S_ALL, H5P_DEFAULT, pointers.data()) < 0) {
     Fail("cannot read strings of dataset " + name);
   }
   std::vector<std::string> out;

@@ -100,8 +100,8 @@ void ParseBeam(const YamlValue& value, PartSpec& part) {
     seg.elements = int(elements.Integer());
     if (seg.elements < 1) elements.Fail("a segment needs at least 1 element, got " + std::to_string(seg.elements));
     if ((beam.points[seg.to] - beam.points[seg.from]).norm() == 0.0) {
-      item.Fail("zero-length element: points '" + beam.point_names[seg.from] + "' and '" +
-                beam.point_names[seg.to] + "' coincide");
+      item.Fail("zero-length element: points '" + beam.point_names[seg.from] + "' and '" + beam.point_names[seg.to] +
+                "' coincide");
     }
     if (auto sec = s.Optional("section")) seg.section = ParseSection(*sec);
     s.CheckNoUnknownKeys();
@@ -115,9 +115,12 @@ void ParseBeam(const YamlValue& value, PartSpec& part) {
   }
   if (auto v = m.Optional("theory")) {
     std::string theory = v->String();
-    if (theory == "timoshenko") beam.shear_deformation = true;
-    else if (theory == "euler_bernoulli") beam.shear_deformation = false;
-    else v->Fail("unknown beam theory '" + theory + "' (known: timoshenko, euler_bernoulli)");
+    if (theory == "timoshenko")
+      beam.shear_deformation = true;
+    else if (theory == "euler_bernoulli")
+      beam.shear_deformation = false;
+    else
+      v->Fail("unknown beam theory '" + theory + "' (known: timoshenko, euler_bernoulli)");
   }
   m.CheckNoUnknownKeys();
 }
@@ -127,8 +130,8 @@ void ParseBeam(const YamlValue& value, PartSpec& part) {
 namespace {
 
 // Plausible ranges per unit system: densities from foams to tungsten, moduli from rubber to
-// 1000 x steel (stand-ins for rigid parts), parts from 1 mm to 50 m. A value outside its system's range but inside another's
-// is the signature of mixed units.
+// 1000 x steel (stand-ins for rigid parts), parts from 1 mm to 50 m. A value outside its system's range but inside
+// another's is the signature of mixed units.
 struct UnitRange {
   const char* system;
   double rho_lo, rho_hi, E_lo, E_hi, length_lo, length_hi;
@@ -152,7 +155,8 @@ const UnitRange& RangeOf(const std::string& system) {
 std::string LooksLike(double value, double UnitRange::*lo, double UnitRange::*hi, const std::string& declared) {
   std::string systems;
   for (const UnitRange& r : kUnitRanges) {
-    if (declared != r.system && value >= r.*lo && value <= r.*hi) systems += (systems.empty() ? "" : " or ") + std::string(r.system);
+    if (declared != r.system && value >= r.*lo && value <= r.*hi)
+      systems += (systems.empty() ? "" : " or ") + std::string(r.system);
   }
   return systems.empty() ? "" : "; it looks like " + systems + " (mixed units?)";
 }
@@ -160,9 +164,10 @@ std::string LooksLike(double value, double UnitRange::*lo, double UnitRange::*hi
 std::string Implausible(const char* what, double value, const std::string& system, const char* unit, double lo,
                         double hi, const std::string& looks_like) {
   char buffer[300];
-  std::snprintf(buffer, sizeof buffer, "%s = %.4g is implausible for units %s (%s, expected %.3g .. %.3g)%s; fix the "
-                "value or 'units', or set check_units: false", what, value, system.c_str(), unit, lo, hi,
-                looks_like.c_str());
+  std::snprintf(buffer, sizeof buffer,
+                "%s = %.4g is implausible for units %s (%s, expected %.3g .. %.3g)%s; fix the "
+                "value or 'units', or set check_units: false",
+                what, value, system.c_str(), unit, lo, hi, looks_like.c_str());
   return buffer;
 }
 
@@ -240,10 +245,10 @@ void CheckPartSize(const PartSpec& part, double diagonal, const std::string& whe
   if (!part.check_units) return;
   const UnitRange& r = RangeOf(part.units.system);
   if (diagonal < r.length_lo || diagonal > r.length_hi) {
-    throw InputError(where + ": " + Implausible("part size (bounding-box diagonal)", diagonal, part.units.system,
-                                                r.length_unit, r.length_lo, r.length_hi,
-                                                LooksLike(diagonal, &UnitRange::length_lo, &UnitRange::length_hi,
-                                                          part.units.system)));
+    throw InputError(where + ": " +
+                     Implausible("part size (bounding-box diagonal)", diagonal, part.units.system, r.length_unit,
+                                 r.length_lo, r.length_hi,
+                                 LooksLike(diagonal, &UnitRange::length_lo, &UnitRange::length_hi, part.units.system)));
   }
 }
 
@@ -252,18 +257,25 @@ Units UnitSystem(const std::string& name, const std::string& where) {
   u.system = name;
   if (name == "SI") return u;
   if (name == "mm-t-s") {
-    u.length = "mm"; u.mass = "t"; u.time = "s"; u.force = "N"; u.stress = "MPa";
+    u.length = "mm";
+    u.mass = "t";
+    u.time = "s";
+    u.force = "N";
+    u.stress = "MPa";
     return u;
   }
   if (name == "mm-kg-ms") {
-    u.length = "mm"; u.mass = "kg"; u.time = "ms"; u.force = "kN"; u.stress = "GPa";
+    u.length = "mm";
+    u.mass = "kg";
+    u.time = "ms";
+    u.force = "kN";
+    u.stress = "GPa";
     return u;
   }
   throw InputError(where + ": unknown unit system '" + name + "' (known: SI, mm-t-s, mm-kg-ms)");
 }
 
-PartSpec ParsePart(const std::string& text, const std::string& name,
-                   const std::vector<std::string>& overrides) {
+PartSpec ParsePart(const std::string& text, const std::string& name, const std::vector<std::string>& overrides) {
   YamlDocument doc = YamlDocument::LoadString(text, name);
   std::string effective = text;
   for (const auto& o : overrides) {
@@ -314,7 +326,8 @@ PartSpec ParsePart(const std::string& text, const std::string& name,
     x.stiffness = resolve(m.Required("stiffness"), "stiffness matrix file");
     x.mass = resolve(m.Required("mass"), "mass matrix file");
     if (x.format != "abaqus") {
-      x.dofs = resolve(m.Required("dofs"), x.format == "calculix" ? "DOF map (job.dof)" : "DOF map (CSV: node, component)");
+      x.dofs =
+          resolve(m.Required("dofs"), x.format == "calculix" ? "DOF map (job.dof)" : "DOF map (CSV: node, component)");
     }
     m.CheckNoUnknownKeys();
   } else if (part.type == "beam") {
@@ -373,7 +386,8 @@ PartSpec ParsePart(const std::string& text, const std::string& name,
 
   auto interfaces = root.Optional("interfaces");
   if (!interfaces || interfaces->List().empty()) {
-    throw InputError(name + ": no interface defined: list at least one under 'interfaces' "
+    throw InputError(name +
+                     ": no interface defined: list at least one under 'interfaces' "
                      "(a superelement couples to the world only through interface nodes)");
   }
   for (const YamlValue& item : interfaces->List()) {
@@ -389,20 +403,23 @@ PartSpec ParsePart(const std::string& text, const std::string& name,
       }
       if (spec.point < 0) point.Fail("interface point '" + point_name + "' not found in beam.points");
       for (const auto& other : part.interfaces) {
-        if (other.point == spec.point) item.Fail("point '" + point_name + "' is already interface '" + other.name + "'");
+        if (other.point == spec.point)
+          item.Fail("point '" + point_name + "' is already interface '" + other.name + "'");
       }
     } else {
       auto group = m.Optional("group");
       auto select = m.Optional("select");
       if (group.has_value() == select.has_value()) {
-        item.Fail("interface '" + spec.name + "': give either 'group' (a named node set of the mesh) or 'select' "
+        item.Fail("interface '" + spec.name +
+                  "': give either 'group' (a named node set of the mesh) or 'select' "
                   "(nodes picked by geometry: cylinder, sphere, box or plane)");
       }
       if (group) spec.group = group->String();
       if (select) spec.select = ParseSelection(*select);
       if (auto c = m.Optional("coupling")) {
         spec.coupling = c->String();
-        if (spec.coupling != "rbe2" && spec.coupling != "rbe3") c->Fail("unknown coupling '" + spec.coupling + "' (known: rbe2, rbe3)");
+        if (spec.coupling != "rbe2" && spec.coupling != "rbe3")
+          c->Fail("unknown coupling '" + spec.coupling + "' (known: rbe2, rbe3)");
       }
       if (auto p = m.Optional("point")) spec.location = p->Vector3();
     }
@@ -439,16 +456,16 @@ PartSpec ParsePart(const std::string& text, const std::string& name,
         for (const auto& i : part.interfaces) found |= (i.name == iname);
         if (!found) v->Fail("floating frame interface '" + iname + "' is not one of the part's interfaces");
       } else if (f != "center_of_mass" && f != "mean_axes" && f != "cardona") {
-        v->Fail("unknown floating frame '" + f +
-                "' (known: center_of_mass, mean_axes, interface:<name>, cardona)");
+        v->Fail("unknown floating frame '" + f + "' (known: center_of_mass, mean_axes, interface:<name>, cardona)");
       }
     }
     if (auto v = m.Optional("keep_mesh")) part.reduction.keep_mesh = v->Bool();
     if (auto v = m.Optional("stresses")) {
       part.reduction.stresses = v->Bool();
       if (*part.reduction.stresses && part.type == "imported" && !part.has_material) {
-        v->Fail("stresses of imported matrices need the part's material: (femb's own elements on the imported mesh's "
-                "solid cells recover them)");
+        v->Fail(
+            "stresses of imported matrices need the part's material: (femb's own elements on the imported mesh's "
+            "solid cells recover them)");
       }
       part.reduction.where_stresses = v->Where();
       if (*part.reduction.stresses && part.reduction.keep_mesh == false) {
@@ -458,8 +475,9 @@ PartSpec ParsePart(const std::string& text, const std::string& name,
     if (auto v = m.Optional("geometric_stiffening")) {
       part.reduction.geometric_stiffening = v->Bool();
       if (*part.reduction.geometric_stiffening && part.type == "imported" && !part.has_material) {
-        v->Fail("geometric stiffening of imported matrices needs the part's material: (E, nu, rho; femb's own elements "
-                "on the imported mesh's solid cells give the stress of each field)");
+        v->Fail(
+            "geometric stiffening of imported matrices needs the part's material: (E, nu, rho; femb's own elements "
+            "on the imported mesh's solid cells give the stress of each field)");
       }
     }
     if (auto v = m.Optional("full_modes")) {
@@ -475,7 +493,8 @@ PartSpec ParsePart(const std::string& text, const std::string& name,
       } else {
         d.enabled = true;
         YamlMap dm = v->Map();
-        if (auto o = dm.Optional("of")) d.of = o->OneOf({"all", "static", "internal"}, "(which coordinates are paired)");
+        if (auto o = dm.Optional("of"))
+          d.of = o->OneOf({"all", "static", "internal"}, "(which coordinates are paired)");
         if (auto t = dm.Optional("tolerance")) d.tolerance = t->PositiveNumber();
         if (auto p = dm.Optional("pairs")) {
           for (const YamlValue& item : p->List()) {
@@ -487,13 +506,15 @@ PartSpec ParsePart(const std::string& text, const std::string& name,
         dm.CheckNoUnknownKeys();
       }
       if (d.enabled && part.type == "imported") {
-        v->Fail("modal derivatives need femb's own elements (the nonlinear strain); imported matrices do not have them");
+        v->Fail(
+            "modal derivatives need femb's own elements (the nonlinear strain); imported matrices do not have them");
       }
     }
     m.CheckNoUnknownKeys();
     if (part.reduction.method != "craig_bampton" &&
         (part.reduction.modal_derivatives.enabled || part.reduction.geometric_stiffening.value_or(false))) {
-      throw InputError(part.reduction.where_method + ": modal derivatives and geometric stiffening are built on the "
+      throw InputError(part.reduction.where_method +
+                       ": modal derivatives and geometric stiffening are built on the "
                        "Craig-Bampton basis: use reduction.method: craig_bampton with them");
     }
   }

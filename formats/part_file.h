@@ -42,14 +42,14 @@ struct BeamSpec {
   std::vector<Eigen::Vector3d> points;
   std::vector<BeamSegmentSpec> segments;
   std::optional<Eigen::Vector3d> orientation;  ///< a vector in the local x-y plane
-  bool shear_deformation = true;                ///< false: Euler-Bernoulli
+  bool shear_deformation = true;               ///< false: Euler-Bernoulli
   BeamSectionSpec section;
 };
 
 /// Nodes picked by geometry: the mesh nodes on a surface (cylinder, sphere, plane)
 /// within `tolerance`, or inside a box. reducer/mesh/node_selection.h applies it.
 struct NodeSelectionSpec {
-  std::string shape;  ///< "cylinder", "sphere", "box" or "plane"
+  std::string shape;                                ///< "cylinder", "sphere", "box" or "plane"
   Eigen::Vector3d point = Eigen::Vector3d::Zero();  ///< cylinder: on the axis; sphere: centre; plane: on it; box: min
   Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();  ///< cylinder: axis; plane: normal (unit); box: max
   double radius = 0.0;                              ///< cylinder, sphere
@@ -72,14 +72,14 @@ struct InterfaceSpec {
 
 /// A solid part: a built-in shape or a geometry/mesh file, meshed by gmsh.
 struct SolidSpec {
-  std::string shape;                              ///< "box", "plate", "cylinder", "tube" or "" (file)
-  Eigen::Vector3d size = Eigen::Vector3d::Ones();  ///< box/plate edge lengths [length], corner at the origin
+  std::string shape;                                      ///< "box", "plate", "cylinder", "tube" or "" (file)
+  Eigen::Vector3d size = Eigen::Vector3d::Ones();         ///< box/plate edge lengths [length], corner at the origin
   double radius = 0.0, inner_radius = 0.0, length = 0.0;  ///< cylinder/tube along z from the origin
-  std::string file;                               ///< geometry or mesh file (resolved path)
-  double element_size = 0.0;                      ///< target element size [length]
-  int order = 2;                                  ///< 1: TET4/HEX8, 2: TET10/HEX20
-  bool hexahedra = false;                         ///< mesh.elements: hexahedra (box only)
-  long max_elements = 3000000;                    ///< mesh.max_elements: refuse larger estimated meshes
+  std::string file;                                       ///< geometry or mesh file (resolved path)
+  double element_size = 0.0;                              ///< target element size [length]
+  int order = 2;                                          ///< 1: TET4/HEX8, 2: TET10/HEX20
+  bool hexahedra = false;                                 ///< mesh.elements: hexahedra (box only)
+  long max_elements = 3000000;                            ///< mesh.max_elements: refuse larger estimated meshes
   std::string where;
 };
 
@@ -87,9 +87,9 @@ struct SolidSpec {
 /// coordinates' shapes, zero at the interfaces, deflated against the basis and M-orthonormalized.
 struct ModalDerivativeSpec {
   bool enabled = false;
-  std::string of = "all";  ///< all | static | internal: every pair (i <= j) of those coordinates
+  std::string of = "all";                  ///< all | static | internal: every pair (i <= j) of those coordinates
   std::vector<std::pair<int, int>> pairs;  ///< explicit reduced coordinate indices (then 'of' unused)
-  double tolerance = 1e-4;  ///< drop a vector whose M-norm falls below this fraction when deflated
+  double tolerance = 1e-4;                 ///< drop a vector whose M-norm falls below this fraction when deflated
   std::string where;
 };
 
@@ -143,9 +143,9 @@ struct ReductionSpec {
 /// Imported matrices (`type: imported`): K and M of a model assembled by another FE
 /// code, with the node coordinates from `geometry.file` (SolidSpec::file).
 struct MatricesSpec {
-  std::string format;     ///< "calculix", "abaqus" or "matrix_market"
+  std::string format;           ///< "calculix", "abaqus" or "matrix_market"
   std::string stiffness, mass;  ///< resolved paths
-  std::string dofs;       ///< calculix: job.dof; matrix_market: the row -> (node, component) CSV
+  std::string dofs;             ///< calculix: job.dof; matrix_market: the row -> (node, component) CSV
   std::string where;
 };
 
@@ -153,15 +153,15 @@ struct PartSpec {
   std::string file;
   std::string text_hash;  ///< FNV-1a 64-bit of the file text (after --set), hex
   std::string name;
-  std::string type;       ///< "beam", "solid" or "imported"
+  std::string type;  ///< "beam", "solid" or "imported"
   Units units;
   MaterialSpec material;
   /// Imported parts: `material:` given (optional there), for femb's own elements on the imported
   /// mesh's solid cells: the geometric stiffening. Always true for beams and solids.
   bool has_material = true;
   BeamSpec beam;
-  SolidSpec solid;          ///< solid; imported: file and where only
-  MatricesSpec matrices;    ///< imported
+  SolidSpec solid;        ///< solid; imported: file and where only
+  MatricesSpec matrices;  ///< imported
   std::vector<InterfaceSpec> interfaces;
   ReductionSpec reduction;
   bool check_units = true;  ///< flag implausible (mixed-unit) density, modulus and part size
@@ -177,8 +177,7 @@ void CheckPartSize(const PartSpec& part, double diagonal, const std::string& whe
 PartSpec ReadPartFile(const std::string& path, const std::vector<std::string>& overrides = {});
 
 /// Same, from text (`name` is used in messages).
-PartSpec ParsePart(const std::string& text, const std::string& name,
-                   const std::vector<std::string>& overrides = {});
+PartSpec ParsePart(const std::string& text, const std::string& name, const std::vector<std::string>& overrides = {});
 
 /// The named consistent unit systems: "SI", "mm-t-s", "mm-kg-ms". Throws InputError otherwise.
 Units UnitSystem(const std::string& name, const std::string& where);

@@ -150,7 +150,8 @@ TimeFunctionSpec ParseFunction(const YamlValue& value) {
     f.type = TimeFunctionType::kLinear;
     if (auto v = m.Optional("slope")) f.value = v->Number();
   } else {
-    type.Fail("unknown time function type '" + name + "' (known: linear, constant, ramp, step, pulse, sine, table, spin_up)");
+    type.Fail("unknown time function type '" + name +
+              "' (known: linear, constant, ramp, step, pulse, sine, table, spin_up)");
   }
   m.CheckNoUnknownKeys();
   return f;
@@ -183,7 +184,8 @@ SceneSpec ParseScene(const std::string& text, const std::string& name, const std
     }
     if (auto t = m.Optional("type")) {
       const std::string name = t->String();
-      if (name != "superelement" && name != "rigid") t->Fail("unknown body type '" + name + "' (known: superelement, rigid)");
+      if (name != "superelement" && name != "rigid")
+        t->Fail("unknown body type '" + name + "' (known: superelement, rigid)");
       b.type = name == "rigid" ? SceneBodyType::kRigid : SceneBodyType::kSuperelement;
     }
     if (b.type == SceneBodyType::kSuperelement) {
@@ -203,7 +205,8 @@ SceneSpec ParseScene(const std::string& text, const std::string& name, const std
       }
       const Eigen::Vector3d p = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(b.inertia).eigenvalues();
       if (!(p[0] > 0) || p[0] + p[1] < p[2] * (1 - 1e-12)) {
-        inertia.Fail("not a physical inertia tensor (principal moments must be positive and obey the triangle inequality)");
+        inertia.Fail(
+            "not a physical inertia tensor (principal moments must be positive and obey the triangle inequality)");
       }
       if (auto pts = m.Optional("points")) {
         for (const auto& [pname, value] : pts->Map().Entries()) b.points[pname] = value.Vector3();
@@ -218,7 +221,8 @@ SceneSpec ParseScene(const std::string& text, const std::string& name, const std
     YamlValue node_map = m.Required("nodes");
     for (const auto& [iname, scene_node] : node_map.Map().Entries()) {
       if (b.type == SceneBodyType::kRigid && iname != "com" && !b.points.count(iname)) {
-        scene_node.Fail("rigid body '" + b.name + "' has no point '" + iname + "' (define it under 'points'; 'com' is the centre of mass)");
+        scene_node.Fail("rigid body '" + b.name + "' has no point '" + iname +
+                        "' (define it under 'points'; 'com' is the centre of mass)");
       }
       b.nodes[iname] = scene_node.String();
       nodes.insert(scene_node.String());
@@ -229,11 +233,14 @@ SceneSpec ParseScene(const std::string& text, const std::string& name, const std
     }
     if (auto o = m.Optional("options")) {
       YamlMap om = o->Map();
-      if (auto v = om.Optional("transformations")) b.approximated = v->OneOf({"exact", "approximated"}) == "approximated";
+      if (auto v = om.Optional("transformations"))
+        b.approximated = v->OneOf({"exact", "approximated"}) == "approximated";
       if (auto v = om.Optional("tangent")) b.full_tangent = v->OneOf({"full", "K1"}) == "full";
       if (auto v = om.Optional("quadratic_velocity_terms")) b.quadratic_velocity_terms = v->Bool();
       if (auto v = om.Optional("internal_force")) {
-        b.polynomial_force = v->OneOf({"polynomial", "linear"}, "(polynomial: the file's Green-Lagrange force when it has modal derivatives)") == "polynomial";
+        b.polynomial_force =
+            v->OneOf({"polynomial", "linear"},
+                     "(polynomial: the file's Green-Lagrange force when it has modal derivatives)") == "polynomial";
       }
       if (auto v = om.Optional("geometric_stiffening")) b.geometric_stiffening = v->Bool();
       if (auto v = om.Optional("inertia")) {
@@ -298,7 +305,8 @@ SceneSpec ParseScene(const std::string& text, const std::string& name, const std
             v->Fail("prescribed motion of a " + name + " joint is not supported; use revolute or prismatic");
           }
           j.prescribed = v->String();
-          if (!scene.functions.count(j.prescribed)) v->Fail("time function '" + j.prescribed + "' is not defined under 'functions'");
+          if (!scene.functions.count(j.prescribed))
+            v->Fail("time function '" + j.prescribed + "' is not defined under 'functions'");
         }
       }
       if (auto v = m.Optional("cut")) {
@@ -327,7 +335,8 @@ SceneSpec ParseScene(const std::string& text, const std::string& name, const std
         if (auto v = m.Optional("follower")) l.follower = v->Bool();
         if (auto v = m.Optional("function")) {
           l.function = v->String();
-          if (!scene.functions.count(l.function)) v->Fail("time function '" + l.function + "' is not defined under 'functions'");
+          if (!scene.functions.count(l.function))
+            v->Fail("time function '" + l.function + "' is not defined under 'functions'");
         }
       } else if (name == "gravity") {
         l.type = SceneLoadType::kGravity;
@@ -379,7 +388,8 @@ SceneSpec ParseScene(const std::string& text, const std::string& name, const std
       m.CheckNoUnknownKeys();
       if (!nodes.count(node)) value.Fail("node '" + node + "' is not a node of any body");
       if (joint) {
-        if (m.Optional("linear") || m.Optional("angular")) value.Fail("give either joint rates or linear/angular velocities");
+        if (m.Optional("linear") || m.Optional("angular"))
+          value.Fail("give either joint rates or linear/angular velocities");
         std::vector<double> rates;
         for (const YamlValue& r : joint->List()) rates.push_back(r.Number());
         scene.initial_joint_rates[node] = rates;
@@ -435,7 +445,7 @@ SceneSpec ParseScene(const std::string& text, const std::string& name, const std
     }
     if (auto v = m.Optional("integrator")) {
       a.integrator = v->OneOf({"generalized_alpha", "midpoint"}) == "midpoint" ? IntegratorType::kMidpoint
-                                                                              : IntegratorType::kGeneralizedAlpha;
+                                                                               : IntegratorType::kGeneralizedAlpha;
     }
     if (auto v = m.Optional("tolerance")) a.tolerance = v->PositiveNumber();
     if (auto v = m.Optional("max_iterations")) a.max_iterations = int(v->NonNegativeInteger());
@@ -443,7 +453,7 @@ SceneSpec ParseScene(const std::string& text, const std::string& name, const std
     if (auto v = m.Optional("jacobian_reuse")) {
       // true and false: the values before `step` existed (across steps, and full Newton).
       const std::string s = v->OneOf({"step", "steps", "none", "true", "false"});
-      a.jacobian_reuse = s == "step"                     ? JacobianReuseType::kStep
+      a.jacobian_reuse = s == "step"                   ? JacobianReuseType::kStep
                          : s == "steps" || s == "true" ? JacobianReuseType::kSteps
                                                        : JacobianReuseType::kNone;
     }
@@ -453,7 +463,8 @@ SceneSpec ParseScene(const std::string& text, const std::string& name, const std
       if (a.body_matrices_every < 1) v->Fail("body_matrices_every must be a whole number of steps, at least 1");
     }
     if (auto v = m.Optional("body_matrices_kept")) {
-      a.body_matrices_kept = v->OneOf({"inertia", "all"}) == "all" ? BodyMatricesKeptType::kAll : BodyMatricesKeptType::kInertia;
+      a.body_matrices_kept =
+          v->OneOf({"inertia", "all"}) == "all" ? BodyMatricesKeptType::kAll : BodyMatricesKeptType::kInertia;
     }
     m.CheckNoUnknownKeys();
   }
@@ -478,7 +489,8 @@ SceneSpec ParseScene(const std::string& text, const std::string& name, const std
       if (auto list = em.Optional("interfaces")) {
         for (const YamlValue& item : list->List()) {
           const std::string name = item.String();
-          if (name.find('.') == std::string::npos) item.Fail("stress_exclude.interfaces: '" + name + "' is not <body>.<interface>");
+          if (name.find('.') == std::string::npos)
+            item.Fail("stress_exclude.interfaces: '" + name + "' is not <body>.<interface>");
           scene.stress_exclude.interfaces.push_back(name);
         }
       }
@@ -495,15 +507,17 @@ SceneSpec ParseScene(const std::string& text, const std::string& name, const std
           // A point probe: a body and a point.
           p.body = body->String();
           p.point = pm.Required("point").Vector3();
-          if (pm.Optional("node")) item.Fail("probe '" + p.name + "': give either node (node quantities) or body and point (point quantities), not both");
+          if (pm.Optional("node"))
+            item.Fail("probe '" + p.name +
+                      "': give either node (node quantities) or body and point (point quantities), not both");
         } else {
           p.node = check_node(pm.Required("node"));
         }
         YamlValue q = pm.Required("quantities");
         static const ProbeQuantity node_quantities[] = {
-            ProbeQuantity::kPosition,     ProbeQuantity::kRotation,            ProbeQuantity::kVelocity,
-            ProbeQuantity::kAngularVelocity, ProbeQuantity::kAcceleration,     ProbeQuantity::kAngularAcceleration,
-            ProbeQuantity::kJoint,        ProbeQuantity::kReaction,            ProbeQuantity::kEffort};
+            ProbeQuantity::kPosition,        ProbeQuantity::kRotation,     ProbeQuantity::kVelocity,
+            ProbeQuantity::kAngularVelocity, ProbeQuantity::kAcceleration, ProbeQuantity::kAngularAcceleration,
+            ProbeQuantity::kJoint,           ProbeQuantity::kReaction,     ProbeQuantity::kEffort};
         static const ProbeQuantity point_quantities[] = {ProbeQuantity::kPosition, ProbeQuantity::kVelocity,
                                                          ProbeQuantity::kAcceleration, ProbeQuantity::kDeformation,
                                                          ProbeQuantity::kStress};
@@ -528,7 +542,8 @@ SceneSpec ParseScene(const std::string& text, const std::string& name, const std
                     names(point_quantities) + ")");
           }
           if (!body && in_node == std::end(node_quantities)) {
-            qi.Fail("probe quantity '" + s + "' needs body and point (e.g. {name: s, body: rod0, point: [x, y, z], quantities: [" + s + "]})");
+            qi.Fail("probe quantity '" + s +
+                    "' needs body and point (e.g. {name: s, body: rod0, point: [x, y, z], quantities: [" + s + "]})");
           }
           if (s == "reaction" || s == "effort") scene.reactions = true;
           p.quantities.push_back(body ? *in_point : *in_node);
@@ -547,52 +562,74 @@ const char* Name(SceneBodyType type) { return type == SceneBodyType::kRigid ? "r
 
 const char* Name(SceneJointType type) {
   switch (type) {
-    case SceneJointType::kClamp: return "clamp";
-    case SceneJointType::kRigid: return "rigid";
-    case SceneJointType::kSpherical: return "spherical";
-    case SceneJointType::kRevolute: return "revolute";
-    case SceneJointType::kPrismatic: return "prismatic";
-    case SceneJointType::kCylindrical: return "cylindrical";
-    case SceneJointType::kUniversal: return "universal";
+    case SceneJointType::kClamp:
+      return "clamp";
+    case SceneJointType::kRigid:
+      return "rigid";
+    case SceneJointType::kSpherical:
+      return "spherical";
+    case SceneJointType::kRevolute:
+      return "revolute";
+    case SceneJointType::kPrismatic:
+      return "prismatic";
+    case SceneJointType::kCylindrical:
+      return "cylindrical";
+    case SceneJointType::kUniversal:
+      return "universal";
   }
   return "?";
 }
 
 const char* Name(SceneLoadType type) {
   switch (type) {
-    case SceneLoadType::kForce: return "force";
-    case SceneLoadType::kGravity: return "gravity";
-    case SceneLoadType::kSpring: return "spring";
+    case SceneLoadType::kForce:
+      return "force";
+    case SceneLoadType::kGravity:
+      return "gravity";
+    case SceneLoadType::kSpring:
+      return "spring";
   }
   return "?";
 }
 
 const char* Name(AnalysisType type) {
   switch (type) {
-    case AnalysisType::kStatic: return "static";
-    case AnalysisType::kDynamic: return "dynamic";
-    case AnalysisType::kModes: return "modes";
+    case AnalysisType::kStatic:
+      return "static";
+    case AnalysisType::kDynamic:
+      return "dynamic";
+    case AnalysisType::kModes:
+      return "modes";
   }
   return "?";
 }
 
-const char* Name(IntegratorType type) {
-  return type == IntegratorType::kMidpoint ? "midpoint" : "generalized_alpha";
-}
+const char* Name(IntegratorType type) { return type == IntegratorType::kMidpoint ? "midpoint" : "generalized_alpha"; }
 
 const char* Name(ProbeQuantity quantity) {
   switch (quantity) {
-    case ProbeQuantity::kPosition: return "position";
-    case ProbeQuantity::kRotation: return "rotation";
-    case ProbeQuantity::kVelocity: return "velocity";
-    case ProbeQuantity::kAngularVelocity: return "angular_velocity";
-    case ProbeQuantity::kJoint: return "joint";
-    case ProbeQuantity::kReaction: return "reaction";
-    case ProbeQuantity::kStress: return "stress";
-    case ProbeQuantity::kAcceleration: return "acceleration";
-    case ProbeQuantity::kAngularAcceleration: return "angular_acceleration";
-    case ProbeQuantity::kDeformation: return "deformation";
-    case ProbeQuantity::kEffort: return "effort";
+    case ProbeQuantity::kPosition:
+      return "position";
+    case ProbeQuantity::kRotation:
+      return "rotation";
+    case ProbeQuantity::kVelocity:
+      return "velocity";
+    case ProbeQuantity::kAngularVelocity:
+      return "angular_velocity";
+    case ProbeQuantity::kJoint:
+      return "joint";
+    case ProbeQuantity::kReaction:
+      return "reaction";
+    case ProbeQuantity::kStress:
+      return "stress";
+    case ProbeQuantity::kAcceleration:
+      return "acceleration";
+    case ProbeQuantity::kAngularAcceleration:
+      return "angular_acceleration";
+    case ProbeQuantity::kDeformation:
+      return "deformation";
+    case ProbeQuantity::kEffort:
+      return "effort";
   }
   return "?";
 }

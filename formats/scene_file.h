@@ -25,10 +25,10 @@ enum class TimeFunctionType {
 
 struct TimeFunctionSpec {
   TimeFunctionType type = TimeFunctionType::kLinear;
-  double value = 1.0;           ///< constant value; final value of ramp and step
+  double value = 1.0;                 ///< constant value; final value of ramp and step
   double t_start = 0.0, t_end = 1.0;  ///< ramp from 0 at t_start to value at t_end; step at t_start
   double amplitude = 0.0, frequency = 0.0, phase = 0.0, offset = 0.0;  ///< sine [Hz]
-  std::vector<std::pair<double, double>> table;  ///< (t, f) pairs, linear in between
+  std::vector<std::pair<double, double>> table;                        ///< (t, f) pairs, linear in between
   double Evaluate(double t) const;
   double Rate(double t) const;          ///< f'(t) (piecewise: the right derivative)
   double Acceleration(double t) const;  ///< f''(t) (kinks: 0)
@@ -43,10 +43,24 @@ struct TimeFunctionSpec {
 enum class AnalysisType { kStatic, kDynamic, kModes };
 enum class IntegratorType { kGeneralizedAlpha, kMidpoint };
 enum class BodyMatricesKeptType { kInertia, kAll };  ///< analysis.body_matrices_kept: inertia | all
-enum class JacobianReuseType { kDefault, kNone, kStep, kSteps };  ///< analysis.jacobian_reuse: none | step | steps (kDefault: unset)
+enum class JacobianReuseType {
+  kDefault,
+  kNone,
+  kStep,
+  kSteps
+};  ///< analysis.jacobian_reuse: none | step | steps (kDefault: unset)
 enum class ProbeQuantity {
-  kPosition, kRotation, kVelocity, kAngularVelocity, kJoint, kReaction, kStress,
-  kAcceleration, kAngularAcceleration, kDeformation, kEffort
+  kPosition,
+  kRotation,
+  kVelocity,
+  kAngularVelocity,
+  kJoint,
+  kReaction,
+  kStress,
+  kAcceleration,
+  kAngularAcceleration,
+  kDeformation,
+  kEffort
 };
 /// Bodies, joints and loads by type (SCENE_FORMAT.md `bodies`, `joints`, `loads`).
 enum class SceneBodyType { kSuperelement, kRigid };
@@ -62,7 +76,7 @@ const char* Name(ProbeQuantity quantity);
 struct SceneBodySpec {
   std::string name;
   SceneBodyType type = SceneBodyType::kSuperelement;
-  std::string superelement;      ///< file path (relative paths are relative to the scene file)
+  std::string superelement;  ///< file path (relative paths are relative to the scene file)
   // rigid: mass, centre of mass and inertia about it (part axes), attachment points (part axes)
   double mass = 0.0;
   Eigen::Vector3d center_of_mass = Eigen::Vector3d::Zero();
@@ -70,7 +84,7 @@ struct SceneBodySpec {
   std::map<std::string, Eigen::Vector3d> points;
   Eigen::Vector3d position = Eigen::Vector3d::Zero();
   Eigen::Vector3d rotation = Eigen::Vector3d::Zero();  ///< rotation vector [rad]
-  std::map<std::string, std::string> nodes;  ///< interface name -> scene node name
+  std::map<std::string, std::string> nodes;            ///< interface name -> scene node name
   bool approximated = false, full_tangent = true, quadratic_velocity_terms = true, option_b = false;
   bool polynomial_force = true;  ///< use the file's polynomial internal force when it has one
   /// options.geometric_stiffening: unset = use what the file has; true = require it; false = off.
@@ -78,15 +92,15 @@ struct SceneBodySpec {
   /// options.inertia: unset = exact when the file has the inertia invariants; exact = require
   /// them; corotational = the thesis' kinetic energy (SuperelementOptions::exact_inertia).
   std::optional<bool> exact_inertia;
-  double modal_damping = 0.0;    ///< damping ratio of the internal modes
+  double modal_damping = 0.0;  ///< damping ratio of the internal modes
   std::string where;
 };
 
 struct SceneJointSpec {
   SceneJointType type = SceneJointType::kClamp;  ///< kRigid needs a parent; kClamp has none
   std::string node;
-  std::string parent;  ///< "" = to ground; else the node this one depends on
-  Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();  ///< revolute/prismatic/cylindrical/universal (global)
+  std::string parent;                                ///< "" = to ground; else the node this one depends on
+  Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();   ///< revolute/prismatic/cylindrical/universal (global)
   Eigen::Vector3d axis2 = Eigen::Vector3d::UnitY();  ///< universal: second axis (global at t = 0)
   std::string prescribed;  ///< time function of the joint coordinate (angle or travel); "" = free
   bool cut = false;        ///< close it by constraint equations even where it could be a tree joint
@@ -135,11 +149,11 @@ struct StressExcludeSpec {
 
 struct SceneAnalysisSpec {
   AnalysisType type = AnalysisType::kStatic;
-  int mode_count = 10;          ///< modes: how many
+  int mode_count = 10;              ///< modes: how many
   bool modes_about_static = false;  ///< modes: about the static state under the loads at end_time
   double end_time = 1.0;
-  int steps = 10;               ///< static: load steps over [0, end_time]
-  double step = 1e-3;           ///< dynamic: time step (unused with step: auto)
+  int steps = 10;      ///< static: load steps over [0, end_time]
+  double step = 1e-3;  ///< dynamic: time step (unused with step: auto)
   /// dynamic, `step: auto`: error-controlled steps (solver/analysis/dynamic_analysis.h,
   /// DynamicOptions): the local error of the positions relative to the model's motion below
   /// step_tolerance, steps within [min_step, max_step] (0: defaults from end_time), results
@@ -155,8 +169,10 @@ struct SceneAnalysisSpec {
   int max_iterations = 25;
   int output_every = 1;
   JacobianReuseType jacobian_reuse = JacobianReuseType::kDefault;  ///< dynamic: which Newton iterations factor anew
-  bool gyroscopic_tangent = false;  ///< generalized-alpha: configuration derivative of the quadratic velocity terms in S
-  int body_matrices_every = 0;      ///< generalized-alpha: bodies' matrices computed every n-th step (0: unset, the solver's default)
+  bool gyroscopic_tangent =
+      false;  ///< generalized-alpha: configuration derivative of the quadratic velocity terms in S
+  int body_matrices_every =
+      0;  ///< generalized-alpha: bodies' matrices computed every n-th step (0: unset, the solver's default)
   BodyMatricesKeptType body_matrices_kept = BodyMatricesKeptType::kAll;  ///< which of them body_matrices_every keeps
 };
 

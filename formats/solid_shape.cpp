@@ -19,20 +19,28 @@ constexpr int kTet10Edge[6][2] = {{0, 1}, {1, 2}, {0, 2}, {0, 3}, {2, 3}, {1, 3}
 
 int SolidNodeCount(SolidType type) {
   switch (type) {
-    case SolidType::kTet4: return 4;
-    case SolidType::kTet10: return 10;
-    case SolidType::kHex8: return 8;
-    case SolidType::kHex20: return 20;
+    case SolidType::kTet4:
+      return 4;
+    case SolidType::kTet10:
+      return 10;
+    case SolidType::kHex8:
+      return 8;
+    case SolidType::kHex20:
+      return 20;
   }
   return 0;
 }
 
 std::string SolidTypeName(SolidType type) {
   switch (type) {
-    case SolidType::kTet4: return "tet4";
-    case SolidType::kTet10: return "tet10";
-    case SolidType::kHex8: return "hex8";
-    case SolidType::kHex20: return "hex20";
+    case SolidType::kTet4:
+      return "tet4";
+    case SolidType::kTet10:
+      return "tet10";
+    case SolidType::kHex8:
+      return "hex8";
+    case SolidType::kHex20:
+      return "hex20";
   }
   return "";
 }

@@ -38,7 +38,7 @@ std::string ReducedCoordinateLabel(const Superelement& se, int i) {
       const auto [a, b] = se.modal_derivative_pairs[size_t(d)];
       const auto base = [&](int k) {
         return k >= 0 && k < se.n_interface_dofs() + se.n_internal_modes() ? ReducedCoordinateLabel(se, k)
-                                                                          : std::to_string(k);
+                                                                           : std::to_string(k);
       };
       std::string la = base(a), lb = base(b);
       for (std::string* l : {&la, &lb})
@@ -48,8 +48,7 @@ std::string ReducedCoordinateLabel(const Superelement& se, int i) {
     return label;
   }
   char buffer[64];
-  std::snprintf(buffer, sizeof buffer, "mode %d (%.6g Hz)", mode + 1,
-                se.internal_frequencies_hz[mode]);
+  std::snprintf(buffer, sizeof buffer, "mode %d (%.6g Hz)", mode + 1, se.internal_frequencies_hz[mode]);
   return buffer;
 }
 
@@ -86,12 +85,11 @@ MassProperties ComputeMassProperties(const Superelement& se) {
   p.mass = M0.block<3, 3>(0, 0).trace() / 3.0;
   // Lower-left block is m c~ (skew): read c from its antisymmetric part.
   const Eigen::Matrix3d mc = M0.block<3, 3>(3, 0);
-  const Eigen::Vector3d c = Eigen::Vector3d(mc(2, 1) - mc(1, 2), mc(0, 2) - mc(2, 0), mc(1, 0) - mc(0, 1)) /
-                            (2.0 * p.mass);
+  const Eigen::Vector3d c =
+      Eigen::Vector3d(mc(2, 1) - mc(1, 2), mc(0, 2) - mc(2, 0), mc(1, 0) - mc(0, 1)) / (2.0 * p.mass);
   p.center_of_mass = c;
   // Parallel axis theorem: J_0 = J_c + m (|c|^2 1 - c c^T).
-  p.inertia_com = M0.block<3, 3>(3, 3) -
-                  p.mass * (c.squaredNorm() * Eigen::Matrix3d::Identity() - c * c.transpose());
+  p.inertia_com = M0.block<3, 3>(3, 3) - p.mass * (c.squaredNorm() * Eigen::Matrix3d::Identity() - c * c.transpose());
   return p;
 }
 
@@ -100,9 +98,7 @@ MassProperties ComputeMassProperties(const Superelement& se) {
 #include <Eigen/Eigenvalues>
 #include <cmath>
 namespace femb {
-double FrequencyHz(double lambda) {
-  return std::copysign(std::sqrt(std::abs(lambda)), lambda) / (2.0 * M_PI);
-}
+double FrequencyHz(double lambda) { return std::copysign(std::sqrt(std::abs(lambda)), lambda) / (2.0 * M_PI); }
 
 double VonMises(const Eigen::Matrix<double, 6, 1>& s) {
   const double a = s[0] - s[1], b = s[1] - s[2], c = s[2] - s[0];
@@ -150,7 +146,8 @@ Eigen::Vector2d ExtremePrincipalStresses(const Eigen::Matrix<double, 6, 1>& s) {
   if (a.p == 0.0) return Eigen::Vector2d::Constant(a.m);
   float sine = 0.0f, cosine = 0.0f;
   sincosf(float(a.phi), &sine, &cosine);
-  return Eigen::Vector2d(a.m + 2.0 * a.p * double(cosine), a.m - a.p * (double(cosine) + std::sqrt(3.0) * double(sine)));
+  return Eigen::Vector2d(a.m + 2.0 * a.p * double(cosine),
+                         a.m - a.p * (double(cosine) + std::sqrt(3.0) * double(sine)));
 }
 
 namespace {
@@ -188,7 +185,8 @@ Eigen::Matrix<double, 6, 1> QuadraticStress(const ModalStress& modal, long p, co
 Eigen::Matrix<double, 6, 1> PointStress(const ModalStress& modal, int p, const Eigen::VectorXd& q,
                                         const Eigen::VectorXd* inertia) {
   Eigen::Matrix<double, 6, 1> s = modal.modes.middleRows(6 * p, 6).cast<double>() * q;
-  if (inertia && modal.inertia_modes.size() > 0) s += modal.inertia_modes.middleRows(6 * p, 6).cast<double>() * *inertia;
+  if (inertia && modal.inertia_modes.size() > 0)
+    s += modal.inertia_modes.middleRows(6 * p, 6).cast<double>() * *inertia;
   if (modal.gradients.size() > 0 || modal.element_quadratic.size() > 0) s += QuadraticStress(modal, p, q);
   return s;
 }

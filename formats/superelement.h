@@ -2,12 +2,13 @@
 // Written and read by superelement_file.h; the on-disk schema is in SUPERELEMENT_FORMAT.md.
 #pragma once
 
-#include "formats/reduced_polynomial.h"
 #include <Eigen/Core>
 #include <optional>
 #include <string>
 #include <utility>
 #include <vector>
+
+#include "formats/reduced_polynomial.h"
 
 namespace femb {
 
@@ -35,28 +36,28 @@ struct InterfaceNode {
 /// Phi_CB * q = 0, with Phi_CB (6 x n_reduced) and Phi_CB * Phi_rig0 = 1, Phi_rig0 built from
 /// the interface positions relative to `origin` (thesis 3.20).
 struct FloatingFrame {
-  std::string type;  ///< center_of_mass | mean_axes | interface:<name> | cardona
-  Eigen::Vector3d origin = Eigen::Vector3d::Zero();            ///< undeformed, part axes [length]
-  Eigen::Matrix3d orientation = Eigen::Matrix3d::Identity();   ///< frame axes in part axes
-  Eigen::MatrixXd Phi_CB;                                      ///< 6 x n_reduced
-  Eigen::VectorXd cardona_weights;                             ///< alpha_k (cardona only)
+  std::string type;                                  ///< center_of_mass | mean_axes | interface:<name> | cardona
+  Eigen::Vector3d origin = Eigen::Vector3d::Zero();  ///< undeformed, part axes [length]
+  Eigen::Matrix3d orientation = Eigen::Matrix3d::Identity();  ///< frame axes in part axes
+  Eigen::MatrixXd Phi_CB;                                     ///< 6 x n_reduced
+  Eigen::VectorXd cardona_weights;                            ///< alpha_k (cardona only)
 };
 
 /// Rigid-body mass properties of the undeformed part (from the full FE mass matrix).
 struct MassProperties {
-  double mass = 0.0;                                           ///< [mass]
-  Eigen::Vector3d center_of_mass = Eigen::Vector3d::Zero();    ///< part axes [length]
-  Eigen::Matrix3d inertia_com = Eigen::Matrix3d::Zero();       ///< about the CoM, part axes [mass length^2]
+  double mass = 0.0;                                         ///< [mass]
+  Eigen::Vector3d center_of_mass = Eigen::Vector3d::Zero();  ///< part axes [length]
+  Eigen::Matrix3d inertia_com = Eigen::Matrix3d::Zero();     ///< about the CoM, part axes [mass length^2]
 };
 
 /// Optional: the full mesh and each reduced coordinate's full displacement field, for
 /// visualization and stress recovery.
 struct Visualization {
-  Eigen::MatrixXd nodes;        ///< n_nodes x 3, part axes [length]
-  Eigen::MatrixXi cells;        ///< n_cells x nodes_per_cell, 0-based node indices
-  std::string cell_type;        ///< "line2", "tet4", "tet10", "hex8", "hex20"
-  int dofs_per_node = 6;        ///< 6 (u, theta) for beams, 3 (u) for solids
-  Eigen::MatrixXd shapes;       ///< (n_nodes * dofs_per_node) x n_reduced, node-major
+  Eigen::MatrixXd nodes;   ///< n_nodes x 3, part axes [length]
+  Eigen::MatrixXi cells;   ///< n_cells x nodes_per_cell, 0-based node indices
+  std::string cell_type;   ///< "line2", "tet4", "tet10", "hex8", "hex20"
+  int dofs_per_node = 6;   ///< 6 (u, theta) for beams, 3 (u) for solids
+  Eigen::MatrixXd shapes;  ///< (n_nodes * dofs_per_node) x n_reduced, node-major
   /// Per interface: the mesh nodes its coupling ties (a beam's interface: its own node); empty
   /// in files written before they were stored.
   std::vector<std::vector<int>> interface_nodes;
@@ -72,10 +73,10 @@ struct Visualization {
 /// normal force and the bending moments, shear from torsion and transverse shear; see
 /// reducer/reduction/modal_stress.h), several per mesh node.
 struct ModalStress {
-  std::string method;            ///< "solid_nodal_l2" or "beam_fibres": how the points were made
-  Eigen::MatrixXd points;        ///< n_points x 3, part axes [length]
-  Eigen::VectorXi node;          ///< n_points: the visualization mesh node each point belongs to
-  Eigen::MatrixXf modes;         ///< (6 n_points) x n_reduced, point-major
+  std::string method;      ///< "solid_nodal_l2" or "beam_fibres": how the points were made
+  Eigen::MatrixXd points;  ///< n_points x 3, part axes [length]
+  Eigen::VectorXi node;    ///< n_points: the visualization mesh node each point belongs to
+  Eigen::MatrixXf modes;   ///< (6 n_points) x n_reduced, point-major
   /// Beams: the section forces at the element ends, (12 n_cells) x n_reduced: per element
   /// (N, V_y, V_z, T, M_y, M_z) at its first node, then at its second, in element axes (the
   /// force and moment that the part beyond the cut exerts, i.e. tension and sagging positive as
@@ -113,7 +114,7 @@ struct ModalStress {
 struct Provenance {
   std::string femb_version;
   std::string input_file;
-  std::string input_hash;       ///< FNV-1a 64-bit of the part file text, hex
+  std::string input_hash;  ///< FNV-1a 64-bit of the part file text, hex
   std::string element_type;
   std::string reduction_method;  ///< craig_bampton | free_interface ("" in files before it was stored)
   long n_nodes = 0;
@@ -137,7 +138,7 @@ struct Superelement {
   /// [node 1 (u, theta), ..., node N (u, theta), internal mode 1, ..., internal mode m].
   Eigen::MatrixXd K;
   Eigen::MatrixXd M;
-  Eigen::VectorXd internal_frequencies_hz;   ///< fixed-interface frequencies of the internal modes
+  Eigen::VectorXd internal_frequencies_hz;  ///< fixed-interface frequencies of the internal modes
   FloatingFrame floating_frame;
   MassProperties mass_properties;
   long n_full_dofs = 0;
@@ -226,7 +227,8 @@ Eigen::Vector2d ExtremePrincipalStresses(const Eigen::Matrix<double, 6, 1>& s);
 /// `inertia`: the 12 inertia load factors of the body's frame, for the inertia load cases'
 /// stresses (ModalStress::inertia_modes; ignored when the file has none or when null).
 void NodeStresses(const ModalStress& modal, const Eigen::VectorXd& q, long n_nodes, Eigen::MatrixXd* stress,
-                  Eigen::VectorXd* von_mises, const Eigen::VectorXd* inertia = nullptr, Eigen::VectorXf* scratch = nullptr);
+                  Eigen::VectorXd* von_mises, const Eigen::VectorXd* inertia = nullptr,
+                  Eigen::VectorXf* scratch = nullptr);
 /// The stress (6 components) at stress point p of local coordinates q (and inertia factors).
 Eigen::Matrix<double, 6, 1> PointStress(const ModalStress& modal, int p, const Eigen::VectorXd& q,
                                         const Eigen::VectorXd* inertia = nullptr);

@@ -50,11 +50,13 @@ Check Finite(const Superelement& se) {
   Eigen::MatrixXd positions(se.interfaces.size(), 3), orientations(se.interfaces.size(), 9);
   for (size_t k = 0; k < se.interfaces.size(); ++k) {
     positions.row(Eigen::Index(k)) = se.interfaces[k].position.transpose();
-    orientations.row(Eigen::Index(k)) = Eigen::Map<const Eigen::Matrix<double, 1, 9>>(se.interfaces[k].orientation.data());
+    orientations.row(Eigen::Index(k)) =
+        Eigen::Map<const Eigen::Matrix<double, 1, 9>>(se.interfaces[k].orientation.data());
   }
   check("/interfaces/positions", positions);
   check("/interfaces/orientations", orientations);
-  if (se.floating_frame.cardona_weights.size() > 0) check("/floating_frame/cardona_weights", se.floating_frame.cardona_weights);
+  if (se.floating_frame.cardona_weights.size() > 0)
+    check("/floating_frame/cardona_weights", se.floating_frame.cardona_weights);
   if (se.polynomial) {
     check("/reduced/polynomial/A", se.polynomial->A);
     check("/reduced/polynomial/B", se.polynomial->B);
@@ -103,8 +105,8 @@ SuperelementChecks CheckSuperelement(const Superelement& se) {
   a.checks.push_back(Symmetric("M_symmetric", "/reduced/M", se.M));
   // One check for the 12 load cases: the first that fails, else the last.
   for (size_t k = 0; k < se.inertia_stiffness.size(); ++k) {
-    const Check c = Symmetric("inertia_stiffness_symmetric", "/reduced/geometric_stiffness/inertia",
-                              se.inertia_stiffness[k]);
+    const Check c =
+        Symmetric("inertia_stiffness_symmetric", "/reduced/geometric_stiffness/inertia", se.inertia_stiffness[k]);
     if (!c.ok || k + 1 == se.inertia_stiffness.size()) {
       a.checks.push_back(c);
       break;
@@ -189,9 +191,10 @@ SuperelementChecks CheckSuperelement(const Superelement& se) {
                  ") is outside the " + std::to_string(n) + " reduced coordinates";
     }
   }
-  a.checks.push_back({"modal_derivative_pairs", bad_pair.empty(),
-                      bad_pair.empty() ? std::to_string(se.modal_derivative_pairs.size()) + " pairs in range" : bad_pair,
-                      "/reduced/modal_derivative_pairs"});
+  a.checks.push_back(
+      {"modal_derivative_pairs", bad_pair.empty(),
+       bad_pair.empty() ? std::to_string(se.modal_derivative_pairs.size()) + " pairs in range" : bad_pair,
+       "/reduced/modal_derivative_pairs"});
 
   if (se.interface_constraint.rows() > 0) {
     // Thesis 8.2 case 4: the constraint must leave the rigid motions free (C Phi_rig0 = 0 on the
@@ -206,14 +209,14 @@ SuperelementChecks CheckSuperelement(const Superelement& se) {
       condition = sv.size() && sv[0] > 0 ? sv[sv.size() - 1] / sv[0] : 0.0;
     }
     a.checks.push_back({"interface_constraint", shaped && rigid <= 1e-8 && condition > 1e-8,
-                        std::to_string(C.rows()) + " rows" + Sci(", ||C Phi_rig0|| / (||C|| ||Phi_rig0||) = %.3g", rigid) +
+                        std::to_string(C.rows()) + " rows" +
+                            Sci(", ||C Phi_rig0|| / (||C|| ||Phi_rig0||) = %.3g", rigid) +
                             Sci(", smallest / largest singular value %.3g", condition),
                         "/reduced/interface_constraint"});
   }
 
   const double m_reduced = (Phi_rig0.col(0).transpose() * se.M * Phi_rig0.col(0))(0, 0);
-  const double mass_error =
-      std::abs(m_reduced - se.mass_properties.mass) / std::max(std::abs(m_reduced), 1e-300);
+  const double mass_error = std::abs(m_reduced - se.mass_properties.mass) / std::max(std::abs(m_reduced), 1e-300);
   a.checks.push_back({"mass", mass_error <= 1e-6,
                       Sci("stored mass %.9g", se.mass_properties.mass) + Sci(", from the reduced M %.9g", m_reduced),
                       "/mass_properties/mass"});
@@ -245,7 +248,8 @@ SuperelementChecks CheckSuperelement(const Superelement& se) {
     const double relative = scale > 0 ? error / scale : error;
     a.checks.push_back({"inertia_invariants", shapes_ok && relative <= 1e-8,
                         shapes_ok ? Sci("||Gamma_a Phi_rig0 e_b - M Phi_rig0 (e_a x e_b)||, ||Xi_aa - Xi_aa^T|| = %.3g "
-                                        "of ||M|| ||Phi_rig0||", relative)
+                                        "of ||M|| ||Phi_rig0||",
+                                        relative)
                                   : std::string("need 3 Gamma and 6 Xi blocks of the reduced size"),
                         "/reduced/inertia_invariants"});
   }

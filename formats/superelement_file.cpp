@@ -74,7 +74,8 @@ void WriteContent(const Superelement& se, h5::Writer& w) {
     for (const Eigen::MatrixXd& K_sigma : se.inertia_stiffness) {
       if (K_sigma.rows() != n || K_sigma.cols() != n) {
         throw InputError("an inertia stiffness matrix is " + std::to_string(K_sigma.rows()) + " x " +
-                         std::to_string(K_sigma.cols()) + ", the reduced K " + std::to_string(n) + " x " + std::to_string(n));
+                         std::to_string(K_sigma.cols()) + ", the reduced K " + std::to_string(n) + " x " +
+                         std::to_string(n));
       }
     }
     Eigen::MatrixXd stacked(kInertiaLoadCaseCount * n, n);
@@ -176,10 +177,12 @@ void WriteContent(const Superelement& se, h5::Writer& w) {
       w.IntVector("/stress/point_element",
                   std::vector<int>(st.point_element.data(), st.point_element.data() + st.point_element.size()));
     }
-    if (st.gradients.size() > 0 || st.element_quadratic.size() > 0) w.Vector("/stress/material", Eigen::Vector2d(st.E, st.nu));
+    if (st.gradients.size() > 0 || st.element_quadratic.size() > 0)
+      w.Vector("/stress/material", Eigen::Vector2d(st.E, st.nu));
     if (st.inertia_modes.size() > 0) {
       w.FloatMatrix("/stress/inertia_modes", st.inertia_modes);
-      if (st.inertia_section_forces.size() > 0) w.FloatMatrix("/stress/inertia_section_forces", st.inertia_section_forces);
+      if (st.inertia_section_forces.size() > 0)
+        w.FloatMatrix("/stress/inertia_section_forces", st.inertia_section_forces);
     }
   }
 
@@ -211,8 +214,7 @@ void RequireShape(const h5::Reader& r, const std::string& name, long rows, long 
     std::string got;
     for (auto d : shape) got += (got.empty() ? "" : " x ") + std::to_string(d);
     std::string want = std::to_string(rows) + (cols < 0 ? "" : " x " + std::to_string(cols));
-    throw InputError(r.path() + ": dataset " + name + " has shape (" + got + "), expected (" +
-                     want + ")");
+    throw InputError(r.path() + ": dataset " + name + " has shape (" + got + "), expected (" + want + ")");
   }
 }
 
@@ -252,8 +254,8 @@ Superelement ReadSuperelementFile(const std::string& path, const SuperelementRea
   long major = r.IntAttribute("/", "format_version_major");
   if (major != kSuperelementFormatMajor) {
     throw InputError(path + ": superelement format version " + r.StringAttribute("/", "format_version") +
-                     " is not supported by this femb (reads major version " +
-                     std::to_string(kSuperelementFormatMajor) + "); re-run femb-reduce on the part");
+                     " is not supported by this femb (reads major version " + std::to_string(kSuperelementFormatMajor) +
+                     "); re-run femb-reduce on the part");
   }
   se.name = r.StringAttribute("/", "name");
   se.units.system = r.StringAttribute("/units", "system");
@@ -311,8 +313,8 @@ Superelement ReadSuperelementFile(const std::string& path, const SuperelementRea
     const long rows = shape.size() == 2 ? long(shape[0]) : 0;
     if (shape.size() != 2) RequireShape(r, "/reduced/interface_constraint", 1, 6 * N);  // names the shape
     if (rows < 1 || rows > 6 * N - 6) {
-      throw InputError(path + ": dataset /reduced/interface_constraint has " + std::to_string(rows) + " rows (need 1 to " +
-                       std::to_string(6 * N - 6) + ": the rigid motions stay free)");
+      throw InputError(path + ": dataset /reduced/interface_constraint has " + std::to_string(rows) +
+                       " rows (need 1 to " + std::to_string(6 * N - 6) + ": the rigid motions stay free)");
     }
     RequireShape(r, "/reduced/interface_constraint", rows, 6 * N);
     se.interface_constraint = r.Matrix("/reduced/interface_constraint");
@@ -361,17 +363,21 @@ Superelement ReadSuperelementFile(const std::string& path, const SuperelementRea
     if (r.Exists("/visualization/interface_nodes")) {
       const Eigen::VectorXi flat = r.IntVector("/visualization/interface_nodes");
       const Eigen::VectorXi offsets = r.IntVector("/visualization/interface_node_offsets");
-      if (offsets.size() != long(se.interfaces.size()) + 1 || offsets[0] != 0 || offsets[offsets.size() - 1] != flat.size()) {
-        throw InputError(path + ": /visualization/interface_node_offsets: expected " + std::to_string(se.interfaces.size() + 1) +
-                         " offsets from 0 to " + std::to_string(flat.size()));
+      if (offsets.size() != long(se.interfaces.size()) + 1 || offsets[0] != 0 ||
+          offsets[offsets.size() - 1] != flat.size()) {
+        throw InputError(path + ": /visualization/interface_node_offsets: expected " +
+                         std::to_string(se.interfaces.size() + 1) + " offsets from 0 to " +
+                         std::to_string(flat.size()));
       }
       for (long k = 0; k + 1 < offsets.size(); ++k) {
-        if (offsets[k + 1] < offsets[k]) throw InputError(path + ": /visualization/interface_node_offsets: decreasing at " + std::to_string(k));
+        if (offsets[k + 1] < offsets[k])
+          throw InputError(path + ": /visualization/interface_node_offsets: decreasing at " + std::to_string(k));
         std::vector<int> set(flat.data() + offsets[k], flat.data() + offsets[k + 1]);
         for (int node : set) {
           if (node < 0 || node >= v.nodes.rows()) {
-            throw InputError(path + ": /visualization/interface_nodes: node " + std::to_string(node) + " of interface '" +
-                             se.interfaces[size_t(k)].name + "' is not a node of /visualization/nodes");
+            throw InputError(path + ": /visualization/interface_nodes: node " + std::to_string(node) +
+                             " of interface '" + se.interfaces[size_t(k)].name +
+                             "' is not a node of /visualization/nodes");
           }
         }
         v.interface_nodes.push_back(std::move(set));
@@ -446,7 +452,8 @@ Superelement ReadSuperelementFile(const std::string& path, const SuperelementRea
     p.input_file = r.StringAttribute("/provenance", "input_file");
     p.input_hash = r.StringAttribute("/provenance", "input_hash");
     p.element_type = r.StringAttribute("/provenance", "element_type");
-    if (r.HasAttribute("/provenance", "reduction_method")) p.reduction_method = r.StringAttribute("/provenance", "reduction_method");
+    if (r.HasAttribute("/provenance", "reduction_method"))
+      p.reduction_method = r.StringAttribute("/provenance", "reduction_method");
     p.n_nodes = r.IntAttribute("/provenance", "n_nodes");
     p.n_elements = r.IntAttribute("/provenance", "n_elements");
     std::vector<std::string> stages = r.Strings("/provenance/stages");

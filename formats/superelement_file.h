@@ -24,7 +24,6 @@ struct SuperelementReadOptions {
 /// Reads a superelement file. Throws InputError naming the file and the problem for: a missing
 /// or non-HDF5 or truncated file, another major format version, a missing dataset, or datasets
 /// whose shapes disagree.
-Superelement ReadSuperelementFile(const std::string& path,
-                                  const SuperelementReadOptions& options = {});
+Superelement ReadSuperelementFile(const std::string& path, const SuperelementReadOptions& options = {});
 
 }  // namespace femb

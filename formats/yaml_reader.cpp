@@ -134,8 +134,8 @@ void YamlMap::CheckNoUnknownKeys() const {
     std::string known;
     for (const auto& k : *asked_) known += (known.empty() ? "" : ", ") + k;
     YamlValue where(it->first, Child(key), source_);
-    where.Fail("unknown key '" + key + "'" + (path_.empty() ? "" : " in '" + path_ + "'") +
-               " (known keys: " + known + ")");
+    where.Fail("unknown key '" + key + "'" + (path_.empty() ? "" : " in '" + path_ + "'") + " (known keys: " + known +
+               ")");
   }
 }
 
@@ -147,8 +147,8 @@ YamlDocument YamlDocument::LoadString(const std::string& text, const std::string
   try {
     doc.root_ = YAML::Load(text);
   } catch (const YAML::Exception& e) {
-    throw InputError(name + ":" + std::to_string(e.mark.line + 1) + ":" +
-                     std::to_string(e.mark.column + 1) + ": YAML syntax error: " + e.msg);
+    throw InputError(name + ":" + std::to_string(e.mark.line + 1) + ":" + std::to_string(e.mark.column + 1) +
+                     ": YAML syntax error: " + e.msg);
   }
   if (!doc.root_.IsMap()) {
     throw InputError(name + ": expected a YAML mapping of keys to values at the top level");
@@ -208,7 +208,8 @@ void YamlDocument::Set(const std::string& assignment) {
       const YAML::Node list = chain.back();
       if (!list.IsSequence() || index >= long(list.size())) {
         throw InputError("--set " + assignment + ": '" + walked + "' has no item " + std::to_string(index) + " in " +
-                         file() + (list.IsSequence() ? " (it has " + std::to_string(list.size()) + ")" : " (not a list)"));
+                         file() +
+                         (list.IsSequence() ? " (it has " + std::to_string(list.size()) + ")" : " (not a list)"));
       }
       walked += "[" + std::to_string(index) + "]";
       chain.push_back(list[std::size_t(index)]);
@@ -217,8 +218,8 @@ void YamlDocument::Set(const std::string& assignment) {
     // A key below a list item or a scalar (found by fuzzing: 'points.R[0].element' on a
     // coordinate list made yaml-cpp throw BadSubscript).
     if (chain.back().IsDefined() && !chain.back().IsNull() && !chain.back().IsMap()) {
-      throw InputError("--set " + assignment + ": '" + walked + "' is not a mapping in " + file() + " (it has no key '" +
-                       name + "')");
+      throw InputError("--set " + assignment + ": '" + walked + "' is not a mapping in " + file() +
+                       " (it has no key '" + name + "')");
     }
     walked += (walked.empty() ? "" : ".") + name;
     YAML::Node next = chain.back()[name];
@@ -239,8 +240,9 @@ void YamlDocument::Set(const std::string& assignment) {
     YAML::Node list = chain.back();
     if (!list.IsSequence()) throw InputError("--set " + assignment + ": '" + walked + "' is not a list in " + file());
     if (last > long(list.size())) {
-      throw InputError("--set " + assignment + ": '" + walked + "' has no item " + std::to_string(last) + " in " + file() +
-                       " (it has " + std::to_string(list.size()) + "; [" + std::to_string(list.size()) + "] appends one)");
+      throw InputError("--set " + assignment + ": '" + walked + "' has no item " + std::to_string(last) + " in " +
+                       file() + " (it has " + std::to_string(list.size()) + "; [" + std::to_string(list.size()) +
+                       "] appends one)");
     }
     if (last == long(list.size())) {
       list.push_back(value);

@@ -13,7 +13,8 @@
 
 namespace {
 
-constexpr const char* kUsage = R"(usage: femb-inspect FILE.h5 [--json] [--check] [--dump K|M|PhiCB [--format mtx|csv]] [--vtu DIR]
+constexpr const char* kUsage =
+    R"(usage: femb-inspect FILE.h5 [--json] [--check] [--dump K|M|PhiCB [--format mtx|csv]] [--vtu DIR]
 
 Shows a superelement file: units, interfaces, floating frame, mass properties, the 6x6 rigid-body
 mass matrix, a label for every reduced coordinate, reduced vs full free-free frequencies, checks.
@@ -70,7 +71,9 @@ int main(int argc, char** argv) {
     }
     if (check && !analysis.all_ok()) {
       for (const auto& c : analysis.checks) {
-        if (!c.ok) std::fprintf(stderr, "femb-inspect: %s: check %s failed: %s\n", path.c_str(), c.name.c_str(), c.detail.c_str());
+        if (!c.ok)
+          std::fprintf(stderr, "femb-inspect: %s: check %s failed: %s\n", path.c_str(), c.name.c_str(),
+                       c.detail.c_str());
       }
       return 1;
     }

@@ -41,21 +41,22 @@ nlohmann::json ToJson(const Eigen::VectorXd& v) {
 std::string TextSummary(const Superelement& se, const SuperelementAnalysis& a, const std::string& path) {
   const Units& u = se.units;
   std::string s;
-  s += F("Superelement '%s'  (%s, format %ld.%ld)\n", se.name.c_str(), path.c_str(),
-         kSuperelementFormatMajor, kSuperelementFormatMinor);
+  s += F("Superelement '%s'  (%s, format %ld.%ld)\n", se.name.c_str(), path.c_str(), kSuperelementFormatMajor,
+         kSuperelementFormatMinor);
   s += F("  units: %s (length %s, mass %s, time %s, force %s, stress %s, angle %s)\n", u.system.c_str(),
          u.length.c_str(), u.mass.c_str(), u.time.c_str(), u.force.c_str(), u.stress.c_str(), u.angle.c_str());
   const Provenance& p = se.provenance;
-  s += F("  from %s (hash %s), femb %s: %ld nodes, %ld %s elements\n", p.input_file.c_str(),
-         p.input_hash.c_str(), p.femb_version.c_str(), p.n_nodes, p.n_elements, p.element_type.c_str());
+  s += F("  from %s (hash %s), femb %s: %ld nodes, %ld %s elements\n", p.input_file.c_str(), p.input_hash.c_str(),
+         p.femb_version.c_str(), p.n_nodes, p.n_elements, p.element_type.c_str());
   s += F("  %ld full DOFs -> %d reduced: %d interface DOFs (%d nodes) + %d internal modes + %ld modal derivatives\n",
-         se.n_full_dofs, se.n_reduced_dofs(), se.n_interface_dofs(), se.n_interface_nodes(),
-         se.n_internal_modes(), se.n_modal_derivatives);
+         se.n_full_dofs, se.n_reduced_dofs(), se.n_interface_dofs(), se.n_interface_nodes(), se.n_internal_modes(),
+         se.n_modal_derivatives);
   if (se.polynomial && se.polynomial->cubic()) {
     const long n = se.n_reduced_dofs(), P = n * (n + 1) / 2;
-    s += F("  nonlinear internal force: cubic in the reduced coordinates (Green-Lagrange), quadratic coefficients A "
-           "%ld x %ld, cubic B %ld x %ld (%.3g MB)\n",
-           n, P, P, P, 8.0 * double(n * P + P * P) / 1e6);
+    s +=
+        F("  nonlinear internal force: cubic in the reduced coordinates (Green-Lagrange), quadratic coefficients A "
+          "%ld x %ld, cubic B %ld x %ld (%.3g MB)\n",
+          n, P, P, P, 8.0 * double(n * P + P * P) / 1e6);
   } else if (se.polynomial) {
     const long n = se.n_reduced_dofs(), P = n * (n + 1) / 2;
     s += F("  geometric stiffening: the basis vectors' stress geometric stiffness (A %ld x %ld, %.3g MB)\n", n, P,
@@ -104,14 +105,18 @@ std::string TextSummary(const Superelement& se, const SuperelementAnalysis& a, c
   s += F("\nFloating frame: %s, origin %s %s\n", f.type.c_str(), Vec(f.origin).c_str(), u.length.c_str());
   if (f.cardona_weights.size()) {
     s += "  Cardona weights alpha:";
-    for (int k = 0; k < f.cardona_weights.size(); ++k) s += F(" %s=%.6g", se.interfaces[k].name.c_str(), f.cardona_weights[k]);
+    for (int k = 0; k < f.cardona_weights.size(); ++k)
+      s += F(" %s=%.6g", se.interfaces[k].name.c_str(), f.cardona_weights[k]);
     s += "\n";
   }
 
   const MassProperties& m = se.mass_properties;
-  s += F("\nMass properties:\n  mass %.8g %s\n  centre of mass %s %s\n  inertia about the centre of mass (part axes) [%s %s^2]:\n",
-         m.mass, u.mass.c_str(), Vec(m.center_of_mass).c_str(), u.length.c_str(), u.mass.c_str(), u.length.c_str());
-  for (int i = 0; i < 3; ++i) s += F("    %14.8g %14.8g %14.8g\n", m.inertia_com(i, 0), m.inertia_com(i, 1), m.inertia_com(i, 2));
+  s +=
+      F("\nMass properties:\n  mass %.8g %s\n  centre of mass %s %s\n  inertia about the centre of mass (part axes) "
+        "[%s %s^2]:\n",
+        m.mass, u.mass.c_str(), Vec(m.center_of_mass).c_str(), u.length.c_str(), u.mass.c_str(), u.length.c_str());
+  for (int i = 0; i < 3; ++i)
+    s += F("    %14.8g %14.8g %14.8g\n", m.inertia_com(i, 0), m.inertia_com(i, 1), m.inertia_com(i, 2));
   s += "  6x6 rigid-body mass matrix about the floating frame origin, thesis (3.21):\n";
   for (int i = 0; i < 6; ++i) {
     s += "   ";
@@ -164,7 +169,7 @@ nlohmann::json JsonSummary(const Superelement& se, const SuperelementAnalysis& a
   j["format_version"] = std::to_string(kSuperelementFormatMajor) + "." + std::to_string(kSuperelementFormatMinor);
   j["name"] = se.name;
   j["units"] = {{"system", se.units.system}, {"length", se.units.length}, {"mass", se.units.mass},
-                {"time", se.units.time}, {"force", se.units.force}, {"stress", se.units.stress},
+                {"time", se.units.time},     {"force", se.units.force},   {"stress", se.units.stress},
                 {"angle", se.units.angle}};
   j["n_interface_nodes"] = se.n_interface_nodes();
   nlohmann::json names = nlohmann::json::array();
@@ -204,9 +209,9 @@ nlohmann::json JsonSummary(const Superelement& se, const SuperelementAnalysis& a
   nlohmann::json checks = nlohmann::json::object();
   for (const Check& c : a.checks) checks[c.name] = {{"ok", c.ok}, {"detail", c.detail}};
   j["checks"] = checks;
-  j["provenance"] = {{"input_file", se.provenance.input_file}, {"input_hash", se.provenance.input_hash},
+  j["provenance"] = {{"input_file", se.provenance.input_file},     {"input_hash", se.provenance.input_hash},
                      {"femb_version", se.provenance.femb_version}, {"element_type", se.provenance.element_type},
-                     {"n_nodes", se.provenance.n_nodes}, {"n_elements", se.provenance.n_elements}};
+                     {"n_nodes", se.provenance.n_nodes},           {"n_elements", se.provenance.n_elements}};
   return j;
 }
 

@@ -13,7 +13,7 @@
 namespace femb {
 
 struct SuperelementAnalysis {
-  Eigen::VectorXd free_free_frequencies_hz;    ///< all eigenvalues of (K, M), signed, ascending
+  Eigen::VectorXd free_free_frequencies_hz;      ///< all eigenvalues of (K, M), signed, ascending
   Eigen::Matrix<double, 6, 6> rigid_mass_frame;  ///< about the floating frame origin
   int rigid_body_mode_count = 0;
   std::vector<Check> checks;  ///< CheckSuperelement's, in its order

@@ -31,7 +31,8 @@ int WriteModeShapesVtu(const Superelement& se, const std::string& directory) {
       std::ofstream out(tmp);
       if (!out) throw InputError(tmp + ": cannot write");
       out.precision(12);
-      out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
+      out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" "
+             "byte_order=\"LittleEndian\">\n"
           << "<!-- " << ReducedCoordinateLabel(se, i) << " -->\n<UnstructuredGrid>\n"
           << "<Piece NumberOfPoints=\"" << n << "\" NumberOfCells=\"" << cells.rows() << "\">\n"
           << "<Points><DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n";

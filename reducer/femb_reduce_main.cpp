@@ -8,8 +8,8 @@
 
 #include "formats/command_line.h"
 #include "formats/input_error.h"
-#include "formats/superelement_checks.h"
 #include "formats/part_file.h"
+#include "formats/superelement_checks.h"
 #include "formats/superelement_file.h"
 #include "reducer/fe/imported_model.h"
 #include "reducer/linalg/sparse_cholesky.h"
@@ -17,7 +17,8 @@
 
 namespace {
 
-constexpr const char* kUsage = R"(usage: femb-reduce PART.yaml [-o OUT.h5] [--full-modes K] [--set key=value]... [--quiet]
+constexpr const char* kUsage =
+    R"(usage: femb-reduce PART.yaml [-o OUT.h5] [--full-modes K] [--set key=value]... [--quiet]
        femb-reduce PART.yaml --export-matrices DIR [--matrix-format F]
 
 Reduces a part (beam polyline; solid: gmsh geometry, built-in shape or mesh file; or matrices
@@ -64,14 +65,15 @@ int main(int argc, char** argv) {
   try {
     femb::Stopwatch total;
     if (matrix_format != "calculix" && matrix_format != "abaqus" && matrix_format != "matrix_market") {
-      throw femb::InputError("--matrix-format: unknown format '" + matrix_format + "' (known: calculix, abaqus, matrix_market)");
+      throw femb::InputError("--matrix-format: unknown format '" + matrix_format +
+                             "' (known: calculix, abaqus, matrix_market)");
     }
     const femb::PartSpec part = femb::ReadPartFile(part_path, overrides);
     if (output.empty()) output = part.name + ".h5";
     auto progress = [&](const std::string& stage, double seconds, const std::string& detail) {
       if (quiet) return;
-      std::printf("femb-reduce: [%8.3f s] %-16s %8.3f s  %s\n", total.Seconds(), stage.c_str(),
-                  seconds, detail.c_str());
+      std::printf("femb-reduce: [%8.3f s] %-16s %8.3f s  %s\n", total.Seconds(), stage.c_str(), seconds,
+                  detail.c_str());
       std::fflush(stdout);
     };
     if (!export_dir.empty()) {
@@ -86,11 +88,12 @@ int main(int argc, char** argv) {
       return 4;
     }
     if (!result.ok) {
-      std::fprintf(stderr, "femb-reduce: %s: numerical failure: %s (no output written)\n",
-                   part_path.c_str(), result.message.c_str());
+      std::fprintf(stderr, "femb-reduce: %s: numerical failure: %s (no output written)\n", part_path.c_str(),
+                   result.message.c_str());
       return 3;
     }
-    for (const std::string& w : result.warnings) std::printf("femb-reduce: warning: %s: %s\n", part_path.c_str(), w.c_str());
+    for (const std::string& w : result.warnings)
+      std::printf("femb-reduce: warning: %s: %s\n", part_path.c_str(), w.c_str());
     // The file's contract (formats/superelement_checks.h): a model that fails it is not written.
     femb::Stopwatch check_clock;
     const femb::SuperelementChecks checks = femb::CheckSuperelement(result.superelement);
@@ -108,9 +111,9 @@ int main(int argc, char** argv) {
     femb::WriteSuperelementFile(result.superelement, output);
     progress("write", write_clock.Seconds(), output);
     if (!quiet) {
-      std::printf("femb-reduce: wrote %s (%d reduced DOFs from %ld) in %.3f s, peak memory %.3g GB\n",
-                  output.c_str(), result.superelement.n_reduced_dofs(), result.superelement.n_full_dofs,
-                  total.Seconds(), femb::PeakResidentBytes() / 1e9);
+      std::printf("femb-reduce: wrote %s (%d reduced DOFs from %ld) in %.3f s, peak memory %.3g GB\n", output.c_str(),
+                  result.superelement.n_reduced_dofs(), result.superelement.n_full_dofs, total.Seconds(),
+                  femb::PeakResidentBytes() / 1e9);
     }
     return 0;
   } catch (const femb::ResourceLimitError& e) {

@@ -14,9 +14,7 @@ using ProgressFn = std::function<void(const std::string& stage, double seconds, 
 class Stopwatch {
  public:
   Stopwatch() : start_(std::chrono::steady_clock::now()) {}
-  double Seconds() const {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
-  }
+  double Seconds() const { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count(); }
   void Restart() { start_ = std::chrono::steady_clock::now(); }
 
  private:

@@ -1,11 +1,10 @@
 #include "reducer/reduce_part.h"
 
+#include <Eigen/Eigenvalues>
+#include <Eigen/SparseCholesky>
 #include <algorithm>
 #include <cstdio>
 #include <memory>
-
-#include <Eigen/Eigenvalues>
-#include <Eigen/SparseCholesky>
 
 #include "formats/hdf5_file.h"
 #include "formats/input_error.h"
@@ -65,8 +64,8 @@ std::vector<std::pair<int, int>> DerivativePairs(const PartSpec& part, int n_int
   if (!spec.pairs.empty()) {
     for (const auto& [i, j] : spec.pairs) {
       if (i >= n_cb || j >= n_cb) {
-        throw InputError(spec.where + ".pairs: [" + std::to_string(i) + ", " +
-                         std::to_string(j) + "] is not a pair of the " + std::to_string(n_cb) +
+        throw InputError(spec.where + ".pairs: [" + std::to_string(i) + ", " + std::to_string(j) +
+                         "] is not a pair of the " + std::to_string(n_cb) +
                          " Craig-Bampton coordinates (0-based: interfaces' 6 each, then the internal modes)");
       }
     }
@@ -104,8 +103,8 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
     model = BuildImportedModel(part, report);
   } else {
     model = BuildBeamModel(part);
-    std::snprintf(detail, sizeof detail, "%ld nodes, %ld %s elements, %ld DOFs", model.n_nodes(),
-                  model.n_elements(), model.element_type.c_str(), model.n_dofs());
+    std::snprintf(detail, sizeof detail, "%ld nodes, %ld %s elements, %ld DOFs", model.n_nodes(), model.n_elements(),
+                  model.element_type.c_str(), model.n_dofs());
     report("mesh+assembly", clock.Seconds(), detail);
   }
 
@@ -113,22 +112,24 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
   CheckFloatingFrame(part.reduction.floating_frame, part.reduction.where_floating_frame, model);
   const bool keep_mesh = part.reduction.keep_mesh.value_or(model.n_dofs() <= ReductionSpec::kKeepMeshMaxDofs);
   if (!keep_mesh && part.reduction.stresses.value_or(false)) {
-    throw InputError(part.reduction.where_stresses + ": reduction.stresses: true needs the mesh, which is not kept for "
-                     "more than " + std::to_string(ReductionSpec::kKeepMeshMaxDofs) + " DOFs (this part has " +
+    throw InputError(part.reduction.where_stresses +
+                     ": reduction.stresses: true needs the mesh, which is not kept for "
+                     "more than " +
+                     std::to_string(ReductionSpec::kKeepMeshMaxDofs) + " DOFs (this part has " +
                      std::to_string(model.n_dofs()) + "): set reduction.keep_mesh: true");
   }
   const long n_interior = long(InteriorDofs(model).size());
   if (part.reduction.internal_modes > n_interior) {
-    throw InputError(part.file + ": reduction.internal_modes = " +
-                     std::to_string(part.reduction.internal_modes) + " exceeds the " +
-                     std::to_string(n_interior) + " interior DOFs of the mesh (refine it or keep fewer modes)");
+    throw InputError(part.file + ": reduction.internal_modes = " + std::to_string(part.reduction.internal_modes) +
+                     " exceeds the " + std::to_string(n_interior) +
+                     " interior DOFs of the mesh (refine it or keep fewer modes)");
   }
   // Memory for the factor of K_ii: what is left beside the dense blocks the reduction keeps
   // (constraint modes, Lanczos vectors, the mode shapes of the full model).
   const int n_b = 6 * int(model.interface_names.size()), m = part.reduction.internal_modes;
   const double dense_bytes = 8.0 * double(model.n_dofs()) * (2.0 * (n_b + m) + 2.0 * m + 20.0);
-  const double limit = part.reduction.memory_limit_gb > 0 ? part.reduction.memory_limit_gb * 1e9
-                                                          : AvailableMemoryBytes();
+  const double limit =
+      part.reduction.memory_limit_gb > 0 ? part.reduction.memory_limit_gb * 1e9 : AvailableMemoryBytes();
   const double factor_budget = limit > 0 ? std::max(limit - dense_bytes, 0.1 * limit) : 0.0;
   // Modal derivatives: (dK/dq_j) phi_i = 2 f2(phi_i, phi_j), the symmetric bilinear part of the
   // cubic internal force f(u) = K u + f2(u, u) + f3(u, u, u) of the nonlinear model (solids:
@@ -143,7 +144,8 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
   auto make_nonlinear = [&] {
     if (nonlinear) return;
     if (part.type == "solid" || part.type == "imported") {
-      nonlinear = std::make_unique<SvkSolidMesh>(SolidCellType(model.cell_type), model.nodes, model.cells, part.material);
+      nonlinear =
+          std::make_unique<SvkSolidMesh>(SolidCellType(model.cell_type), model.nodes, model.cells, part.material);
     } else {
       nonlinear = std::make_unique<VonKarmanBeams>(part);
       to_model_dofs.resize(model.n_dofs(), model.n_dofs());
@@ -155,7 +157,8 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
     request.tolerance = part.reduction.modal_derivatives.tolerance;
     make_nonlinear();
     const double size = (model.nodes.colwise().maxCoeff() - model.nodes.colwise().minCoeff()).norm();
-    request.stiffness_derivative = [&, size](const Eigen::MatrixXd& shapes, const std::vector<std::pair<int, int>>& pairs) {
+    request.stiffness_derivative = [&, size](const Eigen::MatrixXd& shapes,
+                                             const std::vector<std::pair<int, int>>& pairs) {
       const SparseMatrix& T = to_model_dofs;
       const Eigen::MatrixXd mesh_shapes = T * shapes;
       Eigen::MatrixXd out(model.n_dofs(), long(pairs.size()));
@@ -164,8 +167,9 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
         const double sa = 1e-6 * size / std::max(a0.cwiseAbs().maxCoeff(), 1e-300);
         const double sb = 1e-6 * size / std::max(b0.cwiseAbs().maxCoeff(), 1e-300);
         const Eigen::VectorXd a = sa * a0, b = sb * b0;
-        const Eigen::VectorXd f2 =
-            ((nonlinear->Force(a + b) - nonlinear->Force(a - b)) - (nonlinear->Force(b - a) - nonlinear->Force(-a - b))) / 8;
+        const Eigen::VectorXd f2 = ((nonlinear->Force(a + b) - nonlinear->Force(a - b)) -
+                                    (nonlinear->Force(b - a) - nonlinear->Force(-a - b))) /
+                                   8;
         out.col(long(k)) = T.transpose() * (2 * f2 / (sa * sb));
       }
       return out;
@@ -184,7 +188,8 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
       why = "its mesh has " + cell + " cells (femb's solid elements: tet4, tet10, hex8, hex20)";
     } else {
       for (size_t d = 0; d < model.dof_component.size() && why.empty(); ++d)
-        if (model.dof_component[d] >= 3 && model.dof_node[d] < model.n_nodes()) why = "its matrices have rotational DOFs";
+        if (model.dof_component[d] >= 3 && model.dof_node[d] < model.n_nodes())
+          why = "its matrices have rotational DOFs";
     }
     if (!why.empty()) {
       if (part.reduction.geometric_stiffening.value_or(false)) {
@@ -195,13 +200,15 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
     }
   }
   if (part.reduction.geometric_stiffening.value_or(false) && !stiffening) {
-    if (progress) progress("stiffening", 0.0, "none stored: the basis is the six rigid motions (one interface node, no internal modes)");
+    if (progress)
+      progress("stiffening", 0.0,
+               "none stored: the basis is the six rigid motions (one interface node, no internal modes)");
   }
   const Eigen::MatrixXd inertia_fields = stiffening ? InertiaFields(model) : Eigen::MatrixXd();
   const bool free_interface = part.reduction.method == "free_interface";
   const bool general = part.reduction.method == "general";
-  CraigBamptonResult cb = CraigBamptonReduce(model, free_interface || general ? 0 : part.reduction.internal_modes, report, 200,
-                                             factor_budget, request.pairs.empty() ? nullptr : &request,
+  CraigBamptonResult cb = CraigBamptonReduce(model, free_interface || general ? 0 : part.reduction.internal_modes,
+                                             report, 200, factor_budget, request.pairs.empty() ? nullptr : &request,
                                              stiffening ? &inertia_fields : nullptr);
   if (!cb.ok) {
     result.too_big = cb.factorization.too_big;
@@ -209,7 +216,8 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
     if (result.too_big) {
       char why[160];
       std::snprintf(why, sizeof why, " (%s; %.3g GB kept for the dense blocks of the reduction)",
-                    part.reduction.memory_limit_gb > 0 ? "reduction.memory_limit_gb" : "MemAvailable", dense_bytes / 1e9);
+                    part.reduction.memory_limit_gb > 0 ? "reduction.memory_limit_gb" : "MemAvailable",
+                    dense_bytes / 1e9);
       result.message += std::string(why) +
                         ": coarsen the mesh (mesh.size), use first-order elements (mesh.order: 1), or run on a "
                         "machine with more memory";
@@ -251,15 +259,17 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
         std::snprintf(b, sizeof b, "%s%.4g", freqs.empty() ? "" : ", ", FrequencyHz(free_lambda[j]));
         freqs += b;
       }
-      source = std::to_string(k) + " free-free modes (" + freqs + (k > 4 ? ", ..." : "") + " Hz) + " + std::to_string(n_b) +
-               " static modes";
+      source = std::to_string(k) + " free-free modes (" + freqs + (k > 4 ? ", ..." : "") + " Hz) + " +
+               std::to_string(n_b) + " static modes";
     } else {
       // The shapes' rows: the imported matrices' DOFs, or for femb's own parts the mesh's nodes
       // (dofs_per_node each, node-major, the order of /visualization/nodes): the RBE2 couplings
       // eliminate coupled solid nodes (mesh_map); beam DOFs are the model's own.
       SparseMatrix identity(model.n_dofs(), model.n_dofs());
       identity.setIdentity();
-      const SparseMatrix& T = model.full_map.size() ? model.full_map : model.mesh_map.size() ? model.mesh_map : identity;
+      const SparseMatrix& T = model.full_map.size()   ? model.full_map
+                              : model.mesh_map.size() ? model.mesh_map
+                                                      : identity;
       const Eigen::MatrixXd V_full = ReadShapes(part.reduction.basis_file, T.rows());
       Eigen::SimplicialLDLT<SparseMatrix> normal(SparseMatrix(T.transpose() * T));
       V = normal.solve(Eigen::MatrixXd(T.transpose() * V_full));
@@ -290,7 +300,8 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
         constrained += (j ? " & " : "") + model.interface_names[size_t(at / 6)] + "." + kNames[at % 6];
       }
     }
-    std::snprintf(detail, sizeof detail, "%s: %d of %d shapes with the rigid fields independent, interface rank %d of %d "
+    std::snprintf(detail, sizeof detail,
+                  "%s: %d of %d shapes with the rigid fields independent, interface rank %d of %d "
                   "(thesis 8.2), %ld reduced DOFs",
                   source.c_str(), g.columns_kept, g.columns_given + 6, g.interface_rank, n_b, long(g.K.rows()));
     report(free_interface ? "free-interface basis" : "general basis", basis_clock.Seconds(), detail + constrained);
@@ -301,8 +312,7 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
   se.name = part.name;
   se.units = part.units;
   for (size_t k = 0; k < model.interface_names.size(); ++k) {
-    se.interfaces.push_back({model.interface_names[k], model.interface_positions[k],
-                             Eigen::Matrix3d::Identity()});
+    se.interfaces.push_back({model.interface_names[k], model.interface_positions[k], Eigen::Matrix3d::Identity()});
   }
   se.K = cb.K;
   se.M = cb.M;
@@ -333,8 +343,8 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
   se.n_modal_derivatives = long(cb.derivative_pairs.size());
   se.modal_derivative_pairs = cb.derivative_pairs;
   se.mass_properties = ComputeMassProperties(se);
-  se.floating_frame = ComputeFloatingFrame(part.reduction.floating_frame,
-                                           part.reduction.where_floating_frame, se, model, cb.shapes);
+  se.floating_frame =
+      ComputeFloatingFrame(part.reduction.floating_frame, part.reduction.where_floating_frame, se, model, cb.shapes);
   {
     // Rigid motions cost no energy exactly: K_r <- T0^T K_r T0 with T0 = 1 - Phi_rig0 Phi_CB
     // (thesis 3.17-3.20 at the undeformed state; T0 Phi_rig0 = 0 as Phi_CB Phi_rig0 = 1). It
@@ -367,8 +377,8 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
     // with modal derivatives the cubic polynomial of reduced_polynomial.h; for the geometric
     // stiffening alone its quadratic part (the geometric stiffness of the stress of each basis
     // vector). Its linear part equals K_r. With stiffening also the geometric stiffness of the
-    // inertia load cases' stresses (SuperelementBody::InertiaLoads, solver/body/superelement_body.h), about the frame origin o:
-    // a field about o is the one about the part origin minus the translation it has at o.
+    // inertia load cases' stresses (SuperelementBody::InertiaLoads, solver/body/superelement_body.h), about the frame
+    // origin o: a field about o is the one about the part origin minus the translation it has at o.
     Stopwatch tensors;
     const Eigen::MatrixXd mesh_shapes = to_model_dofs * cb.shapes;
     const auto completion = InterfaceRotationCompletion(model.nodes, mesh_shapes, model.interface_positions,
@@ -382,9 +392,10 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
       stress_fields = to_model_dofs * u;
       poly_request.stress_fields = &stress_fields;
     }
-    ReducedPolynomial poly = part.type != "beam"
-                                 ? ReduceSvk(static_cast<const SvkSolidMesh&>(*nonlinear), mesh_shapes, completion, poly_request)
-                                 : ReduceVonKarman(static_cast<const VonKarmanBeams&>(*nonlinear), mesh_shapes, completion, poly_request);
+    ReducedPolynomial poly =
+        part.type != "beam"
+            ? ReduceSvk(static_cast<const SvkSolidMesh&>(*nonlinear), mesh_shapes, completion, poly_request)
+            : ReduceVonKarman(static_cast<const VonKarmanBeams&>(*nonlinear), mesh_shapes, completion, poly_request);
     const double mismatch = (poly.K - cb.K).norm() / cb.K.norm();
     if (part.type == "imported" && mismatch > kImportedStiffnessMismatch) {
       // femb's elements with the part's material on the imported mesh must be the imported
@@ -447,8 +458,9 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
   prov.reduction_method = part.reduction.method;
   prov.n_nodes = model.n_nodes();
   prov.n_elements = model.n_elements();
-  report("frame+mass", clock.Seconds(), "floating frame " + se.floating_frame.type +
-                                             (keep_mesh ? ", mesh and mode shapes kept" : ", mesh and mode shapes not kept (reduction.keep_mesh)"));
+  report("frame+mass", clock.Seconds(),
+         "floating frame " + se.floating_frame.type +
+             (keep_mesh ? ", mesh and mode shapes kept" : ", mesh and mode shapes not kept (reduction.keep_mesh)"));
   // Imported matrices: femb's solid elements on the imported mesh with the part's material (the
   // same conditions as the stiffening's; the part file refuses true without a material).
   bool stresses = keep_mesh && part.reduction.stresses.value_or(part.type != "imported" || part.has_material);
@@ -474,9 +486,9 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
     // beams: the von Karman axial term), as the body's polynomial force does; the inertia load
     // cases' stresses are linear.
     auto stresses_of = [&](const Eigen::MatrixXd& fields, bool quadratic) {
-      return part.type != "beam" ? SolidModalStress(SolidCellType(model.cell_type), model.nodes, model.cells, part.material, fields,
-                                                     quadratic)
-                                  : BeamModalStress(part, fields, quadratic);
+      return part.type != "beam" ? SolidModalStress(SolidCellType(model.cell_type), model.nodes, model.cells,
+                                                    part.material, fields, quadratic)
+                                 : BeamModalStress(part, fields, quadratic);
     };
     se.stress = stresses_of(v.shapes, derivatives);
     if (stress_fields.cols() > 0) {
@@ -487,11 +499,14 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
     const ModalStress& st = *se.stress;
     std::snprintf(detail, sizeof detail, "%d stress points x %ld coordinates (%s%s%s), %.3g MB in single precision",
                   st.n_points(), long(v.shapes.cols()), st.method.c_str(),
-                  st.gradients.size() ? "; displacement gradients for the Green-Lagrange quadratic part"
-                  : st.element_quadratic.size() ? "; element forms of the von Karman axial strain" : "",
+                  st.gradients.size()           ? "; displacement gradients for the Green-Lagrange quadratic part"
+                  : st.element_quadratic.size() ? "; element forms of the von Karman axial strain"
+                                                : "",
                   st.inertia_modes.size() ? "; 12 inertia load cases" : "",
-                  4.0 * double(st.modes.size() + st.section_forces.size() + st.gradients.size() + st.element_quadratic.size() + st.inertia_modes.size() +
-                               st.inertia_section_forces.size()) / 1e6);
+                  4.0 *
+                      double(st.modes.size() + st.section_forces.size() + st.gradients.size() +
+                             st.element_quadratic.size() + st.inertia_modes.size() + st.inertia_section_forces.size()) /
+                      1e6);
     report("stresses", stress_clock.Seconds(), detail);
   }
 
@@ -502,8 +517,9 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
   if (!part.reduction.full_modes_given) {
     full_modes = model.n_dofs() <= ReductionSpec::kFullModesMaxDofs ? std::min(12, se.n_reduced_dofs() - 6) : 0;
     if (full_modes <= 0 && model.n_dofs() > ReductionSpec::kFullModesMaxDofs && progress) {
-      progress("free-free check", 0.0, "skipped above " + std::to_string(ReductionSpec::kFullModesMaxDofs) +
-                                           " DOFs (reduction.full_modes: K or --full-modes K computes K)");
+      progress("free-free check", 0.0,
+               "skipped above " + std::to_string(ReductionSpec::kFullModesMaxDofs) +
+                   " DOFs (reduction.full_modes: K or --full-modes K computes K)");
     }
   }
   FullModesResult full_result;
@@ -527,7 +543,8 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
       return result;
     }
     if (!full.ok) {
-      report("free-free check", clock.Seconds(), "skipped: the full model's free-free eigen solve failed (" + full.message + ")");
+      report("free-free check", clock.Seconds(),
+             "skipped: the full model's free-free eigen solve failed (" + full.message + ")");
       full_modes = 0;
     }
   }

@@ -12,8 +12,8 @@ namespace femb {
 
 struct ReduceResult {
   bool ok = false;
-  std::string message;  ///< numerical failure, when !ok
-  bool too_big = false;  ///< refused: the factor would not fit in memory (message says how much)
+  std::string message;                ///< numerical failure, when !ok
+  bool too_big = false;               ///< refused: the factor would not fit in memory (message says how much)
   std::vector<std::string> warnings;  ///< said by femb-reduce, also with -q
   Superelement superelement;
 };

@@ -1,7 +1,7 @@
 // femb-solve: simulate a scene of superelements (static or dynamic).
 #include <chrono>
-#include <csignal>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -20,8 +20,8 @@
 #include "solver/output/checkpoint.h"
 #include "solver/output/results_recorder.h"
 #include "solver/parallel.h"
-#include "solver/stop_request.h"
 #include "solver/scene/scene_builder.h"
+#include "solver/stop_request.h"
 
 namespace {
 
@@ -49,7 +49,8 @@ void RecordModeShapes(const femb::Scene& scene, const femb::SystemState& state, 
   for (int k = 0; k < modes.shapes.cols(); ++k) {
     const Eigen::VectorXd v = modes.shapes.col(k);
     double largest = 0.0;
-    for (int n = 0; n < model.n_nodes(); ++n) largest = std::max(largest, femb::NodeMotion(state, n, v).head<3>().norm());
+    for (int n = 0; n < model.n_nodes(); ++n)
+      largest = std::max(largest, femb::NodeMotion(state, n, v).head<3>().norm());
     if (!(largest > 0)) continue;  // a mode of modal coordinates or rotations only: no motion to show
     femb::SystemState moved = state;
     femb::ApplyIncrement(model, dofs, (0.05 * size / largest) * v, moved);
@@ -60,7 +61,8 @@ void RecordModeShapes(const femb::Scene& scene, const femb::SystemState& state, 
   }
 }
 
-constexpr const char* kUsage = R"(usage: femb-solve SCENE.yaml [-o OUTDIR | --restart OUTDIR] [--set key=value]... [--threads N] [--quiet]
+constexpr const char* kUsage =
+    R"(usage: femb-solve SCENE.yaml [-o OUTDIR | --restart OUTDIR] [--set key=value]... [--threads N] [--quiet]
 
 Simulates a scene of superelements and rigid bodies in absolute interface coordinates (see
 formats/SCENE_FORMAT.md), with joints along a tree and closed loops cut into constraint equations:
@@ -143,19 +145,22 @@ int main(int argc, char** argv) {
     if (!restart.empty()) {
       const std::string checkpoint = (std::filesystem::path(restart) / "checkpoint.h5").string();
       if (spec.analysis.type != femb::AnalysisType::kDynamic) {
-        throw femb::InputError("--restart " + restart + ": continues dynamic analyses only (start one from a static run's "
+        throw femb::InputError("--restart " + restart +
+                               ": continues dynamic analyses only (start one from a static run's "
                                "state with initial_state)");
       }
       resume.emplace();
       if (!femb::ReadResume(restart, scene, *resume)) {
-        throw femb::InputError(checkpoint + ": holds no dynamic run to continue (a static run's state, or one written "
+        throw femb::InputError(checkpoint +
+                               ": holds no dynamic run to continue (a static run's state, or one written "
                                "before the first step: start anew, or from it with initial_state)");
       }
       if (!(spec.analysis.end_time > resume->state.t + 1e-12 * std::abs(spec.analysis.end_time))) {
         char buffer[300];
         std::snprintf(buffer, sizeof buffer,
                       ": the run reached t = %.9g; analysis.end_time %.9g is not later (--set analysis.end_time=... "
-                      "extends it)", resume->state.t, spec.analysis.end_time);
+                      "extends it)",
+                      resume->state.t, spec.analysis.end_time);
         throw femb::InputError(checkpoint + buffer);
       }
     }
@@ -166,11 +171,13 @@ int main(int argc, char** argv) {
     if (!spec.initial_state.from.empty() && !resume) {  // a restarted run began from it already
       const femb::SceneSpec::InitialStateSpec& is = spec.initial_state;
       if (spec.analysis.type == femb::AnalysisType::kStatic) {
-        throw femb::InputError(is.where + ": initial_state: a static analysis starts from the model's placement (give it "
+        throw femb::InputError(is.where +
+                               ": initial_state: a static analysis starts from the model's placement (give it "
                                "to a dynamic or modes analysis)");
       }
       if (!spec.initial_velocities.empty() || !spec.initial_joint_rates.empty()) {
-        throw femb::InputError(is.where + ": initial_state: the velocities are the state's; leave out initial_velocity");
+        throw femb::InputError(is.where +
+                               ": initial_state: the velocities are the state's; leave out initial_velocity");
       }
       std::filesystem::path dir(is.from);
       if (dir.is_relative()) dir = std::filesystem::path(spec.file).parent_path() / dir;
@@ -222,9 +229,10 @@ int main(int argc, char** argv) {
         stiffened += body.options().geometric_stiffening && body.has_inertia_stiffening();
       }
       if (flexible > 0) {
-        std::printf("femb-solve: %d flexible bodies: %d with the exact inertia, %d with the corotational one; %d "
-                    "with geometric stiffening, %d linear inside\n",
-                    flexible, exact, flexible - exact, stiffened, flexible - stiffened);
+        std::printf(
+            "femb-solve: %d flexible bodies: %d with the exact inertia, %d with the corotational one; %d "
+            "with geometric stiffening, %d linear inside\n",
+            flexible, exact, flexible - exact, stiffened, flexible - stiffened);
       }
       // One note per file, not per body.
       std::set<std::string> said;
@@ -235,9 +243,9 @@ int main(int argc, char** argv) {
     }
     std::string status = "completed";
     bool ok = true;
-    int stopped = 0;           // the signal that stopped the analysis, or 0
-    double stopped_at = 0.0;   // the time (static: load factor) it stopped at
-    long rejected = 0;  // steps rejected so far (step: auto)
+    int stopped = 0;          // the signal that stopped the analysis, or 0
+    double stopped_at = 0.0;  // the time (static: load factor) it stopped at
+    long rejected = 0;        // steps rejected so far (step: auto)
     // Results on disk during the run: results.h5's status says how far it got.
     const bool is_static = spec.analysis.type == femb::AnalysisType::kStatic;
     const char* kind = is_static ? "static" : "dynamic";
@@ -285,7 +293,8 @@ int main(int argc, char** argv) {
       last_print = Seconds(wall);
       // Closed loops: the largest violation of their equations so far (a length).
       char loops[64] = "";
-      if (scene.model.has_constraints()) std::snprintf(loops, sizeof loops, " loop gap %.2g", recorder.max_loop_violation());
+      if (scene.model.has_constraints())
+        std::snprintf(loops, sizeof loops, " loop gap %.2g", recorder.max_loop_violation());
       if (spec.analysis.adaptive_step) {
         std::printf("femb-solve: t = %-10.6g steps %-7ld rejected %-5ld Newton iterations %-8ld wall %.2f s%s\n", t,
                     step_count, rejected, total_iterations, Seconds(wall), loops);
@@ -351,8 +360,8 @@ int main(int argc, char** argv) {
             total_iterations += s.iterations;
             if (step_count % spec.analysis.output_every == 0) {
               const auto reactions = static_reactions(s.lambda, st);
-              recorder.Record(s.lambda, st, Eigen::VectorXd(), 0.0, s.elastic_energy, s.external_work, Eigen::Vector3d::Zero(),
-                              Eigen::Vector3d::Zero(), spec.reactions ? &reactions : nullptr);
+              recorder.Record(s.lambda, st, Eigen::VectorXd(), 0.0, s.elastic_energy, s.external_work,
+                              Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), spec.reactions ? &reactions : nullptr);
               if (recorder.FlushDue()) flush(at_rest(st, s.lambda), true);
             }
             progress(s.lambda, false);
@@ -366,12 +375,13 @@ int main(int argc, char** argv) {
     } else {
       femb::DynamicState state =
           resume ? resume->state
-          : from ? femb::InitialDynamicState(scene.model, from->config, from->W.size() ? from->W : scene.initial_velocity, t0)
+          : from ? femb::InitialDynamicState(scene.model, from->config,
+                                             from->W.size() ? from->W : scene.initial_velocity, t0)
                  : femb::InitialDynamicState(scene.model, femb::InitialState(scene.model), scene.initial_velocity);
       if (!resume) {
         const femb::DynamicStepReport r0 = femb::Measure(scene.model, state);
-        const auto reactions0 = spec.reactions ? femb::DynamicReactions(scene.model, state)
-                                               : std::vector<Eigen::Matrix<double, 6, 1>>();
+        const auto reactions0 =
+            spec.reactions ? femb::DynamicReactions(scene.model, state) : std::vector<Eigen::Matrix<double, 6, 1>>();
         recorder.Record(state.t, state.config, state.W, r0.kinetic_energy, r0.elastic_energy, 0.0, r0.linear_momentum,
                         r0.angular_momentum, spec.reactions ? &reactions0 : nullptr, &state.Wdot);
         recorder.RecordStepSize(0.0);
@@ -385,10 +395,17 @@ int main(int argc, char** argv) {
       options.tolerance = spec.analysis.tolerance;
       options.max_iterations = spec.analysis.max_iterations;
       switch (spec.analysis.jacobian_reuse) {
-        case femb::JacobianReuseType::kDefault: break;  // the integrator's (femb::JacobianReuseOf)
-        case femb::JacobianReuseType::kNone: options.jacobian_reuse = femb::JacobianReuse::kNone; break;
-        case femb::JacobianReuseType::kStep: options.jacobian_reuse = femb::JacobianReuse::kStep; break;
-        case femb::JacobianReuseType::kSteps: options.jacobian_reuse = femb::JacobianReuse::kSteps; break;
+        case femb::JacobianReuseType::kDefault:
+          break;  // the integrator's (femb::JacobianReuseOf)
+        case femb::JacobianReuseType::kNone:
+          options.jacobian_reuse = femb::JacobianReuse::kNone;
+          break;
+        case femb::JacobianReuseType::kStep:
+          options.jacobian_reuse = femb::JacobianReuse::kStep;
+          break;
+        case femb::JacobianReuseType::kSteps:
+          options.jacobian_reuse = femb::JacobianReuse::kSteps;
+          break;
       }
       options.full_inertia_tangent = spec.analysis.gyroscopic_tangent;
       if (spec.analysis.body_matrices_every > 0) options.body_matrices_every = spec.analysis.body_matrices_every;
@@ -439,23 +456,27 @@ int main(int argc, char** argv) {
       for (const std::string& w : r.warnings) std::printf("femb-solve: warning: %s\n", w.c_str());
       if (!quiet) {
         const std::string analysed = r.pattern_analyses == 1 ? "once" : std::to_string(r.pattern_analyses) + " times";
-        std::printf("femb-solve: %ld factorizations of the iteration matrix; its sparsity pattern analysed %s; pivots "
-                    "chosen in %ld, reused in %ld\n", r.factorizations, analysed.c_str(), r.pivoted,
-                    r.factorizations - r.pivoted);
+        std::printf(
+            "femb-solve: %ld factorizations of the iteration matrix; its sparsity pattern analysed %s; pivots "
+            "chosen in %ld, reused in %ld\n",
+            r.factorizations, analysed.c_str(), r.pivoted, r.factorizations - r.pivoted);
         if (r.body_matrices_turned > 0) {
           const bool all = options.body_matrices_kept == femb::BodyMatricesKept::kAll;
-          std::printf("femb-solve: bodies' %smatrices computed %ld times, turned with their floating frames %ld times "
-                      "(analysis.body_matrices_every %d, body_matrices_kept %s)\n", all ? "" : "inertia ",
-                      r.body_matrices_computed, r.body_matrices_turned, options.body_matrices_every, all ? "all" : "inertia");
+          std::printf(
+              "femb-solve: bodies' %smatrices computed %ld times, turned with their floating frames %ld times "
+              "(analysis.body_matrices_every %d, body_matrices_kept %s)\n",
+              all ? "" : "inertia ", r.body_matrices_computed, r.body_matrices_turned, options.body_matrices_every,
+              all ? "all" : "inertia");
         }
       }
       if (!quiet && spec.analysis.adaptive_step) {
         std::printf("femb-solve: %ld steps rejected (%ld by the error test, %ld by Newton)\n",
                     r.rejected_by_error + r.newton_cuts, r.rejected_by_error, r.newton_cuts);
         if (r.steps > 0) {
-          std::printf("femb-solve: steps: smallest %.3g s (ending at t = %.6g), largest %.3g s, mean %.3g s; every step "
-                      "in results.h5 /steps\n", r.smallest_step, r.smallest_step_time, r.largest_step,
-                      spec.analysis.end_time / double(r.steps));
+          std::printf(
+              "femb-solve: steps: smallest %.3g s (ending at t = %.6g), largest %.3g s, mean %.3g s; every step "
+              "in results.h5 /steps\n",
+              r.smallest_step, r.smallest_step_time, r.largest_step, spec.analysis.end_time / double(r.steps));
         }
       }
       recorder.StepCounts(r.steps, r.rejected_by_error, r.newton_cuts);
@@ -495,11 +516,12 @@ int main(int argc, char** argv) {
       // The phases: reading (scene, superelement files, model), the analysis with its per-step
       // recording, writing results.h5 and the animation.
       const double end = Seconds(wall);
-      std::printf("femb-solve: done in %.2f s (reading %.3f s, solving %.3f s, writing %.3f s): %ld steps, %.2f "
-                  "Newton iterations per step; results in %s, %s\n",
-                  end, read_seconds, solve_end - read_seconds, end - solve_end, step_count,
-                  step_count ? double(total_iterations) / step_count : 0.0, recorder.h5_path().c_str(),
-                  recorder.csv_path().c_str());
+      std::printf(
+          "femb-solve: done in %.2f s (reading %.3f s, solving %.3f s, writing %.3f s): %ld steps, %.2f "
+          "Newton iterations per step; results in %s, %s\n",
+          end, read_seconds, solve_end - read_seconds, end - solve_end, step_count,
+          step_count ? double(total_iterations) / step_count : 0.0, recorder.h5_path().c_str(),
+          recorder.csv_path().c_str());
     }
     return 0;
   } catch (const femb::InputError& e) {

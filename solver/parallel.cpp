@@ -52,10 +52,8 @@ void BodyThreads::Helper(int thread) {
   for (;;) {
     // Passes come every few hundred microseconds in a time step: look for the next one for a
     // while before sleeping (a sleeping helper wakes 10-50 us late and finds the bodies taken).
-    const auto until =
-        std::chrono::steady_clock::now() + std::chrono::microseconds(kSpinMicroseconds);
-    while (published_.load(std::memory_order_acquire) == seen &&
-           std::chrono::steady_clock::now() < until) {
+    const auto until = std::chrono::steady_clock::now() + std::chrono::microseconds(kSpinMicroseconds);
+    while (published_.load(std::memory_order_acquire) == seen && std::chrono::steady_clock::now() < until) {
       std::this_thread::yield();  // a process that shares the core runs meanwhile
     }
     Pass* pass = nullptr;

@@ -84,7 +84,7 @@ class BodyThreads {
   std::atomic<long> published_{0};  ///< generation_, for helpers looking without the lock
   bool stop_ = false;
   std::vector<std::exception_ptr> errors_;  ///< a pass's (Pass::errors): its storage is reused
-  std::unique_ptr<Range[]> ranges_;          ///< a pass's (Pass::ranges), one per thread
+  std::unique_ptr<Range[]> ranges_;         ///< a pass's (Pass::ranges), one per thread
 };
 
 }  // namespace femb

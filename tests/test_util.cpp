@@ -1,7 +1,6 @@
 #include "test_util.h"
 
 #include <gtest/gtest.h>
-
 #include <unistd.h>
 
 #include <cmath>
@@ -52,10 +51,8 @@ Eigen::Vector2d ElasticaTip(double P, double EI, double L) {
   return tip;
 }
 
-
-std::string StraightBeamYaml(double L, int elements, const std::string& section,
-                             const std::string& material, const std::string& interfaces,
-                             const std::string& extra) {
+std::string StraightBeamYaml(double L, int elements, const std::string& section, const std::string& material,
+                             const std::string& interfaces, const std::string& extra) {
   std::ostringstream s;
   s.precision(17);
   s << "name: test_beam\ntype: beam\nmaterial: " << material << "\nsection: " << section
@@ -81,12 +78,18 @@ SystemModel ClampedOneBodyModel(const Superelement& se, double L, const Eigen::V
 }
 
 Superelement TubeSegment(double L, int elements, bool stiffened) {
-  return Reduce("name: seg\ntype: beam\nmaterial: {E: 70.0e9, nu: 0.3, rho: 2700}\n"
-                "section: {shape: tube, outer_radius: 0.01, wall: 0.001}\n"
-                "beam:\n  points: {A: [0, 0, 0], B: [" + std::to_string(L) + ", 0, 0]}\n"
-                "  segments: [{from: A, to: B, elements: " + std::to_string(elements) + "}]\n"
-                "interfaces: [{name: A}, {name: B}]\nreduction: {internal_modes: 2, keep_mesh: false, "
-                "geometric_stiffening: " + std::string(stiffened ? "true" : "false") + "}\n");
+  return Reduce(
+      "name: seg\ntype: beam\nmaterial: {E: 70.0e9, nu: 0.3, rho: 2700}\n"
+      "section: {shape: tube, outer_radius: 0.01, wall: 0.001}\n"
+      "beam:\n  points: {A: [0, 0, 0], B: [" +
+      std::to_string(L) +
+      ", 0, 0]}\n"
+      "  segments: [{from: A, to: B, elements: " +
+      std::to_string(elements) +
+      "}]\n"
+      "interfaces: [{name: A}, {name: B}]\nreduction: {internal_modes: 2, keep_mesh: false, "
+      "geometric_stiffening: " +
+      std::string(stiffened ? "true" : "false") + "}\n");
 }
 
 SystemModel SliderCrankModel(const Superelement& crank, const Superelement& rod, double Lc, double Lr) {
@@ -175,7 +178,8 @@ Eigen::MatrixXd femb::test::StaticTangentByDifferences(const SystemModel& model,
     ApplyIncrement(model, dofs, h * Eigen::VectorXd::Unit(n, i), plus);
     ApplyIncrement(model, dofs, -h * Eigen::VectorXd::Unit(n, i), minus);
     K.col(i) = -(AssembleStatic(model, dofs, plus, lambda, false).residual -
-                 AssembleStatic(model, dofs, minus, lambda, false).residual) / (2 * h);
+                 AssembleStatic(model, dofs, minus, lambda, false).residual) /
+               (2 * h);
   }
   return K;
 }

@@ -15,9 +15,8 @@ std::string Number(double x);
 
 /// A straight beam part along x from 0 to L with interfaces at the named ends ("A" at x = 0,
 /// "B" at x = L), `extra` appended to the YAML (e.g. a reduction block).
-std::string StraightBeamYaml(double L, int elements, const std::string& section,
-                             const std::string& material, const std::string& interfaces,
-                             const std::string& extra = "");
+std::string StraightBeamYaml(double L, int elements, const std::string& section, const std::string& material,
+                             const std::string& interfaces, const std::string& extra = "");
 
 /// Elastica of a clamped inextensible Euler-Bernoulli cantilever (bending stiffness EI, length
 /// L) under a tip force P that stays perpendicular to the undeformed axis, by shooting with RK4

@@ -28,7 +28,8 @@ std::vector<BeamElement> BeamElements(const PartSpec& part, std::vector<Eigen::V
     const Eigen::Vector3d a = spec.points[seg.from], b = spec.points[seg.to];
     const Eigen::Vector3d v = Orientation(spec, b - a);
     if ((b - a).normalized().cross(v.normalized()).norm() < 1e-6) {
-      throw InputError(seg.where + ": beam.orientation is parallel to this segment; give a vector "
+      throw InputError(seg.where +
+                       ": beam.orientation is parallel to this segment; give a vector "
                        "that lies in the local x-y plane but not along the beam");
     }
     const Eigen::Matrix3d R = BeamFrame(a, b, v);

@@ -19,12 +19,12 @@ struct FullDof {
 };
 
 struct FeModel {
-  int dofs_per_node = 6;             ///< 6 for beams (u, theta); 3 for solids
-  Eigen::MatrixXd nodes;             ///< n_nodes x 3, part axes
-  Eigen::MatrixXi cells;             ///< n_cells x nodes_per_cell
-  std::string cell_type;             ///< "line2", ...
-  std::string element_type;          ///< e.g. "timoshenko_beam"
-  SparseMatrix K, M;                 ///< n_dofs x n_dofs, full (both triangles stored)
+  int dofs_per_node = 6;     ///< 6 for beams (u, theta); 3 for solids
+  Eigen::MatrixXd nodes;     ///< n_nodes x 3, part axes
+  Eigen::MatrixXi cells;     ///< n_cells x nodes_per_cell
+  std::string cell_type;     ///< "line2", ...
+  std::string element_type;  ///< e.g. "timoshenko_beam"
+  SparseMatrix K, M;         ///< n_dofs x n_dofs, full (both triangles stored)
 
   /// Boundary coordinates: 6 per interface, ordered (u_x, u_y, u_z, th_x, th_y, th_z) in part
   /// axes. For beams these are DOFs of interface nodes directly.

@@ -55,9 +55,10 @@ FeModel BuildImportedModel(const PartSpec& part, const ProgressFn& progress) {
   for (long r = 0; r < n_full; ++r) {
     auto it = index_of.find(im.node[size_t(r)]);
     if (it == index_of.end()) {
-      throw InputError(part.matrices.where + ": node " + std::to_string(im.node[size_t(r)]) + " of the matrices is not in " +
-                       part.solid.file + " (its node labels run " + std::to_string(geometry.ids.front()) + " .. " +
-                       std::to_string(geometry.ids.back()) + "): the geometry file must be the mesh the matrices were exported from");
+      throw InputError(part.matrices.where + ": node " + std::to_string(im.node[size_t(r)]) +
+                       " of the matrices is not in " + part.solid.file + " (its node labels run " +
+                       std::to_string(geometry.ids.front()) + " .. " + std::to_string(geometry.ids.back()) +
+                       "): the geometry file must be the mesh the matrices were exported from");
     }
     full_node[size_t(r)] = it->second;
     full_dof[size_t(it->second)][size_t(im.component[size_t(r)])] = int(r);
@@ -103,7 +104,9 @@ FeModel BuildImportedModel(const PartSpec& part, const ProgressFn& progress) {
   // Model DOFs: the imported DOFs of nodes in no RBE2 set (file order), then 6 per RBE2
   // interface. T (imported -> model): u_s = u_k + theta_k x (x_s - x_k) = u_k - (x_s - x_k)~ theta_k,
   // theta_s = theta_k.
-  auto rbe2 = [&](long s) { return owner[size_t(s)] >= 0 && part.interfaces[size_t(owner[size_t(s)])].coupling == "rbe2"; };
+  auto rbe2 = [&](long s) {
+    return owner[size_t(s)] >= 0 && part.interfaces[size_t(owner[size_t(s)])].coupling == "rbe2";
+  };
   std::vector<int> model_of(static_cast<size_t>(n_full), -1);
   int n_model = 0;
   for (long r = 0; r < n_full; ++r) {
@@ -160,8 +163,8 @@ FeModel BuildImportedModel(const PartSpec& part, const ProgressFn& progress) {
         const auto& f = full_dof[size_t(s)];
         if (f[0] >= 0 && f[1] >= 0 && f[2] >= 0) nodes.push_back(s);
       }
-      const Eigen::MatrixXd w = Rbe3Weights(geometry.nodes, nodes, model.interface_positions[k], part.interfaces[k].where,
-                                            part.interfaces[k].name);
+      const Eigen::MatrixXd w = Rbe3Weights(geometry.nodes, nodes, model.interface_positions[k],
+                                            part.interfaces[k].where, part.interfaces[k].name);
       std::vector<Eigen::Triplet<double>> entries;
       for (size_t a = 0; a < nodes.size(); ++a)
         for (int c = 0; c < 3; ++c)
@@ -195,14 +198,17 @@ FeModel BuildImportedModel(const PartSpec& part, const ProgressFn& progress) {
   double k_scale = 0.0;
   for (int j = 0; j < model.K.outerSize(); ++j) k_scale = std::max(k_scale, model.K.coeff(j, j));
   double residual = 0.0;
-  for (int j = 0; j < 6; ++j) residual = std::max(residual, KR.col(j).cwiseAbs().maxCoeff() / (k_scale * R.col(j).cwiseAbs().maxCoeff()));
+  for (int j = 0; j < 6; ++j)
+    residual = std::max(residual, KR.col(j).cwiseAbs().maxCoeff() / (k_scale * R.col(j).cwiseAbs().maxCoeff()));
   const double mass = (R.col(0).transpose() * model.M * R.col(0)).value();
   if (residual > 1e-6) {
-    throw InputError(part.matrices.where + ": the stiffness resists a rigid-body motion (|K r| = " + ShortNumber(residual) +
+    throw InputError(part.matrices.where +
+                     ": the stiffness resists a rigid-body motion (|K r| = " + ShortNumber(residual) +
                      " of the largest diagonal): the export kept boundary conditions or grounded springs; export the "
                      "free part");
   }
-  if (!(mass > 0)) throw InputError(part.matrices.where + ": the mass matrix gives the part no mass (" + ShortNumber(mass) + ")");
+  if (!(mass > 0))
+    throw InputError(part.matrices.where + ": the mass matrix gives the part no mass (" + ShortNumber(mass) + ")");
   if (progress) {
     progress("couplings", clock.Seconds(),
              std::to_string(part.interfaces.size()) + " interfaces (" + selected + "), " + std::to_string(n_model) +
@@ -211,9 +217,10 @@ FeModel BuildImportedModel(const PartSpec& part, const ProgressFn& progress) {
   return model;
 }
 
-std::vector<std::string> ExportPartMatrices(const PartSpec& part, const std::string& format, const std::string& directory,
-                                            const ProgressFn& progress) {
-  if (part.type == "imported") throw InputError(part.file + ": --export-matrices: the part's matrices are imported already");
+std::vector<std::string> ExportPartMatrices(const PartSpec& part, const std::string& format,
+                                            const std::string& directory, const ProgressFn& progress) {
+  if (part.type == "imported")
+    throw InputError(part.file + ": --export-matrices: the part's matrices are imported already");
   Stopwatch clock;
   SparseMatrix K, M;
   std::vector<long> node;
@@ -242,8 +249,10 @@ std::vector<std::string> ExportPartMatrices(const PartSpec& part, const std::str
       }
     nodes = mesh.nodes;
     cells = ToVtkOrder(SolidTypeName(mesh.type), mesh.cells);  // VTK order = Abaqus order for these
-    const std::map<SolidType, std::string> names = {
-        {SolidType::kTet4, "C3D4"}, {SolidType::kTet10, "C3D10"}, {SolidType::kHex8, "C3D8"}, {SolidType::kHex20, "C3D20"}};
+    const std::map<SolidType, std::string> names = {{SolidType::kTet4, "C3D4"},
+                                                    {SolidType::kTet10, "C3D10"},
+                                                    {SolidType::kHex8, "C3D8"},
+                                                    {SolidType::kHex20, "C3D20"}};
     element = names.at(mesh.type);
     node_sets = mesh.node_sets;
   } else {
@@ -267,7 +276,8 @@ std::vector<std::string> ExportPartMatrices(const PartSpec& part, const std::str
     std::ofstream out(tmp);
     out.precision(13);  // CalculiX reads at most 20 characters per field ("-7.347880794884e-18" is 19)
     out << "** " << part.name << ": mesh of femb-reduce --export-matrices (node labels = matrix node numbers)\n*NODE\n";
-    for (long s = 0; s < nodes.rows(); ++s) out << s + 1 << ", " << nodes(s, 0) << ", " << nodes(s, 1) << ", " << nodes(s, 2) << '\n';
+    for (long s = 0; s < nodes.rows(); ++s)
+      out << s + 1 << ", " << nodes(s, 0) << ", " << nodes(s, 1) << ", " << nodes(s, 2) << '\n';
     out << "*ELEMENT, TYPE=" << element << ", ELSET=EALL\n";
     for (long e = 0; e < cells.rows(); ++e) {
       out << e + 1;
@@ -285,8 +295,8 @@ std::vector<std::string> ExportPartMatrices(const PartSpec& part, const std::str
   written.push_back(mesh_path);
   if (progress) {
     progress("export", clock.Seconds(),
-             std::to_string(node.size()) + " DOFs, " + std::to_string(cells.rows()) + " " + element + " elements, " + format +
-                 " matrices and " + mesh_path);
+             std::to_string(node.size()) + " DOFs, " + std::to_string(cells.rows()) + " " + element + " elements, " +
+                 format + " matrices and " + mesh_path);
   }
   return written;
 }

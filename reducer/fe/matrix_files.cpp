@@ -26,7 +26,6 @@ std::string ShortNumber(double v) {
 
 namespace {
 
-
 constexpr const char* kComponentNames[6] = {"u_x", "u_y", "u_z", "theta_x", "theta_y", "theta_z"};
 
 struct Entry {
@@ -106,7 +105,8 @@ long IntegerField(const LineReader& r, std::string_view text) {
 
 // One row of the DOF map: node label and component 1..6.
 void AddDof(const LineReader& r, long node, long c, ImportedMatrices* out) {
-  if (c < 1 || c > 6) r.Fail("component " + std::to_string(c) + " is not 1..6 (u_x, u_y, u_z, theta_x, theta_y, theta_z)");
+  if (c < 1 || c > 6)
+    r.Fail("component " + std::to_string(c) + " is not 1..6 (u_x, u_y, u_z, theta_x, theta_y, theta_z)");
   out->node.push_back(node);
   out->component.push_back(int(c - 1));
 }
@@ -205,10 +205,12 @@ void ReadAbaqus(const MatricesSpec& spec, ImportedMatrices* out, std::vector<Ent
     while (r.Next(&line, "*")) {
       const std::vector<std::string_view> f = Fields(line);
       if (f.size() != 5) r.Fail("expected 'node, dof, node, dof, value', got '" + line + "'");
-      Raw e{IntegerField(r, f[0]), IntegerField(r, f[1]), IntegerField(r, f[2]), IntegerField(r, f[3]), NumberField(r, f[4])};
+      Raw e{IntegerField(r, f[0]), IntegerField(r, f[1]), IntegerField(r, f[2]), IntegerField(r, f[3]),
+            NumberField(r, f[4])};
       for (long label : {e.n1, e.n2}) {
         if (label <= 0) {
-          r.Fail("node " + std::to_string(label) + " is an Abaqus internal node (Lagrange multipliers of hybrid elements, "
+          r.Fail("node " + std::to_string(label) +
+                 " is an Abaqus internal node (Lagrange multipliers of hybrid elements, "
                  "MPCs or connectors): export a model without them");
         }
       }
@@ -263,17 +265,17 @@ void ReadMatrixMarket(const MatricesSpec& spec, ImportedMatrices* out, std::vect
     if (size.size() != 3) r.Fail("expected 'rows columns entries', got '" + line + "'");
     const long rows = IntegerField(r, size[0]), cols = IntegerField(r, size[1]), nnz = IntegerField(r, size[2]);
     if (rows != cols) r.Fail("the matrix is " + std::string(size[0]) + " x " + std::string(size[1]) + ", not square");
-    if (rows != n) r.Fail("the matrix has " + std::string(size[0]) + " rows but " + spec.dofs + " maps " + std::to_string(n));
+    if (rows != n)
+      r.Fail("the matrix has " + std::string(size[0]) + " rows but " + spec.dofs + " maps " + std::to_string(n));
     const size_t before = entries->size();
     ReadCoordinateEntries(&r, n, n, "1.." + std::to_string(n), entries, "%");
     const long count = long(entries->size() - before);
-    if (count != nnz) r.Fail("the size line announces " + std::to_string(nnz) + " entries, the file has " + std::to_string(count));
+    if (count != nnz)
+      r.Fail("the size line announces " + std::to_string(nnz) + " entries, the file has " + std::to_string(count));
   }
 }
 
-
 }  // namespace
-
 
 ImportedMatrices ReadImportedMatrices(const MatricesSpec& spec) {
   ImportedMatrices out;
@@ -291,8 +293,9 @@ ImportedMatrices ReadImportedMatrices(const MatricesSpec& spec) {
     for (long r = 0; r < n; ++r) {
       auto [it, fresh] = seen.emplace(std::pair{out.node[size_t(r)], out.component[size_t(r)]}, r);
       if (!fresh) {
-        throw InputError(spec.dofs + ": " + DofName(out.node[size_t(r)], out.component[size_t(r)]) + " appears twice (rows " +
-                         std::to_string(it->second + 1) + " and " + std::to_string(r + 1) + ")");
+        throw InputError(spec.dofs + ": " + DofName(out.node[size_t(r)], out.component[size_t(r)]) +
+                         " appears twice (rows " + std::to_string(it->second + 1) + " and " + std::to_string(r + 1) +
+                         ")");
       }
     }
   }
@@ -302,10 +305,12 @@ ImportedMatrices ReadImportedMatrices(const MatricesSpec& spec) {
   for (long r = 0; r < n; ++r) {
     const double kd = out.K.coeff(r, r), md = out.M.coeff(r, r);
     const std::string dof = DofName(out.node[size_t(r)], out.component[size_t(r)]);
-    if (kd < 0) throw InputError(spec.stiffness + ": the diagonal of " + dof + " is negative (" + ShortNumber(kd) + ")");
+    if (kd < 0)
+      throw InputError(spec.stiffness + ": the diagonal of " + dof + " is negative (" + ShortNumber(kd) + ")");
     if (md < 0) throw InputError(spec.mass + ": the diagonal of " + dof + " is negative (" + ShortNumber(md) + ")");
     if (kd == 0) {
-      throw InputError(spec.stiffness + ": " + dof + " has no stiffness (zero diagonal): a node of no element, or a "
+      throw InputError(spec.stiffness + ": " + dof +
+                       " has no stiffness (zero diagonal): a node of no element, or a "
                        "shell's drilling rotation; leave it out of the export");
     }
   }
@@ -325,7 +330,8 @@ Eigen::MatrixXd ReadShapeMatrix(const std::string& path, long rows) {
   }
   if (!r.Next(&line, "%")) r.Fail("no size line");
   const std::vector<std::string_view> size = Fields(line);
-  if (size.size() != (array ? 2u : 3u)) r.Fail("expected the size line 'rows columns" + std::string(array ? "'" : " entries'"));
+  if (size.size() != (array ? 2u : 3u))
+    r.Fail("expected the size line 'rows columns" + std::string(array ? "'" : " entries'"));
   const long n = IntegerField(r, size[0]), m = IntegerField(r, size[1]);
   if (n != rows) {
     r.Fail("the shapes have " + std::string(size[0]) + " rows but the matrices have " + std::to_string(rows) +
@@ -334,24 +340,29 @@ Eigen::MatrixXd ReadShapeMatrix(const std::string& path, long rows) {
   if (m <= 0) r.Fail("no shapes (columns)");
   // Before allocating n x m: more shapes than DOFs cannot be independent, and an array file
   // holds at least 2 bytes per value (a digit and a newline).
-  if (m > n) r.Fail("the file announces " + std::to_string(m) + " shapes for " + std::to_string(n) + " DOFs (at most one per DOF)");
+  if (m > n)
+    r.Fail("the file announces " + std::to_string(m) + " shapes for " + std::to_string(n) +
+           " DOFs (at most one per DOF)");
   std::error_code ec;
   const auto bytes = std::filesystem::file_size(path, ec);
   if (array && !ec && double(bytes) < 2.0 * double(n) * double(m)) {
-    r.Fail("the file is too short for the " + std::to_string(n) + " x " + std::to_string(m) + " values its size line announces");
+    r.Fail("the file is too short for the " + std::to_string(n) + " x " + std::to_string(m) +
+           " values its size line announces");
   }
   Eigen::MatrixXd V = Eigen::MatrixXd::Zero(n, m);
   if (array) {
     for (long j = 0; j < m; ++j)
       for (long i = 0; i < n; ++i) {
-        if (!r.Next(&line, "%")) r.Fail("the file ends after " + std::to_string(j * n + i) + " of " + std::to_string(n * m) + " values");
+        if (!r.Next(&line, "%"))
+          r.Fail("the file ends after " + std::to_string(j * n + i) + " of " + std::to_string(n * m) + " values");
         const std::vector<std::string_view> f = Fields(line);
         if (f.size() != 1) r.Fail("expected one value per line (array format, column by column), got '" + line + "'");
         V(i, j) = NumberField(r, f[0]);
       }
   } else {
     std::vector<Entry> entries;
-    ReadCoordinateEntries(&r, n, m, "the " + std::string(size[0]) + " x " + std::string(size[1]) + " matrix", &entries, "%");
+    ReadCoordinateEntries(&r, n, m, "the " + std::string(size[0]) + " x " + std::string(size[1]) + " matrix", &entries,
+                          "%");
     for (const Entry& e : entries) V(e.row, e.col) = e.value;
   }
   return V;

@@ -29,7 +29,7 @@ double VonKarmanBeams::ElementState(const Element& e, const Eigen::VectorXd& u, 
   Eigen::Matrix<double, 12, 1> fl = Eigen::Matrix<double, 12, 1>::Zero();
   Eigen::Matrix<double, 12, 12> Kl = Eigen::Matrix<double, 12, 12>::Zero();
   double energy = 0.0, length = 0.0, mean = 0.0;
-  Eigen::Matrix<double, 1, 12> grad = Eigen::Matrix<double, 1, 12>::Zero();  // d mean / d ul
+  Eigen::Matrix<double, 1, 12> grad = Eigen::Matrix<double, 1, 12>::Zero();    // d mean / d ul
   Eigen::Matrix<double, 12, 12> hess = Eigen::Matrix<double, 12, 12>::Zero();  // d2 mean / d ul2
   Eigen::Matrix<double, 6, 1> D = e.D;
   D[0] = 0.0;  // the axial term is the element's mean strain, below

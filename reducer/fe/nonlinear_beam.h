@@ -2,8 +2,9 @@
 // with the axial strain u' + (v'^2 + w'^2) / 2 in element axes, the other strains (torsion,
 // curvatures, shear) linear. The axial strain enters as its element mean (assumed constant
 // membrane strain): pointwise, u' (constant per element) cannot balance v'^2 / 2 (quadratic), and
-// the thin leaf of the tests locked by 5% at 40 elements (membrane locking). The strain is quadratic in the displacements, so the internal force
-// is cubic and the reduced force is the same polynomial as for solids (nonlinear_solid.h):
+// the thin leaf of the tests locked by 5% at 40 elements (membrane locking). The strain is quadratic in the
+// displacements, so the internal force is cubic and the reduced force is the same polynomial as for solids
+// (nonlinear_solid.h):
 //   W = sum over the elements of [EA L_e mean^2 + sum over 4 Gauss points w sum_i>0 D_i s_i^2] / 2,
 //   mean = sum_g w_g (B_0 + v'^2/2 + w'^2/2) / L_e, g = (v', w') = S T u_e;
 //   f and K_t are its exact derivatives (N = EA mean: K_t gets EA L_e grad grad^T + N L_e hess).

@@ -1,7 +1,7 @@
 #include "reducer/fe/nonlinear_solid.h"
 
-#include <Eigen/Dense>
 #include <Eigen/Cholesky>
+#include <Eigen/Dense>
 #include <Eigen/SparseCholesky>
 #include <cmath>
 #include <cstdio>
@@ -44,7 +44,7 @@ void AddPoint(const Eigen::MatrixXd& g, double dV, const Eigen::Matrix<double, 6
   Eigen::Matrix3d S;
   S << Sv[0], Sv[5], Sv[4], Sv[5], Sv[1], Sv[3], Sv[4], Sv[3], Sv[2];
   out->energy += 0.5 * Ev.dot(Sv) * dV;
-  const Eigen::Matrix3d P = F * S;  // first Piola-Kirchhoff stress
+  const Eigen::Matrix3d P = F * S;                   // first Piola-Kirchhoff stress
   const Eigen::MatrixXd f = g * P.transpose() * dV;  // n x 3: f_a = P grad N_a
   for (int a = 0; a < n; ++a) out->force.segment<3>(3 * a) += f.row(a).transpose();
   if (!with_tangent) return;
@@ -156,10 +156,9 @@ SparseMatrix SvkSolidMesh::Tangent(const Eigen::VectorXd& u) const {
   return K;
 }
 
-std::vector<std::pair<int, Eigen::VectorXd>> InterfaceRotationCompletion(const Eigen::MatrixXd& mesh_nodes,
-                                                                          const Eigen::MatrixXd& mesh_shapes,
-                                                                          const std::vector<Eigen::Vector3d>& interface_points,
-                                                                          const Eigen::Vector3d& origin, int dofs_per_node) {
+std::vector<std::pair<int, Eigen::VectorXd>> InterfaceRotationCompletion(
+    const Eigen::MatrixXd& mesh_nodes, const Eigen::MatrixXd& mesh_shapes,
+    const std::vector<Eigen::Vector3d>& interface_points, const Eigen::Vector3d& origin, int dofs_per_node) {
   const int n = int(mesh_shapes.cols());
   const long n_nodes = mesh_nodes.rows();
   auto pair_index = [n](int j, int k) { return j * n - j * (j - 1) / 2 + (k - j); };  // j <= k
@@ -220,7 +219,8 @@ ReducedPolynomial ReduceSvk(const SvkSolidMesh& solid, const Eigen::MatrixXd& me
       int p = 0;
       for (int j = 0; j < n; ++j)
         for (int k = j; k < n; ++k, ++p) {
-          const Eigen::Matrix3d S = 0.5 * (G[size_t(j)].transpose() * G[size_t(k)] + G[size_t(k)].transpose() * G[size_t(j)]);
+          const Eigen::Matrix3d S =
+              0.5 * (G[size_t(j)].transpose() * G[size_t(k)] + G[size_t(k)].transpose() * G[size_t(j)]);
           Q.col(p) << S(0, 0), S(1, 1), S(2, 2), 2 * S(1, 2), 2 * S(0, 2), 2 * S(0, 1);
         }
       const bool separate = n_stress > 0 && n_fields > 0;
@@ -327,8 +327,9 @@ NonlinearStaticResult SolveNonlinearStatic(const NonlinearModel& solid, const Sp
       if (it == max_iterations) {
         result.converged = false;
         char buffer[200];
-        std::snprintf(buffer, sizeof buffer, "no convergence at load factor %.4g after %d Newton iterations (residual %.3g of %.3g)",
-                      lambda, it, r_free.norm(), scale);
+        std::snprintf(buffer, sizeof buffer,
+                      "no convergence at load factor %.4g after %d Newton iterations (residual %.3g of %.3g)", lambda,
+                      it, r_free.norm(), scale);
         result.message = buffer;
         return result;
       }

@@ -136,11 +136,9 @@ ReducedPolynomial ReduceSvk(const SvkSolidMesh& solid, const Eigen::MatrixXd& me
 /// the n reduced coordinates (reduced_polynomial.h).
 /// `dofs_per_node`: 3 (solid mesh) or 6 (beam nodes: translations first; the rotation rows of
 /// W_p hold only the -Psi_k term).
-std::vector<std::pair<int, Eigen::VectorXd>> InterfaceRotationCompletion(const Eigen::MatrixXd& mesh_nodes,
-                                                                          const Eigen::MatrixXd& mesh_shapes,
-                                                                          const std::vector<Eigen::Vector3d>& interface_points,
-                                                                          const Eigen::Vector3d& origin,
-                                                                          int dofs_per_node = 3);
+std::vector<std::pair<int, Eigen::VectorXd>> InterfaceRotationCompletion(
+    const Eigen::MatrixXd& mesh_nodes, const Eigen::MatrixXd& mesh_shapes,
+    const std::vector<Eigen::Vector3d>& interface_points, const Eigen::Vector3d& origin, int dofs_per_node = 3);
 
 /// Static equilibrium of a full nonlinear model by Newton with load stepping:
 ///   T^T f(T u) = lambda f_ext  on the free model DOFs, u = prescribed values on the others

@@ -14,11 +14,18 @@ namespace {
 // Gauss-Legendre on [-1, 1].
 void GaussLegendre(int n, std::vector<double>* x, std::vector<double>* w) {
   switch (n) {
-    case 2: *x = {-0.5773502691896257, 0.5773502691896257}; *w = {1.0, 1.0}; break;
-    case 3: *x = {-0.7745966692414834, 0.0, 0.7745966692414834};
-            *w = {0.5555555555555556, 0.8888888888888888, 0.5555555555555556}; break;
-    default: *x = {-0.8611363115940526, -0.3399810435848563, 0.3399810435848563, 0.8611363115940526};
-             *w = {0.3478548451374538, 0.6521451548625461, 0.6521451548625461, 0.3478548451374538}; break;
+    case 2:
+      *x = {-0.5773502691896257, 0.5773502691896257};
+      *w = {1.0, 1.0};
+      break;
+    case 3:
+      *x = {-0.7745966692414834, 0.0, 0.7745966692414834};
+      *w = {0.5555555555555556, 0.8888888888888888, 0.5555555555555556};
+      break;
+    default:
+      *x = {-0.8611363115940526, -0.3399810435848563, 0.3399810435848563, 0.8611363115940526};
+      *w = {0.3478548451374538, 0.6521451548625461, 0.6521451548625461, 0.3478548451374538};
+      break;
   }
 }
 
@@ -85,8 +92,9 @@ std::vector<SolidPoint> SolidElementPoints(SolidType type, const Eigen::MatrixXd
     const double det = J.determinant();
     if (!(det > 1e-10 * size * size * size)) {
       char buffer[200];
-      std::snprintf(buffer, sizeof buffer, "element %ld (%s): inverted or degenerate (det J = %.3g at a quadrature point)",
-                    element_id, SolidTypeName(type).c_str(), det);
+      std::snprintf(buffer, sizeof buffer,
+                    "element %ld (%s): inverted or degenerate (det J = %.3g at a quadrature point)", element_id,
+                    SolidTypeName(type).c_str(), det);
       throw InputError(buffer);
     }
     out[q].dNdX = dN * J.inverse();

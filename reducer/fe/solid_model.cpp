@@ -244,10 +244,12 @@ InterfaceNodes ResolveInterfaceNodes(const PartSpec& part, const Eigen::MatrixXd
       if (found == node_sets.end()) {
         std::string known;
         for (const auto& [name, _] : node_sets) known += (known.empty() ? "" : ", ") + name;
-        throw InputError(i.where + ": interface '" + i.name + "': node set '" + i.group + "' not found in " + mesh_name +
-                         " (known: " + (known.empty() ? "none" : known) + "; or pick the nodes by geometry with 'select')");
+        throw InputError(i.where + ": interface '" + i.name + "': node set '" + i.group + "' not found in " +
+                         mesh_name + " (known: " + (known.empty() ? "none" : known) +
+                         "; or pick the nodes by geometry with 'select')");
       }
-      if (found->second.empty()) throw InputError(i.where + ": interface '" + i.name + "': node set '" + i.group + "' is empty");
+      if (found->second.empty())
+        throw InputError(i.where + ": interface '" + i.name + "': node set '" + i.group + "' is empty");
       set = found->second;
     }
     std::vector<int>& used = out.sets[k];
@@ -304,8 +306,8 @@ Eigen::MatrixXd Rbe3Weights(const Eigen::MatrixXd& nodes, const std::vector<int>
   return W;
 }
 
-std::function<std::optional<SparseMatrix>(const Eigen::Vector3d&)> SolidInterpolation(std::shared_ptr<const SolidMesh> mesh,
-                                                                                      const SparseMatrix& T) {
+std::function<std::optional<SparseMatrix>(const Eigen::Vector3d&)> SolidInterpolation(
+    std::shared_ptr<const SolidMesh> mesh, const SparseMatrix& T) {
   return [mesh, T](const Eigen::Vector3d& x) -> std::optional<SparseMatrix> {
     const int per = SolidNodeCount(mesh->type);
     for (int e = 0; e < mesh->cells.rows(); ++e) {
@@ -354,7 +356,8 @@ SolidMesh MeshSolidPart(const PartSpec& part) {
                                                                     : ImportWithMeshio(request.file, part.solid.where);
   if (mesh.nodes.rows() > 0) {
     const Eigen::Vector3d lo = mesh.nodes.colwise().minCoeff(), hi = mesh.nodes.colwise().maxCoeff();
-    CheckPartSize(part, (hi - lo).norm(), part.solid.where + " (" + (request.file.empty() ? part.solid.shape : request.file) + ")");
+    CheckPartSize(part, (hi - lo).norm(),
+                  part.solid.where + " (" + (request.file.empty() ? part.solid.shape : request.file) + ")");
   }
   return mesh;
 }
@@ -398,7 +401,8 @@ FeModel BuildSolidModel(const PartSpec& part, const ProgressFn& progress) {
     if (part.interfaces[k].coupling != "rbe3") continue;
     const std::vector<int>& set = sets[k];
     Rbe3& r3 = rbe3[k];
-    r3.W = Rbe3Weights(mesh->nodes, set, model.interface_positions[k], part.interfaces[k].where, part.interfaces[k].name);
+    r3.W =
+        Rbe3Weights(mesh->nodes, set, model.interface_positions[k], part.interfaces[k].where, part.interfaces[k].name);
     for (int node : set)
       for (int i = 0; i < 3; ++i) r3.dofs.push_back(3 * node + i);
   }
@@ -473,8 +477,9 @@ FeModel BuildSolidModel(const PartSpec& part, const ProgressFn& progress) {
   }
   AssembleSolid(*mesh, part.material, map, &model.K, &model.M);
   if (progress) {
-    progress("assembly", clock.Seconds(),
-             std::to_string(mesh->cells.rows()) + " elements, " + std::to_string(model.K.nonZeros()) + " stiffness entries");
+    progress(
+        "assembly", clock.Seconds(),
+        std::to_string(mesh->cells.rows()) + " elements, " + std::to_string(model.K.nonZeros()) + " stiffness entries");
   }
   for (size_t k = 0; k < part.interfaces.size(); ++k) {
     std::vector<FullDof> dofs;

@@ -79,7 +79,7 @@ InterfaceNodes ResolveInterfaceNodes(const PartSpec& part, const Eigen::MatrixXd
 
 /// FeModel::interpolate_at for a volume mesh whose mesh DOFs (3 per node) are T x model DOFs:
 /// displacement and small rotation (curl / 2) of the element containing x.
-std::function<std::optional<SparseMatrix>(const Eigen::Vector3d&)> SolidInterpolation(std::shared_ptr<const SolidMesh> mesh,
-                                                                                      const SparseMatrix& T);
+std::function<std::optional<SparseMatrix>(const Eigen::Vector3d&)> SolidInterpolation(
+    std::shared_ptr<const SolidMesh> mesh, const SparseMatrix& T);
 
 }  // namespace femb

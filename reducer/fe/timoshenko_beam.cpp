@@ -15,21 +15,13 @@ struct BendingShapes {
 BendingShapes Bending(double xi, double L, double Phi) {
   const double c = 1.0 / (1.0 + Phi), x2 = xi * xi, x3 = x2 * xi;
   BendingShapes s;
-  s.N << c * (2 * x3 - 3 * x2 - Phi * xi + 1 + Phi),
-      c * L * (x3 - (2 + Phi / 2) * x2 + (1 + Phi / 2) * xi),
-      c * (-2 * x3 + 3 * x2 + Phi * xi),
-      c * L * (x3 - (1 - Phi / 2) * x2 - (Phi / 2) * xi);
-  s.dN << c * (6 * x2 - 6 * xi - Phi) / L,
-      c * (3 * x2 - (4 + Phi) * xi + 1 + Phi / 2),
-      c * (-6 * x2 + 6 * xi + Phi) / L,
-      c * (3 * x2 - (2 - Phi) * xi - Phi / 2);
-  s.Nt << c * 6 * (x2 - xi) / L,
-      c * (3 * x2 - (4 + Phi) * xi + 1 + Phi),
-      -c * 6 * (x2 - xi) / L,
+  s.N << c * (2 * x3 - 3 * x2 - Phi * xi + 1 + Phi), c * L * (x3 - (2 + Phi / 2) * x2 + (1 + Phi / 2) * xi),
+      c * (-2 * x3 + 3 * x2 + Phi * xi), c * L * (x3 - (1 - Phi / 2) * x2 - (Phi / 2) * xi);
+  s.dN << c * (6 * x2 - 6 * xi - Phi) / L, c * (3 * x2 - (4 + Phi) * xi + 1 + Phi / 2),
+      c * (-6 * x2 + 6 * xi + Phi) / L, c * (3 * x2 - (2 - Phi) * xi - Phi / 2);
+  s.Nt << c * 6 * (x2 - xi) / L, c * (3 * x2 - (4 + Phi) * xi + 1 + Phi), -c * 6 * (x2 - xi) / L,
       c * (3 * x2 - (2 - Phi) * xi);
-  s.dNt << c * 6 * (2 * xi - 1) / (L * L),
-      c * (6 * xi - 4 - Phi) / L,
-      -c * 6 * (2 * xi - 1) / (L * L),
+  s.dNt << c * 6 * (2 * xi - 1) / (L * L), c * (6 * xi - 4 - Phi) / L, -c * 6 * (2 * xi - 1) / (L * L),
       c * (6 * xi - 2 + Phi) / L;
   return s;
 }
@@ -40,15 +32,12 @@ constexpr int kPlaneZ[4] = {2, 4, 8, 10};  // (u_z, th_y): t = -th_y
 constexpr double kSignZ[4] = {1, -1, 1, -1};
 
 // 4-point Gauss-Legendre on [0, 1]: exact for the degree-6 integrands here.
-constexpr double kGaussX[4] = {0.0694318442029737, 0.3300094782075719, 0.6699905217924281,
-                               0.9305681557970263};
-constexpr double kGaussW[4] = {0.1739274225687269, 0.3260725774312731, 0.3260725774312731,
-                               0.1739274225687269};
+constexpr double kGaussX[4] = {0.0694318442029737, 0.3300094782075719, 0.6699905217924281, 0.9305681557970263};
+constexpr double kGaussW[4] = {0.1739274225687269, 0.3260725774312731, 0.3260725774312731, 0.1739274225687269};
 
 }  // namespace
 
-Eigen::Matrix3d BeamFrame(const Eigen::Vector3d& x1, const Eigen::Vector3d& x2,
-                          const Eigen::Vector3d& v) {
+Eigen::Matrix3d BeamFrame(const Eigen::Vector3d& x1, const Eigen::Vector3d& x2, const Eigen::Vector3d& v) {
   const Eigen::Vector3d e1 = (x2 - x1).normalized();
   const Eigen::Vector3d e3 = e1.cross(v).normalized();
   const Eigen::Vector3d e2 = e3.cross(e1);
@@ -65,8 +54,7 @@ Matrix12d BeamTransformation(const Eigen::Matrix3d& R) {
   return T;
 }
 
-TimoshenkoBeam::TimoshenkoBeam(double L, const MaterialSpec& material,
-                               const SectionProperties& section, bool shear)
+TimoshenkoBeam::TimoshenkoBeam(double L, const MaterialSpec& material, const SectionProperties& section, bool shear)
     : L_(L), material_(material), section_(section) {
   const double G = material.E / (2.0 * (1.0 + material.nu));
   if (!shear) {
@@ -100,8 +88,8 @@ Eigen::Matrix<double, 6, 12> TimoshenkoBeam::StrainInterpolation(double xi) cons
   B(1, 9) = 1.0 / L_;
   const BendingShapes y = Bending(xi, L_, Phi_y_), z = Bending(xi, L_, Phi_z_);
   for (int a = 0; a < 4; ++a) {
-    B(2, kPlaneY[a]) = y.dNt[a];                       // curvature t'
-    B(3, kPlaneY[a]) = y.dN[a] - y.Nt[a];              // shear v' - t
+    B(2, kPlaneY[a]) = y.dNt[a];           // curvature t'
+    B(3, kPlaneY[a]) = y.dN[a] - y.Nt[a];  // shear v' - t
     B(4, kPlaneZ[a]) = kSignZ[a] * z.dNt[a];
     B(5, kPlaneZ[a]) = kSignZ[a] * (z.dN[a] - z.Nt[a]);
   }
@@ -111,8 +99,8 @@ Eigen::Matrix<double, 6, 12> TimoshenkoBeam::StrainInterpolation(double xi) cons
 Eigen::Matrix<double, 6, 1> TimoshenkoBeam::SectionStiffness() const {
   const double E = material_.E, G = E / (2.0 * (1.0 + material_.nu));
   Eigen::Matrix<double, 6, 1> D;
-  D << E * section_.A, G * section_.J, E * section_.Iz, section_.ky * G * section_.A,
-      E * section_.Iy, section_.kz * G * section_.A;
+  D << E * section_.A, G * section_.J, E * section_.Iz, section_.ky * G * section_.A, E * section_.Iy,
+      section_.kz * G * section_.A;
   return D;
 }
 
@@ -125,8 +113,8 @@ std::vector<TimoshenkoBeam::QuadraturePoint> TimoshenkoBeam::QuadraturePoints() 
     p.slope.setZero();
     const BendingShapes y = Bending(kGaussX[g], L_, Phi_y_), z = Bending(kGaussX[g], L_, Phi_z_);
     for (int a = 0; a < 4; ++a) {
-      p.slope(0, kPlaneY[a]) = y.dN[a];               // v'
-      p.slope(1, kPlaneZ[a]) = kSignZ[a] * z.dN[a];   // w'
+      p.slope(0, kPlaneY[a]) = y.dN[a];              // v'
+      p.slope(1, kPlaneZ[a]) = kSignZ[a] * z.dN[a];  // w'
     }
   }
   return points;
@@ -145,8 +133,7 @@ Matrix12d TimoshenkoBeam::LocalStiffness() const {
 Matrix12d TimoshenkoBeam::LocalMass() const {
   const double rho = material_.rho;
   Eigen::Matrix<double, 6, 1> m;
-  m << rho * section_.A, rho * section_.A, rho * section_.A, rho * section_.Ip,
-      rho * section_.Iy, rho * section_.Iz;
+  m << rho * section_.A, rho * section_.A, rho * section_.A, rho * section_.Ip, rho * section_.Iy, rho * section_.Iz;
   Matrix12d M = Matrix12d::Zero();
   for (int g = 0; g < 4; ++g) {
     const Matrix6x12d N = LocalInterpolation(kGaussX[g]);

@@ -25,8 +25,7 @@ using Matrix6x12d = Eigen::Matrix<double, 6, 12>;
 /// Local axes of a beam from x1 to x2: rows of the returned matrix are e1 (along the beam),
 /// e2, e3, with e3 = e1 x v / |e1 x v| and e2 = e3 x e1, v the orientation vector (lies in the
 /// local x-y plane). Precondition: v not parallel to x2 - x1.
-Eigen::Matrix3d BeamFrame(const Eigen::Vector3d& x1, const Eigen::Vector3d& x2,
-                          const Eigen::Vector3d& v);
+Eigen::Matrix3d BeamFrame(const Eigen::Vector3d& x1, const Eigen::Vector3d& x2, const Eigen::Vector3d& v);
 
 class TimoshenkoBeam {
  public:

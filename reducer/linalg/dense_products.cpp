@@ -25,7 +25,8 @@ void Gemm(const Eigen::Ref<const Eigen::MatrixXd>& A, bool transpose_a, const Ei
     return;
   }
   const int mi = int(m), ni = int(n), ki = int(k);
-  const int lda = int(std::max<Eigen::Index>(1, A.outerStride())), ldb = int(std::max<Eigen::Index>(1, B.outerStride()));
+  const int lda = int(std::max<Eigen::Index>(1, A.outerStride())),
+            ldb = int(std::max<Eigen::Index>(1, B.outerStride()));
   const int ldc = int(std::max<Eigen::Index>(1, C.outerStride()));
   dgemm_(transpose_a ? "T" : "N", transpose_b ? "T" : "N", &mi, &ni, &ki, &alpha, A.data(), &lda, B.data(), &ldb, &beta,
          C.data(), &ldc);

@@ -3,12 +3,11 @@
 // explicitly: OpenBLAS picks its kernels for the processor at run time and runs them on its
 // threads.
 //
-// Why explicit calls and not EIGEN_USE_BLAS: that macro redefines Eigen's product templates, so a program linking the reducer
-// and the solver (every test program, the solver benchmarks) had them compiled two ways under
-// the same names, a one-definition violation, and the solver's small products ran in whichever
-// the linker kept. The solver is built for Eigen's own kernels: femb-solve with EIGEN_USE_BLAS
-// measured 3% slower on one thread and 20% on two (OpenBLAS entered from both body threads at
-// once). Measured on the 1e5-DOF crank: the same reduction time, the same matrices to 6e-14.
+// Why explicit calls and not EIGEN_USE_BLAS: that macro redefines Eigen's product templates, so a program linking the
+// reducer and the solver (every test program, the solver benchmarks) had them compiled two ways under the same names, a
+// one-definition violation, and the solver's small products ran in whichever the linker kept. The solver is built for
+// Eigen's own kernels: femb-solve with EIGEN_USE_BLAS measured 3% slower on one thread and 20% on two (OpenBLAS entered
+// from both body threads at once). Measured on the 1e5-DOF crank: the same reduction time, the same matrices to 6e-14.
 #pragma once
 
 #include <Eigen/Core>

@@ -1,9 +1,10 @@
 #include "reducer/linalg/generalized_eigen.h"
 
-#include <Eigen/Eigenvalues>
-#include <Eigen/LU>
 #include <Spectra/MatOp/SparseSymMatProd.h>
 #include <Spectra/SymGEigsShiftSolver.h>
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/LU>
 #include <algorithm>
 #include <numeric>
 #include <stdexcept>
@@ -47,7 +48,8 @@ bool NothingToSolve(int nev, long n, long n_free, EigenResult* result) {
     return true;
   }
   if (nev > n_free) {
-    result->message = "asked for " + std::to_string(nev) + " eigenpairs of a " + std::to_string(n_free) + "-DOF problem";
+    result->message =
+        "asked for " + std::to_string(nev) + " eigenpairs of a " + std::to_string(n_free) + "-DOF problem";
     return true;
   }
   return false;
@@ -75,8 +77,8 @@ EigenResult LowestEigenpairs(const SparseMatrix& K, const SparseMatrix& M, int n
   return LowestConstrainedEigenpairs(K, M, Eigen::MatrixXd(0, K.rows()), nev, sigma, solve, dense_limit);
 }
 
-EigenResult LowestConstrainedEigenpairs(const SparseMatrix& K, const SparseMatrix& M, const Eigen::MatrixXd& C,
-                                        int nev, double sigma, const ShiftInvertFn& solve, long dense_limit) {
+EigenResult LowestConstrainedEigenpairs(const SparseMatrix& K, const SparseMatrix& M, const Eigen::MatrixXd& C, int nev,
+                                        double sigma, const ShiftInvertFn& solve, long dense_limit) {
   EigenResult result;
   const long n = K.rows();
   const long n_free = n - C.rows();
@@ -103,8 +105,7 @@ EigenResult LowestConstrainedEigenpairs(const SparseMatrix& K, const SparseMatri
   SolveShiftInvertOp op(&solve, n, sigma);
   Spectra::SparseSymMatProd<double> Bop(M);
   const Eigen::Index ncv = std::min<Eigen::Index>(n_free, std::max<Eigen::Index>(2 * nev + 1, 20));
-  Spectra::SymGEigsShiftSolver<SolveShiftInvertOp, Spectra::SparseSymMatProd<double>,
-                               Spectra::GEigsMode::ShiftInvert>
+  Spectra::SymGEigsShiftSolver<SolveShiftInvertOp, Spectra::SparseSymMatProd<double>, Spectra::GEigsMode::ShiftInvert>
       solver(op, Bop, nev, ncv, sigma);
   if (C.rows() > 0) {
     // Start inside the constrained space (the operator's range), so that no Ritz vector keeps a
@@ -116,12 +117,12 @@ EigenResult LowestConstrainedEigenpairs(const SparseMatrix& K, const SparseMatri
   } else {
     solver.init();
   }
-  const Eigen::Index converged = solver.compute(Spectra::SortRule::LargestMagn, 1000, 1e-10,
-                                                Spectra::SortRule::SmallestAlge);
+  const Eigen::Index converged =
+      solver.compute(Spectra::SortRule::LargestMagn, 1000, 1e-10, Spectra::SortRule::SmallestAlge);
   result.linear_solves = op.calls();
   if (solver.info() != Spectra::CompInfo::Successful || converged < nev) {
-    result.message = "shift-invert Lanczos converged " + std::to_string(converged) + " of " +
-                     std::to_string(nev) + " eigenpairs";
+    result.message =
+        "shift-invert Lanczos converged " + std::to_string(converged) + " of " + std::to_string(nev) + " eigenpairs";
     return result;
   }
   result.lambda = solver.eigenvalues();
@@ -200,7 +201,8 @@ EigenResult BlockLanczosEigenpairs(const SparseMatrix& K, const SparseMatrix& M,
     // A V y - theta V y = W y_new (y_new: y's rows of the newest block), so its M-norm is
     // sqrt(y_new^T (W^T M W) y_new): no n-sized work to test convergence.
     Eigen::MatrixXd W = AQ;
-    for (int pass = 0; pass < 2; ++pass) Gemm(V.leftCols(m), false, TransposeTimes(MV.leftCols(m), W), false, W, -1.0, 1.0);
+    for (int pass = 0; pass < 2; ++pass)
+      Gemm(V.leftCols(m), false, TransposeTimes(MV.leftCols(m), W), false, W, -1.0, 1.0);
     Eigen::MatrixXd MW = M * W;
     const Eigen::MatrixXd G = TransposeTimes(W, MW);
     if (m >= nev) {

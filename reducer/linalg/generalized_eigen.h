@@ -45,7 +45,8 @@ EigenResult BlockLanczosEigenpairs(const SparseMatrix& K, const SparseMatrix& M,
 /// The same for K x = lambda M x restricted to C x = 0 (C: `constraints`, c x n, may have no
 /// rows), with the shift-invert solve given as a function. The dense fallback projects on the
 /// null space of C.
-EigenResult LowestConstrainedEigenpairs(const SparseMatrix& K, const SparseMatrix& M, const Eigen::MatrixXd& constraints,
-                                        int nev, double sigma, const ShiftInvertFn& solve, long dense_limit = 200);
+EigenResult LowestConstrainedEigenpairs(const SparseMatrix& K, const SparseMatrix& M,
+                                        const Eigen::MatrixXd& constraints, int nev, double sigma,
+                                        const ShiftInvertFn& solve, long dense_limit = 200);
 
 }  // namespace femb

@@ -19,12 +19,18 @@ class Cholmod : public Eigen::CholmodSupernodalLLT<SparseMatrix, Eigen::Lower> {
 
 const char* OrderingName(int ordering) {
   switch (ordering) {
-    case CHOLMOD_NATURAL: return "natural";
-    case CHOLMOD_AMD: return "amd";
-    case CHOLMOD_METIS: return "metis";
-    case CHOLMOD_NESDIS: return "nesdis";
-    case CHOLMOD_COLAMD: return "colamd";
-    default: return "other";
+    case CHOLMOD_NATURAL:
+      return "natural";
+    case CHOLMOD_AMD:
+      return "amd";
+    case CHOLMOD_METIS:
+      return "metis";
+    case CHOLMOD_NESDIS:
+      return "nesdis";
+    case CHOLMOD_COLAMD:
+      return "colamd";
+    default:
+      return "other";
   }
 }
 

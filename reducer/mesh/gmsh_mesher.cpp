@@ -23,11 +23,20 @@ struct GmshSession {
 
 bool SolidTypeOfGmsh(int gmsh_type, SolidType* type) {
   switch (gmsh_type) {
-    case 4: *type = SolidType::kTet4; return true;
-    case 11: *type = SolidType::kTet10; return true;
-    case 5: *type = SolidType::kHex8; return true;
-    case 17: *type = SolidType::kHex20; return true;
-    default: return false;
+    case 4:
+      *type = SolidType::kTet4;
+      return true;
+    case 11:
+      *type = SolidType::kTet10;
+      return true;
+    case 5:
+      *type = SolidType::kHex8;
+      return true;
+    case 17:
+      *type = SolidType::kHex20;
+      return true;
+    default:
+      return false;
   }
 }
 
@@ -59,8 +68,8 @@ void RequireElementBudget(const MeshRequest& r) {
   std::snprintf(buffer, sizeof buffer,
                 "%s: mesh.size %.4g on a geometry of volume %.4g would give about %.3g elements, more than "
                 "mesh.max_elements = %ld: use a larger mesh.size (%.4g gives about %ld) or raise mesh.max_elements",
-                r.where.c_str(), h, volume, estimate, r.max_elements,
-                h * std::cbrt(estimate / double(r.max_elements)), r.max_elements);
+                r.where.c_str(), h, volume, estimate, r.max_elements, h * std::cbrt(estimate / double(r.max_elements)),
+                r.max_elements);
   throw ResourceLimitError(buffer);
 }
 

@@ -23,11 +23,11 @@ struct SolidMesh {
 };
 
 struct MeshRequest {
-  std::string shape;            ///< "box", "plate", "cylinder", "tube" or "" (file)
+  std::string shape;  ///< "box", "plate", "cylinder", "tube" or "" (file)
   Eigen::Vector3d size = Eigen::Vector3d::Ones();
   double radius = 0.0, inner_radius = 0.0, length = 0.0;  ///< cylinder / tube along z
-  std::string file;             ///< geometry or mesh file
-  double element_size = 0.0;    ///< target element size [length]
+  std::string file;                                       ///< geometry or mesh file
+  double element_size = 0.0;                              ///< target element size [length]
   int order = 2;
   bool hexahedra = false;       ///< structured hexahedra (built-in box only): HEX8 / HEX20
   long max_elements = 3000000;  ///< refuse to mesh when the estimated element count exceeds it

@@ -5,9 +5,8 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-#include <cerrno>
-
 #include <algorithm>
+#include <cerrno>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -75,7 +74,8 @@ ForeignMesh ReadWithMeshio(const std::string& path, const std::string& where, bo
   const char* env = std::getenv("FEMB_PYTHON");
   const std::string python = env && *env ? env : "/usr/bin/python3";
   if (!std::filesystem::exists(python)) {
-    throw InputError(where + ": reading " + path + " needs Debian's python3 and meshio: apt-get install python3-meshio");
+    throw InputError(where + ": reading " + path +
+                     " needs Debian's python3 and meshio: apt-get install python3-meshio");
   }
   const std::string bridge = BridgePath();
   if (!std::filesystem::exists(bridge)) {
@@ -122,8 +122,8 @@ ForeignMesh ReadWithMeshio(const std::string& path, const std::string& where, bo
   for (long i = 0; i < n; ++i)
     if (!(in >> mesh.ids[size_t(i)])) fail("node id " + std::to_string(i));
   if (!(in >> word >> type >> m >> k) || word != "cells") fail("no cell block");
-  const std::map<std::string, long> types = {{"tet4", 4}, {"tet10", 10}, {"hex8", 8}, {"hex20", 20}, {"tri3", 3},
-                                             {"tri6", 6}, {"quad4", 4}, {"quad8", 8}, {"line2", 2}};
+  const std::map<std::string, long> types = {{"tet4", 4}, {"tet10", 10}, {"hex8", 8},  {"hex20", 20}, {"tri3", 3},
+                                             {"tri6", 6}, {"quad4", 4},  {"quad8", 8}, {"line2", 2}};
   const auto found = types.find(type);
   if (found == types.end()) fail("cell type '" + type + "'");  // it once fell back to hex20 silently
   if (m <= 0 || k != found->second) fail(type + " cells with " + std::to_string(k) + " nodes");
@@ -149,8 +149,10 @@ ForeignMesh ReadWithMeshio(const std::string& path, const std::string& where, bo
 
 SolidMesh ImportWithMeshio(const std::string& path, const std::string& where) {
   ForeignMesh foreign = ReadWithMeshio(path, where, false);
-  const std::map<std::string, SolidType> types = {
-      {"tet4", SolidType::kTet4}, {"tet10", SolidType::kTet10}, {"hex8", SolidType::kHex8}, {"hex20", SolidType::kHex20}};
+  const std::map<std::string, SolidType> types = {{"tet4", SolidType::kTet4},
+                                                  {"tet10", SolidType::kTet10},
+                                                  {"hex8", SolidType::kHex8},
+                                                  {"hex20", SolidType::kHex20}};
   const auto found = types.find(foreign.cell_type);
   if (found == types.end()) throw InputError(where + ": " + path + " has no volume elements");
   SolidMesh mesh;

@@ -50,7 +50,8 @@ std::vector<int> SelectNodes(const NodeSelectionSpec& s, const Eigen::MatrixXd& 
   }
   if (selected.empty()) {
     char b[200];
-    std::snprintf(b, sizeof b, "selects no node: the nearest of the %ld mesh nodes is %.4g from it, the tolerance is %.4g",
+    std::snprintf(b, sizeof b,
+                  "selects no node: the nearest of the %ld mesh nodes is %.4g from it, the tolerance is %.4g",
                   long(nodes.rows()), nearest, tol);
     throw InputError(s.where + ": interface '" + interface + "': the " + DescribeSelection(s) + " " + b +
                      " (check the units and the position, or set select.tolerance)");

@@ -1,6 +1,5 @@
 #include "reducer/reduction/craig_bampton.h"
 
-
 #include <Eigen/Cholesky>
 #include <Eigen/Geometry>
 #include <Eigen/SparseCholesky>
@@ -35,8 +34,8 @@ struct Blocks {
   Eigen::MatrixXd bb;
 };
 
-Blocks Partition(const SparseMatrix& A, const std::vector<int>& interior_index,
-                 const std::vector<int>& boundary_index, int n_i, int n_b) {
+Blocks Partition(const SparseMatrix& A, const std::vector<int>& interior_index, const std::vector<int>& boundary_index,
+                 int n_i, int n_b) {
   // Interior and boundary indices keep the order of A, so each block fills column by column
   // with rows ascending: built in place, no triplet list (A may hold 1e8 entries).
   Blocks out;
@@ -139,7 +138,8 @@ Eigen::MatrixXd InertiaFields(const FeModel& model) {
   // Solids: exact on the free mesh nodes; a least-squares rigid fit on an RBE2 face, whose DOFs
   // the load cases hold anyway.
   Eigen::MatrixXd A_mesh(model.mesh_map.rows(), 12);
-  for (long k = 0; k < model.n_nodes(); ++k) A_mesh.middleRows(3 * k, 3) = InertiaFieldAt(model.nodes.row(k).transpose());
+  for (long k = 0; k < model.n_nodes(); ++k)
+    A_mesh.middleRows(3 * k, 3) = InertiaFieldAt(model.nodes.row(k).transpose());
   return ModelFieldsFromMesh(model, A_mesh);
 }
 
@@ -209,9 +209,9 @@ std::vector<int> InteriorDofs(const FeModel& model) {
   return interior;
 }
 
-CraigBamptonResult CraigBamptonReduce(const FeModel& model, int internal_modes,
-                                      const ProgressFn& progress, long dense_limit, double memory_limit_bytes,
-                                      const DerivativeRequest* derivatives, const Eigen::MatrixXd* inertia_fields) {
+CraigBamptonResult CraigBamptonReduce(const FeModel& model, int internal_modes, const ProgressFn& progress,
+                                      long dense_limit, double memory_limit_bytes, const DerivativeRequest* derivatives,
+                                      const Eigen::MatrixXd* inertia_fields) {
   CraigBamptonResult r;
   Stopwatch clock;
   const int n = int(model.n_dofs());
@@ -371,10 +371,10 @@ CraigBamptonResult CraigBamptonReduce(const FeModel& model, int internal_modes,
   // One mode more than kept (when there is one): its frequency tells whether the cut splits
   // equal modes.
   const int nev = internal_modes > 0 && internal_modes + 1 <= n_i - n_c ? internal_modes + 1 : internal_modes;
-  EigenResult eig =
-      n_i <= dense_limit || 2 * nev + 1 > n_i - n_c
-          ? LowestConstrainedEigenpairs(K.ii, M.ii, C, nev, 0.0, solve, dense_limit)
-          : BlockLanczosEigenpairs(K.ii, M.ii, C, nev, 0.0, constrained_solve, kLanczosBlock, kLanczosTolerance, &passes);
+  EigenResult eig = n_i <= dense_limit || 2 * nev + 1 > n_i - n_c
+                        ? LowestConstrainedEigenpairs(K.ii, M.ii, C, nev, 0.0, solve, dense_limit)
+                        : BlockLanczosEigenpairs(K.ii, M.ii, C, nev, 0.0, constrained_solve, kLanczosBlock,
+                                                 kLanczosTolerance, &passes);
   if (!eig.ok) {
     r.message = "fixed-interface eigen solve failed: " + eig.message;
     return r;

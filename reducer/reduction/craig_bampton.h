@@ -37,14 +37,14 @@ struct DerivativeRequest {
 
 struct CraigBamptonResult {
   bool ok = false;
-  std::string message;        ///< why it failed (numerical), when !ok
-  Eigen::MatrixXd K, M;       ///< reduced, n_r x n_r
-  Eigen::VectorXd lambda;     ///< internal eigenvalues omega^2, ascending
+  std::string message;     ///< why it failed (numerical), when !ok
+  Eigen::MatrixXd K, M;    ///< reduced, n_r x n_r
+  Eigen::VectorXd lambda;  ///< internal eigenvalues omega^2, ascending
   /// The eigenvalue after the last internal mode kept, solved for to tell whether the cut splits
   /// a group of equal frequencies (a round or square section, a symmetric part); 0 when none is
   /// left to solve for.
   double next_lambda = 0.0;
-  Eigen::MatrixXd shapes;     ///< n_full x n_r: full DOF field of each reduced coordinate
+  Eigen::MatrixXd shapes;  ///< n_full x n_r: full DOF field of each reduced coordinate
   FactorizationInfo factorization;
   long eigen_linear_solves = 0;
   bool dense_eigen = false;
@@ -59,9 +59,9 @@ struct CraigBamptonResult {
 /// `internal_modes` fixed-interface modes are kept. Reports stages through `progress`. With
 /// `memory_limit_bytes` > 0, refuses (factorization.too_big) when the factor of K_ii would not fit.
 /// `derivatives` (optional) appends modal derivatives to the basis.
-CraigBamptonResult CraigBamptonReduce(const FeModel& model, int internal_modes,
-                                      const ProgressFn& progress, long dense_limit = 200,
-                                      double memory_limit_bytes = 0, const DerivativeRequest* derivatives = nullptr,
+CraigBamptonResult CraigBamptonReduce(const FeModel& model, int internal_modes, const ProgressFn& progress,
+                                      long dense_limit = 200, double memory_limit_bytes = 0,
+                                      const DerivativeRequest* derivatives = nullptr,
                                       const Eigen::MatrixXd* inertia_fields = nullptr);
 
 /// The six rigid-body motions (translations, rotations about the part origin) as fields on the

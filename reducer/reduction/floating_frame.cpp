@@ -15,7 +15,8 @@ namespace {
 std::optional<SparseMatrix> CenterOfMassInterpolation(const std::string& where, const FeModel& model,
                                                       const Eigen::Vector3d& c) {
   if (!model.interpolate_at) {
-    throw InputError(where + ": floating_frame center_of_mass interpolates the field at the centre of mass, and this "
+    throw InputError(where +
+                     ": floating_frame center_of_mass interpolates the field at the centre of mass, and this "
                      "model's mesh has no volume cells to interpolate in (an imported surface or line mesh): use "
                      "floating_frame: mean_axes");
   }
@@ -43,9 +44,8 @@ void CheckFloatingFrame(const std::string& type, const std::string& where, const
   CenterOfMassInterpolation(where, model, c);
 }
 
-FloatingFrame ComputeFloatingFrame(const std::string& type, const std::string& where,
-                                   const Superelement& se, const FeModel& model,
-                                   const Eigen::MatrixXd& shapes) {
+FloatingFrame ComputeFloatingFrame(const std::string& type, const std::string& where, const Superelement& se,
+                                   const FeModel& model, const Eigen::MatrixXd& shapes) {
   FloatingFrame frame;
   frame.type = type;
   const int n_r = se.n_reduced_dofs(), N = se.n_interface_nodes();

@@ -20,9 +20,8 @@ namespace femb {
 
 /// `se` must have interfaces, K, M and mass_properties set; `shapes` is n_full x n_r.
 /// Throws InputError (prefixed by `where`) for center_of_mass outside the material.
-FloatingFrame ComputeFloatingFrame(const std::string& type, const std::string& where,
-                                   const Superelement& se, const FeModel& model,
-                                   const Eigen::MatrixXd& shapes);
+FloatingFrame ComputeFloatingFrame(const std::string& type, const std::string& where, const Superelement& se,
+                                   const FeModel& model, const Eigen::MatrixXd& shapes);
 
 /// The refusals of `type` that need only the model's mesh and mass, before any reduction work:
 /// center_of_mass without volume cells or with the centre of mass (from the full M and the rigid

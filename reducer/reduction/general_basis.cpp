@@ -43,7 +43,8 @@ GeneralBasisResult ReduceOnGeneralBasis(const FeModel& model, const Eigen::Matri
   for (int k = 0; k < g.size(); ++k)
     if (g[k] > 1e-10 * g_max) keep.push_back(k);
   Eigen::MatrixXd Q(V.rows(), long(keep.size()));
-  for (size_t j = 0; j < keep.size(); ++j) Q.col(long(j)) = V * gram.eigenvectors().col(keep[j]) / std::sqrt(g[keep[j]]);
+  for (size_t j = 0; j < keep.size(); ++j)
+    Q.col(long(j)) = V * gram.eigenvectors().col(keep[j]) / std::sqrt(g[keep[j]]);
   r.columns_kept = int(Q.cols());
 
   // 2. The interface span (8.12) and its SVD, rotation rows scaled by the part's size L so that
@@ -115,8 +116,9 @@ GeneralBasisResult ReduceOnGeneralBasis(const FeModel& model, const Eigen::Matri
     const Eigen::MatrixXd Mpp = TransposeTimes(Psi, Eigen::MatrixXd(model.M * Psi));
     Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> eig(Kpp, 0.5 * (Mpp + Mpp.transpose()));
     if (eig.info() != Eigen::Success || !(eig.eigenvalues().minCoeff() > 0)) {
-      r.message = "the shapes' internal part (zero at the interfaces) has no stiffness in some direction (a mechanism "
-                  "or a dependent shape): the basis cannot carry it";
+      r.message =
+          "the shapes' internal part (zero at the interfaces) has no stiffness in some direction (a mechanism "
+          "or a dependent shape): the basis cannot carry it";
       r.input_error = true;
       return r;
     }

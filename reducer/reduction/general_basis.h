@@ -17,12 +17,12 @@
 //         suppressed". The SVD is taken of L Phi_IP (rotation rows times the part's size L, so
 //         that every row is a length); its left singular vectors past the rank, U_2, give the
 //         constraint C q_int = 0 with C = E L (r x 6N, r = 6N - m; E the reduced row echelon
-//         form of U_2^T with unit rows, so that each row involves few coordinates), stored in the file for femb-solve to enforce with multipliers
-//         (SuperelementBody::InterfaceConstraint). Phi0 = V (L Phi_IP)^+ L moves the spanned
-//         directions; the constrained ones get the static constraint modes' field
-//         Psi_c L^-1 U_2 U_2^T L (when `static_modes` are given; else none): it never deforms the
-//         body (the constraint holds their coordinates at zero) but keeps K and M regular
-//         outside the constraint, so that every check and analysis of a file applies unchanged;
+//         form of U_2^T with unit rows, so that each row involves few coordinates), stored in the file for femb-solve
+//         to enforce with multipliers (SuperelementBody::InterfaceConstraint). Phi0 = V (L Phi_IP)^+ L moves the
+//         spanned directions; the constrained ones get the static constraint modes' field Psi_c L^-1 U_2 U_2^T L (when
+//         `static_modes` are given; else none): it never deforms the body (the constraint holds their coordinates at
+//         zero) but keeps K and M regular outside the constraint, so that every check and analysis of a file applies
+//         unchanged;
 //  3. Phi is condensed within the basis, Phi = Phi0 - Psi0 (Psi0^T K Psi0)^-1 Psi0^T K Phi0: the
 //     least-strain-energy field of span V for each unit interface motion. The pseudo-inverse of
 //     (8.13) is one of many right inverses of Phi_IP; this one reproduces rigid-body motions
@@ -43,13 +43,13 @@ namespace femb {
 
 struct GeneralBasisResult {
   bool ok = false;
-  std::string message;     ///< why not (input: an unspanned interface direction; or numerical)
-  bool input_error = false;  ///< the shapes cannot serve as a basis (case 4, or no internal stiffness)
-  Eigen::MatrixXd shapes;  ///< n_dofs x (6N + k): [Phi, Psi]
-  Eigen::MatrixXd K, M;    ///< reduced
-  Eigen::VectorXd lambda;  ///< internal eigenvalues, ascending
+  std::string message;                      ///< why not (input: an unspanned interface direction; or numerical)
+  bool input_error = false;                 ///< the shapes cannot serve as a basis (case 4, or no internal stiffness)
+  Eigen::MatrixXd shapes;                   ///< n_dofs x (6N + k): [Phi, Psi]
+  Eigen::MatrixXd K, M;                     ///< reduced
+  Eigen::VectorXd lambda;                   ///< internal eigenvalues, ascending
   int columns_given = 0, columns_kept = 0;  ///< of V (+ rigid fields), after dropping dependent ones
-  int interface_rank = 0;  ///< m
+  int interface_rank = 0;                   ///< m
   /// Case 4 (m < 6N): C (r x 6N) with C q_int = 0 on the local interface coordinates; no rows
   /// otherwise. L: the size that scales its rotation columns (C q_int is a length).
   Eigen::MatrixXd interface_constraint;

@@ -93,7 +93,6 @@ void DriveForces(const DofMap& dofs, const Eigen::VectorXd& residual, Eigen::Vec
 
 using namespace dynamic_internal;
 
-
 namespace {
 
 // The free accelerations from M_g Wdot = f_ext - f_int - f_gyro at s (prescribed ones as set),
@@ -116,8 +115,9 @@ void ConsistentAccelerations(const SystemModel& model, const DofMap& dofs, Dynam
     M = b.M + ToMatrix(dofs.n_dofs(), G);
     const double L = std::max(BoundingDiagonal(model.node_x0), 1e-300);
     double speed = 0.0;
-    for (int k = 0; k < model.n_nodes(); ++k) speed = std::max(speed, NodeMotion(s.config, k, s.W).head<3>().norm() +
-                                                                         L * NodeMotion(s.config, k, s.W).tail<3>().norm());
+    for (int k = 0; k < model.n_nodes(); ++k)
+      speed = std::max(
+          speed, NodeMotion(s.config, k, s.W).head<3>().norm() + L * NodeMotion(s.config, k, s.W).tail<3>().norm());
     const int m = dofs.n_multipliers();
     rhs.tail(m).setZero();
     if (speed > 0) {
@@ -177,8 +177,10 @@ DynamicState InitialDynamicState(const SystemModel& model, const SystemState& co
   // would be an impulsive start.
   bool free_at_rest = true, driven = false;
   for (int j = 0; j < dofs.n_dofs(); ++j) {
-    if (dofs.prescribed(j)) driven |= s.W[j] != 0.0;
-    else free_at_rest &= s.W[j] == 0.0;
+    if (dofs.prescribed(j))
+      driven |= s.W[j] != 0.0;
+    else
+      free_at_rest &= s.W[j] == 0.0;
   }
   if (driven && free_at_rest) {
     SystemState copy = s.config;
@@ -229,7 +231,7 @@ std::string UnresolvedModesWarning(const SystemModel& model, double h) {
   }
   if (worst < 0 || omega * h <= 1.0) return "";
   const std::string name = size_t(worst) < model.body_names.size() ? "'" + model.body_names[size_t(worst)] + "'"
-                                                                    : "number " + std::to_string(worst + 1);
+                                                                   : "number " + std::to_string(worst + 1);
   char buffer[600];
   std::snprintf(buffer, sizeof buffer,
                 "the midpoint integrator neither damps nor resolves body %s's highest mode, %.4g Hz, at steps of up to "
@@ -271,7 +273,8 @@ DynamicStepReport MeasureWith(const SystemModel& model, const DofMap& dofs, cons
   };
   if (passes.size() == model.bodies.size() && measures) {
     measures->resize(size_t(n_bodies));
-    ForEachBody(threads, n_bodies, [&](int b) { measure(b, passes[size_t(b)].data, passes[size_t(b)].w, (*measures)[size_t(b)]); });
+    ForEachBody(threads, n_bodies,
+                [&](int b) { measure(b, passes[size_t(b)].data, passes[size_t(b)].w, (*measures)[size_t(b)]); });
     for (const BodyMeasure& m : *measures) add(m);
     return r;
   }
@@ -293,10 +296,7 @@ double EnergyNoise(double mass, const SystemState& config, double h) {
 }
 }  // namespace
 
-DynamicStepReport Measure(const SystemModel& model, DynamicState& s) {
-  return MeasureWith(model, model.dofs(), s, {});
-}
-
+DynamicStepReport Measure(const SystemModel& model, DynamicState& s) { return MeasureWith(model, model.dofs(), s, {}); }
 
 DynamicResult SolveDynamic(const SystemModel& model, DynamicState& state, const DynamicOptions& options,
                            const std::function<void(const DynamicStepReport&, const DynamicState&)>& on_step) {
@@ -409,7 +409,9 @@ DynamicResult SolveDynamic(const SystemModel& model, DynamicState& state, const 
     count_factorizations();
     return result;
   };
-  const auto before_end = [&] { return state.t < options.end_time - 1e-12 * std::max(std::abs(options.end_time), options.step); };
+  const auto before_end = [&] {
+    return state.t < options.end_time - 1e-12 * std::max(std::abs(options.end_time), options.step);
+  };
   while (before_end()) {
     if (options.adaptive) {
       h = control.Fit(state.t, h);
@@ -472,8 +474,8 @@ DynamicResult SolveDynamic(const SystemModel& model, DynamicState& state, const 
       ++result.newton_cuts;
       if (cuts >= options.max_cuts) {
         char buffer[200];
-        std::snprintf(buffer, sizeof buffer, "Newton diverged at t = %.6g after %d step cuts (step %.3g)",
-                      state.t, cuts, h);
+        std::snprintf(buffer, sizeof buffer, "Newton diverged at t = %.6g after %d step cuts (step %.3g)", state.t,
+                      cuts, h);
         return fail(buffer);
       }
       h *= 0.5;
@@ -522,7 +524,8 @@ DynamicResult SolveDynamic(const SystemModel& model, DynamicState& state, const 
     result.steps += 1;
     result.newton_iterations += step.iterations;
     static const std::vector<BodyPass> kNone;
-    DynamicStepReport r = MeasureWith(model, dofs, state, step.passes_kept ? work.passes : kNone, &threads, &work.measures);
+    DynamicStepReport r =
+        MeasureWith(model, dofs, state, step.passes_kept ? work.passes : kNone, &threads, &work.measures);
     r.h = h;
     r.iterations = step.iterations;
     r.rejected = result.rejected_by_error + result.newton_cuts;
@@ -573,7 +576,8 @@ DynamicResult SolveDynamic(const SystemModel& model, DynamicState& state, const 
   }
   count_factorizations();
   if (options.integrator == Integrator::kMidpoint) {
-    if (const std::string w = UnresolvedModesWarning(model, result.largest_step); !w.empty()) result.warnings.push_back(w);
+    if (const std::string w = UnresolvedModesWarning(model, result.largest_step); !w.empty())
+      result.warnings.push_back(w);
   }
   if (!options.adaptive && first_cut_time >= 0) {
     // A fixed step that Newton could not take was replaced: said once, with the step used.

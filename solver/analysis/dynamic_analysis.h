@@ -11,7 +11,8 @@
 // Both cut the step when Newton diverges. Steps are fixed, or error-controlled (`adaptive`):
 // the local error of the positions (and what the velocities' error moves them over a step) is
 // estimated from the accelerations of the steps taken (dynamic_analysis.cpp, "Error-controlled
-// steps") and kept below step_tolerance of the model's motion; steps land on the kinks and jumps of the loads and drives and on output times.
+// steps") and kept below step_tolerance of the model's motion; steps land on the kinks and jumps of the loads and
+// drives and on output times.
 #pragma once
 
 #include <atomic>
@@ -54,12 +55,12 @@ struct DynamicOptions {
   /// a SIGINT or SIGTERM (solver/stop_request.h).
   const std::atomic<int>* stop = nullptr;
   Integrator integrator = Integrator::kGeneralizedAlpha;
-  double step = 1e-3;         ///< time step h [time]
+  double step = 1e-3;  ///< time step h [time]
   double end_time = 1.0;
-  double rho_inf = 0.9;       ///< spectral radius at infinity in [0, 1]; 1: no numerical damping
+  double rho_inf = 0.9;  ///< spectral radius at infinity in [0, 1]; 1: no numerical damping
   int max_iterations = 20;
-  double tolerance = 1e-9;    ///< ||residual|| <= tol * (force scale of the step)
-  int max_cuts = 8;           ///< halvings of the step before giving up
+  double tolerance = 1e-9;  ///< ||residual|| <= tol * (force scale of the step)
+  int max_cuts = 8;         ///< halvings of the step before giving up
   /// Which iterations factor the iteration matrix anew (JacobianReuseOf). Unset: kStep with
   /// generalized-alpha, once a step as Adams' pattern T:F:F:F; the residual is exact, so the
   /// converged motion is the same to the Newton tolerance, and a step's later iterations (where
@@ -103,10 +104,10 @@ struct DynamicOptions {
   /// size), within [min_step, max_step]. A step below min_step is a failure.
   bool adaptive = false;
   double step_tolerance = 1e-5;
-  double min_step = 0.0;     ///< 0: 1e-8 of the analysed time span
-  double max_step = 0.0;     ///< 0: 1/100 of the analysed time span
-  double output_step = 0.0;  ///< > 0: DynamicStepReport::output marks the steps at its multiples
-                             ///< (adaptive steps land on them; fixed steps: the first at or after)
+  double min_step = 0.0;            ///< 0: 1e-8 of the analysed time span
+  double max_step = 0.0;            ///< 0: 1/100 of the analysed time span
+  double output_step = 0.0;         ///< > 0: DynamicStepReport::output marks the steps at its multiples
+                                    ///< (adaptive steps land on them; fixed steps: the first at or after)
   std::vector<double> breakpoints;  ///< adaptive steps land on these times (kinks and jumps of loads, drives)
   /// Threads for the bodies' forces and matrices (generalized-alpha; solver/parallel.h). The
   /// results are the same bits for any number.
@@ -148,8 +149,8 @@ struct DynamicStepReport {
   double t = 0.0;
   double h = 0.0;
   int iterations = 0;
-  long rejected = 0;    ///< steps rejected so far (error test and Newton failures)
-  bool output = true;   ///< at an output time (DynamicOptions::output_step)
+  long rejected = 0;   ///< steps rejected so far (error test and Newton failures)
+  bool output = true;  ///< at an output time (DynamicOptions::output_step)
   double kinetic_energy = 0.0, elastic_energy = 0.0, external_work = 0.0;
   Eigen::Vector3d linear_momentum = Eigen::Vector3d::Zero();
   Eigen::Vector3d angular_momentum = Eigen::Vector3d::Zero();
@@ -161,14 +162,14 @@ struct DynamicResult {
   int stopped = 0;  ///< the stop request's value when the run stopped on it (ok, before end_time), else 0
   std::vector<std::string> warnings;  ///< said once each (energy growth below the stop limit)
   long steps = 0;
-  long rejected_by_error = 0;  ///< adaptive steps: tried and rejected by the error test
-  long newton_cuts = 0;        ///< steps cut because Newton diverged
+  long rejected_by_error = 0;                      ///< adaptive steps: tried and rejected by the error test
+  long newton_cuts = 0;                            ///< steps cut because Newton diverged
   double smallest_step = 0.0, largest_step = 0.0;  ///< of the steps taken (0 when none)
   double smallest_step_time = 0.0;                 ///< where the smallest one ended
   long newton_iterations = 0;
-  long factorizations = 0;  ///< of the iteration matrix
-  long pattern_analyses = 0;  ///< of its sparsity pattern (once unless the pattern changes)
-  long pivoted = 0;           ///< factorizations that chose their pivots anew (the others reused them)
+  long factorizations = 0;          ///< of the iteration matrix
+  long pattern_analyses = 0;        ///< of its sparsity pattern (once unless the pattern changes)
+  long pivoted = 0;                 ///< factorizations that chose their pivots anew (the others reused them)
   long body_matrices_computed = 0;  ///< bodies' inertia matrices computed (body_matrices_every), all bodies
   long body_matrices_turned = 0;    ///< and turned with their frames instead
 };

@@ -4,8 +4,8 @@
 // other code.
 //
 // Storage: a step of either integrator allocates nothing once the first steps have
-// sized everything (tests/solver/analysis/allocation_free_test.cpp counts it). Everything a step or an iteration needs lives in the BodyWorkspace
-// (the midpoint scheme's in its MidpointWorkspace), in each body's Data (its scratch) or in
+// sized everything (tests/solver/analysis/allocation_free_test.cpp counts it). Everything a step or an iteration needs
+// lives in the BodyWorkspace (the midpoint scheme's in its MidpointWorkspace), in each body's Data (its scratch) or in
 // thread_local scratch of the joint-tree and force functions, and is written in place: no Eigen object
 // returned by value, no product of dynamic-size blocks assigned without noalias() or a fixed-size
 // holder, no std::function built per call (BodyTask), no std::optional reset that frees.
@@ -35,7 +35,7 @@ struct Assembly {
   // each unknown's residual by it (ScaledFreeNorm), so that one stiff body's forces set the
   // tolerance of its own unknowns only.
   Eigen::VectorXd dof_scale;
-  double roundoff = 0.0;  // residual noise from the round-off of absolute positions
+  double roundoff = 0.0;   // residual noise from the round-off of absolute positions
   NodeForces node_forces;  // per node, residual sense (for the reactions)
 };
 
@@ -122,23 +122,23 @@ struct StepColumnMap {
 // end coordinates' increments (delta, as Newton applies them at n+1) to the mid configuration and
 // to the end velocities.
 struct MidpointKinematics {
-  Eigen::VectorXd delta;  // Delta
-  Eigen::VectorXd W1;     // W_n+1 from the kinematics
-  Eigen::VectorXd half;   // the increment from q_n to q_m
-  SystemState mid;        // q_m
-  StepColumnMap T;        // d q_m / d delta: 1/2 off the rotation nodes
-  StepColumnMap V;        // d W_n+1 / d delta: 2/h off the rotation nodes
-  std::vector<Eigen::Matrix<double, 6, 1>> node_w1;  // every node's velocity at n+1 (EndNodeVelocity)
+  Eigen::VectorXd delta;                               // Delta
+  Eigen::VectorXd W1;                                  // W_n+1 from the kinematics
+  Eigen::VectorXd half;                                // the increment from q_n to q_m
+  SystemState mid;                                     // q_m
+  StepColumnMap T;                                     // d q_m / d delta: 1/2 off the rotation nodes
+  StepColumnMap V;                                     // d W_n+1 / d delta: 2/h off the rotation nodes
+  std::vector<Eigen::Matrix<double, 6, 1>> node_w1;    // every node's velocity at n+1 (EndNodeVelocity)
   std::vector<Eigen::Matrix<double, 6, 1>> node_step;  // every node's (x_n+1 - x_n, log(R_n+1 R_n^T))
 };
 
 // One body's storage in a midpoint step (its data at q_n+1 is the BodyWorkspace's pass).
 struct MidpointBody {
-  SuperelementBody::Data d0, dm;  // at q_n (once per step) and at q_m
+  SuperelementBody::Data d0, dm;                   // at q_n (once per step) and at q_m
   Eigen::Vector3d com0 = Eigen::Vector3d::Zero();  // the centre of mass at q_n
   Eigen::VectorXd w0, p0, p1, p_mean, wm, w_first, w_second, dw, wdot, s_first, s_second, u, Du;
   Eigen::MatrixXd d_w, d_p;
-  Eigen::MatrixXd S_b;  // the body's combined iteration matrix (MidpointMatrix)
+  Eigen::MatrixXd S_b;          // the body's combined iteration matrix (MidpointMatrix)
   SuperelementBody::Data side;  // the exact inertia: MomentumConfigurationTangent's perturbed data
   InertiaLoadFactors load;
 };
@@ -179,11 +179,11 @@ struct BodyWorkspace {
     Eigen::MatrixXd M_frame, C_frame, K_frame;
     int age = -1;
   };
-  std::vector<BodyMatrices> matrices;  // the last matrix pass
+  std::vector<BodyMatrices> matrices;               // the last matrix pass
   long matrices_computed = 0, matrices_turned = 0;  // body matrix passes of each kind, all bodies
-  std::vector<BodyMeasure> measures;                 // the step's measures, per body
-  Triplets K, C, M;                    // its system triplets (cleared, capacity kept)
-  TripletAssembler K_build, C_build, M_build;  // their sparse matrices (slots kept)
+  std::vector<BodyMeasure> measures;                // the step's measures, per body
+  Triplets K, C, M;                                 // its system triplets (cleared, capacity kept)
+  TripletAssembler K_build, C_build, M_build;       // their sparse matrices (slots kept)
   // The system-level storage of an assembly and of a step, kept so that neither allocates.
   AssemblyParts parts;
   Assembly assembly;
@@ -231,8 +231,8 @@ struct MatrixCombination {
 // alone with `which` kInertia (everything else computed every time), all of them with kAll; 1:
 // all computed at s.
 void AddDynamicMatrices(const SystemModel& model, const DofMap& dofs, const DynamicState& s, double t,
-                        BodyWorkspace& work, bool full_inertia_tangent, Assembly& out,
-                        BodyThreads* threads = nullptr, const MatrixCombination* combine = nullptr, int every = 1,
+                        BodyWorkspace& work, bool full_inertia_tangent, Assembly& out, BodyThreads* threads = nullptr,
+                        const MatrixCombination* combine = nullptr, int every = 1,
                         BodyMatricesKept which = BodyMatricesKept::kAll);
 
 // Residual and (with `matrices`) K, C, M at s, with a workspace of its own.

@@ -90,13 +90,16 @@ std::string DescribeSingular(const SystemModel& model, const DofMap& dofs, const
     modal |= p.text.rfind("body ", 0) == 0;
     ++count;
   }
-  const int more = int(std::count_if(parts.begin(), parts.end(), [&](const Part& p) { return p.weight >= 0.1 * largest; })) - count;
+  const int more =
+      int(std::count_if(parts.begin(), parts.end(), [&](const Part& p) { return p.weight >= 0.1 * largest; })) - count;
   if (more > 0) listed += "; and " + std::to_string(more) + " more";
   char head[160];
-  std::snprintf(head, sizeof head, "the system matrix is singular (%d free motion%s, smallest/largest singular value %.1e): ",
+  std::snprintf(head, sizeof head,
+                "the system matrix is singular (%d free motion%s, smallest/largest singular value %.1e): ",
                 rank_deficiency, rank_deficiency > 1 ? "s" : "", sigma[n - 1] / sigma[0]);
-  const std::string cause = modal ? "; a modal coordinate with neither stiffness nor mass, or a body held by nothing"
-                                  : "; a missing joint or support (in a static analysis every rigid motion must be held)";
+  const std::string cause = modal
+                                ? "; a modal coordinate with neither stiffness nor mass, or a body held by nothing"
+                                : "; a missing joint or support (in a static analysis every rigid motion must be held)";
   return head + listed + cause;
 }
 

@@ -30,7 +30,8 @@ int NegativeEigenvalues(const DofMap& dofs, const SystemMatrix& S) {
 // geometric stiffness): its first step is this one, along the rod, and the next tangent is
 // regular. False above the dense limit or when the residual drives a free motion (a missing
 // support: the caller names it).
-bool MinimumNormStep(const DofMap& dofs, const SystemMatrix& S, const Eigen::VectorXd& residual, Eigen::VectorXd* delta) {
+bool MinimumNormStep(const DofMap& dofs, const SystemMatrix& S, const Eigen::VectorXd& residual,
+                     Eigen::VectorXd* delta) {
   const std::vector<int>& free = dofs.solved();
   const int n = int(free.size());
   if (n == 0 || n > kDenseLimit) return false;
@@ -41,15 +42,17 @@ bool MinimumNormStep(const DofMap& dofs, const SystemMatrix& S, const Eigen::Vec
     d[i] = a > 0 ? 1.0 / std::sqrt(a) : 1.0;
     r[i] = d[i] * residual[free[size_t(i)]];
   }
-  const Eigen::BDCSVD<Eigen::MatrixXd> svd(d.asDiagonal() * A * d.asDiagonal(), Eigen::ComputeFullU | Eigen::ComputeFullV);
+  const Eigen::BDCSVD<Eigen::MatrixXd> svd(d.asDiagonal() * A * d.asDiagonal(),
+                                           Eigen::ComputeFullU | Eigen::ComputeFullV);
   const Eigen::VectorXd& sv = svd.singularValues();
   int rank = 0;
   while (rank < n && sv[rank] > 1e-13 * sv[0]) ++rank;
   if (rank == n || rank == 0) return false;
   const Eigen::VectorXd driven = svd.matrixU().rightCols(n - rank).transpose() * r;
   if (driven.norm() > 1e-8 * r.norm()) return false;
-  const Eigen::VectorXd step = d.asDiagonal() * (svd.matrixV().leftCols(rank) *
-                                                 (svd.matrixU().leftCols(rank).transpose() * r).cwiseQuotient(sv.head(rank)));
+  const Eigen::VectorXd step =
+      d.asDiagonal() *
+      (svd.matrixV().leftCols(rank) * (svd.matrixU().leftCols(rank).transpose() * r).cwiseQuotient(sv.head(rank)));
   *delta = Eigen::VectorXd::Zero(dofs.n_dofs());
   for (int i = 0; i < n; ++i) (*delta)[free[size_t(i)]] = step[i];
   return delta->allFinite();
@@ -149,8 +152,8 @@ StaticResult SolveStatic(const SystemModel& model, SystemState& state, const Sta
       if (cuts >= options.max_cuts) {
         char buffer[200];
         std::snprintf(buffer, sizeof buffer,
-                      "Newton did not converge at pseudo-time %.6g after %d step cuts (last residual %.3g)",
-                      target, cuts, r_norm);
+                      "Newton did not converge at pseudo-time %.6g after %d step cuts (last residual %.3g)", target,
+                      cuts, r_norm);
         result.message = buffer;
         return result;
       }

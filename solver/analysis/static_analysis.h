@@ -15,15 +15,15 @@ struct StaticOptions {
   /// A stop request, read after each converged step: nonzero stops the run there
   /// (StaticResult::stopped; femb-solve: solver/stop_request.h).
   const std::atomic<int>* stop = nullptr;
-  double end_time = 1.0;      ///< pseudo-time at the end; loads are scaled by their functions of it
-  int steps = 10;             ///< equal pseudo-time steps to end_time
-  int max_iterations = 25;    ///< Newton iterations per step
-  int max_cuts = 6;           ///< halvings of a step before giving up
-  double tolerance = 1e-8;    ///< ||residual|| <= tol * (largest force term of the step); at least kRoundOffTolerance
+  double end_time = 1.0;    ///< pseudo-time at the end; loads are scaled by their functions of it
+  int steps = 10;           ///< equal pseudo-time steps to end_time
+  int max_iterations = 25;  ///< Newton iterations per step
+  int max_cuts = 6;         ///< halvings of a step before giving up
+  double tolerance = 1e-8;  ///< ||residual|| <= tol * (largest force term of the step); at least kRoundOffTolerance
 };
 
 struct StaticStepReport {
-  double lambda = 0.0;        ///< pseudo-time
+  double lambda = 0.0;  ///< pseudo-time
   int iterations = 0;
   double residual = 0.0;
   double elastic_energy = 0.0;
@@ -32,8 +32,8 @@ struct StaticStepReport {
 
 struct StaticResult {
   bool ok = false;
-  std::string message;                  ///< why it stopped early
-  int stopped = 0;                      ///< the stop request's value when it stopped on it (ok), else 0
+  std::string message;  ///< why it stopped early
+  int stopped = 0;      ///< the stop request's value when it stopped on it (ok), else 0
   /// Said once each: the tangent's determinant changed sign (a limit or bifurcation point), a
   /// tolerance below the round-off floor.
   std::vector<std::string> warnings;

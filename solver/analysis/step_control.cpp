@@ -76,8 +76,8 @@ double StepController::Accept(const DynamicState& s1, double h, double E, bool a
   // E^(-1/3) control shows on the estimate's step-to-step scatter. Measured on the 2D
   // slider-crank (4 bodies): 30% of the steps tried were rejected with E^(-1/3), 2.5% with PI,
   // at the same error per step tried.
-  const double f = E_prev_ > 0 && E > 0 ? std::clamp(0.9 * std::pow(E, -0.7 / 3) * std::pow(E_prev_, 0.4 / 3), 0.2, 2.0)
-                                        : Factor(E);
+  const double f =
+      E_prev_ > 0 && E > 0 ? std::clamp(0.9 * std::pow(E, -0.7 / 3) * std::pow(E_prev_, 0.4 / 3), 0.2, 2.0) : Factor(E);
   E_prev_ = std::max(E, 1e-4);
   return h * std::min(after_rejection ? 1.0 : 2.0, f);
 }

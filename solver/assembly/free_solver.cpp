@@ -133,7 +133,8 @@ bool FreeSolver::Factor(const DofMap& dofs, const SystemMatrix& S) {
     ++analysed_;
     k.analysed_outer = k.outer;
     k.analysed_inner = k.inner;
-  } else if (k.numeric && klu_refactor(k.outer.data(), k.inner.data(), k.values.data(), k.symbolic, k.numeric, &k.common)) {
+  } else if (k.numeric &&
+             klu_refactor(k.outer.data(), k.inner.data(), k.values.data(), k.symbolic, k.numeric, &k.common)) {
     // The kept pivot order, while its pivots stay as good as the last full factorization's (the
     // ratio of the smallest to the largest, O(n); the pivot growth would cost a factorization).
     klu_rcond(k.symbolic, k.numeric, &k.common);
@@ -207,8 +208,9 @@ Eigen::MatrixXd DenseFreeMatrix(const DofMap& dofs, const SystemMatrix& S) {
 std::string RoundOffToleranceWarning(double tolerance) {
   if (tolerance >= kRoundOffTolerance) return "";
   char buffer[200];
-  std::snprintf(buffer, sizeof buffer, "analysis.tolerance %.3g is below the round-off floor of the residual; using %.0e",
-                tolerance, kRoundOffTolerance);
+  std::snprintf(buffer, sizeof buffer,
+                "analysis.tolerance %.3g is below the round-off floor of the residual; using %.0e", tolerance,
+                kRoundOffTolerance);
   return buffer;
 }
 

@@ -14,7 +14,8 @@ std::vector<MapEntry> BodyMap(const SystemModel& model, const DofMap& dofs, cons
   return map;
 }
 
-void BodyMap(const SystemModel& model, const DofMap& dofs, const SystemState& state, int b, std::vector<MapEntry>& map) {
+void BodyMap(const SystemModel& model, const DofMap& dofs, const SystemState& state, int b,
+             std::vector<MapEntry>& map) {
   const SuperelementBody& body = model.bodies[b];
   map.clear();
   for (int a = 0; a < body.n_nodes(); ++a) {
@@ -79,8 +80,8 @@ Eigen::VectorXd GatherBody(const SystemModel& model, const DofMap& dofs, const S
   return w;
 }
 
-void GatherBody(const SystemModel& model, const DofMap& dofs, const SystemState& state, int b,
-                const Eigen::VectorXd& W, Eigen::VectorXd& w) {
+void GatherBody(const SystemModel& model, const DofMap& dofs, const SystemState& state, int b, const Eigen::VectorXd& W,
+                Eigen::VectorXd& w) {
   const SuperelementBody& body = model.bodies[b];
   w.resize(body.n_coordinates());
   for (int a = 0; a < body.n_nodes(); ++a) w.segment<6>(6 * a) = NodeMotion(state, model.body_nodes[b][a], W);

@@ -19,15 +19,15 @@ namespace femb {
 /// Result of an evaluation of internal and external forces.
 struct SystemForces {
   bool ok = true;
-  std::string message;            ///< what failed (a floating frame did not converge, ...)
-  Eigen::VectorXd residual;       ///< lambda f_ext - f_int over the unknowns
-  SystemMatrix tangent;           ///< d(f_int - lambda f_ext)/d(unknowns)
+  std::string message;       ///< what failed (a floating frame did not converge, ...)
+  Eigen::VectorXd residual;  ///< lambda f_ext - f_int over the unknowns
+  SystemMatrix tangent;      ///< d(f_int - lambda f_ext)/d(unknowns)
   double elastic_energy = 0.0;
-  double force_scale = 0.0;       ///< largest norm of the internal or external force terms
-  Eigen::VectorXd dof_scale;      ///< per unknown: the force scale of the bodies acting on it (ScaledFreeNorm)
-  double roundoff = 0.0;          ///< residual noise from the round-off of absolute positions
-  NodeForces node_forces;         ///< per node, residual sense (applied minus internal)
-  Eigen::VectorXd loads;          ///< the nodal loads alone, over the coordinates (for their work)
+  double force_scale = 0.0;   ///< largest norm of the internal or external force terms
+  Eigen::VectorXd dof_scale;  ///< per unknown: the force scale of the bodies acting on it (ScaledFreeNorm)
+  double roundoff = 0.0;      ///< residual noise from the round-off of absolute positions
+  NodeForces node_forces;     ///< per node, residual sense (applied minus internal)
+  Eigen::VectorXd loads;      ///< the nodal loads alone, over the coordinates (for their work)
 };
 
 /// Solves every body's floating frame (updating state.frames) and assembles the static
@@ -51,8 +51,8 @@ void AddSpringDampers(const SystemModel& model, const SystemState& state, const 
 Eigen::VectorXd GatherBody(const SystemModel& model, const DofMap& dofs, const SystemState& state, int b,
                            const Eigen::VectorXd& W);
 /// The same into `w` (its storage reused).
-void GatherBody(const SystemModel& model, const DofMap& dofs, const SystemState& state, int b,
-                const Eigen::VectorXd& W, Eigen::VectorXd& w);
+void GatherBody(const SystemModel& model, const DofMap& dofs, const SystemState& state, int b, const Eigen::VectorXd& W,
+                Eigen::VectorXd& w);
 /// Body b's node accelerations (with the joints' convective terms) and modal accelerations.
 Eigen::VectorXd GatherBodyAcceleration(const SystemModel& model, const DofMap& dofs, int b,
                                        const std::vector<Eigen::Matrix<double, 6, 1>>& node_acc,

@@ -47,8 +47,8 @@ class DofMap;
 
 struct SystemModel {
   std::vector<std::string> node_names;
-  std::vector<Eigen::Vector3d> node_x0;   ///< initial positions
-  std::vector<Eigen::Matrix3d> node_R0;   ///< initial rotations
+  std::vector<Eigen::Vector3d> node_x0;  ///< initial positions
+  std::vector<Eigen::Matrix3d> node_R0;  ///< initial rotations
   /// Prescribed node coordinates: node, coordinate index in z_k, value f(t), f'(t), f''(t).
   struct Prescribed {
     int node = -1;
@@ -104,13 +104,13 @@ inline constexpr double kRoundOffTolerance = 1e-13;
 using NodeJacobian = std::vector<std::pair<int, Eigen::Matrix<double, 6, 1>>>;
 
 struct SystemState {
-  std::vector<Eigen::VectorXd> z;           ///< per node: accumulated coordinates (joint values)
-  std::vector<NodeJacobian> J;              ///< per node, at this configuration
+  std::vector<Eigen::VectorXd> z;  ///< per node: accumulated coordinates (joint values)
+  std::vector<NodeJacobian> J;     ///< per node, at this configuration
   std::vector<Eigen::Vector3d> x;
   std::vector<Eigen::Matrix3d> R;
-  std::vector<Eigen::VectorXd> eta;         ///< per body
-  std::vector<FrameSolution> frames;        ///< per body, the last solved floating frame
-  Eigen::VectorXd lambda;                   ///< the multipliers (DofMap::multiplier_first, body_multiplier_first)
+  std::vector<Eigen::VectorXd> eta;   ///< per body
+  std::vector<FrameSolution> frames;  ///< per body, the last solved floating frame
+  Eigen::VectorXd lambda;             ///< the multipliers (DofMap::multiplier_first, body_multiplier_first)
 };
 
 /// Numbering of the unknowns (coordinates). It holds no reference to the model, so it stays
@@ -195,8 +195,8 @@ SystemState InitialState(const SystemModel& model);
 
 /// Sets the prescribed coordinates to their values at t: configuration (through the node's
 /// basis), and, when W / Wdot are given, their rates and accelerations.
-void ApplyPrescribed(const SystemModel& model, const DofMap& dofs, double t, SystemState& state,
-                     Eigen::VectorXd* W, Eigen::VectorXd* Wdot);
+void ApplyPrescribed(const SystemModel& model, const DofMap& dofs, double t, SystemState& state, Eigen::VectorXd* W,
+                     Eigen::VectorXd* Wdot);
 
 /// The diagonal of the bounding box of points (node positions): the model's size; 0 for fewer
 /// than two points.

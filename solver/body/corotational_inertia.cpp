@@ -19,7 +19,8 @@ const BodyVelocityMaps& SuperelementBody::MapsOf(const Data& d) const {
     VelocityMaps(d, &maps.P, &maps.U);
     // M_g = P^T M P with P block diagonal (3 x 3 blocks, then 1 on the modal rows).
     maps.Mg = M_;
-    TurnRowBlocks(maps.Mg, 2 * n_nodes_, [&](int a) { return Eigen::Matrix3d(maps.P.block<3, 3>(3 * a, 3 * a).transpose()); });
+    TurnRowBlocks(maps.Mg, 2 * n_nodes_,
+                  [&](int a) { return Eigen::Matrix3d(maps.P.block<3, 3>(3 * a, 3 * a).transpose()); });
     TurnColBlocks(maps.Mg, 2 * n_nodes_, [&](int a) { return Eigen::Matrix3d(maps.P.block<3, 3>(3 * a, 3 * a)); });
     d.has_maps = true;
   }
@@ -218,7 +219,8 @@ void SuperelementBody::MomentumDerivative(const BodyVelocityMaps& maps, const Bo
   D.noalias() = MgL * U;
   if (options_.cardona_option_b) {
     for (int a = 0; a < n_nodes_; ++a)
-      D.middleCols<3>(6 * a + 3).noalias() += maps.Mg.middleCols<3>(6 * a + 3) * Skew<double>(Eigen::Vector3d(w.segment<3>(6 * a + 3)));
+      D.middleCols<3>(6 * a + 3).noalias() +=
+          maps.Mg.middleCols<3>(6 * a + 3) * Skew<double>(Eigen::Vector3d(w.segment<3>(6 * a + 3)));
   }
   for (int a = 0; a < n_nodes_; ++a) {
     D.middleRows<3>(6 * a).noalias() -= Skew<double>(Eigen::Vector3d(p.segment<3>(6 * a))) * U;
@@ -239,8 +241,8 @@ void SuperelementBody::MomentumSourceDerivatives(const BodyVelocityMaps& maps, c
 }
 
 void SuperelementBody::MomentumSourceDerivatives(const BodyVelocityMaps& maps, const BodyVelocity& w,
-                                                 const Eigen::VectorXd& p, Eigen::MatrixXd& d_w,
-                                                 Eigen::MatrixXd& d_p, BodyScratch& scratch) const {
+                                                 const Eigen::VectorXd& p, Eigen::MatrixXd& d_w, Eigen::MatrixXd& d_p,
+                                                 BodyScratch& scratch) const {
   const int n = n_coordinates();
   const Eigen::MatrixXd& U = maps.U;
   // s = G(w)^T p + Omega_hat(w) p is bilinear in (w, p).
@@ -278,7 +280,8 @@ void SuperelementBody::MomentumSource(const BodyVelocityMaps& maps, const BodyVe
   out.resize(n_coordinates());
   out.noalias() = G.transpose() * p;
   for (int a = 0; a < n_nodes_; ++a) {
-    out.segment<3>(6 * a + 3) += Eigen::Vector3d(w.segment<3>(6 * a + 3)).cross(Eigen::Vector3d(p.segment<3>(6 * a + 3)));
+    out.segment<3>(6 * a + 3) +=
+        Eigen::Vector3d(w.segment<3>(6 * a + 3)).cross(Eigen::Vector3d(p.segment<3>(6 * a + 3)));
   }
 }
 

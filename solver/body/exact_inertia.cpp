@@ -48,7 +48,8 @@ void SuperelementBody::SubtractRateTerms(const Eigen::VectorXd& q, const Eigen::
   for (int a = 0; a < 2 * n_nodes_; ++a) r.segment<3>(3 * a) -= Om.cross(Eigen::Vector3d(Rw.segment<3>(3 * a)));
   for (int k = 0; k < n_nodes_; ++k) {
     r.segment<3>(6 * k) -= Om.cross(Eigen::Vector3d(qd.segment<3>(6 * k)));
-    r.segment<3>(6 * k + 3) -= LeftJacobianRate(Eigen::Vector3d(q.segment<3>(6 * k + 3)), Eigen::Vector3d(qd.segment<3>(6 * k + 3)));
+    r.segment<3>(6 * k + 3) -=
+        LeftJacobianRate(Eigen::Vector3d(q.segment<3>(6 * k + 3)), Eigen::Vector3d(qd.segment<3>(6 * k + 3)));
   }
 }
 
@@ -76,8 +77,8 @@ SuperelementBody::LocalMotion SuperelementBody::LocalRates(const Data& data, con
   return out;
 }
 
-Eigen::VectorXd SuperelementBody::ExactInertiaForce(const Data& data, const BodyVelocity& w,
-                                                    const BodyVelocity& wdot, Eigen::VectorXd* f_acc) const {
+Eigen::VectorXd SuperelementBody::ExactInertiaForce(const Data& data, const BodyVelocity& w, const BodyVelocity& wdot,
+                                                    Eigen::VectorXd* f_acc) const {
   Eigen::VectorXd f;
   ExactInertiaForce(data, w, wdot, f, f_acc);
   return f;
@@ -393,7 +394,7 @@ const Eigen::MatrixXd& SuperelementBody::ExactMass(const Data& data) const {
   const auto Zr = data.kin.Z.bottomRows<3>();
   BodyScratch& s = data.scratch;
   s.n3a.noalias() = d.Y.transpose() * d.H;  // n x 3
-  Eigen::MatrixXd& YHZ = s.nn1;              // (Y^T H) Zr
+  Eigen::MatrixXd& YHZ = s.nn1;             // (Y^T H) Zr
   YHZ.noalias() = s.n3a * Zr;
   s.n3b.noalias() = Zr.transpose() * d.Xq;  // n x 3
   Eigen::MatrixXd& Mg = data.exact_mass;
@@ -423,7 +424,8 @@ Eigen::MatrixXd SuperelementBody::ExactInertiaConfigurationTangent(const Data& d
   return tangent;
 }
 
-void SuperelementBody::AddLocalSourceVelocityDerivative(const Data& d, const BodyVelocity& w, Eigen::MatrixXd& d_w) const {
+void SuperelementBody::AddLocalSourceVelocityDerivative(const Data& d, const BodyVelocity& w,
+                                                        Eigen::MatrixXd& d_w) const {
   if (!has_exact_inertia()) return;
   // c(w) = Q(w, w): c(w + e) - c(w - e) = 4 Q(w, e) = 2 (dc/dw) e for any step e.
   Eigen::VectorXd &wp = d.scratch.v2, &plus = d.scratch.v3, &minus = d.scratch.v4;

@@ -118,7 +118,8 @@ Eigen::VectorXd SuperelementBody::LocalCoordinates(const BodyConfiguration& c, c
   return q;
 }
 
-void SuperelementBody::LocalCoordinates(const BodyConfiguration& c, const FrameSolution& frame, Eigen::VectorXd& q) const {
+void SuperelementBody::LocalCoordinates(const BodyConfiguration& c, const FrameSolution& frame,
+                                        Eigen::VectorXd& q) const {
   q.resize(n_coordinates());
   const Eigen::Matrix3d Rt = frame.R.transpose();
   for (int k = 0; k < n_nodes_; ++k) {
@@ -136,7 +137,8 @@ Eigen::Matrix<double, 6, 6> SuperelementBody::FrameMatrix(const Eigen::VectorXd&
     const Eigen::Vector3d r = X_[a] + q.segment<3>(6 * a);
     const Eigen::Matrix<double, 6, 3> Pt = Phi_CB_.middleCols<3>(6 * a), Pr = Phi_CB_.middleCols<3>(6 * a + 3);
     S.leftCols<3>() += Pt;
-    S.rightCols<3>() += Pr * LeftJacobianInverse<double>(Eigen::Vector3d(q.segment<3>(6 * a + 3))) - Pt * Skew<double>(r);
+    S.rightCols<3>() +=
+        Pr * LeftJacobianInverse<double>(Eigen::Vector3d(q.segment<3>(6 * a + 3))) - Pt * Skew<double>(r);
   }
   return S;
 }
@@ -211,7 +213,8 @@ void SuperelementBody::ComputeKinematics(const Eigen::VectorXd& q, Kinematics& k
     k.T.middleRows<3>(6 * a + 3) -= Zr;
   }
   k.B = k.T;
-  for (int a = 0; a < n_nodes_; ++a) k.B.middleRows<3>(6 * a + 3).noalias() = Jinv[size_t(a)] * k.T.middleRows<3>(6 * a + 3);
+  for (int a = 0; a < n_nodes_; ++a)
+    k.B.middleRows<3>(6 * a + 3).noalias() = Jinv[size_t(a)] * k.T.middleRows<3>(6 * a + 3);
 }
 
 SuperelementBody::Data SuperelementBody::Evaluate(const BodyConfiguration& c, const FrameSolution& frame) const {
@@ -273,8 +276,8 @@ FrameSolution SuperelementBody::SolveFrame(const BodyConfiguration& c, const Fra
   return SolveFrame(c, guess, q);
 }
 
-FrameSolution SuperelementBody::SolveFrame(const BodyConfiguration& c, const FrameSolution& guess,
-                                           Eigen::VectorXd& q, const Eigen::Matrix<double, 6, 6>* S_inv) const {
+FrameSolution SuperelementBody::SolveFrame(const BodyConfiguration& c, const FrameSolution& guess, Eigen::VectorXd& q,
+                                           const Eigen::Matrix<double, 6, 6>* S_inv) const {
   FrameSolution frame = guess;
   frame.ok = false;
   // Translations relative to the body size, plus the round-off of the absolute positions (a
@@ -309,7 +312,8 @@ const Eigen::MatrixXd& SuperelementBody::SigmaProducts(const Data& d) const {
     const int n = n_coordinates();
     // The stacked product K_sigma q (12 n) is the n x 12 matrix column by column.
     d.sigma_q.resize(n, kInertiaLoadCaseCount);
-    Eigen::Map<Eigen::VectorXd>(d.sigma_q.data(), Eigen::Index(n) * kInertiaLoadCaseCount).noalias() = K_sigma_stack_ * d.q;
+    Eigen::Map<Eigen::VectorXd>(d.sigma_q.data(), Eigen::Index(n) * kInertiaLoadCaseCount).noalias() =
+        K_sigma_stack_ * d.q;
     d.has_sigma_q = true;
   }
   return d.sigma_q;
@@ -362,7 +366,7 @@ void SuperelementBody::LocalTangent(const Data& d, const InertiaLoadFactors* loa
 }
 
 InertiaLoadFactors SuperelementBody::InertiaLoads(const Data& d, const BodyVelocity& w, const BodyVelocity& wdot,
-                                                   const Eigen::Vector3d& gravity) const {
+                                                  const Eigen::Vector3d& gravity) const {
   InertiaLoadFactors out;
   InertiaLoads(d, w, wdot, gravity, out);
   return out;
@@ -440,7 +444,8 @@ void SuperelementBody::AddGeometricTangent(const Data& d, const Eigen::VectorXd&
     // K4: variation of D (exact rotation kinematics), v = P^T Q, P = 1 - D Phi_rig S^-1 Phi_CB.
     Eigen::VectorXd& DtQ = d.scratch.v1;  // D^T Q
     DtQ = Q;
-    for (int a = 0; a < n_nodes_; ++a) DtQ.segment<3>(6 * a + 3) = kin.Jinv[size_t(a)].transpose() * Q.segment<3>(6 * a + 3);
+    for (int a = 0; a < n_nodes_; ++a)
+      DtQ.segment<3>(6 * a + 3) = kin.Jinv[size_t(a)].transpose() * Q.segment<3>(6 * a + 3);
     Eigen::Matrix<double, 6, 1> PtDtQ;
     PtDtQ.noalias() = kin.Phi_rig.transpose() * DtQ;
     const Eigen::Matrix<double, 6, 1> SPtDtQ = kin.S_inv.transpose() * PtDtQ;
@@ -703,7 +708,8 @@ void SuperelementBody::GravityForce(const Data& data, const Eigen::Vector3d& g, 
   // P^T block by block (P is block diagonal: its 3 x 3 node blocks, then 1 on the modal rows).
   const Eigen::MatrixXd& P = MapsOf(data).P;
   f.noalias() = M_ * yg;
-  for (int a = 0; a < 2 * n_nodes_; ++a) f.segment<3>(3 * a) = P.block<3, 3>(3 * a, 3 * a).transpose() * Eigen::Vector3d(f.segment<3>(3 * a));
+  for (int a = 0; a < 2 * n_nodes_; ++a)
+    f.segment<3>(3 * a) = P.block<3, 3>(3 * a, 3 * a).transpose() * Eigen::Vector3d(f.segment<3>(3 * a));
 }
 
 Eigen::MatrixXd SuperelementBody::GravityTangent(const Data& d, const Eigen::Vector3d& g) const {

@@ -36,11 +36,11 @@
 namespace femb {
 
 struct SuperelementOptions {
-  bool approximated = false;  ///< Phi_rig0 / constant T0 (thesis 5.3) instead of the deformed Phi_rig
-  bool full_tangent = true;   ///< false: K1 only (the paper shows Newton then fails at high load)
+  bool approximated = false;             ///< Phi_rig0 / constant T0 (thesis 5.3) instead of the deformed Phi_rig
+  bool full_tangent = true;              ///< false: K1 only (the paper shows Newton then fails at high load)
   bool quadratic_velocity_terms = true;  ///< false: inertia force M_g wdot only (thesis 4.11 remark)
-  bool cardona_option_b = false;  ///< angular velocities in node frames R_k^T (Cardona's option B)
-  double modal_damping = 0.0;     ///< damping ratio zeta of the internal modes: f = 2 zeta omega etadot
+  bool cardona_option_b = false;         ///< angular velocities in node frames R_k^T (Cardona's option B)
+  double modal_damping = 0.0;            ///< damping ratio zeta of the internal modes: f = 2 zeta omega etadot
   /// With modal derivatives in the file: the local internal force is its cubic polynomial
   /// (formats/reduced_polynomial.h, Green-Lagrange inside the body) instead of K q_loc.
   bool polynomial_force = true;
@@ -116,20 +116,20 @@ class SuperelementBody {
   /// The configuration-dependent quantities of the kinematics (thesis 3.14-3.18; see the file
   /// comment): Phi_rig, D, S = Phi_CB D Phi_rig, Z = S^-1 Phi_CB D, T = 1 - Phi_rig Z, B = D T.
   struct Kinematics {
-    Eigen::MatrixXd Phi_rig;  ///< n x 6
+    Eigen::MatrixXd Phi_rig;            ///< n x 6
     std::vector<Eigen::Matrix3d> Jinv;  ///< D's rotation blocks J_l^-1(theta_k) (D is 1 elsewhere)
     Eigen::Matrix<double, 6, 6> S, S_inv;
-    Eigen::MatrixXd W;        ///< Phi_CB D (6 x n)
-    Eigen::MatrixXd Z;        ///< 6 x n
-    Eigen::MatrixXd T;        ///< n x n
-    Eigen::MatrixXd B;        ///< n x n
+    Eigen::MatrixXd W;  ///< Phi_CB D (6 x n)
+    Eigen::MatrixXd Z;  ///< 6 x n
+    Eigen::MatrixXd T;  ///< n x n
+    Eigen::MatrixXd B;  ///< n x n
   };
   /// The exact inertia's configuration-dependent products (has_exact_inertia).
   struct ExactData {
-    Eigen::MatrixXd Y;                  ///< Phi_rig0 Z + B
-    Eigen::MatrixXd H;                  ///< n x 3: Gamma_a q
-    Eigen::MatrixXd XQ;                 ///< n x 9: Xi_ab q in column 3 a + b (Xi_ba = Xi_ab^T)
-    Eigen::Matrix3d Xq;                 ///< q^T Xi_ab q
+    Eigen::MatrixXd Y;   ///< Phi_rig0 Z + B
+    Eigen::MatrixXd H;   ///< n x 3: Gamma_a q
+    Eigen::MatrixXd XQ;  ///< n x 9: Xi_ab q in column 3 a + b (Xi_ba = Xi_ab^T)
+    Eigen::Matrix3d Xq;  ///< q^T Xi_ab q
     /// For the matrices only (ExactMass, ExactGyroscopic), made when first asked (has_products):
     /// M Y and H^T Y (3 x n).
     mutable Eigen::MatrixXd MY, HtY;
@@ -146,7 +146,7 @@ class SuperelementBody {
     FrameSolution frame;
     Eigen::VectorXd q;  ///< q_loc
     Kinematics kin;
-    std::optional<ExactData> exact;                 ///< with the exact inertia (kept: its storage reused)
+    std::optional<ExactData> exact;  ///< with the exact inertia (kept: its storage reused)
     mutable BodyVelocityMaps maps;   ///< the corotational maps, made when first asked (has_maps)
     mutable bool has_maps = false;
     mutable Eigen::MatrixXd exact_mass;  ///< M_g of the exact inertia, made when first asked (has_exact_mass)
@@ -165,7 +165,7 @@ class SuperelementBody {
     mutable Eigen::VectorXd eps;  ///< the condensed polynomial's q + K^+ A z, made when first asked (has_eps)
     mutable bool has_eps = false;
     mutable PolynomialScratch polynomial_scratch;
-    mutable BodyScratch scratch;  ///< the kernels' temporaries (BodyScratch)
+    mutable BodyScratch scratch;         ///< the kernels' temporaries (BodyScratch)
     mutable ExactScratch exact_scratch;  ///< the exact inertia's (ExactScratch)
   };
   /// The body's quantities at configuration `c` with its solved floating frame.
@@ -439,8 +439,8 @@ class SuperelementBody {
   void Momentum(const Data& d, const BodyVelocity& w, Eigen::Vector3d* linear, Eigen::Vector3d* angular) const;
   /// The same from the generalized momentum p = M_g w (MassTimes).
   void MomentumFrom(const Data& d, const Eigen::VectorXd& p, Eigen::Vector3d* linear, Eigen::Vector3d* angular) const;
-  void Momentum(const BodyConfiguration& c, const FrameSolution& frame, const BodyVelocity& w,
-                Eigen::Vector3d* linear, Eigen::Vector3d* angular) const {
+  void Momentum(const BodyConfiguration& c, const FrameSolution& frame, const BodyVelocity& w, Eigen::Vector3d* linear,
+                Eigen::Vector3d* angular) const {
     Momentum(Evaluate(c, frame), w, linear, angular);
   }
 
@@ -537,16 +537,16 @@ class SuperelementBody {
   const Eigen::MatrixXd& SigmaProducts(const Data& d) const;
   std::vector<Eigen::MatrixXd> K_sigma_;  ///< the 12 inertia load case geometric stiffnesses, or none
   Eigen::MatrixXd K_sigma_stack_;         ///< the same stacked (12n x n)
-  std::vector<Eigen::Vector3d> X_;    ///< node positions relative to the frame origin, frame axes
-  std::vector<Eigen::Matrix3d> R0_;   ///< node orientations relative to the frame
-  Eigen::MatrixXd T0_;                ///< 1 - Phi_rig0 Phi_CB (approximated option)
+  std::vector<Eigen::Vector3d> X_;        ///< node positions relative to the frame origin, frame axes
+  std::vector<Eigen::Matrix3d> R0_;       ///< node orientations relative to the frame
+  Eigen::MatrixXd T0_;                    ///< 1 - Phi_rig0 Phi_CB (approximated option)
   Eigen::Matrix3d placement_R_;
   Eigen::Vector3d placement_x_;
   Eigen::Vector3d origin_part_;
   FrameSolution initial_frame_;
   double force_floor_ = 0.0;
-  double k_max_ = 0.0;  ///< max|D K D|, D = diag(force_weights_): force per length
-  double m_max_ = 0.0;  ///< max|D M D|: force per acceleration
+  double k_max_ = 0.0;             ///< max|D K D|, D = diag(force_weights_): force per length
+  double m_max_ = 0.0;             ///< max|D M D|: force per acceleration
   Eigen::VectorXd force_weights_;  ///< see ForceNorm
   double modal_weight_ = 1.0;
 };

@@ -9,11 +9,11 @@ namespace femb {
 
 struct SpringDamper {
   int node_a = -1;
-  int node_b = -1;                                    ///< -1: the fixed point `ground`
+  int node_b = -1;  ///< -1: the fixed point `ground`
   Eigen::Vector3d ground = Eigen::Vector3d::Zero();
-  double stiffness = 0.0;                             ///< k [force/length]
-  double damping = 0.0;                               ///< c [force time/length]
-  double free_length = 0.0;                           ///< l0 [length]
+  double stiffness = 0.0;    ///< k [force/length]
+  double damping = 0.0;      ///< c [force time/length]
+  double free_length = 0.0;  ///< l0 [length]
 };
 
 struct SpringDamperForces {

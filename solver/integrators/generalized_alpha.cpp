@@ -73,7 +73,8 @@ void AssembleDynamicResidual(const SystemModel& model, const DofMap& dofs, Dynam
   });
   if (!AddBodyTerms(model, results, parts, out)) return;
   FinishAssembly(model, dofs, s.config, t, s.W, false, parts, out);
-  AddLoopConstraints(model, dofs, s.config, &out.residual, nullptr, &out.node_forces, nullptr, kLoopAll, &work.pass_data);
+  AddLoopConstraints(model, dofs, s.config, &out.residual, nullptr, &out.node_forces, nullptr, kLoopAll,
+                     &work.pass_data);
 }
 
 Assembly AssembleDynamicResidual(const SystemModel& model, const DofMap& dofs, DynamicState& s, double t,
@@ -84,8 +85,8 @@ Assembly AssembleDynamicResidual(const SystemModel& model, const DofMap& dofs, D
 }
 
 void AddDynamicMatrices(const SystemModel& model, const DofMap& dofs, const DynamicState& s, double t,
-                        BodyWorkspace& work, bool full_inertia_tangent, Assembly& out,
-                        BodyThreads* threads, const MatrixCombination* combine, int every, BodyMatricesKept which) {
+                        BodyWorkspace& work, bool full_inertia_tangent, Assembly& out, BodyThreads* threads,
+                        const MatrixCombination* combine, int every, BodyMatricesKept which) {
   const int n_bodies = int(model.bodies.size());
   const std::vector<BodyPass>& passes = work.passes;
   std::vector<BodyWorkspace::BodyMatrices>& results = work.matrices;
@@ -96,8 +97,8 @@ void AddDynamicMatrices(const SystemModel& model, const DofMap& dofs, const Dyna
   for (int b = 0; b < n_bodies; ++b) {
     BodyWorkspace::BodyMatrices& r = results[size_t(b)];
     const int n = model.bodies[b].n_coordinates();
-    const bool kept = every > 1 && r.age >= 0 && r.age < every - 1 && r.M_frame.rows() == n &&
-                      (!all_kept || r.K_frame.rows() == n);
+    const bool kept =
+        every > 1 && r.age >= 0 && r.age < every - 1 && r.M_frame.rows() == n && (!all_kept || r.K_frame.rows() == n);
     r.age = kept ? r.age + 1 : (every > 1 || r.age >= 0 ? 0 : -1);  // a pass that computes keeps them anew
     ++(kept ? work.matrices_turned : work.matrices_computed);
   }
@@ -293,7 +294,8 @@ StepOutcome GeneralizedAlphaStep(const SystemModel& model, const DofMap& dofs, c
     if (ResidualSmall(dofs, a, weights, r_norm, tolerance) && out.iterations > 0 &&
         LoopsClosed(model, next.config, tolerance, &work.pass_data)) {
       out.converged = true;
-      next.a = (alpha_f * state.Wdot + (1 - alpha_f) * next.Wdot - alpha_m * a_n) / (1 - alpha_m);  // (the same relation)
+      next.a =
+          (alpha_f * state.Wdot + (1 - alpha_f) * next.Wdot - alpha_m * a_n) / (1 - alpha_m);  // (the same relation)
       next.t = t_new;
       // External work by the trapezoidal rule on the increment h (W_n + W_n+1) / 2.
       next.external_work += 0.5 * (state.f_ext + a.f_ext).dot(h * 0.5 * (state.W + next.W));
@@ -303,7 +305,8 @@ StepOutcome GeneralizedAlphaStep(const SystemModel& model, const DofMap& dofs, c
       out.passes_kept = true;
       return out;
     }
-    if (divergence.Diverged(r_norm, !model.has_constraints() || LoopsClosed(model, next.config, tolerance, &work.pass_data))) {
+    if (divergence.Diverged(r_norm,
+                            !model.has_constraints() || LoopsClosed(model, next.config, tolerance, &work.pass_data))) {
       return out;
     }
     bool built = false;
@@ -332,7 +335,8 @@ StepOutcome GeneralizedAlphaStep(const SystemModel& model, const DofMap& dofs, c
     Eigen::VectorXd& lie_delta = work.lie_delta;
     lie_delta = delta;
     for (const RotationNode& n : work.rotation_triples) {
-      const Eigen::Matrix3d target = ExpSO3(Eigen::Vector3d(work.dq.segment<3>(n.rotation))) * state.config.R[size_t(n.node)];
+      const Eigen::Matrix3d target =
+          ExpSO3(Eigen::Vector3d(work.dq.segment<3>(n.rotation))) * state.config.R[size_t(n.node)];
       lie_delta.segment<3>(n.rotation) = LogSO3(Eigen::Matrix3d(target * next.config.R[size_t(n.node)].transpose()));
     }
     ApplyIncrement(model, dofs, lie_delta, next.config);

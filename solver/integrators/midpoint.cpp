@@ -252,8 +252,8 @@ void Midpoint(const SystemModel& model, const DofMap& dofs, const std::vector<Ro
 // coordinate by how far it moves the nodes (rotations times the model's size L); modal
 // coordinates and free nodes map exactly and get nothing. The correction is O(h^2) of the forces
 // and is left out of the iteration matrix.
-void AddDiscreteGradientCorrection(const SystemModel& model, const DofMap& dofs, const MidpointKinematics& k,
-                                   double L2, MidpointWorkspace& w, Assembly& out) {
+void AddDiscreteGradientCorrection(const SystemModel& model, const DofMap& dofs, const MidpointKinematics& k, double L2,
+                                   MidpointWorkspace& w, Assembly& out) {
   if (model.joints.empty()) return;
   const int n = dofs.first_multiplier();
   Eigen::VectorXd& D = w.D;
@@ -279,8 +279,8 @@ void AddDiscreteGradientCorrection(const SystemModel& model, const DofMap& dofs,
 // balance, into `out`; each body's data at both configurations kept for the iteration matrix
 // (MidpointMatrix), which an iteration builds only when it needs one. The momenta at the step's
 // start are in work.midpoint.bodies (MidpointStep).
-void AssembleMidpoint(const SystemModel& model, const DofMap& dofs, const DynamicState& s0, double h,
-                      DynamicState& s1, BodyWorkspace& work, BodyThreads* threads, Assembly& out) {
+void AssembleMidpoint(const SystemModel& model, const DofMap& dofs, const DynamicState& s0, double h, DynamicState& s1,
+                      BodyWorkspace& work, BodyThreads* threads, Assembly& out) {
   MidpointWorkspace& mw = work.midpoint;
   MidpointKinematics& k = mw.k;
   AssemblyParts& parts = work.parts;
@@ -626,7 +626,8 @@ StepOutcome MidpointStep(const SystemModel& model, const DofMap& dofs, const Dyn
       out.passes_kept = true;
       return out;
     }
-    if (divergence.Diverged(r_norm, !model.has_constraints() || LoopsClosed(model, next.config, tolerance, &work.pass_data))) {
+    if (divergence.Diverged(r_norm,
+                            !model.has_constraints() || LoopsClosed(model, next.config, tolerance, &work.pass_data))) {
       return out;
     }
     // Newton's increment at n+1, with the iteration matrix built only when it is factored.

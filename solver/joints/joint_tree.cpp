@@ -53,9 +53,8 @@ std::vector<Eigen::Matrix<double, 6, 1>> NodeAccelerations(const SystemModel& mo
   return acc;
 }
 
-void NodeAccelerations(const SystemModel& model, const DofMap& dofs, const SystemState& state,
-                       const Eigen::VectorXd& W, const Eigen::VectorXd& Wdot,
-                       std::vector<Eigen::Matrix<double, 6, 1>>& acc) {
+void NodeAccelerations(const SystemModel& model, const DofMap& dofs, const SystemState& state, const Eigen::VectorXd& W,
+                       const Eigen::VectorXd& Wdot, std::vector<Eigen::Matrix<double, 6, 1>>& acc) {
   thread_local std::vector<Eigen::Matrix<double, 6, 1>> convective;  // kept: its storage is reused
   acc.assign(size_t(model.n_nodes()), Eigen::Matrix<double, 6, 1>::Zero());
   convective.assign(size_t(model.n_nodes()), Eigen::Matrix<double, 6, 1>::Zero());

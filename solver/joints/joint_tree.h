@@ -28,9 +28,8 @@ std::vector<Eigen::Matrix<double, 6, 1>> NodeAccelerations(const SystemModel& mo
                                                            const SystemState& state, const Eigen::VectorXd& W,
                                                            const Eigen::VectorXd& Wdot);
 /// The same into `acc` (its storage reused).
-void NodeAccelerations(const SystemModel& model, const DofMap& dofs, const SystemState& state,
-                       const Eigen::VectorXd& W, const Eigen::VectorXd& Wdot,
-                       std::vector<Eigen::Matrix<double, 6, 1>>& acc);
+void NodeAccelerations(const SystemModel& model, const DofMap& dofs, const SystemState& state, const Eigen::VectorXd& W,
+                       const Eigen::VectorXd& Wdot, std::vector<Eigen::Matrix<double, 6, 1>>& acc);
 
 /// The derivative of the joints' convective accelerations (NodeAccelerations) with respect to
 /// the coordinate velocities W, per node as sparse columns (coordinate, 6-vector); empty for

@@ -3,8 +3,8 @@
 #include <Eigen/Geometry>
 #include <array>
 #include <cmath>
-#include <initializer_list>
 #include <cstdio>
+#include <initializer_list>
 
 #include "solver/rotation.h"
 
@@ -46,12 +46,18 @@ EquationSet Equations(const NodeJoint& j) {
   const Equation pa{true, a, none}, pb1{true, b1, none}, pb2{true, b2, none};
   const Equation r1{false, b1, a}, r2{false, b2, a}, r3{false, b1, b2};
   switch (j.type) {
-    case JointType::kRigid: return {pa, pb1, pb2, r1, r2, r3};
-    case JointType::kRevolute: return {pa, pb1, pb2, r1, r2};
-    case JointType::kPrismatic: return {pb1, pb2, r1, r2, r3};
-    case JointType::kCylindrical: return {pb1, pb2, r1, r2};
-    case JointType::kSpherical: return {pa, pb1, pb2};
-    case JointType::kUniversal: return {pa, pb1, pb2, Equation{false, a, j.axis2.normalized()}};
+    case JointType::kRigid:
+      return {pa, pb1, pb2, r1, r2, r3};
+    case JointType::kRevolute:
+      return {pa, pb1, pb2, r1, r2};
+    case JointType::kPrismatic:
+      return {pb1, pb2, r1, r2, r3};
+    case JointType::kCylindrical:
+      return {pb1, pb2, r1, r2};
+    case JointType::kSpherical:
+      return {pa, pb1, pb2};
+    case JointType::kUniversal:
+      return {pa, pb1, pb2, Equation{false, a, j.axis2.normalized()}};
   }
   return {};
 }
@@ -163,8 +169,8 @@ std::string ConstraintName(const NodeJoint& j, int i) {
   const bool along_axis = v.normalized().isApprox(j.axis.normalized()) || v.normalized().isApprox(-j.axis.normalized());
   if (axial && along_axis) return q.position ? "translation along the axis" : "rotation about the axis";
   char buffer[160];
-  std::snprintf(buffer, sizeof buffer, "%s (%.3g, %.3g, %.3g) of the parent's axes", q.position ? "translation along" : "rotation about",
-                v.x() + 0.0, v.y() + 0.0, v.z() + 0.0);
+  std::snprintf(buffer, sizeof buffer, "%s (%.3g, %.3g, %.3g) of the parent's axes",
+                q.position ? "translation along" : "rotation about", v.x() + 0.0, v.y() + 0.0, v.z() + 0.0);
   return buffer;
 }
 

@@ -13,7 +13,6 @@
 
 #include "solver/assembly/system.h"
 
-
 namespace femb {
 
 namespace {
@@ -40,9 +39,9 @@ const SuperelementBody::Data* BodyDataFor(const SystemModel& model, const System
 // The bodies' interface constraints (thesis 8.2 case 4): g = C q_int of each constrained body,
 // its Jacobian G through the body's map (BodyMap: node Jacobians, modal coordinates) and
 // d(G^T lambda)/dq, in the same blocks as the cut joints'.
-void AddBodyConstraints(const SystemModel& model, const DofMap& dofs, const SystemState& state, Eigen::VectorXd* residual,
-                        Triplets* tangent, NodeForces* node_forces, Triplets* jacobian, int blocks,
-                        const BodyDataAtState* data) {
+void AddBodyConstraints(const SystemModel& model, const DofMap& dofs, const SystemState& state,
+                        Eigen::VectorXd* residual, Triplets* tangent, NodeForces* node_forces, Triplets* jacobian,
+                        int blocks, const BodyDataAtState* data) {
   // This thread's scratch (kept: with `data`, a time step allocates nothing here).
   thread_local Eigen::VectorXd lambda, g, minus_f;
   thread_local Eigen::MatrixXd G, H;
@@ -91,7 +90,8 @@ void AddLoopConstraints(const SystemModel& model, const DofMap& dofs, const Syst
     const CutJoint& cut = model.cut_joints[c];
     const NodeJoint& j = cut.joint;
     const int nodes[2] = {j.parent, j.child};
-    const ConstraintBlock block = EvaluateConstraint(j, state.x[nodes[0]], state.R[nodes[0]], state.x[nodes[1]], state.R[nodes[1]]);
+    const ConstraintBlock block =
+        EvaluateConstraint(j, state.x[nodes[0]], state.R[nodes[0]], state.x[nodes[1]], state.R[nodes[1]]);
     const int first = dofs.multiplier_first(int(c)), m = int(cut.equations.size());
     ConstraintValues l_full = ConstraintValues::Zero(block.g.size());  // dropped equations: none
     for (int i = 0; i < m; ++i) l_full[cut.equations[size_t(i)]] = state.lambda[first - dofs.first_multiplier() + i];
@@ -157,7 +157,8 @@ std::vector<double> EquationRemainders(const SystemModel& model, const DofMap& d
     if (!dofs.multiplier(j)) column[size_t(j)] = n++;
   Eigen::MatrixXd G = Eigen::MatrixXd::Zero(m, n);
   for (const Eigen::Triplet<double>& e : entries)
-    if (e.row() >= first && e.col() < first && column[size_t(e.col())] >= 0) G(e.row() - first, column[size_t(e.col())]) += e.value();
+    if (e.row() >= first && e.col() < first && column[size_t(e.col())] >= 0)
+      G(e.row() - first, column[size_t(e.col())]) += e.value();
   for (int c = 0; c < n; ++c) {
     const double size = G.col(c).cwiseAbs().maxCoeff();
     if (size > 0) G.col(c) /= size;
@@ -231,7 +232,8 @@ double LoopViolation(const SystemModel& model, const SystemState& state, int* wo
   if (worst) *worst = -1;
   for (size_t c = 0; c < model.cut_joints.size(); ++c) {
     const NodeJoint& j = model.cut_joints[c].joint;
-    const ConstraintBlock block = EvaluateConstraint(j, state.x[j.parent], state.R[j.parent], state.x[j.child], state.R[j.child]);
+    const ConstraintBlock block =
+        EvaluateConstraint(j, state.x[j.parent], state.R[j.parent], state.x[j.child], state.R[j.child]);
     for (int eq : model.cut_joints[c].equations) {
       const double v = std::abs(block.g[eq]) * (block.position[size_t(eq)] ? 1.0 : L);
       if (v > largest) {
@@ -245,7 +247,7 @@ double LoopViolation(const SystemModel& model, const SystemState& state, int* wo
     if (body.n_constraints() == 0) continue;
     std::optional<SuperelementBody::Data> own;
     const SuperelementBody::Data* d = BodyDataFor(model, state, int(b), data, own);
-    thread_local Eigen::VectorXd g;  // (kept: no allocation with `data`)
+    thread_local Eigen::VectorXd g;                                      // (kept: no allocation with `data`)
     if (d) body.InterfaceConstraint(*d, &g, nullptr, nullptr, nullptr);  // lengths
     const double v = d ? g.lpNorm<Eigen::Infinity>() : std::numeric_limits<double>::infinity();
     if (v > largest) {
@@ -261,7 +263,8 @@ std::vector<Eigen::Matrix<double, 6, 1>> CutJointReactions(const SystemModel& mo
   int first = 0;  // the joint's first multiplier in state.lambda
   for (const CutJoint& cut : model.cut_joints) {
     const NodeJoint& j = cut.joint;
-    const ConstraintBlock block = EvaluateConstraint(j, state.x[j.parent], state.R[j.parent], state.x[j.child], state.R[j.child]);
+    const ConstraintBlock block =
+        EvaluateConstraint(j, state.x[j.parent], state.R[j.parent], state.x[j.child], state.R[j.child]);
     ConstraintValues l_full = ConstraintValues::Zero(block.g.size());
     for (size_t i = 0; i < cut.equations.size(); ++i) l_full[cut.equations[i]] = state.lambda[first + long(i)];
     first += int(cut.equations.size());

@@ -166,7 +166,8 @@ void NodeAccelerationConfigurationDerivative(const SystemModel& model, const Dof
       dacc.head<3>() += ap.tail<3>().cross(drho);
       // d terms: linear in (w, rho, g, g1, g2) jointly quadratic; by their product rule.
       Vec6 dt;
-      dt.head<3>() = dw.cross(w.cross(rho)) + w.cross(dw.cross(rho) + w.cross(drho)) + 2 * sdot * (dw.cross(g) + w.cross(dg));
+      dt.head<3>() =
+          dw.cross(w.cross(rho)) + w.cross(dw.cross(rho) + w.cross(drho)) + 2 * sdot * (dw.cross(g) + w.cross(dg));
       dt.tail<3>() = phidot * (dw.cross(g) + w.cross(dg));
       if (universal) {
         dt.tail<3>() += zdot[0] * (dw.cross(g1) + w.cross(dg1)) +

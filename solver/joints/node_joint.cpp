@@ -9,19 +9,23 @@ namespace femb {
 
 int NodeJoint::n_coordinates() const {
   switch (type) {
-    case JointType::kRigid: return 0;
-    case JointType::kRevolute: return 1;
-    case JointType::kPrismatic: return 1;
-    case JointType::kCylindrical: return 2;
-    case JointType::kSpherical: return 3;
-    case JointType::kUniversal: return 2;
+    case JointType::kRigid:
+      return 0;
+    case JointType::kRevolute:
+      return 1;
+    case JointType::kPrismatic:
+      return 1;
+    case JointType::kCylindrical:
+      return 2;
+    case JointType::kSpherical:
+      return 3;
+    case JointType::kUniversal:
+      return 2;
   }
   return 0;
 }
 
-int NodeJoint::s_index() const {
-  return (type == JointType::kPrismatic || type == JointType::kCylindrical) ? 0 : -1;
-}
+int NodeJoint::s_index() const { return (type == JointType::kPrismatic || type == JointType::kCylindrical) ? 0 : -1; }
 
 int NodeJoint::phi_index() const {
   if (type == JointType::kRevolute) return 0;
@@ -81,7 +85,8 @@ JointMaps ComputeJointMaps(const NodeJoint& j, const Eigen::Vector3d& x_p, const
 
 Eigen::Matrix<double, 6, 1> ChildConvective(const NodeJoint& j, const JointMaps& maps, const Eigen::Vector3d& x_p,
                                             const Eigen::Matrix3d& R_p, const Eigen::Vector3d& x_c,
-                                            const Eigen::Matrix<double, 6, 1>& w_p, const Eigen::Ref<const Eigen::VectorXd>& zdot,
+                                            const Eigen::Matrix<double, 6, 1>& w_p,
+                                            const Eigen::Ref<const Eigen::VectorXd>& zdot,
                                             const Eigen::Matrix<double, 6, 1>& c_p) {
   const Eigen::Vector3d rho = x_c - x_p, g = R_p * j.axis, omega_p = w_p.tail<3>();
   const double sdot = j.s_index() >= 0 ? zdot[j.s_index()] : 0.0;

@@ -44,9 +44,9 @@ inline bool ConstantMaps(const NodeJoint& j) { return j.parent == kGround && j.t
 
 /// A joint from the initial placements of both nodes; axes are global. To the ground (parent
 /// kGround): x_p = 0, R_p = 1.
-NodeJoint MakeNodeJoint(JointType type, int child, int parent, const Eigen::Vector3d& axis,
-                        const Eigen::Vector3d& x_p, const Eigen::Matrix3d& R_p, const Eigen::Vector3d& x_c,
-                        const Eigen::Matrix3d& R_c, const Eigen::Vector3d& axis2 = Eigen::Vector3d::UnitY());
+NodeJoint MakeNodeJoint(JointType type, int child, int parent, const Eigen::Vector3d& axis, const Eigen::Vector3d& x_p,
+                        const Eigen::Matrix3d& R_p, const Eigen::Vector3d& x_c, const Eigen::Matrix3d& R_c,
+                        const Eigen::Vector3d& axis2 = Eigen::Vector3d::UnitY());
 
 /// Places the child from the parent and the joint coordinates z. For spherical joints the
 /// child's rotation is its own and is left as it is.
@@ -74,7 +74,8 @@ JointMaps ComputeJointMaps(const NodeJoint& j, const Eigen::Vector3d& x_p, const
 /// Convective acceleration of the child: c_c = A c_p + [omega_p x rhodot; 0] + Bdot zdot.
 Eigen::Matrix<double, 6, 1> ChildConvective(const NodeJoint& j, const JointMaps& maps, const Eigen::Vector3d& x_p,
                                             const Eigen::Matrix3d& R_p, const Eigen::Vector3d& x_c,
-                                            const Eigen::Matrix<double, 6, 1>& w_p, const Eigen::Ref<const Eigen::VectorXd>& zdot,
+                                            const Eigen::Matrix<double, 6, 1>& w_p,
+                                            const Eigen::Ref<const Eigen::VectorXd>& zdot,
                                             const Eigen::Matrix<double, 6, 1>& c_p);
 
 /// Derivative of (A^T f, B^T f) — the generalized force the child's force f = (F, M) puts on

@@ -52,7 +52,6 @@ Eigen::MatrixXd Rows9(const std::vector<Eigen::Matrix3d>& v) {
   return out;
 }
 
-
 // Numbers (counts too: exact as doubles below 2^53) of the resume group, by name.
 void WriteExactState(h5::Writer& w, const std::string& g, const DynamicState& s) {
   const SystemState& c = s.config;
@@ -101,7 +100,8 @@ void WriteResume(h5::Writer& w, const DynamicResume& r) {
   w.Vector("/resume/factor_counts",
            Eigen::Vector3d(double(r.factor.analysed), double(r.factor.full), double(r.factor.refactored)));
   Eigen::MatrixXd S_inv(long(r.frame_S_inv.size()), 36);
-  for (size_t b = 0; b < r.frame_S_inv.size(); ++b) S_inv.row(long(b)) = Eigen::Map<const Eigen::Matrix<double, 1, 36>>(r.frame_S_inv[b].data());
+  for (size_t b = 0; b < r.frame_S_inv.size(); ++b)
+    S_inv.row(long(b)) = Eigen::Map<const Eigen::Matrix<double, 1, 36>>(r.frame_S_inv[b].data());
   w.Matrix("/resume/frame_S_inv", S_inv);
   w.IntVector("/resume/has_frame_S_inv", std::vector<int>(r.has_frame_S_inv.begin(), r.has_frame_S_inv.end()));
   w.IntVector("/resume/kept_age", r.kept_age);
@@ -132,7 +132,8 @@ std::string ModelSignature(const Scene& scene) {
     out << "\n";
   }
   const DofMap& dofs = model.dofs();
-  for (int k = 0; k < model.n_nodes(); ++k) out << "node " << model.node_names[size_t(k)] << " " << dofs.node_count(k) << "\n";
+  for (int k = 0; k < model.n_nodes(); ++k)
+    out << "node " << model.node_names[size_t(k)] << " " << dofs.node_count(k) << "\n";
   for (const NodeJoint& j : model.joints) out << "joint " << int(j.type) << " " << j.child << " " << j.parent << "\n";
   for (const CutJoint& c : model.cut_joints) out << "cut joint " << c.name << " " << c.equations.size() << "\n";
   out << "unknowns " << dofs.n_dofs() << "\n";
@@ -275,7 +276,8 @@ bool ReadResume(const std::string& directory, const Scene& scene, DynamicResume&
   const SystemModel& model = scene.model;
   resume.state = ReadState(r, "/state", model);
   const Eigen::VectorXd x = r.Vector("/resume/numbers");
-  if (x.size() != 28) throw InputError(r.path() + ": dataset /resume/numbers has " + std::to_string(x.size()) + " values, not 28");
+  if (x.size() != 28)
+    throw InputError(r.path() + ": dataset /resume/numbers has " + std::to_string(x.size()) + " values, not 28");
   resume.t_start = x[0], resume.h = x[1], resume.t_base = x[2], resume.last_output = x[3], resume.E0 = x[4];
   resume.energy_scale = x[5], resume.first_cut_time = x[6], resume.n_nominal = long(x[7]), resume.cuts = int(x[8]);
   resume.warned = x[9] != 0, resume.travel = x[10], resume.last_error = x[11], resume.has_last_jerk = x[12] != 0;
@@ -294,7 +296,8 @@ bool ReadResume(const std::string& directory, const Scene& scene, DynamicResume&
   resume.factor.pivot_values.assign(pivots.data(), pivots.data() + pivots.size());
   const Eigen::VectorXd counts = r.Vector("/resume/factor_counts");
   if (counts.size() != 3) throw InputError(r.path() + ": dataset /resume/factor_counts must hold 3 values");
-  resume.factor.analysed = long(counts[0]), resume.factor.full = long(counts[1]), resume.factor.refactored = long(counts[2]);
+  resume.factor.analysed = long(counts[0]), resume.factor.full = long(counts[1]),
+  resume.factor.refactored = long(counts[2]);
   const long n_bodies = long(model.bodies.size());
   const Eigen::MatrixXd S_inv = r.Matrix("/resume/frame_S_inv");
   const Eigen::VectorXi has = r.IntVector("/resume/has_frame_S_inv");
@@ -309,7 +312,8 @@ bool ReadResume(const std::string& directory, const Scene& scene, DynamicResume&
     resume.has_frame_S_inv[size_t(b)] = char(has[b] != 0);
   }
   const Eigen::VectorXi age = r.IntVector("/resume/kept_age");
-  if (age.size() != 0 && age.size() != n_bodies) throw InputError(r.path() + ": /resume/kept_age does not have the model's size");
+  if (age.size() != 0 && age.size() != n_bodies)
+    throw InputError(r.path() + ": /resume/kept_age does not have the model's size");
   resume.kept_age.assign(age.data(), age.data() + age.size());
   resume.kept_M.clear(), resume.kept_C.clear(), resume.kept_K.clear();
   for (long b = 0; b < age.size(); ++b) {

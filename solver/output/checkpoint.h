@@ -11,7 +11,6 @@
 #include <string>
 
 #include "formats/hdf5_file.h"
-
 #include "solver/analysis/dynamic_analysis.h"
 #include "solver/scene/scene_builder.h"
 

@@ -1,8 +1,6 @@
 // The ParaView animation of ResultsRecorder (results_recorder.h): the grid of every body's mesh
 // or stick figure, the frames written in part files during the run and gathered into
 // animation.h5 at the end, and animation.xdmf that references them.
-#include "solver/output/results_recorder.h"
-
 #include <unistd.h>
 
 #include <algorithm>
@@ -24,6 +22,7 @@
 #include "formats/input_error.h"
 #include "formats/superelement.h"
 #include "formats/vtk_cells.h"
+#include "solver/output/results_recorder.h"
 #include "solver/parallel.h"
 
 namespace femb {
@@ -142,7 +141,8 @@ const ResultsRecorder::AnimationGrid& ResultsRecorder::Grid() {
     cell_offset += block.cells.rows();
   }
   if (g.uniform) {
-    g.cells = Eigen::Map<Eigen::Matrix<int, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(g.flat.data(), g.n_cells, g.per_cell);
+    g.cells = Eigen::Map<Eigen::Matrix<int, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(g.flat.data(), g.n_cells,
+                                                                                              g.per_cell);
     g.flat.clear();
   }
   g.cell_type = g.uniform ? blocks.front().cell_type : "mixed";
@@ -312,12 +312,14 @@ void ResultsRecorder::WriteXdmf(const std::string& mesh_file) {
     if (g.cell_type == "line2") out << " NodesPerElement=\"2\"";
     out << ">\n     <DataItem Dimensions=\""
         << (g.uniform ? std::to_string(g.n_cells) + " " + std::to_string(g.per_cell) : std::to_string(g.flat.size()))
-        << "\" NumberType=\"Int\" Precision=\"4\" Format=\"HDF\">" << mesh_file << ":/cells</DataItem>\n    </Topology>\n"
+        << "\" NumberType=\"Int\" Precision=\"4\" Format=\"HDF\">" << mesh_file
+        << ":/cells</DataItem>\n    </Topology>\n"
         << "    <Geometry GeometryType=\"XYZ\">\n     <DataItem Dimensions=\"" << n_nodes
         << " 3\" NumberType=\"Float\" Precision=\"4\" Format=\"HDF\">" << file << ":/x_" << s
         << "</DataItem>\n    </Geometry>\n"
         << "    <Attribute Name=\"body\" AttributeType=\"Scalar\" Center=\"Cell\">\n     <DataItem Dimensions=\""
-        << g.n_cells << " 1\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">" << mesh_file << ":/body</DataItem>\n"
+        << g.n_cells << " 1\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">" << mesh_file
+        << ":/body</DataItem>\n"
         << "    </Attribute>\n"
         << "    <Attribute Name=\"node\" AttributeType=\"Scalar\" Center=\"Node\">\n     <DataItem Dimensions=\""
         << n_nodes << " 1\" NumberType=\"Int\" Precision=\"4\" Format=\"HDF\">" << mesh_file << ":/node</DataItem>\n"
@@ -325,13 +327,15 @@ void ResultsRecorder::WriteXdmf(const std::string& mesh_file) {
         << "    <Attribute Name=\"deformation\" AttributeType=\"Vector\" Center=\"Node\">\n     <DataItem Dimensions=\""
         << n_nodes << " 3\" NumberType=\"Float\" Precision=\"4\" Format=\"HDF\">" << file << ":/deformation_" << s
         << "</DataItem>\n    </Attribute>\n"
-        << "    <Attribute Name=\"displacement\" AttributeType=\"Vector\" Center=\"Node\">\n     <DataItem Dimensions=\""
+        << "    <Attribute Name=\"displacement\" AttributeType=\"Vector\" Center=\"Node\">\n     <DataItem "
+           "Dimensions=\""
         << n_nodes << " 3\" NumberType=\"Float\" Precision=\"4\" Format=\"HDF\">" << file << ":/displacement_" << s
         << "</DataItem>\n    </Attribute>\n";
     if (frame_stress_fields_[s]) {
       for (const char* field : {"von_mises", "max_principal", "min_principal"}) {
-        out << "    <Attribute Name=\"" << field << "\" AttributeType=\"Scalar\" Center=\"Node\">\n     <DataItem Dimensions=\""
-            << n_nodes << " 1\" NumberType=\"Float\" Precision=\"4\" Format=\"HDF\">" << file << ":/" << field << "_" << s
+        out << "    <Attribute Name=\"" << field
+            << "\" AttributeType=\"Scalar\" Center=\"Node\">\n     <DataItem Dimensions=\"" << n_nodes
+            << " 1\" NumberType=\"Float\" Precision=\"4\" Format=\"HDF\">" << file << ":/" << field << "_" << s
             << "</DataItem>\n    </Attribute>\n";
       }
     }
@@ -389,7 +393,8 @@ void ResultsRecorder::FinishAnimation() {
         const std::string index = std::to_string(s);
         for (const char* field : {"/x_", "/deformation_", "/displacement_"}) names.push_back(field + index);
         if (frame_stress_fields_[s]) {
-          for (const char* field : {"/von_mises_", "/max_principal_", "/min_principal_"}) names.push_back(field + index);
+          for (const char* field : {"/von_mises_", "/max_principal_", "/min_principal_"})
+            names.push_back(field + index);
         }
       }
       w.CopyFrom((dir / part).string(), names);

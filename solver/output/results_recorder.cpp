@@ -3,8 +3,8 @@
 #include <unistd.h>
 
 #include <Eigen/Geometry>
-#include <cmath>
 #include <charconv>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <optional>
@@ -62,9 +62,10 @@ ResultsRecorder::ResultsRecorder(const Scene& scene, const std::string& director
   // take: load steps, or time steps over output_every).
   constexpr double kAutoFrames = 500;
   const SceneAnalysisSpec& a = scene.spec.analysis;
-  const double outputs = a.type == AnalysisType::kDynamic ? a.end_time / (a.step * std::max(a.output_every, 1)) : double(a.steps);
-  animation_every_ = scene.spec.animation_every > 0 ? scene.spec.animation_every
-                                                    : std::max(1, int(std::ceil(outputs / kAutoFrames)));
+  const double outputs =
+      a.type == AnalysisType::kDynamic ? a.end_time / (a.step * std::max(a.output_every, 1)) : double(a.steps);
+  animation_every_ =
+      scene.spec.animation_every > 0 ? scene.spec.animation_every : std::max(1, int(std::ceil(outputs / kAutoFrames)));
   // Error-controlled steps: how many there will be is not known; a frame per end_time / 500
   // (the first output at or after each such time), or every output step of output_step.
   if (a.type == AnalysisType::kDynamic && a.adaptive_step && scene.spec.animation_every == 0) {
@@ -195,7 +196,8 @@ void ResultsRecorder::Record(double t, const SystemState& state, const Eigen::Ve
   work_.push_back(external_work);
   double* const momentum = momentum_.Append();
   Eigen::Vector3d::Map(momentum) = linear_momentum;
-  Eigen::Vector3d::Map(momentum + 3) = angular_momentum + scene_.origin.cross(linear_momentum);  // about the global origin
+  Eigen::Vector3d::Map(momentum + 3) =
+      angular_momentum + scene_.origin.cross(linear_momentum);  // about the global origin
   // The reaction at node k (zero without `reactions`).
   const auto reaction = [&](int k, int i) { return reactions ? (*reactions)[size_t(k)][i] : 0.0; };
   if (scene_.spec.reactions) {
@@ -230,7 +232,8 @@ void ResultsRecorder::Record(double t, const SystemState& state, const Eigen::Ve
   int joint_count = 0;
   for (int k = 0; k < n; ++k) {
     if (!joint_node_[size_t(k)]) continue;
-    if (joint_count + state.z[k].size() > joints_.width) throw std::logic_error("ResultsRecorder: joint coordinates changed in number");
+    if (joint_count + state.z[k].size() > joints_.width)
+      throw std::logic_error("ResultsRecorder: joint coordinates changed in number");
     for (int i = 0; i < state.z[k].size(); ++i) joint_values[joint_count++] = state.z[k][i];
   }
   bool frame = (time_.size() - 1) % size_t(animation_every_) == 0;
@@ -265,7 +268,8 @@ void ResultsRecorder::Record(double t, const SystemState& state, const Eigen::Ve
     double g = dynamic ? 1.0 : 0.0;
     if (!dynamic && model.static_gravity_end > 0) g = std::min(t / model.static_gravity_end, 1.0);
     factors_[b] = model.bodies[b]
-                      .InertiaLoads(BodyConfigurationOf(model, state, int(b)), state.frames[b], GatherBody(model, dofs, state, int(b), V),
+                      .InertiaLoads(BodyConfigurationOf(model, state, int(b)), state.frames[b],
+                                    GatherBody(model, dofs, state, int(b), V),
                                     GatherBodyAcceleration(model, dofs, int(b), node_acc, A), g * model.gravity)
                       .a;
     has_factors_[b] = 1;
@@ -289,7 +293,8 @@ void ResultsRecorder::Record(double t, const SystemState& state, const Eigen::Ve
         // A stick figure: the positions of its nodes.
         const std::vector<int>& sticks = scene_.stick_nodes[b];
         job.sticks[b].resize(long(sticks.size()), 3);
-        for (size_t i = 0; i < sticks.size(); ++i) job.sticks[b].row(long(i)) = (scene_.origin + state.x[sticks[i]]).transpose().cast<float>();
+        for (size_t i = 0; i < sticks.size(); ++i)
+          job.sticks[b].row(long(i)) = (scene_.origin + state.x[sticks[i]]).transpose().cast<float>();
       }
       if (scene_.spec.stresses && scene_.stresses[b]) {
         job.q_stress[b] = stress_coordinates(b);
@@ -335,7 +340,8 @@ void ResultsRecorder::Record(double t, const SystemState& state, const Eigen::Ve
       for (const ProbeQuantity q : p.quantities) {
         if (q == ProbeQuantity::kStress) {  // at its stress point
           const auto [b, at] = scene_.stress_probes[pi];
-          const Eigen::Matrix<double, 6, 1> s = PointStress(*scene_.stresses[size_t(b)], at, stress_coordinates(size_t(b)), inertia(size_t(b)));
+          const Eigen::Matrix<double, 6, 1> s =
+              PointStress(*scene_.stresses[size_t(b)], at, stress_coordinates(size_t(b)), inertia(size_t(b)));
           put(VonMises(s));
           for (int i = 0; i < 6; ++i) put(s[i]);
           continue;
@@ -363,10 +369,14 @@ void ResultsRecorder::Record(double t, const SystemState& state, const Eigen::Ve
     }
     const int k = scene_.node_index.at(p.node);
     for (const ProbeQuantity q : p.quantities) {
-      if (q == ProbeQuantity::kPosition) for (int i = 0; i < 3; ++i) put(pos[3 * k + i]);
-      if (q == ProbeQuantity::kRotation) for (int i = 0; i < 4; ++i) put(quat[4 * k + i]);
-      if (q == ProbeQuantity::kVelocity) for (int i = 0; i < 3; ++i) put(vel[3 * k + i]);
-      if (q == ProbeQuantity::kAngularVelocity) for (int i = 0; i < 3; ++i) put(ang[3 * k + i]);
+      if (q == ProbeQuantity::kPosition)
+        for (int i = 0; i < 3; ++i) put(pos[3 * k + i]);
+      if (q == ProbeQuantity::kRotation)
+        for (int i = 0; i < 4; ++i) put(quat[4 * k + i]);
+      if (q == ProbeQuantity::kVelocity)
+        for (int i = 0; i < 3; ++i) put(vel[3 * k + i]);
+      if (q == ProbeQuantity::kAngularVelocity)
+        for (int i = 0; i < 3; ++i) put(ang[3 * k + i]);
       if (q == ProbeQuantity::kAcceleration) put3(node_accelerations()[size_t(k)].head<3>());
       if (q == ProbeQuantity::kAngularAcceleration) put3(node_accelerations()[size_t(k)].tail<3>());
       if (q == ProbeQuantity::kEffort) {
@@ -386,7 +396,8 @@ void ResultsRecorder::Record(double t, const SystemState& state, const Eigen::Ve
           for (int i = 0; i < state.z[k].size(); ++i) put(state.z[k][i]);
         } else {
           const NodeJoint& j = model.cut_joints[size_t(c)].joint;
-          Eigen::VectorXd z = CutJointCoordinates(j, state.x[j.parent], state.R[j.parent], state.x[j.child], state.R[j.child]);
+          Eigen::VectorXd z =
+              CutJointCoordinates(j, state.x[j.parent], state.R[j.parent], state.x[j.child], state.R[j.child]);
           probe_last_.resize(scene_.spec.probes.size());
           if (probe_last_[pi].size() == z.size()) {  // angles continuous through +-pi
             for (int i = 0; i < z.size(); ++i) {
@@ -398,7 +409,8 @@ void ResultsRecorder::Record(double t, const SystemState& state, const Eigen::Ve
           for (int i = 0; i < z.size(); ++i) put(z[i]);
         }
       }
-      if (q == ProbeQuantity::kReaction) for (int i = 0; i < 6; ++i) put(reaction(k, i));
+      if (q == ProbeQuantity::kReaction)
+        for (int i = 0; i < 6; ++i) put(reaction(k, i));
     }
   }
   put(kinetic);
@@ -417,10 +429,11 @@ std::vector<std::string> ResultsRecorder::StressSummary() const {
     const Eigen::Vector3d X = scene_.meshes[b]->nodes.row(node).transpose();
     const bool excluded = b < scene_.stress_excluded.size() && !scene_.stress_excluded[b].empty();
     char buffer[300];
-    std::snprintf(buffer, sizeof buffer,
-                  "body '%s': largest von Mises stress %.4g %s at t = %.6g, mesh node %d at (%.6g, %.6g, %.6g) in part axes%s",
-                  scene_.body_names[b].c_str(), v[s], UnitSystem(scene_.spec.units, "units").stress.c_str(), time_[s], node,
-                  X.x(), X.y(), X.z(), excluded ? " (outside outputs.stress_exclude)" : "");
+    std::snprintf(
+        buffer, sizeof buffer,
+        "body '%s': largest von Mises stress %.4g %s at t = %.6g, mesh node %d at (%.6g, %.6g, %.6g) in part axes%s",
+        scene_.body_names[b].c_str(), v[s], UnitSystem(scene_.spec.units, "units").stress.c_str(), time_[s], node,
+        X.x(), X.y(), X.z(), excluded ? " (outside outputs.stress_exclude)" : "");
     lines.push_back(buffer);
   }
   return lines;
@@ -534,7 +547,8 @@ void ResultsRecorder::WriteResults(const std::string& status) {
       std::vector<std::string> names;
       for (const CutJoint& cut : model.cut_joints) names.push_back(cut.name);
       w.Strings("/loops/cut_joints", names);
-      w.Vector("/loops/violation", Eigen::Map<const Eigen::VectorXd>(loop_violation_.data(), long(loop_violation_.size())));
+      w.Vector("/loops/violation",
+               Eigen::Map<const Eigen::VectorXd>(loop_violation_.data(), long(loop_violation_.size())));
       if (loop_reactions_.count > 0) w.Matrix("/loops/reaction", loop_reactions_.Matrix());
     }
     w.CreateGroup("/nodes");
@@ -577,7 +591,8 @@ void ResultsRecorder::WriteResults(const std::string& status) {
         w.Vector(g + "/max_von_mises", Eigen::Map<const Eigen::VectorXd>(v.data(), long(v.size())));
         w.IntVector(g + "/max_von_mises_node", max_von_mises_node_[b]);
         Eigen::MatrixXd where(long(v.size()), 3);
-        for (size_t s = 0; s < v.size(); ++s) where.row(long(s)) = scene_.meshes[b]->nodes.row(max_von_mises_node_[b][s]);
+        for (size_t s = 0; s < v.size(); ++s)
+          where.row(long(s)) = scene_.meshes[b]->nodes.row(max_von_mises_node_[b][s]);
         w.Matrix(g + "/max_von_mises_point", where);
       }
     }

@@ -104,8 +104,8 @@ class ResultsRecorder {
 
  private:
   const Scene& scene_;
-  const DofMap dofs_;  ///< the scene model's numbering (the model does not change while recording)
-  int animation_every_ = 1;  ///< one animation frame per this many output steps (spec, or auto)
+  const DofMap dofs_;          ///< the scene model's numbering (the model does not change while recording)
+  int animation_every_ = 1;    ///< one animation frame per this many output steps (spec, or auto)
   double frame_interval_ = 0;  ///< > 0: one animation frame per this much time (auto, with step: auto)
   double next_frame_time_ = 0;
   std::vector<double> step_size_, all_steps_t_, all_steps_h_;
@@ -127,6 +127,7 @@ class ResultsRecorder {
     Eigen::MatrixXd Matrix() const;  ///< count x width
     /// Appends the first n rows of m (its width checked; `what` names it in the error).
     void Load(const Eigen::MatrixXd& m, long n, const std::string& what);
+
    private:
     long ChunkRows() const { return std::max(1L, 8192L / std::max(width, 1)); }
   };
@@ -157,8 +158,8 @@ class ResultsRecorder {
   // positions, deformation, displacement, stresses) are made when written, on the machine's
   // cores (MakePending): Record keeps what they need, a few numbers per body.
   struct PendingOutput {
-    long output = 0;  ///< the output step's index
-    long frame = -1;  ///< its animation frame's index, or -1
+    long output = 0;                       ///< the output step's index
+    long frame = -1;                       ///< its animation frame's index, or -1
     std::vector<Eigen::Vector3d> frame_x;  ///< per body, its floating frame (global, relative to origin)
     std::vector<Eigen::Matrix3d> frame_R;
     std::vector<Eigen::VectorXd> q_loc;     ///< per body with a mesh (frames)
@@ -192,9 +193,9 @@ class ResultsRecorder {
     std::string cell_type;  ///< "line2", "tet10", ... or "mixed"
     int per_cell = 0;       ///< nodes per cell (uniform)
     long n_nodes = 0, n_cells = 0;
-    Eigen::MatrixXi cells;  ///< uniform: n_cells x per_cell
-    std::vector<int> flat;  ///< mixed: (XDMF type, [count,] nodes...) per cell
-    Eigen::MatrixXd body;   ///< per cell, its body's index
+    Eigen::MatrixXi cells;     ///< uniform: n_cells x per_cell
+    std::vector<int> flat;     ///< mixed: (XDMF type, [count,] nodes...) per cell
+    Eigen::MatrixXd body;      ///< per cell, its body's index
     std::vector<long> offset;  ///< per body, its first node in the grid
     /// Per body, the mesh node (or stick node) at each of its grid nodes: solid and shell meshes
     /// in spatial (Morton) order, which neighbours' values compress better in; lines in order.
@@ -203,10 +204,10 @@ class ResultsRecorder {
   };
   std::unique_ptr<AnimationGrid> grid_;
   size_t frames_written_ = 0;
-  std::vector<std::string> frame_file_;  ///< per written frame, the file (in directory_) holding it
-  std::vector<char> frame_stress_fields_;  ///< per written frame, whether it has stress fields
+  std::vector<std::string> frame_file_;       ///< per written frame, the file (in directory_) holding it
+  std::vector<char> frame_stress_fields_;     ///< per written frame, whether it has stress fields
   std::vector<std::string> animation_parts_;  ///< part files written during the run
-  Eigen::MatrixXf x0_;  ///< the first frame's stored positions (displacement = x - x0)
+  Eigen::MatrixXf x0_;                        ///< the first frame's stored positions (displacement = x - x0)
   const AnimationGrid& Grid();
   /// Writes the packed frames into `w` (the file `file` in directory_) and forgets them.
   void WriteFrames(h5::Writer& w, const std::string& file);

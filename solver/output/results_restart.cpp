@@ -1,7 +1,5 @@
 // What femb-solve --restart needs of ResultsRecorder (results_recorder.h): the mark of the
 // results at a saved state, written into the checkpoint, and the results read back up to it.
-#include "solver/output/results_recorder.h"
-
 #include <unistd.h>
 
 #include <algorithm>
@@ -16,20 +14,21 @@
 
 #include "formats/hdf5_file.h"
 #include "formats/input_error.h"
+#include "solver/output/results_recorder.h"
 
 namespace femb {
 
 void ResultsRecorder::Rows::Load(const Eigen::MatrixXd& m, long n, const std::string& what) {
   if (m.rows() < n || (n > 0 && m.cols() != width)) {
-    throw InputError(what + ": " + std::to_string(m.rows()) + " x " + std::to_string(m.cols()) + " values, expected at least " +
-                     std::to_string(n) + " x " + std::to_string(width) + " (the scene's outputs differ from the run's?)");
+    throw InputError(what + ": " + std::to_string(m.rows()) + " x " + std::to_string(m.cols()) +
+                     " values, expected at least " + std::to_string(n) + " x " + std::to_string(width) +
+                     " (the scene's outputs differ from the run's?)");
   }
   for (long i = 0; i < n; ++i) {
     double* const row = Append();
     for (int j = 0; j < width; ++j) row[j] = m(i, j);
   }
 }
-
 
 ResultsRecorder::Mark ResultsRecorder::TakeMark() const {
   Mark m;
@@ -44,7 +43,8 @@ ResultsRecorder::Mark ResultsRecorder::TakeMark() const {
 void ResultsRecorder::WriteMark(h5::Writer& w, const Mark& mark) const {
   if (mark.frames > long(frames_written_)) throw std::logic_error("ResultsRecorder::WriteMark: frames not yet written");
   w.CreateGroup("/recorder");
-  w.Vector("/recorder/numbers", Eigen::Vector4d(double(mark.outputs), double(mark.steps), double(mark.frames), mark.next_frame_time));
+  w.Vector("/recorder/numbers",
+           Eigen::Vector4d(double(mark.outputs), double(mark.steps), double(mark.frames), mark.next_frame_time));
   // The probes' last values (angles unwrapped from them): their lengths, then the values.
   std::vector<int> lengths;
   std::vector<double> values;
@@ -88,7 +88,8 @@ void ResultsRecorder::Resume(const h5::Reader& checkpoint) {
   const std::string where = h5_path_ + ": ";
   const Eigen::VectorXd t = r.Vector("/time");
   if (t.size() < n) {
-    throw InputError(where + "holds " + std::to_string(t.size()) + " output steps, fewer than the checkpoint's " + std::to_string(n));
+    throw InputError(where + "holds " + std::to_string(t.size()) + " output steps, fewer than the checkpoint's " +
+                     std::to_string(n));
   }
   const auto head = [n](const Eigen::VectorXd& v) { return std::vector<double>(v.data(), v.data() + n); };
   time_ = head(t);
@@ -98,7 +99,8 @@ void ResultsRecorder::Resume(const h5::Reader& checkpoint) {
   if (r.Exists("/step_size")) step_size_ = head(r.Vector("/step_size"));
   if (n_steps > 0) {
     const Eigen::VectorXd st = r.Vector("/steps/time"), sh = r.Vector("/steps/size");
-    if (st.size() < n_steps || sh.size() < n_steps) throw InputError(where + "/steps holds fewer steps than the checkpoint");
+    if (st.size() < n_steps || sh.size() < n_steps)
+      throw InputError(where + "/steps holds fewer steps than the checkpoint");
     all_steps_t_.assign(st.data(), st.data() + n_steps);
     all_steps_h_.assign(sh.data(), sh.data() + n_steps);
   }
@@ -106,7 +108,8 @@ void ResultsRecorder::Resume(const h5::Reader& checkpoint) {
   if (!model.cut_joints.empty()) {
     loop_violation_ = head(r.Vector("/loops/violation"));
     for (double v : loop_violation_) max_loop_violation_ = std::max(max_loop_violation_, v);
-    if (loop_reactions_.width > 0 && scene_.spec.reactions) loop_reactions_.Load(r.Matrix("/loops/reaction"), n, where + "/loops/reaction");
+    if (loop_reactions_.width > 0 && scene_.spec.reactions)
+      loop_reactions_.Load(r.Matrix("/loops/reaction"), n, where + "/loops/reaction");
   }
   if (probe_values_.width > 0) {
     if (r.Strings("/probes/names") != probe_columns_) throw InputError(where + "its probes differ from the scene's");
@@ -128,7 +131,8 @@ void ResultsRecorder::Resume(const h5::Reader& checkpoint) {
     modal_[b].Load(r.Matrix(g + "/modal_coordinates"), n, where + g + "/modal_coordinates");
     const Eigen::MatrixXd frame = r.Matrix(g + "/floating_frame"), com = r.Matrix(g + "/center_of_mass");
     Eigen::MatrixXd both(frame.rows(), 10);
-    if (com.rows() != frame.rows() || frame.cols() != 7 || com.cols() != 3) throw InputError(where + g + ": floating frame and centre of mass do not match");
+    if (com.rows() != frame.rows() || frame.cols() != 7 || com.cols() != 3)
+      throw InputError(where + g + ": floating frame and centre of mass do not match");
     both << frame, com;
     frames_[b].Load(both, n, where + g + "/floating_frame");
     if (scene_.spec.stresses && scene_.stresses[b] && r.Exists(g + "/max_von_mises")) {
@@ -149,18 +153,21 @@ void ResultsRecorder::Resume(const h5::Reader& checkpoint) {
   header += ",kinetic_energy,elastic_energy,external_work";
   if (line != header) throw InputError(csv_path_ + ": its columns differ from the scene's probes");
   for (long i = 0; i < n; ++i) {
-    if (!std::getline(in, line)) throw InputError(csv_path_ + ": holds fewer rows than the checkpoint's " + std::to_string(n));
+    if (!std::getline(in, line))
+      throw InputError(csv_path_ + ": holds fewer rows than the checkpoint's " + std::to_string(n));
     csv_ << line << '\n';
   }
   // The animation's frames so far, in the files the checkpoint names.
   const Eigen::VectorXd frame_time = checkpoint.Vector("/recorder/frame_time");
   const std::vector<std::string> files = checkpoint.Strings("/recorder/frame_files");
-  const Eigen::VectorXi file_of = checkpoint.IntVector("/recorder/frame_file"), stress = checkpoint.IntVector("/recorder/frame_stress");
+  const Eigen::VectorXi file_of = checkpoint.IntVector("/recorder/frame_file"),
+                        stress = checkpoint.IntVector("/recorder/frame_stress");
   if (frame_time.size() != n_frames || file_of.size() != n_frames || stress.size() != n_frames) {
     throw InputError(checkpoint.path() + ": /recorder's frames do not match");
   }
   for (long s = 0; s < n_frames; ++s) {
-    if (file_of[s] < 0 || size_t(file_of[s]) >= files.size()) throw InputError(checkpoint.path() + ": /recorder/frame_file out of range");
+    if (file_of[s] < 0 || size_t(file_of[s]) >= files.size())
+      throw InputError(checkpoint.path() + ": /recorder/frame_file out of range");
     frame_time_.push_back(frame_time[s]);
     frame_file_.push_back(files[size_t(file_of[s])]);
     frame_stress_fields_.push_back(char(stress[s] != 0));

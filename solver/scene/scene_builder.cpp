@@ -38,12 +38,18 @@ SystemModel::Prescribed PrescribedBy(const TimeFunctionSpec& f, int k) {
 JointType SolverJointType(SceneJointType type) {
   switch (type) {
     case SceneJointType::kClamp:
-    case SceneJointType::kRigid: return JointType::kRigid;
-    case SceneJointType::kSpherical: return JointType::kSpherical;
-    case SceneJointType::kRevolute: return JointType::kRevolute;
-    case SceneJointType::kPrismatic: return JointType::kPrismatic;
-    case SceneJointType::kCylindrical: return JointType::kCylindrical;
-    case SceneJointType::kUniversal: return JointType::kUniversal;
+    case SceneJointType::kRigid:
+      return JointType::kRigid;
+    case SceneJointType::kSpherical:
+      return JointType::kSpherical;
+    case SceneJointType::kRevolute:
+      return JointType::kRevolute;
+    case SceneJointType::kPrismatic:
+      return JointType::kPrismatic;
+    case SceneJointType::kCylindrical:
+      return JointType::kCylindrical;
+    case SceneJointType::kUniversal:
+      return JointType::kUniversal;
   }
   return JointType::kRigid;
 }
@@ -53,8 +59,8 @@ void RequireJointGap(const SceneJointSpec& j, const Eigen::Vector3d& x_p, const 
   Eigen::Vector3d gap = x_c - x_p;
   const bool cylindrical = j.type == SceneJointType::kCylindrical;
   if (cylindrical) gap -= gap.dot(j.axis.normalized()) * j.axis.normalized();
-  if (j.type != SceneJointType::kSpherical && j.type != SceneJointType::kRevolute && j.type != SceneJointType::kUniversal &&
-      !cylindrical) {
+  if (j.type != SceneJointType::kSpherical && j.type != SceneJointType::kRevolute &&
+      j.type != SceneJointType::kUniversal && !cylindrical) {
     return;
   }
   const double tolerance = 1e-6 * std::max(scene_length, 1e-3 * std::max(x_p.norm(), x_c.norm()));
@@ -89,12 +95,13 @@ namespace {
 // element's shear deflection inside the element, which the nodes' rotations do not carry, is
 // left out (at the nodes it is exact). Returns the 3 x n map from the body's coordinates, as
 // `shape` of Scene::PointProbe; `cell`, `s` and `distance` (from the axis) say where.
-Eigen::MatrixXd BeamPointShape(const Visualization& mesh, const Eigen::Vector3d& X, int* cell, double* s_out, double* distance,
-                               double* length) {
+Eigen::MatrixXd BeamPointShape(const Visualization& mesh, const Eigen::Vector3d& X, int* cell, double* s_out,
+                               double* distance, double* length) {
   *cell = -1;
   *distance = std::numeric_limits<double>::infinity();
   for (int c = 0; c < mesh.cells.rows(); ++c) {
-    const Eigen::Vector3d a = mesh.nodes.row(mesh.cells(c, 0)).transpose(), d = mesh.nodes.row(mesh.cells(c, 1)).transpose() - a;
+    const Eigen::Vector3d a = mesh.nodes.row(mesh.cells(c, 0)).transpose(),
+                          d = mesh.nodes.row(mesh.cells(c, 1)).transpose() - a;
     const double L2 = d.squaredNorm();
     if (!(L2 > 0)) continue;
     const double s = std::clamp((X - a).dot(d) / L2, 0.0, 1.0), away = (X - a - s * d).norm();
@@ -106,12 +113,14 @@ Eigen::MatrixXd BeamPointShape(const Visualization& mesh, const Eigen::Vector3d&
   const Eigen::Vector3d Xa = mesh.nodes.row(a).transpose(), Xb = mesh.nodes.row(b).transpose();
   const double L = *length, s = *s_out;
   const Eigen::Vector3d e = (Xb - Xa) / L;
-  const Eigen::Matrix3d E = e * e.transpose(), P = Eigen::Matrix3d::Identity() - E, C = -Skew(e);  // C theta = theta x e
+  const Eigen::Matrix3d E = e * e.transpose(), P = Eigen::Matrix3d::Identity() - E,
+                        C = -Skew(e);  // C theta = theta x e
   const auto rows = [&](int node, int at) { return mesh.shapes.middleRows(6L * node + at, 3); };
   const Eigen::MatrixXd Ua = rows(a, 0), Ta = rows(a, 3), Ub = rows(b, 0), Tb = rows(b, 3);
   const double H1 = 1 - 3 * s * s + 2 * s * s * s, H2 = s - 2 * s * s + s * s * s, H3 = 3 * s * s - 2 * s * s * s,
                H4 = s * s * s - s * s;
-  const double D1 = -6 * s + 6 * s * s, D2 = 1 - 4 * s + 3 * s * s, D3 = 6 * s - 6 * s * s, D4 = 3 * s * s - 2 * s;  // dH/ds
+  const double D1 = -6 * s + 6 * s * s, D2 = 1 - 4 * s + 3 * s * s, D3 = 6 * s - 6 * s * s,
+               D4 = 3 * s * s - 2 * s;  // dH/ds
   const Eigen::MatrixXd u_axis = E * ((1 - s) * Ua + s * Ub) + P * (H1 * Ua + H3 * Ub) + L * C * (H2 * Ta + H4 * Tb);
   const Eigen::MatrixXd slope = P * (D1 * Ua + D3 * Ub) / L + C * (D2 * Ta + D4 * Tb);  // du_perp / dx
   const Eigen::MatrixXd theta = E * ((1 - s) * Ta + s * Tb) + Skew(e) * slope;
@@ -133,8 +142,9 @@ void ResolveProbes(const SceneSpec& spec, Scene& scene) {
         if (model.prescribed[i].node == k) scene.effort_coordinates.back().push_back(int(i));
       }
       if (scene.effort_coordinates.back().empty()) {
-        throw InputError(p.where + ": probe '" + p.name + "': node '" + p.node +
-                         "' has no prescribed joint coordinate (effort is the force or torque that keeps a prescribed motion)");
+        throw InputError(
+            p.where + ": probe '" + p.name + "': node '" + p.node +
+            "' has no prescribed joint coordinate (effort is the force or torque that keeps a prescribed motion)");
       }
       continue;
     }
@@ -155,8 +165,8 @@ void ResolveProbes(const SceneSpec& spec, Scene& scene) {
       probe.shape = Eigen::MatrixXd::Zero(3, n);
       if (body.type != SceneBodyType::kRigid) {
         if (!scene.meshes[size_t(b)]) {
-          throw InputError(p.where + ": probe '" + p.name + "': body '" + p.body + "' has no mesh in " + body.superelement +
-                           " (reduce it with reduction.keep_mesh: true)");
+          throw InputError(p.where + ": probe '" + p.name + "': body '" + p.body + "' has no mesh in " +
+                           body.superelement + " (reduce it with reduction.keep_mesh: true)");
         }
         const Visualization& mesh = *scene.meshes[size_t(b)];
         if (mesh.cell_type == "line2" && mesh.dofs_per_node == 6 && mesh.cells.cols() == 2) {
@@ -165,17 +175,21 @@ void ResolveProbes(const SceneSpec& spec, Scene& scene) {
           probe.shape = BeamPointShape(mesh, X, &cell, &s, &distance, &length);
           if (cell < 0 || distance > length) {
             std::snprintf(buffer, sizeof buffer,
-                          "point (%.6g, %.6g, %.6g) lies outside body '%s': %.3g from the axis of its nearest beam element, more than the element's length (%.3g)",
+                          "point (%.6g, %.6g, %.6g) lies outside body '%s': %.3g from the axis of its nearest beam "
+                          "element, more than the element's length (%.3g)",
                           p.point.x(), p.point.y(), p.point.z(), p.body.c_str(), distance, length);
             throw InputError(p.where + ": probe '" + p.name + "': " + buffer);
           }
-          std::snprintf(buffer, sizeof buffer, "probe '%s': point of body '%s' on beam element %d of its mesh, at %.4g of its length, %.3g from its axis",
+          std::snprintf(buffer, sizeof buffer,
+                        "probe '%s': point of body '%s' on beam element %d of its mesh, at %.4g of its length, %.3g "
+                        "from its axis",
                         p.name.c_str(), p.body.c_str(), cell, s, distance);
         } else {
           const MeshPoint at = LocateInMesh(mesh.nodes, mesh.cells, mesh.cell_type, X);
           if (at.cell < 0 && at.distance > at.size) {
             std::snprintf(buffer, sizeof buffer,
-                          "point (%.6g, %.6g, %.6g) lies outside body '%s': %.3g from its nearest mesh node, more than the mesh size there (%.3g)",
+                          "point (%.6g, %.6g, %.6g) lies outside body '%s': %.3g from its nearest mesh node, more than "
+                          "the mesh size there (%.3g)",
                           p.point.x(), p.point.y(), p.point.z(), p.body.c_str(), at.distance, at.size);
             throw InputError(p.where + ": probe '" + p.name + "': " + buffer);
           }
@@ -190,12 +204,14 @@ void ResolveProbes(const SceneSpec& spec, Scene& scene) {
             }
           }
           if (at.cell >= 0) {
-            std::snprintf(buffer, sizeof buffer, "probe '%s': point of body '%s' in cell %d of its mesh", p.name.c_str(),
-                          p.body.c_str(), at.cell);
+            std::snprintf(buffer, sizeof buffer, "probe '%s': point of body '%s' in cell %d of its mesh",
+                          p.name.c_str(), p.body.c_str(), at.cell);
           } else {
-            std::snprintf(buffer, sizeof buffer, "probe '%s': body '%s' at its mesh node %d (%.6g, %.6g, %.6g) in part axes, %.3g from the given point",
-                          p.name.c_str(), p.body.c_str(), at.nearest, mesh.nodes(at.nearest, 0), mesh.nodes(at.nearest, 1),
-                          mesh.nodes(at.nearest, 2), at.distance);
+            std::snprintf(
+                buffer, sizeof buffer,
+                "probe '%s': body '%s' at its mesh node %d (%.6g, %.6g, %.6g) in part axes, %.3g from the given point",
+                p.name.c_str(), p.body.c_str(), at.nearest, mesh.nodes(at.nearest, 0), mesh.nodes(at.nearest, 1),
+                mesh.nodes(at.nearest, 2), at.distance);
           }
         }
         scene.notes.push_back(buffer);
@@ -204,20 +220,25 @@ void ResolveProbes(const SceneSpec& spec, Scene& scene) {
     if (!has(ProbeQuantity::kStress)) continue;
     if (!scene.stresses[size_t(b)]) {
       throw InputError(p.where + ": probe '" + p.name + "': body '" + p.body + "' has no modal stresses" +
-                       (body.type == SceneBodyType::kRigid ? std::string(" (a rigid body)")
-                                             : " in " + body.superelement + " (reduce it with the mesh kept: reduction.keep_mesh, reduction.stresses)"));
+                       (body.type == SceneBodyType::kRigid
+                            ? std::string(" (a rigid body)")
+                            : " in " + body.superelement +
+                                  " (reduce it with the mesh kept: reduction.keep_mesh, reduction.stresses)"));
     }
     const ModalStress& st = *scene.stresses[size_t(b)];
     if (st.n_points() == 0) {
-      throw InputError(p.where + ": probe '" + p.name + "': body '" + p.body + "' has no stress points (beams of "
+      throw InputError(p.where + ": probe '" + p.name + "': body '" + p.body +
+                       "' has no stress points (beams of "
                        "'general' sections have section forces only)");
     }
     Eigen::Index nearest = 0;
     (st.points.rowwise() - X.transpose()).rowwise().squaredNorm().minCoeff(&nearest);
     scene.stress_probes.back() = {b, int(nearest)};
-    std::snprintf(buffer, sizeof buffer, "probe '%s': stress point %ld of body '%s' at (%.6g, %.6g, %.6g) in part axes, %.3g from the given point",
-                  p.name.c_str(), long(nearest), p.body.c_str(), st.points(nearest, 0), st.points(nearest, 1),
-                  st.points(nearest, 2), (st.points.row(nearest).transpose() - X).norm());
+    std::snprintf(
+        buffer, sizeof buffer,
+        "probe '%s': stress point %ld of body '%s' at (%.6g, %.6g, %.6g) in part axes, %.3g from the given point",
+        p.name.c_str(), long(nearest), p.body.c_str(), st.points(nearest, 0), st.points(nearest, 1),
+        st.points(nearest, 2), (st.points.row(nearest).transpose() - X).norm());
     scene.notes.push_back(buffer);
   }
 }
@@ -238,7 +259,8 @@ void ResolveStressExclusion(const SceneSpec& spec, Scene& scene) {
     const std::string body_name = name.substr(0, dot), interface = name.substr(dot + 1);
     size_t b = 0;
     while (b < spec.bodies.size() && spec.bodies[b].name != body_name) ++b;
-    if (b == spec.bodies.size()) throw InputError(ex.where + ": stress_exclude.interfaces: no body '" + body_name + "' in the scene");
+    if (b == spec.bodies.size())
+      throw InputError(ex.where + ": stress_exclude.interfaces: no body '" + body_name + "' in the scene");
     int k = -1;
     const auto& names = scene.interface_names[b];
     for (size_t i = 0; i < names.size(); ++i)
@@ -246,8 +268,8 @@ void ResolveStressExclusion(const SceneSpec& spec, Scene& scene) {
     if (k < 0) {
       std::string known;
       for (const std::string& n : names) known += (known.empty() ? "" : ", ") + n;
-      throw InputError(ex.where + ": stress_exclude.interfaces: body '" + body_name + "' has no interface '" + interface +
-                       "' (it has: " + known + ")");
+      throw InputError(ex.where + ": stress_exclude.interfaces: body '" + body_name + "' has no interface '" +
+                       interface + "' (it has: " + known + ")");
     }
     chosen[b].push_back(k);
   }
@@ -280,8 +302,10 @@ void ResolveStressExclusion(const SceneSpec& spec, Scene& scene) {
       }
     }
     char buffer[200];
-    std::snprintf(buffer, sizeof buffer, "body '%s': %ld of %ld mesh nodes within %.3g of its couplings left out of its largest von Mises stress",
-                  spec.bodies[b].name.c_str(), count, long(mesh.nodes.rows()), ex.distance);
+    std::snprintf(
+        buffer, sizeof buffer,
+        "body '%s': %ld of %ld mesh nodes within %.3g of its couplings left out of its largest von Mises stress",
+        spec.bodies[b].name.c_str(), count, long(mesh.nodes.rows()), ex.distance);
     scene.notes.push_back(buffer);
   }
 }
@@ -313,9 +337,11 @@ void RequireLoopsClosedAtStart(const SceneSpec& spec, const SystemModel& model, 
   if (gap <= 1e-9 * std::max(BoundingDiagonal(model.node_x0), 1e-300)) return;
   char buffer[200];
   std::snprintf(buffer, sizeof buffer, ", which opens the loop closed by %s by %.3g at the start",
-                worst >= 0 && size_t(worst) < model.cut_joints.size() ? model.cut_joints[size_t(worst)].name.c_str() : "a cut joint",
+                worst >= 0 && size_t(worst) < model.cut_joints.size() ? model.cut_joints[size_t(worst)].name.c_str()
+                                                                      : "a cut joint",
                 gap);
-  throw InputError(moved + buffer + " (the scene places the mechanism at 0): place the bodies at the drive's start "
+  throw InputError(moved + buffer +
+                   " (the scene places the mechanism at 0): place the bodies at the drive's start "
                    "position, or give the function an offset so that it is 0 at t = 0");
 }
 
@@ -327,7 +353,7 @@ Scene BuildScene(const SceneSpec& spec) {
   SystemModel& model = scene.model;
   const std::filesystem::path base = std::filesystem::path(spec.file).parent_path();
   std::map<std::string, std::pair<Eigen::Vector3d, std::string>> placed;  // node -> position, by body
-  std::vector<std::pair<int, int>> rigid_attachments;  // (child node, COM node)
+  std::vector<std::pair<int, int>> rigid_attachments;                     // (child node, COM node)
   for (const SceneBodySpec& b : spec.bodies) scene.origin += b.position / double(spec.bodies.size());
   for (const SceneBodySpec& b_spec : spec.bodies) {
     SceneBodySpec b = b_spec;
@@ -378,8 +404,8 @@ Scene BuildScene(const SceneSpec& spec) {
         } else {
           k = found->second;
           if ((model.node_x0[k] - x).norm() > 1e-9 * std::max(1.0, x.norm())) {
-            throw InputError(b.where + ": rigid body '" + b.name + "': point '" + point + "' at a different place than node '" +
-                             node + "' of body '" + placed[node].second + "'");
+            throw InputError(b.where + ": rigid body '" + b.name + "': point '" + point +
+                             "' at a different place than node '" + node + "' of body '" + placed[node].second + "'");
           }
         }
         rigid_attachments.emplace_back(k, com);
@@ -434,7 +460,8 @@ Scene BuildScene(const SceneSpec& spec) {
     if (!b.geometric_stiffening.has_value() && !file_has_stiffening && se.n_reduced_dofs() > 6) {
       // What a linear body costs: in a rotating part the centrifugal stiffening of its bending
       // (rotating_beam example: one body without it 43-59% off, with it 2.2%).
-      scene.notes.push_back("body '" + b.name + "': " + file.string() + " has no geometric stiffening; the body is "
+      scene.notes.push_back("body '" + b.name + "': " + file.string() +
+                            " has no geometric stiffening; the body is "
                             "linear inside, so a rotating or highly loaded part misses its stress stiffening (" +
                             (imported ? "an imported part of solid cells gets it from the part's material:, others "
                                         "can be split into several bodies"
@@ -450,15 +477,18 @@ Scene BuildScene(const SceneSpec& spec) {
                        "femb-reduce stores them for every part)");
     }
     if (!b.exact_inertia.has_value() && se.inertia_gamma.empty() && se.n_reduced_dofs() > 6) {
-      scene.notes.push_back("body '" + b.name + "': " + file.string() + " has no inertia invariants (an older "
+      scene.notes.push_back("body '" + b.name + "': " + file.string() +
+                            " has no inertia invariants (an older "
                             "femb-reduce wrote it): the corotational inertia (thesis 3.22) approximates the "
                             "centrifugal and Coriolis coupling of the deformation (a spinning bar stretched 21% too "
                             "much); reduce the part again for the exact inertia");
     }
     if (midpoint && file_has_stiffening && !b.geometric_stiffening.has_value()) {
-      scene.notes.push_back("body '" + b.name + "': the midpoint integrator keeps the body linear inside, whose energy it "
-                            "conserves exactly: the file's geometric stiffening is not used (generalized_alpha uses it; "
-                            "options.geometric_stiffening: true forces it)");
+      scene.notes.push_back(
+          "body '" + b.name +
+          "': the midpoint integrator keeps the body linear inside, whose energy it "
+          "conserves exactly: the file's geometric stiffening is not used (generalized_alpha uses it; "
+          "options.geometric_stiffening: true forces it)");
     }
     std::vector<int> nodes;
     for (const auto& [iname, _] : b.nodes) {
@@ -488,7 +518,8 @@ Scene BuildScene(const SceneSpec& spec) {
         if ((x - x_other).norm() > 1e-9 * std::max(1.0, x.norm())) {
           char buffer[300];
           const Eigen::Vector3d xa = x + scene.origin, xb = x_other + scene.origin;
-          std::snprintf(buffer, sizeof buffer, "node '%s' is placed at (%.6g, %.6g, %.6g) by body '%s' but at (%.6g, %.6g, %.6g) by body '%s'",
+          std::snprintf(buffer, sizeof buffer,
+                        "node '%s' is placed at (%.6g, %.6g, %.6g) by body '%s' but at (%.6g, %.6g, %.6g) by body '%s'",
                         node.c_str(), xa.x(), xa.y(), xa.z(), b.name.c_str(), xb.x(), xb.y(), xb.z(), other.c_str());
           throw InputError(b.where + ": " + buffer);
         }
@@ -540,7 +571,8 @@ Scene BuildScene(const SceneSpec& spec) {
   const auto add_cut = [&](JointType type, int k, int p, const Eigen::Vector3d& axis, const Eigen::Vector3d& axis2,
                            const std::string& name) {
     CutJoint cut;
-    cut.joint = MakeNodeJoint(type, k, p, axis, model.node_x0[p], model.node_R0[p], model.node_x0[k], model.node_R0[k], axis2);
+    cut.joint =
+        MakeNodeJoint(type, k, p, axis, model.node_x0[p], model.node_R0[p], model.node_x0[k], model.node_R0[k], axis2);
     cut.name = name;
     for (int i = 0; i < ConstraintCount(type); ++i) cut.equations.push_back(i);
     model.cut_joints.push_back(cut);
@@ -585,10 +617,12 @@ Scene BuildScene(const SceneSpec& spec) {
     const JointType type = SolverJointType(j.type);
     if (!tree) {
       if (!j.prescribed.empty()) {
-        throw InputError(j.where + ": " + Name(j.type) + " joint of node '" + j.node + "' is prescribed but closes a loop (node '" +
-                         j.node + "' already hangs on " +
-                         (holder[size_t(k)] >= 0 ? "node '" + model.node_names[holder[size_t(k)]] + "'" : std::string("the ground")) +
-                         "); a drive must be a tree joint: swap 'node' and 'parent', or prescribe another joint of the loop");
+        throw InputError(
+            j.where + ": " + Name(j.type) + " joint of node '" + j.node + "' is prescribed but closes a loop (node '" +
+            j.node + "' already hangs on " +
+            (holder[size_t(k)] >= 0 ? "node '" + model.node_names[holder[size_t(k)]] + "'"
+                                    : std::string("the ground")) +
+            "); a drive must be a tree joint: swap 'node' and 'parent', or prescribe another joint of the loop");
       }
       const std::string name = j.where + ": " + Name(j.type) + " joint of node '" + j.node + "'" +
                                (p >= 0 ? " on node '" + j.parent + "'" : std::string(" to the ground"));
@@ -606,7 +640,8 @@ Scene BuildScene(const SceneSpec& spec) {
     const int all = ConstraintCount(cut.joint.type), kept = int(cut.equations.size());
     std::string note = cut.name + " closes a loop: ";
     if (kept == 0) {
-      note += "the other joints already hold it; its " + std::to_string(all) + " equations repeat theirs and are dropped";
+      note +=
+          "the other joints already hold it; its " + std::to_string(all) + " equations repeat theirs and are dropped";
     } else {
       note += std::to_string(kept) + " constraint equations with Lagrange multipliers";
       if (kept < all) {
@@ -617,7 +652,7 @@ Scene BuildScene(const SceneSpec& spec) {
     }
     scene.notes.push_back(note);
   }
- // The joint graph (cycles, two parents) before anything walks it.
+  // The joint graph (cycles, two parents) before anything walks it.
   std::unique_ptr<DofMap> dofs_ptr;
   try {
     dofs_ptr = std::make_unique<DofMap>(model);
@@ -647,7 +682,8 @@ Scene BuildScene(const SceneSpec& spec) {
       continue;
     }
     const int k = scene.node_index.at(l.node);
-    if (FixedToGround(model, k)) throw InputError(l.where + ": load on node '" + l.node + "', which is clamped to the ground");
+    if (FixedToGround(model, k))
+      throw InputError(l.where + ": load on node '" + l.node + "', which is clamped to the ground");
     NodeLoad load;
     load.node = k;
     load.force = l.force;
@@ -680,7 +716,8 @@ Scene BuildScene(const SceneSpec& spec) {
     // is admissible).
     const NodeJoint& joint = model.joints[size_t(j)];
     const JointColumns B = ComputeJointMaps(joint, Eigen::Vector3d::Zero(), Eigen::Matrix3d::Identity(),
-                                            model.node_x0[k], Eigen::VectorXd::Zero(joint.n_coordinates())).B;
+                                            model.node_x0[k], Eigen::VectorXd::Zero(joint.n_coordinates()))
+                               .B;
     scene.initial_velocity.segment(dofs.node_first(k), dofs.node_count(k)) = B.colPivHouseholderQr().solve(v6);
   }
   for (const auto& [node, rates] : spec.initial_joint_rates) {
@@ -693,9 +730,10 @@ Scene BuildScene(const SceneSpec& spec) {
         (model.joints[size_t(j)].type == JointType::kSpherical || model.joints[size_t(j)].type == JointType::kRigid);
     const bool has_joint = j >= 0 && !support_without_rates;
     if (!has_joint || int(rates.size()) != dofs.node_count(k)) {
-      throw InputError(spec.file + ": initial_velocity: node '" + node + "' has " +
-                       (has_joint ? std::to_string(dofs.node_count(k)) + " joint coordinates" : std::string("no joint")) +
-                       ", got " + std::to_string(rates.size()) + " joint rates");
+      throw InputError(
+          spec.file + ": initial_velocity: node '" + node + "' has " +
+          (has_joint ? std::to_string(dofs.node_count(k)) + " joint coordinates" : std::string("no joint")) + ", got " +
+          std::to_string(rates.size()) + " joint rates");
     }
     for (size_t i = 0; i < rates.size(); ++i) scene.initial_velocity[dofs.node_first(k) + int(i)] = rates[i];
   }

@@ -13,23 +13,23 @@ namespace femb {
 namespace {
 
 const std::string kGood =
-    "name: pendulum\n"                                                              // 1
-    "bodies:\n"                                                                     // 2
-    "  - {name: rod, superelement: rod.h5, nodes: {A: pivot, B: tip}}\n"            // 3
-    "joints:\n"                                                                     // 4
-    "  - {type: revolute, node: pivot, axis: [0, 0, 1], prescribed: drive}\n"       // 5
-    "functions:\n"                                                                  // 6
-    "  drive: {type: ramp, value: 2.0, t_start: 0.1, t_end: 0.3}\n"                 // 7
-    "  push: {type: pulse, value: 5.0, t_start: 0.2, t_end: 0.25}\n"                // 8
-    "  path: {type: table, points: [[0, 0], [1, 2], [3, 0]]}\n"                     // 9
-    "  spin: {type: spin_up, omega: 6.0, t_spin: 15.0}\n"                           // 10
-    "loads:\n"                                                                      // 11
-    "  - {type: force, node: tip, force: [0, 1, 0], function: push}\n"              // 12
-    "analysis:\n"                                                                   // 13
-    "  type: dynamic\n"                                                             // 14
-    "  end_time: 1.0\n"                                                             // 15
-    "  step: 1.0e-3\n"                                                              // 16
-    "  integrator: midpoint\n";                                                     // 17
+    "name: pendulum\n"                                                         // 1
+    "bodies:\n"                                                                // 2
+    "  - {name: rod, superelement: rod.h5, nodes: {A: pivot, B: tip}}\n"       // 3
+    "joints:\n"                                                                // 4
+    "  - {type: revolute, node: pivot, axis: [0, 0, 1], prescribed: drive}\n"  // 5
+    "functions:\n"                                                             // 6
+    "  drive: {type: ramp, value: 2.0, t_start: 0.1, t_end: 0.3}\n"            // 7
+    "  push: {type: pulse, value: 5.0, t_start: 0.2, t_end: 0.25}\n"           // 8
+    "  path: {type: table, points: [[0, 0], [1, 2], [3, 0]]}\n"                // 9
+    "  spin: {type: spin_up, omega: 6.0, t_spin: 15.0}\n"                      // 10
+    "loads:\n"                                                                 // 11
+    "  - {type: force, node: tip, force: [0, 1, 0], function: push}\n"         // 12
+    "analysis:\n"                                                              // 13
+    "  type: dynamic\n"                                                        // 14
+    "  end_time: 1.0\n"                                                        // 15
+    "  step: 1.0e-3\n"                                                         // 16
+    "  integrator: midpoint\n";                                                // 17
 
 using test::Replace;
 
@@ -106,7 +106,7 @@ TEST(SceneFile, TimeFunctionsFollowTheirClosedForms) {
   EXPECT_DOUBLE_EQ(ramp.Rate(0.2), 10.0);
   EXPECT_EQ(ramp.Breakpoints(), (std::vector<double>{0.1, 0.3}));
   const TimeFunctionSpec& pulse = s.functions.at("push");
-  EXPECT_DOUBLE_EQ(pulse.Evaluate(0.2), 5.0);  // on from t_start
+  EXPECT_DOUBLE_EQ(pulse.Evaluate(0.2), 5.0);   // on from t_start
   EXPECT_DOUBLE_EQ(pulse.Evaluate(0.25), 0.0);  // off at t_end
   EXPECT_EQ(pulse.Breakpoints(), (std::vector<double>{0.2, 0.25}));
   const TimeFunctionSpec& table = s.functions.at("path");
@@ -126,7 +126,8 @@ TEST(SceneFile, TimeFunctionsFollowTheirClosedForms) {
   EXPECT_DOUBLE_EQ(spin.Rate(20.0), 6.0);
   EXPECT_NEAR(spin.Evaluate(15.0), 6.0 * 7.5, 1e-12);  // continuous at Ts
   EXPECT_EQ(spin.Breakpoints(), (std::vector<double>{15.0}));
-  const SceneSpec sine = ParseScene(kGood, "scene.yaml", {"functions.drive={type: sine, amplitude: 2, frequency: 0.5}"});
+  const SceneSpec sine =
+      ParseScene(kGood, "scene.yaml", {"functions.drive={type: sine, amplitude: 2, frequency: 0.5}"});
   EXPECT_NEAR(sine.functions.at("drive").Evaluate(0.5), 2.0, 1e-15);
   EXPECT_TRUE(sine.functions.at("drive").Breakpoints().empty());
 }

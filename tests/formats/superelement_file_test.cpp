@@ -5,10 +5,10 @@
 #include <hdf5.h>
 
 #include <Eigen/Geometry>
-#include <filesystem>
 #include <cstring>
-#include <functional>
+#include <filesystem>
 #include <fstream>
+#include <functional>
 #include <random>
 #include <thread>
 
@@ -21,10 +21,9 @@ namespace {
 namespace fs = std::filesystem;
 
 Superelement Sample() {
-  Superelement se = test::Reduce(test::StraightBeamYaml(0.3, 6, "{shape: circle, diameter: 0.006}",
-                                                        "{E: 2.0e11, nu: 0.3, rho: 7870}",
-                                                        "[{name: A}, {name: B}]",
-                                                        "reduction: {internal_modes: 3, full_modes: 4, floating_frame: cardona}\n"));
+  Superelement se = test::Reduce(test::StraightBeamYaml(
+      0.3, 6, "{shape: circle, diameter: 0.006}", "{E: 2.0e11, nu: 0.3, rho: 7870}", "[{name: A}, {name: B}]",
+      "reduction: {internal_modes: 3, full_modes: 4, floating_frame: cardona}\n"));
   se.interfaces[1].orientation = Eigen::AngleAxisd(0.3, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
   return se;
 }
@@ -81,7 +80,8 @@ TEST(Hdf5Writer, PackedFramesReadBackExactly) {
   const std::string path = TempPath("compressed.h5");
   Eigen::MatrixXf smooth(5000, 3), noise(700, 3), empty(0, 3);
   Eigen::MatrixXf tall(1300000, 1);
-  for (int i = 0; i < smooth.rows(); ++i) smooth.row(i) << std::round(1e4f * std::sin(1e-3f * i)) / 1024.0f, 0.5f, float(i % 7);
+  for (int i = 0; i < smooth.rows(); ++i)
+    smooth.row(i) << std::round(1e4f * std::sin(1e-3f * i)) / 1024.0f, 0.5f, float(i % 7);
   // Random bits in every byte (finite numbers: exponent field 1..254).
   std::mt19937 random(5);
   for (Eigen::Index i = 0; i < noise.size(); ++i) {
@@ -149,7 +149,9 @@ TEST(SuperelementFile, WriteReplacesAtomicallyAndLeavesNoTemporary) {
 }
 
 TEST(SuperelementFile, MissingFile) {
-  EXPECT_NE(test::ThrownMessage([] { ReadSuperelementFile("/nonexistent/x.h5"); }).find("/nonexistent/x.h5: cannot open file"),
+  EXPECT_NE(test::ThrownMessage([] {
+              ReadSuperelementFile("/nonexistent/x.h5");
+            }).find("/nonexistent/x.h5: cannot open file"),
             std::string::npos);
 }
 

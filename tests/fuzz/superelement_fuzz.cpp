@@ -5,12 +5,12 @@
 // an InputError from the reader or the checks, or a superelement that passes the checks and on
 // which a body's frame solve and elastic force are finite.
 #include <hdf5.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
 #include <string>
-#include <unistd.h>
 
 #include "formats/input_error.h"
 #include "formats/superelement_checks.h"
@@ -25,10 +25,14 @@ std::string path;
 
 Eigen::MatrixXd& Pick(femb::Superelement& se, unsigned which, Eigen::MatrixXd& scratch) {
   switch (which) {
-    case 0: return se.K;
-    case 1: return se.M;
-    case 2: return se.floating_frame.Phi_CB;
-    default: return scratch;
+    case 0:
+      return se.K;
+    case 1:
+      return se.M;
+    case 2:
+      return se.floating_frame.Phi_CB;
+    default:
+      return scratch;
   }
 }
 
@@ -42,7 +46,7 @@ void Mutate(femb::Superelement& se, femb::fuzz::Input& in) {
   switch (in.Below(8)) {
     case 0: {  // one value of a matrix (K, M, Phi_CB, the inertia, the frame orientation)
       const unsigned which = in.Below(5);
-      double* data = which == 3 ? se.mass_properties.inertia_com.data()
+      double* data = which == 3   ? se.mass_properties.inertia_com.data()
                      : which == 4 ? se.floating_frame.orientation.data()
                                   : Pick(se, which, scratch).data();
       const long size = which >= 3 ? 9 : long(Pick(se, which, scratch).size());
@@ -61,16 +65,21 @@ void Mutate(femb::Superelement& se, femb::fuzz::Input& in) {
       if (se.interfaces.empty()) return;
       femb::InterfaceNode& node = se.interfaces[in.Below(unsigned(se.interfaces.size()))];
       const unsigned i = in.Below(12);
-      if (i < 3) node.position[i] = Special(in.Byte(), node.position[i]);
-      else node.orientation.data()[i - 3] = Special(in.Byte(), node.orientation.data()[i - 3]);
+      if (i < 3)
+        node.position[i] = Special(in.Byte(), node.position[i]);
+      else
+        node.orientation.data()[i - 3] = Special(in.Byte(), node.orientation.data()[i - 3]);
       return;
     }
     case 3:  // an interface removed or duplicated
-      if (in.Byte() % 2 && !se.interfaces.empty()) se.interfaces.pop_back();
-      else if (!se.interfaces.empty()) se.interfaces.push_back(se.interfaces.front());
+      if (in.Byte() % 2 && !se.interfaces.empty())
+        se.interfaces.pop_back();
+      else if (!se.interfaces.empty())
+        se.interfaces.push_back(se.interfaces.front());
       return;
     case 4:  // internal frequencies / modal derivative counts
-      se.internal_frequencies_hz.conservativeResize(std::max(0L, long(se.internal_frequencies_hz.size()) + long(in.Below(3)) - 1));
+      se.internal_frequencies_hz.conservativeResize(
+          std::max(0L, long(se.internal_frequencies_hz.size()) + long(in.Below(3)) - 1));
       se.n_modal_derivatives = long(in.Below(5)) - 1;
       if (in.Byte() % 2) se.modal_derivative_pairs.emplace_back(int(in.Below(40)) - 5, int(in.Below(40)) - 5);
       return;
@@ -87,8 +96,13 @@ void Mutate(femb::Superelement& se, femb::fuzz::Input& in) {
 }
 
 void DeleteSomething(unsigned which) {
-  const char* datasets[] = {"/reduced/K", "/reduced/M", "/floating_frame/Phi_CB", "/interfaces/names",
-                            "/interfaces/positions", "/mass_properties/mass", "/reduced/internal_frequencies_hz",
+  const char* datasets[] = {"/reduced/K",
+                            "/reduced/M",
+                            "/floating_frame/Phi_CB",
+                            "/interfaces/names",
+                            "/interfaces/positions",
+                            "/mass_properties/mass",
+                            "/reduced/internal_frequencies_hz",
                             "/floating_frame/origin"};
   const hid_t file = H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
   if (file < 0) return;

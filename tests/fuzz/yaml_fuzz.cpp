@@ -11,17 +11,34 @@ namespace {
 // Walks every value as every type: the accessors must throw InputError or answer.
 void Walk(const femb::YamlValue& v, int depth) {
   if (depth > 64) return;
-  try { (void)v.Number(); } catch (const femb::InputError&) {}
-  try { (void)v.Integer(); } catch (const femb::InputError&) {}
-  try { (void)v.Bool(); } catch (const femb::InputError&) {}
-  try { (void)v.String(); } catch (const femb::InputError&) {}
-  try { (void)v.Vector3(); } catch (const femb::InputError&) {}
+  try {
+    (void)v.Number();
+  } catch (const femb::InputError&) {
+  }
+  try {
+    (void)v.Integer();
+  } catch (const femb::InputError&) {
+  }
+  try {
+    (void)v.Bool();
+  } catch (const femb::InputError&) {
+  }
+  try {
+    (void)v.String();
+  } catch (const femb::InputError&) {
+  }
+  try {
+    (void)v.Vector3();
+  } catch (const femb::InputError&) {
+  }
   try {
     for (const auto& [key, child] : v.Map().Entries()) Walk(child, depth + 1);
-  } catch (const femb::InputError&) {}
+  } catch (const femb::InputError&) {
+  }
   try {
     for (const femb::YamlValue& child : v.List()) Walk(child, depth + 1);
-  } catch (const femb::InputError&) {}
+  } catch (const femb::InputError&) {
+  }
 }
 
 }  // namespace
@@ -34,7 +51,10 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   try {
     femb::YamlDocument doc = femb::YamlDocument::LoadString(text, "fuzz.yaml");
     if (first.find('=') != std::string::npos && first.size() < 200) {
-      try { doc.Set(first); } catch (const femb::InputError&) {}
+      try {
+        doc.Set(first);
+      } catch (const femb::InputError&) {
+      }
     }
     Walk(doc.Root().AsValue(), 0);
   } catch (const femb::InputError&) {

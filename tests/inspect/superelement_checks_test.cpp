@@ -7,7 +7,6 @@
 #include <functional>
 
 #include "formats/input_error.h"
-
 #include "test_util.h"
 
 namespace femb {
@@ -110,7 +109,8 @@ TEST(SuperelementChecks, EachDefectIsCaught) {
     EXPECT_EQ(ReducedCoordinateLabel(se, -5), "coordinate -5 (out of range)");
     EXPECT_EQ(ReducedCoordinateLabel(se, se.n_reduced_dofs() + 3),
               "coordinate " + std::to_string(se.n_reduced_dofs() + 3) + " (out of range)");
-    EXPECT_NE(ReducedCoordinateLabel(se, se.n_interface_dofs() + se.n_internal_modes()).find("(-5 x 99)"), std::string::npos);
+    EXPECT_NE(ReducedCoordinateLabel(se, se.n_interface_dofs() + se.n_internal_modes()).find("(-5 x 99)"),
+              std::string::npos);
   }
 }
 

@@ -24,13 +24,14 @@ namespace {
 std::string RodYaml(double L, int modes, bool mm, double E_factor = 1.0, double rho_factor = 1.0) {
   const double s = mm ? 1000.0 : 1.0;  // length unit per metre
   char text[1024];
-  std::snprintf(text, sizeof text,
-                "name: rod\ntype: beam\nunits: %s\nmaterial: {E: %.17g, nu: 0.3, rho: %.17g}\n"
-                "section: {shape: circle, diameter: %.17g}\n"
-                "beam:\n  points: {A: [0, 0, 0], B: [%.17g, 0, 0]}\n  segments: [{from: A, to: B, elements: 12}]\n"
-                "interfaces: [{name: A}, {name: B}]\nreduction: {internal_modes: %d, floating_frame: center_of_mass}\n%s",
-                mm ? "mm-t-s" : "SI", 2e11 * E_factor / (mm ? 1e6 : 1.0), 7870.0 * rho_factor / (mm ? 1e12 : 1.0),
-                0.006 * s, L * s, modes, E_factor != 1.0 || rho_factor != 1.0 ? "check_units: false\n" : "");
+  std::snprintf(
+      text, sizeof text,
+      "name: rod\ntype: beam\nunits: %s\nmaterial: {E: %.17g, nu: 0.3, rho: %.17g}\n"
+      "section: {shape: circle, diameter: %.17g}\n"
+      "beam:\n  points: {A: [0, 0, 0], B: [%.17g, 0, 0]}\n  segments: [{from: A, to: B, elements: 12}]\n"
+      "interfaces: [{name: A}, {name: B}]\nreduction: {internal_modes: %d, floating_frame: center_of_mass}\n%s",
+      mm ? "mm-t-s" : "SI", 2e11 * E_factor / (mm ? 1e6 : 1.0), 7870.0 * rho_factor / (mm ? 1e12 : 1.0), 0.006 * s,
+      L * s, modes, E_factor != 1.0 || rho_factor != 1.0 ? "check_units: false\n" : "");
   return text;
 }
 
@@ -39,16 +40,16 @@ struct Outcome {
   std::string message;
   std::vector<std::string> warnings;
   std::vector<double> t;
-  std::vector<Eigen::Vector3d> tip;      ///< position of the probe node (relative to origin)
-  Eigen::Vector3d origin;                ///< the scene's computing origin (scene_builder.h)
-  std::vector<double> energy_balance;    ///< T + U - W_loads - W_drives
+  std::vector<Eigen::Vector3d> tip;    ///< position of the probe node (relative to origin)
+  Eigen::Vector3d origin;              ///< the scene's computing origin (scene_builder.h)
+  std::vector<double> energy_balance;  ///< T + U - W_loads - W_drives
   long steps = 0;
 };
 
 // Writes the superelements into a fresh folder, builds the scene from `scene` (YAML) and runs
 // its analysis; `tip` names the node recorded.
 Outcome Simulate(const std::string& name, const std::string& scene, const std::map<std::string, Superelement>& files,
-             const std::string& tip, const std::function<void(DynamicOptions&)>& tweak = nullptr) {
+                 const std::string& tip, const std::function<void(DynamicOptions&)>& tweak = nullptr) {
   const std::string dir = ::testing::TempDir() + "stress_" + name;
   std::filesystem::create_directories(dir);
   for (const auto& [file, se] : files) WriteSuperelementFile(se, dir + "/" + file);
@@ -63,10 +64,11 @@ Outcome Simulate(const std::string& name, const std::string& scene, const std::m
     options.end_time = a.end_time;
     options.steps = a.steps;
     options.tolerance = a.tolerance;
-    const StaticResult r = SolveStatic(s.model, state, options, [&](const StaticStepReport& step, const SystemState& st) {
-      run.t.push_back(step.lambda);
-      run.tip.push_back(st.x[node]);
-    });
+    const StaticResult r =
+        SolveStatic(s.model, state, options, [&](const StaticStepReport& step, const SystemState& st) {
+          run.t.push_back(step.lambda);
+          run.tip.push_back(st.x[node]);
+        });
     run.ok = r.ok;
     run.message = r.message;
     run.warnings = r.warnings;
@@ -83,11 +85,13 @@ Outcome Simulate(const std::string& name, const std::string& scene, const std::m
   if (tweak) tweak(options);
   const DynamicStepReport r0 = Measure(s.model, state);
   const double E0 = r0.kinetic_energy + r0.elastic_energy;
-  const DynamicResult r = SolveDynamic(s.model, state, options, [&](const DynamicStepReport& step, const DynamicState& st) {
-    run.t.push_back(step.t);
-    run.tip.push_back(st.config.x[node]);
-    run.energy_balance.push_back(step.kinetic_energy + step.elastic_energy - step.external_work - st.drive_work - E0);
-  });
+  const DynamicResult r =
+      SolveDynamic(s.model, state, options, [&](const DynamicStepReport& step, const DynamicState& st) {
+        run.t.push_back(step.t);
+        run.tip.push_back(st.config.x[node]);
+        run.energy_balance.push_back(step.kinetic_energy + step.elastic_energy - step.external_work - st.drive_work -
+                                     E0);
+      });
   run.ok = r.ok;
   run.message = r.message;
   run.warnings = r.warnings;
@@ -100,19 +104,21 @@ Outcome Simulate(const std::string& name, const std::string& scene, const std::m
 std::string Pendulum(bool mm, const Eigen::Vector3d& origin, const std::string& analysis) {
   const double s = mm ? 1000.0 : 1.0;
   char text[2048];
-  std::snprintf(text, sizeof text,
-                "name: pendulum\nunits: %s\n"
-                "bodies:\n"
-                "  - {name: rod, superelement: rod.h5, placement: {position: [%.17g, %.17g, %.17g], rotation: [0, 0, -1.0707963267948966]}, nodes: {A: pivot, B: tip}}\n"
-                "  - {name: block, type: rigid, mass: %.17g, center_of_mass: [0, %.17g, 0], inertia: [%.17g, %.17g, %.17g],\n"
-                "     points: {P: [0, 0, 0]}, placement: {position: [%.17g, %.17g, %.17g]}, nodes: {P: tip}}\n"
-                "joints:\n  - {type: revolute, node: pivot, axis: [0, 0, 1]}\n"
-                "loads:\n  - {type: gravity, g: [0, %.17g, 0]}\n"
-                "analysis: %s\n",
-                mm ? "mm-t-s" : "SI", origin.x() * s, origin.y() * s, origin.z() * s, 0.05 / (mm ? 1000.0 : 1.0),
-                -0.02 * s, 1e-5 * (mm ? 1e3 : 1.0), 1e-5 * (mm ? 1e3 : 1.0), 1e-5 * (mm ? 1e3 : 1.0),
-                (origin.x() + 0.3 * std::cos(-1.0707963267948966)) * s, (origin.y() + 0.3 * std::sin(-1.0707963267948966)) * s,
-                origin.z() * s, -9.81 * s, analysis.c_str());
+  std::snprintf(
+      text, sizeof text,
+      "name: pendulum\nunits: %s\n"
+      "bodies:\n"
+      "  - {name: rod, superelement: rod.h5, placement: {position: [%.17g, %.17g, %.17g], rotation: [0, 0, "
+      "-1.0707963267948966]}, nodes: {A: pivot, B: tip}}\n"
+      "  - {name: block, type: rigid, mass: %.17g, center_of_mass: [0, %.17g, 0], inertia: [%.17g, %.17g, %.17g],\n"
+      "     points: {P: [0, 0, 0]}, placement: {position: [%.17g, %.17g, %.17g]}, nodes: {P: tip}}\n"
+      "joints:\n  - {type: revolute, node: pivot, axis: [0, 0, 1]}\n"
+      "loads:\n  - {type: gravity, g: [0, %.17g, 0]}\n"
+      "analysis: %s\n",
+      mm ? "mm-t-s" : "SI", origin.x() * s, origin.y() * s, origin.z() * s, 0.05 / (mm ? 1000.0 : 1.0), -0.02 * s,
+      1e-5 * (mm ? 1e3 : 1.0), 1e-5 * (mm ? 1e3 : 1.0), 1e-5 * (mm ? 1e3 : 1.0),
+      (origin.x() + 0.3 * std::cos(-1.0707963267948966)) * s, (origin.y() + 0.3 * std::sin(-1.0707963267948966)) * s,
+      origin.z() * s, -9.81 * s, analysis.c_str());
   return text;
 }
 
@@ -122,7 +128,8 @@ std::string ClampedChain(const std::string& name, int n, double segment) {
   std::string scene = "name: " + name + "\nunits: SI\nbodies:\n";
   for (int b = 0; b < n; ++b) {
     char line[200];
-    std::snprintf(line, sizeof line, "  - {name: b%d, superelement: seg.h5, placement: {position: [%g, 0, 0]}, nodes: {A: n%d, B: n%d}}\n",
+    std::snprintf(line, sizeof line,
+                  "  - {name: b%d, superelement: seg.h5, placement: {position: [%g, 0, 0]}, nodes: {A: n%d, B: n%d}}\n",
                   b, segment * b, b, b + 1);
     scene += line;
   }
@@ -142,16 +149,17 @@ double Amplitude(const Outcome& r, const Eigen::Vector3d& centre) {
 TEST(NumericalStress, SameModelInSiAndMillimetresAgrees) {
   const std::string analysis = "{type: dynamic, end_time: 1.0, step: 1e-3, rho_inf: 0.9}";
   const Outcome si = Simulate("si", Pendulum(false, Eigen::Vector3d::Zero(), analysis),
-                          {{"rod.h5", test::Reduce(RodYaml(0.3, 2, false))}}, "tip");
+                              {{"rod.h5", test::Reduce(RodYaml(0.3, 2, false))}}, "tip");
   const Outcome mm = Simulate("mm", Pendulum(true, Eigen::Vector3d::Zero(), analysis),
-                          {{"rod.h5", test::Reduce(RodYaml(0.3, 2, true))}}, "tip");
+                              {{"rod.h5", test::Reduce(RodYaml(0.3, 2, true))}}, "tip");
   ASSERT_TRUE(si.ok) << si.message;
   ASSERT_TRUE(mm.ok) << mm.message;
   ASSERT_EQ(si.tip.size(), mm.tip.size());
   double worst = 0.0;
   for (size_t k = 0; k < si.tip.size(); ++k) worst = std::max(worst, (mm.tip[k] / 1000.0 - si.tip[k]).norm());
   const double radius = Amplitude(si, Eigen::Vector3d::Zero());
-  std::printf("[ info ] SI vs mm-t-s: largest tip difference %.3g of the swing radius %.3g m\n", worst / radius, radius);
+  std::printf("[ info ] SI vs mm-t-s: largest tip difference %.3g of the swing radius %.3g m\n", worst / radius,
+              radius);
   EXPECT_LT(worst / radius, 1e-10);
 }
 
@@ -161,7 +169,8 @@ TEST(NumericalStress, ModelFarFromTheOriginAgrees) {
   const std::string analysis = "{type: dynamic, end_time: 1.0, step: 1e-3, rho_inf: 0.9}";
   const Superelement rod = test::Reduce(RodYaml(0.3, 2, false));
   const Eigen::Vector3d far(1e4, -1e4, 1e4);
-  const Outcome near_run = Simulate("near", Pendulum(false, Eigen::Vector3d::Zero(), analysis), {{"rod.h5", rod}}, "tip");
+  const Outcome near_run =
+      Simulate("near", Pendulum(false, Eigen::Vector3d::Zero(), analysis), {{"rod.h5", rod}}, "tip");
   const Outcome far_run = Simulate("far", Pendulum(false, far, analysis), {{"rod.h5", rod}}, "tip");
   ASSERT_TRUE(near_run.ok) << near_run.message;
   ASSERT_TRUE(far_run.ok) << far_run.message;
@@ -184,11 +193,14 @@ TEST(NumericalStress, ConservativeFlexibleSystemOver1e5StepsKeepsItsEnergy) {
   const Superelement rod = test::Reduce(RodYaml(0.3, 2, false));
   const std::string scene =
       "name: swing\nunits: SI\nbodies:\n"
-      "  - {name: rod, superelement: rod.h5, placement: {rotation: [0, 0, -1.0707963267948966]}, nodes: {A: pivot, B: tip}}\n"
+      "  - {name: rod, superelement: rod.h5, placement: {rotation: [0, 0, -1.0707963267948966]}, nodes: {A: pivot, B: "
+      "tip}}\n"
       "joints:\n  - {type: revolute, node: pivot, axis: [0, 0, 1]}\nloads:\n  - {type: gravity, g: [0, -9.81, 0]}\n";
   for (const std::string integrator : {"midpoint", "generalized_alpha"}) {
-    const Outcome r = Simulate("swing_" + integrator, scene + "analysis: {type: dynamic, end_time: 10.0, step: 1e-4, rho_inf: 1.0, integrator: " + integrator + "}\n",
-                           {{"rod.h5", rod}}, "tip");
+    const Outcome r = Simulate(
+        "swing_" + integrator,
+        scene + "analysis: {type: dynamic, end_time: 10.0, step: 1e-4, rho_inf: 1.0, integrator: " + integrator + "}\n",
+        {{"rod.h5", rod}}, "tip");
     ASSERT_TRUE(r.ok) << integrator << ": " << r.message;
     ASSERT_EQ(r.steps, 100000);
     const double swing = 0.0556 * 9.81 * 0.15 * (1 - std::cos(0.5));  // m g (L/2)(1 - cos 0.5)
@@ -219,7 +231,8 @@ TEST(NumericalStress, FortyModesAtALongStepAreStableOrStopped) {
   std::printf("[ info ] 40 modes: highest %.4g Hz, h = %.3g s = %.0f highest periods\n", f_max, h, h * f_max);
   const std::string scene =
       "name: stiff\nunits: SI\nbodies:\n"
-      "  - {name: rod, superelement: rod.h5, placement: {rotation: [0, 0, -1.0707963267948966]}, nodes: {A: pivot, B: tip}}\n"
+      "  - {name: rod, superelement: rod.h5, placement: {rotation: [0, 0, -1.0707963267948966]}, nodes: {A: pivot, B: "
+      "tip}}\n"
       "joints:\n  - {type: revolute, node: pivot, axis: [0, 0, 1]}\nloads:\n  - {type: gravity, g: [0, -9.81, 0]}\n";
   char analysis[200];
   std::snprintf(analysis, sizeof analysis, "analysis: {type: dynamic, end_time: 2.0, step: %.17g, rho_inf: 0.5}\n", h);
@@ -261,18 +274,23 @@ TEST(NumericalStress, StiffnessAndMassContrastBetweenBodies) {
       "  - {name: soft, superelement: soft.h5, nodes: {A: n0, B: n1}}\n"
       "  - {name: hard, superelement: hard.h5, placement: {position: [0.3, 0, 0]}, nodes: {A: n1, B: n2}}\n"
       "joints:\n  - {type: clamp, node: n0}\n";
-  const Outcome st = Simulate("contrast_static", bodies + "loads:\n  - {type: force, node: n2, force: [0, -0.01, 0]}\n"
-                                                      "analysis: {type: static, end_time: 1.0, steps: 1}\n",
-                          {{"soft.h5", soft}, {"hard.h5", hard}}, "n2");
+  const Outcome st = Simulate("contrast_static",
+                              bodies +
+                                  "loads:\n  - {type: force, node: n2, force: [0, -0.01, 0]}\n"
+                                  "analysis: {type: static, end_time: 1.0, steps: 1}\n",
+                              {{"soft.h5", soft}, {"hard.h5", hard}}, "n2");
   ASSERT_TRUE(st.ok) << st.message;
   const double EI = 2e11 * M_PI * std::pow(0.006, 4) / 64, L1 = 0.3, L2 = 0.3, P = 0.01;
-  const double w = P * (L1 * L1 * L1 + 3 * L1 * L1 * L2 + 3 * L1 * L2 * L2) / (3 * EI) + P * L2 * L2 * L2 / (3 * 1e6 * EI);
+  const double w =
+      P * (L1 * L1 * L1 + 3 * L1 * L1 * L2 + 3 * L1 * L2 * L2) / (3 * EI) + P * L2 * L2 * L2 / (3 * 1e6 * EI);
   const double got = -(st.tip.back().y());
   std::printf("[ info ] contrast 1e6 / 1e5: tip deflection %.6g m, beam theory %.6g m (%.2e)\n", got, w, got / w - 1);
   EXPECT_NEAR(got / w, 1.0, 1e-3);
-  const Outcome dyn = Simulate("contrast_dynamic", bodies + "loads:\n  - {type: gravity, g: [0, -9.81, 0]}\n"
-                                                       "analysis: {type: dynamic, end_time: 0.2, step: 1e-4, rho_inf: 0.8}\n",
-                           {{"soft.h5", soft}, {"hard.h5", hard}}, "n2");
+  const Outcome dyn = Simulate("contrast_dynamic",
+                               bodies +
+                                   "loads:\n  - {type: gravity, g: [0, -9.81, 0]}\n"
+                                   "analysis: {type: dynamic, end_time: 0.2, step: 1e-4, rho_inf: 0.8}\n",
+                               {{"soft.h5", soft}, {"hard.h5", hard}}, "n2");
   ASSERT_TRUE(dyn.ok) << dyn.message;
   double growth = -HUGE_VAL;
   for (double e : dyn.energy_balance) growth = std::max(growth, e);
@@ -341,8 +359,9 @@ TEST(NumericalStress, ColumnPastItsEulerLoad) {
 // the 2% sag's geometric nonlinearity are below 0.1%).
 TEST(NumericalStress, StaticEquilibriumUnderGravity) {
   const Superelement seg = test::Reduce(RodYaml(0.25, 2, false));
-  const std::string scene = ClampedChain("sag", 4, 0.25) + "loads:\n  - {type: gravity, g: [0, -9.81, 0]}\n"
-                                                          "analysis: {type: static, end_time: 1.0, steps: 2}\n";
+  const std::string scene = ClampedChain("sag", 4, 0.25) +
+                            "loads:\n  - {type: gravity, g: [0, -9.81, 0]}\n"
+                            "analysis: {type: static, end_time: 1.0, steps: 2}\n";
   const Outcome r = Simulate("sag", scene, {{"seg.h5", seg}}, "n4");
   ASSERT_TRUE(r.ok) << r.message;
   const double EI = 2e11 * M_PI * std::pow(0.006, 4) / 64, q = 7870 * M_PI * 0.006 * 0.006 / 4 * 9.81;
@@ -365,18 +384,19 @@ TEST(NumericalStress, UniversalJointThroughNearGimbalLock) {
   for (const double beta_deg : {80.0, 85.0}) {
     const double b = beta_deg * M_PI / 180;
     char scene[2048];
-    std::snprintf(scene, sizeof scene,
-                  "name: cardan\nunits: SI\nbodies:\n"
-                  "  - {name: input, type: rigid, mass: 1, center_of_mass: [0, 0, 0], inertia: [1e-3, 1e-3, 1e-3],\n"
-                  "     points: {P: [0.1, 0, 0]}, placement: {position: [-0.1, 0, 0]}, nodes: {P: in}}\n"
-                  "  - {name: output, superelement: shaft.h5, placement: {rotation: [0, 0, %.17g]}, nodes: {A: u, B: o}}\n"
-                  "joints:\n"
-                  "  - {type: revolute, node: in, axis: [1, 0, 0], prescribed: turn}\n"
-                  "  - {type: universal, node: u, parent: in, axis: [0, 0, 1], axis2: [%.17g, %.17g, 0]}\n"
-                  "  - {type: revolute, node: o, axis: [%.17g, %.17g, 0]}\n"
-                  "functions:\n  turn: {type: linear}\n"
-                  "analysis: {type: static, end_time: %.17g, steps: 144}\n",
-                  b, -std::sin(b), std::cos(b), std::cos(b), std::sin(b), 2 * M_PI);
+    std::snprintf(
+        scene, sizeof scene,
+        "name: cardan\nunits: SI\nbodies:\n"
+        "  - {name: input, type: rigid, mass: 1, center_of_mass: [0, 0, 0], inertia: [1e-3, 1e-3, 1e-3],\n"
+        "     points: {P: [0.1, 0, 0]}, placement: {position: [-0.1, 0, 0]}, nodes: {P: in}}\n"
+        "  - {name: output, superelement: shaft.h5, placement: {rotation: [0, 0, %.17g]}, nodes: {A: u, B: o}}\n"
+        "joints:\n"
+        "  - {type: revolute, node: in, axis: [1, 0, 0], prescribed: turn}\n"
+        "  - {type: universal, node: u, parent: in, axis: [0, 0, 1], axis2: [%.17g, %.17g, 0]}\n"
+        "  - {type: revolute, node: o, axis: [%.17g, %.17g, 0]}\n"
+        "functions:\n  turn: {type: linear}\n"
+        "analysis: {type: static, end_time: %.17g, steps: 144}\n",
+        b, -std::sin(b), std::cos(b), std::cos(b), std::sin(b), 2 * M_PI);
     const std::string dir = ::testing::TempDir() + "stress_cardan";
     std::filesystem::create_directories(dir);
     WriteSuperelementFile(shaft, dir + "/shaft.h5");
@@ -387,19 +407,22 @@ TEST(NumericalStress, UniversalJointThroughNearGimbalLock) {
     options.end_time = 2 * M_PI;
     options.steps = 144;
     double worst = 0.0, previous = 0.0, unwrapped_reference = 0.0, fastest = 0.0;
-    const StaticResult r = SolveStatic(sc.model, state, options, [&](const StaticStepReport& step, const SystemState& st) {
-      const double theta_in = step.lambda;
-      const double reference = std::atan2(std::cos(b) * std::sin(theta_in), std::cos(theta_in));
-      double d = reference - previous;  // unwrap the closed form along the turn
-      d -= 2 * M_PI * std::round(d / (2 * M_PI));
-      fastest = std::max(fastest, std::abs(d) / (2 * M_PI / 144));
-      unwrapped_reference += d;
-      previous = reference;
-      worst = std::max(worst, std::abs(st.z[o][0] - unwrapped_reference));
-    });
+    const StaticResult r =
+        SolveStatic(sc.model, state, options, [&](const StaticStepReport& step, const SystemState& st) {
+          const double theta_in = step.lambda;
+          const double reference = std::atan2(std::cos(b) * std::sin(theta_in), std::cos(theta_in));
+          double d = reference - previous;  // unwrap the closed form along the turn
+          d -= 2 * M_PI * std::round(d / (2 * M_PI));
+          fastest = std::max(fastest, std::abs(d) / (2 * M_PI / 144));
+          unwrapped_reference += d;
+          previous = reference;
+          worst = std::max(worst, std::abs(st.z[o][0] - unwrapped_reference));
+        });
     ASSERT_TRUE(r.ok) << beta_deg << " deg: " << r.message;
-    std::printf("[ info ] Cardan joint at %.0f deg: output angle within %.2e rad of the closed form over a turn "
-                "(output up to %.1fx the input rate per step)\n", beta_deg, worst, fastest);
+    std::printf(
+        "[ info ] Cardan joint at %.0f deg: output angle within %.2e rad of the closed form over a turn "
+        "(output up to %.1fx the input rate per step)\n",
+        beta_deg, worst, fastest);
     EXPECT_LT(worst, 1e-6) << beta_deg;
   }
 }
@@ -407,9 +430,10 @@ TEST(NumericalStress, UniversalJointThroughNearGimbalLock) {
 // Newton's tolerance below round-off: a clear message, no hang, no silent slowdown.
 TEST(NumericalStress, ToleranceBelowRoundOffIsSaid) {
   const Superelement rod = test::Reduce(RodYaml(0.3, 2, false));
-  const Outcome r = Simulate("roundoff", Pendulum(false, Eigen::Vector3d::Zero(),
-                                              "{type: dynamic, end_time: 0.05, step: 1e-3, tolerance: 1e-20}"),
-                         {{"rod.h5", rod}}, "tip");
+  const Outcome r = Simulate(
+      "roundoff",
+      Pendulum(false, Eigen::Vector3d::Zero(), "{type: dynamic, end_time: 0.05, step: 1e-3, tolerance: 1e-20}"),
+      {{"rod.h5", rod}}, "tip");
   ASSERT_TRUE(r.ok) << r.message;
   bool said = false;
   for (const std::string& w : r.warnings) said |= w.find("round-off") != std::string::npos;

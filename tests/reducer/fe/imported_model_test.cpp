@@ -63,8 +63,10 @@ std::string MatricesBlock(const std::string& format, const std::string& dir) {
   if (format == "calculix") {
     return "{format: calculix, stiffness: " + dir + "/bar.sti, mass: " + dir + "/bar.mas, dofs: " + dir + "/bar.dof}";
   }
-  if (format == "abaqus") return "{format: abaqus, stiffness: " + dir + "/bar_STIF1.mtx, mass: " + dir + "/bar_MASS1.mtx}";
-  return "{format: matrix_market, stiffness: " + dir + "/bar_K.mtx, mass: " + dir + "/bar_M.mtx, dofs: " + dir + "/bar_dofs.csv}";
+  if (format == "abaqus")
+    return "{format: abaqus, stiffness: " + dir + "/bar_STIF1.mtx, mass: " + dir + "/bar_MASS1.mtx}";
+  return "{format: matrix_market, stiffness: " + dir + "/bar_K.mtx, mass: " + dir + "/bar_M.mtx, dofs: " + dir +
+         "/bar_dofs.csv}";
 }
 
 TEST(ImportedModel, EveryFormatRoundTripsToTheNativeSuperelement) {
@@ -72,16 +74,18 @@ TEST(ImportedModel, EveryFormatRoundTripsToTheNativeSuperelement) {
   WriteText(dir / "bar.yaml", kBar);
   const PartSpec part = ReadPartFile((dir / "bar.yaml").string());
   // The native reference on the exported mesh (the same nodes in the same order).
-  WriteText(dir / "native.yaml", test::Replace(kBar, "{shape: box, size: [1.0, 0.05, 0.05]}", "{file: calculix/bar.inp}"));
+  WriteText(dir / "native.yaml",
+            test::Replace(kBar, "{shape: box, size: [1.0, 0.05, 0.05]}", "{file: calculix/bar.inp}"));
   for (const std::string format : {"calculix", "abaqus", "matrix_market"}) {
     ExportPartMatrices(part, format, (dir / format).string());
   }
   const Superelement native = ReduceFile(dir / "native.yaml");
   for (const std::string format : {"calculix", "abaqus", "matrix_market"}) {
-    WriteText(dir / "imported.yaml", "name: bar\ntype: imported\ngeometry: {file: " + format + "/bar.inp}\nmatrices: " +
-                                         MatricesBlock(format, format) +
-                                         "\ninterfaces: [{name: root, group: xmin}, {name: tip, group: xmax, coupling: rbe3}]\n"
-                                         "reduction: {internal_modes: 6}\n");
+    WriteText(dir / "imported.yaml",
+              "name: bar\ntype: imported\ngeometry: {file: " + format +
+                  "/bar.inp}\nmatrices: " + MatricesBlock(format, format) +
+                  "\ninterfaces: [{name: root, group: xmin}, {name: tip, group: xmax, coupling: rbe3}]\n"
+                  "reduction: {internal_modes: 6}\n");
     const Superelement imported = ReduceFile(dir / "imported.yaml");
     ASSERT_EQ(imported.K.rows(), native.K.rows()) << format;
     // The fixed-interface modes are unique up to sign (and to a turn within the square bar's
@@ -90,7 +94,8 @@ TEST(ImportedModel, EveryFormatRoundTripsToTheNativeSuperelement) {
     const double f = (imported.internal_frequencies_hz - native.internal_frequencies_hz).cwiseAbs().maxCoeff() /
                      native.internal_frequencies_hz.minCoeff();
     const double m_static = Relative(imported.M.topLeftCorner(12, 12), native.M.topLeftCorner(12, 12));
-    const double shapes = Relative(imported.visualization->shapes.leftCols(12), native.visualization->shapes.leftCols(12));
+    const double shapes =
+        Relative(imported.visualization->shapes.leftCols(12), native.visualization->shapes.leftCols(12));
     std::printf("[ info ] %s: frequencies %.2e, K_r %.2e, M_r static block %.2e, static shapes %.2e, mass %.2e\n",
                 format.c_str(), f, Relative(imported.K, native.K), m_static, shapes,
                 std::abs(imported.mass_properties.mass / native.mass_properties.mass - 1));
@@ -110,22 +115,27 @@ TEST(ImportedModel, EveryFormatRoundTripsToTheNativeSuperelement) {
 // A beam: 6 DOFs per node (rotations), line cells, interfaces = named points of the part.
 TEST(ImportedModel, BeamWithRotationalDofsRoundTrips) {
   const fs::path dir = TempDir("beam");
-  const std::string beam = test::StraightBeamYaml(0.3, 12, "{shape: circle, diameter: 0.006}", "{E: 2.1e11, nu: 0.3, rho: 7850}",
-                                                  "[{name: A}, {name: B}]", "reduction: {internal_modes: 5, floating_frame: mean_axes}\n");
+  const std::string beam =
+      test::StraightBeamYaml(0.3, 12, "{shape: circle, diameter: 0.006}", "{E: 2.1e11, nu: 0.3, rho: 7850}",
+                             "[{name: A}, {name: B}]", "reduction: {internal_modes: 5, floating_frame: mean_axes}\n");
   WriteText(dir / "rod.yaml", beam);
   const PartSpec part = ReadPartFile((dir / "rod.yaml").string());
   ExportPartMatrices(part, "calculix", dir.string());
   const Superelement native = ReduceFile(dir / "rod.yaml");
   const std::string name = part.name;
-  WriteText(dir / "imported.yaml", "name: rod\ntype: imported\ngeometry: {file: " + name + ".inp}\nmatrices: {format: calculix, "
-                                   "stiffness: " + name + ".sti, mass: " + name + ".mas, dofs: " + name + ".dof}\n"
-                                   "interfaces: [{name: A, group: A}, {name: B, select: {sphere: {center: [0.3, 0, 0], radius: 1e-3}, "
-                                   "tolerance: 2e-3}}]\nreduction: {internal_modes: 5, floating_frame: mean_axes}\n");
+  WriteText(dir / "imported.yaml",
+            "name: rod\ntype: imported\ngeometry: {file: " + name +
+                ".inp}\nmatrices: {format: calculix, "
+                "stiffness: " +
+                name + ".sti, mass: " + name + ".mas, dofs: " + name +
+                ".dof}\n"
+                "interfaces: [{name: A, group: A}, {name: B, select: {sphere: {center: [0.3, 0, 0], radius: 1e-3}, "
+                "tolerance: 2e-3}}]\nreduction: {internal_modes: 5, floating_frame: mean_axes}\n");
   const Superelement imported = ReduceFile(dir / "imported.yaml");
   const double f = (imported.internal_frequencies_hz - native.internal_frequencies_hz).cwiseAbs().maxCoeff() /
                    native.internal_frequencies_hz.minCoeff();
-  std::printf("[ info ] beam: frequencies %.2e, K_r %.2e, M_r %.2e (first %.3f Hz)\n", f, Relative(imported.K, native.K),
-              Relative(imported.M, native.M), native.internal_frequencies_hz[0]);
+  std::printf("[ info ] beam: frequencies %.2e, K_r %.2e, M_r %.2e (first %.3f Hz)\n", f,
+              Relative(imported.K, native.K), Relative(imported.M, native.M), native.internal_frequencies_hz[0]);
   EXPECT_LT(f, 1e-8);
   EXPECT_LT(Relative(imported.K, native.K), 1e-8);
   EXPECT_LT(Relative(imported.M, native.M), 1e-8);
@@ -151,21 +161,25 @@ TEST(ImportedModel, BeamWithRotationalDofsRoundTrips) {
 // integration differs from femb's in round-off and quadrature only, so the frequencies agree to
 // 1e-4 (measured 6e-6 on a finer mesh).
 TEST(ImportedModel, CalculixAssemblyMatchesFembsOwn) {
-  if (std::system("command -v ccx > /dev/null 2>&1") != 0) GTEST_SKIP() << "ccx not installed (apt-get install calculix-ccx)";
+  if (std::system("command -v ccx > /dev/null 2>&1") != 0)
+    GTEST_SKIP() << "ccx not installed (apt-get install calculix-ccx)";
   const fs::path dir = TempDir("ccx");
   WriteText(dir / "bar.yaml", kBar);
   ExportPartMatrices(ReadPartFile((dir / "bar.yaml").string()), "calculix", (dir / "mesh").string());
-  WriteText(dir / "job.inp", "*INCLUDE, INPUT=mesh/bar.inp\n*MATERIAL, NAME=STEEL\n*ELASTIC\n2.1e11, 0.3\n*DENSITY\n7850.\n"
-                             "*SOLID SECTION, ELSET=EALL, MATERIAL=STEEL\n*STEP\n*FREQUENCY, SOLVER=MATRIXSTORAGE\n*END STEP\n");
+  WriteText(dir / "job.inp",
+            "*INCLUDE, INPUT=mesh/bar.inp\n*MATERIAL, NAME=STEEL\n*ELASTIC\n2.1e11, 0.3\n*DENSITY\n7850.\n"
+            "*SOLID SECTION, ELSET=EALL, MATERIAL=STEEL\n*STEP\n*FREQUENCY, SOLVER=MATRIXSTORAGE\n*END STEP\n");
   ASSERT_EQ(std::system(("cd " + dir.string() + " && ccx job > ccx.log 2>&1").c_str()), 0) << ReadText(dir / "ccx.log");
   WriteText(dir / "native.yaml", test::Replace(kBar, "{shape: box, size: [1.0, 0.05, 0.05]}", "{file: mesh/bar.inp}"));
-  WriteText(dir / "ccx.yaml", "name: bar\ntype: imported\ngeometry: {file: mesh/bar.inp}\n"
-                              "matrices: {format: calculix, stiffness: job.sti, mass: job.mas, dofs: job.dof}\n"
-                              "interfaces: [{name: root, group: xmin}, {name: tip, group: xmax, coupling: rbe3}]\n"
-                              "reduction: {internal_modes: 6}\n");
+  WriteText(dir / "ccx.yaml",
+            "name: bar\ntype: imported\ngeometry: {file: mesh/bar.inp}\n"
+            "matrices: {format: calculix, stiffness: job.sti, mass: job.mas, dofs: job.dof}\n"
+            "interfaces: [{name: root, group: xmin}, {name: tip, group: xmax, coupling: rbe3}]\n"
+            "reduction: {internal_modes: 6}\n");
   const Superelement native = ReduceFile(dir / "native.yaml");
   const Superelement ccx = ReduceFile(dir / "ccx.yaml");
-  const double f = ((ccx.internal_frequencies_hz.array() / native.internal_frequencies_hz.array()) - 1).abs().maxCoeff();
+  const double f =
+      ((ccx.internal_frequencies_hz.array() / native.internal_frequencies_hz.array()) - 1).abs().maxCoeff();
   std::printf("[ info ] CalculiX vs femb assembly: frequencies within %.2e, mass %.2e\n", f,
               ccx.mass_properties.mass / native.mass_properties.mass - 1);
   EXPECT_LT(f, 1e-4);
@@ -183,9 +197,11 @@ TEST(ImportedModel, BadMatricesAreOneLineEach) {
   auto reduce = [&](const std::string& sti_text, const std::string& dof_text, const std::string& extra = "") {
     WriteText(dir / "bad.sti", sti_text);
     WriteText(dir / "bad.dof", dof_text);
-    WriteText(dir / "imported.yaml", "name: bar\ntype: imported\ngeometry: {file: bar.inp}\n"
-                                     "matrices: {format: calculix, stiffness: bad.sti, mass: bar.mas, dofs: bad.dof}\n"
-                                     "interfaces: [{name: root, group: xmin}]\n" + extra);
+    WriteText(dir / "imported.yaml",
+              "name: bar\ntype: imported\ngeometry: {file: bar.inp}\n"
+              "matrices: {format: calculix, stiffness: bad.sti, mass: bar.mas, dofs: bad.dof}\n"
+              "interfaces: [{name: root, group: xmin}]\n" +
+                  extra);
     return test::ThrownMessage([&] { ReduceFile(dir / "imported.yaml"); });
   };
   auto expect = [](const std::string& message, const std::string& part) {
@@ -196,8 +212,8 @@ TEST(ImportedModel, BadMatricesAreOneLineEach) {
   std::snprintf(line, sizeof line, "1 1 %.17g", -k11);
   expect(reduce(test::Replace(sti, first, line), dof), "bad.sti: the diagonal of node 1 u_x is negative");
   expect(reduce(sti + "2 1 5.0\n", dof), "and its transpose differ by");
-  expect(reduce(sti + "2 1 nan\n", dof), "bad.sti:" + std::to_string(std::count(sti.begin(), sti.end(), '\n') + 1) +
-                                             ": entry nan is not finite");
+  expect(reduce(sti + "2 1 nan\n", dof),
+         "bad.sti:" + std::to_string(std::count(sti.begin(), sti.end(), '\n') + 1) + ": entry nan is not finite");
   expect(reduce(sti + "1 99999 1.0\n", dof), "outside the");
   expect(reduce(sti, test::Replace(dof, "1.1\n", "99999.1\n")), "node 99999 of the matrices is not in");
   expect(reduce(sti, test::Replace(dof, "1.2\n", "1.1\n")), "node 1 u_x appears twice");
@@ -207,9 +223,10 @@ TEST(ImportedModel, BadMatricesAreOneLineEach) {
   // Keys the imported matrices cannot honour (stresses: not without the part's material).
   expect(reduce(sti, dof, "reduction: {stresses: true}\n"), "stresses of imported matrices need the part's material");
   expect(reduce(sti, dof, "reduction: {modal_derivatives: true}\n"), "modal derivatives need femb's own elements");
-  WriteText(dir / "missing.yaml", "name: bar\ntype: imported\ngeometry: {file: bar.inp}\n"
-                                  "matrices: {format: calculix, stiffness: nothere.sti, mass: bar.mas, dofs: bar.dof}\n"
-                                  "interfaces: [{name: root, group: xmin}]\n");
+  WriteText(dir / "missing.yaml",
+            "name: bar\ntype: imported\ngeometry: {file: bar.inp}\n"
+            "matrices: {format: calculix, stiffness: nothere.sti, mass: bar.mas, dofs: bar.dof}\n"
+            "interfaces: [{name: root, group: xmin}]\n");
   expect(test::ThrownMessage([&] { ReadPartFile((dir / "missing.yaml").string()); }), "nothere.sti' not found");
   fs::remove_all(dir);
 }
@@ -220,9 +237,9 @@ TEST(ImportedModel, BadMatricesAreOneLineEach) {
 // same internal frequencies. Four free-free modes alone do not move every interface direction.
 TEST(ImportedModel, GeneralBasisFromAFileMatchesFreeInterface) {
   const fs::path dir = TempDir("general");
-  const std::string rod = test::StraightBeamYaml(0.3, 10, "{shape: circle, diameter: 0.006}", "{E: 2.1e11, nu: 0.3, rho: 7850}",
-                                                 "[{name: A}, {name: B}]",
-                                                 "reduction: {method: free_interface, internal_modes: 8, floating_frame: mean_axes}\n");
+  const std::string rod = test::StraightBeamYaml(
+      0.3, 10, "{shape: circle, diameter: 0.006}", "{E: 2.1e11, nu: 0.3, rho: 7850}", "[{name: A}, {name: B}]",
+      "reduction: {method: free_interface, internal_modes: 8, floating_frame: mean_axes}\n");
   WriteText(dir / "rod.yaml", rod);
   const PartSpec part = ReadPartFile((dir / "rod.yaml").string());
   ExportPartMatrices(part, "calculix", dir.string());
@@ -260,40 +277,55 @@ TEST(ImportedModel, GeneralBasisFromAFileMatchesFreeInterface) {
       for (long i = 0; i < A.rows(); ++i) out << A(i, j) << "\n";
   };
   write_array(dir / "shapes.mtx", V);
-  const std::string imported = "name: rod\ntype: imported\ngeometry: {file: " + name + ".inp}\nmatrices: {format: calculix, "
-                               "stiffness: " + name + ".sti, mass: " + name + ".mas, dofs: " + name + ".dof}\n"
+  const std::string imported = "name: rod\ntype: imported\ngeometry: {file: " + name +
+                               ".inp}\nmatrices: {format: calculix, "
+                               "stiffness: " +
+                               name + ".sti, mass: " + name + ".mas, dofs: " + name +
+                               ".dof}\n"
                                "interfaces: [{name: A, group: A}, {name: B, group: B}]\n";
-  WriteText(dir / "general.yaml", imported + "reduction: {method: general, basis: {file: shapes.mtx}, floating_frame: mean_axes}\n");
+  WriteText(dir / "general.yaml",
+            imported + "reduction: {method: general, basis: {file: shapes.mtx}, floating_frame: mean_axes}\n");
   const Superelement native = ReduceFile(dir / "rod.yaml");
   const Superelement general = ReduceFile(dir / "general.yaml");
   ASSERT_EQ(general.internal_frequencies_hz.size(), 8);
-  const double f = ((general.internal_frequencies_hz.array() / native.internal_frequencies_hz.array()) - 1).abs().maxCoeff();
-  std::printf("[ info ] general basis from a file vs free_interface: internal frequencies within %.2e, K_r static block %.2e\n", f,
-              Relative(general.K.topLeftCorner(12, 12), native.K.topLeftCorner(12, 12)));
+  const double f =
+      ((general.internal_frequencies_hz.array() / native.internal_frequencies_hz.array()) - 1).abs().maxCoeff();
+  std::printf(
+      "[ info ] general basis from a file vs free_interface: internal frequencies within %.2e, K_r static block %.2e\n",
+      f, Relative(general.K.topLeftCorner(12, 12), native.K.topLeftCorner(12, 12)));
   EXPECT_LT(f, 1e-8);
   EXPECT_LT(Relative(general.K.topLeftCorner(12, 12), native.K.topLeftCorner(12, 12)), 1e-8);
   EXPECT_EQ(general.provenance.reduction_method, "general");
   // Case 4: four free-free modes (with the rigid fields) cannot stretch or twist the rod: the file
   // holds those two directions by its interface constraint, and passes every check.
   write_array(dir / "few.mtx", eig.eigenvectors().middleCols(6, 4));
-  WriteText(dir / "few.yaml", imported + "reduction: {method: general, basis: {file: few.mtx}, floating_frame: mean_axes}\n");
+  WriteText(dir / "few.yaml",
+            imported + "reduction: {method: general, basis: {file: few.mtx}, floating_frame: mean_axes}\n");
   const Superelement few = ReduceFile(dir / "few.yaml");
   EXPECT_EQ(few.interface_constraint.rows(), 2);
   EXPECT_EQ(few.interface_constraint.cols(), 12);
   EXPECT_EQ(few.n_internal_modes(), 0);
   const SuperelementChecks few_checks = CheckSuperelement(few);
-  EXPECT_EQ(few_checks.first_failure(), nullptr) << (few_checks.first_failure() ? few_checks.first_failure()->detail : "");
+  EXPECT_EQ(few_checks.first_failure(), nullptr)
+      << (few_checks.first_failure() ? few_checks.first_failure()->detail : "");
   // A shapes file with the wrong number of rows.
   write_array(dir / "short.mtx", V.topRows(n - 1));
-  WriteText(dir / "short.yaml", imported + "reduction: {method: general, basis: {file: short.mtx}, floating_frame: mean_axes}\n");
-  EXPECT_NE(test::ThrownMessage([&] { ReduceFile(dir / "short.yaml"); }).find("short.mtx:3: the shapes have"), std::string::npos);
+  WriteText(dir / "short.yaml",
+            imported + "reduction: {method: general, basis: {file: short.mtx}, floating_frame: mean_axes}\n");
+  EXPECT_NE(test::ThrownMessage([&] { ReduceFile(dir / "short.yaml"); }).find("short.mtx:3: the shapes have"),
+            std::string::npos);
   // A size line announcing absurdly many shapes is refused before anything is allocated.
-  WriteText(dir / "huge.mtx", "%%MatrixMarket matrix array real general\n" + std::to_string(n) + " 1000000000000\n1.0\n");
-  WriteText(dir / "huge.yaml", imported + "reduction: {method: general, basis: {file: huge.mtx}, floating_frame: mean_axes}\n");
-  EXPECT_NE(test::ThrownMessage([&] { ReduceFile(dir / "huge.yaml"); }).find("huge.mtx:2: the file announces 1000000000000 shapes"),
+  WriteText(dir / "huge.mtx",
+            "%%MatrixMarket matrix array real general\n" + std::to_string(n) + " 1000000000000\n1.0\n");
+  WriteText(dir / "huge.yaml",
+            imported + "reduction: {method: general, basis: {file: huge.mtx}, floating_frame: mean_axes}\n");
+  EXPECT_NE(test::ThrownMessage([&] {
+              ReduceFile(dir / "huge.yaml");
+            }).find("huge.mtx:2: the file announces 1000000000000 shapes"),
             std::string::npos);
   WriteText(dir / "huge.mtx", "%%MatrixMarket matrix array real general\n" + std::to_string(n) + " 20\n1.0\n");
-  EXPECT_NE(test::ThrownMessage([&] { ReduceFile(dir / "huge.yaml"); }).find("the file is too short"), std::string::npos);
+  EXPECT_NE(test::ThrownMessage([&] { ReduceFile(dir / "huge.yaml"); }).find("the file is too short"),
+            std::string::npos);
   fs::remove_all(dir);
 }
 

@@ -16,13 +16,18 @@ namespace femb {
 namespace {
 
 PartSpec Leaf(int elements, const std::string& theory = "euler_bernoulli") {
-  return ParsePart("name: leaf\ntype: beam\nmaterial: {E: 2.1e11, nu: 0.3, rho: 7850}\n"
-                   "section: {shape: rectangle, width: 0.01, height: 0.0005}\n"
-                   "beam:\n  theory: " + theory + "\n  orientation: [0, 1, 0]\n"
-                   "  points: {A: [0, 0, 0], B: [0.05, 0, 0]}\n"
-                   "  segments: [{from: A, to: B, elements: " + std::to_string(elements) + "}]\n"
-                   "interfaces: [{name: A}, {name: B}]\n",
-                   "leaf.yaml");
+  return ParsePart(
+      "name: leaf\ntype: beam\nmaterial: {E: 2.1e11, nu: 0.3, rho: 7850}\n"
+      "section: {shape: rectangle, width: 0.01, height: 0.0005}\n"
+      "beam:\n  theory: " +
+          theory +
+          "\n  orientation: [0, 1, 0]\n"
+          "  points: {A: [0, 0, 0], B: [0.05, 0, 0]}\n"
+          "  segments: [{from: A, to: B, elements: " +
+          std::to_string(elements) +
+          "}]\n"
+          "interfaces: [{name: A}, {name: B}]\n",
+      "leaf.yaml");
 }
 
 TEST(VonKarmanBeam, ForceAndTangentMatchFiniteDifferences) {
@@ -62,7 +67,7 @@ TEST(VonKarmanBeam, ClampedGuidedLeafShortensByThreeFifthsDeltaSquaredOverL) {
   const VonKarmanBeams beams(part);
   const double L = 0.05, EI = 2.1e11 * 0.01 * std::pow(0.0005, 3) / 12, F = 10.0;
   std::vector<int> held;
-  for (int d = 0; d < 6; ++d) held.push_back(d);        // A: node 0
+  for (int d = 0; d < 6; ++d) held.push_back(d);         // A: node 0
   for (int d : {1, 3, 4, 5}) held.push_back(6 * 1 + d);  // B: node 1 (the part's second point)
   Eigen::VectorXd f = Eigen::VectorXd::Zero(beams.n_dofs());
   f[6 * 1 + 2] = F;

@@ -49,7 +49,9 @@ Eigen::MatrixXd Distorted(SolidType type) {
   }
   for (int a = 0; a < n; ++a) {
     const Eigen::Vector3d p = X.row(a).transpose();
-    X.row(a) = 0.05 * Eigen::Vector3d(p.x() + 0.1 * p.y() * p.y(), 1.2 * p.y() + 0.1 * p.z(), 0.9 * p.z() + 0.05 * p.x() * p.x()).transpose();
+    X.row(a) = 0.05 * Eigen::Vector3d(p.x() + 0.1 * p.y() * p.y(), 1.2 * p.y() + 0.1 * p.z(),
+                                      0.9 * p.z() + 0.05 * p.x() * p.x())
+                          .transpose();
   }
   return X;
 }
@@ -79,7 +81,8 @@ TEST_P(NonlinearElement, ForceIsTheEnergyGradientAndTangentTheForceDerivative) {
   }
   const double f_err = (grad - s.force).norm() / s.force.norm();
   const double k_err = (dforce - s.tangent).norm() / s.tangent.norm();
-  std::printf("[ info ] %s: force vs energy FD %.2e, tangent vs force FD %.2e\n", SolidTypeName(type).c_str(), f_err, k_err);
+  std::printf("[ info ] %s: force vs energy FD %.2e, tangent vs force FD %.2e\n", SolidTypeName(type).c_str(), f_err,
+              k_err);
   EXPECT_LT(f_err, 1e-6);
   EXPECT_LT(k_err, 1e-6);
 }

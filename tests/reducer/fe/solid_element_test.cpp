@@ -26,7 +26,8 @@ Eigen::MatrixXd ReferenceNodes(SolidType type) {
     for (int e = 0; e < 6 && n == 10; ++e) X.row(4 + e) = 0.5 * (X.row(edges[e][0]) + X.row(edges[e][1]));
   } else {
     X.topRows(8) << -1, -1, -1, 1, -1, -1, 1, 1, -1, -1, 1, -1, -1, -1, 1, 1, -1, 1, 1, 1, 1, -1, 1, 1;
-    const int edges[12][2] = {{0, 1}, {0, 3}, {0, 4}, {1, 2}, {1, 5}, {2, 3}, {2, 6}, {3, 7}, {4, 5}, {4, 7}, {5, 6}, {6, 7}};
+    const int edges[12][2] = {{0, 1}, {0, 3}, {0, 4}, {1, 2}, {1, 5}, {2, 3},
+                              {2, 6}, {3, 7}, {4, 5}, {4, 7}, {5, 6}, {6, 7}};
     for (int e = 0; e < 12 && n == 20; ++e) X.row(8 + e) = 0.5 * (X.row(edges[e][0]) + X.row(edges[e][1]));
   }
   return X;
@@ -53,19 +54,24 @@ TEST(SolidElement, TetrahedronQuadratureIsExactToItsDegree) {
   // TET10: 14 points, degree 5; TET4: 4 points, degree 2 (exact monomial integrals over the
   // reference tetrahedron: a! b! c! / (a + b + c + 3)!).
   for (const auto& [type, degree, count] : {std::tuple{SolidType::kTet10, 5, 14}, std::tuple{SolidType::kTet4, 2, 4}}) {
-  std::vector<Eigen::Vector3d> p;
-  std::vector<double> w;
-  SolidQuadrature(type, &p, &w);
-  EXPECT_EQ(int(p.size()), count);
-  auto factorial = [](int k) { double f = 1; for (int i = 2; i <= k; ++i) f *= i; return f; };
-  for (int a = 0; a <= degree; ++a)
-    for (int b = 0; a + b <= degree; ++b)
-      for (int c = 0; a + b + c <= degree; ++c) {
-        double sum = 0;
-        for (size_t q = 0; q < p.size(); ++q) sum += w[q] * std::pow(p[q].x(), a) * std::pow(p[q].y(), b) * std::pow(p[q].z(), c);
-        const double exact = factorial(a) * factorial(b) * factorial(c) / factorial(a + b + c + 3);
-        EXPECT_NEAR(sum, exact, 1e-14) << SolidTypeName(type) << " " << a << b << c;
-      }
+    std::vector<Eigen::Vector3d> p;
+    std::vector<double> w;
+    SolidQuadrature(type, &p, &w);
+    EXPECT_EQ(int(p.size()), count);
+    auto factorial = [](int k) {
+      double f = 1;
+      for (int i = 2; i <= k; ++i) f *= i;
+      return f;
+    };
+    for (int a = 0; a <= degree; ++a)
+      for (int b = 0; a + b <= degree; ++b)
+        for (int c = 0; a + b + c <= degree; ++c) {
+          double sum = 0;
+          for (size_t q = 0; q < p.size(); ++q)
+            sum += w[q] * std::pow(p[q].x(), a) * std::pow(p[q].y(), b) * std::pow(p[q].z(), c);
+          const double exact = factorial(a) * factorial(b) * factorial(c) / factorial(a + b + c + 3);
+          EXPECT_NEAR(sum, exact, 1e-14) << SolidTypeName(type) << " " << a << b << c;
+        }
   }
 }
 

@@ -14,19 +14,26 @@
 namespace femb {
 namespace {
 
-std::string Bar(const std::string& interfaces, int modes, double h = 0.025, const std::string& elements = "tetrahedra") {
+std::string Bar(const std::string& interfaces, int modes, double h = 0.025,
+                const std::string& elements = "tetrahedra") {
   return "name: bar\ntype: solid\nmaterial: {E: 2.1e11, nu: 0.3, rho: 7850}\n"
          "geometry: {shape: box, size: [1.0, 0.05, 0.05]}\n"
-         "mesh: {size: " + std::to_string(h) + ", order: 2, elements: " + elements + "}\n"
-         "interfaces: " + interfaces + "\n"
-         "reduction: {internal_modes: " + std::to_string(modes) + ", floating_frame: center_of_mass}\n";
+         "mesh: {size: " +
+         std::to_string(h) + ", order: 2, elements: " + elements +
+         "}\n"
+         "interfaces: " +
+         interfaces +
+         "\n"
+         "reduction: {internal_modes: " +
+         std::to_string(modes) + ", floating_frame: center_of_mass}\n";
 }
 
 TEST(SolidModel, FreeFreeBoxHasSixRigidModesAndExactMassProperties) {
   const Superelement se = test::Reduce(Bar("[{name: root, group: xmin}, {name: tip, group: xmax}]", 4));
   Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> eig(se.K, se.M);
   int rigid = 0;
-  for (int k = 0; k < eig.eigenvalues().size(); ++k) rigid += std::abs(eig.eigenvalues()[k]) < 1e-8 * eig.eigenvalues().maxCoeff();
+  for (int k = 0; k < eig.eigenvalues().size(); ++k)
+    rigid += std::abs(eig.eigenvalues()[k]) < 1e-8 * eig.eigenvalues().maxCoeff();
   EXPECT_EQ(rigid, 6);
   // Box 1 x 0.05 x 0.05 m: m = rho V, I_x = m (b^2 + h^2) / 12, I_y = I_z = m (L^2 + h^2) / 12.
   const double m = 7850 * 1.0 * 0.05 * 0.05;
@@ -49,9 +56,9 @@ TEST(SolidModel, Hex20CantileverBarMatchesBeamTheoryWithin1Percent) {
   const Superelement se = test::Reduce(Bar("[{name: root, group: xmin}]", 4, 0.025, "hexahedra"));
   EXPECT_EQ(se.provenance.element_type, "hex20");
   EXPECT_NEAR(se.mass_properties.mass, 7850 * 0.05 * 0.05, 1e-9 * 19.625);  // gmsh node positions to ~1e-10
-  const Superelement beam = test::Reduce(test::StraightBeamYaml(1.0, 40, "{shape: rectangle, width: 0.05, height: 0.05}",
-                                                               "{E: 2.1e11, nu: 0.3, rho: 7850}", "[{name: A}]",
-                                                               "reduction: {internal_modes: 4}\n"));
+  const Superelement beam = test::Reduce(
+      test::StraightBeamYaml(1.0, 40, "{shape: rectangle, width: 0.05, height: 0.05}",
+                             "{E: 2.1e11, nu: 0.3, rho: 7850}", "[{name: A}]", "reduction: {internal_modes: 4}\n"));
   std::printf("[ info ] cantilever HEX20: %.3f %.3f %.3f %.3f Hz; Timoshenko beam %.3f %.3f Hz\n",
               se.internal_frequencies_hz[0], se.internal_frequencies_hz[1], se.internal_frequencies_hz[2],
               se.internal_frequencies_hz[3], beam.internal_frequencies_hz[0], beam.internal_frequencies_hz[2]);
@@ -75,9 +82,10 @@ TEST(SolidModel, CantileverBarMatchesBeamTheoryWithin1Percent) {
               se.internal_frequencies_hz[0], se.internal_frequencies_hz[1], se.internal_frequencies_hz[2],
               se.internal_frequencies_hz[3], f1, f2);
   const Superelement beam = test::Reduce(test::StraightBeamYaml(L, 40, "{shape: rectangle, width: 0.05, height: 0.05}",
-                                                               "{E: 2.1e11, nu: 0.3, rho: 7850}", "[{name: A}]",
-                                                               "reduction: {internal_modes: 4}\n"));
-  std::printf("[ info ] Timoshenko beam: %.3f %.3f Hz\n", beam.internal_frequencies_hz[0], beam.internal_frequencies_hz[2]);
+                                                                "{E: 2.1e11, nu: 0.3, rho: 7850}", "[{name: A}]",
+                                                                "reduction: {internal_modes: 4}\n"));
+  std::printf("[ info ] Timoshenko beam: %.3f %.3f Hz\n", beam.internal_frequencies_hz[0],
+              beam.internal_frequencies_hz[2]);
   for (int k = 0; k < 2; ++k) EXPECT_NEAR(se.internal_frequencies_hz[k], f1, 0.01 * f1) << k;
   for (int k = 0; k < 4; ++k) {
     const double ref = beam.internal_frequencies_hz[k];
@@ -89,9 +97,9 @@ TEST(SolidModel, Rbe2IsStifferThanRbe3) {
   // Clamp the root (RBE2), couple the tip face by RBE2 or RBE3 and compare the static tip
   // compliance (the reduced K of the tip node with the root clamped: exact statics).
   auto tip_compliance = [](const std::string& coupling) {
-    const Superelement se = test::Reduce(
-        Bar("[{name: root, group: xmin}, {name: tip, group: xmax, coupling: " + coupling + "}]", 0),
-        {"reduction.full_modes=8"});
+    const Superelement se =
+        test::Reduce(Bar("[{name: root, group: xmin}, {name: tip, group: xmax, coupling: " + coupling + "}]", 0),
+                     {"reduction.full_modes=8"});
     const Eigen::MatrixXd K_tip = se.K.block(6, 6, 6, 6);
     return std::make_pair(Eigen::MatrixXd(K_tip.inverse()), se.full_free_free_frequencies_hz);
   };
@@ -119,13 +127,15 @@ TEST(SolidModel, CylinderAndTubeHaveTheMassPropertiesOfTheirGeometry) {
     const std::string part = std::string("name: c\ntype: solid\nmaterial: {E: 2.1e11, nu: 0.3, rho: 7850}\n") +
                              "geometry: {shape: " + (tube ? "tube" : "cylinder") + ", radius: 0.05, length: 0.3" +
                              (tube ? ", inner_radius: 0.03}" : "}") + "\nmesh: {size: 0.015, order: 2}\n" +
-                             "interfaces: [{name: a, group: " + (tube ? "outer" : "bottom") + "}, {name: b, group: " +
-                             (tube ? "inner" : "top") + ", coupling: rbe3}]\nreduction: {internal_modes: 2, floating_frame: " +
+                             "interfaces: [{name: a, group: " + (tube ? "outer" : "bottom") +
+                             "}, {name: b, group: " + (tube ? "inner" : "top") +
+                             ", coupling: rbe3}]\nreduction: {internal_modes: 2, floating_frame: " +
                              (tube ? "mean_axes" : "center_of_mass") + "}\n";
     const Superelement se = test::Reduce(part);
     Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> eig(se.K, se.M);
     int rigid = 0;
-    for (int k = 0; k < eig.eigenvalues().size(); ++k) rigid += std::abs(eig.eigenvalues()[k]) < 1e-8 * eig.eigenvalues().maxCoeff();
+    for (int k = 0; k < eig.eigenvalues().size(); ++k)
+      rigid += std::abs(eig.eigenvalues()[k]) < 1e-8 * eig.eigenvalues().maxCoeff();
     EXPECT_EQ(rigid, 6);
     const double ri = tube ? r : 0.0;
     const double m = rho * M_PI * (R * R - ri * ri) * L;
@@ -155,8 +165,9 @@ TEST(SolidModel, CylinderAndTubeHaveTheMassPropertiesOfTheirGeometry) {
 // constraints W u = q exactly; the reduced model has 6 rigid-body modes and its free-free
 // frequencies are Rayleigh-Ritz upper bounds of the full model's, within 1% for the first four.
 TEST(SolidModel, AllDistributingInterfacesReduceThroughAnAugmentedFactor) {
-  const PartSpec part = ParsePart(Bar("[{name: root, group: xmin, coupling: rbe3}, {name: tip, group: xmax, coupling: rbe3}]", 8) +
-                                      "", "test.yaml", {"reduction.full_modes=10"});
+  const PartSpec part =
+      ParsePart(Bar("[{name: root, group: xmin, coupling: rbe3}, {name: tip, group: xmax, coupling: rbe3}]", 8) + "",
+                "test.yaml", {"reduction.full_modes=10"});
   const FeModel model = BuildSolidModel(part);
   ASSERT_EQ(model.interface_weights.size(), 2u);
   ASSERT_EQ(model.interface_weights[0].rows(), 6);
@@ -168,11 +179,13 @@ TEST(SolidModel, AllDistributingInterfacesReduceThroughAnAugmentedFactor) {
     expected.block(0, 6 * k, 6, 6).setIdentity();
     EXPECT_LT((q - expected).cwiseAbs().maxCoeff(), 1e-10) << "interface " << k;
   }
-  const Superelement se = test::Reduce(Bar("[{name: root, group: xmin, coupling: rbe3}, {name: tip, group: xmax, coupling: rbe3}]", 8),
-                                       {"reduction.full_modes=10"});
+  const Superelement se =
+      test::Reduce(Bar("[{name: root, group: xmin, coupling: rbe3}, {name: tip, group: xmax, coupling: rbe3}]", 8),
+                   {"reduction.full_modes=10"});
   Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> eig(se.K, se.M);
   int rigid = 0;
-  for (int k = 0; k < eig.eigenvalues().size(); ++k) rigid += std::abs(eig.eigenvalues()[k]) < 1e-8 * eig.eigenvalues().maxCoeff();
+  for (int k = 0; k < eig.eigenvalues().size(); ++k)
+    rigid += std::abs(eig.eigenvalues()[k]) < 1e-8 * eig.eigenvalues().maxCoeff();
   EXPECT_EQ(rigid, 6);
   for (int k = 6; k < 10; ++k) {
     const double reduced = std::sqrt(eig.eigenvalues()[k]) / (2 * M_PI), full = se.full_free_free_frequencies_hz[k];
@@ -191,12 +204,13 @@ TEST(SolidModel, AllDistributingInterfacesReduceAtAnyScale) {
   Eigen::VectorXd reference;
   for (const double L : {0.01, 0.1, 1.0, 10.0}) {
     char text[512];
-    std::snprintf(text, sizeof text,
-                  "name: box\ntype: solid\nmaterial: {E: 1.0e11, nu: 0.3, rho: 7850}\n"
-                  "geometry: {shape: box, size: [%.17g, %.17g, %.17g]}\nmesh: {size: %.17g, order: 2, elements: hexahedra}\n"
-                  "interfaces: [{name: A, group: xmin, coupling: rbe3}, {name: B, group: xmax, coupling: rbe3}]\n"
-                  "reduction: {internal_modes: 4}\n",
-                  L, 0.2 * L, 0.2 * L, 0.1 * L);
+    std::snprintf(
+        text, sizeof text,
+        "name: box\ntype: solid\nmaterial: {E: 1.0e11, nu: 0.3, rho: 7850}\n"
+        "geometry: {shape: box, size: [%.17g, %.17g, %.17g]}\nmesh: {size: %.17g, order: 2, elements: hexahedra}\n"
+        "interfaces: [{name: A, group: xmin, coupling: rbe3}, {name: B, group: xmax, coupling: rbe3}]\n"
+        "reduction: {internal_modes: 4}\n",
+        L, 0.2 * L, 0.2 * L, 0.1 * L);
     const PartSpec part = ParsePart(text, "box.yaml", {});
     const FeModel model = BuildSolidModel(part);
     const CraigBamptonResult cb = CraigBamptonReduce(model, 4, nullptr);
@@ -237,8 +251,10 @@ TEST(SolidModel, InterfacePointIsTheFaceCentroid) {
 
 TEST(SolidModel, MissingNodeSetIsNamed) {
   const std::string message = test::ThrownMessage([] { test::Reduce(Bar("[{name: root, group: xlow}]", 2)); });
-  EXPECT_NE(message.find("interface 'root': node set 'xlow' not found in the mesh (known: xmax, xmin, ymax, ymin, zmax, zmin; or pick the nodes by geometry with 'select')"),
-            std::string::npos) << message;
+  EXPECT_NE(message.find("interface 'root': node set 'xlow' not found in the mesh (known: xmax, xmin, ymax, ymin, "
+                         "zmax, zmin; or pick the nodes by geometry with 'select')"),
+            std::string::npos)
+      << message;
 }
 
 // Interfaces picked by geometry take the same nodes as the named sets of the same
@@ -246,13 +262,15 @@ TEST(SolidModel, MissingNodeSetIsNamed) {
 // radius 30 mm, bounded to the tube's length), the bottom face (plane z = 0) and the top face
 // (a box around z = 0.3); also a sphere cap on a box's corner.
 TEST(SolidModel, GeometricSelectionsTakeTheNodesOfTheNamedSets) {
-  const std::string head = "name: t\ntype: solid\nmaterial: {E: 2.1e11, nu: 0.3, rho: 7850}\n"
-                           "geometry: {shape: tube, radius: 0.05, inner_radius: 0.03, length: 0.3}\n"
-                           "mesh: {size: 0.02, order: 2}\nreduction: {internal_modes: 3, floating_frame: mean_axes}\n";
+  const std::string head =
+      "name: t\ntype: solid\nmaterial: {E: 2.1e11, nu: 0.3, rho: 7850}\n"
+      "geometry: {shape: tube, radius: 0.05, inner_radius: 0.03, length: 0.3}\n"
+      "mesh: {size: 0.02, order: 2}\nreduction: {internal_modes: 3, floating_frame: mean_axes}\n";
   // The bore shares its edge nodes with the end faces: two models.
   const std::vector<std::pair<std::string, std::string>> cases = {
       {"[{name: bore, group: inner, coupling: rbe3}]",
-       "[{name: bore, coupling: rbe3, select: {cylinder: {point: [0, 0, 0], axis: [0, 0, 2], radius: 0.03, length: 0.3}}}]"},
+       "[{name: bore, coupling: rbe3, select: {cylinder: {point: [0, 0, 0], axis: [0, 0, 2], radius: 0.03, length: "
+       "0.3}}}]"},
       {"[{name: bottom, group: bottom}, {name: top, group: top}]",
        "[{name: bottom, select: {plane: {point: [0, 0, 0], normal: [0, 0, -1]}, tolerance: 1e-6}},"
        " {name: top, select: {box: {min: [-1, -1, 0.2999], max: [1, 1, 0.31]}}}]"}};
@@ -271,8 +289,9 @@ TEST(SolidModel, GeometricSelectionsTakeTheNodesOfTheNamedSets) {
 }
 
 TEST(SolidModel, SelectionSphereAndBadSelectionsAreNamed) {
-  PartSpec part = ParsePart(Bar("[{name: corner, select: {sphere: {center: [1, 0.05, 0.05], radius: 0.02}, tolerance: 0.02}}]", 2),
-                            "bar.yaml");
+  PartSpec part =
+      ParsePart(Bar("[{name: corner, select: {sphere: {center: [1, 0.05, 0.05], radius: 0.02}, tolerance: 0.02}}]", 2),
+                "bar.yaml");
   // Every node within 0.04 of the corner (the sphere's surface +- 0.02 includes the inside).
   const FeModel model = BuildSolidModel(part);
   int expected = 0;
@@ -283,21 +302,28 @@ TEST(SolidModel, SelectionSphereAndBadSelectionsAreNamed) {
   EXPECT_EQ(model.n_dofs(), 3 * (model.n_nodes() - expected) + 6);
   // No node on the surface: the nearest node's distance and the tolerance are named (a part in
   // mm-sized numbers while the mesh is in m).
-  std::string message = test::ThrownMessage([] {
-    test::Reduce(Bar("[{name: root, select: {plane: {point: [-20, 0, 0], normal: [1, 0, 0]}}}]", 2));
-  });
-  EXPECT_NE(message.find("test.yaml:6: interfaces[0].select: interface 'root': the plane through (-20, 0, 0) normal to (1, 0, 0) "
-                         "selects no node: the nearest of the"), std::string::npos) << message;
+  std::string message = test::ThrownMessage(
+      [] { test::Reduce(Bar("[{name: root, select: {plane: {point: [-20, 0, 0], normal: [1, 0, 0]}}}]", 2)); });
+  EXPECT_NE(
+      message.find(
+          "test.yaml:6: interfaces[0].select: interface 'root': the plane through (-20, 0, 0) normal to (1, 0, 0) "
+          "selects no node: the nearest of the"),
+      std::string::npos)
+      << message;
   EXPECT_NE(message.find("is 20 from it, the tolerance is 0.0001"), std::string::npos) << message;
   // Two selections sharing nodes.
   message = test::ThrownMessage([] {
-    test::Reduce(Bar("[{name: a, group: xmin}, {name: b, select: {box: {min: [0, 0, 0], max: [0.1, 0.05, 0.05]}}}]", 2));
+    test::Reduce(
+        Bar("[{name: a, group: xmin}, {name: b, select: {box: {min: [0, 0, 0], max: [0.1, 0.05, 0.05]}}}]", 2));
   });
-  EXPECT_NE(message.find("interface 'b': the box selection shares nodes with interface 'a'"), std::string::npos) << message;
+  EXPECT_NE(message.find("interface 'b': the box selection shares nodes with interface 'a'"), std::string::npos)
+      << message;
   // Both or neither of group and select.
-  message = test::ThrownMessage([] { test::Reduce(Bar("[{name: a, group: xmin, select: {plane: {point: [0, 0, 0], normal: [1, 0, 0]}}}]", 2)); });
+  message = test::ThrownMessage(
+      [] { test::Reduce(Bar("[{name: a, group: xmin, select: {plane: {point: [0, 0, 0], normal: [1, 0, 0]}}}]", 2)); });
   EXPECT_NE(message.find("give either 'group'"), std::string::npos) << message;
-  message = test::ThrownMessage([] { test::Reduce(Bar("[{name: a, select: {plane: {point: [0, 0, 0], normal: [0, 0, 0]}}}]", 2)); });
+  message = test::ThrownMessage(
+      [] { test::Reduce(Bar("[{name: a, select: {plane: {point: [0, 0, 0], normal: [0, 0, 0]}}}]", 2)); });
   EXPECT_NE(message.find("normal: must be a nonzero vector"), std::string::npos) << message;
 }
 

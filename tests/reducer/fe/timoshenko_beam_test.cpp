@@ -25,10 +25,8 @@ SectionProperties Rect() {
 // Bending block of plane x-y (DOFs v1, th1, v2, th2).
 Eigen::Matrix4d ClosedFormBending(double EI, double L, double Phi) {
   Eigen::Matrix4d K;
-  K << 12, 6 * L, -12, 6 * L,
-      6 * L, (4 + Phi) * L * L, -6 * L, (2 - Phi) * L * L,
-      -12, -6 * L, 12, -6 * L,
-      6 * L, (2 - Phi) * L * L, -6 * L, (4 + Phi) * L * L;
+  K << 12, 6 * L, -12, 6 * L, 6 * L, (4 + Phi) * L * L, -6 * L, (2 - Phi) * L * L, -12, -6 * L, 12, -6 * L, 6 * L,
+      (2 - Phi) * L * L, -6 * L, (4 + Phi) * L * L;
   return EI / ((1 + Phi) * L * L * L) * K;
 }
 
@@ -67,12 +65,11 @@ TEST(TimoshenkoBeam, EulerBernoulliMassIsHermiteConsistentMassWithRotaryInertia)
   EXPECT_EQ(beam.Phi_y(), 0.0);
   const double L = kL;
   Eigen::Matrix4d translational, rotary;
-  translational << 156, 22 * L, 54, -13 * L, 22 * L, 4 * L * L, 13 * L, -3 * L * L, 54, 13 * L, 156,
-      -22 * L, -13 * L, -3 * L * L, -22 * L, 4 * L * L;
-  rotary << 36, 3 * L, -36, 3 * L, 3 * L, 4 * L * L, -3 * L, -L * L, -36, -3 * L, 36, -3 * L, 3 * L,
-      -L * L, -3 * L, 4 * L * L;
-  const Eigen::Matrix4d expected =
-      m.rho * s.A * L / 420.0 * translational + m.rho * s.Iz / (30.0 * L) * rotary;
+  translational << 156, 22 * L, 54, -13 * L, 22 * L, 4 * L * L, 13 * L, -3 * L * L, 54, 13 * L, 156, -22 * L, -13 * L,
+      -3 * L * L, -22 * L, 4 * L * L;
+  rotary << 36, 3 * L, -36, 3 * L, 3 * L, 4 * L * L, -3 * L, -L * L, -36, -3 * L, 36, -3 * L, 3 * L, -L * L, -3 * L,
+      4 * L * L;
+  const Eigen::Matrix4d expected = m.rho * s.A * L / 420.0 * translational + m.rho * s.Iz / (30.0 * L) * rotary;
   const int plane_y[4] = {1, 5, 7, 11};
   const Matrix12d M = beam.LocalMass();
   EXPECT_LT((Pick(M, plane_y) - expected).norm(), 1e-12 * expected.norm());

@@ -23,10 +23,9 @@ const double kA = M_PI * kD * kD / 4, kI = M_PI * std::pow(kD, 4) / 64;
 // Clamped-free cantilever: the fixed-interface modes of a part whose only interface is the
 // clamped end ARE the cantilever modes. Euler-Bernoulli: f_n = (beta_n L)^2 / (2 pi L^2) sqrt(EI / rho A).
 void ExpectCantileverFrequencies(const std::string& theory, double tolerance) {
-  const Superelement se = test::Reduce(test::StraightBeamYaml(
-      kL, 20, kRod, kSteel, "[{name: A}]",
-      "reduction: {internal_modes: 6}\n"),
-      {"beam.theory=" + theory});
+  const Superelement se =
+      test::Reduce(test::StraightBeamYaml(kL, 20, kRod, kSteel, "[{name: A}]", "reduction: {internal_modes: 6}\n"),
+                   {"beam.theory=" + theory});
   const double beta_L[3] = {1.8751, 4.6941, 7.8548};
   for (int n = 0; n < 3; ++n) {
     const double exact = beta_L[n] * beta_L[n] / (2 * M_PI * kL * kL) * std::sqrt(kE * kI / (kRho * kA));
@@ -77,8 +76,8 @@ TEST(CraigBampton, FreeFreeModelHasSixRigidModesAndTheBeamsMassProperties) {
   const double m = kRho * kA * kL, r = kD / 2;
   EXPECT_NEAR(se.mass_properties.mass, m, 1e-12 * m);
   EXPECT_LT((se.mass_properties.center_of_mass - Eigen::Vector3d(kL / 2, 0, 0)).norm(), 1e-12);
-  const Eigen::Matrix3d expected = Eigen::Vector3d(m * r * r / 2, m * kL * kL / 12 + m * r * r / 4,
-                                                   m * kL * kL / 12 + m * r * r / 4).asDiagonal();
+  const Eigen::Matrix3d expected =
+      Eigen::Vector3d(m * r * r / 2, m * kL * kL / 12 + m * r * r / 4, m * kL * kL / 12 + m * r * r / 4).asDiagonal();
   EXPECT_LT((se.mass_properties.inertia_com - expected).norm(), 1e-10 * expected.norm());
 }
 
@@ -122,8 +121,8 @@ TEST(CraigBampton, ReducedFrequenciesConvergeToFullModelAsModesAreAdded) {
   Eigen::VectorXd full;
   std::printf("[ info ] internal modes | rel. error of free-free flexible modes 1..8 (pairs)\n");
   for (int m : counts) {
-    const Superelement se = test::Reduce(yaml, {"reduction.internal_modes=" + std::to_string(m),
-                                                "reduction.full_modes=8"});
+    const Superelement se =
+        test::Reduce(yaml, {"reduction.internal_modes=" + std::to_string(m), "reduction.full_modes=8"});
     Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> eig(se.K, se.M);
     full = se.full_free_free_frequencies_hz;
     ASSERT_EQ(full.size(), 14);

@@ -79,9 +79,8 @@ TEST(FloatingFrame, InterfaceFrameSitsOnTheNode) {
 std::string RefusalBeforeTheFactorization(const std::string& yaml) {
   std::vector<std::string> stages;
   const std::string message = test::ThrownMessage([&] {
-    ReducePart(ParsePart(yaml, "test.yaml"), [&](const std::string& stage, double, const std::string&) {
-      stages.push_back(stage);
-    });
+    ReducePart(ParsePart(yaml, "test.yaml"),
+               [&](const std::string& stage, double, const std::string&) { stages.push_back(stage); });
   });
   EXPECT_FALSE(stages.empty());
   for (const std::string& stage : stages) {

@@ -21,8 +21,9 @@
 namespace femb {
 namespace {
 
-const std::string kRod = test::StraightBeamYaml(0.3, 20, "{shape: circle, diameter: 0.006}", "{E: 2.0e11, nu: 0.3, rho: 7870}",
-                                                "[{name: A}, {name: B}]", "reduction: {internal_modes: 6}\n");
+const std::string kRod =
+    test::StraightBeamYaml(0.3, 20, "{shape: circle, diameter: 0.006}", "{E: 2.0e11, nu: 0.3, rho: 7870}",
+                           "[{name: A}, {name: B}]", "reduction: {internal_modes: 6}\n");
 
 double Relative(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) { return (a - b).norm() / b.norm(); }
 
@@ -38,7 +39,8 @@ TEST(GeneralBasis, CraigBamptonBasisGivesCraigBamptonBack) {
     EXPECT_EQ(g.columns_kept, 12 + modes);  // the 6 rigid fields appended lie in the static modes' span
     const int n = 12 + modes;
     std::printf("[ info ] %d modes: K_r %.2e, M_r %.2e, static shapes %.2e\n", modes,
-                Relative(g.K, cb.K.topLeftCorner(n, n)), Relative(g.M.topLeftCorner(12, 12), cb.M.topLeftCorner(12, 12)),
+                Relative(g.K, cb.K.topLeftCorner(n, n)),
+                Relative(g.M.topLeftCorner(12, 12), cb.M.topLeftCorner(12, 12)),
                 Relative(g.shapes.leftCols(12), cb.shapes.leftCols(12)));
     EXPECT_LT(Relative(g.K.topLeftCorner(12, 12), cb.K.topLeftCorner(12, 12)), 1e-9);
     EXPECT_LT(Relative(g.M.topLeftCorner(12, 12), cb.M.topLeftCorner(12, 12)), 1e-9);
@@ -53,8 +55,9 @@ TEST(GeneralBasis, FreeInterfaceBasisHasTheFullModelsFreeFreeFrequencies) {
   const double f_full_7 = cb.full_free_free_frequencies_hz[6 + 6];  // the 7th flexible mode
   double previous = 1e300;
   for (const int k : {4, 8, 12}) {
-    const Superelement fi = test::Reduce(part, {"reduction.method=free_interface", "reduction.internal_modes=" + std::to_string(k),
-                                                "reduction.full_modes=12"});
+    const Superelement fi =
+        test::Reduce(part, {"reduction.method=free_interface", "reduction.internal_modes=" + std::to_string(k),
+                            "reduction.full_modes=12"});
     EXPECT_EQ(fi.provenance.reduction_method, "free_interface");
     EXPECT_EQ(fi.n_reduced_dofs(), 12 + k);
     const SuperelementChecks checks = CheckSuperelement(fi);
@@ -67,10 +70,11 @@ TEST(GeneralBasis, FreeInterfaceBasisHasTheFullModelsFreeFreeFrequencies) {
       worst_included = std::max(worst_included, std::abs(f / fi.full_free_free_frequencies_hz[6 + j] - 1));
     }
     const double f7 = std::sqrt(eig.eigenvalues()[6 + 6]) / (2 * M_PI);
-    std::printf("[ info ] free-interface, %d modes: the %d included free-free frequencies within %.2e; 7th flexible "
-                "%+.3f%% (Craig-Bampton 6 modes: %+.3f%%)\n",
-                k, k, worst_included, 100 * (f7 / f_full_7 - 1),
-                100 * (std::sqrt(CheckSuperelement(cb).lambda[12]) / (2 * M_PI) / f_full_7 - 1));
+    std::printf(
+        "[ info ] free-interface, %d modes: the %d included free-free frequencies within %.2e; 7th flexible "
+        "%+.3f%% (Craig-Bampton 6 modes: %+.3f%%)\n",
+        k, k, worst_included, 100 * (f7 / f_full_7 - 1),
+        100 * (std::sqrt(CheckSuperelement(cb).lambda[12]) / (2 * M_PI) / f_full_7 - 1));
     EXPECT_LT(worst_included, 1e-8) << k;
     // Rayleigh-Ritz: never below the full model, and better as modes are added.
     EXPECT_GE(f7, f_full_7 * (1 - 1e-9));
@@ -128,8 +132,9 @@ TEST(GeneralBasis, TooFewShapesToMoveEveryInterfaceDirectionAreConstrained) {
                                                                 Eigen::EigenvaluesOnly);
   double worst = 0.0;
   for (int j = 0; j < 4; ++j) worst = std::max(worst, std::abs(eig.eigenvalues()[6 + j] / lambda[6 + j] - 1));
-  std::printf("[ info ] 4 bending shapes, constraint C (2 x 12): free-free eigenvalues within %.2e of the full model's\n",
-              worst);
+  std::printf(
+      "[ info ] 4 bending shapes, constraint C (2 x 12): free-free eigenvalues within %.2e of the full model's\n",
+      worst);
   EXPECT_LT(worst, 1e-8);
   for (int j = 0; j < 6; ++j) EXPECT_LT(std::abs(eig.eigenvalues()[j]), 1e-8 * lambda[6]) << j;
   // Without the constraint K and M are regular but for the 6 rigid motions.

@@ -25,7 +25,8 @@ std::string Leaf(const std::string& derivatives) {
          "geometry: {shape: box, size: [0.05, 0.01, 0.0005]}\n"
          "mesh: {size: 0.002, order: 2, elements: hexahedra}\n"
          "interfaces: [{name: A, group: xmin}, {name: B, group: xmax}]\n"
-         "reduction: {internal_modes: 4, floating_frame: center_of_mass" + derivatives + "}\n";
+         "reduction: {internal_modes: 4, floating_frame: center_of_mass" +
+         derivatives + "}\n";
 }
 
 // Relative distance of x from the column span of V (least squares).
@@ -72,12 +73,14 @@ TEST(ModalDerivatives, SecondOrderStaticResponseLiesInTheAugmentedBasis) {
   };
   double plain_coarse = 0, plain_fine = 0;
   const double coarse = outside(5e-4, &plain_coarse), fine = outside(2.5e-4, &plain_fine);
-  std::printf("[ info ] even part of the response outside the basis, delta = 0.5 / 0.25 mm: with the derivative "
-              "%.2e / %.2e (ratio %.2f), without %.2e / %.2e\n", coarse, fine, coarse / fine, plain_coarse, plain_fine);
+  std::printf(
+      "[ info ] even part of the response outside the basis, delta = 0.5 / 0.25 mm: with the derivative "
+      "%.2e / %.2e (ratio %.2f), without %.2e / %.2e\n",
+      coarse, fine, coarse / fine, plain_coarse, plain_fine);
   EXPECT_LT(fine, 0.01);
   EXPECT_GT(coarse / fine, 3.0);  // second order: 4 in the limit
   EXPECT_LT(coarse / fine, 5.0);
-  EXPECT_GT(plain_fine, 0.5);     // the plain Craig-Bampton basis misses the stretch entirely
+  EXPECT_GT(plain_fine, 0.5);  // the plain Craig-Bampton basis misses the stretch entirely
 }
 
 TEST(ModalDerivatives, VanishAtTheInterfacesAndAreMOrthonormalToTheModes) {
@@ -124,9 +127,9 @@ TEST(ModalDerivatives, ReducedPolynomialForceIsTheProjectedFullForce) {
   const SvkSolidMesh solid(SolidType::kHex20, model.nodes, model.cells, part.material);
   const Eigen::MatrixXd& V = se.visualization->shapes;
   Eigen::VectorXd q = Eigen::VectorXd::Zero(n);
-  q[8] = 1e-3;      // B.u_z: 2 thicknesses
-  q[7] = -2e-4;     // B.u_y
-  q[12] = 3e-4;     // mode 1 (mass-normalized: ~1 mm of displacement per 1e-3)
+  q[8] = 1e-3;   // B.u_z: 2 thicknesses
+  q[7] = -2e-4;  // B.u_y
+  q[12] = 3e-4;  // mode 1 (mass-normalized: ~1 mm of displacement per 1e-3)
   for (int k = 16; k < n; ++k) q[k] = 1e-4 * (k - 15);
   const Eigen::VectorXd direct = V.transpose() * solid.Force(V * q);
   const Eigen::VectorXd poly = PolynomialForce(se.K, *se.polynomial, q);
@@ -190,8 +193,9 @@ TEST(ModalDerivatives, FiniteRigidRotationCostsNoStrainEnergyWithTheRotationComp
     const double scale = 0.5 * bend.dot(se.K * bend);
     const double with_completion = PolynomialEnergy(se.K, *se.polynomial, q) / scale;
     const double linear_faces = PolynomialEnergy(se.K, without, q) / scale;
-    std::printf("[ info ] rigid rotation %.2f rad: strain energy / bending energy %.2e with the completion, %.2e without\n",
-                theta, with_completion, linear_faces);
+    std::printf(
+        "[ info ] rigid rotation %.2f rad: strain energy / bending energy %.2e with the completion, %.2e without\n",
+        theta, with_completion, linear_faces);
     EXPECT_LT(std::abs(with_completion), 0.05 * linear_faces);
   }
 }

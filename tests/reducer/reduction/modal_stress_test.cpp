@@ -21,7 +21,9 @@ namespace {
 std::string SolidBar(const std::string& elements, double size) {
   return "name: bar\ntype: solid\nmaterial: {E: 2.1e11, nu: 0.3, rho: 7850}\n"
          "geometry: {shape: box, size: [1.0, 0.05, 0.05]}\n"
-         "mesh: {size: " + std::to_string(size) + ", order: 2, elements: " + elements + "}\n"
+         "mesh: {size: " +
+         std::to_string(size) + ", order: 2, elements: " + elements +
+         "}\n"
          "interfaces: [{name: root, group: xmin}, {name: tip, group: xmax}]\n"
          "reduction: {internal_modes: 4}\n";
 }
@@ -85,9 +87,10 @@ TEST(ModalStress, SolidCantileverBendingStressIsBeamTheoryTet10) {
 TEST(ModalStress, RigidBodyMotionsCauseNoStress) {
   // Phi_rig0's six rigid motions (about the frame origin) against the stress of one interface
   // coordinate: zero to the single precision of the stored modes.
-  for (const Superelement& se : {test::Reduce(SolidBar("hexahedra", 0.025)),
-                                 test::Reduce(test::StraightBeamYaml(1.0, 10, "{shape: rectangle, width: 0.02, height: 0.04}",
-                                                                     "{E: 2.1e11, nu: 0.3, rho: 7850}", "[{name: A}, {name: B}]"))}) {
+  for (const Superelement& se :
+       {test::Reduce(SolidBar("hexahedra", 0.025)),
+        test::Reduce(test::StraightBeamYaml(1.0, 10, "{shape: rectangle, width: 0.02, height: 0.04}",
+                                            "{E: 2.1e11, nu: 0.3, rho: 7850}", "[{name: A}, {name: B}]"))}) {
     ASSERT_TRUE(se.stress.has_value());
     const Eigen::MatrixXd Phi_rig0 = RigidBodyModes(se, se.floating_frame.origin);
     const Eigen::MatrixXd modes = se.stress->modes.cast<double>();
@@ -111,8 +114,9 @@ TEST(ModalStress, BeamFibreStressesAreBeamTheoryExactly) {
   // torsion (tau_max = T / (alpha a b^2), alpha = 0.246 at a / b = 2 (Timoshenko and Goodier,
   // table 9; the series gives 0.24588), the short side's middle k = 0.795 tau_max); exact for an
   // end-loaded beam up to the single precision of the stored modes (1e-6).
-  const Superelement se = test::Reduce(test::StraightBeamYaml(1.0, 10, "{shape: rectangle, width: 0.02, height: 0.04}",
-                                                              "{E: 2.1e11, nu: 0.3, rho: 7850}", "[{name: A}, {name: B}]"));
+  const Superelement se =
+      test::Reduce(test::StraightBeamYaml(1.0, 10, "{shape: rectangle, width: 0.02, height: 0.04}",
+                                          "{E: 2.1e11, nu: 0.3, rho: 7850}", "[{name: A}, {name: B}]"));
   ASSERT_TRUE(se.stress.has_value());
   const ModalStress& s = *se.stress;
   EXPECT_EQ(s.method, "beam_fibres");
@@ -131,9 +135,9 @@ TEST(ModalStress, BeamFibreStressesAreBeamTheoryExactly) {
     double y, z, sigma, tau_xy, tau_xz;
   };
   const Expect fibres[] = {
-      {0.01, 0.02, N / A + My * 0.02 / Iy - Mz * 0.01 / Iz, 0, 0},      // corner
-      {-0.01, -0.02, N / A - My * 0.02 / Iy + Mz * 0.01 / Iz, 0, 0},    // opposite corner
-      {0.01, 0, N / A - Mz * 0.01 / Iz, 0, tau_max + 1.5 * Vz / A},       // long side's middle
+      {0.01, 0.02, N / A + My * 0.02 / Iy - Mz * 0.01 / Iz, 0, 0},            // corner
+      {-0.01, -0.02, N / A - My * 0.02 / Iy + Mz * 0.01 / Iz, 0, 0},          // opposite corner
+      {0.01, 0, N / A - Mz * 0.01 / Iz, 0, tau_max + 1.5 * Vz / A},           // long side's middle
       {0, 0.02, N / A + My * 0.02 / Iy, 1.5 * Vy / A - 0.7950 * tau_max, 0},  // short side's middle
   };
   for (const Expect& e : fibres) {
@@ -168,7 +172,8 @@ TEST(ModalStress, AffineFieldsHaveExactGradientsAndGreenLagrangeStress) {
   double worst = 0;
   for (long i = 0; i < model.nodes.rows(); ++i) {
     const Eigen::Matrix<double, 9, 1> h = s.gradients.block<9, 1>(9 * i, 0).cast<double>();
-    worst = std::max(worst, (Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(h.data()) - A).cwiseAbs().maxCoeff());
+    worst = std::max(
+        worst, (Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(h.data()) - A).cwiseAbs().maxCoeff());
   }
   EXPECT_LT(worst, 1e-6);
   const double q = 0.7, E = part.material.E, nu = part.material.nu;
@@ -179,12 +184,13 @@ TEST(ModalStress, AffineFieldsHaveExactGradientsAndGreenLagrangeStress) {
   expected << S(0, 0), S(1, 1), S(2, 2), S(1, 2), S(0, 2), S(0, 1);
   const Eigen::VectorXd amplitude = Eigen::VectorXd::Constant(1, q);
   for (int p : {0, 17, int(model.nodes.rows()) - 1}) {
-    EXPECT_LT((PointStress(s, p, amplitude) - expected).cwiseAbs().maxCoeff(), 1e-6 * expected.cwiseAbs().maxCoeff()) << p;
+    EXPECT_LT((PointStress(s, p, amplitude) - expected).cwiseAbs().maxCoeff(), 1e-6 * expected.cwiseAbs().maxCoeff())
+        << p;
   }
   // A part with modal derivatives stores the gradients of its whole basis (and the file keeps
   // them); one without does not.
-  const Superelement se = test::Reduce(
-      test::Replace(SolidBar("hexahedra", 0.025), "internal_modes: 4}", "internal_modes: 4, modal_derivatives: {of: internal}}"));
+  const Superelement se = test::Reduce(test::Replace(SolidBar("hexahedra", 0.025), "internal_modes: 4}",
+                                                     "internal_modes: 4, modal_derivatives: {of: internal}}"));
   ASSERT_TRUE(se.stress.has_value());
   EXPECT_GT(se.n_modal_derivatives, 0);
   EXPECT_EQ(se.stress->gradients.rows(), 9 * se.stress->n_points());

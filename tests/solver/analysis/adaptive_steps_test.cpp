@@ -112,7 +112,9 @@ void ErrorFallsWithTheTolerance(Integrator integrator) {
   EXPECT_LT(last_error, 2e-3);
 }
 
-TEST(AdaptiveSteps, GeneralizedAlphaErrorFallsWithTheTolerance) { ErrorFallsWithTheTolerance(Integrator::kGeneralizedAlpha); }
+TEST(AdaptiveSteps, GeneralizedAlphaErrorFallsWithTheTolerance) {
+  ErrorFallsWithTheTolerance(Integrator::kGeneralizedAlpha);
+}
 
 TEST(AdaptiveSteps, MidpointErrorFallsWithTheTolerance) { ErrorFallsWithTheTolerance(Integrator::kMidpoint); }
 

@@ -178,24 +178,28 @@ TEST(AllocationFree, GeneralizedAlphaStepsAllocateNothing) {
   const Superelement se = Tube(0.25, true);
   long steps = 0;
   const long two = LargestAllocationsPerStep(Chain(se, 0.25), 1e-3, "threads", &steps, 2);
-  std::printf("[ info ] stiffened chain on 2 threads: at most %ld allocations in a step (%ld steps counted)\n", two, steps);
+  std::printf("[ info ] stiffened chain on 2 threads: at most %ld allocations in a step (%ld steps counted)\n", two,
+              steps);
   EXPECT_EQ(two, 0);
   // Error-controlled steps (analysis.step: auto): the error estimate and the step's choice.
-  const long adaptive =
-      LargestAllocationsPerStep(test::SliderCrankModel(Tube(0.15, true), se, 0.15, 0.25), 1e-5, "adaptive", &steps, 1, true);
+  const long adaptive = LargestAllocationsPerStep(test::SliderCrankModel(Tube(0.15, true), se, 0.15, 0.25), 1e-5,
+                                                  "adaptive", &steps, 1, true);
   std::printf("[ info ] stiffened slider-crank, step: auto: at most %ld allocations in a step (%ld steps counted)\n",
               adaptive, steps);
   EXPECT_EQ(adaptive, 0);
   // The bodies' inertia matrices kept in their frames and turned (body_matrices_every).
   const long kept = LargestAllocationsPerStep(test::SliderCrankModel(Tube(0.15, true), se, 0.15, 0.25), 1e-5, "kept",
                                               &steps, 1, false, 4);
-  std::printf("[ info ] stiffened slider-crank, body_matrices_every 4: at most %ld allocations in a step (%ld steps counted)\n",
-              kept, steps);
+  std::printf(
+      "[ info ] stiffened slider-crank, body_matrices_every 4: at most %ld allocations in a step (%ld steps counted)\n",
+      kept, steps);
   EXPECT_EQ(kept, 0);
   // Spring-dampers (their forces, matrices and energy) and a follower load.
   const long sprung = LargestAllocationsPerStep(SprungChain(se, 0.25), 1e-3, "springs", &steps);
-  std::printf("[ info ] stiffened chain with 2 spring-dampers and a follower load: at most %ld allocations in a step (%ld steps counted)\n",
-              sprung, steps);
+  std::printf(
+      "[ info ] stiffened chain with 2 spring-dampers and a follower load: at most %ld allocations in a step (%ld "
+      "steps counted)\n",
+      sprung, steps);
   EXPECT_EQ(sprung, 0);
   // A closed loop (cut joint): its equations, forces and matrix blocks.
   const long loop = LargestAllocationsPerStep(PinnedChain(se, 0.25), 1e-3, "loop", &steps);
@@ -205,8 +209,9 @@ TEST(AllocationFree, GeneralizedAlphaStepsAllocateNothing) {
   // Bodies with interface constraints (their multipliers; the bodies' data of the pass reused).
   const long constrained =
       LargestAllocationsPerStep(ConstrainedPendulum(test::BendingShapesRod(0.5), 0.5), 1e-3, "constrained", &steps);
-  std::printf("[ info ] pendulum of 2 interface-constrained rods: at most %ld allocations in a step (%ld steps counted)\n",
-              constrained, steps);
+  std::printf(
+      "[ info ] pendulum of 2 interface-constrained rods: at most %ld allocations in a step (%ld steps counted)\n",
+      constrained, steps);
   EXPECT_EQ(constrained, 0);
 }
 
@@ -221,8 +226,8 @@ TEST(AllocationFree, MidpointStepsAllocateNothing) {
     const double L = 0.25;
     const Superelement se = Tube(L, stiffened);
     long steps = 0;
-    const long chain = LargestAllocationsPerStep(Chain(se, L), 1e-3, "midpoint", &steps, 1, false, 1,
-                                                 Integrator::kMidpoint);
+    const long chain =
+        LargestAllocationsPerStep(Chain(se, L), 1e-3, "midpoint", &steps, 1, false, 1, Integrator::kMidpoint);
     std::printf("[ info ] midpoint, %s chain of 4 bodies: at most %ld allocations in a step (%ld steps counted)\n",
                 stiffened ? "stiffened" : "linear", chain, steps);
     EXPECT_EQ(chain, 0);
@@ -234,29 +239,38 @@ TEST(AllocationFree, MidpointStepsAllocateNothing) {
   }
   const Superelement se = Tube(0.25, true);
   long steps = 0;
-  const long two = LargestAllocationsPerStep(Chain(se, 0.25), 1e-3, "midpoint", &steps, 2, false, 1, Integrator::kMidpoint);
-  std::printf("[ info ] midpoint, stiffened chain on 2 threads: at most %ld allocations in a step (%ld steps counted)\n",
-              two, steps);
+  const long two =
+      LargestAllocationsPerStep(Chain(se, 0.25), 1e-3, "midpoint", &steps, 2, false, 1, Integrator::kMidpoint);
+  std::printf(
+      "[ info ] midpoint, stiffened chain on 2 threads: at most %ld allocations in a step (%ld steps counted)\n", two,
+      steps);
   EXPECT_EQ(two, 0);
   const long adaptive = LargestAllocationsPerStep(test::SliderCrankModel(Tube(0.15, true), se, 0.15, 0.25), 1e-5,
                                                   "midpoint", &steps, 1, true, 1, Integrator::kMidpoint);
-  std::printf("[ info ] midpoint, stiffened slider-crank, step: auto: at most %ld allocations in a step (%ld steps counted)\n",
-              adaptive, steps);
+  std::printf(
+      "[ info ] midpoint, stiffened slider-crank, step: auto: at most %ld allocations in a step (%ld steps counted)\n",
+      adaptive, steps);
   EXPECT_EQ(adaptive, 0);
   const long sprung =
       LargestAllocationsPerStep(SprungChain(se, 0.25), 1e-3, "springs", &steps, 1, false, 1, Integrator::kMidpoint);
-  std::printf("[ info ] midpoint, stiffened chain with 2 spring-dampers and a follower load: at most %ld allocations in a step (%ld steps counted)\n",
-              sprung, steps);
+  std::printf(
+      "[ info ] midpoint, stiffened chain with 2 spring-dampers and a follower load: at most %ld allocations in a step "
+      "(%ld steps counted)\n",
+      sprung, steps);
   EXPECT_EQ(sprung, 0);
   const long loop =
       LargestAllocationsPerStep(PinnedChain(se, 0.25), 1e-3, "loop", &steps, 1, false, 1, Integrator::kMidpoint);
-  std::printf("[ info ] midpoint, stiffened chain closed by a cut joint: at most %ld allocations in a step (%ld steps counted)\n",
-              loop, steps);
+  std::printf(
+      "[ info ] midpoint, stiffened chain closed by a cut joint: at most %ld allocations in a step (%ld steps "
+      "counted)\n",
+      loop, steps);
   EXPECT_EQ(loop, 0);
   const long constrained = LargestAllocationsPerStep(ConstrainedPendulum(test::BendingShapesRod(0.5), 0.5), 1e-3,
                                                      "constrained", &steps, 1, false, 1, Integrator::kMidpoint);
-  std::printf("[ info ] midpoint, pendulum of 2 interface-constrained rods: at most %ld allocations in a step (%ld steps counted)\n",
-              constrained, steps);
+  std::printf(
+      "[ info ] midpoint, pendulum of 2 interface-constrained rods: at most %ld allocations in a step (%ld steps "
+      "counted)\n",
+      constrained, steps);
   EXPECT_EQ(constrained, 0);
 }
 #endif

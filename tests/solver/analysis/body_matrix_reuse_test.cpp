@@ -137,10 +137,11 @@ TEST(BodyMatrices, KeptInTheirFramesGiveTheSameMotion) {
       travel = std::max(travel, (every_step.mid_path[i] - model.node_x0[mid]).norm());
     }
     const DynamicResult &r1 = every_step.result, &r4 = every_4th.result;
-    std::printf("[ info ] every step: %ld iterations, %ld body matrices computed; every 4th (%s kept): %ld iterations, "
-                "%ld computed, %ld turned; rod midpoint paths differ by %.1e m (it travels %.2f m)\n",
-                r1.newton_iterations, r1.body_matrices_computed, which, r4.newton_iterations, r4.body_matrices_computed,
-                r4.body_matrices_turned, largest, travel);
+    std::printf(
+        "[ info ] every step: %ld iterations, %ld body matrices computed; every 4th (%s kept): %ld iterations, "
+        "%ld computed, %ld turned; rod midpoint paths differ by %.1e m (it travels %.2f m)\n",
+        r1.newton_iterations, r1.body_matrices_computed, which, r4.newton_iterations, r4.body_matrices_computed,
+        r4.body_matrices_turned, largest, travel);
     EXPECT_EQ(r1.body_matrices_turned, 0);
     // Three of four steps turn the kept matrices (a step whose first matrix does not contract
     // tenfold computes them anew, and the count starts again).

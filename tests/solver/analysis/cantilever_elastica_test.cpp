@@ -85,7 +85,8 @@ TEST(CantileverElastica, K1OnlyTangentFailsAtHighLoadWithAMessage) {
   StaticOptions options;
   options.steps = 100;
   const StaticResult r = SolveStatic(model, state, options);
-  std::printf("[ info ] K1 only: %s after %zu converged steps\n", r.ok ? "converged" : r.message.c_str(), r.steps.size());
+  std::printf("[ info ] K1 only: %s after %zu converged steps\n", r.ok ? "converged" : r.message.c_str(),
+              r.steps.size());
   EXPECT_FALSE(r.ok);
   EXPECT_NE(r.message.find("Newton did not converge at pseudo-time"), std::string::npos);
 }

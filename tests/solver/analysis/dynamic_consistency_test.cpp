@@ -16,9 +16,9 @@
 #include <string>
 
 #include "formats/scene_file.h"
-#include "solver/assembly/system_model.h"
 #include "formats/superelement_file.h"
 #include "solver/analysis/dynamic_analysis.h"
+#include "solver/assembly/system_model.h"
 #include "solver/joints/loop_constraints.h"
 #include "solver/output/checkpoint.h"
 #include "solver/rotation.h"
@@ -30,7 +30,9 @@ namespace {
 
 using test::Number;
 
-std::string Vector(const Eigen::Vector3d& v) { return "[" + Number(v.x()) + ", " + Number(v.y()) + ", " + Number(v.z()) + "]"; }
+std::string Vector(const Eigen::Vector3d& v) {
+  return "[" + Number(v.x()) + ", " + Number(v.y()) + ", " + Number(v.z()) + "]";
+}
 
 struct TiltedFourBar {
   double d = 0.4, a = 0.1, b = 0.35, c = 0.3, theta0 = 0.3;
@@ -49,8 +51,8 @@ struct TiltedFourBar {
   // The placement of a link from p to q (part axis x along it).
   std::string Placement(const Eigen::Vector2d& p, const Eigen::Vector2d& q) const {
     const double phi = std::atan2(q.y() - p.y(), q.x() - p.x());
-    return "placement: {position: " + Vector(InSpace(p)) + ", rotation: " +
-           Vector(LogSO3(tilt * ExpSO3(Eigen::Vector3d(0, 0, phi)))) + "}";
+    return "placement: {position: " + Vector(InSpace(p)) +
+           ", rotation: " + Vector(LogSO3(tilt * ExpSO3(Eigen::Vector3d(0, 0, phi)))) + "}";
   }
   std::string Rigid(const std::string& name, const Eigen::Vector2d& p, const Eigen::Vector2d& q, const std::string& np,
                     const std::string& nq) const {
@@ -69,18 +71,19 @@ struct TiltedFourBar {
     std::filesystem::create_directories(dir);
     WriteSuperelementFile(coupler, dir + "/coupler.h5");
     const std::string axis = Vector(tilt.col(2));
-    std::ofstream(dir + "/scene.yaml")
-        << "name: tilted_four_bar\nunits: SI\nbodies:\n"
-        << Rigid("crank", Eigen::Vector2d::Zero(), B, "A", "B1") << Rigid("rocker", Eigen::Vector2d(d, 0), Cp, "D", "C2")
-        << (rigid_coupler ? Rigid("coupler", B, Cp, "B2", "C1")
-                          : "  - {name: coupler, superelement: coupler.h5, " + Placement(B, Cp) + ", nodes: {A: B2, B: C1}}\n")
-        << "joints:\n"
-        << "  - {type: revolute, node: A, axis: " << axis << ", prescribed: crank}\n"
-        << "  - {type: revolute, node: B2, parent: B1, axis: " << axis << "}\n"
-        << "  - {type: revolute, node: C2, parent: C1, axis: " << axis << "}\n"
-        << "  - {type: revolute, node: D, axis: " << axis << "}\n"
-        << "functions:\n  crank: " << drive << "\n"
-        << "analysis: " << analysis << "\n";
+    std::ofstream(dir + "/scene.yaml") << "name: tilted_four_bar\nunits: SI\nbodies:\n"
+                                       << Rigid("crank", Eigen::Vector2d::Zero(), B, "A", "B1")
+                                       << Rigid("rocker", Eigen::Vector2d(d, 0), Cp, "D", "C2")
+                                       << (rigid_coupler ? Rigid("coupler", B, Cp, "B2", "C1")
+                                                         : "  - {name: coupler, superelement: coupler.h5, " +
+                                                               Placement(B, Cp) + ", nodes: {A: B2, B: C1}}\n")
+                                       << "joints:\n"
+                                       << "  - {type: revolute, node: A, axis: " << axis << ", prescribed: crank}\n"
+                                       << "  - {type: revolute, node: B2, parent: B1, axis: " << axis << "}\n"
+                                       << "  - {type: revolute, node: C2, parent: C1, axis: " << axis << "}\n"
+                                       << "  - {type: revolute, node: D, axis: " << axis << "}\n"
+                                       << "functions:\n  crank: " << drive << "\n"
+                                       << "analysis: " << analysis << "\n";
     return dir + "/scene.yaml";
   }
 };
@@ -99,7 +102,8 @@ struct Reactions {
     double error = 0.0;
     for (size_t i = 0; i < t.size(); ++i) {
       if (t[i] < t0 || t[i] > t1) continue;
-      const size_t j = size_t(std::lower_bound(reference.t.begin(), reference.t.end(), t[i] - 1e-12) - reference.t.begin());
+      const size_t j =
+          size_t(std::lower_bound(reference.t.begin(), reference.t.end(), t[i] - 1e-12) - reference.t.begin());
       if (j >= reference.t.size()) continue;
       Eigen::Matrix<double, 12, 1> ref = reference.r[j];
       if (j > 0 && std::abs(reference.t[j] - t[i]) > 1e-12) {
@@ -196,13 +200,15 @@ void RestartLeavesASmoothRunUnchanged(const Scene& scene, Integrator integrator)
     const Reactions smooth = Simulate(scene, o);
     ASSERT_TRUE(restarted.result.ok) << restarted.result.message;
     ASSERT_TRUE(smooth.result.ok) << smooth.result.message;
-    const double before = restarted.Error(reference, 0, 0.1 - 1e-9), after = restarted.Error(reference, 0.1 + 1e-9, 0.2);
+    const double before = restarted.Error(reference, 0, 0.1 - 1e-9),
+                 after = restarted.Error(reference, 0.1 + 1e-9, 0.2);
     const double smooth_after = smooth.Error(reference, 0.1 + 1e-9, 0.2);
-    std::printf("[ info ] %s, step_tolerance %.0e: ground reactions against the fixed 5 us run, of each component's "
-                "peak: restarted at 0.1 s (%ld steps) %.2e before, %.2e after; without the breakpoint (%ld steps) "
-                "%.2e after\n",
-                integrator == Integrator::kMidpoint ? "midpoint" : "generalized-alpha", tolerance, restarted.steps,
-                before, after, smooth.steps, smooth_after);
+    std::printf(
+        "[ info ] %s, step_tolerance %.0e: ground reactions against the fixed 5 us run, of each component's "
+        "peak: restarted at 0.1 s (%ld steps) %.2e before, %.2e after; without the breakpoint (%ld steps) "
+        "%.2e after\n",
+        integrator == Integrator::kMidpoint ? "midpoint" : "generalized-alpha", tolerance, restarted.steps, before,
+        after, smooth.steps, smooth_after);
     // The restart adds nothing beyond the run's own error: after the breakpoint the restarted
     // run is no further from the reference than 3 times the run without the breakpoint or its
     // own error before it (the runs' error moves with their step sequence: with clang's build
@@ -234,8 +240,8 @@ TEST_F(TiltedFourBarTest, RestartAtTheBreakpointLeavesASmoothRunUnchangedGeneral
 TEST(DynamicConsistency, RigidTiltedFourBarReactionsFollowAFixedStepRunAtEveryTolerance) {
   TiltedFourBar fb;
   fb.rigid_coupler = true;
-  const Scene scene = BuildScene(ReadSceneFile(fb.Write(::testing::TempDir() + "tilted_four_bar_rigid",
-                                                        "{type: dynamic, end_time: 0.2, step: 1.0e-5}")));
+  const Scene scene = BuildScene(ReadSceneFile(
+      fb.Write(::testing::TempDir() + "tilted_four_bar_rigid", "{type: dynamic, end_time: 0.2, step: 1.0e-5}")));
   ASSERT_EQ(scene.model.cut_joints.size(), 1u);
   EXPECT_EQ(scene.model.cut_joints[0].equations.size(), 2u);
   for (Integrator integrator : {Integrator::kGeneralizedAlpha, Integrator::kMidpoint}) {
@@ -248,10 +254,10 @@ TEST(DynamicConsistency, RigidTiltedFourBarReactionsFollowAFixedStepRunAtEveryTo
       const Reactions run = Simulate(scene, ErrorControlled(integrator, tolerance));
       ASSERT_TRUE(run.result.ok) << run.result.message;
       const double before = run.Error(reference, 0, 0.1 - 1e-9), after = run.Error(reference, 0.1 + 1e-9, 0.2);
-      std::printf("[ info ] rigid links, %s, step_tolerance %.0e (%ld steps): ground reactions against the fixed 5 us "
-                  "run %.2e before t = 0.1 s, %.2e after, of each component's peak\n",
-                  integrator == Integrator::kMidpoint ? "midpoint" : "generalized-alpha", tolerance, run.steps, before,
-                  after);
+      std::printf(
+          "[ info ] rigid links, %s, step_tolerance %.0e (%ld steps): ground reactions against the fixed 5 us "
+          "run %.2e before t = 0.1 s, %.2e after, of each component's peak\n",
+          integrator == Integrator::kMidpoint ? "midpoint" : "generalized-alpha", tolerance, run.steps, before, after);
       EXPECT_LT(before, 1e-3);
       EXPECT_LT(after, 1e-3);
     }
@@ -266,9 +272,9 @@ TEST(DynamicConsistency, RigidTiltedFourBarReactionsFollowAFixedStepRunAtEveryTo
 TEST(DynamicConsistency, AbruptStartReactionsBalanceTheMomentumRateFromTheSecondStep) {
   TiltedFourBar fb;
   fb.rigid_coupler = true;
-  const Scene scene = BuildScene(ReadSceneFile(fb.Write(::testing::TempDir() + "tilted_four_bar_abrupt",
-                                                        "{type: dynamic, end_time: 0.01, step: 2.0e-5}",
-                                                        "{type: linear, slope: 20}")));
+  const Scene scene =
+      BuildScene(ReadSceneFile(fb.Write(::testing::TempDir() + "tilted_four_bar_abrupt",
+                                        "{type: dynamic, end_time: 0.01, step: 2.0e-5}", "{type: linear, slope: 20}")));
   const SystemModel& model = scene.model;
   const int A = scene.node_index.at("A"), D = scene.node_index.at("D");
   for (Integrator integrator : {Integrator::kGeneralizedAlpha, Integrator::kMidpoint}) {
@@ -294,9 +300,10 @@ TEST(DynamicConsistency, AbruptStartReactionsBalanceTheMomentumRateFromTheSecond
       const Eigen::Vector3d rate = (momentum[i + 1] - momentum[i - 1]) / (t[i + 1] - t[i - 1]);
       error = std::max(error, (force[i] - rate).cwiseAbs().maxCoeff());
     }
-    std::printf("[ info ] %s, abrupt start: ground reactions against the momentum rate from the second step on: %.2e "
-                "of their peak (%.3g N)\n", integrator == Integrator::kMidpoint ? "midpoint" : "generalized-alpha",
-                error / peak, peak);
+    std::printf(
+        "[ info ] %s, abrupt start: ground reactions against the momentum rate from the second step on: %.2e "
+        "of their peak (%.3g N)\n",
+        integrator == Integrator::kMidpoint ? "midpoint" : "generalized-alpha", error / peak, peak);
     EXPECT_LT(error, 5e-5 * peak);
   }
 }
@@ -321,7 +328,8 @@ TEST_F(TiltedFourBarTest, EveryStepFrom100usDownTo1usConverges) {
       if (integrator == Integrator::kMidpoint && h > 1.5e-5) {
         ASSERT_EQ(warnings.size(), 1u) << "at step " << h;
         EXPECT_NE(warnings[0].find("highest mode, 1.165e+04 Hz"), std::string::npos) << warnings[0];
-        EXPECT_NE(warnings[0].find("omega h = " + std::string(h > 5e-5 ? "7.32" : "1.46")), std::string::npos) << warnings[0];
+        EXPECT_NE(warnings[0].find("omega h = " + std::string(h > 5e-5 ? "7.32" : "1.46")), std::string::npos)
+            << warnings[0];
         warnings.clear();
       }
       EXPECT_TRUE(warnings.empty()) << warnings.front() << " at step " << h;
@@ -353,16 +361,17 @@ TEST(DynamicConsistency, DriveAcceleratingAtTheStartRunsAndAnOpenStartIsRefused)
   TiltedFourBar fb;
   fb.rigid_coupler = true;
   const std::string dir = ::testing::TempDir() + "tilted_four_bar_cosine";
-  const Scene scene = BuildScene(ReadSceneFile(fb.Write(dir, "{type: dynamic, end_time: 0.01, step: 1.0e-5}",
-                                                        "{type: sine, amplitude: 1, frequency: 5, phase: 1.5707963267948966, offset: -1}")));
+  const Scene scene = BuildScene(
+      ReadSceneFile(fb.Write(dir, "{type: dynamic, end_time: 0.01, step: 1.0e-5}",
+                             "{type: sine, amplitude: 1, frequency: 5, phase: 1.5707963267948966, offset: -1}")));
   for (Integrator integrator : {Integrator::kGeneralizedAlpha, Integrator::kMidpoint}) {
     for (double h : {1e-4, 1e-5, 1e-6, 1e-7}) {
       DynamicState s = InitialDynamicState(scene.model, InitialState(scene.model), scene.initial_velocity);
       DynamicOptions o = Options(integrator, 20 * h);
       o.step = h;
       const DynamicResult r = SolveDynamic(scene.model, s, o, nullptr);
-      EXPECT_TRUE(r.ok) << (integrator == Integrator::kMidpoint ? "midpoint" : "generalized-alpha") << ", h = " << h << ": "
-                        << r.message;
+      EXPECT_TRUE(r.ok) << (integrator == Integrator::kMidpoint ? "midpoint" : "generalized-alpha") << ", h = " << h
+                        << ": " << r.message;
       EXPECT_TRUE(r.warnings.empty()) << r.warnings.front();
     }
   }
@@ -371,7 +380,8 @@ TEST(DynamicConsistency, DriveAcceleratingAtTheStartRunsAndAnOpenStartIsRefused)
                                       "{type: sine, amplitude: 1, frequency: 5, phase: 1.5707963267948966}")));
   });
   EXPECT_NE(message.find("joints[0]: prescribed 'crank' of node 'A' is 1 at t = 0, which opens the loop closed by"),
-            std::string::npos) << message;
+            std::string::npos)
+      << message;
   EXPECT_NE(message.find("give the function an offset so that it is 0 at t = 0"), std::string::npos) << message;
 }
 
@@ -393,7 +403,8 @@ struct StepTrace {
     v.segment(at, s.W.size()) = s.W, at += s.W.size();
     v.segment(at, s.Wdot.size()) = s.Wdot, at += s.Wdot.size();
     v.segment(at, s.a.size()) = s.a.size() == s.W.size() ? s.a : Eigen::VectorXd::Zero(s.W.size());
-    for (const Eigen::VectorXd& eta : s.config.eta) v.conservativeResize(v.size() + eta.size()), v.tail(eta.size()) = eta;
+    for (const Eigen::VectorXd& eta : s.config.eta)
+      v.conservativeResize(v.size() + eta.size()), v.tail(eta.size()) = eta;
     t.push_back(s.t);
     values.push_back(v);
   }
@@ -409,7 +420,8 @@ void ResumedRunTakesTheSameSteps(const Scene& scene, DynamicOptions o, double t_
   const auto start = [&] { return InitialDynamicState(model, InitialState(model), scene.initial_velocity); };
   StepTrace whole, resumed;
   DynamicState s = start();
-  const DynamicResult all = SolveDynamic(model, s, o, [&](const DynamicStepReport&, const DynamicState& st) { whole.Add(st); });
+  const DynamicResult all =
+      SolveDynamic(model, s, o, [&](const DynamicStepReport&, const DynamicState& st) { whole.Add(st); });
   ASSERT_TRUE(all.ok) << all.message;
   std::atomic<int> stop{0};
   DynamicResume saved;
@@ -445,8 +457,8 @@ void ResumedRunTakesTheSameSteps(const Scene& scene, DynamicOptions o, double t_
     differ += resumed.t[i] != whole.t[skip + i] || d.cwiseAbs().maxCoeff() != 0.0;
     largest = std::max(largest, d.cwiseAbs().maxCoeff());
   }
-  std::printf("[ info ] resumed at t = %.6g: %zu steps after it, %zu differ (largest difference %.3g)\n",
-              saved.state.t, resumed.t.size(), differ, largest);
+  std::printf("[ info ] resumed at t = %.6g: %zu steps after it, %zu differ (largest difference %.3g)\n", saved.state.t,
+              resumed.t.size(), differ, largest);
   EXPECT_EQ(differ, 0u);
   EXPECT_EQ(rest.steps, all.steps);
   EXPECT_EQ(rest.rejected_by_error, all.rejected_by_error);

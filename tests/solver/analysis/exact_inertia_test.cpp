@@ -36,10 +36,11 @@ const double kEI = kE * M_PI / 4 * (std::pow(kRo, 4) - std::pow(kRi, 4));
 const double kRhoA = kRho * M_PI * (kRo * kRo - kRi * kRi);
 
 Superelement Tube(const std::string& frame, bool invariants = true) {
-  std::string yaml = test::StraightBeamYaml(kL, 40, "{shape: tube, outer_radius: 0.01, wall: 0.001}",
-                                             "{E: 70.0e9, nu: 0.3, rho: 2700}", "[{name: A}, {name: B}]",
-                                             std::string("reduction: {internal_modes: 4, geometric_stiffening: ") +
-                                                 (invariants ? "true" : "false") + ", floating_frame: '" + frame + "'}\n");
+  std::string yaml =
+      test::StraightBeamYaml(kL, 40, "{shape: tube, outer_radius: 0.01, wall: 0.001}",
+                             "{E: 70.0e9, nu: 0.3, rho: 2700}", "[{name: A}, {name: B}]",
+                             std::string("reduction: {internal_modes: 4, geometric_stiffening: ") +
+                                 (invariants ? "true" : "false") + ", floating_frame: '" + frame + "'}\n");
   yaml.replace(yaml.find("beam:\n"), 6, "beam:\n  theory: euler_bernoulli\n");  // as the 1-D reference
   return test::Reduce(yaml);
 }
@@ -73,7 +74,8 @@ TEST(ExactInertia, ForceIsTheLagrangianDerivativeAndMatchesItsMatrices) {
       BodyConfiguration p = c;
       for (int k = 0; k < N; ++k) {
         p.x[k] += h * w.segment<3>(6 * k) + 0.5 * h * h * wdot.segment<3>(6 * k);
-        p.R[k] = ExpSO3(Eigen::Vector3d(h * w.segment<3>(6 * k + 3) + 0.5 * h * h * wdot.segment<3>(6 * k + 3))) * p.R[k];
+        p.R[k] =
+            ExpSO3(Eigen::Vector3d(h * w.segment<3>(6 * k + 3) + 0.5 * h * h * wdot.segment<3>(6 * k + 3))) * p.R[k];
       }
       p.eta += h * w.tail(body.n_modes()) + 0.5 * h * h * wdot.tail(body.n_modes());
       return body.KineticEnergy(p, body.SolveFrame(p, f0), w + h * wdot);
@@ -216,10 +218,12 @@ TEST(ExactInertia, OneRotatingBodyFollowsSouthwell) {
           const double expected = std::sqrt(reference::RotatingBeamOmega2(kEI, kRhoA, kL, Omega, in_plane, hinged));
           const double measured = LinearizedOmega(exact, Omega, in_plane, hinged);
           const double thesis_value = LinearizedOmega(corotational, Omega, in_plane, hinged);
-          std::printf("[ info ] %-15s %-7s %-9s Omega = %.1f omega_0: %9.3f rad/s, 1-D %9.3f (%+.3f%%); corotational %+.1f%%\n",
-                      frame, hinged ? "hinged" : "clamped", in_plane ? "in-plane" : "flapwise", ratio, measured,
-                      expected, 100 * (measured / expected - 1), 100 * (thesis_value / expected - 1));
-          EXPECT_NEAR(measured, expected, 0.01 * expected) << frame << (in_plane ? " in-plane " : " flapwise ") << ratio;
+          std::printf(
+              "[ info ] %-15s %-7s %-9s Omega = %.1f omega_0: %9.3f rad/s, 1-D %9.3f (%+.3f%%); corotational %+.1f%%\n",
+              frame, hinged ? "hinged" : "clamped", in_plane ? "in-plane" : "flapwise", ratio, measured, expected,
+              100 * (measured / expected - 1), 100 * (thesis_value / expected - 1));
+          EXPECT_NEAR(measured, expected, 0.01 * expected)
+              << frame << (in_plane ? " in-plane " : " flapwise ") << ratio;
         }
       }
     }
@@ -242,7 +246,8 @@ TEST(ExactInertia, CompressedCantileverInOneBodyMatchesTheOneDimensionalModel) {
     const ModalResult modes = LinearizedModes(model, state, 1.0, 1);
     ASSERT_TRUE(modes.ok) << modes.message;
     const double measured = 2 * M_PI * modes.frequencies_hz[0];
-    const double expected = std::sqrt(reference::RotatingBeamOmega2(kEI, kRhoA, kL, 0.0, false, false, -fraction * P_cr));
+    const double expected =
+        std::sqrt(reference::RotatingBeamOmega2(kEI, kRhoA, kL, 0.0, false, false, -fraction * P_cr));
     std::printf("[ info ] P = %.1f P_cr: omega_1 %.4f rad/s, 1-D %.4f (%+.3f%%)\n", fraction, measured, expected,
                 100 * (measured / expected - 1));
     EXPECT_NEAR(measured, expected, 0.01 * expected);

@@ -17,7 +17,8 @@ Superelement Tube(int modes) {
       "name: tube\ntype: beam\nmaterial: {E: 70.0e9, nu: 0.3, rho: 2700}\n"
       "section: {shape: tube, outer_radius: 0.01, wall: 0.001}\n"
       "beam:\n  points: {A: [0, 0, 0], B: [1, 0, 0]}\n  segments: [{from: A, to: B, elements: 10}]\n"
-      "interfaces: [{name: A}, {name: B}]\nreduction: {internal_modes: " + std::to_string(modes) + ", geometric_stiffening: false}\n");
+      "interfaces: [{name: A}, {name: B}]\nreduction: {internal_modes: " +
+      std::to_string(modes) + ", geometric_stiffening: false}\n");
 }
 
 // One tube body on nodes A (x = 0, clamped) and B (x = 1).
@@ -65,7 +66,8 @@ TEST(FlexibleDynamics, ClampedBodyRingsAtTheReducedModelsFirstFrequency) {
   for (size_t i = 1; i < y_hist.size(); ++i) {
     if (y_hist[i] < -0.5 * amplitude) armed = true;
     if (armed && y_hist[i - 1] < 0 && y_hist[i] >= 0) {
-      up_crossings.push_back(t_hist[i - 1] + (t_hist[i] - t_hist[i - 1]) * (-y_hist[i - 1]) / (y_hist[i] - y_hist[i - 1]));
+      up_crossings.push_back(t_hist[i - 1] +
+                             (t_hist[i] - t_hist[i - 1]) * (-y_hist[i - 1]) / (y_hist[i] - y_hist[i - 1]));
       armed = false;
     }
   }
@@ -117,9 +119,11 @@ TEST(FlexibleDynamics, FreeSpinningFlexibleBodyConservesEnergyAndMomentum) {
                   e.dL = std::max(e.dL, r.linear_momentum.norm());
                   e.max_elastic = std::max(e.max_elastic, r.elastic_energy);
                 }).ok);
-    std::printf("[ info ] free spin, %s, %d steps/turn: energy %.2e, angular momentum %.2e, linear momentum %.2e kg m/s, "
-                "max elastic energy %.3e J of %.3e J\n",
-                integrator == Integrator::kMidpoint ? "midpoint" : "generalized-alpha", steps_per_turn, e.dE, e.dH, e.dL, e.max_elastic, E0);
+    std::printf(
+        "[ info ] free spin, %s, %d steps/turn: energy %.2e, angular momentum %.2e, linear momentum %.2e kg m/s, "
+        "max elastic energy %.3e J of %.3e J\n",
+        integrator == Integrator::kMidpoint ? "midpoint" : "generalized-alpha", steps_per_turn, e.dE, e.dH, e.dL,
+        e.max_elastic, E0);
     return e;
   };
   const Errors coarse = run(200, Integrator::kGeneralizedAlpha), fine = run(400, Integrator::kGeneralizedAlpha);
@@ -191,12 +195,13 @@ TEST(FlexibleDynamics, ReuseWithinTheStepGivesTheSameMotionWithOneFactorizationP
   const Eigen::Vector3d a = run(JacobianReuse::kNone, &full), b = run(JacobianReuse::kStep, &step);
   const Eigen::Vector3d c = run(std::nullopt, &unset);
   ASSERT_TRUE(full.ok && step.ok && unset.ok);
-  std::printf("[ info ] full Newton: %ld steps, %ld iterations, %ld factorizations; within the step: %ld iterations, "
-              "%ld factorizations\n",
-              full.steps, full.newton_iterations, full.factorizations, step.newton_iterations, step.factorizations);
-  EXPECT_GT(full.newton_iterations, full.steps);  // the steps do iterate: the test has something to show
+  std::printf(
+      "[ info ] full Newton: %ld steps, %ld iterations, %ld factorizations; within the step: %ld iterations, "
+      "%ld factorizations\n",
+      full.steps, full.newton_iterations, full.factorizations, step.newton_iterations, step.factorizations);
+  EXPECT_GT(full.newton_iterations, full.steps);              // the steps do iterate: the test has something to show
   EXPECT_LT((a - b).norm(), 1e-8 * std::max(1.0, a.norm()));  // same converged motion
-  EXPECT_EQ(step.factorizations, step.steps);                  // every step factors once (all contract)
+  EXPECT_EQ(step.factorizations, step.steps);                 // every step factors once (all contract)
   EXPECT_LT(step.factorizations, full.factorizations);
   EXPECT_EQ((b - c).norm(), 0.0);  // generalized-alpha's default is kStep
 }

@@ -9,8 +9,8 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <functional>
 #include <fstream>
+#include <functional>
 
 #include "formats/part_file.h"
 #include "formats/reduced_polynomial.h"
@@ -34,10 +34,10 @@ const double kA = M_PI * (kRo * kRo - kRi * kRi);
 
 Superelement Tube(int internal_modes, bool stiffening, const std::string& frame = "center_of_mass") {
   std::string yaml = test::StraightBeamYaml(kL, 40, "{shape: tube, outer_radius: 0.01, wall: 0.001}",
-                                             "{E: 70.0e9, nu: 0.3, rho: 2700}", "[{name: A}, {name: B}]",
-                                             "reduction: {internal_modes: " + std::to_string(internal_modes) +
-                                                 ", geometric_stiffening: " + (stiffening ? "true" : "false") +
-                                                 ", floating_frame: '" + frame + "'}\n");
+                                            "{E: 70.0e9, nu: 0.3, rho: 2700}", "[{name: A}, {name: B}]",
+                                            "reduction: {internal_modes: " + std::to_string(internal_modes) +
+                                                ", geometric_stiffening: " + (stiffening ? "true" : "false") +
+                                                ", floating_frame: '" + frame + "'}\n");
   yaml.replace(yaml.find("beam:\n"), 6, "beam:\n  theory: euler_bernoulli\n");  // as the closed forms
   return test::Reduce(yaml);
 }
@@ -81,8 +81,12 @@ TEST(GeometricStiffening, InertiaLoadFactorsAndTheirDerivativesMatchFiniteDiffer
   for (int i = 0; i < n; ++i) {
     const double h = 1e-4;  // a is linear in wdot and quadratic in w: central differences are exact up to round-off
     const Eigen::VectorXd e = Eigen::VectorXd::Unit(n, i);
-    d_w.col(i) = (body.InertiaLoads(c, frame, w + h * e, wdot, g).a - body.InertiaLoads(c, frame, w - h * e, wdot, g).a) / (2 * h);
-    d_wdot.col(i) = (body.InertiaLoads(c, frame, w, wdot + h * e, g).a - body.InertiaLoads(c, frame, w, wdot - h * e, g).a) / (2 * h);
+    d_w.col(i) =
+        (body.InertiaLoads(c, frame, w + h * e, wdot, g).a - body.InertiaLoads(c, frame, w - h * e, wdot, g).a) /
+        (2 * h);
+    d_wdot.col(i) =
+        (body.InertiaLoads(c, frame, w, wdot + h * e, g).a - body.InertiaLoads(c, frame, w, wdot - h * e, g).a) /
+        (2 * h);
   }
   EXPECT_LT((load.d_w - d_w).norm(), 1e-9 * d_w.norm());
   EXPECT_LT((load.d_wdot - d_wdot).norm(), 1e-9 * d_wdot.norm());
@@ -112,8 +116,10 @@ TEST(GeometricStiffening, InertiaLoadFactorsAndTheirDerivativesMatchFiniteDiffer
       const double e = side == 0 ? h : -h;
       if (i < 6 * body.n_nodes()) {
         const int a = i / 6, k = i % 6;
-        if (k < 3) p.x[a][k] += e;
-        else p.R[a] = ExpSO3(e * Eigen::Vector3d::Unit(k - 3)) * p.R[a];
+        if (k < 3)
+          p.x[a][k] += e;
+        else
+          p.R[a] = ExpSO3(e * Eigen::Vector3d::Unit(k - 3)) * p.R[a];
       } else {
         p.eta[i - 6 * body.n_nodes()] += e;
       }
@@ -272,8 +278,9 @@ TEST(GeometricStiffening, CondensedPolynomialIsABoundedEnergysGradient) {
 // to stiffen: asked for the stiffening, it reduces (it used to stop with "the polynomial internal
 // force's linear part differs from K_r by 1": both are round-off) and stores none.
 TEST(GeometricStiffening, RigidBasisReducesAndStoresNone) {
-  const std::string yaml = test::StraightBeamYaml(0.3, 4, "{shape: circle, diameter: 0.01}", "{E: 2.0e11, nu: 0.3, rho: 7800}",
-                                                  "[{name: A}]", "reduction: {internal_modes: 0, geometric_stiffening: true, "
+  const std::string yaml = test::StraightBeamYaml(0.3, 4, "{shape: circle, diameter: 0.01}",
+                                                  "{E: 2.0e11, nu: 0.3, rho: 7800}", "[{name: A}]",
+                                                  "reduction: {internal_modes: 0, geometric_stiffening: true, "
                                                   "floating_frame: 'interface:A'}\n");
   const ReduceResult r = ReducePart(ParsePart(yaml, "rigid.yaml"), nullptr);
   ASSERT_TRUE(r.ok) << r.message;
@@ -294,7 +301,8 @@ TEST(GeometricStiffening, MidpointUsesAStiffenedFileLinearUnlessAsked) {
     const std::string path = dir + "/scene.yaml";
     std::ofstream(path) << "name: s\nunits: SI\nbodies:\n  - {name: tube, superelement: tube.h5, nodes: {A: a, B: b}"
                         << options << "}\njoints:\n  - {type: revolute, node: a, axis: [0, 0, 1]}\n"
-                        << "analysis: {type: dynamic, end_time: 0.01, step: 1.0e-3, integrator: " << integrator << "}\n";
+                        << "analysis: {type: dynamic, end_time: 0.01, step: 1.0e-3, integrator: " << integrator
+                        << "}\n";
     return BuildScene(ReadSceneFile(path));
   };
   auto noted = [](const Scene& s, const std::string& text) {

@@ -41,16 +41,17 @@ const char* kLeaf =
 std::string SceneText(const std::string& file, const std::string& internal_force, double z = 0.00025,
                       double y = 0.005) {
   char text[1500];
-  std::snprintf(text, sizeof text,
-                "name: leaf_guided\nunits: SI\nbodies:\n"
-                "  - {name: leaf, superelement: %s, nodes: {A: a, B: b}, options: {internal_force: %s}}\n"
-                "  - {name: carriage, type: rigid, mass: 1.0e-6, center_of_mass: [0, 0, 0], inertia: [1e-12, 1e-12, 1e-12],\n"
-                "     points: {P: [0, 0, 0]}, placement: {position: [0.05, %.17g, %.17g]}, nodes: {P: p}}\n"
-                "joints:\n  - {type: clamp, node: a}\n  - {type: prismatic, node: p, axis: [0, 0, 1]}\n"
-                "  - {type: prismatic, node: b, parent: p, axis: [1, 0, 0]}\n"
-                "loads:\n  - {type: force, node: b, force: [0, 0, %.17g]}\n"
-                "analysis: {type: static, end_time: 1, steps: %d}\n",
-                file.c_str(), internal_force.c_str(), y, z, kForce, kSteps);
+  std::snprintf(
+      text, sizeof text,
+      "name: leaf_guided\nunits: SI\nbodies:\n"
+      "  - {name: leaf, superelement: %s, nodes: {A: a, B: b}, options: {internal_force: %s}}\n"
+      "  - {name: carriage, type: rigid, mass: 1.0e-6, center_of_mass: [0, 0, 0], inertia: [1e-12, 1e-12, 1e-12],\n"
+      "     points: {P: [0, 0, 0]}, placement: {position: [0.05, %.17g, %.17g]}, nodes: {P: p}}\n"
+      "joints:\n  - {type: clamp, node: a}\n  - {type: prismatic, node: p, axis: [0, 0, 1]}\n"
+      "  - {type: prismatic, node: b, parent: p, axis: [1, 0, 0]}\n"
+      "loads:\n  - {type: force, node: b, force: [0, 0, %.17g]}\n"
+      "analysis: {type: static, end_time: 1, steps: %d}\n",
+      file.c_str(), internal_force.c_str(), y, z, kForce, kSteps);
   return text;
 }
 
@@ -82,7 +83,8 @@ TEST(LeafSpring, OneBodyWithModalDerivativesMatchesTheFullNonlinearModel) {
   std::filesystem::create_directories(dir);
   const PartSpec part = ParsePart(kLeaf, "leaf.yaml");
   for (const std::string frame : {"interface:A", "center_of_mass"}) {
-    const ReduceResult reduced = ReducePart(ParsePart(kLeaf, "leaf.yaml", {"reduction.floating_frame=" + frame}), nullptr);
+    const ReduceResult reduced =
+        ReducePart(ParsePart(kLeaf, "leaf.yaml", {"reduction.floating_frame=" + frame}), nullptr);
     ASSERT_TRUE(reduced.ok) << reduced.message;
     WriteSuperelementFile(reduced.superelement, dir + "/leaf_" + frame.substr(0, 4) + ".h5");
     std::printf("[ info ] superelement (frame %s): %d coordinates (%ld modal derivatives)\n", frame.c_str(),
@@ -106,17 +108,21 @@ TEST(LeafSpring, OneBodyWithModalDerivativesMatchesTheFullNonlinearModel) {
   const Curve com = Reduced(dir, "leaf_cent.h5", "polynomial");
   ASSERT_EQ(poly.deflection.size(), size_t(kSteps));
   ASSERT_EQ(linear.deflection.size(), size_t(kSteps));
-  std::printf("[ info ]  F [N]   full: w, shortening [mm]   1 body + derivatives: error w, s   linear body: error w, s"
-              "   centre-of-mass frame: error w, s\n");
+  std::printf(
+      "[ info ]  F [N]   full: w, shortening [mm]   1 body + derivatives: error w, s   linear body: error w, s"
+      "   centre-of-mass frame: error w, s\n");
   double worst_poly = 0, worst_linear_s = 0;
   for (int s = 0; s < kSteps; ++s) {
     const double w = full.u[size_t(s)][model.interface_dofs[1][2].value];
     const double sh = -full.u[size_t(s)][model.interface_dofs[1][0].value];
     const double ew = std::abs(poly.deflection[size_t(s)] - w) / w, es = std::abs(poly.shortening[size_t(s)] - sh) / sh;
-    const double lw = std::abs(linear.deflection[size_t(s)] - w) / w, ls = std::abs(linear.shortening[size_t(s)] - sh) / sh;
+    const double lw = std::abs(linear.deflection[size_t(s)] - w) / w,
+                 ls = std::abs(linear.shortening[size_t(s)] - sh) / sh;
     const double cw = std::abs(com.deflection[size_t(s)] - w) / w, cs = std::abs(com.shortening[size_t(s)] - sh) / sh;
-    std::printf("[ info ]  %5.1f   %7.4f  %7.5f            %6.2f%%  %6.2f%%               %6.2f%%  %6.2f%%          %6.2f%%  %6.2f%%\n",
-                kForce * (s + 1) / kSteps, 1e3 * w, 1e3 * sh, 100 * ew, 100 * es, 100 * lw, 100 * ls, 100 * cw, 100 * cs);
+    std::printf(
+        "[ info ]  %5.1f   %7.4f  %7.5f            %6.2f%%  %6.2f%%               %6.2f%%  %6.2f%%          %6.2f%%  "
+        "%6.2f%%\n",
+        kForce * (s + 1) / kSteps, 1e3 * w, 1e3 * sh, 100 * ew, 100 * es, 100 * lw, 100 * ls, 100 * cw, 100 * cs);
     worst_poly = std::max({worst_poly, ew, es});
     worst_linear_s = std::max(worst_linear_s, ls);
   }
@@ -143,8 +149,8 @@ TEST(LeafSpring, OneBeamBodyWithModalDerivativesMatchesTheFullBeamModel) {
   ASSERT_TRUE(reduced.ok) << reduced.message;
   ASSERT_TRUE(reduced.superelement.polynomial.has_value());
   WriteSuperelementFile(reduced.superelement, dir + "/leaf_beam.h5");
-  std::printf("[ info ] beam superelement: %d coordinates (%ld modal derivatives)\n", reduced.superelement.n_reduced_dofs(),
-              reduced.superelement.n_modal_derivatives);
+  std::printf("[ info ] beam superelement: %d coordinates (%ld modal derivatives)\n",
+              reduced.superelement.n_reduced_dofs(), reduced.superelement.n_modal_derivatives);
   const VonKarmanBeams beams(part);
   std::vector<int> held;
   for (int d = 0; d < 6; ++d) held.push_back(d);
@@ -154,15 +160,18 @@ TEST(LeafSpring, OneBeamBodyWithModalDerivativesMatchesTheFullBeamModel) {
   const NonlinearStaticResult full =
       SolveNonlinearStatic(beams, SparseMatrix(), held, Eigen::VectorXd::Zero(long(held.size())), f, kSteps);
   ASSERT_TRUE(full.converged) << full.message;
-  const Curve poly = Reduced(dir, "leaf_beam.h5", "polynomial", 0.0, 0.0), linear = Reduced(dir, "leaf_beam.h5", "linear", 0.0, 0.0);
+  const Curve poly = Reduced(dir, "leaf_beam.h5", "polynomial", 0.0, 0.0),
+              linear = Reduced(dir, "leaf_beam.h5", "linear", 0.0, 0.0);
   double worst = 0, worst_linear_s = 0;
   for (int s = 0; s < kSteps; ++s) {
     const double w = full.u[size_t(s)][6 + 2], sh = -full.u[size_t(s)][6];
-    worst = std::max({worst, std::abs(poly.deflection[size_t(s)] - w) / w, std::abs(poly.shortening[size_t(s)] - sh) / sh});
+    worst =
+        std::max({worst, std::abs(poly.deflection[size_t(s)] - w) / w, std::abs(poly.shortening[size_t(s)] - sh) / sh});
     worst_linear_s = std::max(worst_linear_s, std::abs(linear.shortening[size_t(s)] - sh) / sh);
   }
-  std::printf("[ info ] beam leaf, one body with modal derivatives: largest error %.3f%% (linear body: shortening %.1f%%)\n",
-              100 * worst, 100 * worst_linear_s);
+  std::printf(
+      "[ info ] beam leaf, one body with modal derivatives: largest error %.3f%% (linear body: shortening %.1f%%)\n",
+      100 * worst, 100 * worst_linear_s);
   EXPECT_LT(worst, 0.02);
   EXPECT_GT(worst_linear_s, 0.5);
 }

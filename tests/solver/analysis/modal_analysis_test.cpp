@@ -23,7 +23,9 @@ SystemModel Chain(int n_bodies, double axial_force) {
   const Superelement se = test::Reduce(
       "name: seg\ntype: beam\nmaterial: {E: 70.0e9, nu: 0.3, rho: 2700}\n"
       "section: {shape: tube, outer_radius: 0.01, wall: 0.001}\n"
-      "beam:\n  theory: euler_bernoulli\n  points: {A: [0, 0, 0], B: [" + std::to_string(Lb) + ", 0, 0]}\n"
+      "beam:\n  theory: euler_bernoulli\n  points: {A: [0, 0, 0], B: [" +
+      std::to_string(Lb) +
+      ", 0, 0]}\n"
       "  segments: [{from: A, to: B, elements: 4}]\n"
       "interfaces: [{name: A}, {name: B}]\nreduction: {internal_modes: 2}\n");
   SystemModel model;

@@ -67,10 +67,13 @@ TEST(NewtonScale, EachUnknownIsJudgedByTheBodiesActingOnIt) {
   const int mid = 3;  // rod_mid: a free node between the two rod bodies
   double rod_largest = 0.0;
   for (int b = 1; b <= 2; ++b)
-    for (int m = 0; m < model.bodies[size_t(b)].n_modes(); ++m) rod_largest = std::max(rod_largest, a.dof_scale[dofs.mode_dof(b) + m]);
-  for (int k = 0; k < dofs.node_count(mid); ++k) rod_largest = std::max(rod_largest, a.dof_scale[dofs.node_first(mid) + k]);
+    for (int m = 0; m < model.bodies[size_t(b)].n_modes(); ++m)
+      rod_largest = std::max(rod_largest, a.dof_scale[dofs.mode_dof(b) + m]);
+  for (int k = 0; k < dofs.node_count(mid); ++k)
+    rod_largest = std::max(rod_largest, a.dof_scale[dofs.node_first(mid) + k]);
   double crank_smallest = HUGE_VAL;
-  for (int m = 0; m < model.bodies[0].n_modes(); ++m) crank_smallest = std::min(crank_smallest, a.dof_scale[dofs.mode_dof(0) + m]);
+  for (int m = 0; m < model.bodies[0].n_modes(); ++m)
+    crank_smallest = std::min(crank_smallest, a.dof_scale[dofs.mode_dof(0) + m]);
   std::printf("[ info ] scales: the whole model %.3e N, the crank's modes %.3e N, the rod's unknowns at most %.3e N\n",
               a.scale, crank_smallest, rod_largest);
   EXPECT_EQ(crank_smallest, a.scale);
@@ -89,8 +92,10 @@ TEST(NewtonScale, StaticsJudgesEachUnknownByItsBodiesToo) {
   ASSERT_EQ(f.dof_scale.size(), dofs.n_dofs());
   double rod_largest = 0.0, crank_smallest = HUGE_VAL;
   for (int b = 1; b <= 2; ++b)
-    for (int m = 0; m < model.bodies[size_t(b)].n_modes(); ++m) rod_largest = std::max(rod_largest, f.dof_scale[dofs.mode_dof(b) + m]);
-  for (int m = 0; m < model.bodies[0].n_modes(); ++m) crank_smallest = std::min(crank_smallest, f.dof_scale[dofs.mode_dof(0) + m]);
+    for (int m = 0; m < model.bodies[size_t(b)].n_modes(); ++m)
+      rod_largest = std::max(rod_largest, f.dof_scale[dofs.mode_dof(b) + m]);
+  for (int m = 0; m < model.bodies[0].n_modes(); ++m)
+    crank_smallest = std::min(crank_smallest, f.dof_scale[dofs.mode_dof(0) + m]);
   std::printf("[ info ] static scales: the crank's modes %.3e N, the rod's modes at most %.3e N\n", crank_smallest,
               rod_largest);
   EXPECT_GT(rod_largest, 0.0);

@@ -23,10 +23,12 @@ Superelement Jack(const std::string& node = "C") {
   return test::Reduce(
       "name: jack\ntype: beam\nmaterial: {E: 2.0e11, nu: 0.3, rho: 7800}\n"
       "section: {shape: circle, diameter: 0.01}\n"
-      "beam:\n  points: {C: [0, 0, 0], A: [0.3, 0, 0], B: [0, 0.2, 0], D: [0, 0, 0.1], E: [-0.3, 0, 0], F: [0, -0.2, 0], G: [0, 0, -0.1]}\n"
+      "beam:\n  points: {C: [0, 0, 0], A: [0.3, 0, 0], B: [0, 0.2, 0], D: [0, 0, 0.1], E: [-0.3, 0, 0], F: [0, -0.2, "
+      "0], G: [0, 0, -0.1]}\n"
       "  segments: [{from: C, to: A, elements: 4}, {from: C, to: B, elements: 4}, {from: C, to: D, elements: 2},\n"
       "             {from: C, to: E, elements: 4}, {from: C, to: F, elements: 4}, {from: C, to: G, elements: 2}]\n"
-      "interfaces: [{name: " + node + "}]\nreduction: {internal_modes: 0, floating_frame: 'interface:" + node + "'}\n");
+      "interfaces: [{name: " +
+      node + "}]\nreduction: {internal_modes: 0, floating_frame: 'interface:" + node + "'}\n");
 }
 
 struct FlightErrors {
@@ -112,10 +114,11 @@ TEST(RigidBodyDynamics, MidpointSchemeConservesEnergyAndMomentumExactly) {
     const FlightErrors fine = FreeFlight(se, omega0, period / 200, 2000, 1.0, none, Integrator::kMidpoint);
     // Tight tolerance: round-off.
     const FlightErrors tight = FreeFlight(se, omega0, period / 100, 1000, 1.0, none, Integrator::kMidpoint, 1e-12);
-    std::printf("[ info ] midpoint, node %s: 100 steps/rev: energy %.3e momentum %.3e; 200 steps/rev: energy %.3e "
-                "momentum %.3e; 100 steps/rev, Newton to 1e-12: energy %.3e momentum %.3e\n",
-                node.c_str(), coarse.energy_error, coarse.momentum_error, fine.energy_error, fine.momentum_error,
-                tight.energy_error, tight.momentum_error);
+    std::printf(
+        "[ info ] midpoint, node %s: 100 steps/rev: energy %.3e momentum %.3e; 200 steps/rev: energy %.3e "
+        "momentum %.3e; 100 steps/rev, Newton to 1e-12: energy %.3e momentum %.3e\n",
+        node.c_str(), coarse.energy_error, coarse.momentum_error, fine.energy_error, fine.momentum_error,
+        tight.energy_error, tight.momentum_error);
     for (const FlightErrors& run : {coarse, fine}) {
       EXPECT_LT(run.energy_error, 1e-6);
       EXPECT_LT(run.momentum_error, 1e-6);
@@ -174,39 +177,41 @@ TEST(RigidBodyDynamics, HeavySymmetricTopPrecessesAtTheAnalyticRate) {
   const Eigen::Vector3d omega = Omega_p * z + psidot * axis;
 
   auto precession = [&](int steps_per_precession, double* nutation, Integrator integrator) {
-  SystemModel model;
-  AddNode(model, "P", Eigen::Vector3d::Zero(), R0);
-  Pin(model, 0);
-  model.bodies.emplace_back(se, SuperelementOptions{}, R0, Eigen::Vector3d::Zero());
-  model.body_nodes.push_back({0});
-  model.gravity = Eigen::Vector3d(0, 0, -g);
-  Eigen::VectorXd W(3);
-  W << omega;
-  DynamicState s = InitialDynamicState(model, InitialState(model), W);
-  DynamicOptions options;
-  const double precession_period = 2 * M_PI / Omega_p;
-  options.step = precession_period / steps_per_precession;
-  options.end_time = 0.25 * precession_period;
-  options.rho_inf = 1.0;
-  options.integrator = integrator;
-  double max_nutation = 0;
-  EXPECT_TRUE(SolveDynamic(model, s, options, [&](const DynamicStepReport&, const DynamicState& st) {
-                const Eigen::Vector3d a = st.config.R[0] * Eigen::Vector3d::UnitZ();
-                max_nutation = std::max(max_nutation, std::abs(std::acos(a.z()) - theta));
-              }).ok);
-  const Eigen::Vector3d a = s.config.R[0] * Eigen::Vector3d::UnitZ();
-  const Eigen::Vector3d a0 = axis;
-  const double azimuth = std::atan2(a.y(), a.x()) - std::atan2(a0.y(), a0.x());
-  *nutation = max_nutation;
-  return azimuth / s.t;
+    SystemModel model;
+    AddNode(model, "P", Eigen::Vector3d::Zero(), R0);
+    Pin(model, 0);
+    model.bodies.emplace_back(se, SuperelementOptions{}, R0, Eigen::Vector3d::Zero());
+    model.body_nodes.push_back({0});
+    model.gravity = Eigen::Vector3d(0, 0, -g);
+    Eigen::VectorXd W(3);
+    W << omega;
+    DynamicState s = InitialDynamicState(model, InitialState(model), W);
+    DynamicOptions options;
+    const double precession_period = 2 * M_PI / Omega_p;
+    options.step = precession_period / steps_per_precession;
+    options.end_time = 0.25 * precession_period;
+    options.rho_inf = 1.0;
+    options.integrator = integrator;
+    double max_nutation = 0;
+    EXPECT_TRUE(SolveDynamic(model, s, options, [&](const DynamicStepReport&, const DynamicState& st) {
+                  const Eigen::Vector3d a = st.config.R[0] * Eigen::Vector3d::UnitZ();
+                  max_nutation = std::max(max_nutation, std::abs(std::acos(a.z()) - theta));
+                }).ok);
+    const Eigen::Vector3d a = s.config.R[0] * Eigen::Vector3d::UnitZ();
+    const Eigen::Vector3d a0 = axis;
+    const double azimuth = std::atan2(a.y(), a.x()) - std::atan2(a0.y(), a0.x());
+    *nutation = max_nutation;
+    return azimuth / s.t;
   };
   for (Integrator integrator : {Integrator::kGeneralizedAlpha, Integrator::kMidpoint}) {
     double nutation_coarse, nutation_fine;
     const double coarse = precession(2000, &nutation_coarse, integrator);
     const double fine = precession(8000, &nutation_fine, integrator);
-    std::printf("[ info ] precession (%s): analytic %.6f rad/s, femb %.6f (55 steps per spin turn), %.6f (220); "
-                "nutation %.2e, %.2e rad\n", integrator == Integrator::kMidpoint ? "midpoint" : "generalized-alpha",
-                Omega_p, coarse, fine, nutation_coarse, nutation_fine);
+    std::printf(
+        "[ info ] precession (%s): analytic %.6f rad/s, femb %.6f (55 steps per spin turn), %.6f (220); "
+        "nutation %.2e, %.2e rad\n",
+        integrator == Integrator::kMidpoint ? "midpoint" : "generalized-alpha", Omega_p, coarse, fine, nutation_coarse,
+        nutation_fine);
     // Time discretization error, second order in the spin step: within 0.05% at 220 steps per
     // spin revolution and shrinking ~16x from 55 steps.
     EXPECT_NEAR(fine, Omega_p, 5e-4 * Omega_p);

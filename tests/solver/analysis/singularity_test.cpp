@@ -64,7 +64,8 @@ TEST(Singularity, RevoluteSupportLeavesTheRotationAboutItsAxis) {
   SystemState s = InitialState(model);
   const StaticResult r = SolveStatic(model, s, StaticOptions{});
   EXPECT_FALSE(r.ok);
-  EXPECT_NE(r.message.find("static tangent at the start: the system matrix is singular"), std::string::npos) << r.message;
+  EXPECT_NE(r.message.find("static tangent at the start: the system matrix is singular"), std::string::npos)
+      << r.message;
 }
 
 // Units do not count: the same regular system scaled (translations in mm, say) stays regular

@@ -30,7 +30,9 @@ SpinUpResult SpinUp(double ws, int n_bodies, double end_time) {
   const Superelement se = test::Reduce(
       "name: seg\ntype: beam\nmaterial: {E: 7.0e10, nu: 0.3, rho: 3000}\n"
       "section: {shape: general, A: 4.0e-4, Iy: 2.0e-7, Iz: 2.0e-7, J: 4.0e-7}\n"
-      "beam:\n  points: {A: [0, 0, 0], B: [" + std::to_string(Lb) + ", 0, 0]}\n"
+      "beam:\n  points: {A: [0, 0, 0], B: [" +
+      std::to_string(Lb) +
+      ", 0, 0]}\n"
       "  segments: [{from: A, to: B, elements: 4}]\n"
       "interfaces: [{name: A}, {name: B}]\nreduction: {internal_modes: 2}\n");
   SystemModel model;
@@ -56,14 +58,15 @@ SpinUpResult SpinUp(double ws, int n_bodies, double end_time) {
   options.end_time = end_time;
   options.rho_inf = 0.5;
   SpinUpResult r;
-  const DynamicResult result = SolveDynamic(model, s, options, [&](const DynamicStepReport& rep, const DynamicState& st) {
-    const Eigen::Vector3d rel = st.config.x[n_bodies] - st.config.x[0];
-    const double tip = (st.config.R[0] * Eigen::Vector3d::UnitY()).dot(rel);  // in the hub frame
-    r.max_tip = std::max(r.max_tip, std::abs(tip));
-    if (rep.t > 17.0) r.late_tip = std::max(r.late_tip, std::abs(tip));
-    r.hub_angle = st.config.z[0][0];
-    r.kinetic = rep.kinetic_energy;
-  });
+  const DynamicResult result =
+      SolveDynamic(model, s, options, [&](const DynamicStepReport& rep, const DynamicState& st) {
+        const Eigen::Vector3d rel = st.config.x[n_bodies] - st.config.x[0];
+        const double tip = (st.config.R[0] * Eigen::Vector3d::UnitY()).dot(rel);  // in the hub frame
+        r.max_tip = std::max(r.max_tip, std::abs(tip));
+        if (rep.t > 17.0) r.late_tip = std::max(r.late_tip, std::abs(tip));
+        r.hub_angle = st.config.z[0][0];
+        r.kinetic = rep.kinetic_energy;
+      });
   r.ok = result.ok;
   return r;
 }

@@ -131,7 +131,8 @@ double FullModelStretch(const FeModel& full) {
   Eigen::VectorXd u = Eigen::VectorXd::Zero(n);
   for (long i = 0; i < n; ++i)
     if (index[size_t(i)] >= 0) u[i] = u_free[index[size_t(i)]];
-  const Eigen::Vector3d u_A = (full.interface_weights[0] * u).head<3>(), u_B = (full.interface_weights[1] * u).head<3>();
+  const Eigen::Vector3d u_A = (full.interface_weights[0] * u).head<3>(),
+                        u_B = (full.interface_weights[1] * u).head<3>();
   const Eigen::Vector3d span = full.interface_positions[1] - full.interface_positions[0];
   return (span + u_B - u_A).norm() - span.norm();
 }
@@ -159,8 +160,8 @@ SystemModel SpinningBar(const Superelement& se, bool exact, bool tumble, Eigen::
 
 // The spinning bar (SpinningBar) from its undeformed start: the end-face centroids' positions
 // at every step.
-std::vector<std::array<Eigen::Vector3d, 2>> Spin(const Superelement& se, Integrator integrator, double end_time, double step,
-                                                 bool tumble, bool exact = true) {
+std::vector<std::array<Eigen::Vector3d, 2>> Spin(const Superelement& se, Integrator integrator, double end_time,
+                                                 double step, bool tumble, bool exact = true) {
   Eigen::VectorXd W;
   const SystemModel model = SpinningBar(se, exact, tumble, &W);
   DynamicState s = InitialDynamicState(model, InitialState(model), W);
@@ -217,8 +218,8 @@ TEST(SpinningPart, EveryPartStretchesAsTheUnreducedModel) {
   const Files files;
   const double full = FullModelStretch(BuildSolidModel(ReadPartFile((files.dir / "native.yaml").string())));
   const double closed_form = kRho * kOmega * kOmega / (12 * kE);
-  std::printf("[ info ] unreduced model's static stretch %.5e m, closed form (1-D) %.5e m (%+.2f%%)\n", full, closed_form,
-              100 * (closed_form / full - 1));
+  std::printf("[ info ] unreduced model's static stretch %.5e m, closed form (1-D) %.5e m (%+.2f%%)\n", full,
+              closed_form, 100 * (closed_form / full - 1));
   EXPECT_LT(std::abs(full / closed_form - 1), 0.01);
   for (const char* part : {"native.yaml", "imported.yaml"}) {
     for (const char* method : {"craig_bampton", "free_interface"}) {
@@ -243,8 +244,8 @@ TEST(SpinningPart, ImportedPartMovesAsFembsOwn) {
   for (const bool stiffened : {false, true}) {
     const std::string on = stiffened ? "true" : "false";
     const Superelement native = files.Reduce("native.yaml", {"reduction.geometric_stiffening=" + on});
-    const Superelement imported =
-        files.Reduce("imported.yaml", {"reduction.geometric_stiffening=" + on, "material={E: 2.1e11, nu: 0.3, rho: 7850}"});
+    const Superelement imported = files.Reduce(
+        "imported.yaml", {"reduction.geometric_stiffening=" + on, "material={E: 2.1e11, nu: 0.3, rho: 7850}"});
     ASSERT_EQ(imported.inertia_stiffness.empty(), !stiffened);
     // With the material, the imported part also recovers stresses with femb's elements: the same
     // modal stresses as the own part's (single precision; up to the signs of the fixed-interface
@@ -252,11 +253,13 @@ TEST(SpinningPart, ImportedPartMovesAsFembsOwn) {
     ASSERT_TRUE(imported.stress.has_value());
     ASSERT_TRUE(native.stress.has_value());
     const float scale = native.stress->modes.cwiseAbs().maxCoeff();
-    EXPECT_LT((imported.stress->modes.cwiseAbs() - native.stress->modes.cwiseAbs()).cwiseAbs().maxCoeff(), 1e-6f * scale);
+    EXPECT_LT((imported.stress->modes.cwiseAbs() - native.stress->modes.cwiseAbs()).cwiseAbs().maxCoeff(),
+              1e-6f * scale);
     ASSERT_EQ(imported.stress->inertia_modes.size(), native.stress->inertia_modes.size());
     if (stiffened) {
       const float inertia_scale = native.stress->inertia_modes.cwiseAbs().maxCoeff();
-      EXPECT_LT((imported.stress->inertia_modes - native.stress->inertia_modes).cwiseAbs().maxCoeff(), 1e-6f * inertia_scale);
+      EXPECT_LT((imported.stress->inertia_modes - native.stress->inertia_modes).cwiseAbs().maxCoeff(),
+                1e-6f * inertia_scale);
     }
     for (const Integrator integrator : {Integrator::kGeneralizedAlpha, Integrator::kMidpoint}) {
       const auto a = Spin(native, integrator, 2e-3, 1e-5, true), b = Spin(imported, integrator, 2e-3, 1e-5, true);
@@ -266,10 +269,11 @@ TEST(SpinningPart, ImportedPartMovesAsFembsOwn) {
         for (int k = 0; k < 2; ++k) worst = std::max(worst, (a[i][size_t(k)] - b[i][size_t(k)]).norm());
         stretch = std::max(stretch, std::abs((a[i][1] - a[i][0]).norm() - 1.0));
       }
-      std::printf("[ info ] %s, %s: imported against femb's own part: largest position difference %.2e m (largest stretch "
-                  "%.2e m)\n",
-                  stiffened ? "stiffened" : "linear", integrator == Integrator::kMidpoint ? "midpoint" : "generalized-alpha",
-                  worst, stretch);
+      std::printf(
+          "[ info ] %s, %s: imported against femb's own part: largest position difference %.2e m (largest stretch "
+          "%.2e m)\n",
+          stiffened ? "stiffened" : "linear", integrator == Integrator::kMidpoint ? "midpoint" : "generalized-alpha",
+          worst, stretch);
       EXPECT_LT(worst, 1e-8);
     }
   }
@@ -279,13 +283,16 @@ TEST(SpinningPart, ImportedPartMovesAsFembsOwn) {
 // with: one line each.
 TEST(SpinningPart, ImportedStiffeningRefusesAMissingOrWrongMaterial) {
   const Files files;
-  const std::string missing = test::ThrownMessage([&] { files.Reduce("imported.yaml", {"reduction.geometric_stiffening=true"}); });
-  EXPECT_NE(missing.find("geometric stiffening of imported matrices needs the part's material"), std::string::npos) << missing;
+  const std::string missing =
+      test::ThrownMessage([&] { files.Reduce("imported.yaml", {"reduction.geometric_stiffening=true"}); });
+  EXPECT_NE(missing.find("geometric stiffening of imported matrices needs the part's material"), std::string::npos)
+      << missing;
   const std::string wrong =
       test::ThrownMessage([&] { files.Reduce("imported.yaml", {"material={E: 2.0e11, nu: 0.3, rho: 7850}"}); });
-  EXPECT_NE(wrong.find("imported.yaml: material: femb's elements on the imported mesh with this material differ from the "
-                       "imported stiffness by 0.048"),
-            std::string::npos)
+  EXPECT_NE(
+      wrong.find("imported.yaml: material: femb's elements on the imported mesh with this material differ from the "
+                 "imported stiffness by 0.048"),
+      std::string::npos)
       << wrong;
 }
 
@@ -322,9 +329,10 @@ TEST(SpinningPart, MidpointConservesMomentumWithTheExactInertia) {
     });
     EXPECT_TRUE(r.ok) << r.message;
     EXPECT_EQ(r.newton_cuts, 0);
-    std::printf("[ info ] midpoint, %s inertia, 20 periods: energy %.2e, angular momentum %.2e, %.2f Newton iterations per "
-                "step\n",
-                exact ? "exact" : "corotational", dE, dH, double(iterations) / 2000.0);
+    std::printf(
+        "[ info ] midpoint, %s inertia, 20 periods: energy %.2e, angular momentum %.2e, %.2f Newton iterations per "
+        "step\n",
+        exact ? "exact" : "corotational", dE, dH, double(iterations) / 2000.0);
     EXPECT_LT(dH, 1e-8);  // a Newton tolerance of 1e-12 per step, 2 000 steps
     EXPECT_LT(iterations, 6 * 2000);
     (exact ? dE_exact : dE_corotational) = dE;

@@ -32,7 +32,7 @@ TEST(StepControl, StepsLandOnTheEndBreakpointsAndOutputTimes) {
   EXPECT_DOUBLE_EQ(c.Fit(0.2, 0.1), 0.05);  // lands on the breakpoint
   EXPECT_TRUE(c.at_breakpoint());
   EXPECT_DOUBLE_EQ(c.boundary(), 0.25);
-  EXPECT_DOUBLE_EQ(c.Fit(0.25, 0.1), 0.1);  // the breakpoint it stands on is behind it
+  EXPECT_DOUBLE_EQ(c.Fit(0.25, 0.1), 0.1);    // the breakpoint it stands on is behind it
   EXPECT_DOUBLE_EQ(c.Fit(0.55, 0.1), 0.075);  // two equal steps rather than a sliver
   EXPECT_FALSE(c.lands());
   EXPECT_DOUBLE_EQ(c.Fit(0.9, 0.5), 0.1);  // max_step, then the end

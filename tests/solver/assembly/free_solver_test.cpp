@@ -32,7 +32,8 @@ SystemMatrix Banded(int n, double diagonal, unsigned seed, int band = 8) {
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   Triplets t;
   for (int i = 0; i < n; ++i)
-    for (int j = std::max(0, i - band); j < std::min(n, i + band + 1); ++j) t.emplace_back(i, j, i == j ? diagonal + u(rng) : u(rng));
+    for (int j = std::max(0, i - band); j < std::min(n, i + band + 1); ++j)
+      t.emplace_back(i, j, i == j ? diagonal + u(rng) : u(rng));
   return ToMatrix(n, t);
 }
 
@@ -63,9 +64,12 @@ TEST(FreeSolver, SolvesOnTheFreeCoordinatesLikeADenseLU) {
   Eigen::VectorXd rf(dofs.solved().size());
   for (size_t i = 0; i < dofs.solved().size(); ++i) rf[Eigen::Index(i)] = r[dofs.solved()[i]];
   const Eigen::VectorXd xf = A.partialPivLu().solve(rf);
-  for (size_t i = 0; i < dofs.solved().size(); ++i) EXPECT_NEAR(x[dofs.solved()[i]], xf[Eigen::Index(i)], 1e-12 * xf.norm());
+  for (size_t i = 0; i < dofs.solved().size(); ++i)
+    EXPECT_NEAR(x[dofs.solved()[i]], xf[Eigen::Index(i)], 1e-12 * xf.norm());
   for (int j = 0; j < n; ++j) {
-    if (dofs.prescribed(j)) { EXPECT_EQ(x[j], 0.0); }
+    if (dofs.prescribed(j)) {
+      EXPECT_EQ(x[j], 0.0);
+    }
   }
 }
 

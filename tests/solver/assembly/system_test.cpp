@@ -29,11 +29,10 @@ constexpr double kL = 0.4;
 // A rod along x; `stiffened`: with geometric stiffening and the exact inertia; otherwise linear
 // inside with the corotational inertia.
 Superelement Rod(int modes, bool stiffened = false) {
-  return test::Reduce(
-      test::StraightBeamYaml(kL, 6, "{shape: circle, diameter: 0.02}",
-                             "{E: 2.0e9, nu: 0.3, rho: 7800}", "[{name: A}, {name: B}]",
-                             "reduction: {internal_modes: " + std::to_string(modes) +
-                                 (stiffened ? ", geometric_stiffening: true" : ", geometric_stiffening: false") + "}\n"));
+  return test::Reduce(test::StraightBeamYaml(
+      kL, 6, "{shape: circle, diameter: 0.02}", "{E: 2.0e9, nu: 0.3, rho: 7800}", "[{name: A}, {name: B}]",
+      "reduction: {internal_modes: " + std::to_string(modes) +
+          (stiffened ? ", geometric_stiffening: true" : ", geometric_stiffening: false") + "}\n"));
 }
 
 void AddRod(SystemModel& model, const Superelement& se, int a, int b) {
@@ -59,22 +58,21 @@ TEST(System, DofMapNumbersNodesModesAndMultipliers) {
   held.interface_constraint(0, 0) = M_SQRT1_2;
   held.interface_constraint(0, 6) = -M_SQRT1_2;
   SystemModel model;
-  for (int k = 0; k < 6; ++k)
-    AddNode(model, "n" + std::to_string(k), Eigen::Vector3d(kL * (k / 2 + k % 2), 0, 0));
+  for (int k = 0; k < 6; ++k) AddNode(model, "n" + std::to_string(k), Eigen::Vector3d(kL * (k / 2 + k % 2), 0, 0));
   // n0 (0) - n1 (L): rod 0; n2 (L) - n3 (2L): rod 1, held; n4 (2L) - n5 (3L): rod 2.
   AddRod(model, rod, 0, 1);
   AddRod(model, held, 2, 3);
   AddRod(model, rod, 4, 5);
   RevoluteToGround(model, 0, Eigen::Vector3d::UnitZ());  // 1 coordinate
-  model.joints.push_back(MakeNodeJoint(JointType::kSpherical, 2, 1, Eigen::Vector3d::UnitZ(),
-                                       model.node_x0[1], model.node_R0[1], model.node_x0[2],
+  model.joints.push_back(MakeNodeJoint(JointType::kSpherical, 2, 1, Eigen::Vector3d::UnitZ(), model.node_x0[1],
+                                       model.node_R0[1], model.node_x0[2],
                                        model.node_R0[2]));  // 3
   Pin(model, 3);                                            // 3
   Clamp(model, 4);                                          // 0
   // n5 free (6), closing a loop to n3 through a cut revolute joint (5 equations).
   CutJoint cut;
-  cut.joint = MakeNodeJoint(JointType::kRevolute, 5, 3, Eigen::Vector3d::UnitZ(), model.node_x0[3],
-                            model.node_R0[3], model.node_x0[5], model.node_R0[5]);
+  cut.joint = MakeNodeJoint(JointType::kRevolute, 5, 3, Eigen::Vector3d::UnitZ(), model.node_x0[3], model.node_R0[3],
+                            model.node_x0[5], model.node_R0[5]);
   cut.name = "cut";
   for (int i = 0; i < 5; ++i) cut.equations.push_back(i);
   model.cut_joints.push_back(cut);
@@ -122,15 +120,15 @@ TEST(System, ModelOwnsItsDofMap) {
   const Superelement rod = Rod(2);
   SystemModel model = OneFreeRod(rod);
   const DofMap* first = &model.dofs();
-  EXPECT_EQ(first->n_dofs(), 14);  // two free nodes and two modes
+  EXPECT_EQ(first->n_dofs(), 14);   // two free nodes and two modes
   EXPECT_EQ(&model.dofs(), first);  // kept, not made again
   const SystemModel copy = model;
-  EXPECT_EQ(&copy.dofs(), first);  // a copy of the model shares it
+  EXPECT_EQ(&copy.dofs(), first);                        // a copy of the model shares it
   RevoluteToGround(model, 0, Eigen::Vector3d::UnitZ());  // the structure changes: a new map
   EXPECT_EQ(model.dofs().n_dofs(), 9);
   EXPECT_EQ(model.dofs().node_count(0), 1);
   RevoluteToGround(model, 0, Eigen::Vector3d::UnitY());  // same shape, another axis
-  ASSERT_EQ(model.joints.size(), 1u);                     // replaced, not added
+  ASSERT_EQ(model.joints.size(), 1u);                    // replaced, not added
   EXPECT_EQ(model.dofs().n_dofs(), 9);
   const SystemState state = InitialState(model);
   ASSERT_EQ(state.J[0].size(), 1u);
@@ -202,8 +200,7 @@ TEST(System, StaticResidualOfAFreeBodyBalancesItsLoads) {
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> u(-1, 1);
   Eigen::VectorXd shift(dofs.n_dofs());
-  for (int i = 0; i < shift.size(); ++i)
-    shift[i] = 0.3 * u(rng);  // a large rotation and a deformation
+  for (int i = 0; i < shift.size(); ++i) shift[i] = 0.3 * u(rng);  // a large rotation and a deformation
   ApplyIncrement(model, dofs, shift, state);
   const SystemForces f = AssembleStatic(model, dofs, state, 1.0, false);
   ASSERT_TRUE(f.ok) << f.message;
@@ -289,8 +286,7 @@ TEST(System, DynamicIterationMatrixUnderGravityMatchesFiniteDifferences) {
     AddRod(model, rod, 0, 1);
     AddRod(model, rod, 2, 3);
     RevoluteToGround(model, 0, Eigen::Vector3d::UnitZ());
-    model.joints.push_back(MakeNodeJoint(JointType::kRevolute, 2, 1,
-                                         Eigen::Vector3d(0.36, 0.48, 0.8), model.node_x0[1],
+    model.joints.push_back(MakeNodeJoint(JointType::kRevolute, 2, 1, Eigen::Vector3d(0.36, 0.48, 0.8), model.node_x0[1],
                                          model.node_R0[1], model.node_x0[2], model.node_R0[2]));
     model.gravity = Eigen::Vector3d(0, -9.81, 0);
     const DofMap dofs(model);
@@ -343,9 +339,9 @@ TEST(System, DynamicIterationMatrixUnderGravityMatchesFiniteDifferences) {
 // the tension's geometric stiffness together.
 TEST(System, HangingRodSolvesStaticallyAndSwingsAtThePendulumFrequency) {
   const double E = 2.0e11, rho = 7800, g = 9.81;
-  const Superelement rod = test::Reduce(test::StraightBeamYaml(
-      kL, 6, "{shape: circle, diameter: 0.02}", "{E: 2.0e11, nu: 0.3, rho: 7800}",
-      "[{name: A}, {name: B}]", "reduction: {internal_modes: 2}\n"));
+  const Superelement rod =
+      test::Reduce(test::StraightBeamYaml(kL, 6, "{shape: circle, diameter: 0.02}", "{E: 2.0e11, nu: 0.3, rho: 7800}",
+                                          "[{name: A}, {name: B}]", "reduction: {internal_modes: 2}\n"));
   SystemModel model;
   const Eigen::Matrix3d down = ExpSO3(Eigen::Vector3d(0, 0, -M_PI / 2));
   AddNode(model, "a", Eigen::Vector3d::Zero(), down);
@@ -368,8 +364,8 @@ TEST(System, HangingRodSolvesStaticallyAndSwingsAtThePendulumFrequency) {
       "[ info ] hanging rod: stretch %.6e m (rho g L^2 / 2E %.6e m); swing %.5f Hz (compound "
       "pendulum %.5f "
       "Hz, %+.3f%%), next mode %.1f Hz\n",
-      stretch, closed, modes.frequencies_hz[0], pendulum,
-      100 * (modes.frequencies_hz[0] / pendulum - 1), modes.frequencies_hz[1]);
+      stretch, closed, modes.frequencies_hz[0], pendulum, 100 * (modes.frequencies_hz[0] / pendulum - 1),
+      modes.frequencies_hz[1]);
   EXPECT_NEAR(stretch, closed, 1e-3 * closed);
   EXPECT_NEAR(modes.frequencies_hz[0], pendulum, 1e-3 * pendulum);
   EXPECT_GT(modes.frequencies_hz[1], 50 * pendulum);

@@ -15,9 +15,10 @@ namespace femb {
 namespace {
 
 Superelement Rod(const std::string& frame, int modes = 3) {
-  return test::Reduce(test::StraightBeamYaml(0.5, 8, "{shape: rectangle, width: 0.02, height: 0.01}",
-                                             "{E: 7.0e10, nu: 0.3, rho: 2700}", "[{name: A}, {name: B}]",
-                                             "reduction: {internal_modes: " + std::to_string(modes) + ", geometric_stiffening: false}\n"),
+  return test::Reduce(test::StraightBeamYaml(
+                          0.5, 8, "{shape: rectangle, width: 0.02, height: 0.01}", "{E: 7.0e10, nu: 0.3, rho: 2700}",
+                          "[{name: A}, {name: B}]",
+                          "reduction: {internal_modes: " + std::to_string(modes) + ", geometric_stiffening: false}\n"),
                       {"reduction.floating_frame=" + frame});
 }
 
@@ -99,7 +100,8 @@ void CheckAgainstFiniteDifferences(const Superelement& se, const SuperelementOpt
     // 2e-9); a coordinate that turns the floating frame strongly (a thin leaf's torsion mode) gets
     // a proportionally smaller one.
     double size = 0.0;
-    for (const InterfaceNode& node : se.interfaces) size = std::max(size, (node.position - se.mass_properties.center_of_mass).norm());
+    for (const InterfaceNode& node : se.interfaces)
+      size = std::max(size, (node.position - se.mass_properties.center_of_mass).norm());
     const double h = (i < se.n_interface_dofs() ? 1e-6 : 1e-6 * size * std::sqrt(se.mass_properties.mass)) /
                      std::max(1.0, se.floating_frame.Phi_CB.col(i).norm());
     const Evaluation plus = Evaluate(body, Perturb(c, e, h), frame);
@@ -108,8 +110,8 @@ void CheckAgainstFiniteDifferences(const Superelement& se, const SuperelementOpt
     f_fd[i] = (plus.energy - minus.energy) / (2 * h);
   }
   // Central differences: truncation O(h^2), round-off O(eps |f| / h): 1e-6 relative is ample.
-  EXPECT_LT((K - K_fd).norm(), 1e-6 * K.norm()) << "tangent, approximated=" << options.approximated
-                                                  << "\nK - K_fd (max) " << (K - K_fd).cwiseAbs().maxCoeff();
+  EXPECT_LT((K - K_fd).norm(), 1e-6 * K.norm())
+      << "tangent, approximated=" << options.approximated << "\nK - K_fd (max) " << (K - K_fd).cwiseAbs().maxCoeff();
   if (!options.approximated) {
     // The force is the gradient of the strain energy.
     EXPECT_LT((f - f_fd).norm(), 1e-6 * f.norm()) << "force vs energy gradient";
@@ -295,7 +297,8 @@ TEST(SuperelementBody, MomentumDerivativesMatchFiniteDifferences) {
       const Eigen::VectorXd e = Eigen::VectorXd::Unit(n, i);
       const BodyConfiguration cp = Perturb(c, e, eps), cm = Perturb(c, e, -eps);
       fd.col(i) = (body.GeneralizedMomentum(body.Maps(cp, body.SolveFrame(cp, frame)), w) -
-                   body.GeneralizedMomentum(body.Maps(cm, body.SolveFrame(cm, frame)), w)) / (2 * eps);
+                   body.GeneralizedMomentum(body.Maps(cm, body.SolveFrame(cm, frame)), w)) /
+                  (2 * eps);
     }
     EXPECT_LT((D - fd).norm(), 1e-6 * fd.norm()) << (option_b ? "option B" : "option A");
 
@@ -329,8 +332,8 @@ TEST(SuperelementBody, MomentumDerivativesMatchFiniteDifferences) {
         body.InertiaForce(cm, body.SolveFrame(cm, frame), full ? w : zero, wdot, &fm, nullptr, nullptr);
         fd_in.col(i) = (fp - fm) / (2 * eps);
       }
-      EXPECT_LT((K_in - fd_in).norm(), 1e-5 * fd_in.norm()) << (option_b ? "option B" : "option A")
-                                                             << (full ? ", full" : ", M_g wdot");
+      EXPECT_LT((K_in - fd_in).norm(), 1e-5 * fd_in.norm())
+          << (option_b ? "option B" : "option A") << (full ? ", full" : ", M_g wdot");
     }
   }
 }
@@ -360,7 +363,8 @@ TEST(SuperelementBody, ExactMomentumConfigurationTangentMatchesFiniteDifferences
     const SuperelementBody::Data dm = body.Evaluate(cm, body.SolveFrame(cm, frame));
     fd.col(i) = (body.MassTimes(dp, w) - body.MassTimes(dm, w)) / (2 * eps);
   }
-  std::printf("[ info ] exact momentum's configuration tangent against differences: %.2e\n", (D - fd).norm() / fd.norm());
+  std::printf("[ info ] exact momentum's configuration tangent against differences: %.2e\n",
+              (D - fd).norm() / fd.norm());
   EXPECT_LT((D - fd).norm(), 1e-6 * fd.norm());
 }
 
@@ -423,9 +427,10 @@ TEST(SuperelementBody, InertiaForceIsTheLagrangianDerivativeAlongAMotion) {
       Eigen::VectorXd source;
       body.MomentumSource(d, w, p, source);
       const Eigen::VectorXd balance = pdot_exact - source;
-      std::printf("[ info ] exact inertia: momentum form against f_in %.2e (relative)\n", (balance - f_in).norm() / f_in.norm());
-      EXPECT_LT((balance - f_in).norm(), 1e-5 * f_in.norm()) << "exact: f_in " << f_in.transpose() << "\nbalance "
-                                                               << balance.transpose();
+      std::printf("[ info ] exact inertia: momentum form against f_in %.2e (relative)\n",
+                  (balance - f_in).norm() / f_in.norm());
+      EXPECT_LT((balance - f_in).norm(), 1e-5 * f_in.norm())
+          << "exact: f_in " << f_in.transpose() << "\nbalance " << balance.transpose();
       continue;
     }
 
@@ -439,8 +444,8 @@ TEST(SuperelementBody, InertiaForceIsTheLagrangianDerivativeAlongAMotion) {
     const FrameSolution frame = body.SolveFrame(c, body.GuessFrame(c));
     const BodyVelocityMaps maps = body.Maps(c, frame);
     const Eigen::VectorXd balance = pdot - body.MomentumSource(maps, w, body.GeneralizedMomentum(maps, w));
-    EXPECT_LT((balance - f_in).norm(), 1e-5 * f_in.norm()) << "f_in " << f_in.transpose() << "\nbalance "
-                                                             << balance.transpose();
+    EXPECT_LT((balance - f_in).norm(), 1e-5 * f_in.norm())
+        << "f_in " << f_in.transpose() << "\nbalance " << balance.transpose();
   }
 }
 

@@ -84,7 +84,8 @@ TEST(SpringDamper, BodyOnASpringOscillatesAndDecaysAsTheClosedForm) {
   const double f_measured = (t_peak.size() - 1) / (t_peak.back() - t_peak.front());
   const double delta = std::log(x_peak.front() / x_peak.back()) / (x_peak.size() - 1);
   const double zeta_measured = delta / std::sqrt(4 * M_PI * M_PI + delta * delta);
-  std::printf("[ info ] f: closed form %.5f Hz, femb %.5f Hz; zeta: %.5f vs %.5f\n", f_d, f_measured, zeta, zeta_measured);
+  std::printf("[ info ] f: closed form %.5f Hz, femb %.5f Hz; zeta: %.5f vs %.5f\n", f_d, f_measured, zeta,
+              zeta_measured);
   EXPECT_NEAR(f_measured, f_d, 2e-3 * f_d);  // peaks located to one step: 1/400 of a period
   EXPECT_NEAR(zeta_measured, zeta, 0.02 * zeta);
 }

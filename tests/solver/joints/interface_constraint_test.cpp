@@ -49,9 +49,8 @@ SystemModel Chain(const Superelement& se, const SuperelementOptions& options = {
   model.bodies.emplace_back(se, options, Eigen::Matrix3d::Identity(), Eigen::Vector3d(kL, 0, 0));
   model.body_nodes.push_back({2, 3});
   RevoluteToGround(model, 0, Eigen::Vector3d::UnitZ());
-  model.joints.push_back(MakeNodeJoint(JointType::kRevolute, 2, 1, Eigen::Vector3d(0, 0, 1),
-                                       model.node_x0[1], model.node_R0[1], model.node_x0[2],
-                                       model.node_R0[2]));
+  model.joints.push_back(MakeNodeJoint(JointType::kRevolute, 2, 1, Eigen::Vector3d(0, 0, 1), model.node_x0[1],
+                                       model.node_R0[1], model.node_x0[2], model.node_R0[2]));
   model.gravity = Eigen::Vector3d(0, -9.81, 0);
   return model;
 }
@@ -61,8 +60,8 @@ TEST(InterfaceConstraint, StaticTangentMatchesFiniteDifferences) {
   SystemModel model = Chain(se);
   // A hinge about a tilted axis and a load with a moment, so that every block is exercised.
   model.joints[1] =  // joint 0 is n0's revolute to the ground
-      MakeNodeJoint(JointType::kRevolute, 2, 1, Eigen::Vector3d(0.36, 0.48, 0.8), model.node_x0[1],
-                    model.node_R0[1], model.node_x0[2], model.node_R0[2]);
+      MakeNodeJoint(JointType::kRevolute, 2, 1, Eigen::Vector3d(0.36, 0.48, 0.8), model.node_x0[1], model.node_R0[1],
+                    model.node_x0[2], model.node_R0[2]);
   NodeLoad load;
   load.node = 3;
   load.force = Eigen::Vector3d(10, -20, 15);
@@ -75,8 +74,7 @@ TEST(InterfaceConstraint, StaticTangentMatchesFiniteDifferences) {
   std::mt19937 rng(3);
   std::uniform_real_distribution<double> u(-1, 1);
   Eigen::VectorXd shift(dofs.n_dofs());
-  for (int i = 0; i < shift.size(); ++i)
-    shift[i] = dofs.multiplier(i) ? 50.0 * u(rng) : 0.05 * u(rng);
+  for (int i = 0; i < shift.size(); ++i) shift[i] = dofs.multiplier(i) ? 50.0 * u(rng) : 0.05 * u(rng);
   ApplyIncrement(model, dofs, shift, state);
   const SystemForces f0 = AssembleStatic(model, dofs, state, 1.0, true);
   ASSERT_TRUE(f0.ok) << f0.message;
@@ -84,15 +82,15 @@ TEST(InterfaceConstraint, StaticTangentMatchesFiniteDifferences) {
   const Eigen::MatrixXd K(f0.tangent);
   const int m = dofs.n_multipliers(), c = dofs.first_multiplier();
   const double error = (K - K_fd).norm() / K_fd.norm();
-  const double g_error = (K.bottomLeftCorner(m, c) - K_fd.bottomLeftCorner(m, c)).norm() /
-                         K_fd.bottomLeftCorner(m, c).norm();
+  const double g_error =
+      (K.bottomLeftCorner(m, c) - K_fd.bottomLeftCorner(m, c)).norm() / K_fd.bottomLeftCorner(m, c).norm();
   // The multipliers' share alone: the tangent with and without them.
   SystemState no_lambda = state;
   no_lambda.lambda.setZero();
   const Eigen::MatrixXd K0(AssembleStatic(model, dofs, no_lambda, 1.0, true).tangent);
   const Eigen::MatrixXd K0_fd = test::StaticTangentByDifferences(model, dofs, no_lambda, 1.0);
-  const double h_error = ((K - K0) - (K_fd - K0_fd)).topLeftCorner(c, c).norm() /
-                         (K_fd - K0_fd).topLeftCorner(c, c).norm();
+  const double h_error =
+      ((K - K0) - (K_fd - K0_fd)).topLeftCorner(c, c).norm() / (K_fd - K0_fd).topLeftCorner(c, c).norm();
   std::printf(
       "[ info ] %d coordinates, %d multipliers: tangent error %.2e, constraint rows %.2e, "
       "multipliers' "
@@ -121,10 +119,8 @@ Eigen::Matrix<double, 6, 1> ClampedTip(const Superelement& se, const Eigen::Vect
 TEST(InterfaceConstraint, AxialForceAndTorqueNeitherStretchNorTwistTheRod) {
   const Superelement bending = Rod(true), cb = Rod(false);
   const double A = M_PI * kD * kD / 4, P = 2.0e4, T = 20.0;
-  const Eigen::Matrix<double, 6, 1> stiff =
-      ClampedTip(bending, Eigen::Vector3d(P, 0, 0), Eigen::Vector3d(T, 0, 0));
-  const Eigen::Matrix<double, 6, 1> elastic =
-      ClampedTip(cb, Eigen::Vector3d(P, 0, 0), Eigen::Vector3d(T, 0, 0));
+  const Eigen::Matrix<double, 6, 1> stiff = ClampedTip(bending, Eigen::Vector3d(P, 0, 0), Eigen::Vector3d(T, 0, 0));
+  const Eigen::Matrix<double, 6, 1> elastic = ClampedTip(cb, Eigen::Vector3d(P, 0, 0), Eigen::Vector3d(T, 0, 0));
   const double stretch = P * kL / (kE * A);
   std::printf(
       "[ info ] axial %.0f N, torque %.0f N m: Craig-Bampton stretch %.6e m (P L / E A %.6e), "
@@ -141,8 +137,7 @@ TEST(InterfaceConstraint, AxialForceAndTorqueNeitherStretchNorTwistTheRod) {
 TEST(InterfaceConstraint, SmallTransverseLoadGivesTheReducedModelsLinearAnswer) {
   const Superelement se = Rod(true);
   const double F = 0.01, I = M_PI * std::pow(kD, 4) / 64;
-  const Eigen::Matrix<double, 6, 1> tip =
-      ClampedTip(se, Eigen::Vector3d(0, F, 0), Eigen::Vector3d::Zero());
+  const Eigen::Matrix<double, 6, 1> tip = ClampedTip(se, Eigen::Vector3d(0, F, 0), Eigen::Vector3d::Zero());
   // The same reduced model solved by hand: node A held, B's six coordinates and the constraint's
   // columns of B (C's columns of A multiply zeros), [K_BB C_B^T; C_B 0] [q; mu] = [f; 0].
   Eigen::MatrixXd S = Eigen::MatrixXd::Zero(8, 8);
@@ -179,8 +174,7 @@ TEST(InterfaceConstraint, LinearizedModesAreThoseOfTheConstrainedReducedModel) {
   const Eigen::MatrixXd N = lu.kernel();
   ASSERT_EQ(N.cols(), 4);
   Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> eig(
-      N.transpose() * se.K.block(6, 6, 6, 6) * N, N.transpose() * se.M.block(6, 6, 6, 6) * N,
-      Eigen::EigenvaluesOnly);
+      N.transpose() * se.K.block(6, 6, 6, 6) * N, N.transpose() * se.M.block(6, 6, 6, 6) * N, Eigen::EigenvaluesOnly);
   ASSERT_EQ(modes.frequencies_hz.size(), 4);
   double worst = 0.0;
   for (int j = 0; j < 4; ++j) {
@@ -191,8 +185,8 @@ TEST(InterfaceConstraint, LinearizedModesAreThoseOfTheConstrainedReducedModel) {
       "[ info ] clamped bending-only rod: %d modes (%.2f, %.2f, %.2f, %.2f Hz), within %.2e of the "
       "constrained "
       "reduced model's\n",
-      int(modes.frequencies_hz.size()), modes.frequencies_hz[0], modes.frequencies_hz[1],
-      modes.frequencies_hz[2], modes.frequencies_hz[3], worst);
+      int(modes.frequencies_hz.size()), modes.frequencies_hz[0], modes.frequencies_hz[1], modes.frequencies_hz[2],
+      modes.frequencies_hz[3], worst);
   EXPECT_LT(worst, 1e-8);
 }
 
@@ -209,8 +203,7 @@ TEST(InterfaceConstraint, SwingingChainKeepsItsConstraintAndItsEnergy) {
     body_options.exact_inertia = integrator == Integrator::kGeneralizedAlpha;
     const SystemModel model = Chain(se, body_options);
     const DofMap dofs(model);
-    DynamicState s =
-        InitialDynamicState(model, InitialState(model), Eigen::VectorXd::Zero(dofs.n_dofs()));
+    DynamicState s = InitialDynamicState(model, InitialState(model), Eigen::VectorXd::Zero(dofs.n_dofs()));
     const DynamicStepReport r0 = Measure(model, s);
     DynamicOptions options;
     options.step = 1e-3;

@@ -31,9 +31,12 @@ Superelement Rod(double L, int modes) {
   return test::Reduce(
       "name: rod\ntype: beam\nmaterial: {E: 2.0e9, nu: 0.3, rho: 7800}\n"
       "section: {shape: circle, diameter: 0.02}\n"
-      "beam:\n  points: {A: [0, 0, 0], B: [" + std::to_string(L) + ", 0, 0]}\n"
+      "beam:\n  points: {A: [0, 0, 0], B: [" +
+      std::to_string(L) +
+      ", 0, 0]}\n"
       "  segments: [{from: A, to: B, elements: 4}]\n"
-      "interfaces: [{name: A}, {name: B}]\nreduction: {internal_modes: " + std::to_string(modes) + "}\n");
+      "interfaces: [{name: A}, {name: B}]\nreduction: {internal_modes: " +
+      std::to_string(modes) + "}\n");
 }
 
 // Rod 0 clamped at n0; rod 1 hangs on rod 0's end through a tree revolute joint (node c1 child
@@ -81,10 +84,10 @@ TEST(LoopClosure, ClosureAtThePlacementAndEquationCounts) {
                               JointType::kCylindrical, JointType::kSpherical, JointType::kUniversal};
   for (int t = 0; t < 6; ++t) {
     EXPECT_EQ(ConstraintCount(types[t]), expected[t]);
-    EXPECT_EQ(ConstraintCount(types[t]), 6 - MakeNodeJoint(types[t], 1, 0, Eigen::Vector3d::UnitZ(), Eigen::Vector3d::Zero(),
-                                                            Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero(),
-                                                            Eigen::Matrix3d::Identity())
-                                                  .n_coordinates());
+    EXPECT_EQ(ConstraintCount(types[t]),
+              6 - MakeNodeJoint(types[t], 1, 0, Eigen::Vector3d::UnitZ(), Eigen::Vector3d::Zero(),
+                                Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero(), Eigen::Matrix3d::Identity())
+                      .n_coordinates());
     const SystemModel model = Loop(Rod(0.5, 0), 0.5, types[t]);
     EXPECT_LT(LoopViolation(model, InitialState(model)), 1e-15);
   }
@@ -97,7 +100,8 @@ TEST(LoopClosure, CutJointCoordinatesGiveBackTheTreeJointsCoordinates) {
   const Eigen::Vector3d x_p(0.3, -0.2, 0.5), axis = Eigen::Vector3d(0.36, 0.48, 0.8), axis2(0.8, 0, -0.36);
   const Eigen::Matrix3d R_p = ExpSO3(Eigen::Vector3d(0.4, -1.1, 0.7)), R_c0 = ExpSO3(Eigen::Vector3d(-0.3, 0.2, 0.9));
   const Eigen::Vector3d x_c0 = x_p + R_p * Eigen::Vector3d(0.1, 0.2, -0.05);
-  for (const JointType type : {JointType::kRevolute, JointType::kPrismatic, JointType::kCylindrical, JointType::kUniversal}) {
+  for (const JointType type :
+       {JointType::kRevolute, JointType::kPrismatic, JointType::kCylindrical, JointType::kUniversal}) {
     const NodeJoint j = MakeNodeJoint(type, 1, 0, axis, x_p, R_p, x_c0, R_c0, axis2);
     for (const double scale : {0.3, 1.0, 2.9}) {
       Eigen::VectorXd z(j.n_coordinates());
@@ -135,7 +139,8 @@ TEST(LoopClosure, StaticTangentWithCutJointsMatchesFiniteDifferences) {
     const Eigen::MatrixXd K(f0.tangent);
     const int m = dofs.n_multipliers(), c = dofs.first_multiplier();
     const double error = (K - K_fd).norm() / K_fd.norm();
-    const double g_error = (K.bottomLeftCorner(m, c) - K_fd.bottomLeftCorner(m, c)).norm() / K_fd.bottomLeftCorner(m, c).norm();
+    const double g_error =
+        (K.bottomLeftCorner(m, c) - K_fd.bottomLeftCorner(m, c)).norm() / K_fd.bottomLeftCorner(m, c).norm();
     std::printf("[ info ] %s cut joint: %d coordinates, %d multipliers; tangent error %.2e, constraint rows %.2e\n",
                 JointName(type), c, m, error, g_error);
     EXPECT_LT(error, 1e-6);
@@ -149,12 +154,12 @@ std::string Point(const Eigen::Vector2d& p) { return "[" + Number(p.x()) + ", " 
 
 // A rigid link from p to q in the xy plane: mass 2 kg per metre, a uniform rod's inertia about
 // z (m L^2 / 12 about the centre), points P and Q on scene nodes np and nq.
-std::string RigidLink(const std::string& name, const Eigen::Vector2d& p, const Eigen::Vector2d& q, const std::string& np,
-                      const std::string& nq) {
+std::string RigidLink(const std::string& name, const Eigen::Vector2d& p, const Eigen::Vector2d& q,
+                      const std::string& np, const std::string& nq) {
   const double L = (q - p).norm(), m = 2.0 * L, I = m * L * L / 12;
-  return "  - {name: " + name + ", type: rigid, mass: " + Number(m) + ", inertia: [" + Number(0.01 * I) + ", " + Number(I) +
-         ", " + Number(I) + "], center_of_mass: " + Point(0.5 * (p + q)) + ", points: {P: " + Point(p) + ", Q: " +
-         Point(q) + "}, nodes: {P: " + np + ", Q: " + nq + "}}\n";
+  return "  - {name: " + name + ", type: rigid, mass: " + Number(m) + ", inertia: [" + Number(0.01 * I) + ", " +
+         Number(I) + ", " + Number(I) + "], center_of_mass: " + Point(0.5 * (p + q)) + ", points: {P: " + Point(p) +
+         ", Q: " + Point(q) + "}, nodes: {P: " + np + ", Q: " + nq + "}}\n";
 }
 
 // A crank-rocker four-bar in the xy plane: ground pivots A (origin) and D (d, 0); crank AB of
@@ -177,23 +182,28 @@ struct FourBar {
            "  - {type: revolute, node: A, axis: [0, 0, 1], prescribed: drive}\n"
            "  - {type: revolute, node: B2, parent: B1, axis: [0, 0, 1]}\n"
            "  - {type: revolute, node: C2, parent: C1, axis: [0, 0, 1]}\n"
-           "  - {type: revolute, node: D, axis: [0, 0, 1]" + extra_joint_keys + "}\n"
-           "functions:\n  drive: {type: linear, slope: " + Number(omega) + "}\n" + analysis;
+           "  - {type: revolute, node: D, axis: [0, 0, 1]" +
+           extra_joint_keys +
+           "}\n"
+           "functions:\n  drive: {type: linear, slope: " +
+           Number(omega) + "}\n" + analysis;
   }
 };
 
 TEST(LoopClosure, RigidFourBarFollowsItsClosedFormKinematics) {
   const FourBar fb;
-  const Scene scene = BuildScene(ParseScene(fb.Scene("analysis: {type: dynamic, end_time: 10, step: 1.0e-4}\n"), "four_bar.yaml"));
+  const Scene scene =
+      BuildScene(ParseScene(fb.Scene("analysis: {type: dynamic, end_time: 10, step: 1.0e-4}\n"), "four_bar.yaml"));
   const SystemModel& model = scene.model;
   ASSERT_EQ(model.cut_joints.size(), 1u);
   // The revolute at D closes the loop; 3 of its 5 equations are the plane's (redundant).
   EXPECT_EQ(model.cut_joints[0].equations.size(), 2u);
   bool noted = false;
   for (const std::string& note : scene.notes) {
-    noted |= note.find("revolute joint of node 'D' to the ground closes a loop: 2 constraint equations with Lagrange "
-                       "multipliers; 3 more (translation along the axis, rotation about (-1, 0, 0) of the parent's axes, "
-                       "rotation about (0, -1, 0) of the parent's axes) repeat other constraints") != std::string::npos;
+    noted |= note.find(
+                 "revolute joint of node 'D' to the ground closes a loop: 2 constraint equations with Lagrange "
+                 "multipliers; 3 more (translation along the axis, rotation about (-1, 0, 0) of the parent's axes, "
+                 "rotation about (0, -1, 0) of the parent's axes) repeat other constraints") != std::string::npos;
   }
   EXPECT_TRUE(noted) << (scene.notes.empty() ? std::string() : scene.notes.back());
   EXPECT_EQ(DofMap(model).n_multipliers(), 2);
@@ -211,8 +221,10 @@ TEST(LoopClosure, RigidFourBarFollowsItsClosedFormKinematics) {
     violation = std::max(violation, (st.config.x[C1] - st.config.x[C2]).norm());
   });
   ASSERT_TRUE(r.ok) << r.message;
-  std::printf("[ info ] rigid four-bar, ten crank turns in %ld steps: largest error of B, C %.2e m, joint C gap %.2e m, "
-              "loop violation at the end %.2e m\n", r.steps, error, violation, LoopViolation(model, s.config));
+  std::printf(
+      "[ info ] rigid four-bar, ten crank turns in %ld steps: largest error of B, C %.2e m, joint C gap %.2e m, "
+      "loop violation at the end %.2e m\n",
+      r.steps, error, violation, LoopViolation(model, s.config));
   EXPECT_LT(error, 1e-8);  // the closed form, to 1e-8 of a 1 m mechanism
   EXPECT_LT(violation, 1e-8);
   EXPECT_LT(LoopViolation(model, s.config), 1e-12);
@@ -229,7 +241,8 @@ TEST(LoopClosure, RigidFourBarFollowsItsClosedFormKinematics) {
 // iteration instead of 3e-7).
 TEST(LoopClosure, IterationMatrixOfAMovingFourBarMatchesFiniteDifferences) {
   const FourBar fb;
-  const Scene scene = BuildScene(ParseScene(fb.Scene("analysis: {type: dynamic, end_time: 0.1, step: 1.0e-3}\n"), "four_bar.yaml"));
+  const Scene scene =
+      BuildScene(ParseScene(fb.Scene("analysis: {type: dynamic, end_time: 0.1, step: 1.0e-3}\n"), "four_bar.yaml"));
   const SystemModel& model = scene.model;
   const DofMap dofs(model);
   DynamicState s = InitialDynamicState(model, InitialState(model), scene.initial_velocity);
@@ -279,8 +292,10 @@ TEST(LoopClosure, IterationMatrixOfAMovingFourBarMatchesFiniteDifferences) {
   const int m = dofs.n_multipliers();
   const Eigen::MatrixXd dK = restrict(K) - restrict(K_fd);
   const double g_error = (dK.bottomRows(m).norm() + dK.rightCols(m).norm()) / restrict(K_fd).bottomRows(m).norm();
-  std::printf("[ info ] four-bar iteration matrix against central differences: K %.2e (its constraint rows and "
-              "columns %.2e), C %.2e, M %.2e (relative)\n", k_error, g_error, c_error, m_error);
+  std::printf(
+      "[ info ] four-bar iteration matrix against central differences: K %.2e (its constraint rows and "
+      "columns %.2e), C %.2e, M %.2e (relative)\n",
+      k_error, g_error, c_error, m_error);
   EXPECT_LT(k_error, 1e-6);
   EXPECT_LT(g_error, 1e-6);
   EXPECT_LT(c_error, 1e-6);
@@ -302,8 +317,9 @@ struct Swing {
 };
 Swing SwingUnderGravity(double h, bool open = false) {
   FourBar fb;
-  std::string text = fb.Scene("loads: [{type: gravity, g: [0, -9.81, 0]}]\n"
-                              "analysis: {type: dynamic, end_time: 10, step: 1.0e-3, integrator: midpoint}\n");
+  std::string text = fb.Scene(
+      "loads: [{type: gravity, g: [0, -9.81, 0]}]\n"
+      "analysis: {type: dynamic, end_time: 10, step: 1.0e-3, integrator: midpoint}\n");
   text = test::Replace(text, ", prescribed: drive}", "}");
   if (open) text = test::Replace(text, "  - {type: revolute, node: D, axis: [0, 0, 1]}\n", "");
   const Scene scene = BuildScene(ParseScene(text, "four_bar.yaml"));
@@ -324,7 +340,8 @@ Swing SwingUnderGravity(double h, bool open = false) {
     double V = 0.0;
     for (size_t b = 0; b < model.bodies.size(); ++b) {
       const SuperelementBody& body = model.bodies[b];
-      V -= body.mass() * model.gravity.dot(body.CenterOfMass(BodyConfigurationOf(model, st.config, int(b)), st.config.frames[b]));
+      V -= body.mass() *
+           model.gravity.dot(body.CenterOfMass(BodyConfigurationOf(model, st.config, int(b)), st.config.frames[b]));
     }
     if (first) E0 = rep.kinetic_energy + V;
     first = false;
@@ -337,9 +354,10 @@ Swing SwingUnderGravity(double h, bool open = false) {
   EXPECT_TRUE(r.ok) << r.message;
   run.drift /= scale;
   run.potential_drift /= scale;
-  std::printf("[ info ] %s under gravity, midpoint, h = %.0e s: %d crank reversals, energy drift %.2e (T - W_ext) and "
-              "%.2e (T + V) of %.3g J, largest loop violation %.2e m\n", open ? "triple pendulum" : "four-bar", h,
-              run.reversals, run.drift, run.potential_drift, scale, run.violation);
+  std::printf(
+      "[ info ] %s under gravity, midpoint, h = %.0e s: %d crank reversals, energy drift %.2e (T - W_ext) and "
+      "%.2e (T + V) of %.3g J, largest loop violation %.2e m\n",
+      open ? "triple pendulum" : "four-bar", h, run.reversals, run.drift, run.potential_drift, scale, run.violation);
   return run;
 }
 
@@ -402,7 +420,8 @@ TEST(LoopClosure, ParallelogramSwingHasThePendulumFrequencyOfItsClosedForm) {
   const DofMap dofs(scene.model);
   SystemState copy = state;
   const SystemForces forces = AssembleStatic(scene.model, dofs, copy, 1.0, false);
-  const std::vector<Eigen::Matrix<double, 6, 1>> reactions = JointReactions(scene.model, dofs, copy, forces.node_forces);
+  const std::vector<Eigen::Matrix<double, 6, 1>> reactions =
+      JointReactions(scene.model, dofs, copy, forces.node_forces);
   const std::vector<Eigen::Matrix<double, 6, 1>> cut = CutJointReactions(scene.model, copy);
   const double W = (2 * m_l + m_c) * g;
   Eigen::Matrix<double, 6, 1> half = Eigen::Matrix<double, 6, 1>::Zero();
@@ -423,7 +442,8 @@ TEST(LoopClosure, DeadPointStopsTheRunAndNamesTheLoop) {
   FourBar fb;
   std::string text = fb.Scene("analysis: {type: dynamic, end_time: 3, step: 1.0e-3}\n");
   text = test::Replace(text, ", prescribed: drive}", "}");
-  text = test::Replace(text, "{type: revolute, node: D, axis: [0, 0, 1]}", "{type: revolute, node: D, axis: [0, 0, 1], prescribed: drive}");
+  text = test::Replace(text, "{type: revolute, node: D, axis: [0, 0, 1]}",
+                       "{type: revolute, node: D, axis: [0, 0, 1], prescribed: drive}");
   text = test::Replace(text, "slope: " + Number(fb.omega), "slope: 1");
   const Scene scene = BuildScene(ParseScene(text, "four_bar.yaml"));
   DynamicState s = InitialDynamicState(scene.model, InitialState(scene.model), scene.initial_velocity);
@@ -431,11 +451,14 @@ TEST(LoopClosure, DeadPointStopsTheRunAndNamesTheLoop) {
   options.step = 1e-3;
   options.end_time = 3.0;
   double t_last = 0.0;
-  const DynamicResult r = SolveDynamic(scene.model, s, options, [&](const DynamicStepReport& rep, const DynamicState&) { t_last = rep.t; });
+  const DynamicResult r =
+      SolveDynamic(scene.model, s, options, [&](const DynamicStepReport& rep, const DynamicState&) { t_last = rep.t; });
   std::printf("[ info ] rocker driven at 1 rad/s: stopped at t = %.4f s: %s\n", t_last, r.message.c_str());
   EXPECT_FALSE(r.ok);
   EXPECT_NE(r.message.find("revolute joint of node 'C2' on node 'C1': the loop it closes is at or near a singular "
-                           "configuration (a dead point"), std::string::npos) << r.message;
+                           "configuration (a dead point"),
+            std::string::npos)
+      << r.message;
 }
 
 // Given velocities that would open the loop (the crank's rate alone, the other joints at rest)
@@ -444,7 +467,8 @@ TEST(LoopClosure, DeadPointStopsTheRunAndNamesTheLoop) {
 // dpsi/dtheta from the loop's velocity equations.
 TEST(LoopClosure, InitialVelocitiesThatWouldOpenTheLoopAreMadeConsistent) {
   FourBar fb;
-  std::string text = fb.Scene("initial_velocity: {A: {joint: [3.0]}}\nanalysis: {type: dynamic, end_time: 0.01, step: 1.0e-3}\n");
+  std::string text =
+      fb.Scene("initial_velocity: {A: {joint: [3.0]}}\nanalysis: {type: dynamic, end_time: 0.01, step: 1.0e-3}\n");
   text = test::Replace(text, ", prescribed: drive}", "}");
   const Scene scene = BuildScene(ParseScene(text, "four_bar.yaml"));
   const SystemModel& model = scene.model;
@@ -474,7 +498,8 @@ TEST(LoopClosure, LinksThatDoNotMeetAreAnInputErrorNamingTheJointAndTheGap) {
   text = test::Replace(text, RigidLink("rocker", D, C, "D", "C2"), RigidLink("rocker", D, C_short, "D", "C2"));
   const std::string message = test::ThrownMessage([&] { BuildScene(ParseScene(text, "four_bar.yaml")); });
   EXPECT_NE(message.find("revolute joint between nodes 'C2' and 'C1': the nodes are 0.001 apart at t = 0"),
-            std::string::npos) << message;
+            std::string::npos)
+      << message;
 }
 
 TEST(LoopClosure, PrescribedJointThatClosesALoopIsAnInputError) {

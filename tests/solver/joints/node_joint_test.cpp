@@ -23,10 +23,12 @@ Superelement Rod(double L, int modes, const std::string& frame = "center_of_mass
   return test::Reduce(
       "name: rod\ntype: beam\nmaterial: {E: 2.0e9, nu: 0.3, rho: 7800}\n"
       "section: {shape: circle, diameter: 0.02}\n"
-      "beam:\n  points: {A: [0, 0, 0], B: [" + std::to_string(L) + ", 0, 0]}\n"
+      "beam:\n  points: {A: [0, 0, 0], B: [" +
+      std::to_string(L) +
+      ", 0, 0]}\n"
       "  segments: [{from: A, to: B, elements: 4}]\n"
-      "interfaces: [{name: A}, {name: B}]\nreduction: {internal_modes: " + std::to_string(modes) +
-      ", floating_frame: " + frame + ", geometric_stiffening: false}\n");
+      "interfaces: [{name: A}, {name: B}]\nreduction: {internal_modes: " +
+      std::to_string(modes) + ", floating_frame: " + frame + ", geometric_stiffening: false}\n");
 }
 
 // A chain of six rods, node pairs at the joints: revolute (axis z), prismatic (axis x),
@@ -132,9 +134,12 @@ TEST(NodeJoint, ConstraintsHoldExactlyAtAnyConfiguration) {
   }
 }
 
-void DoublePendulum(JointType second, const Eigen::Vector3d& spin, Integrator integrator = Integrator::kGeneralizedAlpha);
+void DoublePendulum(JointType second, const Eigen::Vector3d& spin,
+                    Integrator integrator = Integrator::kGeneralizedAlpha);
 
-TEST(NodeJoint, FlexibleDoublePendulumConservesEnergy) { DoublePendulum(JointType::kRevolute, Eigen::Vector3d::Zero()); }
+TEST(NodeJoint, FlexibleDoublePendulumConservesEnergy) {
+  DoublePendulum(JointType::kRevolute, Eigen::Vector3d::Zero());
+}
 
 // The midpoint scheme on the same chain: its bodies have free nodes (n1, n3) and nodes on joints
 // (n0 on the ground, n2 on n1), so the scheme's node velocities come from W for some and from
@@ -190,14 +195,15 @@ void DoublePendulum(JointType second, const Eigen::Vector3d& spin, Integrator in
     *drift = 0;
     *min_y = 0;
     const double scale = 2 * se.mass_properties.mass * 9.81 * L;  // energy scale
-    const DynamicResult result = SolveDynamic(model, s, options, [&](const DynamicStepReport& r, const DynamicState& st) {
-                  const double E = r.kinetic_energy + r.elastic_energy - r.external_work;
-                  *drift = std::max(*drift, std::abs(E - (r0.kinetic_energy + r0.elastic_energy)) / scale);
-                  *min_y = std::min(*min_y, st.config.x[3].y());
-                  max_z = std::max(max_z, std::abs(st.config.x[3].z()));
-                  // The hinge: nodes n1 and n2 coincide exactly.
-                  EXPECT_LT((st.config.x[1] - st.config.x[2]).norm(), 1e-12);
-                });
+    const DynamicResult result =
+        SolveDynamic(model, s, options, [&](const DynamicStepReport& r, const DynamicState& st) {
+          const double E = r.kinetic_energy + r.elastic_energy - r.external_work;
+          *drift = std::max(*drift, std::abs(E - (r0.kinetic_energy + r0.elastic_energy)) / scale);
+          *min_y = std::min(*min_y, st.config.x[3].y());
+          max_z = std::max(max_z, std::abs(st.config.x[3].z()));
+          // The hinge: nodes n1 and n2 coincide exactly.
+          EXPECT_LT((st.config.x[1] - st.config.x[2]).norm(), 1e-12);
+        });
     EXPECT_TRUE(result.ok) << result.message;
   };
   double drift_coarse, drift_fine, y_coarse, y_fine;
@@ -205,7 +211,7 @@ void DoublePendulum(JointType second, const Eigen::Vector3d& spin, Integrator in
   run(1e-3, &drift_fine, &y_fine);
   std::printf("[ info ] energy error / (2 m g L): %.2e (h = 2 ms), %.2e (1 ms); lowest tip y %.4f m\n", drift_coarse,
               drift_fine, y_fine);
-  EXPECT_LT(y_fine, -0.5);        // it swings down
+  EXPECT_LT(y_fine, -0.5);  // it swings down
   // and out of the plane (measured 0.043 m; planar motion would keep z at round-off)
   if (second == JointType::kUniversal) {
     EXPECT_GT(max_z, 0.01);
@@ -273,8 +279,9 @@ TEST(NodeJoint, SupportsAreJointsToTheGroundAndMoveAsOnAClampedNode) {
       DynamicOptions options;
       options.step = 2e-3;
       options.end_time = 0.2;
-      const DynamicResult result = SolveDynamic(
-          model, s, options, [&](const DynamicStepReport&, const DynamicState& st) { tips[m].push_back(st.config.x[1]); });
+      const DynamicResult result =
+          SolveDynamic(model, s, options,
+                       [&](const DynamicStepReport&, const DynamicState& st) { tips[m].push_back(st.config.x[1]); });
       ASSERT_TRUE(result.ok) << result.message;
     }
     ASSERT_EQ(tips[0].size(), tips[1].size());

@@ -85,16 +85,18 @@ std::map<std::string, std::vector<double>> RunScene(const std::string& dir, cons
     options.steps = spec.analysis.steps;
     options.end_time = spec.analysis.end_time;
     options.tolerance = spec.analysis.tolerance;
-    const StaticResult r = SolveStatic(scene.model, state, options, [&](const StaticStepReport& s, const SystemState& st) {
-      recorder.Record(s.lambda, st, Eigen::VectorXd(), 0.0, s.elastic_energy, s.external_work);
-    });
+    const StaticResult r =
+        SolveStatic(scene.model, state, options, [&](const StaticStepReport& s, const SystemState& st) {
+          recorder.Record(s.lambda, st, Eigen::VectorXd(), 0.0, s.elastic_energy, s.external_work);
+        });
     EXPECT_TRUE(r.ok) << r.message;
     recorder.Finish(r.ok ? "completed" : r.message);
   } else {
     DynamicState state = InitialDynamicState(scene.model, InitialState(scene.model), scene.initial_velocity);
     const auto record = [&](double t, const DynamicState& st, double kinetic) {
       const DynamicState out = spec.reactions ? WithConsistentAccelerations(scene.model, st) : st;
-      const auto reactions = spec.reactions ? DynamicReactions(scene.model, out) : std::vector<Eigen::Matrix<double, 6, 1>>();
+      const auto reactions =
+          spec.reactions ? DynamicReactions(scene.model, out) : std::vector<Eigen::Matrix<double, 6, 1>>();
       recorder.Record(t, out.config, out.W, kinetic, 0.0, 0.0, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(),
                       spec.reactions ? &reactions : nullptr, &out.Wdot);
     };
@@ -105,7 +107,8 @@ std::map<std::string, std::vector<double>> RunScene(const std::string& dir, cons
     options.rho_inf = spec.analysis.rho_inf;
     options.tolerance = spec.analysis.tolerance;
     const DynamicResult r =
-        SolveDynamic(scene.model, state, options, [&](const DynamicStepReport& s, const DynamicState& st) { record(s.t, st, s.kinetic_energy); });
+        SolveDynamic(scene.model, state, options,
+                     [&](const DynamicStepReport& s, const DynamicState& st) { record(s.t, st, s.kinetic_energy); });
     EXPECT_TRUE(r.ok) << r.message;
     recorder.Finish(r.ok ? "completed" : r.message);
   }
@@ -153,7 +156,8 @@ outputs:
     - {name: tip, node: B, quantities: [position]}
     - {name: face, body: bar, point: [0.5363, 0.0059, -0.0063], quantities: [position]}
     - {name: p, body: bar, point: [0, 0, 0], quantities: [position, deformation]}
-)", "BAR", *dir_ + "/bar.h5");
+)",
+                                          "BAR", *dir_ + "/bar.h5");
   const auto probes = RunScene(Folder("static"), scene);
 
   // The unreduced model: its K over the model DOFs (RBE2 couplings folded in), the root's six
@@ -168,7 +172,8 @@ outputs:
   std::vector<Eigen::Triplet<double>> entries;
   for (int c = 0; c < full.K.outerSize(); ++c)
     for (SparseMatrix::InnerIterator it(full.K, c); it; ++it)
-      if (index[size_t(it.row())] >= 0 && index[size_t(c)] >= 0) entries.emplace_back(index[size_t(it.row())], index[size_t(c)], it.value());
+      if (index[size_t(it.row())] >= 0 && index[size_t(c)] >= 0)
+        entries.emplace_back(index[size_t(it.row())], index[size_t(c)], it.value());
   SparseMatrix K(n_free, n_free);
   K.setFromTriplets(entries.begin(), entries.end());
   Eigen::VectorXd f = Eigen::VectorXd::Zero(n_free);
@@ -186,8 +191,8 @@ outputs:
 
   const auto odd = [&](const std::string& name) { return 0.5 * (probes.at(name)[1] - probes.at(name)[2]); };
   const Eigen::Vector3d moved(odd("p.position.x"), odd("p.position.y"), odd("p.position.z"));
-  std::printf("point (0.4637, 0.0191, 0.0313): deflection %.9e %.9e %.9e, unreduced model %.9e %.9e %.9e\n", moved.x(), moved.y(),
-              moved.z(), reference.x(), reference.y(), reference.z());
+  std::printf("point (0.4637, 0.0191, 0.0313): deflection %.9e %.9e %.9e, unreduced model %.9e %.9e %.9e\n", moved.x(),
+              moved.y(), moved.z(), reference.x(), reference.y(), reference.z());
   EXPECT_LT((moved - reference).norm(), 1e-6 * reference.norm());
   // The deformation is the elastic part relative to the floating frame: not the displacement
   // of a clamped bar, but with it the same size (the frame moves little).
@@ -195,7 +200,8 @@ outputs:
   EXPECT_GT(deformation.norm(), 1e-3 * reference.norm());
   (void)face_centre;
   const auto at_step = [&](const std::string& name, int i) {
-    return Eigen::Vector3d(probes.at(name + ".x")[size_t(i)], probes.at(name + ".y")[size_t(i)], probes.at(name + ".z")[size_t(i)]);
+    return Eigen::Vector3d(probes.at(name + ".x")[size_t(i)], probes.at(name + ".y")[size_t(i)],
+                           probes.at(name + ".z")[size_t(i)]);
   };
   for (int i : {1, 2}) {
     const Eigen::Vector3d moved_node = at_step("tip.position", i) - at_step("tip.position", 0);
@@ -212,9 +218,9 @@ outputs:
 // floating frame's nonlinearity is taken out with +F and -F, as above.
 TEST(BeamPointProbe, PointsBetweenNodesFollowBeamTheory) {
   const std::string dir = Folder("beam");
-  const std::string part = test::StraightBeamYaml(1.0, 4, "{shape: general, A: 1.0e-4, Iy: 1.0e-8, Iz: 1.0e-8, J: 2.0e-8}",
-                                                  "{E: 2.1e11, nu: 0.3, rho: 7850}", "[{name: A}, {name: B}]",
-                                                  "reduction: {internal_modes: 4, keep_mesh: true}\n");
+  const std::string part = test::StraightBeamYaml(
+      1.0, 4, "{shape: general, A: 1.0e-4, Iy: 1.0e-8, Iz: 1.0e-8, J: 2.0e-8}", "{E: 2.1e11, nu: 0.3, rho: 7850}",
+      "[{name: A}, {name: B}]", "reduction: {internal_modes: 4, keep_mesh: true}\n");
   WriteSuperelementFile(test::Reduce(part), dir + "/beam.h5");
   const std::string scene = test::Replace(R"(name: beam_static
 units: SI
@@ -233,13 +239,15 @@ outputs:
     - {name: tip, node: b, quantities: [position]}
     - {name: axis, body: beam, point: [0.37, 0, 0], quantities: [position]}
     - {name: off, body: beam, point: [0.37, 0.01, 0], quantities: [position]}
-)", "BEAM", dir + "/beam.h5");
+)",
+                                          "BEAM", dir + "/beam.h5");
   const auto probes = RunScene(dir, scene);
   const auto odd = [&](const std::string& name) { return 0.5 * (probes.at(name)[1] - probes.at(name)[2]); };
   const double EI = 2.1e11 * 1e-8, x = 0.37;
   const double w = x * x * (3 - x) / (6 * EI), slope = x * (2 - x) / (2 * EI), tip = 1.0 / (3 * EI);
-  std::printf("x = 0.37 L: deflection %.9e (beam theory %.9e), off-axis point's axial motion %.9e (%.9e); tip %.9e (%.9e)\n",
-              odd("axis.position.y"), w, odd("off.position.x"), -0.01 * slope, odd("tip.position.y"), tip);
+  std::printf(
+      "x = 0.37 L: deflection %.9e (beam theory %.9e), off-axis point's axial motion %.9e (%.9e); tip %.9e (%.9e)\n",
+      odd("axis.position.y"), w, odd("off.position.x"), -0.01 * slope, odd("tip.position.y"), tip);
   EXPECT_LT(std::abs(odd("tip.position.y") - tip), 1e-6 * tip);
   EXPECT_LT(std::abs(odd("axis.position.y") - w), 1e-6 * tip);
   EXPECT_LT(std::abs(odd("axis.position.x")), 1e-6 * tip);
@@ -273,7 +281,8 @@ outputs:
   animation: false
   probes:
     - {name: p, body: bar, point: [0, 0, 0], quantities: [position, velocity, acceleration]}
-)", "BAR", *dir_ + "/bar.h5");
+)",
+                                          "BAR", *dir_ + "/bar.h5");
   std::map<std::string, double> errors[2];
   for (int run = 0; run < 2; ++run) {
     const auto probes = RunScene(Folder("dynamic"), test::Replace(scene, "STEP", run == 0 ? "1.0e-5" : "5.0e-6"));
@@ -290,8 +299,10 @@ outputs:
         v_error = std::max(v_error, std::abs((x[i + 1] - x[i - 1]) / dt - v[i]));
         a_error = std::max(a_error, std::abs((v[i + 1] - v[i - 1]) / dt - a[i]));
       }
-      std::printf("h = %s, %s: velocity peak %.4g, largest difference from d/dt position %.3g; acceleration peak %.4g, "
-                  "from d/dt velocity %.3g\n", run == 0 ? "10 us" : "5 us", c, v_peak, v_error, a_peak, a_error);
+      std::printf(
+          "h = %s, %s: velocity peak %.4g, largest difference from d/dt position %.3g; acceleration peak %.4g, "
+          "from d/dt velocity %.3g\n",
+          run == 0 ? "10 us" : "5 us", c, v_peak, v_error, a_peak, a_error);
       EXPECT_GT(v_peak, 0.0);
       errors[run][std::string("v") + c] = v_error / v_peak;
       errors[run][std::string("a") + c] = a_error / a_peak;
@@ -326,7 +337,8 @@ outputs:
   animation: false
   probes:
     - {name: p, body: bar, point: [0.6, 0.045, 0.04], quantities: [position, velocity, acceleration]}
-)", "BAR", *dir_ + "/bar.h5");
+)",
+                                          "BAR", *dir_ + "/bar.h5");
   const auto probes = RunScene(Folder("turning"), scene);
   const std::vector<double>& t = probes.at("time");
   double worst_a = 0, worst_v = 0;
@@ -335,15 +347,18 @@ outputs:
     if (t[i] < 0.5 - 1e-12) continue;
     // The axis: x through the root face's centroid (0, 0.025, 0.025).
     const Eigen::Vector3d r(0.0, probes.at("p.position.y")[i] - 0.025, probes.at("p.position.z")[i] - 0.025);
-    const Eigen::Vector3d a(probes.at("p.acceleration.x")[i], probes.at("p.acceleration.y")[i], probes.at("p.acceleration.z")[i]);
+    const Eigen::Vector3d a(probes.at("p.acceleration.x")[i], probes.at("p.acceleration.y")[i],
+                            probes.at("p.acceleration.z")[i]);
     const Eigen::Vector3d v(probes.at("p.velocity.x")[i], probes.at("p.velocity.y")[i], probes.at("p.velocity.z")[i]);
     const Eigen::Vector3d a_ref = -1e4 * r, v_ref = 100.0 * Eigen::Vector3d::UnitX().cross(r);
     worst_a = std::max(worst_a, (a - a_ref).norm() / a_ref.norm());
     worst_v = std::max(worst_v, (v - v_ref).norm() / v_ref.norm());
     ++checked;
   }
-  std::printf("turning at 100 rad/s: point acceleration within %.2e of omega^2 r, velocity within %.2e of omega r (%d outputs)\n",
-              worst_a, worst_v, checked);
+  std::printf(
+      "turning at 100 rad/s: point acceleration within %.2e of omega^2 r, velocity within %.2e of omega r (%d "
+      "outputs)\n",
+      worst_a, worst_v, checked);
   EXPECT_GT(checked, 900);
   EXPECT_LT(worst_a, 1e-6);
   EXPECT_LT(worst_v, 1e-6);
@@ -374,7 +389,8 @@ outputs:
   probes:
     - {name: pin, node: pin, quantities: [joint, effort]}
     - {name: com, body: arm, point: [0.3, 0, 0], quantities: [position]}
-)", "DRIVE", drive);
+)",
+                                            "DRIVE", drive);
     const auto probes = RunScene(Folder("pendulum"), scene);
     const bool linear = drive.find("linear") != std::string::npos;
     double peak = 0, error = 0, radius_error = 0;
@@ -386,9 +402,11 @@ outputs:
       EXPECT_NEAR(probes.at("pin.joint.0")[i], theta, 1e-9);
       peak = std::max(peak, std::abs(torque));
       error = std::max(error, std::abs(probes.at("pin.effort.0")[i] - torque));
-      radius_error = std::max(radius_error, std::abs(std::hypot(probes.at("com.position.x")[i], probes.at("com.position.y")[i]) - l));
+      radius_error = std::max(radius_error,
+                              std::abs(std::hypot(probes.at("com.position.x")[i], probes.at("com.position.y")[i]) - l));
     }
-    std::printf("pendulum, drive %s: effort within %.2e of I alpha + m g l cos(theta) (peak %.4g N m)\n", drive.c_str(), error, peak);
+    std::printf("pendulum, drive %s: effort within %.2e of I alpha + m g l cos(theta) (peak %.4g N m)\n", drive.c_str(),
+                error, peak);
     EXPECT_LT(error, 1e-8 * peak);
     EXPECT_LT(radius_error, 1e-9);
   }
@@ -431,7 +449,8 @@ outputs:
   const std::vector<double>& t = probes.at("time");
   const auto energy = [&](size_t i) {
     return probes.at("kinetic_energy")[i] +
-           9.81 * (0.4 * probes.at("g1.position.y")[i] + 1.2 * probes.at("g2.position.y")[i] + 0.9 * probes.at("g3.position.y")[i]);
+           9.81 * (0.4 * probes.at("g1.position.y")[i] + 1.2 * probes.at("g2.position.y")[i] +
+                   0.9 * probes.at("g3.position.y")[i]);
   };
   double peak = 0, error = 0;
   for (size_t i = 1; i + 1 < t.size(); ++i) {
@@ -458,7 +477,8 @@ outputs:
   stresses: true
   probes:
     - PROBE
-)", "BAR", *dir_ + "/bar.h5");
+)",
+                                         "BAR", *dir_ + "/bar.h5");
   const std::string dir = Folder("bad");
   const auto message = [&](const std::string& probe, const std::string& extra = "") {
     std::ofstream(dir + "/scene.yaml") << test::Replace(base, "PROBE", probe) + extra;
@@ -469,15 +489,18 @@ outputs:
   EXPECT_NE(outside.find("scene.yaml:"), std::string::npos) << outside;
   const std::string effort = message("{name: e, node: B, quantities: [effort]}");
   EXPECT_NE(effort.find("probe 'e': node 'B' has no prescribed joint coordinate"), std::string::npos) << effort;
-  const std::string exclude =
-      message("{name: t, node: B, quantities: [position]}", "  stress_exclude: {distance: 0.01, interfaces: [bar.middle]}\n");
-  EXPECT_NE(exclude.find("stress_exclude.interfaces: body 'bar' has no interface 'middle' (it has: root, tip)"), std::string::npos)
+  const std::string exclude = message("{name: t, node: B, quantities: [position]}",
+                                      "  stress_exclude: {distance: 0.01, interfaces: [bar.middle]}\n");
+  EXPECT_NE(exclude.find("stress_exclude.interfaces: body 'bar' has no interface 'middle' (it has: root, tip)"),
+            std::string::npos)
       << exclude;
   // Just outside a face (less than the mesh size): the nearest mesh node, said in the log.
-  std::ofstream(dir + "/scene.yaml") << test::Replace(base, "PROBE", "{name: p, body: bar, point: [0.5, 0.0501, 0.025], quantities: [position]}");
+  std::ofstream(dir + "/scene.yaml") << test::Replace(
+      base, "PROBE", "{name: p, body: bar, point: [0.5, 0.0501, 0.025], quantities: [position]}");
   const Scene scene = BuildScene(ReadSceneFile(dir + "/scene.yaml"));
   bool said = false;
-  for (const std::string& note : scene.notes) said |= note.find("probe 'p': body 'bar' at its mesh node") != std::string::npos;
+  for (const std::string& note : scene.notes)
+    said |= note.find("probe 'p': body 'bar' at its mesh node") != std::string::npos;
   EXPECT_TRUE(said);
   fs::remove_all(dir);
 }
