@@ -183,10 +183,10 @@ SceneSpec ParseScene(const std::string& text, const std::string& name, const std
       if (other.name == b.name) item.Fail("body name '" + b.name + "' used twice");
     }
     if (auto t = m.Optional("type")) {
-      const std::string name = t->String();
-      if (name != "superelement" && name != "rigid")
-        t->Fail("unknown body type '" + name + "' (known: superelement, rigid)");
-      b.type = name == "rigid" ? SceneBodyType::kRigid : SceneBodyType::kSuperelement;
+      const std::string kind = t->String();
+      if (kind != "superelement" && kind != "rigid")
+        t->Fail("unknown body type '" + kind + "' (known: superelement, rigid)");
+      b.type = kind == "rigid" ? SceneBodyType::kRigid : SceneBodyType::kSuperelement;
     }
     if (b.type == SceneBodyType::kSuperelement) {
       b.superelement = m.Required("superelement").String();
@@ -270,30 +270,30 @@ SceneSpec ParseScene(const std::string& text, const std::string& name, const std
       SceneJointSpec j;
       j.where = item.Where();
       YamlValue type = m.Required("type");
-      const std::string name = type.String();
-      const bool axial = name == "revolute" || name == "prismatic" || name == "cylindrical" || name == "universal";
-      if (name != "clamp" && name != "spherical" && name != "rigid" && !axial) {
-        type.Fail("unknown joint type '" + name +
+      const std::string kind = type.String();
+      const bool axial = kind == "revolute" || kind == "prismatic" || kind == "cylindrical" || kind == "universal";
+      if (kind != "clamp" && kind != "spherical" && kind != "rigid" && !axial) {
+        type.Fail("unknown joint type '" + kind +
                   "' (known: clamp, spherical, revolute, prismatic, cylindrical, universal, rigid)");
       }
       static const SceneJointType all[] = {SceneJointType::kClamp,     SceneJointType::kRigid,
                                            SceneJointType::kSpherical, SceneJointType::kRevolute,
                                            SceneJointType::kPrismatic, SceneJointType::kCylindrical,
                                            SceneJointType::kUniversal};
-      j.type = *std::find_if(std::begin(all), std::end(all), [&](SceneJointType x) { return name == Name(x); });
+      j.type = *std::find_if(std::begin(all), std::end(all), [&](SceneJointType x) { return kind == Name(x); });
       j.node = check_node(m.Required("node"));
       if (auto p = m.Optional("parent")) {
         j.parent = check_node(*p);
         if (j.parent == j.node) p->Fail("a node cannot be its own parent");
-        if (name == "clamp") type.Fail("a clamp holds a node to the ground; between two nodes use 'rigid'");
-      } else if (name == "rigid") {
+        if (kind == "clamp") type.Fail("a clamp holds a node to the ground; between two nodes use 'rigid'");
+      } else if (kind == "rigid") {
         type.Fail("a rigid joint needs a 'parent' node (to the ground use 'clamp')");
       }
       if (axial) {
         YamlValue axis = m.Required("axis");
         j.axis = axis.Vector3();
         if (j.axis.norm() == 0) axis.Fail("axis must not be zero");
-        if (name == "universal") {
+        if (kind == "universal") {
           YamlValue axis2 = m.Required("axis2");
           j.axis2 = axis2.Vector3();
           if (std::abs(j.axis.normalized().dot(j.axis2.normalized())) > 1e-6) {
@@ -301,8 +301,8 @@ SceneSpec ParseScene(const std::string& text, const std::string& name, const std
           }
         }
         if (auto v = m.Optional("prescribed")) {
-          if (name == "cylindrical" || name == "universal") {
-            v->Fail("prescribed motion of a " + name + " joint is not supported; use revolute or prismatic");
+          if (kind == "cylindrical" || kind == "universal") {
+            v->Fail("prescribed motion of a " + kind + " joint is not supported; use revolute or prismatic");
           }
           j.prescribed = v->String();
           if (!scene.functions.count(j.prescribed))
@@ -326,8 +326,8 @@ SceneSpec ParseScene(const std::string& text, const std::string& name, const std
       SceneLoadSpec l;
       l.where = item.Where();
       YamlValue type = m.Required("type");
-      const std::string name = type.String();
-      if (name == "force") {
+      const std::string kind = type.String();
+      if (kind == "force") {
         l.type = SceneLoadType::kForce;
         l.node = check_node(m.Required("node"));
         if (auto v = m.Optional("force")) l.force = v->Vector3();
@@ -338,10 +338,10 @@ SceneSpec ParseScene(const std::string& text, const std::string& name, const std
           if (!scene.functions.count(l.function))
             v->Fail("time function '" + l.function + "' is not defined under 'functions'");
         }
-      } else if (name == "gravity") {
+      } else if (kind == "gravity") {
         l.type = SceneLoadType::kGravity;
         l.g = m.Required("g").Vector3();
-      } else if (name == "spring") {
+      } else if (kind == "spring") {
         l.type = SceneLoadType::kSpring;
         l.node = check_node(m.Required("node"));
         auto node_b = m.Optional("node_b");
@@ -361,7 +361,7 @@ SceneSpec ParseScene(const std::string& text, const std::string& name, const std
           if (l.free_length < 0) v->Fail("free length must be >= 0");
         }
       } else {
-        type.Fail("unknown load type '" + name + "' (known: force, gravity, spring)");
+        type.Fail("unknown load type '" + kind + "' (known: force, gravity, spring)");
       }
       m.CheckNoUnknownKeys();
       scene.loads.push_back(l);
@@ -488,10 +488,10 @@ SceneSpec ParseScene(const std::string& text, const std::string& name, const std
       if (!(scene.stress_exclude.distance >= 0)) distance.Fail("stress_exclude.distance must be >= 0 (a length)");
       if (auto list = em.Optional("interfaces")) {
         for (const YamlValue& item : list->List()) {
-          const std::string name = item.String();
-          if (name.find('.') == std::string::npos)
-            item.Fail("stress_exclude.interfaces: '" + name + "' is not <body>.<interface>");
-          scene.stress_exclude.interfaces.push_back(name);
+          const std::string entry = item.String();
+          if (entry.find('.') == std::string::npos)
+            item.Fail("stress_exclude.interfaces: '" + entry + "' is not <body>.<interface>");
+          scene.stress_exclude.interfaces.push_back(entry);
         }
       }
       em.CheckNoUnknownKeys();

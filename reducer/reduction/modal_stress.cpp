@@ -198,9 +198,9 @@ ModalStress BeamModalStress(const PartSpec& part, const Eigen::MatrixXd& shapes,
           length += g.weight;
         }
         Q /= length;
-        long k = 0;
+        long entry = 0;
         for (long i = 0; i < m; ++i)
-          for (long j = i; j < m; ++j) out.element_quadratic(e, k++) = float(Q(i, j));
+          for (long j = i; j < m; ++j) out.element_quadratic(e, entry++) = float(Q(i, j));
       }
       Eigen::MatrixXd ends(12, m);
       ends.topRows(6) = -f.topRows(6);

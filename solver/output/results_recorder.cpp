@@ -349,20 +349,20 @@ void ResultsRecorder::Record(double t, const SystemState& state, const Eigen::Ve
         // The material point: s = s0 + u from the frame origin in frame axes, u = shape q_loc
         // (SuperelementBody::LocalRates for its velocity and acceleration).
         const int b = point.body;
-        const FrameSolution& frame = state.frames[size_t(b)];
+        const FrameSolution& body_frame = state.frames[size_t(b)];
         const Eigen::Vector3d u = point.shape * q_loc_[size_t(b)];
         const Eigen::Vector3d r = point.s0 + u;
-        if (q == ProbeQuantity::kPosition) put3(scene_.origin + frame.x + frame.R * r);
-        if (q == ProbeQuantity::kDeformation) put3(frame.R * u);
+        if (q == ProbeQuantity::kPosition) put3(scene_.origin + body_frame.x + body_frame.R * r);
+        if (q == ProbeQuantity::kDeformation) put3(body_frame.R * u);
         if (q == ProbeQuantity::kVelocity) {
           const SuperelementBody::LocalMotion& m = motion_of(b);
-          put3(frame.R * (m.V + m.Omega.cross(r) + point.shape * m.qdot));
+          put3(body_frame.R * (m.V + m.Omega.cross(r) + point.shape * m.qdot));
         }
         if (q == ProbeQuantity::kAcceleration) {
           const SuperelementBody::LocalMotion& m = motion_of(b);
           const Eigen::Vector3d ud = point.shape * m.qdot, udd = point.shape * m.qddot;
-          put3(frame.R * (m.Vdot + m.Omega.cross(m.V) + m.Omegadot.cross(r) + m.Omega.cross(m.Omega.cross(r)) +
-                          2.0 * m.Omega.cross(ud) + udd));
+          put3(body_frame.R * (m.Vdot + m.Omega.cross(m.V) + m.Omegadot.cross(r) + m.Omega.cross(m.Omega.cross(r)) +
+                               2.0 * m.Omega.cross(ud) + udd));
         }
       }
       continue;

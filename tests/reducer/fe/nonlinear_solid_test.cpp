@@ -112,7 +112,7 @@ TEST_P(NonlinearElement, LargeRigidRotationCostsNothing) {
 
 INSTANTIATE_TEST_SUITE_P(Types, NonlinearElement,
                          ::testing::Values(SolidType::kTet4, SolidType::kTet10, SolidType::kHex8, SolidType::kHex20),
-                         [](const auto& info) { return SolidTypeName(info.param); });
+                         [](const auto& test) { return SolidTypeName(test.param); });
 
 TEST(NonlinearSolid, UniaxialStretchMatchesTheClosedForm) {
   // Unit cube (HEX8), nu = 0, u_x = (lambda - 1) X: S_xx = E (lambda^2 - 1) / 2, first Piola-

@@ -99,10 +99,10 @@ void CheckAgainstFiniteDifferences(const Superelement& se, const SuperelementOpt
     // body by ~1/sqrt(mass), so their step is 1e-6 of the body size in displacement (a 2 g leaf:
     // 2e-9); a coordinate that turns the floating frame strongly (a thin leaf's torsion mode) gets
     // a proportionally smaller one.
-    double size = 0.0;
+    double extent = 0.0;
     for (const InterfaceNode& node : se.interfaces)
-      size = std::max(size, (node.position - se.mass_properties.center_of_mass).norm());
-    const double h = (i < se.n_interface_dofs() ? 1e-6 : 1e-6 * size * std::sqrt(se.mass_properties.mass)) /
+      extent = std::max(extent, (node.position - se.mass_properties.center_of_mass).norm());
+    const double h = (i < se.n_interface_dofs() ? 1e-6 : 1e-6 * extent * std::sqrt(se.mass_properties.mass)) /
                      std::max(1.0, se.floating_frame.Phi_CB.col(i).norm());
     const Evaluation plus = Evaluate(body, Perturb(c, e, h), frame);
     const Evaluation minus = Evaluate(body, Perturb(c, e, -h), frame);
@@ -418,8 +418,8 @@ TEST(SuperelementBody, InertiaForceIsTheLagrangianDerivativeAlongAMotion) {
       // p = MassTimes (dT/dw), s = MomentumSource at the body's data, with its local term.
       auto momentum_exact = [&](double time) {
         const BodyConfiguration ct = config(time);
-        const SuperelementBody::Data dt = body.Evaluate(ct, body.SolveFrame(ct, body.GuessFrame(ct)));
-        return Eigen::VectorXd(body.MassTimes(dt, velocity(time)));
+        const SuperelementBody::Data data = body.Evaluate(ct, body.SolveFrame(ct, body.GuessFrame(ct)));
+        return Eigen::VectorXd(body.MassTimes(data, velocity(time)));
       };
       const Eigen::VectorXd pdot_exact = (momentum_exact(t + dt) - momentum_exact(t - dt)) / (2 * dt);
       const SuperelementBody::Data d = body.Evaluate(c, body.SolveFrame(c, body.GuessFrame(c)));

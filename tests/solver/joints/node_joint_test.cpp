@@ -187,16 +187,16 @@ void DoublePendulum(JointType second, const Eigen::Vector3d& spin, Integrator in
     }
     DynamicState s = InitialDynamicState(model, InitialState(model), W0);
     const DynamicStepReport r0 = Measure(model, s);
-    DynamicOptions options;
-    options.step = h;
-    options.end_time = 1.0;
-    options.rho_inf = 1.0;
-    options.integrator = integrator;
+    DynamicOptions run_options;
+    run_options.step = h;
+    run_options.end_time = 1.0;
+    run_options.rho_inf = 1.0;
+    run_options.integrator = integrator;
     *drift = 0;
     *min_y = 0;
     const double scale = 2 * se.mass_properties.mass * 9.81 * L;  // energy scale
     const DynamicResult result =
-        SolveDynamic(model, s, options, [&](const DynamicStepReport& r, const DynamicState& st) {
+        SolveDynamic(model, s, run_options, [&](const DynamicStepReport& r, const DynamicState& st) {
           const double E = r.kinetic_energy + r.elastic_energy - r.external_work;
           *drift = std::max(*drift, std::abs(E - (r0.kinetic_energy + r0.elastic_energy)) / scale);
           *min_y = std::min(*min_y, st.config.x[3].y());
