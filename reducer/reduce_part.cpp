@@ -55,9 +55,6 @@ Eigen::MatrixXd ReadShapes(const std::string& path, long rows) {
   return V;
 }
 
-}  // namespace
-namespace {
-
 // The pairs of Craig-Bampton coordinates whose modal derivatives are asked for.
 std::vector<std::pair<int, int>> DerivativePairs(const PartSpec& part, int n_interface_dofs, int n_cb) {
   const ModalDerivativeSpec& spec = part.reduction.modal_derivatives;
@@ -84,34 +81,36 @@ SolidType SolidCellType(const std::string& name) {
   throw InputError("no solid element type '" + name + "'");
 }
 
-}  // namespace
-
-ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
-  ReduceResult result;
-  Provenance& prov = result.superelement.provenance;
-  auto report = [&](const std::string& stage, double seconds, const std::string& detail) {
-    prov.stage_seconds.emplace_back(stage, seconds);
-    if (progress) progress(stage, seconds, detail);
-  };
-
+// The FE model of the part: meshed solids, imported matrices or beams.
+FeModel BuildFeModel(const PartSpec& part, const ProgressFn& report) {
+  if (part.type == "solid") return BuildSolidModel(part, report);
+  if (part.type == "imported") return BuildImportedModel(part, report);
   Stopwatch clock;
-  char detail[640];
-  FeModel model;
-  if (part.type == "solid") {
-    model = BuildSolidModel(part, report);
-  } else if (part.type == "imported") {
-    model = BuildImportedModel(part, report);
-  } else {
-    model = BuildBeamModel(part);
-    std::snprintf(detail, sizeof detail, "%ld nodes, %ld %s elements, %ld DOFs", model.n_nodes(), model.n_elements(),
-                  model.element_type.c_str(), model.n_dofs());
-    report("mesh+assembly", clock.Seconds(), detail);
-  }
+  FeModel model = BuildBeamModel(part);
+  char detail[200];
+  std::snprintf(detail, sizeof detail, "%ld nodes, %ld %s elements, %ld DOFs", model.n_nodes(), model.n_elements(),
+                model.element_type.c_str(), model.n_dofs());
+  report("mesh+assembly", clock.Seconds(), detail);
+  return model;
+}
 
-  // What needs only the mesh and the mass is refused before the factorization and eigen solve.
+// What the factorization may use, from the checks that need only the mesh and the mass.
+struct Budget {
+  bool keep_mesh = false;
+  double dense_bytes = 0.0;   ///< the dense blocks the reduction keeps
+  double factor_bytes = 0.0;  ///< what is left for the factor of K_ii (0: no limit known)
+  bool limit_given = false;   ///< reduction.memory_limit_gb (else MemAvailable)
+};
+
+// Refuses before the factorization and eigen solve what needs only the mesh and the mass: the
+// floating frame, stresses without the mesh, more modes than interior DOFs. The memory for the
+// factor of K_ii is what is left beside the dense blocks the reduction keeps (constraint modes,
+// Lanczos vectors, the mode shapes of the full model).
+Budget CheckBeforeFactorization(const PartSpec& part, const FeModel& model) {
   CheckFloatingFrame(part.reduction.floating_frame, part.reduction.where_floating_frame, model);
-  const bool keep_mesh = part.reduction.keep_mesh.value_or(model.n_dofs() <= ReductionSpec::kKeepMeshMaxDofs);
-  if (!keep_mesh && part.reduction.stresses.value_or(false)) {
+  Budget budget;
+  budget.keep_mesh = part.reduction.keep_mesh.value_or(model.n_dofs() <= ReductionSpec::kKeepMeshMaxDofs);
+  if (!budget.keep_mesh && part.reduction.stresses.value_or(false)) {
     throw InputError(part.reduction.where_stresses +
                      ": reduction.stresses: true needs the mesh, which is not kept for "
                      "more than " +
@@ -124,74 +123,98 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
                      " exceeds the " + std::to_string(n_interior) +
                      " interior DOFs of the mesh (refine it or keep fewer modes)");
   }
-  // Memory for the factor of K_ii: what is left beside the dense blocks the reduction keeps
-  // (constraint modes, Lanczos vectors, the mode shapes of the full model).
   const int n_b = 6 * int(model.interface_names.size()), m = part.reduction.internal_modes;
-  const double dense_bytes = 8.0 * double(model.n_dofs()) * (2.0 * (n_b + m) + 2.0 * m + 20.0);
-  const double limit =
-      part.reduction.memory_limit_gb > 0 ? part.reduction.memory_limit_gb * 1e9 : AvailableMemoryBytes();
-  const double factor_budget = limit > 0 ? std::max(limit - dense_bytes, 0.1 * limit) : 0.0;
-  // Modal derivatives: (dK/dq_j) phi_i = 2 f2(phi_i, phi_j), the symmetric bilinear part of the
-  // cubic internal force f(u) = K u + f2(u, u) + f3(u, u, u) of the nonlinear model (solids:
-  // Green-Lagrange; beams: moderate rotation), by the exact polarization identity
-  // 8 f2(a, b) = [f(a + b) - f(a - b)] - [f(b - a) - f(-a - b)] (the linear and cubic terms
-  // cancel), evaluated at displacements scaled to 1e-6 of the part size (round-off ~1e-10).
-  DerivativeRequest request;
-  std::unique_ptr<NonlinearModel> nonlinear;
-  SparseMatrix to_model_dofs = model.mesh_map;  // the nonlinear model's DOFs = this x model DOFs
-  // The Green-Lagrange (solids) or von Karman (beams) model, built once for the derivatives
-  // and the geometric stiffening.
-  auto make_nonlinear = [&] {
-    if (nonlinear) return;
-    if (part.type == "solid" || part.type == "imported") {
-      nonlinear =
-          std::make_unique<SvkSolidMesh>(SolidCellType(model.cell_type), model.nodes, model.cells, part.material);
+  budget.dense_bytes = 8.0 * double(model.n_dofs()) * (2.0 * (n_b + m) + 2.0 * m + 20.0);
+  budget.limit_given = part.reduction.memory_limit_gb > 0;
+  const double limit = budget.limit_given ? part.reduction.memory_limit_gb * 1e9 : AvailableMemoryBytes();
+  budget.factor_bytes = limit > 0 ? std::max(limit - budget.dense_bytes, 0.1 * limit) : 0.0;
+  return budget;
+}
+
+// The Green-Lagrange (solids, imported meshes) or von Karman (beams) model of the part, built on
+// first use for the modal derivatives and the geometric stiffening, and the map from the FE
+// model's DOFs to its own (its DOFs = to_model_dofs() x the model's).
+class NonlinearModelOf {
+ public:
+  NonlinearModelOf(const PartSpec& part, const FeModel& model)
+      : part_(part), model_(model), to_model_dofs_(model.mesh_map) {}
+  const NonlinearModel& Get() {
+    if (nonlinear_) return *nonlinear_;
+    if (part_.type == "solid" || part_.type == "imported") {
+      nonlinear_ =
+          std::make_unique<SvkSolidMesh>(SolidCellType(model_.cell_type), model_.nodes, model_.cells, part_.material);
     } else {
-      nonlinear = std::make_unique<VonKarmanBeams>(part);
-      to_model_dofs.resize(model.n_dofs(), model.n_dofs());
-      to_model_dofs.setIdentity();
+      nonlinear_ = std::make_unique<VonKarmanBeams>(part_);
+      to_model_dofs_.resize(model_.n_dofs(), model_.n_dofs());
+      to_model_dofs_.setIdentity();
     }
-  };
-  if (part.reduction.modal_derivatives.enabled) {
-    request.pairs = DerivativePairs(part, n_b, n_b + m);
-    request.tolerance = part.reduction.modal_derivatives.tolerance;
-    make_nonlinear();
-    const double size = (model.nodes.colwise().maxCoeff() - model.nodes.colwise().minCoeff()).norm();
-    request.stiffness_derivative = [&, size](const Eigen::MatrixXd& shapes,
-                                             const std::vector<std::pair<int, int>>& pairs) {
-      const SparseMatrix& T = to_model_dofs;
-      const Eigen::MatrixXd mesh_shapes = T * shapes;
-      Eigen::MatrixXd out(model.n_dofs(), long(pairs.size()));
-      for (size_t k = 0; k < pairs.size(); ++k) {
-        const Eigen::VectorXd a0 = mesh_shapes.col(pairs[k].first), b0 = mesh_shapes.col(pairs[k].second);
-        const double sa = 1e-6 * size / std::max(a0.cwiseAbs().maxCoeff(), 1e-300);
-        const double sb = 1e-6 * size / std::max(b0.cwiseAbs().maxCoeff(), 1e-300);
-        const Eigen::VectorXd a = sa * a0, b = sb * b0;
-        const Eigen::VectorXd f2 = ((nonlinear->Force(a + b) - nonlinear->Force(a - b)) -
-                                    (nonlinear->Force(b - a) - nonlinear->Force(-a - b))) /
-                                   8;
-        out.col(long(k)) = T.transpose() * (2 * f2 / (sa * sb));
-      }
-      return out;
-    };
+    return *nonlinear_;
   }
-  // Geometric stiffening: the unit inertia load cases are solved on the same factor.
-  // A basis without deformation (one interface node, no internal modes: the six rigid motions)
-  // has nothing to stiffen, and its exact and corotational kinetic energies are the same.
+  bool built() const { return nonlinear_ != nullptr; }
+  const SparseMatrix& to_model_dofs() const { return to_model_dofs_; }
+
+ private:
+  const PartSpec& part_;
+  const FeModel& model_;
+  std::unique_ptr<NonlinearModel> nonlinear_;
+  SparseMatrix to_model_dofs_;
+};
+
+// Modal derivatives: (dK/dq_j) phi_i = 2 f2(phi_i, phi_j), the symmetric bilinear part of the
+// cubic internal force f(u) = K u + f2(u, u) + f3(u, u, u) of the nonlinear model (solids:
+// Green-Lagrange; beams: moderate rotation), by the exact polarization identity
+// 8 f2(a, b) = [f(a + b) - f(a - b)] - [f(b - a) - f(-a - b)] (the linear and cubic terms
+// cancel), evaluated at displacements scaled to 1e-6 of the part size (round-off ~1e-10).
+// No pairs when the part asks for none. The request refers to `nonlinear` and `model`.
+DerivativeRequest ModalDerivativeRequest(const PartSpec& part, const FeModel& model, NonlinearModelOf& nonlinear) {
+  DerivativeRequest request;
+  if (!part.reduction.modal_derivatives.enabled) return request;
+  const int n_b = 6 * int(model.interface_names.size());
+  request.pairs = DerivativePairs(part, n_b, n_b + part.reduction.internal_modes);
+  request.tolerance = part.reduction.modal_derivatives.tolerance;
+  nonlinear.Get();
+  const double size = (model.nodes.colwise().maxCoeff() - model.nodes.colwise().minCoeff()).norm();
+  request.stiffness_derivative = [&model, &nonlinear, size](const Eigen::MatrixXd& shapes,
+                                                            const std::vector<std::pair<int, int>>& pairs) {
+    const SparseMatrix& T = nonlinear.to_model_dofs();
+    const NonlinearModel& f = nonlinear.Get();
+    const Eigen::MatrixXd mesh_shapes = T * shapes;
+    Eigen::MatrixXd out(model.n_dofs(), long(pairs.size()));
+    for (size_t k = 0; k < pairs.size(); ++k) {
+      const Eigen::VectorXd a0 = mesh_shapes.col(pairs[k].first), b0 = mesh_shapes.col(pairs[k].second);
+      const double sa = 1e-6 * size / std::max(a0.cwiseAbs().maxCoeff(), 1e-300);
+      const double sb = 1e-6 * size / std::max(b0.cwiseAbs().maxCoeff(), 1e-300);
+      const Eigen::VectorXd a = sa * a0, b = sb * b0;
+      const Eigen::VectorXd f2 = ((f.Force(a + b) - f.Force(a - b)) - (f.Force(b - a) - f.Force(-a - b))) / 8;
+      out.col(long(k)) = T.transpose() * (2 * f2 / (sa * sb));
+    }
+    return out;
+  };
+  return request;
+}
+
+// Why femb's own solid elements cannot be put on an imported part's mesh (empty: they can):
+// only where every cell is a solid femb knows and every DOF a translation.
+std::string WhyNoOwnElements(const FeModel& model) {
+  const std::string& cell = model.cell_type;
+  if (cell != "tet4" && cell != "tet10" && cell != "hex8" && cell != "hex20") return "its mesh has " + cell + " cells";
+  for (size_t d = 0; d < model.dof_component.size(); ++d)
+    if (model.dof_component[d] >= 3 && model.dof_node[d] < model.n_nodes()) return "its matrices have rotational DOFs";
+  return "";
+}
+
+// Whether the file gets geometric stiffening: the unit inertia load cases are then solved on
+// the same factor as the constraint modes. A basis without deformation (one interface node, no
+// internal modes: the six rigid motions) has nothing to stiffen, and its exact and corotational
+// kinetic energies are the same. An imported part has it through femb's own Green-Lagrange solid
+// elements on its mesh with the part's material.
+bool UsesStiffening(const PartSpec& part, const FeModel& model, const ProgressFn& progress) {
+  const int n_b = 6 * int(model.interface_names.size()), m = part.reduction.internal_modes;
   bool stiffening = part.reduction.GeometricStiffening(part.type, part.has_material) && n_b + m > 6;
   if (stiffening && part.type == "imported") {
-    // femb's own Green-Lagrange solid elements on the imported mesh with the part's material:
-    // only where every cell is a solid femb knows and every DOF a translation.
-    std::string why;
-    const std::string& cell = model.cell_type;
-    if (cell != "tet4" && cell != "tet10" && cell != "hex8" && cell != "hex20") {
-      why = "its mesh has " + cell + " cells (femb's solid elements: tet4, tet10, hex8, hex20)";
-    } else {
-      for (size_t d = 0; d < model.dof_component.size() && why.empty(); ++d)
-        if (model.dof_component[d] >= 3 && model.dof_node[d] < model.n_nodes())
-          why = "its matrices have rotational DOFs";
-    }
+    std::string why = WhyNoOwnElements(model);
     if (!why.empty()) {
+      if (why.find("cells") != std::string::npos) why += " (femb's solid elements: tet4, tet10, hex8, hex20)";
       if (part.reduction.geometric_stiffening.value_or(false)) {
         throw InputError(part.file + ": reduction.geometric_stiffening: the imported part cannot have it: " + why);
       }
@@ -204,111 +227,140 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
       progress("stiffening", 0.0,
                "none stored: the basis is the six rigid motions (one interface node, no internal modes)");
   }
-  const Eigen::MatrixXd inertia_fields = stiffening ? InertiaFields(model) : Eigen::MatrixXd();
+  return stiffening;
+}
+
+// The message of a reduction refused for memory: how much, and what to do.
+std::string TooBigMessage(const Budget& budget, const std::string& message) {
+  char why[160];
+  std::snprintf(why, sizeof why, " (%s; %.3g GB kept for the dense blocks of the reduction)",
+                budget.limit_given ? "reduction.memory_limit_gb" : "MemAvailable", budget.dense_bytes / 1e9);
+  return message + why +
+         ": coarsen the mesh (mesh.size), use first-order elements (mesh.order: 1), or run on a "
+         "machine with more memory";
+}
+
+// The free-interface basis: the part's lowest free-free modes with the static constraint modes
+// (which carry the interface stiffness exactly). Into V with its description; false with
+// result.message when the eigen solve fails.
+bool FreeInterfaceShapes(const PartSpec& part, const FeModel& model, const CraigBamptonResult& cb, Eigen::MatrixXd& V,
+                         std::string& source, ReduceResult& result) {
+  const int n_b = 6 * int(model.interface_names.size()), k = part.reduction.internal_modes;
+  Eigen::MatrixXd free_modes;
+  Eigen::VectorXd free_lambda;
+  if (k > 0) {
+    double max_ratio = 0.0;
+    for (int j = 0; j < model.K.outerSize(); ++j) {
+      const double mj = model.M.coeff(j, j);
+      if (mj > 0) max_ratio = std::max(max_ratio, model.K.coeff(j, j) / mj);
+    }
+    const FullModesResult full = FullFreeFreeFrequencies(model, k, 1e-8 * max_ratio, &free_modes, &free_lambda);
+    if (!full.ok) {
+      result.message = "free-free eigen solve failed: " + full.message;
+      return false;
+    }
+  }
+  V.resize(model.n_dofs(), n_b + k);
+  V << cb.shapes.leftCols(n_b), free_modes.rightCols(k);
+  std::string freqs;
+  for (int j = 6; j < std::min<int>(int(free_lambda.size()), 10); ++j) {
+    char b[32];
+    std::snprintf(b, sizeof b, "%s%.4g", freqs.empty() ? "" : ", ", FrequencyHz(free_lambda[j]));
+    freqs += b;
+  }
+  source = std::to_string(k) + " free-free modes (" + freqs + (k > 4 ? ", ..." : "") + " Hz) + " + std::to_string(n_b) +
+           " static modes";
+  return true;
+}
+
+// The general basis: the user's shapes on the imported DOFs or the mesh's, fitted to the model
+// DOFs by least squares (an RBE2 face moves rigidly in the model, the shapes may not). The
+// shapes' rows: the imported matrices' DOFs, or for femb's own parts the mesh's nodes
+// (dofs_per_node each, node-major, the order of /visualization/nodes): the RBE2 couplings
+// eliminate coupled solid nodes (mesh_map); beam DOFs are the model's own.
+Eigen::MatrixXd GeneralShapes(const PartSpec& part, const FeModel& model, std::string& source) {
+  SparseMatrix identity(model.n_dofs(), model.n_dofs());
+  identity.setIdentity();
+  const SparseMatrix& T = model.full_map.size() ? model.full_map : model.mesh_map.size() ? model.mesh_map : identity;
+  const Eigen::MatrixXd V_full = ReadShapes(part.reduction.basis_file, T.rows());
+  Eigen::SimplicialLDLT<SparseMatrix> normal(SparseMatrix(T.transpose() * T));
+  Eigen::MatrixXd V = normal.solve(Eigen::MatrixXd(T.transpose() * V_full));
+  const double off_rigid = (Eigen::MatrixXd(T * V) - V_full).norm() / std::max(V_full.norm(), 1e-300);
+  char b[96];
+  std::snprintf(b, sizeof b, " (%.2g of their norm off the RBE2 faces' rigid motion)", off_rigid);
+  source = std::to_string(V.cols()) + " shapes from " + part.reduction.basis_file + b;
+  return V;
+}
+
+// Thesis 8.2 (reducer/reduction/general_basis.h): replaces cb's basis, K, M and frequencies by
+// the free-interface or general basis' and sets the interface constraint (case 4, m < 6N).
+// false with result.message on a numerical failure.
+bool ReduceOnOtherBasis(const PartSpec& part, const FeModel& model, const ProgressFn& report, CraigBamptonResult& cb,
+                        Eigen::MatrixXd& interface_constraint, ReduceResult& result) {
   const bool free_interface = part.reduction.method == "free_interface";
-  const bool general = part.reduction.method == "general";
-  CraigBamptonResult cb = CraigBamptonReduce(model, free_interface || general ? 0 : part.reduction.internal_modes,
-                                             report, 200, factor_budget, request.pairs.empty() ? nullptr : &request,
-                                             stiffening ? &inertia_fields : nullptr);
-  if (!cb.ok) {
-    result.too_big = cb.factorization.too_big;
-    result.message = cb.message;
-    if (result.too_big) {
-      char why[160];
-      std::snprintf(why, sizeof why, " (%s; %.3g GB kept for the dense blocks of the reduction)",
-                    part.reduction.memory_limit_gb > 0 ? "reduction.memory_limit_gb" : "MemAvailable",
-                    dense_bytes / 1e9);
-      result.message += std::string(why) +
-                        ": coarsen the mesh (mesh.size), use first-order elements (mesh.order: 1), or run on a "
-                        "machine with more memory";
-    }
-    return result;
+  const int n_b = 6 * int(model.interface_names.size());
+  Stopwatch basis_clock;
+  Eigen::MatrixXd V;
+  std::string where, source;
+  if (free_interface) {
+    if (!FreeInterfaceShapes(part, model, cb, V, source, result)) return false;
+    where = part.reduction.where_method + ": reduction.method free_interface";
+  } else {
+    V = GeneralShapes(part, model, source);
+    where = part.reduction.where_basis + ": " + part.reduction.basis_file;
   }
-
-  Eigen::MatrixXd interface_constraint;  // thesis 8.2 case 4 (m < 6N)
-  if (free_interface || general) {
-    // Thesis 8.2 (reducer/reduction/general_basis.h). free_interface: the part's lowest free-free
-    // modes with the static constraint modes (which carry the interface stiffness exactly);
-    // general: the user's shapes on the imported DOFs or the mesh's, fitted to the model DOFs
-    // (least squares: an RBE2 face moves rigidly in the model, the shapes may not).
-    Stopwatch basis_clock;
-    Eigen::MatrixXd V;
-    std::string where, source;
-    if (free_interface) {
-      Eigen::MatrixXd free_modes;
-      Eigen::VectorXd free_lambda;
-      const int k = part.reduction.internal_modes;
-      if (k > 0) {
-        double max_ratio = 0.0;
-        for (int j = 0; j < model.K.outerSize(); ++j) {
-          const double mj = model.M.coeff(j, j);
-          if (mj > 0) max_ratio = std::max(max_ratio, model.K.coeff(j, j) / mj);
-        }
-        const FullModesResult full = FullFreeFreeFrequencies(model, k, 1e-8 * max_ratio, &free_modes, &free_lambda);
-        if (!full.ok) {
-          result.message = "free-free eigen solve failed: " + full.message;
-          return result;
-        }
-      }
-      V.resize(model.n_dofs(), n_b + k);
-      V << cb.shapes.leftCols(n_b), free_modes.rightCols(k);
-      where = part.reduction.where_method + ": reduction.method free_interface";
-      std::string freqs;
-      for (int j = 6; j < std::min<int>(int(free_lambda.size()), 10); ++j) {
-        char b[32];
-        std::snprintf(b, sizeof b, "%s%.4g", freqs.empty() ? "" : ", ", FrequencyHz(free_lambda[j]));
-        freqs += b;
-      }
-      source = std::to_string(k) + " free-free modes (" + freqs + (k > 4 ? ", ..." : "") + " Hz) + " +
-               std::to_string(n_b) + " static modes";
-    } else {
-      // The shapes' rows: the imported matrices' DOFs, or for femb's own parts the mesh's nodes
-      // (dofs_per_node each, node-major, the order of /visualization/nodes): the RBE2 couplings
-      // eliminate coupled solid nodes (mesh_map); beam DOFs are the model's own.
-      SparseMatrix identity(model.n_dofs(), model.n_dofs());
-      identity.setIdentity();
-      const SparseMatrix& T = model.full_map.size()   ? model.full_map
-                              : model.mesh_map.size() ? model.mesh_map
-                                                      : identity;
-      const Eigen::MatrixXd V_full = ReadShapes(part.reduction.basis_file, T.rows());
-      Eigen::SimplicialLDLT<SparseMatrix> normal(SparseMatrix(T.transpose() * T));
-      V = normal.solve(Eigen::MatrixXd(T.transpose() * V_full));
-      const double off_rigid = (Eigen::MatrixXd(T * V) - V_full).norm() / std::max(V_full.norm(), 1e-300);
-      where = part.reduction.where_basis + ": " + part.reduction.basis_file;
-      char b[96];
-      std::snprintf(b, sizeof b, " (%.2g of their norm off the RBE2 faces' rigid motion)", off_rigid);
-      source = std::to_string(V.cols()) + " shapes from " + part.reduction.basis_file + b;
-    }
-    const Eigen::MatrixXd static_modes = cb.shapes.leftCols(n_b);
-    const GeneralBasisResult g = ReduceOnGeneralBasis(model, V, &static_modes);
-    if (!g.ok) {
-      if (g.input_error) throw InputError(where + ": " + g.message);
-      result.message = g.message;
-      return result;
-    }
-    cb.K = g.K;
-    cb.M = g.M;
-    cb.shapes = g.shapes;
-    cb.lambda = g.lambda;
-    interface_constraint = g.interface_constraint;
-    std::string constrained;
-    for (size_t i = 0; i < g.constraint_direction.size(); ++i) {
-      static const char* kNames[6] = {"u_x", "u_y", "u_z", "theta_x", "theta_y", "theta_z"};
-      constrained += i ? "; " : "; constrained inside the body (thesis 8.2 case 4): ";
-      for (size_t j = 0; j < g.constraint_direction[i].size(); ++j) {
-        const int at = g.constraint_direction[i][j];
-        constrained += (j ? " & " : "") + model.interface_names[size_t(at / 6)] + "." + kNames[at % 6];
-      }
-    }
-    std::snprintf(detail, sizeof detail,
-                  "%s: %d of %d shapes with the rigid fields independent, interface rank %d of %d "
-                  "(thesis 8.2), %ld reduced DOFs",
-                  source.c_str(), g.columns_kept, g.columns_given + 6, g.interface_rank, n_b, long(g.K.rows()));
-    report(free_interface ? "free-interface basis" : "general basis", basis_clock.Seconds(), detail + constrained);
+  const Eigen::MatrixXd static_modes = cb.shapes.leftCols(n_b);
+  const GeneralBasisResult g = ReduceOnGeneralBasis(model, V, &static_modes);
+  if (!g.ok) {
+    if (g.input_error) throw InputError(where + ": " + g.message);
+    result.message = g.message;
+    return false;
   }
+  cb.K = g.K;
+  cb.M = g.M;
+  cb.shapes = g.shapes;
+  cb.lambda = g.lambda;
+  interface_constraint = g.interface_constraint;
+  std::string constrained;
+  for (size_t i = 0; i < g.constraint_direction.size(); ++i) {
+    static const char* kNames[6] = {"u_x", "u_y", "u_z", "theta_x", "theta_y", "theta_z"};
+    constrained += i ? "; " : "; constrained inside the body (thesis 8.2 case 4): ";
+    for (size_t j = 0; j < g.constraint_direction[i].size(); ++j) {
+      const int at = g.constraint_direction[i][j];
+      constrained += (j ? " & " : "") + model.interface_names[size_t(at / 6)] + "." + kNames[at % 6];
+    }
+  }
+  char detail[640];
+  std::snprintf(detail, sizeof detail,
+                "%s: %d of %d shapes with the rigid fields independent, interface rank %d of %d "
+                "(thesis 8.2), %ld reduced DOFs",
+                source.c_str(), g.columns_kept, g.columns_given + 6, g.interface_rank, n_b, long(g.K.rows()));
+  report(free_interface ? "free-interface basis" : "general basis", basis_clock.Seconds(), detail + constrained);
+  return true;
+}
 
-  clock.Restart();
-  Superelement& se = result.superelement;
+// A cut inside a group of equal frequencies (within 1e-6: a round or square section, a
+// symmetric part) keeps an arbitrary direction of the group: a round coupler with 1 mode kept
+// of its pair at 728.342 Hz (the two bending planes) put a four-bar's reactions 30-50% off
+// its own converged run, where 2 modes are converged to 2e-4. The warning, or none.
+std::optional<std::string> CutGroupWarning(const CraigBamptonResult& cb) {
+  if (!(cb.next_lambda > 0 && cb.lambda.size() > 0)) return std::nullopt;
+  const double last = cb.lambda[cb.lambda.size() - 1];
+  if (cb.next_lambda - last > 1e-6 * cb.next_lambda) return std::nullopt;
+  char buffer[400];
+  std::snprintf(buffer, sizeof buffer,
+                "reduction.internal_modes = %ld keeps mode %ld at %.6g Hz but not mode %ld at the same frequency "
+                "(%.6g Hz; a symmetric section or part): the modes kept span an arbitrary direction of that group; "
+                "keep the whole group (internal_modes: %ld or more)",
+                long(cb.lambda.size()), long(cb.lambda.size()), FrequencyHz(last), long(cb.lambda.size()) + 1,
+                FrequencyHz(cb.next_lambda), long(cb.lambda.size()) + 1);
+  return std::string(buffer);
+}
+
+// The superelement's linear content: interfaces, K and M, frequencies, mass properties, the
+// floating frame (with K_r cleaned of its rigid motions' round-off) and the inertia invariants.
+void LinearContent(const PartSpec& part, const FeModel& model, const CraigBamptonResult& cb,
+                   const Eigen::MatrixXd& interface_constraint, Superelement& se) {
   se.name = part.name;
   se.units = part.units;
   for (size_t k = 0; k < model.interface_names.size(); ++k) {
@@ -317,23 +369,6 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
   se.K = cb.K;
   se.M = cb.M;
   se.interface_constraint = interface_constraint;
-  // A cut inside a group of equal frequencies (within 1e-6: a round or square section, a
-  // symmetric part) keeps an arbitrary direction of the group: a round coupler with 1 mode kept
-  // of its pair at 728.342 Hz (the two bending planes) put a four-bar's reactions 30-50% off
-  // its own converged run, where 2 modes are converged to 2e-4.
-  if (cb.next_lambda > 0 && cb.lambda.size() > 0) {
-    const double last = cb.lambda[cb.lambda.size() - 1];
-    if (cb.next_lambda - last <= 1e-6 * cb.next_lambda) {
-      char buffer[400];
-      std::snprintf(buffer, sizeof buffer,
-                    "reduction.internal_modes = %ld keeps mode %ld at %.6g Hz but not mode %ld at the same frequency "
-                    "(%.6g Hz; a symmetric section or part): the modes kept span an arbitrary direction of that group; "
-                    "keep the whole group (internal_modes: %ld or more)",
-                    long(cb.lambda.size()), long(cb.lambda.size()), FrequencyHz(last), long(cb.lambda.size()) + 1,
-                    FrequencyHz(cb.next_lambda), long(cb.lambda.size()) + 1);
-      result.warnings.push_back(buffer);
-    }
-  }
   se.internal_frequencies_hz.resize(cb.lambda.size());
   for (int k = 0; k < cb.lambda.size(); ++k) se.internal_frequencies_hz[k] = FrequencyHz(cb.lambda[k]);
   se.n_full_dofs = model.n_dofs();
@@ -345,19 +380,16 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
   se.mass_properties = ComputeMassProperties(se);
   se.floating_frame =
       ComputeFloatingFrame(part.reduction.floating_frame, part.reduction.where_floating_frame, se, model, cb.shapes);
-  {
-    // Rigid motions cost no energy exactly: K_r <- T0^T K_r T0 with T0 = 1 - Phi_rig0 Phi_CB
-    // (thesis 3.17-3.20 at the undeformed state; T0 Phi_rig0 = 0 as Phi_CB Phi_rig0 = 1). It
-    // removes only the round-off of K_r Phi_rig0 = 0 (||K Phi_rig0|| ~ eps ||K_full||), which for a
-    // body with one interface and no modes, whose K_r is nothing but that round-off, made stray
-    // "rigid-body frequencies" of a fraction of a hertz.
-    const Eigen::MatrixXd Phi_rig0 = RigidBodyModes(se, se.floating_frame.origin);
-    const Eigen::MatrixXd T0 =
-        Eigen::MatrixXd::Identity(se.K.rows(), se.K.cols()) - Phi_rig0 * se.floating_frame.Phi_CB;
-    const Eigen::MatrixXd K_T0 = se.K * T0;
-    se.K = T0.transpose() * K_T0;
-    se.K = 0.5 * (se.K + se.K.transpose()).eval();
-  }
+  // Rigid motions cost no energy exactly: K_r <- T0^T K_r T0 with T0 = 1 - Phi_rig0 Phi_CB
+  // (thesis 3.17-3.20 at the undeformed state; T0 Phi_rig0 = 0 as Phi_CB Phi_rig0 = 1). It
+  // removes only the round-off of K_r Phi_rig0 = 0 (||K Phi_rig0|| ~ eps ||K_full||), which for a
+  // body with one interface and no modes, whose K_r is nothing but that round-off, made stray
+  // "rigid-body frequencies" of a fraction of a hertz.
+  const Eigen::MatrixXd Phi_rig0 = RigidBodyModes(se, se.floating_frame.origin);
+  const Eigen::MatrixXd T0 = Eigen::MatrixXd::Identity(se.K.rows(), se.K.cols()) - Phi_rig0 * se.floating_frame.Phi_CB;
+  const Eigen::MatrixXd K_T0 = se.K * T0;
+  se.K = T0.transpose() * K_T0;
+  se.K = 0.5 * (se.K + se.K.transpose()).eval();
   // The inertia invariants for the exact kinetic energy of the reduced field in the floating
   // frame (SuperelementBody, "Exact inertia"), for every basis and every kind of part: they need
   // only M, the DOFs' vector components and the basis. Without them the solver takes the
@@ -367,152 +399,178 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
   if (se.n_reduced_dofs() > 6) {
     InertiaInvariants(model, cb.shapes, &se.inertia_gamma, &se.inertia_xi);
   }
-  const bool derivatives = se.n_modal_derivatives > 0;
-  // With stiffening: the inertia load cases' fields on the mesh (about the frame origin), for
-  // their geometric stiffness and their stresses.
-  Eigen::MatrixXd stress_fields;
-  if (stiffening) make_nonlinear();
-  if (nonlinear && (derivatives || stiffening)) {
-    // The reduced internal force on the whole basis (static and internal modes, derivatives):
-    // with modal derivatives the cubic polynomial of reduced_polynomial.h; for the geometric
-    // stiffening alone its quadratic part (the geometric stiffness of the stress of each basis
-    // vector). Its linear part equals K_r. With stiffening also the geometric stiffness of the
-    // inertia load cases' stresses (SuperelementBody::InertiaLoads, solver/body/superelement_body.h), about the frame
-    // origin o: a field about o is the one about the part origin minus the translation it has at o.
-    Stopwatch tensors;
-    const Eigen::MatrixXd mesh_shapes = to_model_dofs * cb.shapes;
-    const auto completion = InterfaceRotationCompletion(model.nodes, mesh_shapes, model.interface_positions,
-                                                        se.floating_frame.origin, part.type == "beam" ? 6 : 3);
-    PolynomialRequest poly_request;
-    poly_request.cubic = derivatives;
-    if (stiffening) {
-      Eigen::MatrixXd u = cb.inertia_displacements;
-      const Eigen::Matrix<double, 3, 12> at_origin = InertiaFieldAt(se.floating_frame.origin);
-      for (int k = 3; k < kInertiaLoadCaseCount; ++k) u.col(k) -= u.leftCols(3) * at_origin.col(k);
-      stress_fields = to_model_dofs * u;
-      poly_request.stress_fields = &stress_fields;
-    }
-    ReducedPolynomial poly =
-        part.type != "beam"
-            ? ReduceSvk(static_cast<const SvkSolidMesh&>(*nonlinear), mesh_shapes, completion, poly_request)
-            : ReduceVonKarman(static_cast<const VonKarmanBeams&>(*nonlinear), mesh_shapes, completion, poly_request);
-    const double mismatch = (poly.K - cb.K).norm() / cb.K.norm();
-    if (part.type == "imported" && mismatch > kImportedStiffnessMismatch) {
-      // femb's elements with the part's material on the imported mesh must be the imported
-      // stiffness (up to element formulation): else their stresses, hence the geometric
-      // stiffness, belong to another material or model.
-      char text[400];
-      std::snprintf(text, sizeof text,
-                    "%s: material: femb's elements on the imported mesh with this material differ from the imported "
-                    "stiffness by %.2g (reduced K, relative; at most %.0e): give the material the matrices were made "
-                    "with, or reduction.geometric_stiffening: false",
-                    part.file.c_str(), mismatch, kImportedStiffnessMismatch);
-      throw InputError(text);
-    }
-    if (part.type != "imported" && mismatch > 1e-8) {
-      result.message = "the polynomial internal force's linear part differs from K_r by " + std::to_string(mismatch);
-      return result;
-    }
-    se.polynomial = PolynomialStiffness{std::move(poly.A), std::move(poly.B), Eigen::MatrixXd()};
-    const long nr = se.K.rows(), P = nr * (nr + 1) / 2;
-    if (stiffening) {
-      for (int k = 0; k < kInertiaLoadCaseCount; ++k) {
-        Eigen::MatrixXd K_sigma(nr, nr);
-        int p = 0;
-        for (int i = 0; i < nr; ++i)
-          for (int j = i; j < nr; ++j, ++p) K_sigma(i, j) = K_sigma(j, i) = poly.S(k, p);
-        se.inertia_stiffness.push_back(std::move(K_sigma));
-      }
-    }
-    if (derivatives) {
-      std::snprintf(detail, sizeof detail,
-                    "quadratic %ld x %ld + cubic %ld x %ld coefficients (%.3g MB; symmetric pairs: %.0fx smaller than "
-                    "n^3 + n^4), linear part = K_r to %.1e%s",
-                    nr, P, P, P, 8.0 * (nr * P + P * P) / 1e6,
-                    double(nr * nr * nr + nr * nr * nr * nr) / double(nr * P + P * P), mismatch,
-                    stiffening ? "; 12 inertia load case geometric stiffnesses" : "");
-      report("nonlinear force", tensors.Seconds(), detail);
-    } else {
-      std::snprintf(detail, sizeof detail,
-                    "quadratic %ld x %ld coefficients (Green-Lagrange over the Craig-Bampton basis) + 12 inertia load "
-                    "case geometric stiffnesses %ld x %ld (%.3g MB), linear part = K_r to %.1e",
-                    nr, P, nr, nr, 8.0 * (nr * P + 12 * nr * nr) / 1e6, mismatch);
-      report("stiffening", tensors.Seconds(), detail);
-    }
-    clock.Restart();
-  }
-  if (keep_mesh) {
-    Visualization v;
-    v.nodes = model.nodes;
-    v.cells = model.cells;
-    v.cell_type = model.cell_type;
-    v.dofs_per_node = model.dofs_per_node;
-    v.shapes = model.mesh_map.size() ? Eigen::MatrixXd(model.mesh_map * cb.shapes) : cb.shapes;
-    v.interface_nodes = model.interface_node_sets;
-    se.visualization = std::move(v);
-  }
-  prov.femb_version = FEMB_VERSION;
-  prov.input_file = part.file;
-  prov.input_hash = part.text_hash;
-  prov.element_type = model.element_type;
-  prov.reduction_method = part.reduction.method;
-  prov.n_nodes = model.n_nodes();
-  prov.n_elements = model.n_elements();
-  report("frame+mass", clock.Seconds(),
-         "floating frame " + se.floating_frame.type +
-             (keep_mesh ? ", mesh and mode shapes kept" : ", mesh and mode shapes not kept (reduction.keep_mesh)"));
-  // Imported matrices: femb's solid elements on the imported mesh with the part's material (the
-  // same conditions as the stiffening's; the part file refuses true without a material).
-  bool stresses = keep_mesh && part.reduction.stresses.value_or(part.type != "imported" || part.has_material);
-  if (stresses && part.type == "imported") {
-    const std::string& cell = model.cell_type;
-    const bool solid_cells = cell == "tet4" || cell == "tet10" || cell == "hex8" || cell == "hex20";
-    bool rotations = false;
-    for (size_t d = 0; d < model.dof_component.size(); ++d)
-      rotations |= model.dof_component[d] >= 3 && model.dof_node[d] < model.n_nodes();
-    if (!solid_cells || rotations) {
-      const std::string why = !solid_cells ? "its mesh has " + cell + " cells" : "its matrices have rotational DOFs";
-      if (part.reduction.stresses.value_or(false)) {
-        throw InputError(part.file + ": reduction.stresses: the imported part cannot have them: " + why +
-                         " (femb's solid elements: tet4, tet10, hex8, hex20)");
-      }
-      stresses = false;
-    }
-  }
-  if (stresses) {
-    Stopwatch stress_clock;
-    const Visualization& v = *se.visualization;
-    // With modal derivatives the stress keeps the strain's quadratic part (solids: Green-Lagrange;
-    // beams: the von Karman axial term), as the body's polynomial force does; the inertia load
-    // cases' stresses are linear.
-    auto stresses_of = [&](const Eigen::MatrixXd& fields, bool quadratic) {
-      return part.type != "beam" ? SolidModalStress(SolidCellType(model.cell_type), model.nodes, model.cells,
-                                                    part.material, fields, quadratic)
-                                 : BeamModalStress(part, fields, quadratic);
-    };
-    se.stress = stresses_of(v.shapes, derivatives);
-    if (stress_fields.cols() > 0) {
-      const ModalStress inertia = stresses_of(stress_fields, false);
-      se.stress->inertia_modes = inertia.modes;
-      se.stress->inertia_section_forces = inertia.section_forces;
-    }
-    const ModalStress& st = *se.stress;
-    std::snprintf(detail, sizeof detail, "%d stress points x %ld coordinates (%s%s%s), %.3g MB in single precision",
-                  st.n_points(), long(v.shapes.cols()), st.method.c_str(),
-                  st.gradients.size()           ? "; displacement gradients for the Green-Lagrange quadratic part"
-                  : st.element_quadratic.size() ? "; element forms of the von Karman axial strain"
-                                                : "",
-                  st.inertia_modes.size() ? "; 12 inertia load cases" : "",
-                  4.0 *
-                      double(st.modes.size() + st.section_forces.size() + st.gradients.size() +
-                             st.element_quadratic.size() + st.inertia_modes.size() + st.inertia_section_forces.size()) /
-                      1e6);
-    report("stresses", stress_clock.Seconds(), detail);
-  }
+}
 
-  // The full model's free-free modes against the reduced model's: how far the basis carries the
-  // free body's own vibration (a free bar's first axial mode 0.43% stiff with 20 fixed-interface
-  // modes), by default for models up to kFullModesMaxDofs DOFs.
+// The reduced internal force on the whole basis (static and internal modes, derivatives): with
+// modal derivatives the cubic polynomial of reduced_polynomial.h; for the geometric stiffening
+// alone its quadratic part (the geometric stiffness of the stress of each basis vector). Its
+// linear part equals K_r. With stiffening also the geometric stiffness of the inertia load cases'
+// stresses (SuperelementBody::InertiaLoads, solver/body/superelement_body.h), about the frame
+// origin o: a field about o is the one about the part origin minus the translation it has at o;
+// those fields on the mesh go to `stress_fields` for their stresses. false with result.message
+// when the polynomial's linear part is not K_r.
+bool NonlinearForce(const PartSpec& part, const FeModel& model, const CraigBamptonResult& cb, bool stiffening,
+                    NonlinearModelOf& nonlinear, const ProgressFn& report, Superelement& se,
+                    Eigen::MatrixXd& stress_fields, ReduceResult& result) {
+  const bool derivatives = se.n_modal_derivatives > 0;
+  Stopwatch tensors;
+  const NonlinearModel& f = nonlinear.Get();
+  const Eigen::MatrixXd mesh_shapes = nonlinear.to_model_dofs() * cb.shapes;
+  const auto completion = InterfaceRotationCompletion(model.nodes, mesh_shapes, model.interface_positions,
+                                                      se.floating_frame.origin, part.type == "beam" ? 6 : 3);
+  PolynomialRequest poly_request;
+  poly_request.cubic = derivatives;
+  if (stiffening) {
+    Eigen::MatrixXd u = cb.inertia_displacements;
+    const Eigen::Matrix<double, 3, 12> at_origin = InertiaFieldAt(se.floating_frame.origin);
+    for (int k = 3; k < kInertiaLoadCaseCount; ++k) u.col(k) -= u.leftCols(3) * at_origin.col(k);
+    stress_fields = nonlinear.to_model_dofs() * u;
+    poly_request.stress_fields = &stress_fields;
+  }
+  ReducedPolynomial poly =
+      part.type != "beam"
+          ? ReduceSvk(static_cast<const SvkSolidMesh&>(f), mesh_shapes, completion, poly_request)
+          : ReduceVonKarman(static_cast<const VonKarmanBeams&>(f), mesh_shapes, completion, poly_request);
+  const double mismatch = (poly.K - cb.K).norm() / cb.K.norm();
+  if (part.type == "imported" && mismatch > kImportedStiffnessMismatch) {
+    // femb's elements with the part's material on the imported mesh must be the imported
+    // stiffness (up to element formulation): else their stresses, hence the geometric
+    // stiffness, belong to another material or model.
+    char text[400];
+    std::snprintf(text, sizeof text,
+                  "%s: material: femb's elements on the imported mesh with this material differ from the imported "
+                  "stiffness by %.2g (reduced K, relative; at most %.0e): give the material the matrices were made "
+                  "with, or reduction.geometric_stiffening: false",
+                  part.file.c_str(), mismatch, kImportedStiffnessMismatch);
+    throw InputError(text);
+  }
+  if (part.type != "imported" && mismatch > 1e-8) {
+    result.message = "the polynomial internal force's linear part differs from K_r by " + std::to_string(mismatch);
+    return false;
+  }
+  se.polynomial = PolynomialStiffness{std::move(poly.A), std::move(poly.B), Eigen::MatrixXd()};
+  const long nr = se.K.rows(), P = nr * (nr + 1) / 2;
+  if (stiffening) {
+    for (int k = 0; k < kInertiaLoadCaseCount; ++k) {
+      Eigen::MatrixXd K_sigma(nr, nr);
+      int p = 0;
+      for (int i = 0; i < nr; ++i)
+        for (int j = i; j < nr; ++j, ++p) K_sigma(i, j) = K_sigma(j, i) = poly.S(k, p);
+      se.inertia_stiffness.push_back(std::move(K_sigma));
+    }
+  }
+  char detail[640];
+  if (derivatives) {
+    std::snprintf(detail, sizeof detail,
+                  "quadratic %ld x %ld + cubic %ld x %ld coefficients (%.3g MB; symmetric pairs: %.0fx smaller than "
+                  "n^3 + n^4), linear part = K_r to %.1e%s",
+                  nr, P, P, P, 8.0 * (nr * P + P * P) / 1e6,
+                  double(nr * nr * nr + nr * nr * nr * nr) / double(nr * P + P * P), mismatch,
+                  stiffening ? "; 12 inertia load case geometric stiffnesses" : "");
+    report("nonlinear force", tensors.Seconds(), detail);
+  } else {
+    std::snprintf(detail, sizeof detail,
+                  "quadratic %ld x %ld coefficients (Green-Lagrange over the Craig-Bampton basis) + 12 inertia load "
+                  "case geometric stiffnesses %ld x %ld (%.3g MB), linear part = K_r to %.1e",
+                  nr, P, nr, nr, 8.0 * (nr * P + 12 * nr * nr) / 1e6, mismatch);
+    report("stiffening", tensors.Seconds(), detail);
+  }
+  return true;
+}
+
+// The mesh and the mode shapes on it, for pictures and stresses.
+Visualization MeshAndShapes(const FeModel& model, const CraigBamptonResult& cb) {
+  Visualization v;
+  v.nodes = model.nodes;
+  v.cells = model.cells;
+  v.cell_type = model.cell_type;
+  v.dofs_per_node = model.dofs_per_node;
+  v.shapes = model.mesh_map.size() ? Eigen::MatrixXd(model.mesh_map * cb.shapes) : cb.shapes;
+  v.interface_nodes = model.interface_node_sets;
+  return v;
+}
+
+// Whether the file gets modal stresses: with the mesh kept, by default; for imported matrices
+// only with femb's solid elements on the imported mesh and the part's material (the same
+// conditions as the stiffening's; the part file refuses true without a material).
+bool UsesStresses(const PartSpec& part, const FeModel& model, bool keep_mesh) {
+  const bool stresses = keep_mesh && part.reduction.stresses.value_or(part.type != "imported" || part.has_material);
+  if (!stresses || part.type != "imported") return stresses;
+  const std::string why = WhyNoOwnElements(model);
+  if (why.empty()) return true;
+  if (part.reduction.stresses.value_or(false)) {
+    throw InputError(part.file + ": reduction.stresses: the imported part cannot have them: " + why +
+                     " (femb's solid elements: tet4, tet10, hex8, hex20)");
+  }
+  return false;
+}
+
+// The modal stresses of the basis on the mesh (reducer/reduction/modal_stress.h) and of the
+// inertia load cases' fields. With modal derivatives the stress keeps the strain's quadratic part
+// (solids: Green-Lagrange; beams: the von Karman axial term), as the body's polynomial force
+// does; the inertia load cases' stresses are linear.
+void Stresses(const PartSpec& part, const FeModel& model, const Eigen::MatrixXd& stress_fields,
+              const ProgressFn& report, Superelement& se) {
+  Stopwatch stress_clock;
+  const Visualization& v = *se.visualization;
+  auto stresses_of = [&](const Eigen::MatrixXd& fields, bool quadratic) {
+    return part.type != "beam" ? SolidModalStress(SolidCellType(model.cell_type), model.nodes, model.cells,
+                                                  part.material, fields, quadratic)
+                               : BeamModalStress(part, fields, quadratic);
+  };
+  se.stress = stresses_of(v.shapes, se.n_modal_derivatives > 0);
+  if (stress_fields.cols() > 0) {
+    const ModalStress inertia = stresses_of(stress_fields, false);
+    se.stress->inertia_modes = inertia.modes;
+    se.stress->inertia_section_forces = inertia.section_forces;
+  }
+  const ModalStress& st = *se.stress;
+  char detail[640];
+  std::snprintf(detail, sizeof detail, "%d stress points x %ld coordinates (%s%s%s), %.3g MB in single precision",
+                st.n_points(), long(v.shapes.cols()), st.method.c_str(),
+                st.gradients.size()           ? "; displacement gradients for the Green-Lagrange quadratic part"
+                : st.element_quadratic.size() ? "; element forms of the von Karman axial strain"
+                                              : "",
+                st.inertia_modes.size() ? "; 12 inertia load cases" : "",
+                4.0 *
+                    double(st.modes.size() + st.section_forces.size() + st.gradients.size() +
+                           st.element_quadratic.size() + st.inertia_modes.size() + st.inertia_section_forces.size()) /
+                    1e6);
+  report("stresses", stress_clock.Seconds(), detail);
+}
+
+// The reduced model's free-free frequencies (dense, small) against the full model's: the first
+// and the largest relative error, reported.
+void CompareFreeFree(const Superelement& se, const FullModesResult& full, const ProgressFn& report) {
+  Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> reduced(se.K, se.M, Eigen::EigenvaluesOnly);
+  if (reduced.info() != Eigen::Success) return;
+  double worst = 0.0, first = 0.0;
+  int worst_mode = 0, compared = 0;
+  for (int k = 6; k < full.frequencies_hz.size() && k < reduced.eigenvalues().size(); ++k) {
+    const double f_full = full.frequencies_hz[k], f_reduced = FrequencyHz(reduced.eigenvalues()[k]);
+    if (!(f_full > 0)) continue;
+    const double error = f_reduced / f_full - 1;
+    if (compared++ == 0) first = error;
+    if (std::abs(error) > std::abs(worst)) {
+      worst = error;
+      worst_mode = k - 5;
+    }
+  }
+  if (compared == 0) return;
+  char detail[640];
+  std::snprintf(detail, sizeof detail,
+                "%d flexible free-free frequencies of the reduced model against the full model's: first %+.3g%%, "
+                "largest %+.3g%% (mode %d); more modes in the basis lower it (femb-inspect lists them)",
+                compared, 100 * first, 100 * worst, worst_mode);
+  report("free-free check", 0.0, detail);
+}
+
+// The full model's free-free modes against the reduced model's: how far the basis carries the
+// free body's own vibration (a free bar's first axial mode 0.43% stiff with 20 fixed-interface
+// modes), by default for models up to kFullModesMaxDofs DOFs. false with result.message when
+// the eigen solve the part asked for fails (one it did not ask for is skipped with a line).
+bool FreeFreeCheck(const PartSpec& part, const FeModel& model, const CraigBamptonResult& cb, const ProgressFn& progress,
+                   const ProgressFn& report, Superelement& se, ReduceResult& result) {
   int full_modes = part.reduction.full_modes;
   if (!part.reduction.full_modes_given) {
     full_modes = model.n_dofs() <= ReductionSpec::kFullModesMaxDofs ? std::min(12, se.n_reduced_dofs() - 6) : 0;
@@ -522,66 +580,92 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
                    " DOFs (reduction.full_modes: K or --full-modes K computes K)");
     }
   }
-  FullModesResult full_result;
-  if (full_modes > 0) {
+  if (full_modes <= 0) return true;
+  Stopwatch clock;
+  double s = 0.0;
+  if (cb.lambda.size() > 0) {
+    s = 1e-2 * cb.lambda[0];
+  } else {
+    double max_ratio = 0.0;
+    for (int j = 0; j < model.K.outerSize(); ++j) {
+      const double m_jj = model.M.coeff(j, j);
+      if (m_jj > 0) max_ratio = std::max(max_ratio, model.K.coeff(j, j) / m_jj);
+    }
+    s = 1e-8 * max_ratio;
+  }
+  const FullModesResult full = FullFreeFreeFrequencies(model, full_modes, s);
+  if (!full.ok && part.reduction.full_modes_given) {
+    result.message = "full-model free-free eigen solve failed: " + full.message;
+    return false;
+  }
+  if (!full.ok) {
+    report("free-free check", clock.Seconds(),
+           "skipped: the full model's free-free eigen solve failed (" + full.message + ")");
+    return true;
+  }
+  se.full_free_free_frequencies_hz = full.frequencies_hz;
+  std::string rigid;
+  for (const std::string& name : se.full_rigid_couplings) rigid += (rigid.empty() ? "" : ", ") + name;
+  char detail[640];
+  std::snprintf(detail, sizeof detail, "%d free-free frequencies of the full model%s, %ld linear solves",
+                int(full.frequencies_hz.size()),
+                rigid.empty() ? "" : (" with the RBE2 couplings of " + rigid + " (their node sets rigid)").c_str(),
+                full.linear_solves);
+  report("full modes", clock.Seconds(), detail);
+  CompareFreeFree(se, full, report);
+  return true;
+}
+
+}  // namespace
+
+ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
+  ReduceResult result;
+  Provenance& prov = result.superelement.provenance;
+  const ProgressFn report = [&](const std::string& stage, double seconds, const std::string& detail) {
+    prov.stage_seconds.emplace_back(stage, seconds);
+    if (progress) progress(stage, seconds, detail);
+  };
+  const FeModel model = BuildFeModel(part, report);
+  const Budget budget = CheckBeforeFactorization(part, model);
+  NonlinearModelOf nonlinear(part, model);
+  const DerivativeRequest request = ModalDerivativeRequest(part, model, nonlinear);
+  const bool stiffening = UsesStiffening(part, model, progress);
+  const Eigen::MatrixXd inertia_fields = stiffening ? InertiaFields(model) : Eigen::MatrixXd();
+  const bool other_basis = part.reduction.method == "free_interface" || part.reduction.method == "general";
+  CraigBamptonResult cb =
+      CraigBamptonReduce(model, other_basis ? 0 : part.reduction.internal_modes, report, 200, budget.factor_bytes,
+                         request.pairs.empty() ? nullptr : &request, stiffening ? &inertia_fields : nullptr);
+  if (!cb.ok) {
+    result.too_big = cb.factorization.too_big;
+    result.message = result.too_big ? TooBigMessage(budget, cb.message) : cb.message;
+    return result;
+  }
+  Eigen::MatrixXd interface_constraint;  // thesis 8.2 case 4 (m < 6N)
+  if (other_basis && !ReduceOnOtherBasis(part, model, report, cb, interface_constraint, result)) return result;
+
+  Stopwatch clock;
+  Superelement& se = result.superelement;
+  if (std::optional<std::string> warning = CutGroupWarning(cb)) result.warnings.push_back(*warning);
+  LinearContent(part, model, cb, interface_constraint, se);
+  Eigen::MatrixXd stress_fields;  // the inertia load cases' fields on the mesh, with stiffening
+  if (stiffening || (nonlinear.built() && se.n_modal_derivatives > 0)) {
+    if (!NonlinearForce(part, model, cb, stiffening, nonlinear, report, se, stress_fields, result)) return result;
     clock.Restart();
-    double s = 0.0;
-    if (cb.lambda.size() > 0) {
-      s = 1e-2 * cb.lambda[0];
-    } else {
-      double max_ratio = 0.0;
-      for (int j = 0; j < model.K.outerSize(); ++j) {
-        const double m = model.M.coeff(j, j);
-        if (m > 0) max_ratio = std::max(max_ratio, model.K.coeff(j, j) / m);
-      }
-      s = 1e-8 * max_ratio;
-    }
-    full_result = FullFreeFreeFrequencies(model, full_modes, s);
-    const FullModesResult& full = full_result;
-    if (!full.ok && part.reduction.full_modes_given) {
-      result.message = "full-model free-free eigen solve failed: " + full.message;
-      return result;
-    }
-    if (!full.ok) {
-      report("free-free check", clock.Seconds(),
-             "skipped: the full model's free-free eigen solve failed (" + full.message + ")");
-      full_modes = 0;
-    }
   }
-  if (full_modes > 0) {
-    const FullModesResult& full = full_result;
-    se.full_free_free_frequencies_hz = full.frequencies_hz;
-    std::string rigid;
-    for (const std::string& name : se.full_rigid_couplings) rigid += (rigid.empty() ? "" : ", ") + name;
-    std::snprintf(detail, sizeof detail, "%d free-free frequencies of the full model%s, %ld linear solves",
-                  int(full.frequencies_hz.size()),
-                  rigid.empty() ? "" : (" with the RBE2 couplings of " + rigid + " (their node sets rigid)").c_str(),
-                  full.linear_solves);
-    report("full modes", clock.Seconds(), detail);
-    // The reduced model's free-free frequencies (dense, small) against them.
-    Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> reduced(se.K, se.M, Eigen::EigenvaluesOnly);
-    if (reduced.info() == Eigen::Success) {
-      double worst = 0.0, first = 0.0;
-      int worst_mode = 0, compared = 0;
-      for (int k = 6; k < full.frequencies_hz.size() && k < reduced.eigenvalues().size(); ++k) {
-        const double f_full = full.frequencies_hz[k], f_reduced = FrequencyHz(reduced.eigenvalues()[k]);
-        if (!(f_full > 0)) continue;
-        const double error = f_reduced / f_full - 1;
-        if (compared++ == 0) first = error;
-        if (std::abs(error) > std::abs(worst)) {
-          worst = error;
-          worst_mode = k - 5;
-        }
-      }
-      if (compared > 0) {
-        std::snprintf(detail, sizeof detail,
-                      "%d flexible free-free frequencies of the reduced model against the full model's: first %+.3g%%, "
-                      "largest %+.3g%% (mode %d); more modes in the basis lower it (femb-inspect lists them)",
-                      compared, 100 * first, 100 * worst, worst_mode);
-        report("free-free check", 0.0, detail);
-      }
-    }
-  }
+  if (budget.keep_mesh) se.visualization = MeshAndShapes(model, cb);
+  prov.femb_version = FEMB_VERSION;
+  prov.input_file = part.file;
+  prov.input_hash = part.text_hash;
+  prov.element_type = model.element_type;
+  prov.reduction_method = part.reduction.method;
+  prov.n_nodes = model.n_nodes();
+  prov.n_elements = model.n_elements();
+  report(
+      "frame+mass", clock.Seconds(),
+      "floating frame " + se.floating_frame.type +
+          (budget.keep_mesh ? ", mesh and mode shapes kept" : ", mesh and mode shapes not kept (reduction.keep_mesh)"));
+  if (UsesStresses(part, model, budget.keep_mesh)) Stresses(part, model, stress_fields, report, se);
+  if (!FreeFreeCheck(part, model, cb, progress, report, se, result)) return result;
   result.ok = true;
   return result;
 }
