@@ -298,299 +298,402 @@ double EnergyNoise(double mass, const SystemState& config, double h) {
 
 DynamicStepReport Measure(const SystemModel& model, DynamicState& s) { return MeasureWith(model, model.dofs(), s, {}); }
 
-DynamicResult SolveDynamic(const SystemModel& model, DynamicState& state, const DynamicOptions& options,
-                           const std::function<void(const DynamicStepReport&, const DynamicState&)>& on_step) {
-  DynamicResult result;
-  const DynamicResume* resume = options.resume;
-  if (resume) state = resume->state;
-  const DofMap& dofs = model.dofs();
-  StepController control(model, dofs, options, resume ? resume->t_start : state.t);
-  double h = options.adaptive ? control.FirstStep() : options.step;
-  int cuts = 0;
-  bool after_rejection = false;
-  IterationMatrix matrix;
-  BodyThreads threads(options.threads);
-  BodyWorkspace work;
-  DynamicState next;  // the step's result; its storage is reused from step to step
-  // Time is counted in steps: t = t_base + n h while the step stays nominal (summing h over 1e6
-  // steps drifted by 1e-8 s and left a last step of 1e-8 s that Newton could not take), and a
-  // remainder below 1% of a step is merged into the last one.
-  double t_base = state.t;
-  long n_nominal = 0;
-  const double t_output0 = resume ? resume->t_start : state.t;
-  double last_output = 0;
-  // Energy balance E = T + U - W_loads - W_drives: constant for a conservative system, falling
-  // with damping (modal, dampers, generalized-alpha's rho_inf < 1). Growth is numerical: a step
-  // too long for the stiffest modes (generalized-alpha with rho_inf near 1 on stiff modes; the
-  // midpoint scheme's elastic force is not an exact discrete gradient). Above 5% of the energy
-  // scale (the largest of T + U and the works so far) it is said once; above 25% the run stops.
-  // The energy scale has a floor: the kinetic energy of velocities at the noise of the
-  // positions' round-off over a step, E_noise = m |v_noise|^2 / 2 with v_noise = 100 eps |x|_max
-  // / h (m the bodies' mass, |x|_max the largest node distance from the origin), so that a start
-  // from rest is not judged on noise: the spin-up of a four-bar (0.45 kg, 0.4 m) at h = 2 us held
-  // 2e-21 J of kinetic energy after its first step, all of it noise (the drive's work was
-  // 3e-26 J), and 1e-20 J after ten; E_noise is 4e-18 J there, and 1e-25 J at h = 1 ms.
-  constexpr double kEnergyWarn = 0.05, kEnergyStop = 0.25;
-  const DynamicStepReport start = resume ? DynamicStepReport() : Measure(model, state);
-  const double E0 = resume ? resume->E0 : start.kinetic_energy + start.elastic_energy;
-  double energy_scale = resume ? resume->energy_scale : std::abs(E0);
-  double first_cut_time = -1.0;  // fixed steps: where Newton first needed a shorter step
-  double model_mass = 0.0;
-  for (const SuperelementBody& body : model.bodies) model_mass += std::max(body.mass(), 0.0);
-  bool warned = false;
-  if (const std::string w = RoundOffToleranceWarning(options.tolerance); !w.empty()) result.warnings.push_back(w);
-  const int n_bodies = int(model.bodies.size());
-  if (resume) {
-    // The loop's variables, the step controller, the pivot order, the bodies' last frame
-    // matrices and kept matrices as the saved run had them after its last step.
-    h = resume->h, cuts = resume->cuts, t_base = resume->t_base, n_nominal = resume->n_nominal;
-    last_output = resume->last_output, first_cut_time = resume->first_cut_time, warned = resume->warned;
-    result = resume->result;
-    control.Restore(*resume);
-    if (!matrix.solver.Restore(resume->factor)) {
-      result.message = "the saved state's iteration matrix pivots could not be restored";
-      return result;
+namespace {
+
+using OnStep = std::function<void(const DynamicStepReport&, const DynamicState&)>;
+
+// Energy balance E = T + U - W_loads - W_drives: constant for a conservative system, falling
+// with damping (modal, dampers, generalized-alpha's rho_inf < 1). Growth is numerical: a step
+// too long for the stiffest modes (generalized-alpha with rho_inf near 1 on stiff modes; the
+// midpoint scheme's elastic force is not an exact discrete gradient). Above 5% of the energy
+// scale (the largest of T + U and the works so far) it is said once; above 25% the run stops.
+// The energy scale has a floor: the kinetic energy of velocities at the noise of the
+// positions' round-off over a step, E_noise = m |v_noise|^2 / 2 with v_noise = 100 eps |x|_max
+// / h (m the bodies' mass, |x|_max the largest node distance from the origin), so that a start
+// from rest is not judged on noise: the spin-up of a four-bar (0.45 kg, 0.4 m) at h = 2 us held
+// 2e-21 J of kinetic energy after its first step, all of it noise (the drive's work was
+// 3e-26 J), and 1e-20 J after ten; E_noise is 4e-18 J there, and 1e-25 J at h = 1 ms.
+constexpr double kEnergyWarn = 0.05, kEnergyStop = 0.25;
+
+// One run of SolveDynamic: the time loop's state between steps. Run() takes steps until the end
+// time, a stop request or a failure: each step is tried (TryStep), judged (Newton's outcome, the
+// error estimate), placed on the time grid (PlaceStep), taken over (Accept), measured and watched
+// (Report), and the next step's size chosen (NextStepSize).
+class DynamicRun {
+ public:
+  DynamicRun(const SystemModel& model, DynamicState& state, const DynamicOptions& options, const OnStep& on_step)
+      : model_(model),
+        dofs_(model.dofs()),
+        state_(state),
+        options_(options),
+        on_step_(on_step),
+        resume_(options.resume),
+        control_(model, dofs_, options, resume_ ? resume_->t_start : state.t),
+        threads_(options.threads),
+        n_bodies_(int(model.bodies.size())) {}
+
+  DynamicResult Run() {
+    if (resume_) state_ = resume_->state;
+    h_ = options_.adaptive ? control_.FirstStep() : options_.step;
+    t_base_ = state_.t;
+    t_output0_ = resume_ ? resume_->t_start : state_.t;
+    const DynamicStepReport start = resume_ ? DynamicStepReport() : Measure(model_, state_);
+    E0_ = resume_ ? resume_->E0 : start.kinetic_energy + start.elastic_energy;
+    energy_scale_ = resume_ ? resume_->energy_scale : std::abs(E0_);
+    for (const SuperelementBody& body : model_.bodies) model_mass_ += std::max(body.mass(), 0.0);
+    if (const std::string w = RoundOffToleranceWarning(options_.tolerance); !w.empty()) {
+      result_.warnings.push_back(w);
     }
-    matrix.factorizations = resume->factorizations;
-    work.matrices_computed = resume->matrices_computed, work.matrices_turned = resume->matrices_turned;
-    work.passes.resize(size_t(n_bodies));
-    work.matrices.resize(size_t(n_bodies));
-    for (int b = 0; b < n_bodies; ++b) {
-      if (size_t(b) < resume->has_frame_S_inv.size() && resume->has_frame_S_inv[size_t(b)]) {
-        work.passes[size_t(b)].data.kin.S_inv = resume->frame_S_inv[size_t(b)];
-        work.passes[size_t(b)].data.kin.W.resize(6, model.bodies[size_t(b)].n_coordinates());
+    if (resume_ && !Resume()) return result_;
+    grid_time_ = state_.t;
+    capture_ = [this](DynamicResume& r) { Capture(r); };
+    while (BeforeEnd()) {
+      FitStep();
+      const double t_new = options_.adaptive && control_.at_breakpoint()
+                               ? std::nextafter(control_.boundary(), -HUGE_VAL)
+                               : state_.t + h_;
+      const StepOutcome step = TryStep(t_new);
+      if (!step.converged && result_.steps == 0 && result_.newton_cuts == 0 && step.singular_matrix) {
+        // The first iteration matrix is singular: the model's, not the step's.
+        const std::string why = DescribeSingular(model_, dofs_, state_.config, *step.singular_matrix);
+        if (!why.empty()) {
+          result_.message = "iteration matrix at the start: " + why;
+          return result_;
+        }
       }
-      if (size_t(b) < resume->kept_age.size()) {
-        BodyWorkspace::BodyMatrices& m = work.matrices[size_t(b)];
-        m.M_frame = resume->kept_M[size_t(b)], m.C_frame = resume->kept_C[size_t(b)];
-        m.K_frame = resume->kept_K[size_t(b)], m.age = resume->kept_age[size_t(b)];
+      std::string failure;
+      double error = 0.0;
+      if (!Judge(step, &error, &failure)) {
+        if (!failure.empty()) return Fail(failure);
+        continue;
+      }
+      const bool output = PlaceStep();
+      Accept(step);
+      DynamicStepReport r = Report(step, output);
+      const std::string unstable = WatchEnergy(r);
+      NextStepSize(step, error);
+      // A stop requested by now ends the run after this report (one requested during it, after
+      // the next step): the report says which step is the last.
+      const int stop = options_.stop ? options_.stop->load() : 0;
+      r.last = !BeforeEnd() || stop != 0;
+      if (on_step_) on_step_(r, state_);
+      if (!unstable.empty()) return Fail(unstable);
+      if (stop != 0) {
+        result_.stopped = stop;
+        break;
       }
     }
+    CountFactorizations();
+    FinalWarnings();
+    result_.ok = true;
+    return result_;
   }
-  // What the next step starts from (DynamicStepReport::capture, called in on_step). A fixed step's
-  // time is t_base + n h, rounded to end_time at the end for the report: the state goes on from
-  // the unrounded one (grid_time), as in a longer run.
-  double grid_time = state.t;
-  const std::function<void(DynamicResume&)> capture = [&](DynamicResume& r) {
-    r.state = state;
-    if (!options.adaptive) r.state.t = grid_time;
-    r.t_start = t_output0, r.h = h, r.t_base = t_base, r.last_output = last_output, r.E0 = E0;
-    r.energy_scale = energy_scale, r.first_cut_time = first_cut_time, r.n_nominal = n_nominal, r.cuts = cuts;
-    r.warned = warned;
-    r.result = result;
-    control.Save(r);
-    matrix.solver.Save(r.factor);
-    r.factorizations = matrix.factorizations;
-    r.matrices_computed = work.matrices_computed, r.matrices_turned = work.matrices_turned;
-    r.frame_S_inv.assign(size_t(n_bodies), Eigen::Matrix<double, 6, 6>::Zero());
-    r.has_frame_S_inv.assign(size_t(n_bodies), 0);
-    for (int b = 0; b < n_bodies && size_t(b) < work.passes.size(); ++b) {
-      const SuperelementBody::Kinematics& kin = work.passes[size_t(b)].data.kin;
-      if (kin.W.cols() != model.bodies[size_t(b)].n_coordinates()) continue;
+
+ private:
+  // The loop's variables, the step controller, the pivot order, the bodies' last frame matrices
+  // and kept matrices as the saved run had them after its last step. false with result_.message.
+  bool Resume() {
+    const DynamicResume& r = *resume_;
+    h_ = r.h, cuts_ = r.cuts, t_base_ = r.t_base, n_nominal_ = r.n_nominal;
+    last_output_ = r.last_output, first_cut_time_ = r.first_cut_time, warned_ = r.warned;
+    result_ = r.result;
+    control_.Restore(r);
+    if (!matrix_.solver.Restore(r.factor)) {
+      result_.message = "the saved state's iteration matrix pivots could not be restored";
+      return false;
+    }
+    matrix_.factorizations = r.factorizations;
+    work_.matrices_computed = r.matrices_computed, work_.matrices_turned = r.matrices_turned;
+    work_.passes.resize(size_t(n_bodies_));
+    work_.matrices.resize(size_t(n_bodies_));
+    for (int b = 0; b < n_bodies_; ++b) {
+      if (size_t(b) < r.has_frame_S_inv.size() && r.has_frame_S_inv[size_t(b)]) {
+        work_.passes[size_t(b)].data.kin.S_inv = r.frame_S_inv[size_t(b)];
+        work_.passes[size_t(b)].data.kin.W.resize(6, model_.bodies[size_t(b)].n_coordinates());
+      }
+      if (size_t(b) < r.kept_age.size()) {
+        BodyWorkspace::BodyMatrices& m = work_.matrices[size_t(b)];
+        m.M_frame = r.kept_M[size_t(b)], m.C_frame = r.kept_C[size_t(b)];
+        m.K_frame = r.kept_K[size_t(b)], m.age = r.kept_age[size_t(b)];
+      }
+    }
+    return true;
+  }
+
+  // What the next step starts from (DynamicStepReport::capture, called in on_step). A fixed
+  // step's time is t_base + n h, rounded to end_time at the end for the report: the state goes
+  // on from the unrounded one (grid_time_), as in a longer run.
+  void Capture(DynamicResume& r) const {
+    r.state = state_;
+    if (!options_.adaptive) r.state.t = grid_time_;
+    r.t_start = t_output0_, r.h = h_, r.t_base = t_base_, r.last_output = last_output_, r.E0 = E0_;
+    r.energy_scale = energy_scale_, r.first_cut_time = first_cut_time_, r.n_nominal = n_nominal_, r.cuts = cuts_;
+    r.warned = warned_;
+    r.result = result_;
+    control_.Save(r);
+    matrix_.solver.Save(r.factor);
+    r.factorizations = matrix_.factorizations;
+    r.matrices_computed = work_.matrices_computed, r.matrices_turned = work_.matrices_turned;
+    r.frame_S_inv.assign(size_t(n_bodies_), Eigen::Matrix<double, 6, 6>::Zero());
+    r.has_frame_S_inv.assign(size_t(n_bodies_), 0);
+    for (int b = 0; b < n_bodies_ && size_t(b) < work_.passes.size(); ++b) {
+      const SuperelementBody::Kinematics& kin = work_.passes[size_t(b)].data.kin;
+      if (kin.W.cols() != model_.bodies[size_t(b)].n_coordinates()) continue;
       r.frame_S_inv[size_t(b)] = kin.S_inv;
       r.has_frame_S_inv[size_t(b)] = 1;
     }
     r.kept_M.clear(), r.kept_C.clear(), r.kept_K.clear(), r.kept_age.clear();
-    for (const BodyWorkspace::BodyMatrices& m : work.matrices) {
+    for (const BodyWorkspace::BodyMatrices& m : work_.matrices) {
       r.kept_M.push_back(m.M_frame), r.kept_C.push_back(m.C_frame), r.kept_K.push_back(m.K_frame);
       r.kept_age.push_back(m.age);
     }
-  };
-  const auto count_factorizations = [&] {
-    result.factorizations = matrix.factorizations;
-    result.pattern_analyses = matrix.solver.analyses();
-    result.pivoted = matrix.solver.full_factorizations();
-    result.body_matrices_computed = work.matrices_computed;
-    result.body_matrices_turned = work.matrices_turned;
-  };
-  auto fail = [&](const std::string& message) {
-    result.message = message;
-    if (const std::string why = LoopSingularity(model, state.config); !why.empty()) result.message += "; " + why;
-    count_factorizations();
-    return result;
-  };
-  const auto before_end = [&] {
-    return state.t < options.end_time - 1e-12 * std::max(std::abs(options.end_time), options.step);
-  };
-  while (before_end()) {
-    if (options.adaptive) {
-      h = control.Fit(state.t, h);
+  }
+
+  void CountFactorizations() {
+    result_.factorizations = matrix_.factorizations;
+    result_.pattern_analyses = matrix_.solver.analyses();
+    result_.pivoted = matrix_.solver.full_factorizations();
+    result_.body_matrices_computed = work_.matrices_computed;
+    result_.body_matrices_turned = work_.matrices_turned;
+  }
+
+  DynamicResult Fail(const std::string& message) {
+    result_.message = message;
+    if (const std::string why = LoopSingularity(model_, state_.config); !why.empty()) result_.message += "; " + why;
+    CountFactorizations();
+    return result_;
+  }
+
+  bool BeforeEnd() const {
+    return state_.t < options_.end_time - 1e-12 * std::max(std::abs(options_.end_time), options_.step);
+  }
+
+  // The step to try: the controller's, fitted to the next boundary; or the fixed step, the last
+  // one the rest of the time unless that is the nominal step to round-off (then the step stays
+  // nominal: a run extended from this end takes the steps a longer run takes).
+  void FitStep() {
+    if (options_.adaptive) {
+      h_ = control_.Fit(state_.t, h_);
     } else {
-      // The last step: the rest of the time, unless that is the nominal step to round-off (then
-      // the step stays nominal: a run extended from this end takes the steps a longer run takes).
-      const double remaining = options.end_time - state.t;
-      if (remaining <= 1.01 * h && !(h == options.step && std::abs(remaining - h) <= 1e-9 * h)) h = remaining;
+      const double remaining = options_.end_time - state_.t;
+      if (remaining <= 1.01 * h_ && !(h_ == options_.step && std::abs(remaining - h_) <= 1e-9 * h_)) h_ = remaining;
     }
-    matrix.with_this_factor = 0;  // a step may use the kept factor for reuse_max_iterations iterations
-    const double t_new =
-        options.adaptive && control.at_breakpoint() ? std::nextafter(control.boundary(), -HUGE_VAL) : state.t + h;
-    const StepOutcome step =
-        options.integrator == Integrator::kMidpoint
-            ? MidpointStep(model, dofs, options, state, h, t_new, matrix, threads, work, next)
-            : GeneralizedAlphaStep(model, dofs, options, state, h, t_new, matrix, threads, work, next);
-    if (!step.converged && result.steps == 0 && result.newton_cuts == 0 && step.singular_matrix) {
-      // The first iteration matrix is singular: the model's, not the step's.
-      const std::string why = DescribeSingular(model, dofs, state.config, *step.singular_matrix);
-      if (!why.empty()) {
-        result.message = "iteration matrix at the start: " + why;
-        return result;
-      }
-    }
-    if (!step.converged && options.adaptive) {
-      matrix.solver.Invalidate();
-      ++result.newton_cuts;
-      after_rejection = true;
-      if (0.5 * h < control.min_step()) {
+    matrix_.with_this_factor = 0;  // a step may use the kept factor for reuse_max_iterations iterations
+  }
+
+  StepOutcome TryStep(double t_new) {
+    return options_.integrator == Integrator::kMidpoint
+               ? MidpointStep(model_, dofs_, options_, state_, h_, t_new, matrix_, threads_, work_, next_)
+               : GeneralizedAlphaStep(model_, dofs_, options_, state_, h_, t_new, matrix_, threads_, work_, next_);
+  }
+
+  // Whether the step stands: Newton converged and, with error-controlled steps, the error
+  // estimate (into *error) within the tolerance. Otherwise the step is shortened for a retry, or
+  // *failure says why the run cannot go on.
+  bool Judge(const StepOutcome& step, double* error, std::string* failure) {
+    if (!step.converged && options_.adaptive) {
+      matrix_.solver.Invalidate();
+      ++result_.newton_cuts;
+      after_rejection_ = true;
+      if (0.5 * h_ < control_.min_step()) {
         char buffer[200];
-        std::snprintf(buffer, sizeof buffer, "Newton diverged at t = %.6g with step %.3g (min_step %.3g)", state.t, h,
-                      control.min_step());
-        return fail(buffer);
+        std::snprintf(buffer, sizeof buffer, "Newton diverged at t = %.6g with step %.3g (min_step %.3g)", state_.t, h_,
+                      control_.min_step());
+        *failure = buffer;
+        return false;
       }
-      h *= 0.5;
-      continue;
+      h_ *= 0.5;
+      return false;
     }
-    double error = 0.0;
-    if (options.adaptive) {
-      error = control.Error(state, next, h);
-      if (error > 1.0) {
-        ++result.rejected_by_error;
-        after_rejection = true;
-        const double h_new = h * StepController::Factor(error);
-        if (h_new < control.min_step()) {
+    if (options_.adaptive) {
+      *error = control_.Error(state_, next_, h_);
+      if (*error > 1.0) {
+        ++result_.rejected_by_error;
+        after_rejection_ = true;
+        const double h_new = h_ * StepController::Factor(*error);
+        if (h_new < control_.min_step()) {
           char buffer[300];
           std::snprintf(buffer, sizeof buffer,
                         "the step fell below min_step %.3g at t = %.6g (estimated local error %.3g times "
                         "step_tolerance with step %.3g)",
-                        control.min_step(), state.t, error, h);
-          return fail(buffer);
+                        control_.min_step(), state_.t, *error, h_);
+          *failure = buffer;
+          return false;
         }
-        h = h_new;
-        continue;
+        h_ = h_new;
+        return false;
       }
-      next.t = control.lands() ? control.boundary() : state.t + h;
+      next_.t = control_.lands() ? control_.boundary() : state_.t + h_;
     }
     if (!step.converged) {
-      matrix.solver.Invalidate();
-      ++result.newton_cuts;
-      if (cuts >= options.max_cuts) {
+      matrix_.solver.Invalidate();
+      ++result_.newton_cuts;
+      if (cuts_ >= options_.max_cuts) {
         char buffer[200];
-        std::snprintf(buffer, sizeof buffer, "Newton diverged at t = %.6g after %d step cuts (step %.3g)", state.t,
-                      cuts, h);
-        return fail(buffer);
+        std::snprintf(buffer, sizeof buffer, "Newton diverged at t = %.6g after %d step cuts (step %.3g)", state_.t,
+                      cuts_, h_);
+        *failure = buffer;
+        return false;
       }
-      h *= 0.5;
-      ++cuts;
-      continue;
+      h_ *= 0.5;
+      ++cuts_;
+      return false;
     }
-    bool output = true;
-    if (options.adaptive) {
-      output = control.output();
+    return true;
+  }
+
+  // The accepted step's time (fixed steps: on the grid t_base + n h while the step stays
+  // nominal; summing h over 1e6 steps drifted by 1e-8 s and left a last step of 1e-8 s that
+  // Newton could not take, and a remainder below 1% of a step is merged into the last one) and
+  // whether it is an output step.
+  bool PlaceStep() {
+    if (options_.adaptive) return control_.output();
+    if (h_ == options_.step) {
+      next_.t = t_base_ + double(++n_nominal_) * options_.step;
     } else {
-      if (h == options.step) {
-        next.t = t_base + double(++n_nominal) * options.step;
+      t_base_ = next_.t;
+      n_nominal_ = 0;
+    }
+    grid_time_ = next_.t;  // a run continued from here goes on from the unrounded time
+    if (options_.end_time - next_.t < 1e-9 * h_) next_.t = options_.end_time;
+    if (options_.output_step <= 0) return true;
+    // The first step at or after each output time.
+    const double k = std::floor((next_.t - t_output0_) / options_.output_step + 1e-9);
+    const bool output = k > last_output_ || next_.t >= options_.end_time;
+    if (output) last_output_ = k;
+    return output;
+  }
+
+  // The step's end becomes the state; at a breakpoint (a load or drive jumps or kinks there) the
+  // run restarts from it with the accelerations of the right limit, as at the start, so that no
+  // step sees the jump inside it. Generalized-alpha keeps what a_n carries beyond the motion's own
+  // acceleration, (alpha_m - alpha_f) h q3 (q3 the motion's third derivative;
+  // generalized_alpha.cpp): taken away, the stiff directions of flexible bodies take the change as
+  // at a change of step.
+  void Accept(const StepOutcome& step) {
+    next_.h_last = h_;
+    if (result_.steps == 0 || h_ < result_.smallest_step)
+      result_.smallest_step = h_, result_.smallest_step_time = next_.t;
+    result_.largest_step = std::max(result_.largest_step, h_);
+    if (cuts_ > 0 && first_cut_time_ < 0) first_cut_time_ = state_.t;
+    state_ = next_;
+    if (options_.adaptive && control_.at_breakpoint()) {
+      ApplyPrescribed(model_, dofs_, state_.t, state_.config, &state_.W, &state_.Wdot);
+      if (options_.integrator == Integrator::kGeneralizedAlpha) work_.a_n = state_.a - state_.Wdot;
+      ConsistentAccelerations(model_, dofs_, state_);
+      if (options_.integrator == Integrator::kGeneralizedAlpha) {
+        state_.a += work_.a_n;
       } else {
-        t_base = next.t;
-        n_nominal = 0;
-      }
-      grid_time = next.t;  // a run continued from here goes on from the unrounded time
-      if (options.end_time - next.t < 1e-9 * h) next.t = options.end_time;
-      if (options.output_step > 0) {
-        // The first step at or after each output time.
-        const double k = std::floor((next.t - t_output0) / options.output_step + 1e-9);
-        output = k > last_output || next.t >= options.end_time;
-        if (output) last_output = k;
+        state_.h_last = 0.0;
       }
     }
-    next.h_last = h;
-    if (result.steps == 0 || h < result.smallest_step) result.smallest_step = h, result.smallest_step_time = next.t;
-    result.largest_step = std::max(result.largest_step, h);
-    if (cuts > 0 && first_cut_time < 0) first_cut_time = state.t;
-    state = next;
-    if (options.adaptive && control.at_breakpoint()) {
-      // A load or drive jumps or kinks here: restart from the state with the accelerations of the
-      // right limit (as at the start), so no step sees the jump inside it.
-      // Generalized-alpha keeps what a_n carries beyond the motion's own acceleration, (alpha_m -
-      // alpha_f) h q3 (q3 the motion's third derivative; generalized_alpha.cpp): taken away, the
-      // stiff directions of flexible bodies take the change as at a change of step.
-      ApplyPrescribed(model, dofs, state.t, state.config, &state.W, &state.Wdot);
-      if (options.integrator == Integrator::kGeneralizedAlpha) work.a_n = state.a - state.Wdot;
-      ConsistentAccelerations(model, dofs, state);
-      if (options.integrator == Integrator::kGeneralizedAlpha) {
-        state.a += work.a_n;
-      } else {
-        state.h_last = 0.0;
-      }
-    }
-    result.steps += 1;
-    result.newton_iterations += step.iterations;
+    result_.steps += 1;
+    result_.newton_iterations += step.iterations;
+  }
+
+  // The step's report: energies and momenta from the converged pass where the step kept it.
+  DynamicStepReport Report(const StepOutcome& step, bool output) {
     static const std::vector<BodyPass> kNone;
     DynamicStepReport r =
-        MeasureWith(model, dofs, state, step.passes_kept ? work.passes : kNone, &threads, &work.measures);
-    r.h = h;
+        MeasureWith(model_, dofs_, state_, step.passes_kept ? work_.passes : kNone, &threads_, &work_.measures);
+    r.h = h_;
     r.iterations = step.iterations;
-    r.rejected = result.rejected_by_error + result.newton_cuts;
+    r.rejected = result_.rejected_by_error + result_.newton_cuts;
     r.output = output;
-    r.capture = &capture;
+    r.capture = &capture_;
+    return r;
+  }
+
+  // The energy watchdog (kEnergyWarn, kEnergyStop): the message that stops the run, or empty.
+  // Judged from the 10th step on: over the first few steps of a smooth start (a spin-up drive,
+  // energy ~ t^6) the trapezoidal work of the drives is off by tens of percent of an energy that
+  // is itself round-off (a one-body spin-up stopped at t = 0.01 with 2.4e-16 J of 4.1e-16 J); the
+  // rule's error falls as 1/n^2 of the steps taken.
+  std::string WatchEnergy(const DynamicStepReport& r) {
     const double energy = r.kinetic_energy + r.elastic_energy;
-    energy_scale = std::max({energy_scale, std::abs(energy), std::abs(state.external_work), std::abs(state.drive_work),
-                             EnergyNoise(model_mass, state.config, h) / kEnergyWarn});
-    const double growth = energy - state.external_work - state.drive_work - E0;
-    // Judged from the 10th step on: over the first few steps of a smooth start (a spin-up
-    // drive, energy ~ t^6) the trapezoidal work of the drives is off by tens of percent of an
-    // energy that is itself round-off (a one-body spin-up stopped at t = 0.01 with 2.4e-16 J of
-    // 4.1e-16 J); the rule's error falls as 1/n^2 of the steps taken.
-    std::string unstable;  // the energy watchdog's stop
-    if (result.steps >= 10 && energy_scale > 0 && growth > kEnergyWarn * energy_scale) {
-      char buffer[400];
-      std::snprintf(buffer, sizeof buffer,
-                    "the energy grew by %.3g (%.1f%% of %.3g) at t = %.6g beyond the work of the loads and drives: "
-                    "numerically unstable at step %.3g; reduce analysis.%s%s",
-                    growth, 100 * growth / energy_scale, energy_scale, state.t, h,
-                    options.adaptive ? "step_tolerance" : "step",
-                    options.integrator == Integrator::kGeneralizedAlpha ? " or analysis.rho_inf" : "");
-      if (growth > kEnergyStop * energy_scale) {
-        unstable = buffer;
-      } else {
-        if (!warned) result.warnings.push_back(buffer);
-        warned = true;
-      }
-    }
-    // The next step's size, then the report: what on_step captures is what the next step starts from.
-    if (options.adaptive) {
-      h = control.Accept(state, h, error, after_rejection);
-      after_rejection = false;
-    } else if (cuts > 0 && step.iterations <= 4) {
-      h = std::min(options.step, 2 * h);
-      --cuts;
-    }
-    // A stop requested by now ends the run after this report (one requested during it, after the
-    // next step): the report says which step is the last.
-    const int stop = options.stop ? options.stop->load() : 0;
-    r.last = !before_end() || stop != 0;
-    if (on_step) on_step(r, state);
-    if (!unstable.empty()) return fail(unstable);
-    if (stop != 0) {
-      result.stopped = stop;
-      break;
-    }
-  }
-  count_factorizations();
-  if (options.integrator == Integrator::kMidpoint) {
-    if (const std::string w = UnresolvedModesWarning(model, result.largest_step); !w.empty())
-      result.warnings.push_back(w);
-  }
-  if (!options.adaptive && first_cut_time >= 0) {
-    // A fixed step that Newton could not take was replaced: said once, with the step used.
+    energy_scale_ = std::max({energy_scale_, std::abs(energy), std::abs(state_.external_work),
+                              std::abs(state_.drive_work), EnergyNoise(model_mass_, state_.config, h_) / kEnergyWarn});
+    const double growth = energy - state_.external_work - state_.drive_work - E0_;
+    if (!(result_.steps >= 10 && energy_scale_ > 0 && growth > kEnergyWarn * energy_scale_)) return "";
     char buffer[400];
     std::snprintf(buffer, sizeof buffer,
-                  "Newton did not converge with analysis.step %.3g from t = %.6g on (%ld cuts): steps there were "
-                  "shortened, to %.3g at the least (at t = %.6g); the results are those of the shorter steps. Give "
-                  "a step Newton takes, or `step: auto`",
-                  options.step, first_cut_time, result.newton_cuts, result.smallest_step, result.smallest_step_time);
-    result.warnings.push_back(buffer);
+                  "the energy grew by %.3g (%.1f%% of %.3g) at t = %.6g beyond the work of the loads and drives: "
+                  "numerically unstable at step %.3g; reduce analysis.%s%s",
+                  growth, 100 * growth / energy_scale_, energy_scale_, state_.t, h_,
+                  options_.adaptive ? "step_tolerance" : "step",
+                  options_.integrator == Integrator::kGeneralizedAlpha ? " or analysis.rho_inf" : "");
+    if (growth > kEnergyStop * energy_scale_) return buffer;
+    if (!warned_) result_.warnings.push_back(buffer);
+    warned_ = true;
+    return "";
   }
-  result.ok = true;
-  return result;
+
+  // The next step's size, before the report goes out: what on_step captures is what the next
+  // step starts from.
+  void NextStepSize(const StepOutcome& step, double error) {
+    if (options_.adaptive) {
+      h_ = control_.Accept(state_, h_, error, after_rejection_);
+      after_rejection_ = false;
+    } else if (cuts_ > 0 && step.iterations <= 4) {
+      h_ = std::min(options_.step, 2 * h_);
+      --cuts_;
+    }
+  }
+
+  // The midpoint scheme's unresolved modes, and a fixed step that Newton could not take (said
+  // once, with the step used).
+  void FinalWarnings() {
+    if (options_.integrator == Integrator::kMidpoint) {
+      if (const std::string w = UnresolvedModesWarning(model_, result_.largest_step); !w.empty())
+        result_.warnings.push_back(w);
+    }
+    if (!options_.adaptive && first_cut_time_ >= 0) {
+      char buffer[400];
+      std::snprintf(buffer, sizeof buffer,
+                    "Newton did not converge with analysis.step %.3g from t = %.6g on (%ld cuts): steps there were "
+                    "shortened, to %.3g at the least (at t = %.6g); the results are those of the shorter steps. Give "
+                    "a step Newton takes, or `step: auto`",
+                    options_.step, first_cut_time_, result_.newton_cuts, result_.smallest_step,
+                    result_.smallest_step_time);
+      result_.warnings.push_back(buffer);
+    }
+  }
+
+  const SystemModel& model_;
+  const DofMap& dofs_;
+  DynamicState& state_;
+  const DynamicOptions& options_;
+  const OnStep& on_step_;
+  const DynamicResume* resume_;
+  DynamicResult result_;
+  StepController control_;
+  double h_ = 0.0;
+  int cuts_ = 0;
+  bool after_rejection_ = false;
+  IterationMatrix matrix_;
+  BodyThreads threads_;
+  BodyWorkspace work_;
+  DynamicState next_;  ///< the step's result; its storage is reused from step to step
+  // Time is counted in steps on fixed steps: t = t_base_ + n_nominal_ h while the step stays
+  // nominal (PlaceStep).
+  double t_base_ = 0.0;
+  long n_nominal_ = 0;
+  double t_output0_ = 0.0, last_output_ = 0.0;
+  double E0_ = 0.0, energy_scale_ = 0.0;
+  double first_cut_time_ = -1.0;  ///< fixed steps: where Newton first needed a shorter step
+  double model_mass_ = 0.0;
+  bool warned_ = false;
+  const int n_bodies_;
+  double grid_time_ = 0.0;
+  std::function<void(DynamicResume&)> capture_;
+};
+
+}  // namespace
+
+DynamicResult SolveDynamic(const SystemModel& model, DynamicState& state, const DynamicOptions& options,
+                           const OnStep& on_step) {
+  DynamicRun run(model, state, options, on_step);
+  return run.Run();
 }
 
 }  // namespace femb
