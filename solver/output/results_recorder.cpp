@@ -165,29 +165,119 @@ ResultsRecorder::ResultsRecorder(const Scene& scene, const std::string& director
   probe_values_.width = int(probe_columns_.size());
 }
 
+// What one output step's fields and probes derive from its state beyond the series, each made
+// when first asked for: the node accelerations, and per body its stress coordinates, its frame's
+// inertia load factors and the rates of its local coordinates. The velocities and accelerations
+// over the unknowns are zero where the analysis has none (static).
+class ResultsRecorder::OutputStep {
+ public:
+  OutputStep(ResultsRecorder& recorder, double t, const SystemState& state, const Eigen::VectorXd& W,
+             const Eigen::VectorXd* accelerations)
+      : r_(recorder),
+        model_(recorder.scene_.model),
+        t_(t),
+        state_(state),
+        zero_(Eigen::VectorXd::Zero(recorder.dofs_.n_dofs())),
+        V_(W.size() == recorder.dofs_.n_dofs() ? W : zero_),
+        A_(accelerations && accelerations->size() == recorder.dofs_.n_dofs() ? *accelerations : zero_),
+        motion_(model_.bodies.size()) {}
+
+  const std::vector<Eigen::Matrix<double, 6, 1>>& NodeAccelerations() {
+    if (node_acc_.empty()) node_acc_ = femb::NodeAccelerations(model_, r_.dofs_, state_, V_, A_);
+    return node_acc_;
+  }
+  const Eigen::VectorXd& StressCoordinates(size_t b) {
+    if (!r_.has_stress_coordinates_[b]) r_.q_stress_[b] = model_.bodies[b].StressCoordinates(r_.q_loc_[b]);
+    r_.has_stress_coordinates_[b] = 1;
+    return r_.q_stress_[b];
+  }
+  // The inertia load factors of body b's frame (SuperelementBody::InertiaLoads) when its modal
+  // stresses include the inertia load cases: d'Alembert with gravity (static analyses: gravity
+  // as ramped by the analysis, no motion). Null without them.
+  const Eigen::VectorXd* Inertia(size_t b) {
+    const Scene& scene = r_.scene_;
+    if (!scene.stresses[b] || scene.stresses[b]->inertia_modes.size() == 0) return nullptr;
+    if (r_.has_factors_[b]) return &r_.factors_[b];
+    const bool dynamic = scene.spec.analysis.type == AnalysisType::kDynamic;
+    NodeAccelerations();
+    double g = dynamic ? 1.0 : 0.0;
+    if (!dynamic && model_.static_gravity_end > 0) g = std::min(t_ / model_.static_gravity_end, 1.0);
+    r_.factors_[b] =
+        model_.bodies[b]
+            .InertiaLoads(BodyConfigurationOf(model_, state_, int(b)), state_.frames[b],
+                          GatherBody(model_, r_.dofs_, state_, int(b), V_),
+                          GatherBodyAcceleration(model_, r_.dofs_, int(b), node_acc_, A_), g * model_.gravity)
+            .a;
+    r_.has_factors_[b] = 1;
+    return &r_.factors_[b];
+  }
+  // Body b's frame motion and the rates of its local coordinates (SuperelementBody::LocalRates).
+  const SuperelementBody::LocalMotion& MotionOf(int b) {
+    if (!motion_[size_t(b)]) {
+      const SuperelementBody& body = model_.bodies[size_t(b)];
+      // The local coordinates at this frame are q_loc_ already: not solved for again.
+      SuperelementBody::Data d;
+      d.q = r_.q_loc_[size_t(b)];
+      body.EvaluateSolved(BodyConfigurationOf(model_, state_, b), state_.frames[size_t(b)], d);
+      const Eigen::VectorXd wdot = GatherBodyAcceleration(model_, r_.dofs_, b, NodeAccelerations(), A_);
+      motion_[size_t(b)] = body.LocalRates(d, GatherBody(model_, r_.dofs_, state_, b, V_), &wdot);
+    }
+    return *motion_[size_t(b)];
+  }
+
+ private:
+  ResultsRecorder& r_;
+  const SystemModel& model_;
+  const double t_;
+  const SystemState& state_;
+  const Eigen::VectorXd zero_;
+  const Eigen::VectorXd& V_;
+  const Eigen::VectorXd& A_;
+  std::vector<Eigen::Matrix<double, 6, 1>> node_acc_;
+  std::vector<std::optional<SuperelementBody::LocalMotion>> motion_;
+};
+
 void ResultsRecorder::Record(double t, const SystemState& state, const Eigen::VectorXd& W, double kinetic,
                              double elastic, double external_work, const Eigen::Vector3d& linear_momentum,
                              const Eigen::Vector3d& angular_momentum,
                              const std::vector<Eigen::Matrix<double, 6, 1>>* reactions,
                              const Eigen::VectorXd* accelerations) {
+  const NodeRows nodes =
+      RecordSeries(t, state, W, kinetic, elastic, external_work, linear_momentum, angular_momentum, reactions);
+  RecordBodies(state);
+  RecordJoints(state);
+  const bool frame = AnimationFrame(t);
+  OutputStep step(*this, t, state, W, accelerations);
+  QueueFields(state, frame, step);
+  Put(csv_, t);
+  double* const probe_row = probe_values_.Append();
+  ProbeRow row{probe_row, 0};
+  WriteProbes(state, nodes, reactions, step, row);
+  PutProbe(row, kinetic);
+  PutProbe(row, elastic);
+  PutProbe(row, external_work);
+  csv_.put('\n');
+}
+
+ResultsRecorder::NodeRows ResultsRecorder::RecordSeries(double t, const SystemState& state, const Eigen::VectorXd& W,
+                                                        double kinetic, double elastic, double external_work,
+                                                        const Eigen::Vector3d& linear_momentum,
+                                                        const Eigen::Vector3d& angular_momentum,
+                                                        const std::vector<Eigen::Matrix<double, 6, 1>>* reactions) {
   const SystemModel& model = scene_.model;
-  const DofMap& dofs = dofs_;
   const int n = model.n_nodes();
   if (model.has_constraints()) {
     loop_violation_.push_back(LoopViolation(model, state));
     max_loop_violation_ = std::max(max_loop_violation_, loop_violation_.back());
   }
   // Every series appends its row in place (Rows): no allocation per output step once grown.
-  double* const pos = positions_.Append();
-  double* const quat = quaternions_.Append();
-  double* const vel = velocities_.Append();
-  double* const ang = angular_velocities_.Append();
+  NodeRows rows{positions_.Append(), quaternions_.Append(), velocities_.Append(), angular_velocities_.Append()};
   for (int k = 0; k < n; ++k) {
-    Eigen::Vector3d::Map(pos + 3 * k) = state.x[k] + scene_.origin;
-    Eigen::Vector4d::Map(quat + 4 * k) = Quaternion(state.R[k]);
+    Eigen::Vector3d::Map(rows.pos + 3 * k) = state.x[k] + scene_.origin;
+    Eigen::Vector4d::Map(rows.quat + 4 * k) = Quaternion(state.R[k]);
     const Eigen::Matrix<double, 6, 1> v = NodeMotion(state, k, W);
-    Eigen::Vector3d::Map(vel + 3 * k) = v.head<3>();
-    Eigen::Vector3d::Map(ang + 3 * k) = v.tail<3>();
+    Eigen::Vector3d::Map(rows.vel + 3 * k) = v.head<3>();
+    Eigen::Vector3d::Map(rows.ang + 3 * k) = v.tail<3>();
   }
   time_.push_back(t);
   ++outputs_since_flush_;
@@ -198,20 +288,23 @@ void ResultsRecorder::Record(double t, const SystemState& state, const Eigen::Ve
   Eigen::Vector3d::Map(momentum) = linear_momentum;
   Eigen::Vector3d::Map(momentum + 3) =
       angular_momentum + scene_.origin.cross(linear_momentum);  // about the global origin
-  // The reaction at node k (zero without `reactions`).
-  const auto reaction = [&](int k, int i) { return reactions ? (*reactions)[size_t(k)][i] : 0.0; };
   if (scene_.spec.reactions) {
     double* const r = reactions_.Append();
     for (int k = 0; k < n; ++k)
-      for (int i = 0; i < 6; ++i) r[6 * k + i] = reaction(k, i);
+      for (int i = 0; i < 6; ++i) r[6 * k + i] = Reaction(reactions, k, i);
   }
   if (scene_.spec.reactions && !model.cut_joints.empty()) {
     const std::vector<Eigen::Matrix<double, 6, 1>> cut = CutJointReactions(model, state);
     double* const r = loop_reactions_.Append();
     for (size_t c = 0; c < cut.size(); ++c) Eigen::Matrix<double, 6, 1>::Map(r + 6 * c) = cut[c];
   }
-  // Per body: modal coordinates, floating frame and centre of mass; the local coordinates (kept
-  // for the mesh, the stresses and the probes of this output step).
+  return rows;
+}
+
+// Per body: modal coordinates, floating frame and centre of mass; the local coordinates (kept for
+// the mesh, the stresses and the probes of this output step).
+void ResultsRecorder::RecordBodies(const SystemState& state) {
+  const SystemModel& model = scene_.model;
   for (size_t b = 0; b < model.bodies.size(); ++b) {
     const SuperelementBody& body = model.bodies[b];
     double* const modal = modal_[b].Append();
@@ -226,197 +319,180 @@ void ResultsRecorder::Record(double t, const SystemState& state, const Eigen::Ve
     has_stress_coordinates_[b] = 0;
     has_factors_[b] = 0;
   }
-  // Joint coordinates: the coordinates of every node that has a joint (revolute angle,
-  // prismatic travel, ...), in node order.
+}
+
+// Joint coordinates: the coordinates of every node that has a joint (revolute angle, prismatic
+// travel, ...), in node order.
+void ResultsRecorder::RecordJoints(const SystemState& state) {
   double* const joint_values = joints_.Append();
   int joint_count = 0;
-  for (int k = 0; k < n; ++k) {
+  for (int k = 0; k < scene_.model.n_nodes(); ++k) {
     if (!joint_node_[size_t(k)]) continue;
     if (joint_count + state.z[k].size() > joints_.width)
       throw std::logic_error("ResultsRecorder: joint coordinates changed in number");
     for (int i = 0; i < state.z[k].size(); ++i) joint_values[joint_count++] = state.z[k][i];
   }
+}
+
+// Whether the output step just recorded at t is an animation frame: every animation_every-th
+// output step, or the first at or after each frame_interval.
+bool ResultsRecorder::AnimationFrame(double t) {
   bool frame = (time_.size() - 1) % size_t(animation_every_) == 0;
   if (frame_interval_ > 0) {
     frame = t >= next_frame_time_ - 1e-9 * frame_interval_;
     if (frame) next_frame_time_ = (std::floor(t / frame_interval_ + 1e-9) + 1) * frame_interval_;
   }
-  const auto local = [&](size_t b) -> const Eigen::VectorXd& { return q_loc_[b]; };
-  auto stress_coordinates = [&](size_t b) -> const Eigen::VectorXd& {
-    if (!has_stress_coordinates_[b]) q_stress_[b] = model.bodies[b].StressCoordinates(local(b));
-    has_stress_coordinates_[b] = 1;
-    return q_stress_[b];
-  };
-  // The inertia load factors of body b's frame (SuperelementBody::InertiaLoads) when its modal
-  // stresses include the inertia load cases: d'Alembert with gravity (static analyses: gravity
-  // as ramped by the analysis, no motion).
-  // The velocities and accelerations over the unknowns (zero in static analyses) and the node
-  // accelerations, made when first asked for.
-  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(dofs.n_dofs());
-  const Eigen::VectorXd& V = W.size() == dofs.n_dofs() ? W : zero;
-  const Eigen::VectorXd& A = accelerations && accelerations->size() == dofs.n_dofs() ? *accelerations : zero;
-  std::vector<Eigen::Matrix<double, 6, 1>> node_acc;
-  const auto node_accelerations = [&]() -> const std::vector<Eigen::Matrix<double, 6, 1>>& {
-    if (node_acc.empty()) node_acc = NodeAccelerations(model, dofs, state, V, A);
-    return node_acc;
-  };
-  auto inertia = [&](size_t b) -> const Eigen::VectorXd* {
-    if (!scene_.stresses[b] || scene_.stresses[b]->inertia_modes.size() == 0) return nullptr;
-    if (has_factors_[b]) return &factors_[b];
-    const bool dynamic = scene_.spec.analysis.type == AnalysisType::kDynamic;
-    node_accelerations();
-    double g = dynamic ? 1.0 : 0.0;
-    if (!dynamic && model.static_gravity_end > 0) g = std::min(t / model.static_gravity_end, 1.0);
-    factors_[b] = model.bodies[b]
-                      .InertiaLoads(BodyConfigurationOf(model, state, int(b)), state.frames[b],
-                                    GatherBody(model, dofs, state, int(b), V),
-                                    GatherBodyAcceleration(model, dofs, int(b), node_acc, A), g * model.gravity)
-                      .a;
-    has_factors_[b] = 1;
-    return &factors_[b];
-  };
-  // The stresses and the animation's node fields are made when written (MakePending), from what
-  // they need of this output step.
-  const bool frame_fields = frame && scene_.spec.animation;
-  if (scene_.spec.stresses || frame_fields) {
-    const size_t n_bodies = model.bodies.size();
-    PendingOutput job;
-    job.output = long(time_.size()) - 1;
-    job.frame = frame_fields ? long(frame_time_.size()) : -1;
-    job.frame_x.resize(n_bodies), job.frame_R.resize(n_bodies), job.q_loc.resize(n_bodies), job.sticks.resize(n_bodies);
-    job.q_stress.resize(n_bodies), job.factors.resize(n_bodies);
-    if (scene_.spec.stresses) max_von_mises_.resize(n_bodies), max_von_mises_node_.resize(n_bodies);
-    for (size_t b = 0; b < n_bodies; ++b) {
-      job.frame_x[b] = state.frames[b].x, job.frame_R[b] = state.frames[b].R;
-      if (frame_fields && scene_.meshes[b]) job.q_loc[b] = local(b);
-      if (frame_fields && !scene_.meshes[b]) {
-        // A stick figure: the positions of its nodes.
-        const std::vector<int>& sticks = scene_.stick_nodes[b];
-        job.sticks[b].resize(long(sticks.size()), 3);
-        for (size_t i = 0; i < sticks.size(); ++i)
-          job.sticks[b].row(long(i)) = (scene_.origin + state.x[sticks[i]]).transpose().cast<float>();
-      }
-      if (scene_.spec.stresses && scene_.stresses[b]) {
-        job.q_stress[b] = stress_coordinates(b);
-        if (const Eigen::VectorXd* a = inertia(b)) job.factors[b] = *a;
-        max_von_mises_[b].push_back(0.0);
-        max_von_mises_node_[b].push_back(0);
-      }
-    }
-    if (frame_fields) frame_time_.push_back(time_.back());
-    pending_.push_back(std::move(job));
-  }
+  return frame;
+}
 
-  Put(csv_, t);
-  double* const probe_row = probe_values_.Append();
-  int probe_column = 0;
-  const auto put = [&](double v) {
-    csv_.put(',');
-    Put(csv_, v);
-    if (probe_column < probe_values_.width) probe_row[probe_column++] = v;
-  };
-  // Per body with point probes: its frame's motion and the local coordinates' rates
-  // (SuperelementBody::LocalRates), made when first asked for.
-  std::vector<std::optional<SuperelementBody::LocalMotion>> motion(model.bodies.size());
-  const auto motion_of = [&](int b) -> const SuperelementBody::LocalMotion& {
-    if (!motion[size_t(b)]) {
-      const SuperelementBody& body = model.bodies[size_t(b)];
-      // The local coordinates at this frame are q_loc_ already: not solved for again.
-      SuperelementBody::Data d;
-      d.q = q_loc_[size_t(b)];
-      body.EvaluateSolved(BodyConfigurationOf(model, state, b), state.frames[size_t(b)], d);
-      const Eigen::VectorXd wdot = GatherBodyAcceleration(model, dofs, b, node_accelerations(), A);
-      motion[size_t(b)] = body.LocalRates(d, GatherBody(model, dofs, state, b, V), &wdot);
+// The stresses and the animation's node fields are made when written (MakePending), from what
+// they need of this output step.
+void ResultsRecorder::QueueFields(const SystemState& state, bool frame, OutputStep& step) {
+  const bool frame_fields = frame && scene_.spec.animation;
+  if (!scene_.spec.stresses && !frame_fields) return;
+  const size_t n_bodies = scene_.model.bodies.size();
+  PendingOutput job;
+  job.output = long(time_.size()) - 1;
+  job.frame = frame_fields ? long(frame_time_.size()) : -1;
+  job.frame_x.resize(n_bodies), job.frame_R.resize(n_bodies), job.q_loc.resize(n_bodies), job.sticks.resize(n_bodies);
+  job.q_stress.resize(n_bodies), job.factors.resize(n_bodies);
+  if (scene_.spec.stresses) max_von_mises_.resize(n_bodies), max_von_mises_node_.resize(n_bodies);
+  for (size_t b = 0; b < n_bodies; ++b) {
+    job.frame_x[b] = state.frames[b].x, job.frame_R[b] = state.frames[b].R;
+    if (frame_fields && scene_.meshes[b]) job.q_loc[b] = q_loc_[b];
+    if (frame_fields && !scene_.meshes[b]) {
+      // A stick figure: the positions of its nodes.
+      const std::vector<int>& sticks = scene_.stick_nodes[b];
+      job.sticks[b].resize(long(sticks.size()), 3);
+      for (size_t i = 0; i < sticks.size(); ++i)
+        job.sticks[b].row(long(i)) = (scene_.origin + state.x[sticks[i]]).transpose().cast<float>();
     }
-    return *motion[size_t(b)];
-  };
-  const auto put3 = [&](const Eigen::Vector3d& v) {
-    for (int i = 0; i < 3; ++i) put(v[i]);
-  };
+    if (scene_.spec.stresses && scene_.stresses[b]) {
+      job.q_stress[b] = step.StressCoordinates(b);
+      if (const Eigen::VectorXd* a = step.Inertia(b)) job.factors[b] = *a;
+      max_von_mises_[b].push_back(0.0);
+      max_von_mises_node_[b].push_back(0);
+    }
+  }
+  if (frame_fields) frame_time_.push_back(time_.back());
+  pending_.push_back(std::move(job));
+}
+
+// One value of the probes' row: into probes.csv, and into results.h5's /probes/values while the
+// row has room.
+void ResultsRecorder::PutProbe(ProbeRow& row, double v) {
+  csv_.put(',');
+  Put(csv_, v);
+  if (row.column < probe_values_.width) row.values[row.column++] = v;
+}
+
+void ResultsRecorder::WriteProbes(const SystemState& state, const NodeRows& nodes,
+                                  const std::vector<Eigen::Matrix<double, 6, 1>>* reactions, OutputStep& step,
+                                  ProbeRow& row) {
   for (size_t pi = 0; pi < scene_.spec.probes.size(); ++pi) {
-    const SceneProbeSpec& p = scene_.spec.probes[pi];
-    if (!p.body.empty()) {  // a point probe
-      const Scene::PointProbe& point = scene_.point_probes[pi];
-      for (const ProbeQuantity q : p.quantities) {
-        if (q == ProbeQuantity::kStress) {  // at its stress point
-          const auto [b, at] = scene_.stress_probes[pi];
-          const Eigen::Matrix<double, 6, 1> s =
-              PointStress(*scene_.stresses[size_t(b)], at, stress_coordinates(size_t(b)), inertia(size_t(b)));
-          put(VonMises(s));
-          for (int i = 0; i < 6; ++i) put(s[i]);
-          continue;
-        }
-        // The material point: s = s0 + u from the frame origin in frame axes, u = shape q_loc
-        // (SuperelementBody::LocalRates for its velocity and acceleration).
-        const int b = point.body;
-        const FrameSolution& body_frame = state.frames[size_t(b)];
-        const Eigen::Vector3d u = point.shape * q_loc_[size_t(b)];
-        const Eigen::Vector3d r = point.s0 + u;
-        if (q == ProbeQuantity::kPosition) put3(scene_.origin + body_frame.x + body_frame.R * r);
-        if (q == ProbeQuantity::kDeformation) put3(body_frame.R * u);
-        if (q == ProbeQuantity::kVelocity) {
-          const SuperelementBody::LocalMotion& m = motion_of(b);
-          put3(body_frame.R * (m.V + m.Omega.cross(r) + point.shape * m.qdot));
-        }
-        if (q == ProbeQuantity::kAcceleration) {
-          const SuperelementBody::LocalMotion& m = motion_of(b);
-          const Eigen::Vector3d ud = point.shape * m.qdot, udd = point.shape * m.qddot;
-          put3(body_frame.R * (m.Vdot + m.Omega.cross(m.V) + m.Omegadot.cross(r) + m.Omega.cross(m.Omega.cross(r)) +
-                               2.0 * m.Omega.cross(ud) + udd));
-        }
-      }
+    if (!scene_.spec.probes[pi].body.empty()) {
+      WritePointProbe(pi, state, step, row);
+    } else {
+      WriteNodeProbe(pi, state, nodes, reactions, step, row);
+    }
+  }
+}
+
+// A point probe's quantities: the stress at its stress point; the material point s = s0 + u from
+// the frame origin in frame axes, u = shape q_loc (SuperelementBody::LocalRates for its velocity
+// and acceleration).
+void ResultsRecorder::WritePointProbe(size_t pi, const SystemState& state, OutputStep& step, ProbeRow& row) {
+  const SceneProbeSpec& p = scene_.spec.probes[pi];
+  const Scene::PointProbe& point = scene_.point_probes[pi];
+  const auto put3 = [&](const Eigen::Vector3d& v) {
+    for (int i = 0; i < 3; ++i) PutProbe(row, v[i]);
+  };
+  for (const ProbeQuantity q : p.quantities) {
+    if (q == ProbeQuantity::kStress) {
+      const auto [b, at] = scene_.stress_probes[pi];
+      const Eigen::Matrix<double, 6, 1> s =
+          PointStress(*scene_.stresses[size_t(b)], at, step.StressCoordinates(size_t(b)), step.Inertia(size_t(b)));
+      PutProbe(row, VonMises(s));
+      for (int i = 0; i < 6; ++i) PutProbe(row, s[i]);
       continue;
     }
-    const int k = scene_.node_index.at(p.node);
-    for (const ProbeQuantity q : p.quantities) {
-      if (q == ProbeQuantity::kPosition)
-        for (int i = 0; i < 3; ++i) put(pos[3 * k + i]);
-      if (q == ProbeQuantity::kRotation)
-        for (int i = 0; i < 4; ++i) put(quat[4 * k + i]);
-      if (q == ProbeQuantity::kVelocity)
-        for (int i = 0; i < 3; ++i) put(vel[3 * k + i]);
-      if (q == ProbeQuantity::kAngularVelocity)
-        for (int i = 0; i < 3; ++i) put(ang[3 * k + i]);
-      if (q == ProbeQuantity::kAcceleration) put3(node_accelerations()[size_t(k)].head<3>());
-      if (q == ProbeQuantity::kAngularAcceleration) put3(node_accelerations()[size_t(k)].tail<3>());
-      if (q == ProbeQuantity::kEffort) {
-        // The generalized force of each prescribed coordinate: B^T of what the joint exerts on
-        // the node (its reaction: force, moment about the node), B the coordinate's motion of the
-        // node (NodeJoint: a revolute's moment about its axis, a prismatic's force along it).
-        const NodeJoint& j = model.joints[size_t(dofs.joint_of(k))];
-        const ParentNode parent = ParentOf(state, j.parent);
-        const JointMaps maps = ComputeJointMaps(j, parent.x, parent.R, state.x[k], state.z[k]);
-        Eigen::Matrix<double, 6, 1> r;
-        for (int i = 0; i < 6; ++i) r[i] = reaction(k, i);
-        for (int c : scene_.effort_coordinates[pi]) put(maps.B.col(model.prescribed[size_t(c)].coordinate).dot(r));
-      }
-      if (q == ProbeQuantity::kJoint) {
-        const int c = pi < probe_cut_.size() ? probe_cut_[pi] : -1;
-        if (c < 0) {
-          for (int i = 0; i < state.z[k].size(); ++i) put(state.z[k][i]);
-        } else {
-          const NodeJoint& j = model.cut_joints[size_t(c)].joint;
-          Eigen::VectorXd z =
-              CutJointCoordinates(j, state.x[j.parent], state.R[j.parent], state.x[j.child], state.R[j.child]);
-          probe_last_.resize(scene_.spec.probes.size());
-          if (probe_last_[pi].size() == z.size()) {  // angles continuous through +-pi
-            for (int i = 0; i < z.size(); ++i) {
-              if (i != j.phi_index() && j.type != JointType::kUniversal) continue;
-              z[i] += 2 * M_PI * std::round((probe_last_[pi][i] - z[i]) / (2 * M_PI));
-            }
-          }
-          probe_last_[pi] = z;
-          for (int i = 0; i < z.size(); ++i) put(z[i]);
-        }
-      }
-      if (q == ProbeQuantity::kReaction)
-        for (int i = 0; i < 6; ++i) put(reaction(k, i));
+    const int b = point.body;
+    const FrameSolution& body_frame = state.frames[size_t(b)];
+    const Eigen::Vector3d u = point.shape * q_loc_[size_t(b)];
+    const Eigen::Vector3d r = point.s0 + u;
+    if (q == ProbeQuantity::kPosition) put3(scene_.origin + body_frame.x + body_frame.R * r);
+    if (q == ProbeQuantity::kDeformation) put3(body_frame.R * u);
+    if (q == ProbeQuantity::kVelocity) {
+      const SuperelementBody::LocalMotion& m = step.MotionOf(b);
+      put3(body_frame.R * (m.V + m.Omega.cross(r) + point.shape * m.qdot));
+    }
+    if (q == ProbeQuantity::kAcceleration) {
+      const SuperelementBody::LocalMotion& m = step.MotionOf(b);
+      const Eigen::Vector3d ud = point.shape * m.qdot, udd = point.shape * m.qddot;
+      put3(body_frame.R * (m.Vdot + m.Omega.cross(m.V) + m.Omegadot.cross(r) + m.Omega.cross(m.Omega.cross(r)) +
+                           2.0 * m.Omega.cross(ud) + udd));
     }
   }
-  put(kinetic);
-  put(elastic);
-  put(external_work);
-  csv_.put('\n');
+}
+
+// A node probe's quantities, from the node series just recorded where they hold them.
+void ResultsRecorder::WriteNodeProbe(size_t pi, const SystemState& state, const NodeRows& nodes,
+                                     const std::vector<Eigen::Matrix<double, 6, 1>>* reactions, OutputStep& step,
+                                     ProbeRow& row) {
+  const SystemModel& model = scene_.model;
+  const SceneProbeSpec& p = scene_.spec.probes[pi];
+  const int k = scene_.node_index.at(p.node);
+  const auto put3 = [&](const Eigen::Vector3d& v) {
+    for (int i = 0; i < 3; ++i) PutProbe(row, v[i]);
+  };
+  for (const ProbeQuantity q : p.quantities) {
+    if (q == ProbeQuantity::kPosition)
+      for (int i = 0; i < 3; ++i) PutProbe(row, nodes.pos[3 * k + i]);
+    if (q == ProbeQuantity::kRotation)
+      for (int i = 0; i < 4; ++i) PutProbe(row, nodes.quat[4 * k + i]);
+    if (q == ProbeQuantity::kVelocity)
+      for (int i = 0; i < 3; ++i) PutProbe(row, nodes.vel[3 * k + i]);
+    if (q == ProbeQuantity::kAngularVelocity)
+      for (int i = 0; i < 3; ++i) PutProbe(row, nodes.ang[3 * k + i]);
+    if (q == ProbeQuantity::kAcceleration) put3(step.NodeAccelerations()[size_t(k)].head<3>());
+    if (q == ProbeQuantity::kAngularAcceleration) put3(step.NodeAccelerations()[size_t(k)].tail<3>());
+    if (q == ProbeQuantity::kEffort) {
+      // The generalized force of each prescribed coordinate: B^T of what the joint exerts on
+      // the node (its reaction: force, moment about the node), B the coordinate's motion of the
+      // node (NodeJoint: a revolute's moment about its axis, a prismatic's force along it).
+      const NodeJoint& j = model.joints[size_t(dofs_.joint_of(k))];
+      const ParentNode parent = ParentOf(state, j.parent);
+      const JointMaps maps = ComputeJointMaps(j, parent.x, parent.R, state.x[k], state.z[k]);
+      Eigen::Matrix<double, 6, 1> r;
+      for (int i = 0; i < 6; ++i) r[i] = Reaction(reactions, k, i);
+      for (int c : scene_.effort_coordinates[pi])
+        PutProbe(row, maps.B.col(model.prescribed[size_t(c)].coordinate).dot(r));
+    }
+    if (q == ProbeQuantity::kJoint) WriteJointProbe(pi, k, state, row);
+    if (q == ProbeQuantity::kReaction)
+      for (int i = 0; i < 6; ++i) PutProbe(row, Reaction(reactions, k, i));
+  }
+}
+
+// A joint probe: the node's joint coordinates, or those of the cut joint it shows (its node has
+// none of its own), with angles continuous through +-pi.
+void ResultsRecorder::WriteJointProbe(size_t pi, int k, const SystemState& state, ProbeRow& row) {
+  const int c = pi < probe_cut_.size() ? probe_cut_[pi] : -1;
+  if (c < 0) {
+    for (int i = 0; i < state.z[k].size(); ++i) PutProbe(row, state.z[k][i]);
+    return;
+  }
+  const NodeJoint& j = scene_.model.cut_joints[size_t(c)].joint;
+  Eigen::VectorXd z = CutJointCoordinates(j, state.x[j.parent], state.R[j.parent], state.x[j.child], state.R[j.child]);
+  probe_last_.resize(scene_.spec.probes.size());
+  if (probe_last_[pi].size() == z.size()) {
+    for (int i = 0; i < z.size(); ++i) {
+      if (i != j.phi_index() && j.type != JointType::kUniversal) continue;
+      z[i] += 2 * M_PI * std::round((probe_last_[pi][i] - z[i]) / (2 * M_PI));
+    }
+  }
+  probe_last_[pi] = z;
+  for (int i = 0; i < z.size(); ++i) PutProbe(row, z[i]);
 }
 
 std::vector<std::string> ResultsRecorder::StressSummary() const {

@@ -103,6 +103,37 @@ class ResultsRecorder {
   double max_loop_violation() const { return max_loop_violation_; }
 
  private:
+  // Record's stages. OutputStep: what one output step's fields and probes derive from its state,
+  // made when first asked for; NodeRows: the node series' rows just appended; ProbeRow: the
+  // probes' row being written and its next column.
+  class OutputStep;
+  struct NodeRows {
+    double *pos, *quat, *vel, *ang;
+  };
+  struct ProbeRow {
+    double* values;
+    int column;
+  };
+  NodeRows RecordSeries(double t, const SystemState& state, const Eigen::VectorXd& W, double kinetic, double elastic,
+                        double external_work, const Eigen::Vector3d& linear_momentum,
+                        const Eigen::Vector3d& angular_momentum,
+                        const std::vector<Eigen::Matrix<double, 6, 1>>* reactions);
+  void RecordBodies(const SystemState& state);
+  void RecordJoints(const SystemState& state);
+  bool AnimationFrame(double t);
+  void QueueFields(const SystemState& state, bool frame, OutputStep& step);
+  void PutProbe(ProbeRow& row, double v);
+  void WriteProbes(const SystemState& state, const NodeRows& nodes,
+                   const std::vector<Eigen::Matrix<double, 6, 1>>* reactions, OutputStep& step, ProbeRow& row);
+  void WritePointProbe(size_t probe, const SystemState& state, OutputStep& step, ProbeRow& row);
+  void WriteNodeProbe(size_t probe, const SystemState& state, const NodeRows& nodes,
+                      const std::vector<Eigen::Matrix<double, 6, 1>>* reactions, OutputStep& step, ProbeRow& row);
+  void WriteJointProbe(size_t probe, int node, const SystemState& state, ProbeRow& row);
+  /// The reaction at node k, component i (zero without `reactions`).
+  static double Reaction(const std::vector<Eigen::Matrix<double, 6, 1>>* reactions, int k, int i) {
+    return reactions ? (*reactions)[size_t(k)][i] : 0.0;
+  }
+
   const Scene& scene_;
   const DofMap dofs_;          ///< the scene model's numbering (the model does not change while recording)
   int animation_every_ = 1;    ///< one animation frame per this many output steps (spec, or auto)
