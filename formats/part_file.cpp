@@ -275,6 +275,249 @@ Units UnitSystem(const std::string& name, const std::string& where) {
   throw InputError(where + ": unknown unit system '" + name + "' (known: SI, mm-t-s, mm-kg-ms)");
 }
 
+namespace {
+
+// A file named in the part, resolved against the part file's folder; fails naming `file` when it
+// does not exist.
+std::string ResolvePath(const YamlValue& file, const std::string& what, const std::string& part_file) {
+  std::filesystem::path f(file.String());
+  if (f.is_relative()) f = std::filesystem::path(part_file).parent_path() / f;
+  if (!std::filesystem::exists(f)) file.Fail(what + " '" + f.string() + "' not found");
+  return f.string();
+}
+
+// The material: required for beams and solids; optional for imported parts, whose matrices carry
+// it (given, it lets femb's own elements on the imported mesh's solid cells build the geometric
+// stiffening).
+void ParsePartMaterial(YamlMap& root, PartSpec& part) {
+  if (part.type != "imported") {
+    part.material = ParseMaterial(root.Required("material"));
+    if (part.check_units) CheckMaterialUnits(part, root.Required("material"));
+  } else if (auto material = root.Optional("material")) {
+    part.material = ParseMaterial(*material);
+    if (part.check_units) CheckMaterialUnits(part, *material);
+  } else {
+    part.has_material = false;
+  }
+}
+
+// An imported part's files: the matrices carry the material; the geometry file gives the node
+// coordinates (and ids).
+void ParseImported(YamlMap& root, PartSpec& part) {
+  YamlValue geometry = root.Required("geometry");
+  YamlMap g = geometry.Map();
+  part.solid.where = geometry.Where();
+  part.solid.file = ResolvePath(g.Required("file"), "geometry file", part.file);
+  g.CheckNoUnknownKeys();
+  YamlValue matrices = root.Required("matrices");
+  YamlMap m = matrices.Map();
+  MatricesSpec& x = part.matrices;
+  x.where = matrices.Where();
+  x.format = m.Required("format").OneOf({"calculix", "abaqus", "matrix_market"});
+  x.stiffness = ResolvePath(m.Required("stiffness"), "stiffness matrix file", part.file);
+  x.mass = ResolvePath(m.Required("mass"), "mass matrix file", part.file);
+  if (x.format != "abaqus") {
+    x.dofs = ResolvePath(m.Required("dofs"),
+                         x.format == "calculix" ? "DOF map (job.dof)" : "DOF map (CSV: node, component)", part.file);
+  }
+  m.CheckNoUnknownKeys();
+}
+
+// A beam part's section and beam line, with the part's size checked against its units.
+void ParseBeamPart(YamlMap& root, PartSpec& part) {
+  part.beam.section = ParseSection(root.Required("section"));
+  ParseBeam(root.Required("beam"), part);
+  Eigen::Vector3d lo = part.beam.points[0], hi = lo;
+  for (const auto& p : part.beam.points) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  YamlValue beam = root.Required("beam");
+  CheckPartSize(part, (hi - lo).norm(), beam.Where() + ".points");
+}
+
+// A solid part's geometry (a built-in shape or a CAD/mesh file) and mesh settings.
+void ParseSolidPart(YamlMap& root, PartSpec& part) {
+  YamlValue geometry = root.Required("geometry");
+  YamlMap g = geometry.Map();
+  part.solid.where = geometry.Where();
+  if (auto shape = g.Optional("shape")) {
+    part.solid.shape = shape->OneOf({"box", "plate", "cylinder", "tube"});
+    if (part.solid.shape == "box" || part.solid.shape == "plate") {
+      YamlValue size = g.Required("size");
+      part.solid.size = size.Vector3();
+      if (!(part.solid.size.minCoeff() > 0)) size.Fail("edge lengths must be positive");
+      CheckPartSize(part, part.solid.size.norm(), size.Where());
+    } else {
+      part.solid.radius = g.Required("radius").PositiveNumber();
+      YamlValue length = g.Required("length");
+      part.solid.length = length.PositiveNumber();
+      if (part.solid.shape == "tube") {
+        YamlValue inner = g.Required("inner_radius");
+        part.solid.inner_radius = inner.PositiveNumber();
+        if (part.solid.inner_radius >= part.solid.radius) inner.Fail("inner_radius must be smaller than radius");
+      }
+      CheckPartSize(part, std::hypot(2 * part.solid.radius, part.solid.length), length.Where());
+    }
+  } else {
+    part.solid.file = ResolvePath(g.Required("file"), "geometry file", part.file);
+  }
+  g.CheckNoUnknownKeys();
+  if (auto mesh = root.Optional("mesh")) {
+    YamlMap m = mesh->Map();
+    if (auto v = m.Optional("size")) part.solid.element_size = v->PositiveNumber();
+    if (auto v = m.Optional("order")) {
+      part.solid.order = int(v->Integer());
+      if (part.solid.order != 1 && part.solid.order != 2) v->Fail("element order must be 1 or 2");
+    }
+    if (auto v = m.Optional("max_elements")) part.solid.max_elements = long(v->PositiveNumber());
+    if (auto v = m.Optional("elements")) {
+      part.solid.hexahedra = v->OneOf({"tetrahedra", "hexahedra"}) == "hexahedra";
+      if (part.solid.hexahedra && part.solid.shape != "box" && part.solid.shape != "plate") {
+        v->Fail("hexahedra are available for the built-in box and plate only");
+      }
+    }
+    m.CheckNoUnknownKeys();
+  }
+}
+
+// One item of `interfaces`: a beam point, or a node set of a solid (group or selection) with its
+// coupling.
+InterfaceSpec ParseInterface(const YamlValue& item, const PartSpec& part) {
+  YamlMap m = item.Map();
+  InterfaceSpec spec;
+  spec.where = item.Where();
+  spec.name = m.Required("name").String();
+  if (part.type == "beam") {
+    YamlValue point = m.Optional("point").value_or(m.Required("name"));
+    const std::string point_name = point.String();
+    for (size_t i = 0; i < part.beam.point_names.size(); ++i) {
+      if (part.beam.point_names[i] == point_name) spec.point = int(i);
+    }
+    if (spec.point < 0) point.Fail("interface point '" + point_name + "' not found in beam.points");
+    for (const auto& other : part.interfaces) {
+      if (other.point == spec.point) item.Fail("point '" + point_name + "' is already interface '" + other.name + "'");
+    }
+  } else {
+    auto group = m.Optional("group");
+    auto select = m.Optional("select");
+    if (group.has_value() == select.has_value()) {
+      item.Fail("interface '" + spec.name +
+                "': give either 'group' (a named node set of the mesh) or 'select' "
+                "(nodes picked by geometry: cylinder, sphere, box or plane)");
+    }
+    if (group) spec.group = group->String();
+    if (select) spec.select = ParseSelection(*select);
+    if (auto c = m.Optional("coupling")) {
+      spec.coupling = c->String();
+      if (spec.coupling != "rbe2" && spec.coupling != "rbe3")
+        c->Fail("unknown coupling '" + spec.coupling + "' (known: rbe2, rbe3)");
+    }
+    if (auto p = m.Optional("point")) spec.location = p->Vector3();
+  }
+  for (const auto& other : part.interfaces) {
+    if (other.name == spec.name) item.Fail("interface name '" + spec.name + "' used twice");
+  }
+  m.CheckNoUnknownKeys();
+  return spec;
+}
+
+// reduction.floating_frame: center_of_mass, mean_axes, cardona or interface:<name>.
+void ParseFloatingFrame(const YamlValue& v, PartSpec& part) {
+  part.reduction.floating_frame = v.String();
+  part.reduction.where_floating_frame = v.Where();
+  const std::string& f = part.reduction.floating_frame;
+  if (f.rfind("interface:", 0) == 0) {
+    const std::string iname = f.substr(10);
+    bool found = false;
+    for (const auto& i : part.interfaces) found |= (i.name == iname);
+    if (!found) v.Fail("floating frame interface '" + iname + "' is not one of the part's interfaces");
+  } else if (f != "center_of_mass" && f != "mean_axes" && f != "cardona") {
+    v.Fail("unknown floating frame '" + f + "' (known: center_of_mass, mean_axes, interface:<name>, cardona)");
+  }
+}
+
+// reduction.modal_derivatives: true/false, or which pairs and the tolerance.
+void ParseModalDerivatives(const YamlValue& v, PartSpec& part) {
+  ModalDerivativeSpec& d = part.reduction.modal_derivatives;
+  d.where = v.Where();
+  if (v.IsScalar()) {
+    d.enabled = v.Bool();
+  } else {
+    d.enabled = true;
+    YamlMap dm = v.Map();
+    if (auto o = dm.Optional("of")) d.of = o->OneOf({"all", "static", "internal"}, "(which coordinates are paired)");
+    if (auto t = dm.Optional("tolerance")) d.tolerance = t->PositiveNumber();
+    if (auto p = dm.Optional("pairs")) {
+      for (const YamlValue& item : p->List()) {
+        const std::vector<YamlValue> ij = item.List();
+        if (ij.size() != 2) item.Fail("a pair is two reduced coordinate indices, e.g. [1, 7]");
+        d.pairs.emplace_back(int(ij[0].NonNegativeInteger()), int(ij[1].NonNegativeInteger()));
+      }
+    }
+    dm.CheckNoUnknownKeys();
+  }
+  if (d.enabled && part.type == "imported") {
+    v.Fail("modal derivatives need femb's own elements (the nonlinear strain); imported matrices do not have them");
+  }
+}
+
+// `reduction`.
+void ParseReduction(const YamlValue& r, PartSpec& part) {
+  YamlMap m = r.Map();
+  if (auto v = m.Optional("internal_modes")) part.reduction.internal_modes = int(v->NonNegativeInteger());
+  if (auto v = m.Optional("method")) {
+    part.reduction.method = v->OneOf({"craig_bampton", "free_interface", "general"});
+    part.reduction.where_method = v->Where();
+  }
+  if (auto v = m.Optional("basis")) {
+    YamlMap b = v->Map();
+    part.reduction.where_basis = v->Where();
+    part.reduction.basis_file = ResolvePath(b.Required("file"), "deformation shapes file", part.file);
+    b.CheckNoUnknownKeys();
+    if (part.reduction.method != "general") v->Fail("a basis file is read with reduction.method: general only");
+  } else if (part.reduction.method == "general") {
+    m.AsValue().Fail("reduction.method general needs reduction.basis: {file: shapes.mtx}");
+  }
+  if (auto v = m.Optional("floating_frame")) ParseFloatingFrame(*v, part);
+  if (auto v = m.Optional("keep_mesh")) part.reduction.keep_mesh = v->Bool();
+  if (auto v = m.Optional("stresses")) {
+    part.reduction.stresses = v->Bool();
+    if (*part.reduction.stresses && part.type == "imported" && !part.has_material) {
+      v->Fail(
+          "stresses of imported matrices need the part's material: (femb's own elements on the imported mesh's "
+          "solid cells recover them)");
+    }
+    part.reduction.where_stresses = v->Where();
+    if (*part.reduction.stresses && part.reduction.keep_mesh == false) {
+      v->Fail("reduction.stresses: true needs the mesh: keep_mesh is false (the stresses live on its nodes)");
+    }
+  }
+  if (auto v = m.Optional("geometric_stiffening")) {
+    part.reduction.geometric_stiffening = v->Bool();
+    if (*part.reduction.geometric_stiffening && part.type == "imported" && !part.has_material) {
+      v->Fail(
+          "geometric stiffening of imported matrices needs the part's material: (E, nu, rho; femb's own elements "
+          "on the imported mesh's solid cells give the stress of each field)");
+    }
+  }
+  if (auto v = m.Optional("full_modes")) {
+    part.reduction.full_modes = int(v->NonNegativeInteger());
+    part.reduction.full_modes_given = true;
+  }
+  if (auto v = m.Optional("memory_limit_gb")) part.reduction.memory_limit_gb = v->PositiveNumber();
+  if (auto v = m.Optional("modal_derivatives")) ParseModalDerivatives(*v, part);
+  m.CheckNoUnknownKeys();
+  if (part.reduction.method != "craig_bampton" &&
+      (part.reduction.modal_derivatives.enabled || part.reduction.geometric_stiffening.value_or(false))) {
+    throw InputError(part.reduction.where_method +
+                     ": modal derivatives and geometric stiffening are built on the "
+                     "Craig-Bampton basis: use reduction.method: craig_bampton with them");
+  }
+}
+
+}  // namespace
+
 PartSpec ParsePart(const std::string& text, const std::string& name, const std::vector<std::string>& overrides) {
   YamlDocument doc = YamlDocument::LoadString(text, name);
   std::string effective = text;
@@ -294,230 +537,22 @@ PartSpec ParsePart(const std::string& text, const std::string& name, const std::
   }
   if (auto u = root.Optional("units")) part.units = UnitSystem(u->String(), u->Where());
   if (auto v = root.Optional("check_units")) part.check_units = v->Bool();
-  auto resolve = [&](const YamlValue& file, const std::string& what) {
-    std::filesystem::path f(file.String());
-    if (f.is_relative()) f = std::filesystem::path(name).parent_path() / f;
-    if (!std::filesystem::exists(f)) file.Fail(what + " '" + f.string() + "' not found");
-    return f.string();
-  };
-  if (part.type != "imported") {
-    part.material = ParseMaterial(root.Required("material"));
-    if (part.check_units) CheckMaterialUnits(part, root.Required("material"));
-  } else if (auto material = root.Optional("material")) {
-    // Optional: the matrices carry the material; given, it lets femb's own elements on the
-    // imported mesh's solid cells build the geometric stiffening.
-    part.material = ParseMaterial(*material);
-    if (part.check_units) CheckMaterialUnits(part, *material);
-  } else {
-    part.has_material = false;
-  }
+  ParsePartMaterial(root, part);
   if (part.type == "imported") {
-    // The matrices carry the material; the geometry file gives the node coordinates (and ids).
-    YamlValue geometry = root.Required("geometry");
-    YamlMap g = geometry.Map();
-    part.solid.where = geometry.Where();
-    part.solid.file = resolve(g.Required("file"), "geometry file");
-    g.CheckNoUnknownKeys();
-    YamlValue matrices = root.Required("matrices");
-    YamlMap m = matrices.Map();
-    MatricesSpec& x = part.matrices;
-    x.where = matrices.Where();
-    x.format = m.Required("format").OneOf({"calculix", "abaqus", "matrix_market"});
-    x.stiffness = resolve(m.Required("stiffness"), "stiffness matrix file");
-    x.mass = resolve(m.Required("mass"), "mass matrix file");
-    if (x.format != "abaqus") {
-      x.dofs =
-          resolve(m.Required("dofs"), x.format == "calculix" ? "DOF map (job.dof)" : "DOF map (CSV: node, component)");
-    }
-    m.CheckNoUnknownKeys();
+    ParseImported(root, part);
   } else if (part.type == "beam") {
-    part.beam.section = ParseSection(root.Required("section"));
-    ParseBeam(root.Required("beam"), part);
-    Eigen::Vector3d lo = part.beam.points[0], hi = lo;
-    for (const auto& p : part.beam.points) {
-      lo = lo.cwiseMin(p);
-      hi = hi.cwiseMax(p);
-    }
-    YamlValue beam = root.Required("beam");
-    CheckPartSize(part, (hi - lo).norm(), beam.Where() + ".points");
+    ParseBeamPart(root, part);
   } else {
-    YamlValue geometry = root.Required("geometry");
-    YamlMap g = geometry.Map();
-    part.solid.where = geometry.Where();
-    if (auto shape = g.Optional("shape")) {
-      part.solid.shape = shape->OneOf({"box", "plate", "cylinder", "tube"});
-      if (part.solid.shape == "box" || part.solid.shape == "plate") {
-        YamlValue size = g.Required("size");
-        part.solid.size = size.Vector3();
-        if (!(part.solid.size.minCoeff() > 0)) size.Fail("edge lengths must be positive");
-        CheckPartSize(part, part.solid.size.norm(), size.Where());
-      } else {
-        part.solid.radius = g.Required("radius").PositiveNumber();
-        YamlValue length = g.Required("length");
-        part.solid.length = length.PositiveNumber();
-        if (part.solid.shape == "tube") {
-          YamlValue inner = g.Required("inner_radius");
-          part.solid.inner_radius = inner.PositiveNumber();
-          if (part.solid.inner_radius >= part.solid.radius) inner.Fail("inner_radius must be smaller than radius");
-        }
-        CheckPartSize(part, std::hypot(2 * part.solid.radius, part.solid.length), length.Where());
-      }
-    } else {
-      part.solid.file = resolve(g.Required("file"), "geometry file");
-    }
-    g.CheckNoUnknownKeys();
-    if (auto mesh = root.Optional("mesh")) {
-      YamlMap m = mesh->Map();
-      if (auto v = m.Optional("size")) part.solid.element_size = v->PositiveNumber();
-      if (auto v = m.Optional("order")) {
-        part.solid.order = int(v->Integer());
-        if (part.solid.order != 1 && part.solid.order != 2) v->Fail("element order must be 1 or 2");
-      }
-      if (auto v = m.Optional("max_elements")) part.solid.max_elements = long(v->PositiveNumber());
-      if (auto v = m.Optional("elements")) {
-        part.solid.hexahedra = v->OneOf({"tetrahedra", "hexahedra"}) == "hexahedra";
-        if (part.solid.hexahedra && part.solid.shape != "box" && part.solid.shape != "plate") {
-          v->Fail("hexahedra are available for the built-in box and plate only");
-        }
-      }
-      m.CheckNoUnknownKeys();
-    }
+    ParseSolidPart(root, part);
   }
-
   auto interfaces = root.Optional("interfaces");
   if (!interfaces || interfaces->List().empty()) {
     throw InputError(name +
                      ": no interface defined: list at least one under 'interfaces' "
                      "(a superelement couples to the world only through interface nodes)");
   }
-  for (const YamlValue& item : interfaces->List()) {
-    YamlMap m = item.Map();
-    InterfaceSpec spec;
-    spec.where = item.Where();
-    spec.name = m.Required("name").String();
-    if (part.type == "beam") {
-      YamlValue point = m.Optional("point").value_or(m.Required("name"));
-      const std::string point_name = point.String();
-      for (size_t i = 0; i < part.beam.point_names.size(); ++i) {
-        if (part.beam.point_names[i] == point_name) spec.point = int(i);
-      }
-      if (spec.point < 0) point.Fail("interface point '" + point_name + "' not found in beam.points");
-      for (const auto& other : part.interfaces) {
-        if (other.point == spec.point)
-          item.Fail("point '" + point_name + "' is already interface '" + other.name + "'");
-      }
-    } else {
-      auto group = m.Optional("group");
-      auto select = m.Optional("select");
-      if (group.has_value() == select.has_value()) {
-        item.Fail("interface '" + spec.name +
-                  "': give either 'group' (a named node set of the mesh) or 'select' "
-                  "(nodes picked by geometry: cylinder, sphere, box or plane)");
-      }
-      if (group) spec.group = group->String();
-      if (select) spec.select = ParseSelection(*select);
-      if (auto c = m.Optional("coupling")) {
-        spec.coupling = c->String();
-        if (spec.coupling != "rbe2" && spec.coupling != "rbe3")
-          c->Fail("unknown coupling '" + spec.coupling + "' (known: rbe2, rbe3)");
-      }
-      if (auto p = m.Optional("point")) spec.location = p->Vector3();
-    }
-    for (const auto& other : part.interfaces) {
-      if (other.name == spec.name) item.Fail("interface name '" + spec.name + "' used twice");
-    }
-    m.CheckNoUnknownKeys();
-    part.interfaces.push_back(spec);
-  }
-
-  if (auto r = root.Optional("reduction")) {
-    YamlMap m = r->Map();
-    if (auto v = m.Optional("internal_modes")) part.reduction.internal_modes = int(v->NonNegativeInteger());
-    if (auto v = m.Optional("method")) {
-      part.reduction.method = v->OneOf({"craig_bampton", "free_interface", "general"});
-      part.reduction.where_method = v->Where();
-    }
-    if (auto v = m.Optional("basis")) {
-      YamlMap b = v->Map();
-      part.reduction.where_basis = v->Where();
-      part.reduction.basis_file = resolve(b.Required("file"), "deformation shapes file");
-      b.CheckNoUnknownKeys();
-      if (part.reduction.method != "general") v->Fail("a basis file is read with reduction.method: general only");
-    } else if (part.reduction.method == "general") {
-      m.AsValue().Fail("reduction.method general needs reduction.basis: {file: shapes.mtx}");
-    }
-    if (auto v = m.Optional("floating_frame")) {
-      part.reduction.floating_frame = v->String();
-      part.reduction.where_floating_frame = v->Where();
-      const std::string& f = part.reduction.floating_frame;
-      if (f.rfind("interface:", 0) == 0) {
-        const std::string iname = f.substr(10);
-        bool found = false;
-        for (const auto& i : part.interfaces) found |= (i.name == iname);
-        if (!found) v->Fail("floating frame interface '" + iname + "' is not one of the part's interfaces");
-      } else if (f != "center_of_mass" && f != "mean_axes" && f != "cardona") {
-        v->Fail("unknown floating frame '" + f + "' (known: center_of_mass, mean_axes, interface:<name>, cardona)");
-      }
-    }
-    if (auto v = m.Optional("keep_mesh")) part.reduction.keep_mesh = v->Bool();
-    if (auto v = m.Optional("stresses")) {
-      part.reduction.stresses = v->Bool();
-      if (*part.reduction.stresses && part.type == "imported" && !part.has_material) {
-        v->Fail(
-            "stresses of imported matrices need the part's material: (femb's own elements on the imported mesh's "
-            "solid cells recover them)");
-      }
-      part.reduction.where_stresses = v->Where();
-      if (*part.reduction.stresses && part.reduction.keep_mesh == false) {
-        v->Fail("reduction.stresses: true needs the mesh: keep_mesh is false (the stresses live on its nodes)");
-      }
-    }
-    if (auto v = m.Optional("geometric_stiffening")) {
-      part.reduction.geometric_stiffening = v->Bool();
-      if (*part.reduction.geometric_stiffening && part.type == "imported" && !part.has_material) {
-        v->Fail(
-            "geometric stiffening of imported matrices needs the part's material: (E, nu, rho; femb's own elements "
-            "on the imported mesh's solid cells give the stress of each field)");
-      }
-    }
-    if (auto v = m.Optional("full_modes")) {
-      part.reduction.full_modes = int(v->NonNegativeInteger());
-      part.reduction.full_modes_given = true;
-    }
-    if (auto v = m.Optional("memory_limit_gb")) part.reduction.memory_limit_gb = v->PositiveNumber();
-    if (auto v = m.Optional("modal_derivatives")) {
-      ModalDerivativeSpec& d = part.reduction.modal_derivatives;
-      d.where = v->Where();
-      if (v->IsScalar()) {
-        d.enabled = v->Bool();
-      } else {
-        d.enabled = true;
-        YamlMap dm = v->Map();
-        if (auto o = dm.Optional("of"))
-          d.of = o->OneOf({"all", "static", "internal"}, "(which coordinates are paired)");
-        if (auto t = dm.Optional("tolerance")) d.tolerance = t->PositiveNumber();
-        if (auto p = dm.Optional("pairs")) {
-          for (const YamlValue& item : p->List()) {
-            const std::vector<YamlValue> ij = item.List();
-            if (ij.size() != 2) item.Fail("a pair is two reduced coordinate indices, e.g. [1, 7]");
-            d.pairs.emplace_back(int(ij[0].NonNegativeInteger()), int(ij[1].NonNegativeInteger()));
-          }
-        }
-        dm.CheckNoUnknownKeys();
-      }
-      if (d.enabled && part.type == "imported") {
-        v->Fail(
-            "modal derivatives need femb's own elements (the nonlinear strain); imported matrices do not have them");
-      }
-    }
-    m.CheckNoUnknownKeys();
-    if (part.reduction.method != "craig_bampton" &&
-        (part.reduction.modal_derivatives.enabled || part.reduction.geometric_stiffening.value_or(false))) {
-      throw InputError(part.reduction.where_method +
-                       ": modal derivatives and geometric stiffening are built on the "
-                       "Craig-Bampton basis: use reduction.method: craig_bampton with them");
-    }
-  }
+  for (const YamlValue& item : interfaces->List()) part.interfaces.push_back(ParseInterface(item, part));
+  if (auto r = root.Optional("reduction")) ParseReduction(*r, part);
   if (part.reduction.where_method.empty()) part.reduction.where_method = name;
   if (part.reduction.where_floating_frame.empty()) part.reduction.where_floating_frame = name;
   root.CheckNoUnknownKeys();
