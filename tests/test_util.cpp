@@ -92,7 +92,8 @@ Superelement TubeSegment(double L, int elements, bool stiffened) {
       std::string(stiffened ? "true" : "false") + "}\n");
 }
 
-SystemModel SliderCrankModel(const Superelement& crank, const Superelement& rod, double Lc, double Lr) {
+SystemModel SliderCrankModel(const Superelement& crank, const Superelement& rod, double Lc, double Lr,
+                             const SuperelementOptions& options) {
   SystemModel model;
   const int O = AddNode(model, "O", Eigen::Vector3d::Zero());
   const int A = AddNode(model, "A", Eigen::Vector3d(Lc, 0, 0));
@@ -103,8 +104,7 @@ SystemModel SliderCrankModel(const Superelement& crank, const Superelement& rod,
   model.bodies.emplace_back(crank, SuperelementOptions{}, Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero());
   model.body_nodes.push_back({O, A});
   for (int i = 0; i < 2; ++i) {
-    model.bodies.emplace_back(rod, SuperelementOptions{}, Eigen::Matrix3d::Identity(),
-                              Eigen::Vector3d(Lc + i * Lr, 0, 0));
+    model.bodies.emplace_back(rod, options, Eigen::Matrix3d::Identity(), Eigen::Vector3d(Lc + i * Lr, 0, 0));
     model.body_nodes.push_back({i == 0 ? a : m, i == 0 ? m : b});
   }
   RevoluteToGround(model, O, Eigen::Vector3d::UnitZ());

@@ -41,8 +41,10 @@ Superelement BendingShapesRod(double L);
 /// A slider-crank: crank O-A of length Lc (body `crank`, default options) driven at 150 rad/s
 /// about z (revolute to ground, prescribed), a rod of two bodies `rod` of length Lr each hinged to
 /// A (node rod_a) and to the slider node (rod_b), which slides along x (prismatic to ground);
-/// nodes O, A, rod_a, rod_mid, rod_b, slider (indices 0-5); gravity -9.81 along y.
-SystemModel SliderCrankModel(const Superelement& crank, const Superelement& rod, double Lc, double Lr);
+/// nodes O, A, rod_a, rod_mid, rod_b, slider (indices 0-5); gravity -9.81 along y. `options`:
+/// the rod bodies'.
+SystemModel SliderCrankModel(const Superelement& crank, const Superelement& rod, double Lc, double Lr,
+                             const SuperelementOptions& options = SuperelementOptions{});
 
 /// -d(residual)/d(unknowns) of AssembleStatic at `state` (load factor `lambda`) by central
 /// differences with steps h along each unknown (ApplyIncrement): the reference for static

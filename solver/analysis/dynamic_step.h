@@ -370,6 +370,16 @@ StepOutcome GeneralizedAlphaStep(const SystemModel& model, const DofMap& dofs, c
 
 // One step of the momentum-conserving midpoint scheme (solver/integrators/midpoint.cpp) of size h from `state`
 // into `next`; t_new as for the generalized-alpha step.
+// The midpoint scheme's residual (applied minus inertia and internal forces) at the end state s1
+// of a step of h from s0, with s1's kinematics made from the step (its end velocities set), as
+// MidpointStep assembles it; and its iteration matrix -d(residual)/d(delta), delta the increment
+// Newton applies at n+1 (ApplyIncrement). For the tests of the matrix against differences of
+// the residual; the results live in `work`.
+const Assembly& MidpointResidual(const SystemModel& model, const DofMap& dofs, const DynamicState& s0, double h,
+                                 DynamicState& s1, BodyWorkspace& work);
+const SystemMatrix& MidpointIterationMatrix(const SystemModel& model, const DofMap& dofs, const DynamicState& s0,
+                                            double h, DynamicState& s1, BodyWorkspace& work);
+
 StepOutcome MidpointStep(const SystemModel& model, const DofMap& dofs, const DynamicOptions& options,
                          const DynamicState& state, double h, double t_new, IterationMatrix& matrix,
                          BodyThreads& threads, BodyWorkspace& work, DynamicState& next);

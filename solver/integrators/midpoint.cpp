@@ -545,14 +545,16 @@ void BodyVelocityOf(const SystemModel& model, const DofMap& dofs, const DynamicS
   w.tail(body.n_modes()) = s.W.segment(dofs.mode_dof(b), body.n_modes());
 }
 
-StepOutcome MidpointStep(const SystemModel& model, const DofMap& dofs, const DynamicOptions& options,
-                         const DynamicState& state, double h, double t_new, IterationMatrix& matrix,
-                         BodyThreads& threads, BodyWorkspace& work, DynamicState& next) {
-  next = state;  // storage reused: `next` is the caller's, of the same sizes after the first step
-  const Eigen::VectorXd& weights = work.Weights(model, dofs);
+namespace {
+
+// What a step needs before its first iteration: the model's rotation triples and bodies with a
+// free node (once per model), and each body's data, momentum and centre of mass at the step's
+// start.
+void StartMidpointStep(const SystemModel& model, const DofMap& dofs, const DynamicState& state, BodyWorkspace& work,
+                       BodyThreads* threads) {
+  work.Weights(model, dofs);
   const std::vector<RotationNode>& triples = work.rotation_triples;
   MidpointWorkspace& mw = work.midpoint;
-  MidpointKinematics& k = mw.k;
   if (mw.triple_of.size() != size_t(dofs.n_dofs())) {
     // What depends on the model alone.
     TripleOf(dofs, triples, mw.triple_of);
@@ -566,7 +568,7 @@ StepOutcome MidpointStep(const SystemModel& model, const DofMap& dofs, const Dyn
   // Momenta and centres of mass at the start of the step.
   const int n_bodies = int(model.bodies.size());
   mw.bodies.resize(size_t(n_bodies));
-  ForEachBody(&threads, n_bodies, [&](int b) {
+  ForEachBody(threads, n_bodies, [&](int b) {
     const SuperelementBody& body = model.bodies[b];
     MidpointBody& m = mw.bodies[size_t(b)];
     BodyConfigurationOf(model, state.config, b, m.d0.c);
@@ -580,6 +582,33 @@ StepOutcome MidpointStep(const SystemModel& model, const DofMap& dofs, const Dyn
     }
     m.com0 = body.CenterOfMass(m.d0.q, state.config.frames[b]);
   });
+}
+
+}  // namespace
+
+const Assembly& MidpointResidual(const SystemModel& model, const DofMap& dofs, const DynamicState& s0, double h,
+                                 DynamicState& s1, BodyWorkspace& work) {
+  StartMidpointStep(model, dofs, s0, work, nullptr);
+  Midpoint(model, dofs, work.rotation_triples, s0, h, s1, work.midpoint.k);
+  AssembleMidpoint(model, dofs, s0, h, s1, work, nullptr, work.assembly);
+  return work.assembly;
+}
+
+const SystemMatrix& MidpointIterationMatrix(const SystemModel& model, const DofMap& dofs, const DynamicState& s0,
+                                            double h, DynamicState& s1, BodyWorkspace& work) {
+  MidpointResidual(model, dofs, s0, h, s1, work);
+  return MidpointMatrix(model, dofs, s0, h, s1, work, nullptr, work.assembly);
+}
+
+StepOutcome MidpointStep(const SystemModel& model, const DofMap& dofs, const DynamicOptions& options,
+                         const DynamicState& state, double h, double t_new, IterationMatrix& matrix,
+                         BodyThreads& threads, BodyWorkspace& work, DynamicState& next) {
+  next = state;  // storage reused: `next` is the caller's, of the same sizes after the first step
+  StartMidpointStep(model, dofs, state, work, &threads);
+  const Eigen::VectorXd& weights = work.Weights(model, dofs);
+  const std::vector<RotationNode>& triples = work.rotation_triples;
+  MidpointWorkspace& mw = work.midpoint;
+  MidpointKinematics& k = mw.k;
   // Predictor: the configuration reached with the current velocity and acceleration.
   work.dq = h * state.W + 0.5 * h * h * state.Wdot;
   work.inertia_factor = 2.0 / (h * h);  // S_b = K / 2 + C / h + 2 M / h^2
