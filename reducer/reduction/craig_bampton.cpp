@@ -209,98 +209,255 @@ std::vector<int> InteriorDofs(const FeModel& model) {
   return interior;
 }
 
-CraigBamptonResult CraigBamptonReduce(const FeModel& model, int internal_modes, const ProgressFn& progress,
-                                      long dense_limit, double memory_limit_bytes, const DerivativeRequest* derivatives,
-                                      const Eigen::MatrixXd* inertia_fields) {
-  CraigBamptonResult r;
-  Stopwatch clock;
+namespace {
+
+// The reduced coordinates' kinds: 6 per interface in order, then the modes. A DOF interface's six
+// coordinates are boundary DOFs b; a distributing (RBE3) interface's are constraint rows q = W u
+// on the interior DOFs, W^T (n_i x n_c) sparse: nonzero only on the coupled node sets.
+struct InterfacePartition {
+  std::vector<int> boundary, boundary_coordinate, constraint_coordinate, interior;
+  std::vector<int> interior_index, boundary_index;  ///< per full DOF, -1 elsewhere
+  SparseMatrix Wt;
+  int n_b = 0, n_i = 0, n_c = 0;
+};
+
+// The partition of the model's DOFs by its interfaces; false with *message when an RBE3
+// interface weights a DOF of another interface's coupling.
+bool PartitionInterfaces(const FeModel& model, InterfacePartition& p, std::string* message) {
   const int n = int(model.n_dofs());
   const int n_interfaces = int(model.interface_names.size());
-  // Reduced coordinates: 6 per interface in order, then the modes. A DOF interface's six
-  // coordinates are boundary DOFs b; a distributing (RBE3) interface's are constraint rows
-  // q = W u on the interior DOFs.
-  std::vector<int> boundary, boundary_coordinate, constraint_coordinate;
   std::vector<const SparseMatrix*> weights;
   for (int k = 0; k < n_interfaces; ++k) {
     const bool constrained = k < int(model.interface_weights.size()) && model.interface_weights[k].rows() > 0;
     if (constrained) {
       weights.push_back(&model.interface_weights[k]);
-      for (int d = 0; d < 6; ++d) constraint_coordinate.push_back(6 * k + d);
+      for (int d = 0; d < 6; ++d) p.constraint_coordinate.push_back(6 * k + d);
       continue;
     }
     for (int d = 0; d < 6; ++d) {
-      boundary.push_back(model.interface_dofs[k][d].value);
-      boundary_coordinate.push_back(6 * k + d);
+      p.boundary.push_back(model.interface_dofs[k][d].value);
+      p.boundary_coordinate.push_back(6 * k + d);
     }
   }
-  const std::vector<int> interior = InteriorDofs(model);
-  const int n_b = int(boundary.size()), n_i = int(interior.size()), n_c = int(constraint_coordinate.size());
-  std::vector<int> interior_index(n, -1), boundary_index(n, -1);
-  for (int k = 0; k < n_i; ++k) interior_index[interior[k]] = k;
-  for (int k = 0; k < n_b; ++k) boundary_index[boundary[k]] = k;
-  if (internal_modes > n_i - n_c) {
+  p.interior = InteriorDofs(model);
+  p.n_b = int(p.boundary.size()), p.n_i = int(p.interior.size()), p.n_c = int(p.constraint_coordinate.size());
+  p.interior_index.assign(size_t(n), -1);
+  p.boundary_index.assign(size_t(n), -1);
+  for (int k = 0; k < p.n_i; ++k) p.interior_index[p.interior[k]] = k;
+  for (int k = 0; k < p.n_b; ++k) p.boundary_index[p.boundary[k]] = k;
+  p.Wt.resize(p.n_i, p.n_c);
+  std::vector<Eigen::Triplet<double>> entries;
+  int row = 0;
+  for (const SparseMatrix* W : weights) {
+    for (int col = 0; col < W->outerSize(); ++col)
+      for (SparseMatrix::InnerIterator it(*W, col); it; ++it) {
+        if (p.interior_index[col] < 0) {
+          *message = "an RBE3 interface weights a DOF of another interface's coupling";
+          return false;
+        }
+        entries.emplace_back(p.interior_index[col], row + int(it.row()), it.value());
+      }
+    row += 6;
+  }
+  p.Wt.setFromTriplets(entries.begin(), entries.end());
+  return true;
+}
+
+// When no interface is a DOF interface (every interface distributing), the matrix factored is
+// the augmented F = K_ii + a W_1^T W_1, W_1 the six (unit-normalized) constraint rows of the
+// first RBE3 interface: K_ii alone still has the six rigid-body modes that only the constraints
+// W u = q remove, and W_1 alone removes them. Every solve is on W x = 0 or W x = e_j, where F and
+// K_ii give the same answer: on W x = 0, F x = K_ii x; on W x = e_j the extra a W_1^T (W_1 x) is a
+// constraint force that the multipliers absorb. So the static modes, the fixed-interface modes and
+// the modal derivatives are those of K_ii exactly, at any scale of the part (no shift, no
+// iteration); a only sets the conditioning: the mean diagonal of K_ii over the DOFs W_1 weights.
+SparseMatrix Augmented(const SparseMatrix& K_ii, const SparseMatrix& Wt) {
+  const int n_i = int(K_ii.rows());
+  Eigen::MatrixXd W1 = Eigen::MatrixXd(Wt.leftCols(6));  // n_i x 6 (dense columns, sparse support)
+  for (int c = 0; c < 6; ++c) W1.col(c) /= std::max(W1.col(c).norm(), 1e-300);
+  double diagonal = 0.0;
+  int touched = 0;
+  std::vector<Eigen::Triplet<double>> entries;
+  std::vector<int> support;
+  for (int j = 0; j < n_i; ++j) {
+    if (W1.row(j).squaredNorm() == 0.0) continue;
+    support.push_back(j);
+    diagonal += K_ii.coeff(j, j);
+    ++touched;
+  }
+  const double a = touched > 0 ? diagonal / touched : 1.0;
+  for (int i : support)
+    for (int j : support) {
+      const double v = a * W1.row(i).dot(W1.row(j));
+      if (v != 0.0) entries.emplace_back(i, j, v);
+    }
+  SparseMatrix augmentation(n_i, n_i);
+  augmentation.setFromTriplets(entries.begin(), entries.end());
+  return K_ii + augmentation;
+}
+
+// Solves on the constrained space W x = 0 (Lagrange multipliers eliminated through the 6r x 6r
+// Schur complement S = W F^-1 W^T, F the factored matrix):
+//   F x + W^T mu = z, W x = 0   =>   x = F^-1 z - Y S^-1 W F^-1 z,  Y = F^-1 W^T.
+class ConstrainedSolver {
+ public:
+  ConstrainedSolver(SparseCholesky& factor, const SparseMatrix& Wt)
+      : factor_(factor),
+        Wt_(Wt),
+        Y_(Wt.cols() > 0 ? factor.Solve(Eigen::MatrixXd(Wt)) : Eigen::MatrixXd(Wt.rows(), 0)),
+        S_(Eigen::MatrixXd(Wt.transpose() * Y_)) {}
+  Eigen::MatrixXd Solve(const Eigen::MatrixXd& z) const {
+    Eigen::MatrixXd x = factor_.Solve(z);
+    if (Wt_.cols() > 0) x -= Y_ * S_.solve(Eigen::MatrixXd(Wt_.transpose() * x));
+    return x;
+  }
+  // The distributing interfaces' static modes: their six coordinates set to unit values
+  // (W x = e_j) at least strain energy, x0 = Y S^-1 (stationary for F, and so for K_ii).
+  Eigen::MatrixXd UnitConstraintModes() const {
+    return Y_ * S_.solve(Eigen::MatrixXd::Identity(Wt_.cols(), Wt_.cols()));
+  }
+
+ private:
+  SparseCholesky& factor_;
+  const SparseMatrix& Wt_;
+  const Eigen::MatrixXd Y_;
+  const Eigen::LDLT<Eigen::MatrixXd> S_;
+};
+
+// Static modes: a DOF interface moved by a unit motion with the others held (K_ii x = -K_ib,
+// W x = 0), into Psi_b; a distributing interface's, into Psi_c (UnitConstraintModes).
+void StaticModes(const FeModel& model, const InterfacePartition& p, const SparseMatrix& K_ib,
+                 const ConstrainedSolver& solver, Eigen::MatrixXd& Psi_b, Eigen::MatrixXd& Psi_c) {
+  Psi_b = p.n_b > 0 ? Eigen::MatrixXd(-solver.Solve(Eigen::MatrixXd(K_ib))) : Eigen::MatrixXd(p.n_i, 0);
+  // Rigid motions exactly: mathematically the static modes reproduce them (Psi_b R_b = R_i for
+  // the rigid fields R); in floating point only to cond(K_ii) times the round-off of K R = 0,
+  // which a thin part (a 0.5 mm leaf: 3e-8) makes visible in Phi_CB Phi_rig0 = 1. A rank-6
+  // correction Psi_b += (R_i - Psi_b R_b) (R_b^T R_b)^-1 R_b^T restores it to round-off; it
+  // changes the static modes by that residual only. (DOF interfaces only.)
+  if (p.n_b > 0 && p.n_c == 0) {
+    const Eigen::MatrixXd R = RigidFields(model);
+    Eigen::MatrixXd R_b(p.n_b, 6), R_i(p.n_i, 6);
+    for (int k = 0; k < p.n_b; ++k) R_b.row(k) = R.row(p.boundary[k]);
+    for (int k = 0; k < p.n_i; ++k) R_i.row(k) = R.row(p.interior[k]);
+    const Eigen::MatrixXd G = R_b.transpose() * R_b;
+    Psi_b += (R_i - Psi_b * R_b) * G.ldlt().solve(R_b.transpose());
+  }
+  Psi_c.resize(p.n_i, p.n_c);
+  if (p.n_c > 0) Psi_c = solver.UnitConstraintModes();
+}
+
+// The full fields of the Craig-Bampton coordinates (n x (6 interfaces + m)): unit boundary DOFs,
+// the static modes on the interior, the fixed-interface modes.
+Eigen::MatrixXd CraigBamptonShapes(const FeModel& model, const InterfacePartition& p, const Eigen::MatrixXd& Psi_b,
+                                   const Eigen::MatrixXd& Psi_c, const Eigen::MatrixXd& Phi_i, int m) {
+  const int n = int(model.n_dofs()), n_cb = 6 * int(model.interface_names.size()) + m;
+  Eigen::MatrixXd shapes = Eigen::MatrixXd::Zero(n, n_cb);
+  for (int k = 0; k < p.n_b; ++k) shapes(p.boundary[k], p.boundary_coordinate[k]) = 1.0;
+  for (int k = 0; k < p.n_i; ++k) {
+    for (int j = 0; j < p.n_b; ++j) shapes(p.interior[k], p.boundary_coordinate[j]) = Psi_b(k, j);
+    for (int j = 0; j < p.n_c; ++j) shapes(p.interior[k], p.constraint_coordinate[j]) = Psi_c(k, j);
+    if (m > 0) shapes.row(p.interior[k]).tail(m) = Phi_i.row(k);
+  }
+  return shapes;
+}
+
+// Modal derivatives: interior solves with the interfaces held, deflated against the modes and
+// the derivatives kept (M_ii inner product, twice), normalized; a derivative that deflation
+// leaves below the request's tolerance of its norm is dropped. The kept pairs into r.
+Eigen::MatrixXd ModalDerivatives(const InterfacePartition& p, const SparseMatrix& M_ii, const Eigen::MatrixXd& Phi_i,
+                                 const Eigen::MatrixXd& shapes, const DerivativeRequest& derivatives,
+                                 const ConstrainedSolver& solver, CraigBamptonResult& r) {
+  const int m = int(Phi_i.cols());
+  const Eigen::MatrixXd dK = derivatives.stiffness_derivative(shapes, derivatives.pairs);
+  Eigen::MatrixXd z(p.n_i, dK.cols());
+  for (int k = 0; k < p.n_i; ++k) z.row(k) = -dK.row(p.interior[k]);
+  const Eigen::MatrixXd raw = solver.Solve(z);
+  Eigen::MatrixXd Theta(p.n_i, raw.cols());
+  int kept = 0;
+  for (long c = 0; c < raw.cols(); ++c) {
+    Eigen::VectorXd v = raw.col(c);
+    const double before = std::sqrt(std::max(v.dot(M_ii * v), 0.0));
+    for (int pass = 0; pass < 2; ++pass) {
+      if (m > 0) v -= Phi_i * (Phi_i.transpose() * (M_ii * v));
+      if (kept > 0) v -= Theta.leftCols(kept) * (Theta.leftCols(kept).transpose() * (M_ii * v));
+    }
+    const double after = std::sqrt(std::max(v.dot(M_ii * v), 0.0));
+    if (!(before > 0) || after <= derivatives.tolerance * before) continue;
+    Theta.col(kept++) = v / after;
+    r.derivative_pairs.push_back(derivatives.pairs[size_t(c)]);
+  }
+  Theta.conservativeResize(p.n_i, kept);
+  return Theta;
+}
+
+// Inertia load cases: D'Alembert loads -M A_k on the interior, interfaces held; the part in the
+// span of the internal modes and derivatives is removed (M_ii inner product), since the basis
+// carries it through its own coordinates. The full fields (n x 12).
+Eigen::MatrixXd InertiaDisplacements(const FeModel& model, const InterfacePartition& p, const SparseMatrix& M_ii,
+                                     const Eigen::MatrixXd& Phi_i, const Eigen::MatrixXd& Theta,
+                                     const Eigen::MatrixXd& inertia_fields, const ConstrainedSolver& solver) {
+  const Eigen::MatrixXd MA = model.M * inertia_fields;
+  Eigen::MatrixXd z(p.n_i, MA.cols());
+  for (int k = 0; k < p.n_i; ++k) z.row(k) = -MA.row(p.interior[k]);
+  Eigen::MatrixXd u = solver.Solve(z);
+  for (int pass = 0; pass < 2; ++pass) {
+    if (Phi_i.cols() > 0) u -= Phi_i * (Phi_i.transpose() * (M_ii * u));
+    if (Theta.cols() > 0) u -= Theta * (Theta.transpose() * (M_ii * u));
+  }
+  Eigen::MatrixXd out = Eigen::MatrixXd::Zero(model.n_dofs(), u.cols());
+  for (int k = 0; k < p.n_i; ++k) out.row(p.interior[k]) = u.row(k);
+  return out;
+}
+
+// Projection K_r = Phi^T K Phi, M_r = Phi^T M Phi with Phi the full fields of the reduced
+// coordinates (the Craig-Bampton shapes, then the derivatives): a Galerkin projection whatever
+// the accuracy of the vectors (the static and modal blocks of K_r are K-orthogonal and
+// Phi_i^T K Phi_i = Lambda up to the eigen solve's residual; femb-inspect shows both).
+void Project(const FeModel& model, const InterfacePartition& p, const Eigen::MatrixXd& shapes,
+             const Eigen::MatrixXd& Theta, CraigBamptonResult& r) {
+  const int n = int(model.n_dofs()), n_cb = int(shapes.cols()), d = int(Theta.cols());
+  r.shapes = Eigen::MatrixXd::Zero(n, n_cb + d);
+  r.shapes.leftCols(n_cb) = shapes;
+  for (int k = 0; k < p.n_i; ++k)
+    if (d > 0) r.shapes.row(p.interior[k]).tail(d) = Theta.row(k);
+  const Eigen::MatrixXd K_shapes = model.K * r.shapes;  // evaluated first: Eigen would nest it lazily
+  r.K = TransposeTimes(r.shapes, K_shapes);
+  const Eigen::MatrixXd M_shapes = model.M * r.shapes;
+  r.M = TransposeTimes(r.shapes, M_shapes);
+  r.K = 0.5 * (r.K + r.K.transpose()).eval();
+  r.M = 0.5 * (r.M + r.M.transpose()).eval();
+}
+
+// The factorization's progress line.
+std::string FactorizationDetail(const FactorizationInfo& f, int n_i) {
+  return Format("%.0f interior DOFs, factor %.3g MB, %.3g GFLOP, %.2f GFLOP/s", n_i, f.factor_bytes / 1e6,
+                f.flops / 1e9, f.flops / 1e9 / std::max(f.numeric_seconds, 1e-9)) +
+         Format(" (numeric %.3g s; ordering %.3g s, ", f.numeric_seconds, f.analyze_seconds) + f.ordering + ")";
+}
+
+}  // namespace
+
+CraigBamptonResult CraigBamptonReduce(const FeModel& model, int internal_modes, const ProgressFn& progress,
+                                      long dense_limit, double memory_limit_bytes, const DerivativeRequest* derivatives,
+                                      const Eigen::MatrixXd* inertia_fields) {
+  CraigBamptonResult r;
+  Stopwatch clock;
+  InterfacePartition p;
+  if (!PartitionInterfaces(model, p, &r.message)) return r;
+  if (internal_modes > p.n_i - p.n_c) {
     r.message = "reduction.internal_modes = " + std::to_string(internal_modes) + " exceeds the " +
-                std::to_string(n_i - n_c) + " interior DOFs of the model";
+                std::to_string(p.n_i - p.n_c) + " interior DOFs of the model";
     return r;
   }
+  const Blocks K = Partition(model.K, p.interior_index, p.boundary_index, p.n_i, p.n_b);
+  const Blocks M = Partition(model.M, p.interior_index, p.boundary_index, p.n_i, p.n_b);
 
-  const Blocks K = Partition(model.K, interior_index, boundary_index, n_i, n_b);
-  const Blocks M = Partition(model.M, interior_index, boundary_index, n_i, n_b);
-  // W^T on the interior DOFs (n_i x n_c), sparse: nonzero only on the coupled node sets.
-  SparseMatrix Wt(n_i, n_c);
-  {
-    std::vector<Eigen::Triplet<double>> entries;
-    int row = 0;
-    for (const SparseMatrix* W : weights) {
-      for (int col = 0; col < W->outerSize(); ++col)
-        for (SparseMatrix::InnerIterator it(*W, col); it; ++it) {
-          if (interior_index[col] < 0) {
-            r.message = "an RBE3 interface weights a DOF of another interface's coupling";
-            return r;
-          }
-          entries.emplace_back(interior_index[col], row + int(it.row()), it.value());
-        }
-      row += 6;
-    }
-    Wt.setFromTriplets(entries.begin(), entries.end());
-  }
-
-  // One factorization (METIS ordering, supernodal) of K_ii, or, when no interface is a DOF
-  // interface (every interface distributing), of the augmented F = K_ii + a W_1^T W_1, W_1 the
-  // six (unit-normalized) constraint rows of the first RBE3 interface: K_ii alone still has the
-  // six rigid-body modes that only the constraints W u = q remove, and W_1 alone removes them.
-  // Every solve below is on W x = 0 or W x = e_j, where F and K_ii give the same answer: on
-  // W x = 0, F x = K_ii x; on W x = e_j the extra a W_1^T (W_1 x) is a constraint force that the
-  // multipliers absorb. So the static modes, the fixed-interface modes and the modal derivatives
-  // are those of K_ii exactly, at any scale of the part (no shift, no iteration); a only sets the
-  // conditioning: the mean diagonal of K_ii over the DOFs W_1 weights.
+  // One factorization (METIS ordering, supernodal) of K_ii, or of the augmented F (Augmented).
   clock.Restart();
   SparseMatrix F_augmented;
-  if (n_b == 0) {
-    Eigen::MatrixXd W1 = Eigen::MatrixXd(Wt.leftCols(6));  // n_i x 6 (dense columns, sparse support)
-    for (int c = 0; c < 6; ++c) W1.col(c) /= std::max(W1.col(c).norm(), 1e-300);
-    double diagonal = 0.0;
-    int touched = 0;
-    std::vector<Eigen::Triplet<double>> entries;
-    std::vector<int> support;
-    for (int j = 0; j < n_i; ++j) {
-      if (W1.row(j).squaredNorm() == 0.0) continue;
-      support.push_back(j);
-      diagonal += K.ii.coeff(j, j);
-      ++touched;
-    }
-    const double a = touched > 0 ? diagonal / touched : 1.0;
-    for (int i : support)
-      for (int j : support) {
-        const double v = a * W1.row(i).dot(W1.row(j));
-        if (v != 0.0) entries.emplace_back(i, j, v);
-      }
-    SparseMatrix augmentation(n_i, n_i);
-    augmentation.setFromTriplets(entries.begin(), entries.end());
-    F_augmented = K.ii + augmentation;
-  }
+  if (p.n_b == 0) F_augmented = Augmented(K.ii, p.Wt);
   SparseCholesky factor;
-  r.factorization = factor.Compute(n_b == 0 ? F_augmented : K.ii, memory_limit_bytes);
+  r.factorization = factor.Compute(p.n_b == 0 ? F_augmented : K.ii, memory_limit_bytes);
   const double t_factor = clock.Seconds();
   if (r.factorization.too_big) {
     r.message = r.factorization.message;
@@ -311,67 +468,30 @@ CraigBamptonResult CraigBamptonReduce(const FeModel& model, int internal_modes, 
                 "; some part of the model is not held by any interface";
     return r;
   }
-  if (progress) {
-    progress("factorize K_ii", t_factor,
-             Format("%.0f interior DOFs, factor %.3g MB, %.3g GFLOP, %.2f GFLOP/s", n_i,
-                    r.factorization.factor_bytes / 1e6, r.factorization.flops / 1e9,
-                    r.factorization.flops / 1e9 / std::max(r.factorization.numeric_seconds, 1e-9)) +
-                 Format(" (numeric %.3g s; ordering %.3g s, ", r.factorization.numeric_seconds,
-                        r.factorization.analyze_seconds) +
-                 r.factorization.ordering + ")");
-  }
+  if (progress) progress("factorize K_ii", t_factor, FactorizationDetail(r.factorization, p.n_i));
 
-  // Solves on the constrained space W x = 0 (Lagrange multipliers eliminated through the
-  // 6r x 6r Schur complement S = W F^-1 W^T, F the factored matrix):
-  //   F x + W^T mu = z, W x = 0   =>   x = F^-1 z - Y S^-1 W F^-1 z,  Y = F^-1 W^T.
   clock.Restart();
-  const Eigen::MatrixXd Y = n_c > 0 ? factor.Solve(Eigen::MatrixXd(Wt)) : Eigen::MatrixXd(n_i, 0);
-  const Eigen::LDLT<Eigen::MatrixXd> S(Eigen::MatrixXd(Wt.transpose() * Y));
-  auto constrained_solve = [&](const Eigen::MatrixXd& z) {
-    Eigen::MatrixXd x = factor.Solve(z);
-    if (n_c > 0) x -= Y * S.solve(Eigen::MatrixXd(Wt.transpose() * x));
-    return x;
-  };
-  const auto& stiffness_solve = constrained_solve;
-  // Static modes: a DOF interface moved by a unit motion with the others held (K_ii x = -K_ib,
-  // W x = 0); a distributing interface's six coordinates set to unit values (W x = e_j) at
-  // least strain energy: x0 = Y S^-1 (stationary for F, and so for K_ii: see the factorization above).
-  Eigen::MatrixXd Psi_b = n_b > 0 ? Eigen::MatrixXd(-stiffness_solve(Eigen::MatrixXd(K.ib))) : Eigen::MatrixXd(n_i, 0);
-  // Rigid motions exactly: mathematically the static modes reproduce them (Psi_b R_b = R_i for
-  // the rigid fields R); in floating point only to cond(K_ii) times the round-off of K R = 0,
-  // which a thin part (a 0.5 mm leaf: 3e-8) makes visible in Phi_CB Phi_rig0 = 1. A rank-6
-  // correction Psi_b += (R_i - Psi_b R_b) (R_b^T R_b)^-1 R_b^T restores it to round-off; it
-  // changes the static modes by that residual only. (DOF interfaces only.)
-  if (n_b > 0 && n_c == 0) {
-    const Eigen::MatrixXd R = RigidFields(model);
-    Eigen::MatrixXd R_b(n_b, 6), R_i(n_i, 6);
-    for (int k = 0; k < n_b; ++k) R_b.row(k) = R.row(boundary[k]);
-    for (int k = 0; k < n_i; ++k) R_i.row(k) = R.row(interior[k]);
-    const Eigen::MatrixXd G = R_b.transpose() * R_b;
-    Psi_b += (R_i - Psi_b * R_b) * G.ldlt().solve(R_b.transpose());
-  }
-  Eigen::MatrixXd Psi_c(n_i, n_c);
-  if (n_c > 0) {
-    Psi_c = Y * S.solve(Eigen::MatrixXd::Identity(n_c, n_c));
-  }
+  const ConstrainedSolver solver(factor, p.Wt);
+  Eigen::MatrixXd Psi_b, Psi_c;
+  StaticModes(model, p, K.ib, solver, Psi_b, Psi_c);
   if (progress) {
     progress("static modes", clock.Seconds(),
-             Format("%.0f constraint modes, %.0f linear solves", n_b + n_c, double(factor.solves())));
+             Format("%.0f constraint modes, %.0f linear solves", p.n_b + p.n_c, double(factor.solves())));
   }
 
-  // Fixed-interface modes, shift-invert around 0 on the same factor, on W x = 0.
+  // Fixed-interface modes, shift-invert around 0 on the same factor, on W x = 0; one mode more
+  // than kept (when there is one): its frequency tells whether the cut splits equal modes.
   clock.Restart();
   const ShiftInvertFn solve = [&](const double* b, double* x) {
-    Eigen::Map<const Eigen::VectorXd> bv(b, n_i);
-    Eigen::Map<Eigen::VectorXd> xv(x, n_i);
-    xv = constrained_solve(Eigen::MatrixXd(bv));
+    Eigen::Map<const Eigen::VectorXd> bv(b, p.n_i);
+    Eigen::Map<Eigen::VectorXd> xv(x, p.n_i);
+    xv = solver.Solve(Eigen::MatrixXd(bv));
   };
-  const Eigen::MatrixXd C = Eigen::MatrixXd(Wt.transpose());
+  const auto constrained_solve = [&](const Eigen::MatrixXd& z) { return solver.Solve(z); };
+  const Eigen::MatrixXd C = Eigen::MatrixXd(p.Wt.transpose());
   long passes = 0;
-  // One mode more than kept (when there is one): its frequency tells whether the cut splits
-  // equal modes.
-  const int nev = internal_modes > 0 && internal_modes + 1 <= n_i - n_c ? internal_modes + 1 : internal_modes;
-  EigenResult eig = n_i <= dense_limit || 2 * nev + 1 > n_i - n_c
+  const int nev = internal_modes > 0 && internal_modes + 1 <= p.n_i - p.n_c ? internal_modes + 1 : internal_modes;
+  EigenResult eig = p.n_i <= dense_limit || 2 * nev + 1 > p.n_i - p.n_c
                         ? LowestConstrainedEigenpairs(K.ii, M.ii, C, nev, 0.0, solve, dense_limit)
                         : BlockLanczosEigenpairs(K.ii, M.ii, C, nev, 0.0, constrained_solve, kLanczosBlock,
                                                  kLanczosTolerance, &passes);
@@ -396,80 +516,29 @@ CraigBamptonResult CraigBamptonReduce(const FeModel& model, int internal_modes, 
                             : Format(", block shift-invert Lanczos, %.0f passes over the factor", double(passes))));
   }
 
-  // Projection K_r = Phi^T K Phi, M_r = Phi^T M Phi with Phi the full fields of the reduced
-  // coordinates: a Galerkin projection whatever the accuracy of the vectors (the static and
-  // modal blocks of K_r are K-orthogonal and Phi_i^T K Phi_i = Lambda up to the eigen solve's
-  // residual; femb-inspect shows both).
   clock.Restart();
-  const int m = internal_modes, n_cb = 6 * n_interfaces + m;
-  Eigen::MatrixXd shapes = Eigen::MatrixXd::Zero(n, n_cb);
-  for (int k = 0; k < n_b; ++k) shapes(boundary[k], boundary_coordinate[k]) = 1.0;
-  for (int k = 0; k < n_i; ++k) {
-    for (int j = 0; j < n_b; ++j) shapes(interior[k], boundary_coordinate[j]) = Psi_b(k, j);
-    for (int j = 0; j < n_c; ++j) shapes(interior[k], constraint_coordinate[j]) = Psi_c(k, j);
-    if (m > 0) shapes.row(interior[k]).tail(m) = Phi_i.row(k);
-  }
-  // Modal derivatives: interior solves with the interfaces held, deflation, normalization.
-  Eigen::MatrixXd Theta(n_i, 0);
+  const Eigen::MatrixXd shapes = CraigBamptonShapes(model, p, Psi_b, Psi_c, Phi_i, internal_modes);
+  Eigen::MatrixXd Theta(p.n_i, 0);
   if (derivatives && !derivatives->pairs.empty()) {
-    const Eigen::MatrixXd dK = derivatives->stiffness_derivative(shapes, derivatives->pairs);
-    Eigen::MatrixXd z(n_i, dK.cols());
-    for (int k = 0; k < n_i; ++k) z.row(k) = -dK.row(interior[k]);
-    const Eigen::MatrixXd raw = stiffness_solve(z);
-    Theta.resize(n_i, raw.cols());
-    int kept = 0;
-    for (long c = 0; c < raw.cols(); ++c) {
-      Eigen::VectorXd v = raw.col(c);
-      const double before = std::sqrt(std::max(v.dot(M.ii * v), 0.0));
-      for (int pass = 0; pass < 2; ++pass) {
-        if (m > 0) v -= Phi_i * (Phi_i.transpose() * (M.ii * v));
-        if (kept > 0) v -= Theta.leftCols(kept) * (Theta.leftCols(kept).transpose() * (M.ii * v));
-      }
-      const double after = std::sqrt(std::max(v.dot(M.ii * v), 0.0));
-      if (!(before > 0) || after <= derivatives->tolerance * before) continue;
-      Theta.col(kept++) = v / after;
-      r.derivative_pairs.push_back(derivatives->pairs[size_t(c)]);
-    }
-    Theta.conservativeResize(n_i, kept);
+    Theta = ModalDerivatives(p, M.ii, Phi_i, shapes, *derivatives, solver, r);
     if (progress) {
-      progress("modal derivatives", clock.Seconds(),
-               Format("%.0f of %.0f kept (deflation tolerance ", double(kept), double(raw.cols())) +
-                   Format("%.1e), %.0f linear solves", derivatives->tolerance, double(raw.cols())));
+      progress(
+          "modal derivatives", clock.Seconds(),
+          Format("%.0f of %.0f kept (deflation tolerance ", double(Theta.cols()), double(derivatives->pairs.size())) +
+              Format("%.1e), %.0f linear solves", derivatives->tolerance, double(derivatives->pairs.size())));
     }
     clock.Restart();
   }
   if (inertia_fields && inertia_fields->cols() > 0) {
-    // Inertia load cases: D'Alembert loads -M A_k on the interior, interfaces held;
-    // the part in the span of the internal modes and derivatives is removed (M_ii inner
-    // product), since the basis carries it through its own coordinates.
-    const Eigen::MatrixXd MA = model.M * *inertia_fields;
-    Eigen::MatrixXd z(n_i, MA.cols());
-    for (int k = 0; k < n_i; ++k) z.row(k) = -MA.row(interior[k]);
-    Eigen::MatrixXd u = stiffness_solve(z);
-    for (int pass = 0; pass < 2; ++pass) {
-      if (m > 0) u -= Phi_i * (Phi_i.transpose() * (M.ii * u));
-      if (Theta.cols() > 0) u -= Theta * (Theta.transpose() * (M.ii * u));
-    }
-    r.inertia_displacements = Eigen::MatrixXd::Zero(n, u.cols());
-    for (int k = 0; k < n_i; ++k) r.inertia_displacements.row(interior[k]) = u.row(k);
+    r.inertia_displacements = InertiaDisplacements(model, p, M.ii, Phi_i, Theta, *inertia_fields, solver);
     if (progress) {
       progress("inertia loads", clock.Seconds(),
-               Format("%.0f static solves with the interfaces held", double(u.cols())));
+               Format("%.0f static solves with the interfaces held", double(inertia_fields->cols())));
     }
     clock.Restart();
   }
-  const int d = int(Theta.cols()), n_r = n_cb + d;
-  r.shapes = Eigen::MatrixXd::Zero(n, n_r);
-  r.shapes.leftCols(n_cb) = shapes;
-  for (int k = 0; k < n_i; ++k)
-    if (d > 0) r.shapes.row(interior[k]).tail(d) = Theta.row(k);
-  const Eigen::MatrixXd K_shapes = model.K * r.shapes;  // evaluated first: Eigen would nest it lazily
-  r.K = TransposeTimes(r.shapes, K_shapes);
-  const Eigen::MatrixXd M_shapes = model.M * r.shapes;
-  r.M = TransposeTimes(r.shapes, M_shapes);
-  r.K = 0.5 * (r.K + r.K.transpose()).eval();
-  r.M = 0.5 * (r.M + r.M.transpose()).eval();
-  if (progress) progress("projection", clock.Seconds(), Format("%.0f reduced DOFs", n_r));
+  Project(model, p, shapes, Theta, r);
+  if (progress) progress("projection", clock.Seconds(), Format("%.0f reduced DOFs", int(r.shapes.cols())));
   r.ok = true;
   return r;
 }
