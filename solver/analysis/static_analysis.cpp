@@ -60,13 +60,107 @@ bool MinimumNormStep(const DofMap& dofs, const SystemMatrix& S, const Eigen::Vec
 
 }  // namespace
 
+namespace {
+
+// Stability along the load path: the negative eigenvalues of the tangent's symmetric part at the
+// start of each step (Sylvester's inertia of its pivoted LDL^T; dense systems only). A change
+// between two steps is a limit point or a bifurcation, also a double one (a column of round
+// section buckles in two planes at once: det(K) keeps its sign there). Said up to 5 times.
+class StabilityWatch {
+ public:
+  void Check(const DofMap& dofs, const SystemMatrix& tangent, double target, std::vector<std::string>& warnings) {
+    const int negative = NegativeEigenvalues(dofs, tangent);
+    if (negative >= 0 && last_negative_ >= 0 && negative != last_negative_ && reports_++ < 5) {
+      char buffer[400];
+      std::snprintf(buffer, sizeof buffer,
+                    "the tangent's negative eigenvalues went from %d to %d between pseudo-time %.6g and %.6g: "
+                    "a limit or bifurcation point (snap-through or buckling) was crossed%s",
+                    last_negative_, negative, last_lambda_, target,
+                    negative > last_negative_ ? "; a perfect structure stays on its unstable branch (add an "
+                                                "imperfection to follow the buckled one)"
+                                              : "");
+      warnings.push_back(buffer);
+    }
+    last_negative_ = negative;
+    last_lambda_ = target;
+  }
+
+ private:
+  int last_negative_ = -1;
+  double last_lambda_ = 0.0;
+  int reports_ = 0;
+};
+
+// Newton's iterations of one load step, from `trial` at load factor `target`.
+struct StaticNewton {
+  bool converged = false;
+  int iterations = 0;
+  double r_norm = 0.0, energy = 0.0;
+  Eigen::VectorXd travelled, loads_after;  ///< the step's motion and the loads at its end
+};
+
+// Newton on the static residual at load factor `target` from `trial` (moved in place). At the run's
+// first step a singular tangent is the model's, not the step's: it names the free motion in
+// *fatal instead of cutting steps -- unless the loads do not drive it and one minimum-norm step
+// makes the tangent regular (MinimumNormStep). Increments below round-off of the positions
+// (`size` the model's) also mean convergence: an unloaded state has a residual of round-off size
+// and no force scale to compare it with.
+StaticNewton NewtonSteps(const SystemModel& model, const DofMap& dofs, const StaticOptions& options, double target,
+                         double size, double tolerance, const Eigen::VectorXd& weights, bool first_step,
+                         SystemState& trial, StabilityWatch& stability, StaticResult& result, std::string* fatal) {
+  StaticNewton out;
+  double last_step = 1e300;
+  out.travelled = Eigen::VectorXd::Zero(dofs.n_dofs());
+  bool minimum_norm = false;  // the first step of the run was MinimumNormStep's
+  for (; out.iterations < options.max_iterations; ++out.iterations) {
+    const int it = out.iterations;
+    const SystemForces f = AssembleStatic(model, dofs, trial, target, true);
+    if (!f.ok) break;
+    out.r_norm = FreeNorm(dofs, f.residual, weights);
+    out.energy = f.elastic_energy;
+    out.loads_after = f.loads;
+    if (!std::isfinite(out.r_norm)) break;
+    if (it > 0 && LoopsClosed(model, trial, tolerance) &&
+        (out.r_norm <= f.roundoff || ScaledFreeNorm(dofs, f.residual, weights, f.dof_scale) <= tolerance ||
+         last_step <= 1e-13 * size)) {
+      out.converged = true;
+      break;
+    }
+    FreeSolver solver;
+    const bool regular = solver.Factor(dofs, f.tangent);
+    if (regular && it == 0) stability.Check(dofs, f.tangent, target, result.warnings);
+    Eigen::VectorXd delta = regular ? solver.Solve(f.residual) : Eigen::VectorXd();
+    if (!regular || !delta.allFinite()) {
+      if (first_step && (it == 0 || (it == 1 && minimum_norm))) {
+        const std::string why = DescribeSingular(model, dofs, trial, f.tangent);
+        if (!why.empty()) {
+          if (it == 0 && MinimumNormStep(dofs, f.tangent, f.residual, &delta)) {
+            minimum_norm = true;
+            last_step = delta.head(dofs.first_multiplier()).norm();
+            out.travelled += delta;
+            ApplyIncrement(model, dofs, delta, trial);
+            continue;
+          }
+          *fatal = "static tangent at the start: " + why;
+          return out;
+        }
+      }
+      break;
+    }
+    last_step = delta.head(dofs.first_multiplier()).norm();  // coordinates, not multipliers
+    out.travelled += delta;
+    ApplyIncrement(model, dofs, delta, trial);
+  }
+  return out;
+}
+
+}  // namespace
+
 StaticResult SolveStatic(const SystemModel& model, SystemState& state, const StaticOptions& options,
                          const std::function<void(const StaticStepReport&, const SystemState&)>& on_step) {
   StaticResult result;
   const DofMap& dofs = model.dofs();
   const double end = options.end_time, nominal = options.end_time / options.steps;
-  // Increments below round-off of the positions also mean convergence (an unloaded state has a
-  // residual of round-off size and no force scale to compare it with).
   double size = 0.0;
   for (const Eigen::Vector3d& x : model.node_x0) size = std::max(size, x.norm());
   if (size == 0.0) size = 1.0;
@@ -76,84 +170,24 @@ StaticResult SolveStatic(const SystemModel& model, SystemState& state, const Sta
   const double tolerance = std::max(options.tolerance, kRoundOffTolerance);
   const Eigen::VectorXd weights = ResidualWeights(model, dofs);
   if (const std::string w = RoundOffToleranceWarning(options.tolerance); !w.empty()) result.warnings.push_back(w);
-  int last_negative = -1;
-  double last_sign_lambda = 0.0;
-  int sign_reports = 0;
+  StabilityWatch stability;
   while (lambda < end * (1 - 1e-12)) {
     const double target = std::min(end, lambda + step);
     SystemState trial = state;
     ApplyPrescribed(model, dofs, target, trial, nullptr, nullptr);
-    bool converged = false;
-    int it = 0;
-    double r_norm = 0.0, energy = 0.0, last_step = 1e300;
-    Eigen::VectorXd travelled = Eigen::VectorXd::Zero(dofs.n_dofs()), loads_after;
-    bool minimum_norm = false;  // the first step of the run was MinimumNormStep's
-    for (; it < options.max_iterations; ++it) {
-      const SystemForces f = AssembleStatic(model, dofs, trial, target, true);
-      if (!f.ok) break;
-      r_norm = FreeNorm(dofs, f.residual, weights);
-      energy = f.elastic_energy;
-      loads_after = f.loads;
-      if (!std::isfinite(r_norm)) break;
-      if (it > 0 && LoopsClosed(model, trial, tolerance) &&
-          (r_norm <= f.roundoff || ScaledFreeNorm(dofs, f.residual, weights, f.dof_scale) <= tolerance ||
-           last_step <= 1e-13 * size)) {
-        converged = true;
-        break;
-      }
-      FreeSolver solver;
-      const bool regular = solver.Factor(dofs, f.tangent);
-      if (regular && it == 0) {
-        // Stability at the start of the step: the negative eigenvalues of the tangent's
-        // symmetric part (Sylvester's inertia of its pivoted LDL^T; dense systems only). A change
-        // between two steps is a limit point or a bifurcation, also a double one (a column of
-        // round section buckles in two planes at once: det(K) keeps its sign there).
-        const int negative = NegativeEigenvalues(dofs, f.tangent);
-        if (negative >= 0 && last_negative >= 0 && negative != last_negative && sign_reports++ < 5) {
-          char buffer[400];
-          std::snprintf(buffer, sizeof buffer,
-                        "the tangent's negative eigenvalues went from %d to %d between pseudo-time %.6g and %.6g: "
-                        "a limit or bifurcation point (snap-through or buckling) was crossed%s",
-                        last_negative, negative, last_sign_lambda, target,
-                        negative > last_negative ? "; a perfect structure stays on its unstable branch (add an "
-                                                   "imperfection to follow the buckled one)"
-                                                 : "");
-          result.warnings.push_back(buffer);
-        }
-        last_negative = negative;
-        last_sign_lambda = target;
-      }
-      Eigen::VectorXd delta = regular ? solver.Solve(f.residual) : Eigen::VectorXd();
-      if (!regular || !delta.allFinite()) {
-        // At the start, a singular tangent is the model's, not the step's: name the free motion
-        // instead of cutting steps -- unless the loads do not drive it and one minimum-norm step
-        // makes the tangent regular (MinimumNormStep).
-        if (result.steps.empty() && (it == 0 || (it == 1 && minimum_norm))) {
-          const std::string why = DescribeSingular(model, dofs, trial, f.tangent);
-          if (!why.empty()) {
-            if (it == 0 && MinimumNormStep(dofs, f.tangent, f.residual, &delta)) {
-              minimum_norm = true;
-              last_step = delta.head(dofs.first_multiplier()).norm();
-              travelled += delta;
-              ApplyIncrement(model, dofs, delta, trial);
-              continue;
-            }
-            result.message = "static tangent at the start: " + why;
-            return result;
-          }
-        }
-        break;
-      }
-      last_step = delta.head(dofs.first_multiplier()).norm();  // coordinates, not multipliers
-      travelled += delta;
-      ApplyIncrement(model, dofs, delta, trial);
+    std::string fatal;
+    const StaticNewton newton = NewtonSteps(model, dofs, options, target, size, tolerance, weights,
+                                            result.steps.empty(), trial, stability, result, &fatal);
+    if (!fatal.empty()) {
+      result.message = fatal;
+      return result;
     }
-    if (!converged) {
+    if (!newton.converged) {
       if (cuts >= options.max_cuts) {
         char buffer[200];
         std::snprintf(buffer, sizeof buffer,
                       "Newton did not converge at pseudo-time %.6g after %d step cuts (last residual %.3g)", target,
-                      cuts, r_norm);
+                      cuts, newton.r_norm);
         result.message = buffer;
         return result;
       }
@@ -162,11 +196,11 @@ StaticResult SolveStatic(const SystemModel& model, SystemState& state, const Sta
       continue;
     }
     // Prescribed coordinates moved too (ApplyPrescribed): their loads are reactions, not counted.
-    work += 0.5 * (loads_before + loads_after).dot(travelled);
-    loads_before = loads_after;
+    work += 0.5 * (loads_before + newton.loads_after).dot(newton.travelled);
+    loads_before = newton.loads_after;
     state = trial;
     lambda = target;
-    StaticStepReport report{lambda, it, r_norm, energy, work};
+    StaticStepReport report{lambda, newton.iterations, newton.r_norm, newton.energy, work};
     result.steps.push_back(report);
     if (on_step) on_step(report, state);
     if (options.stop && options.stop->load() != 0) {
@@ -174,7 +208,7 @@ StaticResult SolveStatic(const SystemModel& model, SystemState& state, const Sta
       break;
     }
     // Grow back towards the nominal step after easy steps.
-    if (it <= 4 && cuts > 0) {
+    if (newton.iterations <= 4 && cuts > 0) {
       step = std::min(nominal, 2.0 * step);
       --cuts;
     }
