@@ -36,9 +36,28 @@ nlohmann::json ToJson(const Eigen::VectorXd& v) {
   return out;
 }
 
-}  // namespace
+// Thesis 8.2 case 4: the interface constraint's line, each row named by the interface coordinate
+// it weighs most (rotation columns are lengths times the part's size, so compare them as such).
+std::string InterfaceConstraintLine(const Superelement& se) {
+  static const char* kNames[6] = {"u_x", "u_y", "u_z", "theta_x", "theta_y", "theta_z"};
+  const Eigen::MatrixXd& C = se.interface_constraint;
+  std::string rows;
+  for (long i = 0; i < C.rows(); ++i) {
+    const Eigen::VectorXd w = C.row(i).cwiseAbs().transpose();
+    rows += i ? "; " : "";
+    bool first = true;
+    for (long k = 0; k < w.size(); ++k) {
+      if (w[k] < 0.5 * w.maxCoeff()) continue;
+      rows += F("%s%s.%s", first ? "" : " & ", se.interfaces[size_t(k / 6)].name.c_str(), kNames[k % 6]);
+      first = false;
+    }
+  }
+  return F("  interface constraint (basis moves %ld of %d interface directions; femb-solve holds the others): %s\n",
+           long(se.n_interface_dofs() - C.rows()), se.n_interface_dofs(), rows.c_str());
+}
 
-std::string TextSummary(const Superelement& se, const SuperelementAnalysis& a, const std::string& path) {
+// The file's name, units, provenance, sizes and what it holds beyond K and M.
+std::string HeaderLines(const Superelement& se, const std::string& path) {
   const Units& u = se.units;
   std::string s;
   s += F("Superelement '%s'  (%s, format %ld.%ld)\n", se.name.c_str(), path.c_str(), kSuperelementFormatMajor,
@@ -66,25 +85,7 @@ std::string TextSummary(const Superelement& se, const SuperelementAnalysis& a, c
     s += F("  geometric stiffening: 12 inertia load cases (a, alpha, omega products), %d x %d each\n",
            se.n_reduced_dofs(), se.n_reduced_dofs());
   }
-  if (se.interface_constraint.rows() > 0) {
-    // Thesis 8.2 case 4: name each row by the interface coordinate it weighs most (rotation
-    // columns are lengths times the part's size, so compare them as such).
-    static const char* kNames[6] = {"u_x", "u_y", "u_z", "theta_x", "theta_y", "theta_z"};
-    const Eigen::MatrixXd& C = se.interface_constraint;
-    std::string rows;
-    for (long i = 0; i < C.rows(); ++i) {
-      const Eigen::VectorXd w = C.row(i).cwiseAbs().transpose();
-      rows += i ? "; " : "";
-      bool first = true;
-      for (long k = 0; k < w.size(); ++k) {
-        if (w[k] < 0.5 * w.maxCoeff()) continue;
-        rows += F("%s%s.%s", first ? "" : " & ", se.interfaces[size_t(k / 6)].name.c_str(), kNames[k % 6]);
-        first = false;
-      }
-    }
-    s += F("  interface constraint (basis moves %ld of %d interface directions; femb-solve holds the others): %s\n",
-           long(se.n_interface_dofs() - C.rows()), se.n_interface_dofs(), rows.c_str());
-  }
+  if (se.interface_constraint.rows() > 0) s += InterfaceConstraintLine(se);
   if (!se.inertia_gamma.empty()) {
     s += F("  inertia invariants: Gamma (3) and Xi (6), %d x %d each (exact kinetic energy in the floating frame)\n",
            se.n_reduced_dofs(), se.n_reduced_dofs());
@@ -95,7 +96,13 @@ std::string TextSummary(const Superelement& se, const SuperelementAnalysis& a, c
     for (const auto& [stage, sec] : p.stage_seconds) s += F(" %s %.3g s;", stage.c_str(), sec);
     s += "\n";
   }
+  return s;
+}
 
+// The interface nodes, the floating frame, the mass properties and the reduced coordinates.
+std::string BodyLines(const Superelement& se, const SuperelementAnalysis& a) {
+  const Units& u = se.units;
+  std::string s;
   s += F("\nInterface nodes (%d):\n", se.n_interface_nodes());
   for (const InterfaceNode& n : se.interfaces) {
     s += F("  %-12s position %s %s\n", n.name.c_str(), Vec(n.position).c_str(), u.length.c_str());
@@ -128,7 +135,12 @@ std::string TextSummary(const Superelement& se, const SuperelementAnalysis& a, c
   for (int i = 0; i < se.n_reduced_dofs(); ++i) {
     s += F("  %4d  %s\n", i, ReducedCoordinateLabel(se, i).c_str());
   }
+  return s;
+}
 
+// The free-free frequencies of the reduced model, beside the full model's where the file has them.
+std::string FrequencyLines(const Superelement& se, const SuperelementAnalysis& a) {
+  std::string s;
   s += F("\nFree-free frequencies [Hz] (%d rigid-body):\n", a.rigid_body_mode_count);
   const Eigen::VectorXd& full = se.full_free_free_frequencies_hz;
   if (full.size()) {
@@ -158,7 +170,13 @@ std::string TextSummary(const Superelement& se, const SuperelementAnalysis& a, c
     }
     s += line + "\n";
   }
+  return s;
+}
 
+}  // namespace
+
+std::string TextSummary(const Superelement& se, const SuperelementAnalysis& a, const std::string& path) {
+  std::string s = HeaderLines(se, path) + BodyLines(se, a) + FrequencyLines(se, a);
   s += "\nChecks:\n";
   for (const Check& c : a.checks) s += F("  %-24s %-4s %s\n", c.name.c_str(), c.ok ? "ok" : "FAIL", c.detail.c_str());
   return s;
