@@ -97,43 +97,26 @@ const Check* SuperelementChecks::first_failure() const {
   return nullptr;
 }
 
-SuperelementChecks CheckSuperelement(const Superelement& se) {
-  SuperelementChecks a;
-  a.checks.push_back(Finite(se));
-  if (!a.checks.back().ok) return a;  // the other figures would be meaningless
-  a.checks.push_back(Symmetric("K_symmetric", "/reduced/K", se.K));
-  a.checks.push_back(Symmetric("M_symmetric", "/reduced/M", se.M));
-  // One check for the 12 load cases: the first that fails, else the last.
+namespace {
+
+// One check for the 12 inertia load cases' geometric stiffness: the first that fails, else the
+// last.
+void CheckInertiaStiffnessSymmetric(const Superelement& se, std::vector<Check>& checks) {
   for (size_t k = 0; k < se.inertia_stiffness.size(); ++k) {
     const Check c =
         Symmetric("inertia_stiffness_symmetric", "/reduced/geometric_stiffness/inertia", se.inertia_stiffness[k]);
     if (!c.ok || k + 1 == se.inertia_stiffness.size()) {
-      a.checks.push_back(c);
+      checks.push_back(c);
       break;
     }
   }
-  const Eigen::MatrixXd Ms = 0.5 * (se.M + se.M.transpose());
-  const Eigen::MatrixXd Ks = 0.5 * (se.K + se.K.transpose());
+}
 
-  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> m_eig(Ms, Eigen::EigenvaluesOnly);
-  const double m_min = m_eig.eigenvalues().size() ? m_eig.eigenvalues()[0] : 0.0;
-  const bool m_pd = Eigen::LLT<Eigen::MatrixXd>(Ms).info() == Eigen::Success && m_min > 0.0;
-  a.checks.push_back({"M_positive_definite", m_pd, Sci("smallest eigenvalue of M %.6g", m_min), "/reduced/M"});
-
-  const Eigen::MatrixXd Phi_rig0 = RigidBodyModes(se, se.floating_frame.origin);
-  if (m_pd) {
-    Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> eig(Ks, Ms, Eigen::EigenvaluesOnly);
-    a.lambda = eig.eigenvalues();
-    const double lmax = a.lambda.size() ? a.lambda.cwiseAbs().maxCoeff() : 0.0;
-    for (int k = 0; k < a.lambda.size(); ++k) a.rigid_body_mode_count += std::abs(a.lambda[k]) <= 1e-8 * lmax;
-  }
-  const double k_norm = se.K.norm(), phi_norm = Phi_rig0.norm();
-  const double residual = (k_norm > 0 && phi_norm > 0) ? (se.K * Phi_rig0).norm() / (k_norm * phi_norm) : 0.0;
-  a.checks.push_back({"rigid_body_modes", m_pd && a.rigid_body_mode_count == 6 && residual <= 1e-8,
-                      (m_pd ? std::to_string(a.rigid_body_mode_count) : std::string("(M not positive definite:) ?")) +
-                          " eigenvalues with |lambda| <= 1e-8 max|lambda| (need 6), " +
-                          Sci("||K Phi_rig0|| / (||K|| ||Phi_rig0||) = %.3g", residual),
-                      "/reduced/K"});
+// The floating frame: Phi_CB Phi_rig0 = 1, and the elastic projector T0 = 1 - Phi_rig0 Phi_CB
+// moderate. `Ms`: M's symmetric part (positive definite when m_pd).
+Check FloatingFrameCheck(const Superelement& se, const Eigen::MatrixXd& Phi_rig0, const Eigen::MatrixXd& Ms,
+                         bool m_pd) {
+  const double k_norm = se.K.norm();
   const double frame_error =
       (se.floating_frame.Phi_CB * Phi_rig0 - Eigen::Matrix<double, 6, 6>::Identity()).cwiseAbs().maxCoeff();
   // The body's elastic force sees K through the projector T0 = 1 - Phi_rig0 Phi_CB (thesis
@@ -157,14 +140,17 @@ SuperelementChecks CheckSuperelement(const Superelement& se) {
     projector_norm = A.allFinite() ? Eigen::JacobiSVD<Eigen::MatrixXd>(A).singularValues()[0]
                                    : std::numeric_limits<double>::infinity();
   }
-  a.checks.push_back({"floating_frame", frame_error <= 1e-8 && amplified <= 1e-8 && projector_norm <= 1e6,
-                      Sci("max|Phi_CB Phi_rig0 - 1| = %.3g", frame_error) +
-                          Sci(", ||K Phi_rig0 Phi_CB|| / ||K|| = %.3g", amplified) +
-                          Sci(", ||1 - Phi_rig0 Phi_CB||_M = %.3g", projector_norm) +
-                          " (the elastic projector's norm in the mass metric: 1 for mean axes, about the part's "
-                          "aspect ratio for a centre-of-mass or interface frame; fails above 1e6)",
-                      "/floating_frame/Phi_CB"});
+  return {"floating_frame", frame_error <= 1e-8 && amplified <= 1e-8 && projector_norm <= 1e6,
+          Sci("max|Phi_CB Phi_rig0 - 1| = %.3g", frame_error) +
+              Sci(", ||K Phi_rig0 Phi_CB|| / ||K|| = %.3g", amplified) +
+              Sci(", ||1 - Phi_rig0 Phi_CB||_M = %.3g", projector_norm) +
+              " (the elastic projector's norm in the mass metric: 1 for mean axes, about the part's "
+              "aspect ratio for a centre-of-mass or interface frame; fails above 1e6)",
+          "/floating_frame/Phi_CB"};
+}
 
+// The interfaces' orientations are rotations.
+Check OrientationCheck(const Superelement& se) {
   double orientation_error = 0.0;
   std::string worst;
   for (const InterfaceNode& node : se.interfaces) {
@@ -173,11 +159,14 @@ SuperelementChecks CheckSuperelement(const Superelement& se) {
                               std::abs(R.determinant() - 1.0));
     if (e > orientation_error) orientation_error = e, worst = node.name;
   }
-  a.checks.push_back({"interface_orientations", orientation_error <= 1e-9,
-                      Sci("max|R^T R - 1|, |det R - 1| = %.3g", orientation_error) +
-                          (worst.empty() ? "" : " (interface '" + worst + "')"),
-                      "/interfaces/orientations"});
+  return {"interface_orientations", orientation_error <= 1e-9,
+          Sci("max|R^T R - 1|, |det R - 1| = %.3g", orientation_error) +
+              (worst.empty() ? "" : " (interface '" + worst + "')"),
+          "/interfaces/orientations"};
+}
 
+// The modal derivatives' pairs: as many as the derivatives, each of reduced coordinates.
+Check DerivativePairsCheck(const Superelement& se) {
   const int n = se.n_reduced_dofs();
   std::string bad_pair;
   if (long(se.modal_derivative_pairs.size()) != se.n_modal_derivatives) {
@@ -191,68 +180,114 @@ SuperelementChecks CheckSuperelement(const Superelement& se) {
                  ") is outside the " + std::to_string(n) + " reduced coordinates";
     }
   }
-  a.checks.push_back(
-      {"modal_derivative_pairs", bad_pair.empty(),
-       bad_pair.empty() ? std::to_string(se.modal_derivative_pairs.size()) + " pairs in range" : bad_pair,
-       "/reduced/modal_derivative_pairs"});
+  return {"modal_derivative_pairs", bad_pair.empty(),
+          bad_pair.empty() ? std::to_string(se.modal_derivative_pairs.size()) + " pairs in range" : bad_pair,
+          "/reduced/modal_derivative_pairs"};
+}
 
-  if (se.interface_constraint.rows() > 0) {
-    // Thesis 8.2 case 4: the constraint must leave the rigid motions free (C Phi_rig0 = 0 on the
-    // interface rows) and have independent rows.
-    const Eigen::MatrixXd& C = se.interface_constraint;
-    const bool shaped = C.cols() == se.n_interface_dofs() && C.rows() < C.cols();
-    double rigid = 1.0, condition = 0.0;
-    if (shaped) {
-      const Eigen::MatrixXd CP = C * Phi_rig0.topRows(C.cols());
-      rigid = CP.norm() / std::max(C.norm() * Phi_rig0.topRows(C.cols()).norm(), 1e-300);
-      const Eigen::VectorXd sv = Eigen::JacobiSVD<Eigen::MatrixXd>(C).singularValues();
-      condition = sv.size() && sv[0] > 0 ? sv[sv.size() - 1] / sv[0] : 0.0;
-    }
-    a.checks.push_back({"interface_constraint", shaped && rigid <= 1e-8 && condition > 1e-8,
-                        std::to_string(C.rows()) + " rows" +
-                            Sci(", ||C Phi_rig0|| / (||C|| ||Phi_rig0||) = %.3g", rigid) +
-                            Sci(", smallest / largest singular value %.3g", condition),
-                        "/reduced/interface_constraint"});
+// Thesis 8.2 case 4: the constraint must leave the rigid motions free (C Phi_rig0 = 0 on the
+// interface rows) and have independent rows.
+Check InterfaceConstraintCheck(const Superelement& se, const Eigen::MatrixXd& Phi_rig0) {
+  const Eigen::MatrixXd& C = se.interface_constraint;
+  const bool shaped = C.cols() == se.n_interface_dofs() && C.rows() < C.cols();
+  double rigid = 1.0, condition = 0.0;
+  if (shaped) {
+    const Eigen::MatrixXd CP = C * Phi_rig0.topRows(C.cols());
+    rigid = CP.norm() / std::max(C.norm() * Phi_rig0.topRows(C.cols()).norm(), 1e-300);
+    const Eigen::VectorXd sv = Eigen::JacobiSVD<Eigen::MatrixXd>(C).singularValues();
+    condition = sv.size() && sv[0] > 0 ? sv[sv.size() - 1] / sv[0] : 0.0;
   }
+  return {"interface_constraint", shaped && rigid <= 1e-8 && condition > 1e-8,
+          std::to_string(C.rows()) + " rows" + Sci(", ||C Phi_rig0|| / (||C|| ||Phi_rig0||) = %.3g", rigid) +
+              Sci(", smallest / largest singular value %.3g", condition),
+          "/reduced/interface_constraint"};
+}
 
+// The stored mass against the reduced M's.
+Check MassCheck(const Superelement& se, const Eigen::MatrixXd& Phi_rig0) {
   const double m_reduced = (Phi_rig0.col(0).transpose() * se.M * Phi_rig0.col(0))(0, 0);
   const double mass_error = std::abs(m_reduced - se.mass_properties.mass) / std::max(std::abs(m_reduced), 1e-300);
-  a.checks.push_back({"mass", mass_error <= 1e-6,
-                      Sci("stored mass %.9g", se.mass_properties.mass) + Sci(", from the reduced M %.9g", m_reduced),
-                      "/mass_properties/mass"});
+  return {"mass", mass_error <= 1e-6,
+          Sci("stored mass %.9g", se.mass_properties.mass) + Sci(", from the reduced M %.9g", m_reduced),
+          "/mass_properties/mass"};
+}
 
-  if (se.stress && se.stress->modes.rows() > 0 && se.stress->modes.cols() == n) {
-    // Rigid motions cause no stress: the modal stresses of Phi_rig0's columns vanish to the
-    // single precision they are stored in (a mutated or mismatched stress dataset shows here).
-    const Eigen::MatrixXd modes = se.stress->modes.cast<double>();
-    const double scale = modes.cwiseAbs().maxCoeff() * Phi_rig0.cwiseAbs().maxCoeff();
-    const double relative = scale > 0 ? (modes * Phi_rig0).cwiseAbs().maxCoeff() / scale : 0.0;
-    a.checks.push_back({"stress_rigid_body", relative <= 1e-4,
-                        Sci("max|sigma(Phi_rig0)| = %.3g of max|sigma_i| max|Phi_rig0|", relative), "/stress/modes"});
-  }
-  if (!se.inertia_gamma.empty()) {
-    // The frame's rotation turns a rigid translation e_b into the translation e_a x e_b:
-    // Gamma_a Phi_rig0 e_b = M Phi_rig0 (e_a x e_b) (b = translations), and Xi_aa is symmetric.
-    double error = 0.0, scale = se.M.norm() * Phi_rig0.norm();
-    bool shapes_ok = se.inertia_gamma.size() == 3 && se.inertia_xi.size() == 6;
-    for (const Eigen::MatrixXd& X : se.inertia_gamma) shapes_ok &= X.rows() == n && X.cols() == n;
-    for (const Eigen::MatrixXd& X : se.inertia_xi) shapes_ok &= X.rows() == n && X.cols() == n;
-    for (int i = 0; shapes_ok && i < 3; ++i) {
-      for (int b = 0; b < 3; ++b) {
-        const Eigen::Vector3d turned = Eigen::Vector3d::Unit(i).cross(Eigen::Vector3d::Unit(b));
-        const Eigen::VectorXd expected = se.M * (Phi_rig0.leftCols<3>() * turned);
-        error = std::max(error, (se.inertia_gamma[size_t(i)] * Phi_rig0.col(b) - expected).norm());
-      }
-      error = std::max(error, (se.inertia_xi[size_t(i)] - se.inertia_xi[size_t(i)].transpose()).norm());
+// Rigid motions cause no stress: the modal stresses of Phi_rig0's columns vanish to the single
+// precision they are stored in (a mutated or mismatched stress dataset shows here).
+Check StressRigidBodyCheck(const Superelement& se, const Eigen::MatrixXd& Phi_rig0) {
+  const Eigen::MatrixXd modes = se.stress->modes.cast<double>();
+  const double scale = modes.cwiseAbs().maxCoeff() * Phi_rig0.cwiseAbs().maxCoeff();
+  const double relative = scale > 0 ? (modes * Phi_rig0).cwiseAbs().maxCoeff() / scale : 0.0;
+  return {"stress_rigid_body", relative <= 1e-4,
+          Sci("max|sigma(Phi_rig0)| = %.3g of max|sigma_i| max|Phi_rig0|", relative), "/stress/modes"};
+}
+
+// The inertia invariants: the frame's rotation turns a rigid translation e_b into the
+// translation e_a x e_b: Gamma_a Phi_rig0 e_b = M Phi_rig0 (e_a x e_b) (b = translations), and
+// Xi_aa is symmetric.
+Check InertiaInvariantsCheck(const Superelement& se, const Eigen::MatrixXd& Phi_rig0) {
+  const int n = se.n_reduced_dofs();
+  double error = 0.0, scale = se.M.norm() * Phi_rig0.norm();
+  bool shapes_ok = se.inertia_gamma.size() == 3 && se.inertia_xi.size() == 6;
+  for (const Eigen::MatrixXd& X : se.inertia_gamma) shapes_ok &= X.rows() == n && X.cols() == n;
+  for (const Eigen::MatrixXd& X : se.inertia_xi) shapes_ok &= X.rows() == n && X.cols() == n;
+  for (int i = 0; shapes_ok && i < 3; ++i) {
+    for (int b = 0; b < 3; ++b) {
+      const Eigen::Vector3d turned = Eigen::Vector3d::Unit(i).cross(Eigen::Vector3d::Unit(b));
+      const Eigen::VectorXd expected = se.M * (Phi_rig0.leftCols<3>() * turned);
+      error = std::max(error, (se.inertia_gamma[size_t(i)] * Phi_rig0.col(b) - expected).norm());
     }
-    const double relative = scale > 0 ? error / scale : error;
-    a.checks.push_back({"inertia_invariants", shapes_ok && relative <= 1e-8,
-                        shapes_ok ? Sci("||Gamma_a Phi_rig0 e_b - M Phi_rig0 (e_a x e_b)||, ||Xi_aa - Xi_aa^T|| = %.3g "
-                                        "of ||M|| ||Phi_rig0||",
-                                        relative)
-                                  : std::string("need 3 Gamma and 6 Xi blocks of the reduced size"),
-                        "/reduced/inertia_invariants"});
+    error = std::max(error, (se.inertia_xi[size_t(i)] - se.inertia_xi[size_t(i)].transpose()).norm());
   }
+  const double relative = scale > 0 ? error / scale : error;
+  return {"inertia_invariants", shapes_ok && relative <= 1e-8,
+          shapes_ok ? Sci("||Gamma_a Phi_rig0 e_b - M Phi_rig0 (e_a x e_b)||, ||Xi_aa - Xi_aa^T|| = %.3g "
+                          "of ||M|| ||Phi_rig0||",
+                          relative)
+                    : std::string("need 3 Gamma and 6 Xi blocks of the reduced size"),
+          "/reduced/inertia_invariants"};
+}
+
+}  // namespace
+
+SuperelementChecks CheckSuperelement(const Superelement& se) {
+  SuperelementChecks a;
+  a.checks.push_back(Finite(se));
+  if (!a.checks.back().ok) return a;  // the other figures would be meaningless
+  a.checks.push_back(Symmetric("K_symmetric", "/reduced/K", se.K));
+  a.checks.push_back(Symmetric("M_symmetric", "/reduced/M", se.M));
+  CheckInertiaStiffnessSymmetric(se, a.checks);
+  const Eigen::MatrixXd Ms = 0.5 * (se.M + se.M.transpose());
+  const Eigen::MatrixXd Ks = 0.5 * (se.K + se.K.transpose());
+
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> m_eig(Ms, Eigen::EigenvaluesOnly);
+  const double m_min = m_eig.eigenvalues().size() ? m_eig.eigenvalues()[0] : 0.0;
+  const bool m_pd = Eigen::LLT<Eigen::MatrixXd>(Ms).info() == Eigen::Success && m_min > 0.0;
+  a.checks.push_back({"M_positive_definite", m_pd, Sci("smallest eigenvalue of M %.6g", m_min), "/reduced/M"});
+
+  const Eigen::MatrixXd Phi_rig0 = RigidBodyModes(se, se.floating_frame.origin);
+  if (m_pd) {
+    Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> eig(Ks, Ms, Eigen::EigenvaluesOnly);
+    a.lambda = eig.eigenvalues();
+    const double lmax = a.lambda.size() ? a.lambda.cwiseAbs().maxCoeff() : 0.0;
+    for (int k = 0; k < a.lambda.size(); ++k) a.rigid_body_mode_count += std::abs(a.lambda[k]) <= 1e-8 * lmax;
+  }
+  const double k_norm = se.K.norm(), phi_norm = Phi_rig0.norm();
+  const double residual = (k_norm > 0 && phi_norm > 0) ? (se.K * Phi_rig0).norm() / (k_norm * phi_norm) : 0.0;
+  a.checks.push_back({"rigid_body_modes", m_pd && a.rigid_body_mode_count == 6 && residual <= 1e-8,
+                      (m_pd ? std::to_string(a.rigid_body_mode_count) : std::string("(M not positive definite:) ?")) +
+                          " eigenvalues with |lambda| <= 1e-8 max|lambda| (need 6), " +
+                          Sci("||K Phi_rig0|| / (||K|| ||Phi_rig0||) = %.3g", residual),
+                      "/reduced/K"});
+  a.checks.push_back(FloatingFrameCheck(se, Phi_rig0, Ms, m_pd));
+  a.checks.push_back(OrientationCheck(se));
+  a.checks.push_back(DerivativePairsCheck(se));
+  if (se.interface_constraint.rows() > 0) a.checks.push_back(InterfaceConstraintCheck(se, Phi_rig0));
+  a.checks.push_back(MassCheck(se, Phi_rig0));
+  if (se.stress && se.stress->modes.rows() > 0 && se.stress->modes.cols() == se.n_reduced_dofs()) {
+    a.checks.push_back(StressRigidBodyCheck(se, Phi_rig0));
+  }
+  if (!se.inertia_gamma.empty()) a.checks.push_back(InertiaInvariantsCheck(se, Phi_rig0));
   return a;
 }
 
