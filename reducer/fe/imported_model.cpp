@@ -29,29 +29,23 @@ Eigen::Matrix3d Skew(const Eigen::Vector3d& a) {
   return m;
 }
 
-}  // namespace
+// Where each imported DOF sits: its mesh node (full_node), each mesh node's DOF per component
+// (full_dof, -1: none), and how many are rotations. Every node of the matrices must be a node of
+// the geometry file.
+struct ImportedDofs {
+  std::vector<int> full_node;
+  std::vector<std::array<int, 6>> full_dof;
+  int rotational = 0;
+};
 
-FeModel BuildImportedModel(const PartSpec& part, const ProgressFn& progress) {
-  Stopwatch clock;
-  const ForeignMesh geometry = ReadWithMeshio(part.solid.file, part.solid.where, true);
-  const long n_nodes = geometry.nodes.rows();
-  const Eigen::Vector3d lo = geometry.nodes.colwise().minCoeff(), hi = geometry.nodes.colwise().maxCoeff();
-  CheckPartSize(part, (hi - lo).norm(), part.solid.where + " (" + part.solid.file + ")");
-  if (progress) {
-    progress("geometry", clock.Seconds(),
-             std::to_string(n_nodes) + " nodes, " + std::to_string(geometry.cells.rows()) + " " + geometry.cell_type +
-                 " cells from " + part.solid.file);
-  }
-
-  clock.Restart();
-  const ImportedMatrices im = ReadImportedMatrices(part.matrices);
-  const long n_full = long(im.node.size());
+ImportedDofs MapImportedDofs(const PartSpec& part, const ForeignMesh& geometry, const ImportedMatrices& im) {
+  const long n_nodes = geometry.nodes.rows(), n_full = long(im.node.size());
+  ImportedDofs d;
   std::unordered_map<long, int> index_of;
   for (long s = 0; s < n_nodes; ++s) index_of[geometry.ids[size_t(s)]] = int(s);
-  std::vector<int> full_node(static_cast<size_t>(n_full));  // mesh node of each imported DOF
-  std::vector<std::array<int, 6>> full_dof(static_cast<size_t>(n_nodes));
-  for (auto& d : full_dof) d.fill(-1);
-  int rotational = 0;
+  d.full_node.resize(static_cast<size_t>(n_full));  // mesh node of each imported DOF
+  d.full_dof.resize(static_cast<size_t>(n_nodes));
+  for (auto& f : d.full_dof) f.fill(-1);
   for (long r = 0; r < n_full; ++r) {
     auto it = index_of.find(im.node[size_t(r)]);
     if (it == index_of.end()) {
@@ -60,54 +54,41 @@ FeModel BuildImportedModel(const PartSpec& part, const ProgressFn& progress) {
                        std::to_string(geometry.ids.front()) + " .. " + std::to_string(geometry.ids.back()) +
                        "): the geometry file must be the mesh the matrices were exported from");
     }
-    full_node[size_t(r)] = it->second;
-    full_dof[size_t(it->second)][size_t(im.component[size_t(r)])] = int(r);
-    rotational += im.component[size_t(r)] >= 3;
+    d.full_node[size_t(r)] = it->second;
+    d.full_dof[size_t(it->second)][size_t(im.component[size_t(r)])] = int(r);
+    d.rotational += im.component[size_t(r)] >= 3;
   }
-  if (progress) {
-    progress("matrices", clock.Seconds(),
-             std::to_string(n_full) + " DOFs (" + std::to_string(rotational) + " rotational), K " +
-                 std::to_string(im.K.nonZeros()) + " entries (" + im.stored + " in the file), M " +
-                 std::to_string(im.M.nonZeros()) + " entries, " + part.matrices.format);
-  }
+  return d;
+}
 
-  // Interfaces: node sets by name or by geometry.
-  clock.Restart();
-  FeModel model;
-  std::shared_ptr<SolidMesh> volume;
-  if (geometry.cell_type == "tet4" || geometry.cell_type == "tet10" || geometry.cell_type == "hex8" ||
-      geometry.cell_type == "hex20") {
-    volume = std::make_shared<SolidMesh>();
-    volume->nodes = geometry.nodes;
-    volume->cells = geometry.cells;
-    for (SolidType t : {SolidType::kTet4, SolidType::kTet10, SolidType::kHex8, SolidType::kHex20})
-      if (SolidTypeName(t) == geometry.cell_type) volume->type = t;
+// The geometry's cells as a volume mesh when they are solids femb knows (for selections inside
+// the volume and interpolation); null otherwise.
+std::shared_ptr<SolidMesh> SolidVolume(const ForeignMesh& geometry) {
+  if (geometry.cell_type != "tet4" && geometry.cell_type != "tet10" && geometry.cell_type != "hex8" &&
+      geometry.cell_type != "hex20") {
+    return nullptr;
   }
-  // Interface node sets; only nodes that carry DOFs of the matrices take part (a mesh may have
-  // unused nodes).
-  const InterfaceNodes interface_nodes = ResolveInterfaceNodes(
-      part, geometry.nodes, geometry.node_sets, volume.get(), part.solid.file,
-      [&](int s) {
-        for (int c = 0; c < 6; ++c)
-          if (full_dof[size_t(s)][size_t(c)] >= 0) return true;
-        return false;
-      },
-      "has a DOF in the matrices");
-  const std::vector<std::vector<int>>& sets = interface_nodes.sets;
-  const std::vector<int>& owner = interface_nodes.owner;
-  const std::string& selected = interface_nodes.summary;
-  for (size_t k = 0; k < part.interfaces.size(); ++k) {
-    model.interface_names.push_back(part.interfaces[k].name);
-    model.interface_positions.push_back(interface_nodes.positions[k]);
-  }
-  model.interface_node_sets = sets;
-  // Model DOFs: the imported DOFs of nodes in no RBE2 set (file order), then 6 per RBE2
-  // interface. T (imported -> model): u_s = u_k + theta_k x (x_s - x_k) = u_k - (x_s - x_k)~ theta_k,
-  // theta_s = theta_k.
+  auto volume = std::make_shared<SolidMesh>();
+  volume->nodes = geometry.nodes;
+  volume->cells = geometry.cells;
+  for (SolidType t : {SolidType::kTet4, SolidType::kTet10, SolidType::kHex8, SolidType::kHex20})
+    if (SolidTypeName(t) == geometry.cell_type) volume->type = t;
+  return volume;
+}
+
+// Model DOFs: the imported DOFs of nodes in no RBE2 set (file order), then 6 per RBE2 interface,
+// into model.dof_point, dof_component, dof_node; model_of (per imported DOF, -1 in an RBE2 set) and
+// base (per interface, its first model DOF, -1 if not RBE2). The map T (imported -> model):
+// u_s = u_k + theta_k x (x_s - x_k) = u_k - (x_s - x_k)~ theta_k, theta_s = theta_k.
+SparseMatrix RigidCouplingMap(const PartSpec& part, const ForeignMesh& geometry, const ImportedMatrices& im,
+                              const ImportedDofs& d, const std::vector<int>& owner, std::vector<int>& model_of,
+                              std::vector<int>& base, FeModel& model) {
+  const long n_full = long(im.node.size());
+  const std::vector<int>& full_node = d.full_node;
   auto rbe2 = [&](long s) {
     return owner[size_t(s)] >= 0 && part.interfaces[size_t(owner[size_t(s)])].coupling == "rbe2";
   };
-  std::vector<int> model_of(static_cast<size_t>(n_full), -1);
+  model_of.assign(static_cast<size_t>(n_full), -1);
   int n_model = 0;
   for (long r = 0; r < n_full; ++r) {
     if (!rbe2(full_node[size_t(r)])) {
@@ -117,7 +98,7 @@ FeModel BuildImportedModel(const PartSpec& part, const ProgressFn& progress) {
       model.dof_node.push_back(int(full_node[size_t(r)]));
     }
   }
-  std::vector<int> base(part.interfaces.size(), -1);
+  base.assign(part.interfaces.size(), -1);
   for (size_t k = 0; k < part.interfaces.size(); ++k) {
     if (part.interfaces[k].coupling != "rbe2") continue;
     base[k] = n_model;
@@ -146,12 +127,15 @@ FeModel BuildImportedModel(const PartSpec& part, const ProgressFn& progress) {
   }
   SparseMatrix T(n_full, n_model);
   T.setFromTriplets(t.begin(), t.end());
-  const SparseMatrix Tt = T.transpose();
-  model.K = SparseMatrix(Tt * im.K * T);
-  model.M = SparseMatrix(Tt * im.M * T);
-  model.K.prune(0.0);
-  model.M.prune(0.0);
-  // Interfaces: RBE2 DOFs; RBE3 weights on the translations of the set's nodes.
+  return T;
+}
+
+// The interfaces' couplings: an RBE2 interface's six model DOFs; an RBE3 interface's weights on
+// the translations of its set's nodes.
+void InterfaceCouplings(const PartSpec& part, const ForeignMesh& geometry, const ImportedDofs& d,
+                        const std::vector<std::vector<int>>& sets, const std::vector<int>& model_of,
+                        const std::vector<int>& base, int n_model, FeModel& model) {
+  const std::vector<std::array<int, 6>>& full_dof = d.full_dof;
   for (size_t k = 0; k < part.interfaces.size(); ++k) {
     std::vector<FullDof> dofs;
     SparseMatrix W(0, n_model);
@@ -176,23 +160,11 @@ FeModel BuildImportedModel(const PartSpec& part, const ProgressFn& progress) {
     model.interface_dofs.push_back(dofs);
     model.interface_weights.push_back(W);
   }
-  // Mesh DOFs (3 per geometry node: the translations; zero for a node without them) = S T q.
-  std::vector<Eigen::Triplet<double>> pick;
-  for (long s = 0; s < n_nodes; ++s)
-    for (int c = 0; c < 3; ++c)
-      if (full_dof[size_t(s)][size_t(c)] >= 0) pick.emplace_back(int(3 * s + c), full_dof[size_t(s)][size_t(c)], 1.0);
-  SparseMatrix S(3 * n_nodes, n_full);
-  S.setFromTriplets(pick.begin(), pick.end());
-  model.mesh_map = SparseMatrix(S * T);
-  model.full_map = T;
-  model.dofs_per_node = 3;
-  model.nodes = geometry.nodes;
-  model.cells = geometry.cells;
-  model.cell_type = geometry.cell_type;
-  model.element_type = "imported " + part.matrices.format;
-  if (volume) model.interpolate_at = SolidInterpolation(volume, model.mesh_map);
+}
 
-  // The body must float: K R = 0 for the rigid-body fields R (to the round-off of the export).
+// The body must float: K R = 0 for the rigid-body fields R (to the round-off of the export), and
+// have a mass. Returns the residual and the mass for the progress line.
+std::pair<double, double> CheckFloats(const PartSpec& part, const FeModel& model) {
   const Eigen::MatrixXd R = RigidFields(model);
   const Eigen::MatrixXd KR = model.K * R;
   double k_scale = 0.0;
@@ -209,10 +181,83 @@ FeModel BuildImportedModel(const PartSpec& part, const ProgressFn& progress) {
   }
   if (!(mass > 0))
     throw InputError(part.matrices.where + ": the mass matrix gives the part no mass (" + ShortNumber(mass) + ")");
+  return {residual, mass};
+}
+
+}  // namespace
+
+FeModel BuildImportedModel(const PartSpec& part, const ProgressFn& progress) {
+  Stopwatch clock;
+  const ForeignMesh geometry = ReadWithMeshio(part.solid.file, part.solid.where, true);
+  const long n_nodes = geometry.nodes.rows();
+  const Eigen::Vector3d lo = geometry.nodes.colwise().minCoeff(), hi = geometry.nodes.colwise().maxCoeff();
+  CheckPartSize(part, (hi - lo).norm(), part.solid.where + " (" + part.solid.file + ")");
+  if (progress) {
+    progress("geometry", clock.Seconds(),
+             std::to_string(n_nodes) + " nodes, " + std::to_string(geometry.cells.rows()) + " " + geometry.cell_type +
+                 " cells from " + part.solid.file);
+  }
+
+  clock.Restart();
+  const ImportedMatrices im = ReadImportedMatrices(part.matrices);
+  const long n_full = long(im.node.size());
+  const ImportedDofs d = MapImportedDofs(part, geometry, im);
+  if (progress) {
+    progress("matrices", clock.Seconds(),
+             std::to_string(n_full) + " DOFs (" + std::to_string(d.rotational) + " rotational), K " +
+                 std::to_string(im.K.nonZeros()) + " entries (" + im.stored + " in the file), M " +
+                 std::to_string(im.M.nonZeros()) + " entries, " + part.matrices.format);
+  }
+
+  // Interfaces: node sets by name or by geometry; only nodes that carry DOFs of the matrices take
+  // part (a mesh may have unused nodes).
+  clock.Restart();
+  FeModel model;
+  const std::shared_ptr<SolidMesh> volume = SolidVolume(geometry);
+  const InterfaceNodes interface_nodes = ResolveInterfaceNodes(
+      part, geometry.nodes, geometry.node_sets, volume.get(), part.solid.file,
+      [&](int s) {
+        for (int c = 0; c < 6; ++c)
+          if (d.full_dof[size_t(s)][size_t(c)] >= 0) return true;
+        return false;
+      },
+      "has a DOF in the matrices");
+  for (size_t k = 0; k < part.interfaces.size(); ++k) {
+    model.interface_names.push_back(part.interfaces[k].name);
+    model.interface_positions.push_back(interface_nodes.positions[k]);
+  }
+  model.interface_node_sets = interface_nodes.sets;
+  std::vector<int> model_of, base;
+  const SparseMatrix T = RigidCouplingMap(part, geometry, im, d, interface_nodes.owner, model_of, base, model);
+  const int n_model = int(T.cols());
+  const SparseMatrix Tt = T.transpose();
+  model.K = SparseMatrix(Tt * im.K * T);
+  model.M = SparseMatrix(Tt * im.M * T);
+  model.K.prune(0.0);
+  model.M.prune(0.0);
+  InterfaceCouplings(part, geometry, d, interface_nodes.sets, model_of, base, n_model, model);
+  // Mesh DOFs (3 per geometry node: the translations; zero for a node without them) = S T q.
+  std::vector<Eigen::Triplet<double>> pick;
+  for (long s = 0; s < n_nodes; ++s)
+    for (int c = 0; c < 3; ++c)
+      if (d.full_dof[size_t(s)][size_t(c)] >= 0)
+        pick.emplace_back(int(3 * s + c), d.full_dof[size_t(s)][size_t(c)], 1.0);
+  SparseMatrix S(3 * n_nodes, n_full);
+  S.setFromTriplets(pick.begin(), pick.end());
+  model.mesh_map = SparseMatrix(S * T);
+  model.full_map = T;
+  model.dofs_per_node = 3;
+  model.nodes = geometry.nodes;
+  model.cells = geometry.cells;
+  model.cell_type = geometry.cell_type;
+  model.element_type = "imported " + part.matrices.format;
+  if (volume) model.interpolate_at = SolidInterpolation(volume, model.mesh_map);
+  const auto [residual, mass] = CheckFloats(part, model);
   if (progress) {
     progress("couplings", clock.Seconds(),
-             std::to_string(part.interfaces.size()) + " interfaces (" + selected + "), " + std::to_string(n_model) +
-                 " model DOFs; rigid-body residual " + ShortNumber(residual) + ", mass " + ShortNumber(mass));
+             std::to_string(part.interfaces.size()) + " interfaces (" + interface_nodes.summary + "), " +
+                 std::to_string(n_model) + " model DOFs; rigid-body residual " + ShortNumber(residual) + ", mass " +
+                 ShortNumber(mass));
   }
   return model;
 }
