@@ -27,23 +27,37 @@ bool Locate(const SolidMesh& mesh, int e, const Eigen::Vector3d& x, Eigen::Vecto
   return LocateInCell(mesh.type, mesh.nodes, mesh.cells, e, x, xi);
 }
 
-}  // namespace
+// The sparsity of the assembled K and M, column block by model node: the model-node graph in CSR
+// form (neighbours, including the node itself, sorted by first DOF: model nodes are numbered in
+// DOF order, so sorting by number sorts the rows), and per neighbour the offset of its rows in
+// the column. Every column of model node P has the same rows: all DOFs of each neighbour Q for K;
+// for M only the like component when P and Q are both free 3-DOF nodes (consistent mass couples
+// like components), all DOFs of Q otherwise.
+struct SolidPattern {
+  std::vector<long> start;               ///< per model node, its first entry in `adjacent` (n + 1)
+  std::vector<int> adjacent;             ///< neighbours, ascending
+  std::vector<long> prefix_k, prefix_m;  ///< per entry of `adjacent`: its rows' offset in a column
+  std::vector<long> length_k, length_m;  ///< per model node: rows in each of its columns
+  /// 1 when a column of P holds only the like component of Q in M, else Q's DOFs.
+  static int MassRows(const SolidDofMap& map, int P, int Q) {
+    return map.dofs[P] == 3 && map.dofs[Q] == 3 ? 1 : map.dofs[Q];
+  }
+};
 
-void AssembleSolid(const SolidMesh& mesh, const MaterialSpec& material, const SolidDofMap& map, SparseMatrix* K,
-                   SparseMatrix* M) {
+SolidPattern Pattern(const SolidMesh& mesh, const SolidDofMap& map) {
   const int per = SolidNodeCount(mesh.type);
   const long n_cells = mesh.cells.rows();
   const int n_model_nodes = int(map.first_dof.size());
-  // Model-node graph in CSR form: neighbours (including the node itself) sorted by first DOF
-  // (model nodes are numbered in DOF order, so sorting by number sorts the rows).
+  SolidPattern g;
   std::vector<std::vector<int>> cells_of(n_model_nodes);
   for (long e = 0; e < n_cells; ++e)
     for (int a = 0; a < per; ++a) {
       std::vector<int>& c = cells_of[map.model_node[mesh.cells(e, a)]];
       if (c.empty() || c.back() != int(e)) c.push_back(int(e));
     }
-  std::vector<long> start(n_model_nodes + 1, 0);
-  std::vector<int> adjacent;
+  std::vector<long>& start = g.start;
+  std::vector<int>& adjacent = g.adjacent;
+  start.assign(size_t(n_model_nodes) + 1, 0);
   std::vector<int> scratch;
   for (int P = 0; P < n_model_nodes; ++P) {
     scratch.clear();
@@ -55,52 +69,72 @@ void AssembleSolid(const SolidMesh& mesh, const MaterialSpec& material, const So
     start[P + 1] = long(adjacent.size());
   }
   cells_of = {};
-  // Every column of model node P has the same rows: all DOFs of each neighbour Q for K; for M
-  // only the like component when P and Q are both free 3-DOF nodes (consistent mass couples
-  // like components), all DOFs of Q otherwise. prefix_*[k]: offset of neighbour k's rows.
-  auto mass_rows = [&](int P, int Q) { return map.dofs[P] == 3 && map.dofs[Q] == 3 ? 1 : map.dofs[Q]; };
-  std::vector<long> prefix_k(adjacent.size()), prefix_m(adjacent.size());
-  std::vector<long> length_k(n_model_nodes), length_m(n_model_nodes);
+  g.prefix_k.resize(adjacent.size()), g.prefix_m.resize(adjacent.size());
+  g.length_k.resize(size_t(n_model_nodes)), g.length_m.resize(size_t(n_model_nodes));
   double entries_k = 0;
   for (int P = 0; P < n_model_nodes; ++P) {
     long lk = 0, lm = 0;
     for (long k = start[P]; k < start[P + 1]; ++k) {
-      prefix_k[k] = lk;
-      prefix_m[k] = lm;
+      g.prefix_k[k] = lk;
+      g.prefix_m[k] = lm;
       lk += map.dofs[adjacent[k]];
-      lm += mass_rows(P, adjacent[k]);
+      lm += SolidPattern::MassRows(map, P, adjacent[k]);
     }
-    length_k[P] = lk;
-    length_m[P] = lm;
+    g.length_k[P] = lk;
+    g.length_m[P] = lm;
     entries_k += double(lk) * map.dofs[P];
   }
   if (entries_k > 2e9) throw InputError("mesh too large: more than 2^31 stiffness entries");
+  return g;
+}
+
+// An n x n matrix with the pattern's entries for K (or M with `mass`), zero-filled: built column
+// by column, no triplet list.
+void ShapeMatrix(const SolidDofMap& map, const SolidPattern& g, bool mass, SparseMatrix* A) {
   const long n = map.n_dofs;
-  auto shape = [&](SparseMatrix* A, bool mass) {
-    *A = SparseMatrix(n, n);
-    long total = 0;
-    for (int P = 0; P < n_model_nodes; ++P) total += map.dofs[P] * (mass ? length_m[P] : length_k[P]);
-    A->resizeNonZeros(total);
-    int* outer = A->outerIndexPtr();
-    int* inner = A->innerIndexPtr();
-    long p = 0;
-    for (int P = 0; P < n_model_nodes; ++P)
-      for (int d = 0; d < map.dofs[P]; ++d) {
-        outer[map.first_dof[P] + d] = int(p);
-        for (long k = start[P]; k < start[P + 1]; ++k) {
-          const int Q = adjacent[k];
-          if (mass && mass_rows(P, Q) == 1) {
-            inner[p++] = map.first_dof[Q] + d;
-          } else {
-            for (int c = 0; c < map.dofs[Q]; ++c) inner[p++] = map.first_dof[Q] + c;
-          }
+  const int n_model_nodes = int(map.first_dof.size());
+  const std::vector<long>& start = g.start;
+  const std::vector<int>& adjacent = g.adjacent;
+  const std::vector<long>& length_k = g.length_k;
+  const std::vector<long>& length_m = g.length_m;
+  const auto mass_rows = [&](int P, int Q) { return SolidPattern::MassRows(map, P, Q); };
+  *A = SparseMatrix(n, n);
+  long total = 0;
+  for (int P = 0; P < n_model_nodes; ++P) total += map.dofs[P] * (mass ? length_m[P] : length_k[P]);
+  A->resizeNonZeros(total);
+  int* outer = A->outerIndexPtr();
+  int* inner = A->innerIndexPtr();
+  long p = 0;
+  for (int P = 0; P < n_model_nodes; ++P)
+    for (int d = 0; d < map.dofs[P]; ++d) {
+      outer[map.first_dof[P] + d] = int(p);
+      for (long k = start[P]; k < start[P + 1]; ++k) {
+        const int Q = adjacent[k];
+        if (mass && mass_rows(P, Q) == 1) {
+          inner[p++] = map.first_dof[Q] + d;
+        } else {
+          for (int c = 0; c < map.dofs[Q]; ++c) inner[p++] = map.first_dof[Q] + c;
         }
       }
-    outer[n] = int(p);
-    std::fill(A->valuePtr(), A->valuePtr() + p, 0.0);
-  };
-  shape(K, false);
-  shape(M, true);
+    }
+  outer[n] = int(p);
+  std::fill(A->valuePtr(), A->valuePtr() + p, 0.0);
+}
+
+}  // namespace
+
+void AssembleSolid(const SolidMesh& mesh, const MaterialSpec& material, const SolidDofMap& map, SparseMatrix* K,
+                   SparseMatrix* M) {
+  const int per = SolidNodeCount(mesh.type);
+  const long n_cells = mesh.cells.rows();
+  const SolidPattern g = Pattern(mesh, map);
+  ShapeMatrix(map, g, false, K);
+  ShapeMatrix(map, g, true, M);
+  const std::vector<long>& start = g.start;
+  const std::vector<int>& adjacent = g.adjacent;
+  const std::vector<long>& prefix_k = g.prefix_k;
+  const std::vector<long>& prefix_m = g.prefix_m;
+  const auto mass_rows = [&](int P, int Q) { return SolidPattern::MassRows(map, P, Q); };
   double* kv = K->valuePtr();
   double* mv = M->valuePtr();
   const int* k_outer = K->outerIndexPtr();
