@@ -396,57 +396,46 @@ SolidMesh MeshSolidPart(const PartSpec& part) {
   return mesh;
 }
 
-FeModel BuildSolidModel(const PartSpec& part, const ProgressFn& progress) {
-  Stopwatch clock;
-  auto mesh = std::make_shared<SolidMesh>(MeshSolidPart(part));
-  const int n_nodes = int(mesh->nodes.rows());
-  if (progress) {
-    progress("mesh", clock.Seconds(),
-             std::to_string(n_nodes) + " nodes, " + std::to_string(mesh->cells.rows()) + " " +
-                 SolidTypeName(mesh->type) + " elements" + (part.solid.file.empty() ? "" : " from " + part.solid.file));
-  }
+namespace {
 
-  clock.Restart();
+// RBE3 (distributing): the interface motion is the least-squares rigid fit of its node set,
+//   u_k = u_c + theta x (x_k - c),  u_c = mean(u_i),  theta = A^-1 sum r_i x u_i,
+//   A = sum (|r_i|^2 1 - r_i r_i^T), r_i = x_i - c,
+// i.e. q_k = W u_set. The set's DOFs stay free DOFs of the model and q_k = W u is a constraint
+// that the Craig-Bampton reduction imposes through multipliers (no stiffness added, no dense
+// coupling of the set).
+struct Rbe3 {
+  std::vector<int> dofs;  // set DOFs (mesh numbering)
+  Eigen::MatrixXd W;      // 6 x dofs
+};
 
-  // Interface node sets: a named set of the mesh, or nodes picked by geometry.
-  FeModel model;
-  const InterfaceNodes interface_nodes =
-      ResolveInterfaceNodes(part, mesh->nodes, mesh->node_sets, mesh.get(), "the mesh");
-  const std::vector<std::vector<int>>& sets = interface_nodes.sets;
-  const std::vector<int>& owner = interface_nodes.owner;
-  const std::string& selected = interface_nodes.summary;  // per interface, for the progress line
-  for (size_t k = 0; k < part.interfaces.size(); ++k) {
-    model.interface_names.push_back(part.interfaces[k].name);
-    model.interface_positions.push_back(interface_nodes.positions[k]);
-  }
-  model.interface_node_sets = sets;
-  // RBE3 (distributing): the interface motion is the least-squares rigid fit of its node set,
-  //   u_k = u_c + theta x (x_k - c),  u_c = mean(u_i),  theta = A^-1 sum r_i x u_i,
-  //   A = sum (|r_i|^2 1 - r_i r_i^T), r_i = x_i - c,
-  // i.e. q_k = W u_set. The set's DOFs stay free DOFs of the model and q_k = W u is a
-  // constraint that the Craig-Bampton reduction imposes through multipliers (no stiffness added,
-  // no dense coupling of the set).
-  struct Rbe3 {
-    std::vector<int> dofs;  // set DOFs (mesh numbering)
-    Eigen::MatrixXd W;      // 6 x dofs
-  };
+std::vector<Rbe3> Rbe3Couplings(const PartSpec& part, const SolidMesh& mesh, const std::vector<std::vector<int>>& sets,
+                                const FeModel& model) {
   std::vector<Rbe3> rbe3(part.interfaces.size());
   for (size_t k = 0; k < part.interfaces.size(); ++k) {
     if (part.interfaces[k].coupling != "rbe3") continue;
     const std::vector<int>& set = sets[k];
     Rbe3& r3 = rbe3[k];
     r3.W =
-        Rbe3Weights(mesh->nodes, set, model.interface_positions[k], part.interfaces[k].where, part.interfaces[k].name);
+        Rbe3Weights(mesh.nodes, set, model.interface_positions[k], part.interfaces[k].where, part.interfaces[k].name);
     for (int node : set)
       for (int i = 0; i < 3; ++i) r3.dofs.push_back(3 * node + i);
   }
-  // Model coordinates: every mesh DOF not in an RBE2 set, then 6 per RBE2 interface.
+  return rbe3;
+}
+
+// Model coordinates: every mesh DOF not in an RBE2 set (kept: its model DOF, -1 in a set), then 6
+// per RBE2 interface (rbe2_base: its first, -1 if not RBE2). The map T (mesh DOFs -> model DOFs):
+// a node in an RBE2 set moves with the interface's rigid motion.
+SparseMatrix RigidCouplingMap(const PartSpec& part, const SolidMesh& mesh, const std::vector<int>& owner,
+                              const FeModel& model, std::vector<int>& kept, std::vector<int>& rbe2_base) {
+  const int n_nodes = int(mesh.nodes.rows());
   std::vector<int> coupled;
   for (int s = 0; s < n_nodes; ++s) {
     if (owner[s] >= 0) coupled.push_back(s);
   }
-  CheckRegionsHeldByInterfaces(mesh->cells, mesh->nodes, coupled, part.solid.where);
-  std::vector<int> kept(3 * n_nodes, -1);
+  CheckRegionsHeldByInterfaces(mesh.cells, mesh.nodes, coupled, part.solid.where);
+  kept.assign(size_t(3 * n_nodes), -1);
   int n_kept = 0;
   for (int s = 0; s < n_nodes; ++s) {
     const bool rbe2 = owner[s] >= 0 && part.interfaces[owner[s]].coupling == "rbe2";
@@ -454,7 +443,7 @@ FeModel BuildSolidModel(const PartSpec& part, const ProgressFn& progress) {
       if (!rbe2) kept[3 * s + d] = n_kept++;
     }
   }
-  std::vector<int> rbe2_base(part.interfaces.size(), -1);
+  rbe2_base.assign(part.interfaces.size(), -1);
   int n_model = n_kept;
   for (size_t k = 0; k < part.interfaces.size(); ++k) {
     if (part.interfaces[k].coupling == "rbe2") {
@@ -466,7 +455,7 @@ FeModel BuildSolidModel(const PartSpec& part, const ProgressFn& progress) {
   for (int s = 0; s < n_nodes; ++s) {
     if (owner[s] >= 0 && part.interfaces[owner[s]].coupling == "rbe2") {
       const int base = rbe2_base[owner[s]];
-      const Eigen::Matrix3d arm = -SkewOf(mesh->nodes.row(s).transpose() - model.interface_positions[owner[s]]);
+      const Eigen::Matrix3d arm = -SkewOf(mesh.nodes.row(s).transpose() - model.interface_positions[owner[s]]);
       for (int d = 0; d < 3; ++d) {
         t_entries.emplace_back(3 * s + d, base + d, 1.0);
         for (int c = 0; c < 3; ++c) {
@@ -479,14 +468,15 @@ FeModel BuildSolidModel(const PartSpec& part, const ProgressFn& progress) {
   }
   SparseMatrix T(3 * n_nodes, n_model);
   T.setFromTriplets(t_entries.begin(), t_entries.end());
-  if (progress) {
-    progress("couplings", clock.Seconds(),
-             std::to_string(part.interfaces.size()) + " interfaces (" + selected + "), " + std::to_string(n_model) +
-                 " model DOFs");
-  }
+  return T;
+}
 
-  // Element matrices straight onto the model DOFs (RBE2 folded in per element).
-  clock.Restart();
+// The assembly's map of mesh nodes to model nodes: a free node (3 DOFs) each, then one node (6
+// DOFs) per RBE2 interface, on which its set's nodes hang by their arms.
+SolidDofMap AssemblyMap(const PartSpec& part, const SolidMesh& mesh, const std::vector<int>& owner,
+                        const FeModel& model, const std::vector<int>& kept, const std::vector<int>& rbe2_base,
+                        int n_model) {
+  const int n_nodes = int(mesh.nodes.rows());
   SolidDofMap map;
   map.n_dofs = n_model;
   map.model_node.assign(n_nodes, -1);
@@ -507,14 +497,14 @@ FeModel BuildSolidModel(const PartSpec& part, const ProgressFn& progress) {
   for (int s = 0; s < n_nodes; ++s) {
     if (kept[3 * s] >= 0) continue;
     map.model_node[s] = interface_node[owner[s]];
-    map.arm[s] = -SkewOf(mesh->nodes.row(s).transpose() - model.interface_positions[owner[s]]);
+    map.arm[s] = -SkewOf(mesh.nodes.row(s).transpose() - model.interface_positions[owner[s]]);
   }
-  AssembleSolid(*mesh, part.material, map, &model.K, &model.M);
-  if (progress) {
-    progress(
-        "assembly", clock.Seconds(),
-        std::to_string(mesh->cells.rows()) + " elements, " + std::to_string(model.K.nonZeros()) + " stiffness entries");
-  }
+  return map;
+}
+
+// The interfaces' couplings: an RBE2 interface's six model DOFs; an RBE3 interface's weights.
+void InterfaceCouplings(const PartSpec& part, const std::vector<Rbe3>& rbe3, const std::vector<int>& kept,
+                        const std::vector<int>& rbe2_base, int n_model, FeModel& model) {
   for (size_t k = 0; k < part.interfaces.size(); ++k) {
     std::vector<FullDof> dofs;
     SparseMatrix W(0, n_model);
@@ -530,6 +520,50 @@ FeModel BuildSolidModel(const PartSpec& part, const ProgressFn& progress) {
     model.interface_dofs.push_back(dofs);
     model.interface_weights.push_back(W);
   }
+}
+
+}  // namespace
+
+FeModel BuildSolidModel(const PartSpec& part, const ProgressFn& progress) {
+  Stopwatch clock;
+  auto mesh = std::make_shared<SolidMesh>(MeshSolidPart(part));
+  const int n_nodes = int(mesh->nodes.rows());
+  if (progress) {
+    progress("mesh", clock.Seconds(),
+             std::to_string(n_nodes) + " nodes, " + std::to_string(mesh->cells.rows()) + " " +
+                 SolidTypeName(mesh->type) + " elements" + (part.solid.file.empty() ? "" : " from " + part.solid.file));
+  }
+
+  // Interface node sets: a named set of the mesh, or nodes picked by geometry.
+  clock.Restart();
+  FeModel model;
+  const InterfaceNodes interface_nodes =
+      ResolveInterfaceNodes(part, mesh->nodes, mesh->node_sets, mesh.get(), "the mesh");
+  for (size_t k = 0; k < part.interfaces.size(); ++k) {
+    model.interface_names.push_back(part.interfaces[k].name);
+    model.interface_positions.push_back(interface_nodes.positions[k]);
+  }
+  model.interface_node_sets = interface_nodes.sets;
+  const std::vector<Rbe3> rbe3 = Rbe3Couplings(part, *mesh, interface_nodes.sets, model);
+  std::vector<int> kept, rbe2_base;
+  const SparseMatrix T = RigidCouplingMap(part, *mesh, interface_nodes.owner, model, kept, rbe2_base);
+  const int n_model = int(T.cols());
+  if (progress) {
+    progress("couplings", clock.Seconds(),
+             std::to_string(part.interfaces.size()) + " interfaces (" + interface_nodes.summary + "), " +
+                 std::to_string(n_model) + " model DOFs");
+  }
+
+  // Element matrices straight onto the model DOFs (RBE2 folded in per element).
+  clock.Restart();
+  const SolidDofMap map = AssemblyMap(part, *mesh, interface_nodes.owner, model, kept, rbe2_base, n_model);
+  AssembleSolid(*mesh, part.material, map, &model.K, &model.M);
+  if (progress) {
+    progress(
+        "assembly", clock.Seconds(),
+        std::to_string(mesh->cells.rows()) + " elements, " + std::to_string(model.K.nonZeros()) + " stiffness entries");
+  }
+  InterfaceCouplings(part, rbe3, kept, rbe2_base, n_model, model);
   model.mesh_map = T;
   model.dofs_per_node = 3;
   model.nodes = mesh->nodes;
