@@ -47,6 +47,54 @@ std::vector<Timing> MeasureInterleaved(int repeats, const std::vector<std::funct
   return best;
 }
 
+// One kind's body and state: a linear file (kind 0); a stiffened file with the stiffening
+// switched off (kind 1: body option geometric_stiffening: false, the exact inertia alone); the
+// stiffened file as it is (kind 2). A deformed, turned configuration and a spinning,
+// accelerating motion. False when the reduction or the frame fails.
+struct Setup {
+  std::unique_ptr<femb::SuperelementBody> body;
+  femb::BodyConfiguration c;
+  femb::FrameSolution frame;
+  Eigen::VectorXd w, wdot;
+};
+
+bool MakeSetup(int kind, int modes, Setup& u) {
+  const bool stiffening = kind >= 1;
+  const femb::PartSpec part = femb::ParsePart(
+      "name: seg\ntype: beam\nmaterial: {E: 70.0e9, nu: 0.3, rho: 2700}\n"
+      "section: {shape: tube, outer_radius: 0.01, wall: 0.001}\n"
+      "beam:\n  points: {A: [0, 0, 0], B: [0.5, 0, 0]}\n"
+      "  segments: [{from: A, to: B, elements: 8}]\n"
+      "interfaces: [{name: A}, {name: B}]\nreduction: {internal_modes: " +
+          std::to_string(modes) +
+          ", keep_mesh: false, geometric_stiffening: " + std::string(stiffening ? "true" : "false") + "}\n",
+      "bench.yaml");
+  const femb::ReduceResult reduced = femb::ReducePart(part, nullptr);
+  if (!reduced.ok) return false;
+  femb::SuperelementOptions options;
+  options.geometric_stiffening = kind == 2;
+  u.body = std::make_unique<femb::SuperelementBody>(reduced.superelement, options);
+  const femb::SuperelementBody& body = *u.body;
+  const int n = body.n_coordinates();
+  // A deformed, turned configuration and a spinning, accelerating motion.
+  u.c = body.InitialConfiguration();
+  const Eigen::Matrix3d turn = femb::ExpSO3(Eigen::Vector3d(0.3, -0.2, 0.5));
+  for (size_t k = 0; k < u.c.x.size(); ++k) {
+    u.c.x[k] = turn * u.c.x[k] + Eigen::Vector3d(0.01 * double(k), -0.02, 0.005 * double(k));
+    u.c.R[k] = femb::ExpSO3(Eigen::Vector3d(0.02 * double(k), 0.01, -0.03 * double(k))) * turn * u.c.R[k];
+  }
+  for (int i = 0; i < u.c.eta.size(); ++i) u.c.eta[i] = 1e-3 * (i + 1);
+  u.frame = body.SolveFrame(u.c, body.GuessFrame(u.c));
+  if (!u.frame.ok) return false;
+  u.w.resize(n);
+  u.wdot.resize(n);
+  for (int i = 0; i < n; ++i) {
+    u.w[i] = std::sin(1.0 + i);
+    u.wdot[i] = 10.0 * std::cos(2.0 + i);
+  }
+  return true;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -59,16 +107,8 @@ int main(int argc, char** argv) {
   std::printf("%-48s %10s %7s %12s %7s %12s %7s %7s %7s\n", "kernel", "linear us", "allocs", "exact in. us", "allocs",
               "stiffened us", "allocs", "ratio", "ratio");
   std::printf("%-48s %10s %7s %12s %7s %12s %7s %7s %7s\n", "", "", "", "", "", "", "", "st/lin", "st/ex");
-  // Kinds: a linear file; a stiffened file with the stiffening switched off (body option
-  // geometric_stiffening: false: the exact inertia alone); the stiffened file as it is.
-  // Each kind's setup, then its works: names and calls (each call on fresh body data, as an
-  // iteration has).
-  struct Setup {
-    std::unique_ptr<femb::SuperelementBody> body;
-    femb::BodyConfiguration c;
-    femb::FrameSolution frame;
-    Eigen::VectorXd w, wdot;
-  };
+  // Each kind's setup (MakeSetup), then its works: names and calls (each call on fresh body data,
+  // as an iteration has).
   std::vector<Setup> setups(3);
   const Eigen::Vector3d g(0, -9.81, 0);
   const std::vector<std::string> names = {"floating frame (SolveFrame from the last)",
@@ -81,40 +121,8 @@ int main(int argc, char** argv) {
   std::vector<std::function<void()>> works;
   double sink = 0.0;
   for (int kind = 0; kind < 3; ++kind) {
-    const bool stiffening = kind >= 1;
-    const femb::PartSpec part = femb::ParsePart(
-        "name: seg\ntype: beam\nmaterial: {E: 70.0e9, nu: 0.3, rho: 2700}\n"
-        "section: {shape: tube, outer_radius: 0.01, wall: 0.001}\n"
-        "beam:\n  points: {A: [0, 0, 0], B: [0.5, 0, 0]}\n"
-        "  segments: [{from: A, to: B, elements: 8}]\n"
-        "interfaces: [{name: A}, {name: B}]\nreduction: {internal_modes: " +
-            std::to_string(modes) +
-            ", keep_mesh: false, geometric_stiffening: " + std::string(stiffening ? "true" : "false") + "}\n",
-        "bench.yaml");
-    const femb::ReduceResult reduced = femb::ReducePart(part, nullptr);
-    if (!reduced.ok) return 3;
-    femb::SuperelementOptions options;
-    options.geometric_stiffening = kind == 2;
-    Setup& u = setups[size_t(kind)];
-    u.body = std::make_unique<femb::SuperelementBody>(reduced.superelement, options);
-    const femb::SuperelementBody& body = *u.body;
-    const int n = body.n_coordinates();
-    // A deformed, turned configuration and a spinning, accelerating motion.
-    u.c = body.InitialConfiguration();
-    const Eigen::Matrix3d turn = femb::ExpSO3(Eigen::Vector3d(0.3, -0.2, 0.5));
-    for (size_t k = 0; k < u.c.x.size(); ++k) {
-      u.c.x[k] = turn * u.c.x[k] + Eigen::Vector3d(0.01 * double(k), -0.02, 0.005 * double(k));
-      u.c.R[k] = femb::ExpSO3(Eigen::Vector3d(0.02 * double(k), 0.01, -0.03 * double(k))) * turn * u.c.R[k];
-    }
-    for (int i = 0; i < u.c.eta.size(); ++i) u.c.eta[i] = 1e-3 * (i + 1);
-    u.frame = body.SolveFrame(u.c, body.GuessFrame(u.c));
-    if (!u.frame.ok) return 3;
-    u.w.resize(n);
-    u.wdot.resize(n);
-    for (int i = 0; i < n; ++i) {
-      u.w[i] = std::sin(1.0 + i);
-      u.wdot[i] = 10.0 * std::cos(2.0 + i);
-    }
+    if (!MakeSetup(kind, modes, setups[size_t(kind)])) return 3;
+    const Setup& u = setups[size_t(kind)];
     const Setup* p = &u;
     // Stages of an iteration, cumulative: 0 data, 1 + residual, 2 + elastic tangent,
     // 3 + mass and gyroscopic, 4 + configuration tangent.

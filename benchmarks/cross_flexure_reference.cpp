@@ -26,6 +26,39 @@
 namespace femb {
 namespace {
 
+// The cross flexure's two leaves: the leaf mesh placed twice as in make_variant.py (position,
+// rotation angle about y), with the clamped nodes (x = 0) and the tip nodes (x = L) of both.
+struct TwoLeaves {
+  long n1 = 0;  ///< nodes per leaf
+  double width = 0, gap = 0.0005, a = 0;
+  Eigen::MatrixXd nodes;
+  Eigen::MatrixXi cells;
+  std::vector<int> clamp, tip;
+};
+
+TwoLeaves PlaceTwoLeaves(const FeModel& leaf) {
+  TwoLeaves m;
+  const Eigen::MatrixXd& X = leaf.nodes;
+  const long n1 = m.n1 = X.rows();
+  const double L = X.col(0).maxCoeff();
+  m.width = X.col(1).maxCoeff();
+  const double a = m.a = L / (2 * std::sqrt(2.0));
+  const std::vector<std::pair<Eigen::Vector3d, double>> placements = {
+      {Eigen::Vector3d(-a, 0, -a), -M_PI / 4}, {Eigen::Vector3d(a, m.width + m.gap, -a), -3 * M_PI / 4}};
+  m.nodes.resize(2 * n1, 3);
+  m.cells.resize(2 * leaf.cells.rows(), leaf.cells.cols());
+  for (int l = 0; l < 2; ++l) {
+    const Eigen::Matrix3d R = Eigen::AngleAxisd(placements[l].second, Eigen::Vector3d::UnitY()).toRotationMatrix();
+    for (long i = 0; i < n1; ++i) {
+      m.nodes.row(l * n1 + i) = (placements[l].first + R * X.row(i).transpose()).transpose();
+      if (std::abs(X(i, 0)) < 1e-9) m.clamp.push_back(int(l * n1 + i));
+      if (std::abs(X(i, 0) - L) < 1e-9) m.tip.push_back(int(l * n1 + i));
+    }
+    m.cells.middleRows(l * leaf.cells.rows(), leaf.cells.rows()) = leaf.cells.array() + int(l * n1);
+  }
+  return m;
+}
+
 int Run(int argc, char** argv) {
   if (argc < 4) {
     std::fprintf(stderr, "usage: cross_flexure_reference LEAF_PART.yaml OUT.csv THETA[,THETA...] [DTHETA]\n");
@@ -41,25 +74,12 @@ int Run(int argc, char** argv) {
   }
   const double dtheta = argc > 4 ? std::atof(argv[4]) : 0.01;
   const FeModel leaf = BuildSolidModel(part);
-  const Eigen::MatrixXd& X = leaf.nodes;
-  const long n1 = X.rows();
-  const double L = X.col(0).maxCoeff(), width = X.col(1).maxCoeff(), gap = 0.0005;
-  const double a = L / (2 * std::sqrt(2.0));
-  // Placements as in make_variant.py: position, rotation angle about y.
-  const std::vector<std::pair<Eigen::Vector3d, double>> placements = {
-      {Eigen::Vector3d(-a, 0, -a), -M_PI / 4}, {Eigen::Vector3d(a, width + gap, -a), -3 * M_PI / 4}};
-  Eigen::MatrixXd nodes(2 * n1, 3);
-  Eigen::MatrixXi cells(2 * leaf.cells.rows(), leaf.cells.cols());
-  std::vector<int> clamp, tip;
-  for (int l = 0; l < 2; ++l) {
-    const Eigen::Matrix3d R = Eigen::AngleAxisd(placements[l].second, Eigen::Vector3d::UnitY()).toRotationMatrix();
-    for (long i = 0; i < n1; ++i) {
-      nodes.row(l * n1 + i) = (placements[l].first + R * X.row(i).transpose()).transpose();
-      if (std::abs(X(i, 0)) < 1e-9) clamp.push_back(int(l * n1 + i));
-      if (std::abs(X(i, 0) - L) < 1e-9) tip.push_back(int(l * n1 + i));
-    }
-    cells.middleRows(l * leaf.cells.rows(), leaf.cells.rows()) = leaf.cells.array() + int(l * n1);
-  }
+  const TwoLeaves m = PlaceTwoLeaves(leaf);
+  const long n1 = m.n1;
+  const double width = m.width, gap = m.gap, a = m.a;
+  const Eigen::MatrixXd& nodes = m.nodes;
+  const Eigen::MatrixXi& cells = m.cells;
+  const std::vector<int>&clamp = m.clamp, &tip = m.tip;
   SolidType type = SolidType::kHex20;
   for (SolidType t : {SolidType::kTet4, SolidType::kTet10, SolidType::kHex8, SolidType::kHex20})
     if (SolidTypeName(t) == leaf.cell_type) type = t;
