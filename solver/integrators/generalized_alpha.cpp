@@ -84,16 +84,13 @@ Assembly AssembleDynamicResidual(const SystemModel& model, const DofMap& dofs, D
   return out;
 }
 
-void AddDynamicMatrices(const SystemModel& model, const DofMap& dofs, const DynamicState& s, double t,
-                        BodyWorkspace& work, bool full_inertia_tangent, Assembly& out, BodyThreads* threads,
-                        const MatrixCombination* combine, int every, BodyMatricesKept which) {
+namespace {
+
+// Which bodies turn their kept matrices in this pass (BodyMatricesKept, `every`), decided in body
+// order: the same for any number of threads. Counts them into work.
+void DecideKeptMatrices(const SystemModel& model, int every, bool all_kept, BodyWorkspace& work) {
   const int n_bodies = int(model.bodies.size());
-  const std::vector<BodyPass>& passes = work.passes;
   std::vector<BodyWorkspace::BodyMatrices>& results = work.matrices;
-  results.resize(static_cast<size_t>(n_bodies));
-  const bool all_kept = which == BodyMatricesKept::kAll;
-  // Which bodies turn their kept matrices (decided here, in body order: the same for any number
-  // of threads).
   for (int b = 0; b < n_bodies; ++b) {
     BodyWorkspace::BodyMatrices& r = results[size_t(b)];
     const int n = model.bodies[b].n_coordinates();
@@ -102,74 +99,93 @@ void AddDynamicMatrices(const SystemModel& model, const DofMap& dofs, const Dyna
     r.age = kept ? r.age + 1 : (every > 1 || r.age >= 0 ? 0 : -1);  // a pass that computes keeps them anew
     ++(kept ? work.matrices_turned : work.matrices_computed);
   }
-  ForEachBody(threads, n_bodies, [&](int b) {
-    const SuperelementBody& body = model.bodies[b];
-    const BodyPass& pass = passes[size_t(b)];
-    BodyWorkspace::BodyMatrices& r = results[size_t(b)];
-    const bool stiffening = body.has_inertia_stiffening();
-    const int blocks = 2 * body.n_nodes();
-    const Eigen::Matrix3d& R = pass.data.frame.R;
-    const Eigen::Matrix3d Rt = R.transpose();
-    // to <- Rbar from Rbar^T, Rbar = blockdiag(Q, ..., Q, 1) (storage reused: the same size at every pass)
-    const auto turned = [blocks](Eigen::MatrixXd& to, const Eigen::MatrixXd& from, const Eigen::Matrix3d& Q) {
-      to = from;
-      body_blocks::TurnNodeBlocks(to, blocks, Q);
-    };
-    if (all_kept && r.age > 0) {
-      // All of the body's matrices kept (BodyMatricesKept::kAll): turned with the frame.
-      turned(r.K, r.K_frame, R);
-      turned(r.C, r.C_frame, R);
-      turned(r.M, r.M_frame, R);
-      if (combine) r.K += combine->c_C * r.C + combine->c_M * r.M;
-      return;
-    }
-    Eigen::MatrixXd& d_load = r.d_load;
-    body.ElasticForce(pass.data, nullptr, &r.K, stiffening ? &pass.load : nullptr, stiffening ? &d_load : nullptr);
-    // The inertia force's mass and gyroscopic matrices (the exact inertia's are a body's most
-    // expensive kernel): computed, or the kept ones turned. The inertia force is objective:
-    // turning the whole body and its motion by Q turns every node block of the two matrices,
-    // X -> Q X Q^T (tests/solver/analysis/body_matrix_reuse_test.cpp). So X_frame = Rbar^T X Rbar
-    // changes only with the deformation and the velocities in the frame, and Rbar X_frame Rbar^T
-    // is the matrix of this pass but for their change since. With kInertia the elastic tangent
-    // and the inertia's configuration tangent are computed every time: they carry the internal
-    // forces (K2, K3, stiffening) and the accelerations. With kAll they are kept and turned too
-    // (above): the internal forces and accelerations are objective as well, so the kept matrix
-    // lags by their change in the frame, as the inertia's does.
-    if (!all_kept && r.age > 0) {
-      turned(r.M, r.M_frame, R);
-      turned(r.C, r.C_frame, R);
-    } else {
-      body.InertiaForce(pass.data, pass.w, pass.wdot, nullptr, &r.M, &r.C);
-      if (!all_kept && r.age == 0) {
-        turned(r.M_frame, r.M, Rt);
-        turned(r.C_frame, r.C, Rt);
-      }
-    }
-    if (stiffening) {
-      r.M.noalias() += d_load * pass.load.d_wdot;
-      r.C.noalias() += d_load * pass.load.d_w;
-    }
-    // Configuration derivative of the inertia force less the weight: d(M_g wdot)/dq exactly; that
-    // of the quadratic velocity terms by central differences with options.full_inertia_tangent.
-    // The weight is the inertia force's acceleration part at the uniform field g (GravityForce =
-    // f_acc(wdot_g), wdot_g = g on the node translations, for the corotational and the exact
-    // inertia alike), so f_in - f_grav = f_in(w, wdot - wdot_g) and one call takes both.
-    if (model.gravity.squaredNorm() > 0) {
-      r.wdot = pass.wdot;
-      for (int a = 0; a < body.n_nodes(); ++a) r.wdot.segment<3>(6 * a) -= model.gravity;
-      body.InertiaConfigurationTangent(pass.data, pass.w, r.wdot, full_inertia_tangent, r.inertia_K);
-    } else {
-      body.InertiaConfigurationTangent(pass.data, pass.w, pass.wdot, full_inertia_tangent, r.inertia_K);
-    }
-    r.K += r.inertia_K;
-    r.unused.setZero(body.n_coordinates());
-    body.AddModalDamping(pass.w, r.unused, &r.C);
-    if (all_kept && r.age == 0) {
-      turned(r.K_frame, r.K, Rt);
-      turned(r.C_frame, r.C, Rt);
-      turned(r.M_frame, r.M, Rt);
-    }
+}
+
+// One body's K, C and M of the dynamic residual at its pass (computed, or kept and turned with the
+// frame), into r; with `combine` K + c_C C + c_M M into r.K.
+void BodyDynamicMatrices(const SuperelementBody& body, const BodyPass& pass, const Eigen::Vector3d& gravity,
+                         bool full_inertia_tangent, const MatrixCombination* combine, bool all_kept,
+                         BodyWorkspace::BodyMatrices& r) {
+  const bool stiffening = body.has_inertia_stiffening();
+  const int blocks = 2 * body.n_nodes();
+  const Eigen::Matrix3d& R = pass.data.frame.R;
+  const Eigen::Matrix3d Rt = R.transpose();
+  // to <- Rbar from Rbar^T, Rbar = blockdiag(Q, ..., Q, 1) (storage reused: the same size at every pass)
+  const auto turned = [blocks](Eigen::MatrixXd& to, const Eigen::MatrixXd& from, const Eigen::Matrix3d& Q) {
+    to = from;
+    body_blocks::TurnNodeBlocks(to, blocks, Q);
+  };
+  if (all_kept && r.age > 0) {
+    // All of the body's matrices kept (BodyMatricesKept::kAll): turned with the frame.
+    turned(r.K, r.K_frame, R);
+    turned(r.C, r.C_frame, R);
+    turned(r.M, r.M_frame, R);
     if (combine) r.K += combine->c_C * r.C + combine->c_M * r.M;
+    return;
+  }
+  Eigen::MatrixXd& d_load = r.d_load;
+  body.ElasticForce(pass.data, nullptr, &r.K, stiffening ? &pass.load : nullptr, stiffening ? &d_load : nullptr);
+  // The inertia force's mass and gyroscopic matrices (the exact inertia's are a body's most
+  // expensive kernel): computed, or the kept ones turned. The inertia force is objective:
+  // turning the whole body and its motion by Q turns every node block of the two matrices,
+  // X -> Q X Q^T (tests/solver/analysis/body_matrix_reuse_test.cpp). So X_frame = Rbar^T X Rbar
+  // changes only with the deformation and the velocities in the frame, and Rbar X_frame Rbar^T
+  // is the matrix of this pass but for their change since. With kInertia the elastic tangent
+  // and the inertia's configuration tangent are computed every time: they carry the internal
+  // forces (K2, K3, stiffening) and the accelerations. With kAll they are kept and turned too
+  // (above): the internal forces and accelerations are objective as well, so the kept matrix
+  // lags by their change in the frame, as the inertia's does.
+  if (!all_kept && r.age > 0) {
+    turned(r.M, r.M_frame, R);
+    turned(r.C, r.C_frame, R);
+  } else {
+    body.InertiaForce(pass.data, pass.w, pass.wdot, nullptr, &r.M, &r.C);
+    if (!all_kept && r.age == 0) {
+      turned(r.M_frame, r.M, Rt);
+      turned(r.C_frame, r.C, Rt);
+    }
+  }
+  if (stiffening) {
+    r.M.noalias() += d_load * pass.load.d_wdot;
+    r.C.noalias() += d_load * pass.load.d_w;
+  }
+  // Configuration derivative of the inertia force less the weight: d(M_g wdot)/dq exactly; that
+  // of the quadratic velocity terms by central differences with options.full_inertia_tangent.
+  // The weight is the inertia force's acceleration part at the uniform field g (GravityForce =
+  // f_acc(wdot_g), wdot_g = g on the node translations, for the corotational and the exact
+  // inertia alike), so f_in - f_grav = f_in(w, wdot - wdot_g) and one call takes both.
+  if (gravity.squaredNorm() > 0) {
+    r.wdot = pass.wdot;
+    for (int a = 0; a < body.n_nodes(); ++a) r.wdot.segment<3>(6 * a) -= gravity;
+    body.InertiaConfigurationTangent(pass.data, pass.w, r.wdot, full_inertia_tangent, r.inertia_K);
+  } else {
+    body.InertiaConfigurationTangent(pass.data, pass.w, pass.wdot, full_inertia_tangent, r.inertia_K);
+  }
+  r.K += r.inertia_K;
+  r.unused.setZero(body.n_coordinates());
+  body.AddModalDamping(pass.w, r.unused, &r.C);
+  if (all_kept && r.age == 0) {
+    turned(r.K_frame, r.K, Rt);
+    turned(r.C_frame, r.C, Rt);
+    turned(r.M_frame, r.M, Rt);
+  }
+  if (combine) r.K += combine->c_C * r.C + combine->c_M * r.M;
+}
+
+}  // namespace
+
+void AddDynamicMatrices(const SystemModel& model, const DofMap& dofs, const DynamicState& s, double t,
+                        BodyWorkspace& work, bool full_inertia_tangent, Assembly& out, BodyThreads* threads,
+                        const MatrixCombination* combine, int every, BodyMatricesKept which) {
+  const int n_bodies = int(model.bodies.size());
+  const std::vector<BodyPass>& passes = work.passes;
+  std::vector<BodyWorkspace::BodyMatrices>& results = work.matrices;
+  results.resize(static_cast<size_t>(n_bodies));
+  const bool all_kept = which == BodyMatricesKept::kAll;
+  DecideKeptMatrices(model, every, all_kept, work);
+  ForEachBody(threads, n_bodies, [&](int b) {
+    BodyDynamicMatrices(model.bodies[b], passes[size_t(b)], model.gravity, full_inertia_tangent, combine, all_kept,
+                        results[size_t(b)]);
   });
   Triplets &K = work.K, &C = work.C, &M = work.M;
   K.clear();
