@@ -279,6 +279,156 @@ void AddDiscreteGradientCorrection(const SystemModel& model, const DofMap& dofs,
 // balance, into `out`; each body's data at both configurations kept for the iteration matrix
 // (MidpointMatrix), which an iteration builds only when it needs one. The momenta at the step's
 // start are in work.midpoint.bodies (MidpointStep).
+// A body's inertia force of the step into r.f_in (and its acceleration part M_g (w1 - w0) / h into
+// r.f_acc): the change of its momenta over the step less the momentum source. d1, w1, maps1: the
+// body's data, velocities and corotational velocity maps at the end of the step.
+void MidpointInertia(const SystemModel& model, const DynamicState& s0, double h, const DynamicState& s1, int b,
+                     const SuperelementBody::Data& d1, const Eigen::VectorXd& w1, const BodyVelocityMaps& maps1,
+                     MidpointWorkspace& mw, BodyTerms& r) {
+  const SuperelementBody& body = model.bodies[b];
+  const MidpointKinematics& k = mw.k;
+  MidpointBody& m = mw.bodies[size_t(b)];
+  const SuperelementBody::Data& dm = m.dm;
+  const Eigen::VectorXd& wm = m.wm;
+  const bool exact = body.has_exact_inertia();
+  Eigen::VectorXd &f_in = r.f_in, &f_acc = r.f_acc;
+  m.dw = w1 - m.w0;
+  f_acc.resize(body.n_coordinates());
+  if (exact) {
+    f_acc = body.MassTimes(d1, m.dw);
+  } else {
+    f_acc.noalias() = maps1.Mg * m.dw;
+  }
+  f_acc /= h;
+  m.p_mean = 0.5 * (m.p0 + m.p1);  // (also for the source's derivatives in the matrices)
+  if (body.options().quadratic_velocity_terms) {
+    // Source terms with the node motion of each half step, so that their moment matches the
+    // change of sum x_k x p_k exactly: x_m is not the mean of x_n and x_n+1.
+    if (mw.free_node[size_t(b)]) {
+      m.w_second = wm;
+      m.w_first = wm;
+      for (int a = 0; a < body.n_nodes(); ++a) {
+        const int node = model.body_nodes[b][a];
+        m.w_second.segment<3>(6 * a) = 2.0 * (s1.config.x[node] - k.mid.x[node]) / h;
+        m.w_first.segment<3>(6 * a) = 2.0 * (k.mid.x[node] - s0.config.x[node]) / h;
+      }
+      body.MomentumSource(dm, m.w_second, m.p1, m.s_second);
+      body.MomentumSource(dm, m.w_first, m.p0, m.s_first);
+      f_in = (m.p1 - m.p0) / h - 0.5 * (m.s_second + m.s_first);
+    } else {
+      // No free node: every node hangs on joints or supports. The source at the step's mean
+      // motion and mean momentum does no work for a rigid body, s(wm, p_m) . wm =
+      // (wm~ U wm) . M wm = 0 with trapezoidal node velocities, so the energy of a chain of
+      // rigid bodies is conserved to Newton's tolerance (four-bar under gravity: 4e-10 over
+      // 10 s, against 1.5e-5 with the split source). The price: the moment of this source
+      // no longer matches the change of sum x_k x p_k exactly, so a chain whose root floats
+      // free keeps its angular momentum to O(h^2) only (a grounded chain has none to keep).
+      // Energy is the invariant a mechanism on joints is judged by.
+      body.MomentumSource(dm, wm, m.p_mean, m.s_first);
+      f_in = (m.p1 - m.p0) / h - m.s_first;
+    }
+  } else {
+    f_in = f_acc;
+  }
+}
+
+// Gravity on a body as a discrete gradient of its potential V = -m g . x_c (Gonzalez), into
+// f_grav: its work over the step's motion u = h wm is exactly V_n - V_n+1, where the force at q_m
+// alone is off by O(h^3) (x_c turns with the frame). The correction lies along D u, D = 1 on node
+// translations and the model's size squared on node rotations. q1, f1: the end state's local
+// coordinates and frame.
+void MidpointGravity(const SystemModel& model, double h, int b, const Eigen::VectorXd& q1, const FrameSolution& f1,
+                     MidpointWorkspace& mw, Eigen::VectorXd& f_grav) {
+  const SuperelementBody& body = model.bodies[b];
+  MidpointBody& m = mw.bodies[size_t(b)];
+  const SuperelementBody::Data& dm = m.dm;
+  const Eigen::VectorXd& wm = m.wm;
+  if (model.gravity.squaredNorm() > 0) {
+    body.GravityForce(dm, model.gravity, f_grav);
+    Eigen::VectorXd &u = m.u, &Du = m.Du;
+    u = h * wm;
+    const double dV = -body.mass() * model.gravity.dot(body.CenterOfMass(q1, f1) - m.com0);
+    Du.setZero(u.size());
+    for (int a = 0; a < body.n_nodes(); ++a) {
+      Du.segment<3>(6 * a) = u.segment<3>(6 * a);
+      Du.segment<3>(6 * a + 3) = mw.L2 * u.segment<3>(6 * a + 3);
+    }
+    const double norm = Du.dot(u);
+    if (norm > 0) f_grav += Du * ((-dV - f_grav.dot(u)) / norm);
+    mw.gravity_work[size_t(b)] = -dV;
+  } else {
+    f_grav.setZero(body.n_coordinates());
+  }
+}
+
+// One body's terms of the midpoint balance (BodyTerms): its frames at the end and mid
+// configurations, end velocities, inertia force, internal force at q_m (with the inertia
+// stiffening at the step's mean velocity and acceleration), gravity, scales, map at q_m.
+void MidpointBodyTerms(const SystemModel& model, const DofMap& dofs, const DynamicState& s0, double h, DynamicState& s1,
+                       int b, BodyWorkspace& work) {
+  MidpointWorkspace& mw = work.midpoint;
+  MidpointKinematics& k = mw.k;
+  const SuperelementBody& body = model.bodies[b];
+  BodyTerms& r = work.terms[size_t(b)];
+  BodyPass& pass = work.passes[size_t(b)];
+  MidpointBody& m = mw.bodies[size_t(b)];
+  SuperelementBody::Data &d1 = pass.data, &dm = m.dm;
+  r.frame_ok = true;
+  BodyConfigurationOf(model, s1.config, b, d1.c);
+  BodyConfigurationOf(model, k.mid, b, dm.c);
+  const FrameSolution f1 = body.SolveFrameFrom(d1.c, s1.config.frames[b], d1.q);
+  const FrameSolution fm = f1.ok ? body.SolveFrameFrom(dm.c, s0.config.frames[b], dm.q) : FrameSolution{};
+  if (!f1.ok || !fm.ok) {
+    r.frame_ok = false;
+    return;
+  }
+  s1.config.frames[b] = f1;
+  k.mid.frames[b] = fm;
+  // (the local coordinates are the frame solutions', at these frames)
+  body.EvaluateSolved(d1.c, f1, d1);
+  body.EvaluateSolved(dm.c, fm, dm);
+  Eigen::VectorXd& w1 = pass.w;
+  w1.resize(body.n_coordinates());
+  for (int a = 0; a < body.n_nodes(); ++a) w1.segment<6>(6 * a) = k.node_w1[size_t(model.body_nodes[b][a])];
+  w1.tail(body.n_modes()) = s1.W.segment(dofs.mode_dof(int(b)), body.n_modes());
+  // Velocity maps at the end and at the mid configuration, shared by the momentum terms.
+  const BodyVelocityMaps& maps1 = body.MapsOf(d1);
+  // The momenta of the body's kinetic energy, p = dT/dw (the exact inertia's or M_g w).
+  const bool exact = body.has_exact_inertia();
+  m.p1.resize(body.n_coordinates());
+  if (exact) {
+    m.p1 = body.MassTimes(d1, w1);
+  } else {
+    m.p1.noalias() = maps1.Mg * w1;
+  }
+  // Node motion over the step.
+  Eigen::VectorXd& wm = m.wm;
+  wm.resize(body.n_coordinates());
+  for (int a = 0; a < body.n_nodes(); ++a) wm.segment<6>(6 * a) = k.node_step[size_t(model.body_nodes[b][a])] / h;
+  wm.tail(body.n_modes()) = (s1.config.eta[b] - s0.config.eta[b]) / h;
+  Eigen::VectorXd &f_in = r.f_in, &f_int = r.f_int, &f_acc = r.f_acc;
+  MidpointInertia(model, s0, h, s1, b, d1, w1, maps1, mw, r);
+  body.AddModalDamping(wm, f_in, nullptr);
+  if (body.has_inertia_stiffening()) {
+    // Inertia stiffening at the mid configuration with the step's mean velocity and
+    // acceleration.
+    m.wdot = m.dw / h;
+    body.InertiaLoads(dm, wm, m.wdot, model.gravity, m.load);
+    body.ElasticForce(dm, &f_int, nullptr, &m.load);
+  } else {
+    body.ElasticForce(dm, &f_int, nullptr);
+  }
+  Eigen::VectorXd& f_grav = r.f_grav;
+  MidpointGravity(model, h, b, d1.q, f1, mw, f_grav);
+  // Scale: each term on its own (for a torque-free body the momentum change and the source
+  // cancel; M_g (w_n+1 - w_n) / h is the size of the inertia force).
+  r.scale = std::max(
+      {body.ForceNorm(f_int), body.ForceNorm(f_in), body.ForceNorm(f_grav), body.force_floor(), body.ForceNorm(f_acc)});
+  r.roundoff = body.RoundOffForce(d1.c, work.inertia_factor);
+  BodyMap(model, dofs, k.mid, int(b), r.map);
+  r.r_b = f_grav - f_int - f_in;
+}
+
 void AssembleMidpoint(const SystemModel& model, const DofMap& dofs, const DynamicState& s0, double h, DynamicState& s1,
                       BodyWorkspace& work, BodyThreads* threads, Assembly& out) {
   MidpointWorkspace& mw = work.midpoint;
@@ -296,123 +446,7 @@ void AssembleMidpoint(const SystemModel& model, const DofMap& dofs, const Dynami
     mw.mid_data[size_t(b)] = &mw.bodies[size_t(b)].dm;
   }
   mw.gravity_work.assign(size_t(n_bodies), 0.0);
-  ForEachBody(threads, n_bodies, [&](int b) {
-    const SuperelementBody& body = model.bodies[b];
-    BodyTerms& r = work.terms[size_t(b)];
-    BodyPass& pass = work.passes[size_t(b)];
-    MidpointBody& m = mw.bodies[size_t(b)];
-    SuperelementBody::Data &d1 = pass.data, &dm = m.dm;
-    r.frame_ok = true;
-    BodyConfigurationOf(model, s1.config, b, d1.c);
-    BodyConfigurationOf(model, k.mid, b, dm.c);
-    const FrameSolution f1 = body.SolveFrameFrom(d1.c, s1.config.frames[b], d1.q);
-    const FrameSolution fm = f1.ok ? body.SolveFrameFrom(dm.c, s0.config.frames[b], dm.q) : FrameSolution{};
-    if (!f1.ok || !fm.ok) {
-      r.frame_ok = false;
-      return;
-    }
-    s1.config.frames[b] = f1;
-    k.mid.frames[b] = fm;
-    // (the local coordinates are the frame solutions', at these frames)
-    body.EvaluateSolved(d1.c, f1, d1);
-    body.EvaluateSolved(dm.c, fm, dm);
-    Eigen::VectorXd& w1 = pass.w;
-    w1.resize(body.n_coordinates());
-    for (int a = 0; a < body.n_nodes(); ++a) w1.segment<6>(6 * a) = k.node_w1[size_t(model.body_nodes[b][a])];
-    w1.tail(body.n_modes()) = s1.W.segment(dofs.mode_dof(int(b)), body.n_modes());
-    // Velocity maps at the end and at the mid configuration, shared by the momentum terms.
-    const BodyVelocityMaps& maps1 = body.MapsOf(d1);
-    // The momenta of the body's kinetic energy, p = dT/dw (the exact inertia's or M_g w).
-    const bool exact = body.has_exact_inertia();
-    m.p1.resize(body.n_coordinates());
-    if (exact) {
-      m.p1 = body.MassTimes(d1, w1);
-    } else {
-      m.p1.noalias() = maps1.Mg * w1;
-    }
-    // Node motion over the step.
-    Eigen::VectorXd& wm = m.wm;
-    wm.resize(body.n_coordinates());
-    for (int a = 0; a < body.n_nodes(); ++a) wm.segment<6>(6 * a) = k.node_step[size_t(model.body_nodes[b][a])] / h;
-    wm.tail(body.n_modes()) = (s1.config.eta[b] - s0.config.eta[b]) / h;
-    Eigen::VectorXd &f_in = r.f_in, &f_int = r.f_int, &f_acc = r.f_acc;
-    m.dw = w1 - m.w0;
-    f_acc.resize(body.n_coordinates());
-    if (exact) {
-      f_acc = body.MassTimes(d1, m.dw);
-    } else {
-      f_acc.noalias() = maps1.Mg * m.dw;
-    }
-    f_acc /= h;
-    m.p_mean = 0.5 * (m.p0 + m.p1);  // (also for the source's derivatives in the matrices)
-    if (body.options().quadratic_velocity_terms) {
-      // Source terms with the node motion of each half step, so that their moment matches the
-      // change of sum x_k x p_k exactly: x_m is not the mean of x_n and x_n+1.
-      if (mw.free_node[size_t(b)]) {
-        m.w_second = wm;
-        m.w_first = wm;
-        for (int a = 0; a < body.n_nodes(); ++a) {
-          const int node = model.body_nodes[b][a];
-          m.w_second.segment<3>(6 * a) = 2.0 * (s1.config.x[node] - k.mid.x[node]) / h;
-          m.w_first.segment<3>(6 * a) = 2.0 * (k.mid.x[node] - s0.config.x[node]) / h;
-        }
-        body.MomentumSource(dm, m.w_second, m.p1, m.s_second);
-        body.MomentumSource(dm, m.w_first, m.p0, m.s_first);
-        f_in = (m.p1 - m.p0) / h - 0.5 * (m.s_second + m.s_first);
-      } else {
-        // No free node: every node hangs on joints or supports. The source at the step's mean
-        // motion and mean momentum does no work for a rigid body, s(wm, p_m) . wm =
-        // (wm~ U wm) . M wm = 0 with trapezoidal node velocities, so the energy of a chain of
-        // rigid bodies is conserved to Newton's tolerance (four-bar under gravity: 4e-10 over
-        // 10 s, against 1.5e-5 with the split source). The price: the moment of this source
-        // no longer matches the change of sum x_k x p_k exactly, so a chain whose root floats
-        // free keeps its angular momentum to O(h^2) only (a grounded chain has none to keep).
-        // Energy is the invariant a mechanism on joints is judged by.
-        body.MomentumSource(dm, wm, m.p_mean, m.s_first);
-        f_in = (m.p1 - m.p0) / h - m.s_first;
-      }
-    } else {
-      f_in = f_acc;
-    }
-    body.AddModalDamping(wm, f_in, nullptr);
-    if (body.has_inertia_stiffening()) {
-      // Inertia stiffening at the mid configuration with the step's mean velocity and
-      // acceleration.
-      m.wdot = m.dw / h;
-      body.InertiaLoads(dm, wm, m.wdot, model.gravity, m.load);
-      body.ElasticForce(dm, &f_int, nullptr, &m.load);
-    } else {
-      body.ElasticForce(dm, &f_int, nullptr);
-    }
-    Eigen::VectorXd& f_grav = r.f_grav;
-    if (model.gravity.squaredNorm() > 0) {
-      body.GravityForce(dm, model.gravity, f_grav);
-      // Gravity as a discrete gradient of its potential V = -m g . x_c (Gonzalez): its work over
-      // the step's motion u = h wm is exactly V_n - V_n+1, where the force at q_m alone is off
-      // by O(h^3) (x_c turns with the frame). The correction lies along D u, D = 1 on node
-      // translations and the model's size squared on node rotations.
-      Eigen::VectorXd &u = m.u, &Du = m.Du;
-      u = h * wm;
-      const double dV = -body.mass() * model.gravity.dot(body.CenterOfMass(d1.q, f1) - m.com0);
-      Du.setZero(u.size());
-      for (int a = 0; a < body.n_nodes(); ++a) {
-        Du.segment<3>(6 * a) = u.segment<3>(6 * a);
-        Du.segment<3>(6 * a + 3) = mw.L2 * u.segment<3>(6 * a + 3);
-      }
-      const double norm = Du.dot(u);
-      if (norm > 0) f_grav += Du * ((-dV - f_grav.dot(u)) / norm);
-      mw.gravity_work[size_t(b)] = -dV;
-    } else {
-      f_grav.setZero(body.n_coordinates());
-    }
-    // Scale: each term on its own (for a torque-free body the momentum change and the source
-    // cancel; M_g (w_n+1 - w_n) / h is the size of the inertia force).
-    r.scale = std::max({body.ForceNorm(f_int), body.ForceNorm(f_in), body.ForceNorm(f_grav), body.force_floor(),
-                        body.ForceNorm(f_acc)});
-    r.roundoff = body.RoundOffForce(d1.c, work.inertia_factor);
-    BodyMap(model, dofs, k.mid, int(b), r.map);
-    r.r_b = f_grav - f_int - f_in;
-  });
+  ForEachBody(threads, n_bodies, [&](int b) { MidpointBodyTerms(model, dofs, s0, h, s1, b, work); });
   if (!AddBodyTerms(model, work.terms, parts, out)) return;
   // Closed loops: the constraint forces -G^T lambda_n+1 at the mid configuration (their work
   // over the step, lambda . G(q_m) Delta, is lambda . (g_n+1 - g_n) = 0 up to O(h^3)); the
