@@ -116,6 +116,13 @@ struct StepColumnMap {
   std::vector<Eigen::Matrix3d> rotation, translation, coupling;  // (r, r), (t, t), (t, r) per rotation node
 };
 
+// The unknowns' places in a StepColumnMap's blocks (MidpointWorkspace::triple_of), and the
+// StepColumnMap products of the midpoint iteration matrix (solver/integrators/midpoint_columns.cpp).
+void TripleOf(const DofMap& dofs, const std::vector<RotationNode>& nodes, std::vector<int>& triple_of);
+/// out += scale * A X for the matrix A of the triplets `in`.
+void AddTimesColumns(const Triplets& in, double scale, const StepColumnMap& X, const std::vector<RotationNode>& nodes,
+                     const std::vector<int>& triple_of, Triplets& out);
+
 // The midpoint scheme's kinematics of one iteration (solver/integrators/midpoint.cpp): the step's
 // increment Delta of the coordinates (spatial rotation vectors log(R_n+1 R_n^T) on the rotation
 // triples), the end velocities it implies, the mid configuration, and the first-order maps of the
@@ -131,6 +138,12 @@ struct MidpointKinematics {
   std::vector<Eigen::Matrix<double, 6, 1>> node_w1;    // every node's velocity at n+1 (EndNodeVelocity)
   std::vector<Eigen::Matrix<double, 6, 1>> node_step;  // every node's (x_n+1 - x_n, log(R_n+1 R_n^T))
 };
+
+/// out += B^T (K B T' + M B V' / h) for a body's K and M (local) and map B on the rotation nodes'
+/// triples (midpoint_columns.cpp).
+void AddRotationColumns(const std::vector<MapEntry>& map, const Eigen::MatrixXd& K, const Eigen::MatrixXd& M, double h,
+                        const MidpointKinematics& k, const std::vector<RotationNode>& nodes,
+                        const std::vector<int>& triple_of, Triplets& out);
 
 // One body's storage in a midpoint step (its data at q_n+1 is the BodyWorkspace's pass).
 struct MidpointBody {
