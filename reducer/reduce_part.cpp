@@ -240,6 +240,17 @@ std::string TooBigMessage(const Budget& budget, const std::string& message) {
          "machine with more memory";
 }
 
+// The largest K_jj / M_jj over the DOFs with mass: an eigenvalue scale of the model, for the
+// shift of its free-free eigen solves.
+double LargestDiagonalRatio(const FeModel& model) {
+  double max_ratio = 0.0;
+  for (int j = 0; j < model.K.outerSize(); ++j) {
+    const double m_jj = model.M.coeff(j, j);
+    if (m_jj > 0) max_ratio = std::max(max_ratio, model.K.coeff(j, j) / m_jj);
+  }
+  return max_ratio;
+}
+
 // The free-interface basis: the part's lowest free-free modes with the static constraint modes
 // (which carry the interface stiffness exactly). Into V with its description; false with
 // result.message when the eigen solve fails.
@@ -249,12 +260,8 @@ bool FreeInterfaceShapes(const PartSpec& part, const FeModel& model, const Craig
   Eigen::MatrixXd free_modes;
   Eigen::VectorXd free_lambda;
   if (k > 0) {
-    double max_ratio = 0.0;
-    for (int j = 0; j < model.K.outerSize(); ++j) {
-      const double mj = model.M.coeff(j, j);
-      if (mj > 0) max_ratio = std::max(max_ratio, model.K.coeff(j, j) / mj);
-    }
-    const FullModesResult full = FullFreeFreeFrequencies(model, k, 1e-8 * max_ratio, &free_modes, &free_lambda);
+    const FullModesResult full =
+        FullFreeFreeFrequencies(model, k, 1e-8 * LargestDiagonalRatio(model), &free_modes, &free_lambda);
     if (!full.ok) {
       result.message = "free-free eigen solve failed: " + full.message;
       return false;
@@ -586,12 +593,7 @@ bool FreeFreeCheck(const PartSpec& part, const FeModel& model, const CraigBampto
   if (cb.lambda.size() > 0) {
     s = 1e-2 * cb.lambda[0];
   } else {
-    double max_ratio = 0.0;
-    for (int j = 0; j < model.K.outerSize(); ++j) {
-      const double m_jj = model.M.coeff(j, j);
-      if (m_jj > 0) max_ratio = std::max(max_ratio, model.K.coeff(j, j) / m_jj);
-    }
-    s = 1e-8 * max_ratio;
+    s = 1e-8 * LargestDiagonalRatio(model);
   }
   const FullModesResult full = FullFreeFreeFrequencies(model, full_modes, s);
   if (!full.ok && part.reduction.full_modes_given) {
