@@ -80,9 +80,7 @@ int Run(int argc, char** argv) {
   const Eigen::MatrixXd& nodes = m.nodes;
   const Eigen::MatrixXi& cells = m.cells;
   const std::vector<int>&clamp = m.clamp, &tip = m.tip;
-  SolidType type = SolidType::kHex20;
-  for (SolidType t : {SolidType::kTet4, SolidType::kTet10, SolidType::kHex8, SolidType::kHex20})
-    if (SolidTypeName(t) == leaf.cell_type) type = t;
+  const SolidType type = SolidTypeOf(leaf.cell_type).value_or(SolidType::kHex20);
   const SvkSolidMesh solid(type, nodes, cells, part.material);
   const Eigen::Vector3d c0(0, width + gap / 2, a);  // the rotor's centre, as in make_variant.py
   std::vector<char> is_tip(size_t(2 * n1), 0);

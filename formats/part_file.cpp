@@ -42,11 +42,10 @@ BeamSectionSpec ParseSection(const YamlValue& value) {
   YamlMap m = value.Map();
   BeamSectionSpec s;
   s.where = value.Where();
-  YamlValue shape = m.Required("shape");
-  s.shape = shape.String();
-  if (s.shape == "circle") {
+  s.shape = m.Required("shape").Kind<SectionShape>("section shape");
+  if (s.shape == SectionShape::kCircle) {
     s.diameter = m.Required("diameter").PositiveNumber();
-  } else if (s.shape == "tube") {
+  } else if (s.shape == SectionShape::kTube) {
     s.outer_radius = m.Required("outer_radius").PositiveNumber();
     YamlValue wall = m.Required("wall");
     s.wall = wall.PositiveNumber();
@@ -54,17 +53,15 @@ BeamSectionSpec ParseSection(const YamlValue& value) {
       wall.Fail("tube wall " + std::to_string(s.wall) + " is thicker than the outer radius " +
                 std::to_string(s.outer_radius));
     }
-  } else if (s.shape == "rectangle") {
+  } else if (s.shape == SectionShape::kRectangle) {
     s.width = m.Required("width").PositiveNumber();
     s.height = m.Required("height").PositiveNumber();
-  } else if (s.shape == "general") {
+  } else {  // kGeneral
     s.A = m.Required("A").PositiveNumber();
     s.Iy = m.Required("Iy").PositiveNumber();
     s.Iz = m.Required("Iz").PositiveNumber();
     s.J = m.Required("J").PositiveNumber();
     if (auto v = m.Optional("Ip")) s.Ip = v->PositiveNumber();
-  } else {
-    shape.Fail("unknown section shape '" + s.shape + "' (known: circle, tube, rectangle, general)");
   }
   // Shear factors override the shape's own (Cowper) values; a general section without them
   // is rigid in shear.
@@ -201,7 +198,7 @@ NodeSelectionSpec ParseSelection(const YamlValue& value) {
   if (auto c = m.Optional("cylinder")) {
     ++shapes;
     YamlMap g = c->Map();
-    s.shape = "cylinder";
+    s.shape = SelectionShape::kCylinder;
     s.point = g.Required("point").Vector3();
     s.axis = unit(g.Required("axis"));
     s.radius = g.Required("radius").PositiveNumber();
@@ -211,7 +208,7 @@ NodeSelectionSpec ParseSelection(const YamlValue& value) {
   if (auto c = m.Optional("sphere")) {
     ++shapes;
     YamlMap g = c->Map();
-    s.shape = "sphere";
+    s.shape = SelectionShape::kSphere;
     s.point = g.Required("center").Vector3();
     s.radius = g.Required("radius").PositiveNumber();
     g.CheckNoUnknownKeys();
@@ -219,7 +216,7 @@ NodeSelectionSpec ParseSelection(const YamlValue& value) {
   if (auto c = m.Optional("box")) {
     ++shapes;
     YamlMap g = c->Map();
-    s.shape = "box";
+    s.shape = SelectionShape::kBox;
     s.point = g.Required("min").Vector3();
     YamlValue max = g.Required("max");
     s.axis = max.Vector3();
@@ -229,7 +226,7 @@ NodeSelectionSpec ParseSelection(const YamlValue& value) {
   if (auto c = m.Optional("plane")) {
     ++shapes;
     YamlMap g = c->Map();
-    s.shape = "plane";
+    s.shape = SelectionShape::kPlane;
     s.point = g.Required("point").Vector3();
     s.axis = unit(g.Required("normal"));
     g.CheckNoUnknownKeys();
@@ -290,7 +287,7 @@ std::string ResolvePath(const YamlValue& file, const std::string& what, const st
 // it (given, it lets femb's own elements on the imported mesh's solid cells build the geometric
 // stiffening).
 void ParsePartMaterial(YamlMap& root, PartSpec& part) {
-  if (part.type != "imported") {
+  if (part.type != PartType::kImported) {
     part.material = ParseMaterial(root.Required("material"));
     if (part.check_units) CheckMaterialUnits(part, root.Required("material"));
   } else if (auto material = root.Optional("material")) {
@@ -313,12 +310,13 @@ void ParseImported(YamlMap& root, PartSpec& part) {
   YamlMap m = matrices.Map();
   MatricesSpec& x = part.matrices;
   x.where = matrices.Where();
-  x.format = m.Required("format").OneOf({"calculix", "abaqus", "matrix_market"});
+  x.format = m.Required("format").OneOfKinds<MatrixFormat>();
   x.stiffness = ResolvePath(m.Required("stiffness"), "stiffness matrix file", part.file);
   x.mass = ResolvePath(m.Required("mass"), "mass matrix file", part.file);
-  if (x.format != "abaqus") {
+  if (x.format != MatrixFormat::kAbaqus) {
     x.dofs = ResolvePath(m.Required("dofs"),
-                         x.format == "calculix" ? "DOF map (job.dof)" : "DOF map (CSV: node, component)", part.file);
+                         x.format == MatrixFormat::kCalculix ? "DOF map (job.dof)" : "DOF map (CSV: node, component)",
+                         part.file);
   }
   m.CheckNoUnknownKeys();
 }
@@ -342,8 +340,8 @@ void ParseSolidPart(YamlMap& root, PartSpec& part) {
   YamlMap g = geometry.Map();
   part.solid.where = geometry.Where();
   if (auto shape = g.Optional("shape")) {
-    part.solid.shape = shape->OneOf({"box", "plate", "cylinder", "tube"});
-    if (part.solid.shape == "box" || part.solid.shape == "plate") {
+    part.solid.shape = shape->OneOfKinds<SolidShape>();
+    if (part.solid.shape == SolidShape::kBox || part.solid.shape == SolidShape::kPlate) {
       YamlValue size = g.Required("size");
       part.solid.size = size.Vector3();
       if (!(part.solid.size.minCoeff() > 0)) size.Fail("edge lengths must be positive");
@@ -352,7 +350,7 @@ void ParseSolidPart(YamlMap& root, PartSpec& part) {
       part.solid.radius = g.Required("radius").PositiveNumber();
       YamlValue length = g.Required("length");
       part.solid.length = length.PositiveNumber();
-      if (part.solid.shape == "tube") {
+      if (part.solid.shape == SolidShape::kTube) {
         YamlValue inner = g.Required("inner_radius");
         part.solid.inner_radius = inner.PositiveNumber();
         if (part.solid.inner_radius >= part.solid.radius) inner.Fail("inner_radius must be smaller than radius");
@@ -373,7 +371,7 @@ void ParseSolidPart(YamlMap& root, PartSpec& part) {
     if (auto v = m.Optional("max_elements")) part.solid.max_elements = long(v->PositiveNumber());
     if (auto v = m.Optional("elements")) {
       part.solid.hexahedra = v->OneOf({"tetrahedra", "hexahedra"}) == "hexahedra";
-      if (part.solid.hexahedra && part.solid.shape != "box" && part.solid.shape != "plate") {
+      if (part.solid.hexahedra && part.solid.shape != SolidShape::kBox && part.solid.shape != SolidShape::kPlate) {
         v->Fail("hexahedra are available for the built-in box and plate only");
       }
     }
@@ -388,7 +386,7 @@ InterfaceSpec ParseInterface(const YamlValue& item, const PartSpec& part) {
   InterfaceSpec spec;
   spec.where = item.Where();
   spec.name = m.Required("name").String();
-  if (part.type == "beam") {
+  if (part.type == PartType::kBeam) {
     YamlValue point = m.Optional("point").value_or(m.Required("name"));
     const std::string point_name = point.String();
     for (size_t i = 0; i < part.beam.point_names.size(); ++i) {
@@ -408,11 +406,7 @@ InterfaceSpec ParseInterface(const YamlValue& item, const PartSpec& part) {
     }
     if (group) spec.group = group->String();
     if (select) spec.select = ParseSelection(*select);
-    if (auto c = m.Optional("coupling")) {
-      spec.coupling = c->String();
-      if (spec.coupling != "rbe2" && spec.coupling != "rbe3")
-        c->Fail("unknown coupling '" + spec.coupling + "' (known: rbe2, rbe3)");
-    }
+    if (auto c = m.Optional("coupling")) spec.coupling = c->Kind<Coupling>("coupling");
     if (auto p = m.Optional("point")) spec.location = p->Vector3();
   }
   for (const auto& other : part.interfaces) {
@@ -424,15 +418,19 @@ InterfaceSpec ParseInterface(const YamlValue& item, const PartSpec& part) {
 
 // reduction.floating_frame: center_of_mass, mean_axes, cardona or interface:<name>.
 void ParseFloatingFrame(const YamlValue& v, PartSpec& part) {
-  part.reduction.floating_frame = v.String();
   part.reduction.where_floating_frame = v.Where();
-  const std::string& f = part.reduction.floating_frame;
+  const std::string f = v.String();
   if (f.rfind("interface:", 0) == 0) {
     const std::string iname = f.substr(10);
     bool found = false;
     for (const auto& i : part.interfaces) found |= (i.name == iname);
     if (!found) v.Fail("floating frame interface '" + iname + "' is not one of the part's interfaces");
-  } else if (f != "center_of_mass" && f != "mean_axes" && f != "cardona") {
+    part.reduction.floating_frame = FloatingFrameType::kInterface;
+    part.reduction.floating_frame_interface = iname;
+  } else if (std::optional<FloatingFrameType> type = KindOf<FloatingFrameType>(f);
+             type && *type != FloatingFrameType::kInterface) {
+    part.reduction.floating_frame = *type;
+  } else {
     v.Fail("unknown floating frame '" + f + "' (known: center_of_mass, mean_axes, interface:<name>, cardona)");
   }
 }
@@ -446,7 +444,7 @@ void ParseModalDerivatives(const YamlValue& v, PartSpec& part) {
   } else {
     d.enabled = true;
     YamlMap dm = v.Map();
-    if (auto o = dm.Optional("of")) d.of = o->OneOf({"all", "static", "internal"}, "(which coordinates are paired)");
+    if (auto o = dm.Optional("of")) d.of = o->OneOfKinds<DerivativePairs>("(which coordinates are paired)");
     if (auto t = dm.Optional("tolerance")) d.tolerance = t->PositiveNumber();
     if (auto p = dm.Optional("pairs")) {
       for (const YamlValue& item : p->List()) {
@@ -457,7 +455,7 @@ void ParseModalDerivatives(const YamlValue& v, PartSpec& part) {
     }
     dm.CheckNoUnknownKeys();
   }
-  if (d.enabled && part.type == "imported") {
+  if (d.enabled && part.type == PartType::kImported) {
     v.Fail("modal derivatives need femb's own elements (the nonlinear strain); imported matrices do not have them");
   }
 }
@@ -467,7 +465,7 @@ void ParseReduction(const YamlValue& r, PartSpec& part) {
   YamlMap m = r.Map();
   if (auto v = m.Optional("internal_modes")) part.reduction.internal_modes = int(v->NonNegativeInteger());
   if (auto v = m.Optional("method")) {
-    part.reduction.method = v->OneOf({"craig_bampton", "free_interface", "general"});
+    part.reduction.method = v->OneOfKinds<ReductionMethod>();
     part.reduction.where_method = v->Where();
   }
   if (auto v = m.Optional("basis")) {
@@ -475,15 +473,16 @@ void ParseReduction(const YamlValue& r, PartSpec& part) {
     part.reduction.where_basis = v->Where();
     part.reduction.basis_file = ResolvePath(b.Required("file"), "deformation shapes file", part.file);
     b.CheckNoUnknownKeys();
-    if (part.reduction.method != "general") v->Fail("a basis file is read with reduction.method: general only");
-  } else if (part.reduction.method == "general") {
+    if (part.reduction.method != ReductionMethod::kGeneral)
+      v->Fail("a basis file is read with reduction.method: general only");
+  } else if (part.reduction.method == ReductionMethod::kGeneral) {
     m.AsValue().Fail("reduction.method general needs reduction.basis: {file: shapes.mtx}");
   }
   if (auto v = m.Optional("floating_frame")) ParseFloatingFrame(*v, part);
   if (auto v = m.Optional("keep_mesh")) part.reduction.keep_mesh = v->Bool();
   if (auto v = m.Optional("stresses")) {
     part.reduction.stresses = v->Bool();
-    if (*part.reduction.stresses && part.type == "imported" && !part.has_material) {
+    if (*part.reduction.stresses && part.type == PartType::kImported && !part.has_material) {
       v->Fail(
           "stresses of imported matrices need the part's material: (femb's own elements on the imported mesh's "
           "solid cells recover them)");
@@ -495,7 +494,7 @@ void ParseReduction(const YamlValue& r, PartSpec& part) {
   }
   if (auto v = m.Optional("geometric_stiffening")) {
     part.reduction.geometric_stiffening = v->Bool();
-    if (*part.reduction.geometric_stiffening && part.type == "imported" && !part.has_material) {
+    if (*part.reduction.geometric_stiffening && part.type == PartType::kImported && !part.has_material) {
       v->Fail(
           "geometric stiffening of imported matrices needs the part's material: (E, nu, rho; femb's own elements "
           "on the imported mesh's solid cells give the stress of each field)");
@@ -508,7 +507,7 @@ void ParseReduction(const YamlValue& r, PartSpec& part) {
   if (auto v = m.Optional("memory_limit_gb")) part.reduction.memory_limit_gb = v->PositiveNumber();
   if (auto v = m.Optional("modal_derivatives")) ParseModalDerivatives(*v, part);
   m.CheckNoUnknownKeys();
-  if (part.reduction.method != "craig_bampton" &&
+  if (part.reduction.method != ReductionMethod::kCraigBampton &&
       (part.reduction.modal_derivatives.enabled || part.reduction.geometric_stiffening.value_or(false))) {
     throw InputError(part.reduction.where_method +
                      ": modal derivatives and geometric stiffening are built on the "
@@ -530,17 +529,13 @@ PartSpec ParsePart(const std::string& text, const std::string& name, const std::
   part.file = name;
   part.text_hash = Fnv1a64(effective);
   part.name = root.Required("name").String();
-  YamlValue type = root.Required("type");
-  part.type = type.String();
-  if (part.type != "beam" && part.type != "solid" && part.type != "imported") {
-    type.Fail("unknown part type '" + part.type + "' (known: beam, solid, imported)");
-  }
+  part.type = root.Required("type").Kind<PartType>("part type");
   if (auto u = root.Optional("units")) part.units = UnitSystem(u->String(), u->Where());
   if (auto v = root.Optional("check_units")) part.check_units = v->Bool();
   ParsePartMaterial(root, part);
-  if (part.type == "imported") {
+  if (part.type == PartType::kImported) {
     ParseImported(root, part);
-  } else if (part.type == "beam") {
+  } else if (part.type == PartType::kBeam) {
     ParseBeamPart(root, part);
   } else {
     ParseSolidPart(root, part);

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "formats/kinds.h"
 #include "formats/superelement.h"
 
 namespace femb {
@@ -21,7 +22,7 @@ struct MaterialSpec {
 
 /// A beam cross-section: a named shape with its dimensions, or explicit properties.
 struct BeamSectionSpec {
-  std::string shape;  ///< "circle", "tube", "rectangle" or "general"
+  SectionShape shape = SectionShape::kGeneral;
   // circle: diameter; tube: outer_radius + wall; rectangle: width (local y) + height (local z).
   double diameter = 0.0, outer_radius = 0.0, wall = 0.0, width = 0.0, height = 0.0;
   // general: A, Iy = int z^2 dA, Iz = int y^2 dA, J (torsion constant); shear factors ky, kz
@@ -49,7 +50,7 @@ struct BeamSpec {
 /// Nodes picked by geometry: the mesh nodes on a surface (cylinder, sphere, plane)
 /// within `tolerance`, or inside a box. reducer/mesh/node_selection.h applies it.
 struct NodeSelectionSpec {
-  std::string shape;                                ///< "cylinder", "sphere", "box" or "plane"
+  SelectionShape shape = SelectionShape::kBox;
   Eigen::Vector3d point = Eigen::Vector3d::Zero();  ///< cylinder: on the axis; sphere: centre; plane: on it; box: min
   Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();  ///< cylinder: axis; plane: normal (unit); box: max
   double radius = 0.0;                              ///< cylinder, sphere
@@ -65,14 +66,14 @@ struct InterfaceSpec {
   // and the interface point (default: the centroid of the node set)
   std::string group;
   std::optional<NodeSelectionSpec> select;  ///< instead of `group`
-  std::string coupling = "rbe2";
+  Coupling coupling = Coupling::kRbe2;
   std::optional<Eigen::Vector3d> location;
   std::string where;
 };
 
 /// A solid part: a built-in shape or a geometry/mesh file, meshed by gmsh.
 struct SolidSpec {
-  std::string shape;                                      ///< "box", "plate", "cylinder", "tube" or "" (file)
+  SolidShape shape = SolidShape::kFile;                   ///< a built-in shape, or kFile: `file`
   Eigen::Vector3d size = Eigen::Vector3d::Ones();         ///< box/plate edge lengths [length], corner at the origin
   double radius = 0.0, inner_radius = 0.0, length = 0.0;  ///< cylinder/tube along z from the origin
   std::string file;                                       ///< geometry or mesh file (resolved path)
@@ -87,9 +88,9 @@ struct SolidSpec {
 /// coordinates' shapes, zero at the interfaces, deflated against the basis and M-orthonormalized.
 struct ModalDerivativeSpec {
   bool enabled = false;
-  std::string of = "all";                  ///< all | static | internal: every pair (i <= j) of those coordinates
-  std::vector<std::pair<int, int>> pairs;  ///< explicit reduced coordinate indices (then 'of' unused)
-  double tolerance = 1e-4;                 ///< drop a vector whose M-norm falls below this fraction when deflated
+  DerivativePairs of = DerivativePairs::kAll;  ///< every pair (i <= j) of those coordinates
+  std::vector<std::pair<int, int>> pairs;      ///< explicit reduced coordinate indices (then 'of' unused)
+  double tolerance = 1e-4;                     ///< drop a vector whose M-norm falls below this fraction when deflated
   std::string where;
 };
 
@@ -99,27 +100,34 @@ struct ReductionSpec {
   /// with the static constraint modes, brought to interface form by the pseudo-inverse route of
   /// thesis 8.2 (reducer/reduction/general_basis.h); internal_modes counts the free-free modes;
   /// general: shapes from a file (basis_file), the same route.
-  std::string method = "craig_bampton";
+  ReductionMethod method = ReductionMethod::kCraigBampton;
   std::string where_method;
   /// method general (imported parts): the deformation shapes, a Matrix Market file (array or
   /// coordinate, real) with one row per imported DOF in the matrices' order and one column per shape.
   std::string basis_file;
   std::string where_basis;
   ModalDerivativeSpec modal_derivatives;
-  std::string floating_frame = "center_of_mass";
+  FloatingFrameType floating_frame = FloatingFrameType::kCenterOfMass;
+  std::string floating_frame_interface;  ///< kInterface: the interface the frame follows
+  /// The key's value as the part file spells it (center_of_mass, ..., interface:<name>).
+  std::string FloatingFrameWord() const {
+    return floating_frame == FloatingFrameType::kInterface ? "interface:" + floating_frame_interface
+                                                           : Name(floating_frame);
+  }
   /// Geometric stiffening: the geometric stiffness of the basis vectors' stresses and
   /// of the 12 unit inertia load cases, and the inertia invariants of the exact kinetic energy,
   /// stored for femb-solve. Unset: on wherever it can be built (GeometricStiffening below).
   std::optional<bool> geometric_stiffening;
   /// What the reduction does: the key's value, or on for femb's own parts reduced by
   /// Craig-Bampton (the only ones with the element stresses and the basis it is built on).
-  bool GeometricStiffening(const std::string& part_type) const {
-    return geometric_stiffening.value_or(method == "craig_bampton" && part_type != "imported");
+  bool GeometricStiffening(PartType part_type) const {
+    return geometric_stiffening.value_or(method == ReductionMethod::kCraigBampton && part_type != PartType::kImported);
   }
   /// Imported parts with a material: the stiffening is built on femb's own elements over the
   /// imported mesh's solid cells; its default there is on.
-  bool GeometricStiffening(const std::string& part_type, bool has_material) const {
-    if (part_type == "imported") return geometric_stiffening.value_or(has_material && method == "craig_bampton");
+  bool GeometricStiffening(PartType part_type, bool has_material) const {
+    if (part_type == PartType::kImported)
+      return geometric_stiffening.value_or(has_material && method == ReductionMethod::kCraigBampton);
     return GeometricStiffening(part_type);
   }
   /// Store the mesh and mode shapes (visualization group); unset: only for models up to
@@ -143,7 +151,7 @@ struct ReductionSpec {
 /// Imported matrices (`type: imported`): K and M of a model assembled by another FE
 /// code, with the node coordinates from `geometry.file` (SolidSpec::file).
 struct MatricesSpec {
-  std::string format;           ///< "calculix", "abaqus" or "matrix_market"
+  MatrixFormat format = MatrixFormat::kCalculix;
   std::string stiffness, mass;  ///< resolved paths
   std::string dofs;             ///< calculix: job.dof; matrix_market: the row -> (node, component) CSV
   std::string where;
@@ -153,7 +161,7 @@ struct PartSpec {
   std::string file;
   std::string text_hash;  ///< FNV-1a 64-bit of the file text (after --set), hex
   std::string name;
-  std::string type;  ///< "beam", "solid" or "imported"
+  PartType type = PartType::kBeam;
   Units units;
   MaterialSpec material;
   /// Imported parts: `material:` given (optional there), for femb's own elements on the imported

@@ -107,35 +107,28 @@ namespace {
 TimeFunctionSpec ParseFunction(const YamlValue& value) {
   YamlMap m = value.Map();
   TimeFunctionSpec f;
-  YamlValue type = m.Required("type");
-  const std::string name = type.String();
-  if (name == "constant") {
-    f.type = TimeFunctionType::kConstant;
+  f.type = m.Required("type").Kind<TimeFunctionType>("time function type");
+  if (f.type == TimeFunctionType::kConstant) {
     f.value = m.Required("value").Number();
-  } else if (name == "ramp" || name == "pulse") {
-    f.type = name == "ramp" ? TimeFunctionType::kRamp : TimeFunctionType::kPulse;
+  } else if (f.type == TimeFunctionType::kRamp || f.type == TimeFunctionType::kPulse) {
     f.value = m.Required("value").Number();
     f.t_start = m.Required("t_start").Number();
     YamlValue t_end = m.Required("t_end");
     f.t_end = t_end.Number();
     if (!(f.t_end > f.t_start)) t_end.Fail("t_end must be after t_start");
-  } else if (name == "step") {
-    f.type = TimeFunctionType::kStep;
+  } else if (f.type == TimeFunctionType::kStep) {
     f.value = m.Required("value").Number();
     f.t_start = m.Required("t_start").Number();
-  } else if (name == "sine") {
-    f.type = TimeFunctionType::kSine;
+  } else if (f.type == TimeFunctionType::kSine) {
     f.amplitude = m.Required("amplitude").Number();
     f.frequency = m.Required("frequency").Number();
     if (auto v = m.Optional("phase")) f.phase = v->Number();
     if (auto v = m.Optional("offset")) f.offset = v->Number();
-  } else if (name == "spin_up") {
-    f.type = TimeFunctionType::kSpinUp;
+  } else if (f.type == TimeFunctionType::kSpinUp) {
     f.value = m.Required("omega").Number();
     YamlValue ts = m.Required("t_spin");
     f.t_end = ts.PositiveNumber();
-  } else if (name == "table") {
-    f.type = TimeFunctionType::kTable;
+  } else if (f.type == TimeFunctionType::kTable) {
     YamlValue points = m.Required("points");
     for (const YamlValue& p : points.List()) {
       auto pair = p.List();
@@ -146,12 +139,8 @@ TimeFunctionSpec ParseFunction(const YamlValue& value) {
       }
     }
     if (f.table.empty()) points.Fail("a table needs at least one point");
-  } else if (name == "linear") {
-    f.type = TimeFunctionType::kLinear;
+  } else {  // kLinear
     if (auto v = m.Optional("slope")) f.value = v->Number();
-  } else {
-    type.Fail("unknown time function type '" + name +
-              "' (known: linear, constant, ramp, step, pulse, sine, table, spin_up)");
   }
   m.CheckNoUnknownKeys();
   return f;
@@ -228,13 +217,8 @@ SceneBodySpec ParseBody(const YamlValue& item, const SceneSpec& scene, NodeNames
   for (const auto& other : scene.bodies) {
     if (other.name == b.name) item.Fail("body name '" + b.name + "' used twice");
   }
-  if (auto t = m.Optional("type")) {
-    const std::string kind = t->String();
-    if (kind != "superelement" && kind != "rigid")
-      t->Fail("unknown body type '" + kind + "' (known: superelement, rigid)");
-    b.type = kind == "rigid" ? SceneBodyType::kRigid : SceneBodyType::kSuperelement;
-  }
-  if (b.type == SceneBodyType::kSuperelement) {
+  if (auto t = m.Optional("type")) b.type = t->Kind<BodyType>("body type");
+  if (b.type == BodyType::kSuperelement) {
     b.superelement = m.Required("superelement").String();
   } else {
     ParseRigidBody(m, b);
@@ -247,14 +231,14 @@ SceneBodySpec ParseBody(const YamlValue& item, const SceneSpec& scene, NodeNames
   }
   YamlValue node_map = m.Required("nodes");
   for (const auto& [iname, scene_node] : node_map.Map().Entries()) {
-    if (b.type == SceneBodyType::kRigid && iname != "com" && !b.points.count(iname)) {
+    if (b.type == BodyType::kRigid && iname != "com" && !b.points.count(iname)) {
       scene_node.Fail("rigid body '" + b.name + "' has no point '" + iname +
                       "' (define it under 'points'; 'com' is the centre of mass)");
     }
     b.nodes[iname] = scene_node.String();
     nodes.Add(scene_node.String());
   }
-  if (b.type == SceneBodyType::kRigid && !b.nodes.count("com")) {
+  if (b.type == BodyType::kRigid && !b.nodes.count("com")) {
     b.nodes["com"] = b.name + ".com";
     nodes.Add(b.nodes["com"]);
   }
@@ -269,29 +253,29 @@ SceneJointSpec ParseJoint(const YamlValue& item, const SceneSpec& scene, const N
   SceneJointSpec j;
   j.where = item.Where();
   YamlValue type = m.Required("type");
-  const std::string kind = type.String();
-  const bool axial = kind == "revolute" || kind == "prismatic" || kind == "cylindrical" || kind == "universal";
-  if (kind != "clamp" && kind != "spherical" && kind != "rigid" && !axial) {
-    type.Fail("unknown joint type '" + kind +
-              "' (known: clamp, spherical, revolute, prismatic, cylindrical, universal, rigid)");
+  // `clamp`: a rigid joint to the ground, the one joint word that is not a JointType.
+  const bool clamp = type.String() == "clamp";
+  if (!clamp) {
+    const std::string word = type.String();
+    if (!KindOf<JointType>(word))
+      type.Fail("unknown joint type '" + word + "' (known: clamp, " + JoinWords(WordsOf<JointType>()) + ")");
+    j.type = *KindOf<JointType>(word);
   }
-  static const SceneJointType all[] = {
-      SceneJointType::kClamp,     SceneJointType::kRigid,       SceneJointType::kSpherical, SceneJointType::kRevolute,
-      SceneJointType::kPrismatic, SceneJointType::kCylindrical, SceneJointType::kUniversal};
-  j.type = *std::find_if(std::begin(all), std::end(all), [&](SceneJointType x) { return kind == Name(x); });
+  const bool axial = j.type == JointType::kRevolute || j.type == JointType::kPrismatic ||
+                     j.type == JointType::kCylindrical || j.type == JointType::kUniversal;
   j.node = nodes.Check(m.Required("node"));
   if (auto p = m.Optional("parent")) {
     j.parent = nodes.Check(*p);
     if (j.parent == j.node) p->Fail("a node cannot be its own parent");
-    if (kind == "clamp") type.Fail("a clamp holds a node to the ground; between two nodes use 'rigid'");
-  } else if (kind == "rigid") {
+    if (clamp) type.Fail("a clamp holds a node to the ground; between two nodes use 'rigid'");
+  } else if (j.type == JointType::kRigid && !clamp) {
     type.Fail("a rigid joint needs a 'parent' node (to the ground use 'clamp')");
   }
   if (axial) {
     YamlValue axis = m.Required("axis");
     j.axis = axis.Vector3();
     if (j.axis.norm() == 0) axis.Fail("axis must not be zero");
-    if (kind == "universal") {
+    if (j.type == JointType::kUniversal) {
       YamlValue axis2 = m.Required("axis2");
       j.axis2 = axis2.Vector3();
       if (std::abs(j.axis.normalized().dot(j.axis2.normalized())) > 1e-6) {
@@ -299,8 +283,9 @@ SceneJointSpec ParseJoint(const YamlValue& item, const SceneSpec& scene, const N
       }
     }
     if (auto v = m.Optional("prescribed")) {
-      if (kind == "cylindrical" || kind == "universal") {
-        v->Fail("prescribed motion of a " + kind + " joint is not supported; use revolute or prismatic");
+      if (j.type == JointType::kCylindrical || j.type == JointType::kUniversal) {
+        v->Fail(std::string("prescribed motion of a ") + Name(j.type) +
+                " joint is not supported; use revolute or prismatic");
       }
       j.prescribed = v->String();
       if (!scene.functions.count(j.prescribed))
@@ -322,10 +307,8 @@ SceneLoadSpec ParseLoad(const YamlValue& item, const SceneSpec& scene, const Nod
   YamlMap m = item.Map();
   SceneLoadSpec l;
   l.where = item.Where();
-  YamlValue type = m.Required("type");
-  const std::string kind = type.String();
-  if (kind == "force") {
-    l.type = SceneLoadType::kForce;
+  l.type = m.Required("type").Kind<LoadType>("load type");
+  if (l.type == LoadType::kForce) {
     l.node = nodes.Check(m.Required("node"));
     if (auto v = m.Optional("force")) l.force = v->Vector3();
     if (auto v = m.Optional("moment")) l.moment = v->Vector3();
@@ -335,11 +318,9 @@ SceneLoadSpec ParseLoad(const YamlValue& item, const SceneSpec& scene, const Nod
       if (!scene.functions.count(l.function))
         v->Fail("time function '" + l.function + "' is not defined under 'functions'");
     }
-  } else if (kind == "gravity") {
-    l.type = SceneLoadType::kGravity;
+  } else if (l.type == LoadType::kGravity) {
     l.g = m.Required("g").Vector3();
-  } else if (kind == "spring") {
-    l.type = SceneLoadType::kSpring;
+  } else {  // kSpring
     l.node = nodes.Check(m.Required("node"));
     auto node_b = m.Optional("node_b");
     auto point = m.Optional("point");
@@ -357,8 +338,6 @@ SceneLoadSpec ParseLoad(const YamlValue& item, const SceneSpec& scene, const Nod
       l.free_length = v->Number();
       if (l.free_length < 0) v->Fail("free length must be >= 0");
     }
-  } else {
-    type.Fail("unknown load type '" + kind + "' (known: force, gravity, spring)");
   }
   m.CheckNoUnknownKeys();
   return l;
@@ -400,17 +379,7 @@ void ParseInitialVelocity(const YamlValue& initial, const NodeNames& nodes, Scen
 // `analysis`.
 void ParseAnalysis(const YamlValue& analysis, SceneAnalysisSpec& a) {
   YamlMap m = analysis.Map();
-  YamlValue type = m.Required("type");
-  const std::string type_name = type.String();
-  if (type_name == "static") {
-    a.type = AnalysisType::kStatic;
-  } else if (type_name == "dynamic") {
-    a.type = AnalysisType::kDynamic;
-  } else if (type_name == "modes") {
-    a.type = AnalysisType::kModes;
-  } else {
-    type.Fail("unknown analysis type '" + type_name + "' (known: static, dynamic, modes)");
-  }
+  a.type = m.Required("type").Kind<AnalysisType>("analysis type");
   if (auto v = m.Optional("count")) {
     a.mode_count = int(v->Integer());
     if (a.mode_count < 1) v->Fail("needs at least 1 mode");
@@ -441,28 +410,18 @@ void ParseAnalysis(const YamlValue& analysis, SceneAnalysisSpec& a) {
     if (a.rho_inf < 0 || a.rho_inf > 1) v->Fail("rho_inf must be in [0, 1]");
   }
   if (auto v = m.Optional("integrator")) {
-    a.integrator = v->OneOf({"generalized_alpha", "midpoint"}) == "midpoint" ? IntegratorType::kMidpoint
-                                                                             : IntegratorType::kGeneralizedAlpha;
+    a.integrator = v->OneOfKinds<Integrator>();
   }
   if (auto v = m.Optional("tolerance")) a.tolerance = v->PositiveNumber();
   if (auto v = m.Optional("max_iterations")) a.max_iterations = int(v->NonNegativeInteger());
   if (auto v = m.Optional("output_every")) a.output_every = std::max(1, int(v->NonNegativeInteger()));
-  if (auto v = m.Optional("jacobian_reuse")) {
-    // true and false: the values before `step` existed (across steps, and full Newton).
-    const std::string s = v->OneOf({"step", "steps", "none", "true", "false"});
-    a.jacobian_reuse = s == "step"                   ? JacobianReuseType::kStep
-                       : s == "steps" || s == "true" ? JacobianReuseType::kSteps
-                                                     : JacobianReuseType::kNone;
-  }
+  if (auto v = m.Optional("jacobian_reuse")) a.jacobian_reuse = v->OneOfKinds<JacobianReuse>();
   if (auto v = m.Optional("gyroscopic_tangent")) a.gyroscopic_tangent = v->Bool();
   if (auto v = m.Optional("body_matrices_every")) {
     a.body_matrices_every = int(v->Integer());
     if (a.body_matrices_every < 1) v->Fail("body_matrices_every must be a whole number of steps, at least 1");
   }
-  if (auto v = m.Optional("body_matrices_kept")) {
-    a.body_matrices_kept =
-        v->OneOf({"inertia", "all"}) == "all" ? BodyMatricesKeptType::kAll : BodyMatricesKeptType::kInertia;
-  }
+  if (auto v = m.Optional("body_matrices_kept")) a.body_matrices_kept = v->OneOfKinds<BodyMatricesKept>();
   m.CheckNoUnknownKeys();
 }
 
@@ -533,8 +492,9 @@ SceneProbeSpec ParseProbe(const YamlValue& item, const NodeNames& nodes, SceneSp
       qi.Fail("probe quantity '" + s +
               "' needs body and point (e.g. {name: s, body: rod0, point: [x, y, z], quantities: [" + s + "]})");
     }
-    if (s == "reaction" || s == "effort") scene.reactions = true;
     p.quantities.push_back(body ? *in_point : *in_node);
+    if (p.quantities.back() == ProbeQuantity::kReaction || p.quantities.back() == ProbeQuantity::kEffort)
+      scene.reactions = true;
   }
   pm.CheckNoUnknownKeys();
   return p;
@@ -588,82 +548,6 @@ SceneSpec ParseScene(const std::string& text, const std::string& name, const std
   if (auto outputs = root.Optional("outputs")) ParseOutputs(*outputs, nodes, scene);
   root.CheckNoUnknownKeys();
   return scene;
-}
-
-const char* Name(SceneBodyType type) { return type == SceneBodyType::kRigid ? "rigid" : "superelement"; }
-
-const char* Name(SceneJointType type) {
-  switch (type) {
-    case SceneJointType::kClamp:
-      return "clamp";
-    case SceneJointType::kRigid:
-      return "rigid";
-    case SceneJointType::kSpherical:
-      return "spherical";
-    case SceneJointType::kRevolute:
-      return "revolute";
-    case SceneJointType::kPrismatic:
-      return "prismatic";
-    case SceneJointType::kCylindrical:
-      return "cylindrical";
-    case SceneJointType::kUniversal:
-      return "universal";
-  }
-  return "?";
-}
-
-const char* Name(SceneLoadType type) {
-  switch (type) {
-    case SceneLoadType::kForce:
-      return "force";
-    case SceneLoadType::kGravity:
-      return "gravity";
-    case SceneLoadType::kSpring:
-      return "spring";
-  }
-  return "?";
-}
-
-const char* Name(AnalysisType type) {
-  switch (type) {
-    case AnalysisType::kStatic:
-      return "static";
-    case AnalysisType::kDynamic:
-      return "dynamic";
-    case AnalysisType::kModes:
-      return "modes";
-  }
-  return "?";
-}
-
-const char* Name(IntegratorType type) { return type == IntegratorType::kMidpoint ? "midpoint" : "generalized_alpha"; }
-
-const char* Name(ProbeQuantity quantity) {
-  switch (quantity) {
-    case ProbeQuantity::kPosition:
-      return "position";
-    case ProbeQuantity::kRotation:
-      return "rotation";
-    case ProbeQuantity::kVelocity:
-      return "velocity";
-    case ProbeQuantity::kAngularVelocity:
-      return "angular_velocity";
-    case ProbeQuantity::kJoint:
-      return "joint";
-    case ProbeQuantity::kReaction:
-      return "reaction";
-    case ProbeQuantity::kStress:
-      return "stress";
-    case ProbeQuantity::kAcceleration:
-      return "acceleration";
-    case ProbeQuantity::kAngularAcceleration:
-      return "angular_acceleration";
-    case ProbeQuantity::kDeformation:
-      return "deformation";
-    case ProbeQuantity::kEffort:
-      return "effort";
-  }
-  return "?";
 }
 
 SceneSpec ReadSceneFile(const std::string& path, const std::vector<std::string>& overrides) {

@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include "formats/kinds.h"
+
 namespace femb {
 
 /// A scalar function of time (or of the pseudo-time of a static analysis).
@@ -21,6 +23,14 @@ enum class TimeFunctionType {
   kSine,      ///< offset + amplitude sin(2 pi frequency t + phase)
   kTable,     ///< linear between (t, f) points, constant outside
   kSpinUp,    ///< smooth spin-up to the rate `value` over t_end, then constant rate
+};
+template <>
+struct Words<TimeFunctionType> {
+  static constexpr KindWord<TimeFunctionType> list[] = {
+      {TimeFunctionType::kLinear, "linear"}, {TimeFunctionType::kConstant, "constant"},
+      {TimeFunctionType::kRamp, "ramp"},     {TimeFunctionType::kStep, "step"},
+      {TimeFunctionType::kPulse, "pulse"},   {TimeFunctionType::kSine, "sine"},
+      {TimeFunctionType::kTable, "table"},   {TimeFunctionType::kSpinUp, "spin_up"}};
 };
 
 struct TimeFunctionSpec {
@@ -37,18 +47,8 @@ struct TimeFunctionSpec {
   std::vector<double> Breakpoints() const;
 };
 
-/// The analysis (SCENE_FORMAT.md `analysis.type`), the dynamic integrator (`analysis.integrator`)
-/// and the probe quantities, parsed from their names once; Name gives the name back (messages,
-/// the CSV header, results.h5's `analysis` attribute).
-enum class AnalysisType { kStatic, kDynamic, kModes };
-enum class IntegratorType { kGeneralizedAlpha, kMidpoint };
-enum class BodyMatricesKeptType { kInertia, kAll };  ///< analysis.body_matrices_kept: inertia | all
-enum class JacobianReuseType {
-  kDefault,
-  kNone,
-  kStep,
-  kSteps
-};  ///< analysis.jacobian_reuse: none | step | steps (kDefault: unset)
+/// The probe quantities (SCENE_FORMAT.md `probes`); the analysis, integrator, bodies, joints
+/// and loads are kinds of formats/kinds.h.
 enum class ProbeQuantity {
   kPosition,
   kRotation,
@@ -62,20 +62,24 @@ enum class ProbeQuantity {
   kDeformation,
   kEffort
 };
-/// Bodies, joints and loads by type (SCENE_FORMAT.md `bodies`, `joints`, `loads`).
-enum class SceneBodyType { kSuperelement, kRigid };
-enum class SceneJointType { kClamp, kRigid, kSpherical, kRevolute, kPrismatic, kCylindrical, kUniversal };
-enum class SceneLoadType { kForce, kGravity, kSpring };
-const char* Name(SceneBodyType type);
-const char* Name(SceneJointType type);
-const char* Name(SceneLoadType type);
-const char* Name(AnalysisType type);
-const char* Name(IntegratorType type);
-const char* Name(ProbeQuantity quantity);
+template <>
+struct Words<ProbeQuantity> {
+  static constexpr KindWord<ProbeQuantity> list[] = {{ProbeQuantity::kPosition, "position"},
+                                                     {ProbeQuantity::kRotation, "rotation"},
+                                                     {ProbeQuantity::kVelocity, "velocity"},
+                                                     {ProbeQuantity::kAngularVelocity, "angular_velocity"},
+                                                     {ProbeQuantity::kJoint, "joint"},
+                                                     {ProbeQuantity::kReaction, "reaction"},
+                                                     {ProbeQuantity::kStress, "stress"},
+                                                     {ProbeQuantity::kAcceleration, "acceleration"},
+                                                     {ProbeQuantity::kAngularAcceleration, "angular_acceleration"},
+                                                     {ProbeQuantity::kDeformation, "deformation"},
+                                                     {ProbeQuantity::kEffort, "effort"}};
+};
 
 struct SceneBodySpec {
   std::string name;
-  SceneBodyType type = SceneBodyType::kSuperelement;
+  BodyType type = BodyType::kSuperelement;
   std::string superelement;  ///< file path (relative paths are relative to the scene file)
   // rigid: mass, centre of mass and inertia about it (part axes), attachment points (part axes)
   double mass = 0.0;
@@ -97,7 +101,7 @@ struct SceneBodySpec {
 };
 
 struct SceneJointSpec {
-  SceneJointType type = SceneJointType::kClamp;  ///< kRigid needs a parent; kClamp has none
+  JointType type = JointType::kRigid;  ///< a rigid joint without a parent is a clamp (to the ground)
   std::string node;
   std::string parent;                                ///< "" = to ground; else the node this one depends on
   Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();   ///< revolute/prismatic/cylindrical/universal (global)
@@ -105,10 +109,12 @@ struct SceneJointSpec {
   std::string prescribed;  ///< time function of the joint coordinate (angle or travel); "" = free
   bool cut = false;        ///< close it by constraint equations even where it could be a tree joint
   std::string where;
+  /// The scene file's word for the joint: `clamp` for a rigid joint to the ground.
+  const char* Word() const { return type == JointType::kRigid && parent.empty() ? "clamp" : Name(type); }
 };
 
 struct SceneLoadSpec {
-  SceneLoadType type = SceneLoadType::kForce;  ///< force and/or moment on a node, gravity, spring
+  LoadType type = LoadType::kForce;  ///< force and/or moment on a node, gravity, spring
   std::string node;
   Eigen::Vector3d force = Eigen::Vector3d::Zero(), moment = Eigen::Vector3d::Zero();
   bool follower = false;
@@ -164,16 +170,17 @@ struct SceneAnalysisSpec {
   double rho_inf = 0.9;
   /// dynamic: generalized_alpha (numerical damping by rho_inf) or midpoint (momentum-conserving,
   /// no damping; solver/analysis/dynamic_analysis.h)
-  IntegratorType integrator = IntegratorType::kGeneralizedAlpha;
+  Integrator integrator = Integrator::kGeneralizedAlpha;
   double tolerance = 1e-8;
   int max_iterations = 25;
   int output_every = 1;
-  JacobianReuseType jacobian_reuse = JacobianReuseType::kDefault;  ///< dynamic: which Newton iterations factor anew
+  std::optional<JacobianReuse>
+      jacobian_reuse;  ///< dynamic: which Newton iterations factor anew (unset: the integrator's)
   bool gyroscopic_tangent =
       false;  ///< generalized-alpha: configuration derivative of the quadratic velocity terms in S
   int body_matrices_every =
       0;  ///< generalized-alpha: bodies' matrices computed every n-th step (0: unset, the solver's default)
-  BodyMatricesKeptType body_matrices_kept = BodyMatricesKeptType::kAll;  ///< which of them body_matrices_every keeps
+  BodyMatricesKept body_matrices_kept = BodyMatricesKept::kAll;  ///< which of them body_matrices_every keeps
 };
 
 struct SceneSpec {

@@ -31,18 +31,18 @@ int SolidNodeCount(SolidType type) {
   return 0;
 }
 
-std::string SolidTypeName(SolidType type) {
+CellType CellOf(SolidType type) {
   switch (type) {
     case SolidType::kTet4:
-      return "tet4";
+      return CellType::kTet4;
     case SolidType::kTet10:
-      return "tet10";
+      return CellType::kTet10;
     case SolidType::kHex8:
-      return "hex8";
+      return CellType::kHex8;
     case SolidType::kHex20:
-      return "hex20";
+      return CellType::kHex20;
   }
-  return "";
+  return CellType::kTet4;
 }
 
 void SolidShapeFunctions(SolidType type, const Eigen::Vector3d& p, Eigen::VectorXd* N, Eigen::MatrixXd* dN) {
@@ -113,9 +113,9 @@ void SolidShapeFunctions(SolidType type, const Eigen::Vector3d& p, Eigen::Vector
   }
 }
 
-std::optional<SolidType> SolidTypeOf(const std::string& cell_type) {
+std::optional<SolidType> SolidTypeOf(CellType cell_type) {
   for (SolidType t : {SolidType::kTet4, SolidType::kTet10, SolidType::kHex8, SolidType::kHex20}) {
-    if (SolidTypeName(t) == cell_type) return t;
+    if (CellOf(t) == cell_type) return t;
   }
   return std::nullopt;
 }
@@ -144,7 +144,7 @@ bool LocateInCell(SolidType type, const Eigen::MatrixXd& nodes, const Eigen::Mat
   return inside;
 }
 
-MeshPoint LocateInMesh(const Eigen::MatrixXd& nodes, const Eigen::MatrixXi& cells, const std::string& cell_type,
+MeshPoint LocateInMesh(const Eigen::MatrixXd& nodes, const Eigen::MatrixXi& cells, CellType cell_type,
                        const Eigen::Vector3d& x) {
   MeshPoint out;
   if (nodes.rows() == 0) return out;

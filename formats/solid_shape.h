@@ -8,14 +8,19 @@
 #include <string>
 #include <vector>
 
+#include "formats/vtk_cells.h"
+
 namespace femb {
 
 enum class SolidType { kTet4, kTet10, kHex8, kHex20 };
 
 int SolidNodeCount(SolidType type);
-std::string SolidTypeName(SolidType type);  ///< "tet4", ...
-/// The type of a cell name ("tet4", "tet10", "hex8", "hex20"); nullopt for other cells.
-std::optional<SolidType> SolidTypeOf(const std::string& cell_type);
+/// The mesh cell of a solid element.
+CellType CellOf(SolidType type);
+/// Its word: "tet4", ...
+inline std::string SolidTypeName(SolidType type) { return Name(CellOf(type)); }
+/// The solid element of a mesh cell (tet4, tet10, hex8, hex20); nullopt for other cells.
+std::optional<SolidType> SolidTypeOf(CellType cell_type);
 
 /// Shape functions (n) and their derivatives (n x 3) at a reference point.
 void SolidShapeFunctions(SolidType type, const Eigen::Vector3d& xi, Eigen::VectorXd* N, Eigen::MatrixXd* dN);
@@ -37,7 +42,7 @@ struct MeshPoint {
   double distance = 0.0;
   double size = 0.0;
 };
-MeshPoint LocateInMesh(const Eigen::MatrixXd& nodes, const Eigen::MatrixXi& cells, const std::string& cell_type,
+MeshPoint LocateInMesh(const Eigen::MatrixXd& nodes, const Eigen::MatrixXi& cells, CellType cell_type,
                        const Eigen::Vector3d& x);
 
 }  // namespace femb

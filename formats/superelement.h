@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "formats/reduced_polynomial.h"
+#include "formats/vtk_cells.h"
 
 namespace femb {
 
@@ -53,9 +54,9 @@ struct MassProperties {
 /// Optional: the full mesh and each reduced coordinate's full displacement field, for
 /// visualization and stress recovery.
 struct Visualization {
-  Eigen::MatrixXd nodes;   ///< n_nodes x 3, part axes [length]
-  Eigen::MatrixXi cells;   ///< n_cells x nodes_per_cell, 0-based node indices
-  std::string cell_type;   ///< "line2", "tet4", "tet10", "hex8", "hex20"
+  Eigen::MatrixXd nodes;  ///< n_nodes x 3, part axes [length]
+  Eigen::MatrixXi cells;  ///< n_cells x nodes_per_cell, 0-based node indices
+  CellType cell_type = CellType::kLine2;
   int dofs_per_node = 6;   ///< 6 (u, theta) for beams, 3 (u) for solids
   Eigen::MatrixXd shapes;  ///< (n_nodes * dofs_per_node) x n_reduced, node-major
   /// Per interface: the mesh nodes its coupling ties (a beam's interface: its own node); empty

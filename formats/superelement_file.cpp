@@ -161,7 +161,7 @@ void WriteFrameAndMass(const Superelement& se, h5::Writer& w) {
 // The mesh and the mode shapes on it.
 void WriteVisualization(const Visualization& v, h5::Writer& w) {
   w.CreateGroup("/visualization");
-  w.Attribute("/visualization", "cell_type", v.cell_type);
+  w.Attribute("/visualization", "cell_type", std::string(Name(v.cell_type)));
   w.Attribute("/visualization", "dofs_per_node", long(v.dofs_per_node));
   w.Matrix("/visualization/nodes", v.nodes);
   w.IntMatrix("/visualization/cells", v.cells);
@@ -493,7 +493,13 @@ ModalStress ReadStress(const h5::Reader& r, const Visualization& v, long n) {
 // The mesh and the mode shapes on it, with the modal stresses when asked for.
 void ReadVisualization(const h5::Reader& r, const SuperelementReadOptions& options, long n, Superelement& se) {
   Visualization v;
-  v.cell_type = r.StringAttribute("/visualization", "cell_type");
+  const std::string cell_word = r.StringAttribute("/visualization", "cell_type");
+  const std::optional<CellType> cell_type = KindOf<CellType>(cell_word);
+  if (!cell_type) {
+    throw InputError(r.path() + ": /visualization cell_type '" + cell_word +
+                     "' is not a cell femb knows (known: " + JoinWords(WordsOf<CellType>()) + ")");
+  }
+  v.cell_type = *cell_type;
   v.dofs_per_node = int(r.IntAttribute("/visualization", "dofs_per_node"));
   v.nodes = r.Matrix("/visualization/nodes");
   v.cells = r.IntMatrix("/visualization/cells");

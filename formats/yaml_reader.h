@@ -11,6 +11,8 @@
 #include <string>
 #include <vector>
 
+#include "formats/kinds.h"
+
 namespace femb {
 
 class YamlMap;
@@ -35,6 +37,18 @@ class YamlValue {
   std::string String() const;
   /// A string that must be one of `allowed`; fails "expected a or b, got 'x'" (+ `note`).
   std::string OneOf(const std::vector<std::string>& allowed, const std::string& note = "") const;
+  /// The kind this value names (formats/kinds.h); fails "unknown <what> 'x' (known: a, b, c)".
+  template <Worded E>
+  E Kind(const std::string& what) const {
+    const std::string s = String();
+    if (std::optional<E> kind = KindOf<E>(s)) return *kind;
+    Fail("unknown " + what + " '" + s + "' (known: " + JoinWords(WordsOf<E>()) + ")");
+  }
+  /// The same with OneOf's message: "expected a, b or c, got 'x'" (+ `note`).
+  template <Worded E>
+  E OneOfKinds(const std::string& note = "") const {
+    return *KindOf<E>(OneOf(WordsOf<E>(), note));
+  }
   Eigen::Vector3d Vector3() const;
   YamlMap Map() const;
   std::vector<YamlValue> List() const;

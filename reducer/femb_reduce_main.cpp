@@ -52,21 +52,22 @@ int main(int argc, char** argv) {
   std::string output;
   std::vector<std::string> overrides;
   bool quiet = false;
-  std::string export_dir, matrix_format = "calculix";
+  std::string export_dir, matrix_format_word = "calculix";
   femb::CommandLine cli("femb-reduce", kUsage, "part file");
   cli.Value({"-o", "--output"}, [&](const std::string& v) { output = v; });
   cli.Value({"--full-modes"}, [&](const std::string& v) { overrides.push_back("reduction.full_modes=" + v); });
   cli.Value({"--set"}, [&](const std::string& v) { overrides.push_back(v); });
   cli.Value({"--export-matrices"}, [&](const std::string& v) { export_dir = v; });
-  cli.Value({"--matrix-format"}, [&](const std::string& v) { matrix_format = v; });
+  cli.Value({"--matrix-format"}, [&](const std::string& v) { matrix_format_word = v; });
   cli.Switch({"-q", "--quiet"}, [&] { quiet = true; });
   if (!cli.Parse(argc, argv)) return cli.exit_code();
   const std::string part_path = cli.input();
   try {
     femb::Stopwatch total;
-    if (matrix_format != "calculix" && matrix_format != "abaqus" && matrix_format != "matrix_market") {
-      throw femb::InputError("--matrix-format: unknown format '" + matrix_format +
-                             "' (known: calculix, abaqus, matrix_market)");
+    const std::optional<femb::MatrixFormat> matrix_format = femb::KindOf<femb::MatrixFormat>(matrix_format_word);
+    if (!matrix_format) {
+      throw femb::InputError("--matrix-format: unknown format '" + matrix_format_word +
+                             "' (known: " + femb::JoinWords(femb::WordsOf<femb::MatrixFormat>()) + ")");
     }
     const femb::PartSpec part = femb::ReadPartFile(part_path, overrides);
     if (output.empty()) output = part.name + ".h5";
@@ -77,7 +78,7 @@ int main(int argc, char** argv) {
       std::fflush(stdout);
     };
     if (!export_dir.empty()) {
-      const std::vector<std::string> written = femb::ExportPartMatrices(part, matrix_format, export_dir, progress);
+      const std::vector<std::string> written = femb::ExportPartMatrices(part, *matrix_format, export_dir, progress);
       if (!quiet) std::printf("femb-reduce: wrote %zu files to %s\n", written.size(), export_dir.c_str());
       return 0;
     }

@@ -68,23 +68,23 @@ std::vector<std::pair<int, int>> DerivativePairs(const PartSpec& part, int n_int
     }
     return spec.pairs;
   }
-  const int first = spec.of == "internal" ? n_interface_dofs : 0;
-  const int last = spec.of == "static" ? n_interface_dofs : n_cb;
+  const int first = spec.of == DerivativePairs::kInternal ? n_interface_dofs : 0;
+  const int last = spec.of == DerivativePairs::kStatic ? n_interface_dofs : n_cb;
   std::vector<std::pair<int, int>> pairs;
   for (int i = first; i < last; ++i)
     for (int j = i; j < last; ++j) pairs.emplace_back(i, j);
   return pairs;
 }
 
-SolidType SolidCellType(const std::string& name) {
-  if (const std::optional<SolidType> t = SolidTypeOf(name)) return *t;
-  throw InputError("no solid element type '" + name + "'");
+SolidType SolidCellType(CellType cell) {
+  if (const std::optional<SolidType> t = SolidTypeOf(cell)) return *t;
+  throw InputError(std::string("no solid element type '") + Name(cell) + "'");
 }
 
 // The FE model of the part: meshed solids, imported matrices or beams.
 FeModel BuildFeModel(const PartSpec& part, const ProgressFn& report) {
-  if (part.type == "solid") return BuildSolidModel(part, report);
-  if (part.type == "imported") return BuildImportedModel(part, report);
+  if (part.type == PartType::kSolid) return BuildSolidModel(part, report);
+  if (part.type == PartType::kImported) return BuildImportedModel(part, report);
   Stopwatch clock;
   FeModel model = BuildBeamModel(part);
   char detail[200];
@@ -107,7 +107,7 @@ struct Budget {
 // factor of K_ii is what is left beside the dense blocks the reduction keeps (constraint modes,
 // Lanczos vectors, the mode shapes of the full model).
 Budget CheckBeforeFactorization(const PartSpec& part, const FeModel& model) {
-  CheckFloatingFrame(part.reduction.floating_frame, part.reduction.where_floating_frame, model);
+  CheckFloatingFrame(part.reduction, model);
   Budget budget;
   budget.keep_mesh = part.reduction.keep_mesh.value_or(model.n_dofs() <= ReductionSpec::kKeepMeshMaxDofs);
   if (!budget.keep_mesh && part.reduction.stresses.value_or(false)) {
@@ -140,7 +140,7 @@ class NonlinearModelOf {
       : part_(part), model_(model), to_model_dofs_(model.mesh_map) {}
   const NonlinearModel& Get() {
     if (nonlinear_) return *nonlinear_;
-    if (part_.type == "solid" || part_.type == "imported") {
+    if (part_.type == PartType::kSolid || part_.type == PartType::kImported) {
       nonlinear_ =
           std::make_unique<SvkSolidMesh>(SolidCellType(model_.cell_type), model_.nodes, model_.cells, part_.material);
     } else {
@@ -196,8 +196,7 @@ DerivativeRequest ModalDerivativeRequest(const PartSpec& part, const FeModel& mo
 // Why femb's own solid elements cannot be put on an imported part's mesh (empty: they can):
 // only where every cell is a solid femb knows and every DOF a translation.
 std::string WhyNoOwnElements(const FeModel& model) {
-  const std::string& cell = model.cell_type;
-  if (cell != "tet4" && cell != "tet10" && cell != "hex8" && cell != "hex20") return "its mesh has " + cell + " cells";
+  if (!SolidTypeOf(model.cell_type)) return std::string("its mesh has ") + Name(model.cell_type) + " cells";
   for (size_t d = 0; d < model.dof_component.size(); ++d)
     if (model.dof_component[d] >= 3 && model.dof_node[d] < model.n_nodes()) return "its matrices have rotational DOFs";
   return "";
@@ -211,7 +210,7 @@ std::string WhyNoOwnElements(const FeModel& model) {
 bool UsesStiffening(const PartSpec& part, const FeModel& model, const ProgressFn& progress) {
   const int n_b = 6 * int(model.interface_names.size()), m = part.reduction.internal_modes;
   bool stiffening = part.reduction.GeometricStiffening(part.type, part.has_material) && n_b + m > 6;
-  if (stiffening && part.type == "imported") {
+  if (stiffening && part.type == PartType::kImported) {
     std::string why = WhyNoOwnElements(model);
     if (!why.empty()) {
       if (why.find("cells") != std::string::npos) why += " (femb's solid elements: tet4, tet10, hex8, hex20)";
@@ -304,7 +303,7 @@ Eigen::MatrixXd GeneralShapes(const PartSpec& part, const FeModel& model, std::s
 // false with result.message on a numerical failure.
 bool ReduceOnOtherBasis(const PartSpec& part, const FeModel& model, const ProgressFn& report, CraigBamptonResult& cb,
                         Eigen::MatrixXd& interface_constraint, ReduceResult& result) {
-  const bool free_interface = part.reduction.method == "free_interface";
+  const bool free_interface = part.reduction.method == ReductionMethod::kFreeInterface;
   const int n_b = 6 * int(model.interface_names.size());
   Stopwatch basis_clock;
   Eigen::MatrixXd V;
@@ -380,13 +379,12 @@ void LinearContent(const PartSpec& part, const FeModel& model, const CraigBampto
   for (int k = 0; k < cb.lambda.size(); ++k) se.internal_frequencies_hz[k] = FrequencyHz(cb.lambda[k]);
   se.n_full_dofs = model.n_dofs();
   for (const InterfaceSpec& i : part.interfaces) {
-    if (part.type != "beam" && i.coupling == "rbe2") se.full_rigid_couplings.push_back(i.name);
+    if (part.type != PartType::kBeam && i.coupling == Coupling::kRbe2) se.full_rigid_couplings.push_back(i.name);
   }
   se.n_modal_derivatives = long(cb.derivative_pairs.size());
   se.modal_derivative_pairs = cb.derivative_pairs;
   se.mass_properties = ComputeMassProperties(se);
-  se.floating_frame =
-      ComputeFloatingFrame(part.reduction.floating_frame, part.reduction.where_floating_frame, se, model, cb.shapes);
+  se.floating_frame = ComputeFloatingFrame(part.reduction, se, model, cb.shapes);
   // Rigid motions cost no energy exactly: K_r <- T0^T K_r T0 with T0 = 1 - Phi_rig0 Phi_CB
   // (thesis 3.17-3.20 at the undeformed state; T0 Phi_rig0 = 0 as Phi_CB Phi_rig0 = 1). It
   // removes only the round-off of K_r Phi_rig0 = 0 (||K Phi_rig0|| ~ eps ||K_full||), which for a
@@ -424,7 +422,7 @@ bool NonlinearForce(const PartSpec& part, const FeModel& model, const CraigBampt
   const NonlinearModel& f = nonlinear.Get();
   const Eigen::MatrixXd mesh_shapes = nonlinear.to_model_dofs() * cb.shapes;
   const auto completion = InterfaceRotationCompletion(model.nodes, mesh_shapes, model.interface_positions,
-                                                      se.floating_frame.origin, part.type == "beam" ? 6 : 3);
+                                                      se.floating_frame.origin, part.type == PartType::kBeam ? 6 : 3);
   PolynomialRequest poly_request;
   poly_request.cubic = derivatives;
   if (stiffening) {
@@ -435,11 +433,11 @@ bool NonlinearForce(const PartSpec& part, const FeModel& model, const CraigBampt
     poly_request.stress_fields = &stress_fields;
   }
   ReducedPolynomial poly =
-      part.type != "beam"
+      part.type != PartType::kBeam
           ? ReduceSvk(static_cast<const SvkSolidMesh&>(f), mesh_shapes, completion, poly_request)
           : ReduceVonKarman(static_cast<const VonKarmanBeams&>(f), mesh_shapes, completion, poly_request);
   const double mismatch = (poly.K - cb.K).norm() / cb.K.norm();
-  if (part.type == "imported" && mismatch > kImportedStiffnessMismatch) {
+  if (part.type == PartType::kImported && mismatch > kImportedStiffnessMismatch) {
     // femb's elements with the part's material on the imported mesh must be the imported
     // stiffness (up to element formulation): else their stresses, hence the geometric
     // stiffness, belong to another material or model.
@@ -451,7 +449,7 @@ bool NonlinearForce(const PartSpec& part, const FeModel& model, const CraigBampt
                   part.file.c_str(), mismatch, kImportedStiffnessMismatch);
     throw InputError(text);
   }
-  if (part.type != "imported" && mismatch > 1e-8) {
+  if (part.type != PartType::kImported && mismatch > 1e-8) {
     result.message = "the polynomial internal force's linear part differs from K_r by " + std::to_string(mismatch);
     return false;
   }
@@ -501,8 +499,9 @@ Visualization MeshAndShapes(const FeModel& model, const CraigBamptonResult& cb) 
 // only with femb's solid elements on the imported mesh and the part's material (the same
 // conditions as the stiffening's; the part file refuses true without a material).
 bool UsesStresses(const PartSpec& part, const FeModel& model, bool keep_mesh) {
-  const bool stresses = keep_mesh && part.reduction.stresses.value_or(part.type != "imported" || part.has_material);
-  if (!stresses || part.type != "imported") return stresses;
+  const bool stresses =
+      keep_mesh && part.reduction.stresses.value_or(part.type != PartType::kImported || part.has_material);
+  if (!stresses || part.type != PartType::kImported) return stresses;
   const std::string why = WhyNoOwnElements(model);
   if (why.empty()) return true;
   if (part.reduction.stresses.value_or(false)) {
@@ -521,9 +520,9 @@ void Stresses(const PartSpec& part, const FeModel& model, const Eigen::MatrixXd&
   Stopwatch stress_clock;
   const Visualization& v = *se.visualization;
   auto stresses_of = [&](const Eigen::MatrixXd& fields, bool quadratic) {
-    return part.type != "beam" ? SolidModalStress(SolidCellType(model.cell_type), model.nodes, model.cells,
-                                                  part.material, fields, quadratic)
-                               : BeamModalStress(part, fields, quadratic);
+    return part.type != PartType::kBeam ? SolidModalStress(SolidCellType(model.cell_type), model.nodes, model.cells,
+                                                           part.material, fields, quadratic)
+                                        : BeamModalStress(part, fields, quadratic);
   };
   se.stress = stresses_of(v.shapes, se.n_modal_derivatives > 0);
   if (stress_fields.cols() > 0) {
@@ -633,7 +632,8 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
   const DerivativeRequest request = ModalDerivativeRequest(part, model, nonlinear);
   const bool stiffening = UsesStiffening(part, model, progress);
   const Eigen::MatrixXd inertia_fields = stiffening ? InertiaFields(model) : Eigen::MatrixXd();
-  const bool other_basis = part.reduction.method == "free_interface" || part.reduction.method == "general";
+  const bool other_basis =
+      part.reduction.method == ReductionMethod::kFreeInterface || part.reduction.method == ReductionMethod::kGeneral;
   CraigBamptonResult cb =
       CraigBamptonReduce(model, other_basis ? 0 : part.reduction.internal_modes, report, 200, budget.factor_bytes,
                          request.pairs.empty() ? nullptr : &request, stiffening ? &inertia_fields : nullptr);
@@ -659,7 +659,7 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
   prov.input_file = part.file;
   prov.input_hash = part.text_hash;
   prov.element_type = model.element_type;
-  prov.reduction_method = part.reduction.method;
+  prov.reduction_method = Name(part.reduction.method);
   prov.n_nodes = model.n_nodes();
   prov.n_elements = model.n_elements();
   report(

@@ -220,9 +220,9 @@ class SolveRun {
     }
     std::filesystem::path dir(is.from);
     if (dir.is_relative()) dir = std::filesystem::path(spec_.file).parent_path() / dir;
-    std::string kind;
+    femb::AnalysisType kind = femb::AnalysisType::kStatic;
     from_ = femb::ReadCheckpoint(dir.string(), scene_, &kind);
-    t0_ = is.time ? *is.time : kind == "dynamic" ? from_->t : 0.0;
+    t0_ = is.time ? *is.time : kind == femb::AnalysisType::kDynamic ? from_->t : 0.0;
     if (spec_.analysis.type == femb::AnalysisType::kDynamic && !(spec_.analysis.end_time > t0_)) {
       char buffer[200];
       std::snprintf(buffer, sizeof buffer, ": analysis.end_time %.6g is not after the initial state's time %.6g",
@@ -230,7 +230,7 @@ class SolveRun {
       throw femb::InputError(is.where + buffer);
     }
     if (!args_.quiet) {
-      std::printf("femb-solve: initial state: the %s state of %s at t = %.6g, started at t = %.6g\n", kind.c_str(),
+      std::printf("femb-solve: initial state: the %s state of %s at t = %.6g, started at t = %.6g\n", femb::Name(kind),
                   dir.string().c_str(), from_->t, t0_);
     }
   }
@@ -288,7 +288,7 @@ class SolveRun {
     saved_steps_ = step_count_, saved_iterations_ = total_iterations_;
   }
   void WriteCheckpoint(const femb::DynamicState& state) {
-    const char* kind = is_static() ? "static" : "dynamic";
+    const femb::AnalysisType kind = is_static() ? femb::AnalysisType::kStatic : femb::AnalysisType::kDynamic;
     if (!saved_) return femb::WriteCheckpoint(args_.output, scene_, signature_, state, kind);
     femb::WriteCheckpoint(args_.output, scene_, signature_, saved_->state, kind, &*saved_, [&](femb::h5::Writer& w) {
       recorder().WriteMark(w, mark_);
@@ -416,27 +416,13 @@ class SolveRun {
     options.step = a.step;
     options.end_time = a.end_time;
     options.rho_inf = a.rho_inf;
-    if (a.integrator == femb::IntegratorType::kMidpoint) options.integrator = femb::Integrator::kMidpoint;
+    options.integrator = a.integrator;
     options.tolerance = a.tolerance;
     options.max_iterations = a.max_iterations;
-    switch (a.jacobian_reuse) {
-      case femb::JacobianReuseType::kDefault:
-        break;  // the integrator's (femb::JacobianReuseOf)
-      case femb::JacobianReuseType::kNone:
-        options.jacobian_reuse = femb::JacobianReuse::kNone;
-        break;
-      case femb::JacobianReuseType::kStep:
-        options.jacobian_reuse = femb::JacobianReuse::kStep;
-        break;
-      case femb::JacobianReuseType::kSteps:
-        options.jacobian_reuse = femb::JacobianReuse::kSteps;
-        break;
-    }
+    options.jacobian_reuse = a.jacobian_reuse;  // unset: the integrator's (femb::JacobianReuseOf)
     options.full_inertia_tangent = a.gyroscopic_tangent;
     if (a.body_matrices_every > 0) options.body_matrices_every = a.body_matrices_every;
-    options.body_matrices_kept = a.body_matrices_kept == femb::BodyMatricesKeptType::kAll
-                                     ? femb::BodyMatricesKept::kAll
-                                     : femb::BodyMatricesKept::kInertia;
+    options.body_matrices_kept = a.body_matrices_kept;
     options.threads = args_.threads;
     options.stop = &femb::StopRequest();
     if (resume_) options.resume = &*resume_;

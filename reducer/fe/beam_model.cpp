@@ -60,7 +60,7 @@ FeModel BuildBeamModel(const PartSpec& part) {
   FeModel model;
   model.dofs_per_node = 6;
   model.element_type = spec.shear_deformation ? "timoshenko_beam" : "euler_bernoulli_beam";
-  model.cell_type = "line2";
+  model.cell_type = CellType::kLine2;
   model.nodes.resize(long(nodes.size()), 3);
   for (size_t i = 0; i < nodes.size(); ++i) model.nodes.row(long(i)) = nodes[i].transpose();
   model.cells.resize(long(elements.size()), 2);

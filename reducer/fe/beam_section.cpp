@@ -7,20 +7,20 @@ namespace femb {
 
 SectionProperties ComputeSectionProperties(const BeamSectionSpec& s, double nu) {
   SectionProperties p;
-  if (s.shape == "circle") {
+  if (s.shape == SectionShape::kCircle) {
     const double r = 0.5 * s.diameter;
     p.A = M_PI * r * r;
     p.Iy = p.Iz = M_PI * std::pow(r, 4) / 4.0;
     p.J = p.Ip = 2.0 * p.Iy;
     p.ky = p.kz = 6.0 * (1.0 + nu) / (7.0 + 6.0 * nu);
-  } else if (s.shape == "tube") {
+  } else if (s.shape == SectionShape::kTube) {
     const double R = s.outer_radius, r = s.outer_radius - s.wall;
     p.A = M_PI * (R * R - r * r);
     p.Iy = p.Iz = M_PI * (std::pow(R, 4) - std::pow(r, 4)) / 4.0;
     p.J = p.Ip = 2.0 * p.Iy;
     const double m = r / R, m2 = (1 + m * m) * (1 + m * m);
     p.ky = p.kz = 6.0 * (1.0 + nu) * m2 / ((7.0 + 6.0 * nu) * m2 + (20.0 + 12.0 * nu) * m * m);
-  } else if (s.shape == "rectangle") {
+  } else if (s.shape == SectionShape::kRectangle) {
     const double b = s.width, h = s.height;
     p.A = b * h;
     p.Iz = h * b * b * b / 12.0;

@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include "formats/vtk_cells.h"
+
 namespace femb {
 
 using SparseMatrix = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
@@ -19,10 +21,10 @@ struct FullDof {
 };
 
 struct FeModel {
-  int dofs_per_node = 6;     ///< 6 for beams (u, theta); 3 for solids
-  Eigen::MatrixXd nodes;     ///< n_nodes x 3, part axes
-  Eigen::MatrixXi cells;     ///< n_cells x nodes_per_cell
-  std::string cell_type;     ///< "line2", ...
+  int dofs_per_node = 6;  ///< 6 for beams (u, theta); 3 for solids
+  Eigen::MatrixXd nodes;  ///< n_nodes x 3, part axes
+  Eigen::MatrixXi cells;  ///< n_cells x nodes_per_cell
+  CellType cell_type = CellType::kLine2;
   std::string element_type;  ///< e.g. "timoshenko_beam"
   SparseMatrix K, M;         ///< n_dofs x n_dofs, full (both triangles stored)
 

@@ -64,15 +64,12 @@ ImportedDofs MapImportedDofs(const PartSpec& part, const ForeignMesh& geometry, 
 // The geometry's cells as a volume mesh when they are solids femb knows (for selections inside
 // the volume and interpolation); null otherwise.
 std::shared_ptr<SolidMesh> SolidVolume(const ForeignMesh& geometry) {
-  if (geometry.cell_type != "tet4" && geometry.cell_type != "tet10" && geometry.cell_type != "hex8" &&
-      geometry.cell_type != "hex20") {
-    return nullptr;
-  }
+  const std::optional<SolidType> type = SolidTypeOf(geometry.cell_type);
+  if (!type) return nullptr;
   auto volume = std::make_shared<SolidMesh>();
   volume->nodes = geometry.nodes;
   volume->cells = geometry.cells;
-  for (SolidType t : {SolidType::kTet4, SolidType::kTet10, SolidType::kHex8, SolidType::kHex20})
-    if (SolidTypeName(t) == geometry.cell_type) volume->type = t;
+  volume->type = *type;
   return volume;
 }
 
@@ -86,7 +83,7 @@ SparseMatrix RigidCouplingMap(const PartSpec& part, const ForeignMesh& geometry,
   const long n_full = long(im.node.size());
   const std::vector<int>& full_node = d.full_node;
   auto rbe2 = [&](long s) {
-    return owner[size_t(s)] >= 0 && part.interfaces[size_t(owner[size_t(s)])].coupling == "rbe2";
+    return owner[size_t(s)] >= 0 && part.interfaces[size_t(owner[size_t(s)])].coupling == Coupling::kRbe2;
   };
   model_of.assign(static_cast<size_t>(n_full), -1);
   int n_model = 0;
@@ -100,7 +97,7 @@ SparseMatrix RigidCouplingMap(const PartSpec& part, const ForeignMesh& geometry,
   }
   base.assign(part.interfaces.size(), -1);
   for (size_t k = 0; k < part.interfaces.size(); ++k) {
-    if (part.interfaces[k].coupling != "rbe2") continue;
+    if (part.interfaces[k].coupling != Coupling::kRbe2) continue;
     base[k] = n_model;
     for (int c = 0; c < 6; ++c) {
       model.dof_point.push_back(model.interface_positions[k]);
@@ -140,7 +137,7 @@ void InterfaceCouplings(const PartSpec& part, const ForeignMesh& geometry, const
     std::vector<FullDof> dofs;
     SparseMatrix W(0, n_model);
     if (base[k] >= 0) {
-      for (int d = 0; d < 6; ++d) dofs.push_back({base[k] + d});
+      for (int c = 0; c < 6; ++c) dofs.push_back({base[k] + c});
     } else {
       std::vector<int> nodes;
       for (int s : sets[k]) {
@@ -194,8 +191,8 @@ FeModel BuildImportedModel(const PartSpec& part, const ProgressFn& progress) {
   CheckPartSize(part, (hi - lo).norm(), part.solid.where + " (" + part.solid.file + ")");
   if (progress) {
     progress("geometry", clock.Seconds(),
-             std::to_string(n_nodes) + " nodes, " + std::to_string(geometry.cells.rows()) + " " + geometry.cell_type +
-                 " cells from " + part.solid.file);
+             std::to_string(n_nodes) + " nodes, " + std::to_string(geometry.cells.rows()) + " " +
+                 Name(geometry.cell_type) + " cells from " + part.solid.file);
   }
 
   clock.Restart();
@@ -206,7 +203,7 @@ FeModel BuildImportedModel(const PartSpec& part, const ProgressFn& progress) {
     progress("matrices", clock.Seconds(),
              std::to_string(n_full) + " DOFs (" + std::to_string(d.rotational) + " rotational), K " +
                  std::to_string(im.K.nonZeros()) + " entries (" + im.stored + " in the file), M " +
-                 std::to_string(im.M.nonZeros()) + " entries, " + part.matrices.format);
+                 std::to_string(im.M.nonZeros()) + " entries, " + Name(part.matrices.format));
   }
 
   // Interfaces: node sets by name or by geometry; only nodes that carry DOFs of the matrices take
@@ -250,7 +247,7 @@ FeModel BuildImportedModel(const PartSpec& part, const ProgressFn& progress) {
   model.nodes = geometry.nodes;
   model.cells = geometry.cells;
   model.cell_type = geometry.cell_type;
-  model.element_type = "imported " + part.matrices.format;
+  model.element_type = std::string("imported ") + Name(part.matrices.format);
   if (volume) model.interpolate_at = SolidInterpolation(volume, model.mesh_map);
   const auto [residual, mass] = CheckFloats(part, model);
   if (progress) {
@@ -262,9 +259,9 @@ FeModel BuildImportedModel(const PartSpec& part, const ProgressFn& progress) {
   return model;
 }
 
-std::vector<std::string> ExportPartMatrices(const PartSpec& part, const std::string& format,
-                                            const std::string& directory, const ProgressFn& progress) {
-  if (part.type == "imported")
+std::vector<std::string> ExportPartMatrices(const PartSpec& part, MatrixFormat format, const std::string& directory,
+                                            const ProgressFn& progress) {
+  if (part.type == PartType::kImported)
     throw InputError(part.file + ": --export-matrices: the part's matrices are imported already");
   Stopwatch clock;
   SparseMatrix K, M;
@@ -274,7 +271,7 @@ std::vector<std::string> ExportPartMatrices(const PartSpec& part, const std::str
   Eigen::MatrixXi cells;
   std::string element;  // Abaqus element type
   std::map<std::string, std::vector<int>> node_sets;
-  if (part.type == "solid") {
+  if (part.type == PartType::kSolid) {
     const SolidMesh mesh = MeshSolidPart(part);
     SolidDofMap map;
     const int n = int(mesh.nodes.rows());
@@ -293,7 +290,7 @@ std::vector<std::string> ExportPartMatrices(const PartSpec& part, const std::str
         component.push_back(c);
       }
     nodes = mesh.nodes;
-    cells = ToVtkOrder(SolidTypeName(mesh.type), mesh.cells);  // VTK order = Abaqus order for these
+    cells = ToVtkOrder(CellOf(mesh.type), mesh.cells);  // VTK order = Abaqus order for these
     const std::map<SolidType, std::string> names = {{SolidType::kTet4, "C3D4"},
                                                     {SolidType::kTet10, "C3D10"},
                                                     {SolidType::kHex8, "C3D8"},
@@ -341,7 +338,7 @@ std::vector<std::string> ExportPartMatrices(const PartSpec& part, const std::str
   if (progress) {
     progress("export", clock.Seconds(),
              std::to_string(node.size()) + " DOFs, " + std::to_string(cells.rows()) + " " + element + " elements, " +
-                 format + " matrices and " + mesh_path);
+                 Name(format) + " matrices and " + mesh_path);
   }
   return written;
 }

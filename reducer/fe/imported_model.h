@@ -30,7 +30,7 @@ FeModel BuildImportedModel(const PartSpec& part, const ProgressFn& progress = nu
 /// 3 DOFs on every mesh node; beams: 6 per node) and its mesh as DIR/NAME.inp (Abaqus/CalculiX:
 /// *NODE with labels 1..n, *ELEMENT, *NSET per named node set), so that a part file of type
 /// 'imported' reads them back. Returns the paths written.
-std::vector<std::string> ExportPartMatrices(const PartSpec& part, const std::string& format,
-                                            const std::string& directory, const ProgressFn& progress = nullptr);
+std::vector<std::string> ExportPartMatrices(const PartSpec& part, MatrixFormat format, const std::string& directory,
+                                            const ProgressFn& progress = nullptr);
 
 }  // namespace femb

@@ -280,9 +280,9 @@ void ReadMatrixMarket(const MatricesSpec& spec, ImportedMatrices* out, std::vect
 ImportedMatrices ReadImportedMatrices(const MatricesSpec& spec) {
   ImportedMatrices out;
   std::vector<Entry> k, m;
-  if (spec.format == "calculix") {
+  if (spec.format == MatrixFormat::kCalculix) {
     ReadCalculix(spec, &out, &k, &m);
-  } else if (spec.format == "abaqus") {
+  } else if (spec.format == MatrixFormat::kAbaqus) {
     ReadAbaqus(spec, &out, &k, &m);
   } else {
     ReadMatrixMarket(spec, &out, &k, &m);
@@ -368,7 +368,7 @@ Eigen::MatrixXd ReadShapeMatrix(const std::string& path, long rows) {
   return V;
 }
 
-std::vector<std::string> WriteMatrices(const std::string& format, const SparseMatrix& K, const SparseMatrix& M,
+std::vector<std::string> WriteMatrices(MatrixFormat format, const SparseMatrix& K, const SparseMatrix& M,
                                        const std::vector<long>& node, const std::vector<int>& component,
                                        const std::string& directory, const std::string& stem) {
   std::error_code ec;
@@ -399,7 +399,7 @@ std::vector<std::string> WriteMatrices(const std::string& format, const SparseMa
     upper(A, [&](long, long, double) { ++c; });
     return c;
   };
-  if (format == "calculix") {
+  if (format == MatrixFormat::kCalculix) {
     for (auto [ext, A] : {std::pair{".sti", &K}, std::pair{".mas", &M}})
       write(stem + ext, [&, A = A](std::ostream& out) {
         upper(*A, [&](long i, long j, double v) { out << i + 1 << ' ' << j + 1 << ' ' << v << '\n'; });
@@ -407,7 +407,7 @@ std::vector<std::string> WriteMatrices(const std::string& format, const SparseMa
     write(stem + ".dof", [&](std::ostream& out) {
       for (size_t r = 0; r < node.size(); ++r) out << node[r] << '.' << component[r] + 1 << '\n';
     });
-  } else if (format == "abaqus") {
+  } else if (format == MatrixFormat::kAbaqus) {
     for (auto [suffix, A] : {std::pair{"_STIF1.mtx", &K}, std::pair{"_MASS1.mtx", &M}})
       write(stem + suffix, [&, A = A](std::ostream& out) {
         upper(*A, [&](long i, long j, double v) {
@@ -415,7 +415,7 @@ std::vector<std::string> WriteMatrices(const std::string& format, const SparseMa
               << component[size_t(j)] + 1 << ", " << v << '\n';
         });
       });
-  } else if (format == "matrix_market") {
+  } else {  // kMatrixMarket
     // Symmetric storage is the lower triangle: entry (j, i) for each upper (i, j).
     for (auto [suffix, A] : {std::pair{"_K.mtx", &K}, std::pair{"_M.mtx", &M}})
       write(stem + suffix, [&, A = A](std::ostream& out) {
@@ -427,8 +427,6 @@ std::vector<std::string> WriteMatrices(const std::string& format, const SparseMa
       out << "node,component\n";
       for (size_t r = 0; r < node.size(); ++r) out << node[r] << ',' << component[r] + 1 << '\n';
     });
-  } else {
-    throw InputError("--matrix-format: unknown format '" + format + "' (known: calculix, abaqus, matrix_market)");
   }
   return written;
 }

@@ -43,7 +43,7 @@ Eigen::MatrixXd ReadShapeMatrix(const std::string& path, long rows);
 /// (node label, component 0..5): calculix -> DIR/STEM.sti, .mas, .dof; abaqus ->
 /// DIR/STEM_STIF1.mtx, DIR/STEM_MASS1.mtx; matrix_market -> DIR/STEM_K.mtx, DIR/STEM_M.mtx,
 /// DIR/STEM_dofs.csv. Returns the paths written. Throws InputError when DIR cannot be written.
-std::vector<std::string> WriteMatrices(const std::string& format, const SparseMatrix& K, const SparseMatrix& M,
+std::vector<std::string> WriteMatrices(MatrixFormat format, const SparseMatrix& K, const SparseMatrix& M,
                                        const std::vector<long>& node, const std::vector<int>& component,
                                        const std::string& directory, const std::string& stem);
 

@@ -293,9 +293,10 @@ InterfaceNodes ResolveInterfaceNodes(const PartSpec& part, const Eigen::MatrixXd
       throw InputError(i.where + ": interface '" + i.name + "': none of its " + std::to_string(set.size()) + " nodes " +
                        keep_reason);
     }
-    const std::string source = i.select ? "the " + i.select->shape + " selection" : "node set '" + i.group + "'";
+    const std::string source =
+        i.select ? std::string("the ") + Name(i.select->shape) + " selection" : "node set '" + i.group + "'";
     out.summary += (k ? ", " : "") + i.name + ": " + std::to_string(used.size()) + " nodes " +
-                   (i.select ? "by " + i.select->shape : "of set '" + i.group + "'");
+                   (i.select ? std::string("by ") + Name(i.select->shape) : "of set '" + i.group + "'");
     Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
     for (int s : used) {
       if (out.owner[size_t(s)] >= 0) {
@@ -391,7 +392,7 @@ SolidMesh MeshSolidPart(const PartSpec& part) {
   if (mesh.nodes.rows() > 0) {
     const Eigen::Vector3d lo = mesh.nodes.colwise().minCoeff(), hi = mesh.nodes.colwise().maxCoeff();
     CheckPartSize(part, (hi - lo).norm(),
-                  part.solid.where + " (" + (request.file.empty() ? part.solid.shape : request.file) + ")");
+                  part.solid.where + " (" + (request.file.empty() ? Name(part.solid.shape) : request.file) + ")");
   }
   return mesh;
 }
@@ -413,7 +414,7 @@ std::vector<Rbe3> Rbe3Couplings(const PartSpec& part, const SolidMesh& mesh, con
                                 const FeModel& model) {
   std::vector<Rbe3> rbe3(part.interfaces.size());
   for (size_t k = 0; k < part.interfaces.size(); ++k) {
-    if (part.interfaces[k].coupling != "rbe3") continue;
+    if (part.interfaces[k].coupling != Coupling::kRbe3) continue;
     const std::vector<int>& set = sets[k];
     Rbe3& r3 = rbe3[k];
     r3.W =
@@ -438,7 +439,7 @@ SparseMatrix RigidCouplingMap(const PartSpec& part, const SolidMesh& mesh, const
   kept.assign(size_t(3 * n_nodes), -1);
   int n_kept = 0;
   for (int s = 0; s < n_nodes; ++s) {
-    const bool rbe2 = owner[s] >= 0 && part.interfaces[owner[s]].coupling == "rbe2";
+    const bool rbe2 = owner[s] >= 0 && part.interfaces[owner[s]].coupling == Coupling::kRbe2;
     for (int d = 0; d < 3; ++d) {
       if (!rbe2) kept[3 * s + d] = n_kept++;
     }
@@ -446,14 +447,14 @@ SparseMatrix RigidCouplingMap(const PartSpec& part, const SolidMesh& mesh, const
   rbe2_base.assign(part.interfaces.size(), -1);
   int n_model = n_kept;
   for (size_t k = 0; k < part.interfaces.size(); ++k) {
-    if (part.interfaces[k].coupling == "rbe2") {
+    if (part.interfaces[k].coupling == Coupling::kRbe2) {
       rbe2_base[k] = n_model;
       n_model += 6;
     }
   }
   std::vector<Eigen::Triplet<double>> t_entries;
   for (int s = 0; s < n_nodes; ++s) {
-    if (owner[s] >= 0 && part.interfaces[owner[s]].coupling == "rbe2") {
+    if (owner[s] >= 0 && part.interfaces[owner[s]].coupling == Coupling::kRbe2) {
       const int base = rbe2_base[owner[s]];
       const Eigen::Matrix3d arm = -SkewOf(mesh.nodes.row(s).transpose() - model.interface_positions[owner[s]]);
       for (int d = 0; d < 3; ++d) {
@@ -568,7 +569,7 @@ FeModel BuildSolidModel(const PartSpec& part, const ProgressFn& progress) {
   model.dofs_per_node = 3;
   model.nodes = mesh->nodes;
   model.cells = mesh->cells;
-  model.cell_type = SolidTypeName(mesh->type);
+  model.cell_type = CellOf(mesh->type);
   model.element_type = SolidTypeName(mesh->type);
 
   // Material point interpolation: displacement and small rotation (curl / 2) at x.

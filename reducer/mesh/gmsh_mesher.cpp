@@ -77,9 +77,9 @@ using SurfaceEntities = std::map<std::string, std::vector<int>>;  // node set na
 
 // The built-in cylinder or tube along z: its faces named bottom, top, outer and inner.
 void AddCylinder(const MeshRequest& r, SurfaceEntities& surface_entities) {
-  gmsh::model::add(r.shape);
+  gmsh::model::add(Name(r.shape));
   int volume = gmsh::model::occ::addCylinder(0, 0, 0, 0, 0, r.length, r.radius);
-  if (r.shape == "tube") {
+  if (r.shape == SolidShape::kTube) {
     const int bore = gmsh::model::occ::addCylinder(0, 0, -0.1 * r.length, 0, 0, 1.2 * r.length, r.inner_radius);
     gmsh::vectorpair out;
     std::vector<gmsh::vectorpair> map;
@@ -228,9 +228,9 @@ SolidMesh MeshWithGmsh(const MeshRequest& r) {
   SolidMesh mesh;
   SurfaceEntities surface_entities;
   try {
-    if (r.shape == "cylinder" || r.shape == "tube") {
+    if (r.shape == SolidShape::kCylinder || r.shape == SolidShape::kTube) {
       AddCylinder(r, surface_entities);
-    } else if (r.shape == "box" || r.shape == "plate") {
+    } else if (r.shape == SolidShape::kBox || r.shape == SolidShape::kPlate) {
       AddBox(r, surface_entities);
     } else {
       OpenFile(r, surface_entities);

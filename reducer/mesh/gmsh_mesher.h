@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "formats/kinds.h"
 #include "reducer/fe/solid_element.h"
 
 namespace femb {
@@ -23,7 +24,7 @@ struct SolidMesh {
 };
 
 struct MeshRequest {
-  std::string shape;  ///< "box", "plate", "cylinder", "tube" or "" (file)
+  SolidShape shape = SolidShape::kFile;  ///< a built-in shape, or kFile: `file`
   Eigen::Vector3d size = Eigen::Vector3d::Ones();
   double radius = 0.0, inner_radius = 0.0, length = 0.0;  ///< cylinder / tube along z
   std::string file;                                       ///< geometry or mesh file

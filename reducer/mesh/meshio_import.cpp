@@ -122,12 +122,13 @@ ForeignMesh ReadWithMeshio(const std::string& path, const std::string& where, bo
   for (long i = 0; i < n; ++i)
     if (!(in >> mesh.ids[size_t(i)])) fail("node id " + std::to_string(i));
   if (!(in >> word >> type >> m >> k) || word != "cells") fail("no cell block");
-  const std::map<std::string, long> types = {{"tet4", 4}, {"tet10", 10}, {"hex8", 8},  {"hex20", 20}, {"tri3", 3},
-                                             {"tri6", 6}, {"quad4", 4},  {"quad8", 8}, {"line2", 2}};
-  const auto found = types.find(type);
-  if (found == types.end()) fail("cell type '" + type + "'");  // it once fell back to hex20 silently
-  if (m <= 0 || k != found->second) fail(type + " cells with " + std::to_string(k) + " nodes");
-  mesh.cell_type = type;
+  const std::map<CellType, long> node_counts = {{CellType::kTet4, 4},   {CellType::kTet10, 10}, {CellType::kHex8, 8},
+                                                {CellType::kHex20, 20}, {CellType::kTri3, 3},   {CellType::kTri6, 6},
+                                                {CellType::kQuad4, 4},  {CellType::kQuad8, 8},  {CellType::kLine2, 2}};
+  const std::optional<CellType> cell_type = KindOf<CellType>(type);
+  if (!cell_type) fail("cell type '" + type + "'");  // it once fell back to hex20 silently
+  if (m <= 0 || k != node_counts.at(*cell_type)) fail(type + " cells with " + std::to_string(k) + " nodes");
+  mesh.cell_type = *cell_type;
   mesh.cells.resize(m, k);
   for (long e = 0; e < m; ++e)
     for (long a = 0; a < k; ++a)
@@ -149,15 +150,11 @@ ForeignMesh ReadWithMeshio(const std::string& path, const std::string& where, bo
 
 SolidMesh ImportWithMeshio(const std::string& path, const std::string& where) {
   ForeignMesh foreign = ReadWithMeshio(path, where, false);
-  const std::map<std::string, SolidType> types = {{"tet4", SolidType::kTet4},
-                                                  {"tet10", SolidType::kTet10},
-                                                  {"hex8", SolidType::kHex8},
-                                                  {"hex20", SolidType::kHex20}};
-  const auto found = types.find(foreign.cell_type);
-  if (found == types.end()) throw InputError(where + ": " + path + " has no volume elements");
+  const std::optional<SolidType> type = SolidTypeOf(foreign.cell_type);
+  if (!type) throw InputError(where + ": " + path + " has no volume elements");
   SolidMesh mesh;
   mesh.nodes = std::move(foreign.nodes);
-  mesh.type = found->second;
+  mesh.type = *type;
   mesh.cells = std::move(foreign.cells);
   mesh.node_sets = std::move(foreign.node_sets);
   return mesh;

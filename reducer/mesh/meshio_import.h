@@ -15,10 +15,10 @@ bool IsGmshFile(const std::string& path);
 
 /// A mesh as the bridge reads it: any cell type femb draws, and the file's node labels.
 struct ForeignMesh {
-  Eigen::MatrixXd nodes;  ///< n x 3
-  std::vector<long> ids;  ///< node labels of the file (.inp, .bdf), else 1..n in file order
-  std::string cell_type;  ///< tet4, tet10, hex8, hex20; with any_cells also tri3, tri6, quad4, quad8, line2
-  Eigen::MatrixXi cells;  ///< 0-based, gmsh node order
+  Eigen::MatrixXd nodes;                 ///< n x 3
+  std::vector<long> ids;                 ///< node labels of the file (.inp, .bdf), else 1..n in file order
+  CellType cell_type = CellType::kTet4;  ///< solids; with any_cells also tri3, tri6, quad4, quad8, line2
+  Eigen::MatrixXi cells;                 ///< 0-based, gmsh node order
   std::map<std::string, std::vector<int>> node_sets;
 };
 

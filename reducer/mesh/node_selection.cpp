@@ -25,15 +25,15 @@ double DefaultTolerance(const Eigen::MatrixXd& nodes) {
 
 double SelectionDistance(const NodeSelectionSpec& s, const Eigen::Vector3d& x) {
   const Eigen::Vector3d d = x - s.point;
-  if (s.shape == "cylinder") {
+  if (s.shape == SelectionShape::kCylinder) {
     const double along = d.dot(s.axis);
     const double radial = std::abs((d - along * s.axis).norm() - s.radius);
     if (s.length <= 0) return radial;
     const double beyond = along < 0 ? -along : along > s.length ? along - s.length : 0.0;
     return std::hypot(radial, beyond);
   }
-  if (s.shape == "sphere") return std::abs(d.norm() - s.radius);
-  if (s.shape == "plane") return std::abs(d.dot(s.axis));
+  if (s.shape == SelectionShape::kSphere) return std::abs(d.norm() - s.radius);
+  if (s.shape == SelectionShape::kPlane) return std::abs(d.dot(s.axis));
   // box: min = point, max = axis
   const Eigen::Vector3d outside = (s.point - x).cwiseMax(x - s.axis).cwiseMax(0.0);
   return outside.norm();
@@ -61,7 +61,7 @@ std::vector<int> SelectNodes(const NodeSelectionSpec& s, const Eigen::MatrixXd& 
 
 std::string DescribeSelection(const NodeSelectionSpec& s) {
   char b[64];
-  if (s.shape == "cylinder") {
+  if (s.shape == SelectionShape::kCylinder) {
     std::snprintf(b, sizeof b, "cylinder r = %.6g", s.radius);
     std::string out = std::string(b) + " through " + Point(s.point) + " along " + Point(s.axis);
     if (s.length > 0) {
@@ -70,11 +70,11 @@ std::string DescribeSelection(const NodeSelectionSpec& s) {
     }
     return out;
   }
-  if (s.shape == "sphere") {
+  if (s.shape == SelectionShape::kSphere) {
     std::snprintf(b, sizeof b, "sphere r = %.6g", s.radius);
     return std::string(b) + " about " + Point(s.point);
   }
-  if (s.shape == "plane") return "plane through " + Point(s.point) + " normal to " + Point(s.axis);
+  if (s.shape == SelectionShape::kPlane) return "plane through " + Point(s.point) + " normal to " + Point(s.axis);
   return "box " + Point(s.point) + " .. " + Point(s.axis);
 }
 

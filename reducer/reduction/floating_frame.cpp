@@ -32,8 +32,8 @@ std::optional<SparseMatrix> CenterOfMassInterpolation(const std::string& where, 
 
 }  // namespace
 
-void CheckFloatingFrame(const std::string& type, const std::string& where, const FeModel& model) {
-  if (type != "center_of_mass") return;
+void CheckFloatingFrame(const ReductionSpec& reduction, const FeModel& model) {
+  if (reduction.floating_frame != FloatingFrameType::kCenterOfMass) return;
   // The centre of mass from the rigid fields R (translations, rotations about the part origin):
   // R^T M R = [m 1, -S~; S~, J], the first moment S = m c from its (translation, rotation) block.
   const Eigen::MatrixXd R = RigidFields(model);
@@ -41,49 +41,59 @@ void CheckFloatingFrame(const std::string& type, const std::string& where, const
   const double m = M_rig(0, 0);
   if (!(m > 0)) return;  // (a massless model is refused elsewhere, with its own message)
   const Eigen::Vector3d c = Eigen::Vector3d(-M_rig(2, 4), -M_rig(0, 5), -M_rig(1, 3)) / m;
-  CenterOfMassInterpolation(where, model, c);
+  CenterOfMassInterpolation(reduction.where_floating_frame, model, c);
 }
 
-FloatingFrame ComputeFloatingFrame(const std::string& type, const std::string& where, const Superelement& se,
-                                   const FeModel& model, const Eigen::MatrixXd& shapes) {
+FloatingFrame ComputeFloatingFrame(const ReductionSpec& reduction, const Superelement& se, const FeModel& model,
+                                   const Eigen::MatrixXd& shapes) {
+  const std::string& where = reduction.where_floating_frame;
   FloatingFrame frame;
-  frame.type = type;
+  frame.type = reduction.FloatingFrameWord();
   const int n_r = se.n_reduced_dofs(), N = se.n_interface_nodes();
   const Eigen::Vector3d c = se.mass_properties.center_of_mass;
   frame.Phi_CB = Eigen::MatrixXd::Zero(6, n_r);
 
-  if (type == "center_of_mass") {
-    const std::optional<SparseMatrix> interpolation = CenterOfMassInterpolation(where, model, c);
-    frame.origin = c;
-    frame.Phi_CB = (*interpolation) * shapes;
-  } else if (type == "mean_axes") {
-    frame.origin = c;
-    const Eigen::MatrixXd Phi_rig0 = RigidBodyModes(se, c);
-    const Eigen::Matrix<double, 6, 6> M_rig = RigidBodyMassMatrix(se, c);
-    frame.Phi_CB = M_rig.ldlt().solve(Phi_rig0.transpose() * se.M);
-  } else if (type.rfind("interface:", 0) == 0) {
-    const std::string name = type.substr(10);
-    int k = -1;
-    for (int i = 0; i < N; ++i) {
-      if (se.interfaces[i].name == name) k = i;
+  switch (reduction.floating_frame) {
+    case FloatingFrameType::kCenterOfMass: {
+      const std::optional<SparseMatrix> interpolation = CenterOfMassInterpolation(where, model, c);
+      frame.origin = c;
+      frame.Phi_CB = (*interpolation) * shapes;
+      break;
     }
-    if (k < 0) throw InputError(where + ": floating frame interface '" + name + "' not found");
-    frame.origin = se.interfaces[k].position;
-    frame.Phi_CB.block(0, 6 * k, 6, 6).setIdentity();
-  } else if (type == "cardona") {
-    Eigen::MatrixXd X(3, N);
-    for (int k = 0; k < N; ++k) X.col(k) = se.interfaces[k].position - c;
-    Eigen::MatrixXd A(N + 1, N);
-    A.topRows(N) = X.transpose() * X;
-    A.row(N).setOnes();
-    Eigen::VectorXd v = Eigen::VectorXd::Zero(N + 1);
-    v[N] = 1.0;
-    const Eigen::VectorXd alpha = A.completeOrthogonalDecomposition().solve(v);
-    frame.cardona_weights = alpha;
-    frame.origin = c + X * alpha;
-    for (int k = 0; k < N; ++k) frame.Phi_CB.block(0, 6 * k, 6, 6) = alpha[k] * Eigen::Matrix<double, 6, 6>::Identity();
-  } else {
-    throw InputError(where + ": unknown floating frame '" + type + "'");
+    case FloatingFrameType::kMeanAxes: {
+      frame.origin = c;
+      const Eigen::MatrixXd Phi_rig0 = RigidBodyModes(se, c);
+      const Eigen::Matrix<double, 6, 6> M_rig = RigidBodyMassMatrix(se, c);
+      frame.Phi_CB = M_rig.ldlt().solve(Phi_rig0.transpose() * se.M);
+      break;
+    }
+    case FloatingFrameType::kInterface: {
+      const std::string& name = reduction.floating_frame_interface;
+      int k = -1;
+      for (int i = 0; i < N; ++i) {
+        if (se.interfaces[i].name == name) k = i;
+      }
+      if (k < 0) throw InputError(where + ": floating frame interface '" + name + "' not found");
+      frame.origin = se.interfaces[k].position;
+      frame.Phi_CB.block(0, 6 * k, 6, 6).setIdentity();
+      break;
+    }
+    case FloatingFrameType::kCardona: {
+      Eigen::MatrixXd X(3, N);
+      for (int k = 0; k < N; ++k) X.col(k) = se.interfaces[k].position - c;
+      Eigen::MatrixXd A(N + 1, N);
+      A.topRows(N) = X.transpose() * X;
+      A.row(N).setOnes();
+      Eigen::VectorXd v = Eigen::VectorXd::Zero(N + 1);
+      v[N] = 1.0;
+      const Eigen::VectorXd alpha = A.completeOrthogonalDecomposition().solve(v);
+      frame.cardona_weights = alpha;
+      frame.origin = c + X * alpha;
+      for (int k = 0; k < N; ++k) {
+        frame.Phi_CB.block(0, 6 * k, 6, 6) = alpha[k] * Eigen::Matrix<double, 6, 6>::Identity();
+      }
+      break;
+    }
   }
   return frame;
 }

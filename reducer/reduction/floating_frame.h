@@ -13,19 +13,21 @@
 
 #include <string>
 
+#include "formats/part_file.h"
 #include "formats/superelement.h"
 #include "reducer/fe/fe_model.h"
 
 namespace femb {
 
-/// `se` must have interfaces, K, M and mass_properties set; `shapes` is n_full x n_r.
-/// Throws InputError (prefixed by `where`) for center_of_mass outside the material.
-FloatingFrame ComputeFloatingFrame(const std::string& type, const std::string& where, const Superelement& se,
-                                   const FeModel& model, const Eigen::MatrixXd& shapes);
+/// The frame `reduction` asks for (floating_frame, floating_frame_interface; messages name
+/// where_floating_frame). `se` must have interfaces, K, M and mass_properties set; `shapes` is
+/// n_full x n_r. Throws InputError for center_of_mass outside the material.
+FloatingFrame ComputeFloatingFrame(const ReductionSpec& reduction, const Superelement& se, const FeModel& model,
+                                   const Eigen::MatrixXd& shapes);
 
 /// The refusals of `type` that need only the model's mesh and mass, before any reduction work:
 /// center_of_mass without volume cells or with the centre of mass (from the full M and the rigid
 /// fields) outside the material. Throws the same InputError as ComputeFloatingFrame.
-void CheckFloatingFrame(const std::string& type, const std::string& where, const FeModel& model);
+void CheckFloatingFrame(const ReductionSpec& reduction, const FeModel& model);
 
 }  // namespace femb

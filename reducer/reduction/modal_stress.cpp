@@ -56,9 +56,9 @@ std::vector<Fibre> SectionFibres(const BeamSectionSpec& s, const SectionProperti
     f.map(0, 5) = -y / p.Iz;
     return f;
   };
-  if (s.shape == "circle" || s.shape == "tube") {
-    const double R = s.shape == "circle" ? 0.5 * s.diameter : s.outer_radius;
-    const double r = s.shape == "circle" ? 0.0 : s.outer_radius - s.wall;
+  if (s.shape == SectionShape::kCircle || s.shape == SectionShape::kTube) {
+    const double R = s.shape == SectionShape::kCircle ? 0.5 * s.diameter : s.outer_radius;
+    const double r = s.shape == SectionShape::kCircle ? 0.0 : s.outer_radius - s.wall;
     const double jourawski = (4.0 / 3.0) * (R * R + R * r + r * r) / (R * R + r * r) / p.A;
     for (int k = 0; k < 8; ++k) {
       const double phi = k * M_PI / 4, c = std::cos(phi), sn = std::sin(phi);
@@ -70,7 +70,7 @@ std::vector<Fibre> SectionFibres(const BeamSectionSpec& s, const SectionProperti
       if (k % 4 == 0) f.map(2, 2) = jourawski;  // z = 0: the neutral axis of V_z
       fibres.push_back(f);
     }
-  } else if (s.shape == "rectangle") {
+  } else if (s.shape == SectionShape::kRectangle) {
     const double hy = 0.5 * s.width, hz = 0.5 * s.height;
     double t_long = 0, t_short = 0;
     RectangleTorsion(std::max(hy, hz), std::min(hy, hz), &t_long, &t_short);

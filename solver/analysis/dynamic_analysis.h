@@ -21,29 +21,11 @@
 #include <string>
 #include <vector>
 
+#include "formats/kinds.h"
 #include "solver/assembly/free_solver.h"
 #include "solver/assembly/system.h"
 
 namespace femb {
-
-enum class Integrator {
-  kGeneralizedAlpha,  ///< Lie-group generalized-alpha, numerical damping set by rho_inf
-  kMidpoint,          ///< momentum-conserving midpoint (Simo-Wong for rigid bodies), no damping
-};
-
-/// When Newton factors its iteration matrix anew (IterationMatrix, dynamic_step.h).
-enum class JacobianReuse {
-  kNone,   ///< every iteration: full Newton
-  kStep,   ///< the first iteration of every step; its later iterations keep that factor while
-           ///< each of them contracts the residual at least tenfold (modified Newton within the step)
-  kSteps,  ///< kept across steps of the same size; anew after reuse_max_iterations iterations with it
-};
-
-/// Which of a body's matrices DynamicOptions::body_matrices_every keeps between computations.
-enum class BodyMatricesKept {
-  kInertia,  ///< mass and gyroscopic (the inertia force's); the tangents computed every time
-  kAll,      ///< all: also the elastic tangent and the inertia's configuration tangent
-};
 
 struct DynamicOptions;
 JacobianReuse JacobianReuseOf(const DynamicOptions& options);

@@ -16,9 +16,9 @@
 #include <Eigen/Core>
 #include <string>
 
-namespace femb {
+#include "formats/kinds.h"
 
-enum class JointType { kRigid, kRevolute, kPrismatic, kCylindrical, kSpherical, kUniversal };
+namespace femb {
 
 /// The parent of a joint to the ground: a fixed node at the origin with world axes and no
 /// coordinates (x_p = 0, R_p = 1, no Jacobian, no motion). A clamp is a rigid joint to it.

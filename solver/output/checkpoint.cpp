@@ -141,7 +141,7 @@ std::string ModelSignature(const Scene& scene) {
 }
 
 void WriteCheckpoint(const std::string& directory, const Scene& scene, const std::string& signature,
-                     const DynamicState& state, const std::string& analysis, const DynamicResume* resume,
+                     const DynamicState& state, AnalysisType analysis, const DynamicResume* resume,
                      const std::function<void(h5::Writer&)>& extra) {
   const std::string path = (std::filesystem::path(directory) / "checkpoint.h5").string();
   const std::string tmp = path + ".tmp." + std::to_string(::getpid());
@@ -150,7 +150,7 @@ void WriteCheckpoint(const std::string& directory, const Scene& scene, const std
     w.Attribute("/", "format", kFormat);
     w.Attribute("/", "format_version", kVersion);
     w.Attribute("/", "scene", scene.spec.file);
-    w.Attribute("/", "analysis", analysis);
+    w.Attribute("/", "analysis", std::string(Name(analysis)));
     w.Attribute("/", "model", signature);
     // A static state has no velocities: zero.
     DynamicState full;
@@ -264,9 +264,14 @@ DynamicState ReadState(const h5::Reader& r, const std::string& g, const SystemMo
 
 }  // namespace
 
-DynamicState ReadCheckpoint(const std::string& directory, const Scene& scene, std::string* analysis) {
+DynamicState ReadCheckpoint(const std::string& directory, const Scene& scene, AnalysisType* analysis) {
   const h5::Reader r = OpenCheckpoint(directory, scene);
-  if (analysis) *analysis = r.StringAttribute("/", "analysis");
+  if (analysis) {
+    const std::string word = r.StringAttribute("/", "analysis");
+    const std::optional<AnalysisType> type = KindOf<AnalysisType>(word);
+    if (!type) throw InputError(r.path() + ": the analysis '" + word + "' is not one femb writes");
+    *analysis = *type;
+  }
   return ReadState(r, "/state", scene.model);
 }
 

@@ -25,14 +25,14 @@ std::string ModelSignature(const Scene& scene);
 /// `resume` (captured at `state`) the file also holds what a dynamic run carries into its next
 /// step (group /resume), and `extra` adds the caller's own groups (the results so far).
 void WriteCheckpoint(const std::string& directory, const Scene& scene, const std::string& signature,
-                     const DynamicState& state, const std::string& analysis, const DynamicResume* resume = nullptr,
+                     const DynamicState& state, AnalysisType analysis, const DynamicResume* resume = nullptr,
                      const std::function<void(h5::Writer&)>& extra = nullptr);
 
 /// The state in `directory`/checkpoint.h5 for `scene`'s model, with its node Jacobians. Throws
 /// InputError (one line naming the file) when there is none, it is not a femb checkpoint, is
 /// truncated, or belongs to another model (the first difference named). `analysis`: the kind
 /// of run that wrote it.
-DynamicState ReadCheckpoint(const std::string& directory, const Scene& scene, std::string* analysis = nullptr);
+DynamicState ReadCheckpoint(const std::string& directory, const Scene& scene, AnalysisType* analysis = nullptr);
 
 /// The checkpoint's /resume group (ReadCheckpoint's checks first), the state included, to the
 /// bit; false when the checkpoint has none (a static run's, or one written before the first step).

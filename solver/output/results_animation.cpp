@@ -81,7 +81,7 @@ const ResultsRecorder::AnimationGrid& ResultsRecorder::Grid() {
   grid_ = std::make_unique<AnimationGrid>();
   AnimationGrid& g = *grid_;
   struct Block {
-    std::string cell_type;  // "line2", "tet10", ...
+    CellType cell_type;
     Eigen::MatrixXi cells;  // VTK/XDMF node order, body-local node indices
   };
   std::vector<Block> blocks;
@@ -92,7 +92,7 @@ const ResultsRecorder::AnimationGrid& ResultsRecorder::Grid() {
       const Visualization& mesh = *scene_.meshes[b];
       Eigen::MatrixXi cells = ToVtkOrder(mesh.cell_type, mesh.cells);
       std::vector<int>& order = g.node_of[b];
-      if (mesh.cell_type == "line2" || mesh.cell_type == "line3") {
+      if (mesh.cell_type == CellType::kLine2) {
         order.resize(size_t(mesh.nodes.rows()));
         std::iota(order.begin(), order.end(), 0);
       } else {
@@ -108,7 +108,7 @@ const ResultsRecorder::AnimationGrid& ResultsRecorder::Grid() {
       const long m = long(scene_.stick_nodes[b].size());
       Eigen::MatrixXi lines = Eigen::MatrixXi::Zero(std::max(m - 1, 1L), 2);
       for (long i = 1; i < m; ++i) lines.row(i - 1) << 0, int(i);
-      blocks.push_back({"line2", lines});
+      blocks.push_back({CellType::kLine2, lines});
       body_nodes[b] = m;
       g.node_of[b].resize(size_t(m));
       std::iota(g.node_of[b].begin(), g.node_of[b].end(), 0);
@@ -145,7 +145,7 @@ const ResultsRecorder::AnimationGrid& ResultsRecorder::Grid() {
                                                                                               g.per_cell);
     g.flat.clear();
   }
-  g.cell_type = g.uniform ? blocks.front().cell_type : "mixed";
+  g.cell_type = blocks.front().cell_type;
   return g;
 }
 
@@ -309,7 +309,7 @@ void ResultsRecorder::WriteXdmf(const std::string& mesh_file) {
     out << "   <Grid Name=\"step " << s << "\" GridType=\"Uniform\">\n"
         << "    <Time Value=\"" << Num(frame_time_[s]) << "\"/>\n"
         << "    <Topology TopologyType=\"" << topology << "\" NumberOfElements=\"" << g.n_cells << "\"";
-    if (g.cell_type == "line2") out << " NodesPerElement=\"2\"";
+    if (g.uniform && g.cell_type == CellType::kLine2) out << " NodesPerElement=\"2\"";
     out << ">\n     <DataItem Dimensions=\""
         << (g.uniform ? std::to_string(g.n_cells) + " " + std::to_string(g.per_cell) : std::to_string(g.flat.size()))
         << "\" NumberType=\"Int\" Precision=\"4\" Format=\"HDF\">" << mesh_file

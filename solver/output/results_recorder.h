@@ -221,8 +221,8 @@ class ResultsRecorder {
   // the frames not yet written (from frames_written_ on).
   struct AnimationGrid {
     bool uniform = true;
-    std::string cell_type;  ///< "line2", "tet10", ... or "mixed"
-    int per_cell = 0;       ///< nodes per cell (uniform)
+    CellType cell_type = CellType::kLine2;  ///< of every cell (uniform)
+    int per_cell = 0;                       ///< nodes per cell (uniform)
     long n_nodes = 0, n_cells = 0;
     Eigen::MatrixXi cells;     ///< uniform: n_cells x per_cell
     std::vector<int> flat;     ///< mixed: (XDMF type, [count,] nodes...) per cell

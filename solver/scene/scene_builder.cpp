@@ -35,33 +35,13 @@ SystemModel::Prescribed PrescribedBy(const TimeFunctionSpec& f, int k) {
 // Joints that share a point (spherical, revolute, universal; cylindrical up to a shift along its
 // axis) refuse nodes that are apart at t = 0: the offset would silently become a rigid arm of
 // the parent (node_joint.h: x_c = x_p + R_p r0). Tolerance 1e-6 of the scene's size.
-// The solver's joint for a scene joint (a clamp between two nodes is a rigid joint).
-JointType SolverJointType(SceneJointType type) {
-  switch (type) {
-    case SceneJointType::kClamp:
-    case SceneJointType::kRigid:
-      return JointType::kRigid;
-    case SceneJointType::kSpherical:
-      return JointType::kSpherical;
-    case SceneJointType::kRevolute:
-      return JointType::kRevolute;
-    case SceneJointType::kPrismatic:
-      return JointType::kPrismatic;
-    case SceneJointType::kCylindrical:
-      return JointType::kCylindrical;
-    case SceneJointType::kUniversal:
-      return JointType::kUniversal;
-  }
-  return JointType::kRigid;
-}
-
 void RequireJointGap(const SceneJointSpec& j, const Eigen::Vector3d& x_p, const Eigen::Vector3d& x_c,
                      double scene_length) {
   Eigen::Vector3d gap = x_c - x_p;
-  const bool cylindrical = j.type == SceneJointType::kCylindrical;
+  const bool cylindrical = j.type == JointType::kCylindrical;
   if (cylindrical) gap -= gap.dot(j.axis.normalized()) * j.axis.normalized();
-  if (j.type != SceneJointType::kSpherical && j.type != SceneJointType::kRevolute &&
-      j.type != SceneJointType::kUniversal && !cylindrical) {
+  if (j.type != JointType::kSpherical && j.type != JointType::kRevolute && j.type != JointType::kUniversal &&
+      !cylindrical) {
     return;
   }
   const double tolerance = 1e-6 * std::max(scene_length, 1e-3 * std::max(x_p.norm(), x_c.norm()));
@@ -70,8 +50,8 @@ void RequireJointGap(const SceneJointSpec& j, const Eigen::Vector3d& x_p, const 
   std::snprintf(buffer, sizeof buffer,
                 ": %s joint between nodes '%s' and '%s': the nodes are %.6g apart at t = 0 (gap (%.6g, %.6g, %.6g)%s); "
                 "a %s joint needs them at one point: move the bodies or use a rigid joint for an offset",
-                Name(j.type), j.node.c_str(), j.parent.c_str(), gap.norm(), gap.x(), gap.y(), gap.z(),
-                cylindrical ? " across the axis" : "", Name(j.type));
+                j.Word(), j.node.c_str(), j.parent.c_str(), gap.norm(), gap.x(), gap.y(), gap.z(),
+                cylindrical ? " across the axis" : "", j.Word());
   throw InputError(j.where + buffer);
 }
 
@@ -225,7 +205,7 @@ SuperelementOptions BodyOptions(const SceneSpec& spec, const SceneBodySpec& b, c
   // its elastic force is no exact discrete gradient of the stiffened energy, and the
   // corotational inertia gives wrong Southwell slopes with the stiffening (README), so there it
   // is used only when asked for.
-  const bool midpoint = spec.analysis.integrator == IntegratorType::kMidpoint;
+  const bool midpoint = spec.analysis.integrator == Integrator::kMidpoint;
   options.geometric_stiffening = b.geometric_stiffening.value_or(!midpoint);
   const bool file_has_stiffening = !se.inertia_stiffness.empty();
   if (b.geometric_stiffening.value_or(false) && !file_has_stiffening) {
@@ -435,16 +415,16 @@ void AddJoints(const SceneSpec& spec, const Placement& placement, Scene& scene) 
     const int p = j.parent.empty() ? kGround : scene.node_index.at(j.parent);
     if (p >= 0) RequireJointGap(j, model.node_x0[p], model.node_x0[k], scene_length);
     const bool in_tree = !j.cut && tree.Free(k, p);
-    const JointType type = SolverJointType(j.type);
+    const JointType type = j.type;
     if (!in_tree) {
       if (!j.prescribed.empty()) {
         throw InputError(
-            j.where + ": " + Name(j.type) + " joint of node '" + j.node + "' is prescribed but closes a loop (node '" +
+            j.where + ": " + j.Word() + " joint of node '" + j.node + "' is prescribed but closes a loop (node '" +
             j.node + "' already hangs on " +
             (tree.holder(k) >= 0 ? "node '" + model.node_names[tree.holder(k)] + "'" : std::string("the ground")) +
             "); a drive must be a tree joint: swap 'node' and 'parent', or prescribe another joint of the loop");
       }
-      const std::string name = j.where + ": " + Name(j.type) + " joint of node '" + j.node + "'" +
+      const std::string name = j.where + ": " + j.Word() + " joint of node '" + j.node + "'" +
                                (p >= 0 ? " on node '" + j.parent + "'" : std::string(" to the ground"));
       tree.AddCut(type, k, p >= 0 ? p : tree.HiddenGround(k), j.axis, j.axis2, name);
       continue;
@@ -482,12 +462,12 @@ void NoteCutJoints(Scene& scene) {
 void AddLoads(const SceneSpec& spec, Scene& scene) {
   SystemModel& model = scene.model;
   for (const SceneLoadSpec& l : spec.loads) {
-    if (l.type == SceneLoadType::kGravity) {
+    if (l.type == LoadType::kGravity) {
       model.gravity += l.g;
       if (spec.analysis.type != AnalysisType::kDynamic) model.static_gravity_end = spec.analysis.end_time;
       continue;
     }
-    if (l.type == SceneLoadType::kSpring) {
+    if (l.type == LoadType::kSpring) {
       SpringDamper s;
       s.node_a = scene.node_index.at(l.node);
       s.node_b = l.node_b.empty() ? -1 : scene.node_index.at(l.node_b);
@@ -575,7 +555,7 @@ Scene BuildScene(const SceneSpec& spec) {
   for (const SceneBodySpec& b_spec : spec.bodies) {
     SceneBodySpec b = b_spec;
     b.position -= scene.origin;
-    if (b.type == SceneBodyType::kRigid) {
+    if (b.type == BodyType::kRigid) {
       AddRigidBody(spec, b, scene, placement);
     } else {
       AddSuperelementBody(spec, b, scene, placement);

@@ -96,13 +96,13 @@ void ResolveProbes(const SceneSpec& spec, Scene& scene) {
       probe.s0 = X - scene.mesh_origin[size_t(b)];
       const int n = model.bodies[size_t(b)].n_coordinates();
       probe.shape = Eigen::MatrixXd::Zero(3, n);
-      if (body.type != SceneBodyType::kRigid) {
+      if (body.type != BodyType::kRigid) {
         if (!scene.meshes[size_t(b)]) {
           throw InputError(p.where + ": probe '" + p.name + "': body '" + p.body + "' has no mesh in " +
                            body.superelement + " (reduce it with reduction.keep_mesh: true)");
         }
         const Visualization& mesh = *scene.meshes[size_t(b)];
-        if (mesh.cell_type == "line2" && mesh.dofs_per_node == 6 && mesh.cells.cols() == 2) {
+        if (mesh.cell_type == CellType::kLine2 && mesh.dofs_per_node == 6 && mesh.cells.cols() == 2) {
           int cell = -1;
           double s = 0, distance = 0, length = 0;
           probe.shape = BeamPointShape(mesh, X, &cell, &s, &distance, &length);
@@ -153,7 +153,7 @@ void ResolveProbes(const SceneSpec& spec, Scene& scene) {
     if (!has(ProbeQuantity::kStress)) continue;
     if (!scene.stresses[size_t(b)]) {
       throw InputError(p.where + ": probe '" + p.name + "': body '" + p.body + "' has no modal stresses" +
-                       (body.type == SceneBodyType::kRigid
+                       (body.type == BodyType::kRigid
                             ? std::string(" (a rigid body)")
                             : " in " + body.superelement +
                                   " (reduce it with the mesh kept: reduction.keep_mesh, reduction.stresses)"));

@@ -40,7 +40,7 @@ TEST(PartFile, GoodFileParses) {
   EXPECT_EQ(p.interfaces.size(), 2u);
   EXPECT_EQ(p.interfaces[1].point, 1);
   EXPECT_EQ(p.reduction.internal_modes, 4);
-  EXPECT_EQ(p.reduction.floating_frame, "center_of_mass");
+  EXPECT_EQ(p.reduction.floating_frame, FloatingFrameType::kCenterOfMass);
 }
 
 TEST(PartFile, SetOverridesKeys) {
@@ -48,7 +48,7 @@ TEST(PartFile, SetOverridesKeys) {
       kGood, "part.yaml",
       {"reduction.internal_modes=7", "reduction.floating_frame=mean_axes", "units=mm-t-s", "check_units=false"});
   EXPECT_EQ(p.reduction.internal_modes, 7);
-  EXPECT_EQ(p.reduction.floating_frame, "mean_axes");
+  EXPECT_EQ(p.reduction.floating_frame, FloatingFrameType::kMeanAxes);
   EXPECT_EQ(p.units.length, "mm");
   EXPECT_EQ(p.units.stress, "MPa");
   EXPECT_NE(ParsePart(kGood, "part.yaml").text_hash, p.text_hash);

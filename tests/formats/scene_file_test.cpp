@@ -45,7 +45,7 @@ TEST(SceneFile, GoodFileParses) {
   ASSERT_EQ(s.joints.size(), 1u);
   EXPECT_EQ(s.joints[0].prescribed, "drive");
   EXPECT_EQ(s.analysis.type, AnalysisType::kDynamic);
-  EXPECT_EQ(s.analysis.integrator, IntegratorType::kMidpoint);
+  EXPECT_EQ(s.analysis.integrator, Integrator::kMidpoint);
   EXPECT_DOUBLE_EQ(s.analysis.step, 1e-3);
   EXPECT_FALSE(s.analysis.adaptive_step);
   EXPECT_EQ(s.functions.at("spin").type, TimeFunctionType::kSpinUp);
@@ -73,11 +73,11 @@ TEST(SceneFile, BodyMatricesEveryIsAWholeNumberOfSteps) {
 }
 
 TEST(SceneFile, BodyMatricesKeptIsInertiaOrAll) {
-  EXPECT_EQ(ParseScene(kGood, "scene.yaml").analysis.body_matrices_kept, BodyMatricesKeptType::kAll);
+  EXPECT_EQ(ParseScene(kGood, "scene.yaml").analysis.body_matrices_kept, BodyMatricesKept::kAll);
   EXPECT_EQ(ParseScene(kGood, "scene.yaml", {"analysis.body_matrices_kept=inertia"}).analysis.body_matrices_kept,
-            BodyMatricesKeptType::kInertia);
+            BodyMatricesKept::kInertia);
   EXPECT_EQ(ParseScene(kGood, "scene.yaml", {"analysis.body_matrices_kept=all"}).analysis.body_matrices_kept,
-            BodyMatricesKeptType::kAll);
+            BodyMatricesKept::kAll);
   const std::string message = Error(kGood, {"analysis.body_matrices_kept=mass"});
   EXPECT_NE(message.find("body_matrices_kept"), std::string::npos) << message;
 }
@@ -86,12 +86,12 @@ TEST(SceneFile, JacobianReuseTakesItsNamesAndTheOldBooleans) {
   const auto reuse = [](const std::string& value) {
     return ParseScene(kGood, "scene.yaml", {"analysis.jacobian_reuse=" + value}).analysis.jacobian_reuse;
   };
-  EXPECT_EQ(ParseScene(kGood, "scene.yaml").analysis.jacobian_reuse, JacobianReuseType::kDefault);
-  EXPECT_EQ(reuse("step"), JacobianReuseType::kStep);
-  EXPECT_EQ(reuse("steps"), JacobianReuseType::kSteps);
-  EXPECT_EQ(reuse("none"), JacobianReuseType::kNone);
-  EXPECT_EQ(reuse("true"), JacobianReuseType::kSteps);  // the boolean's meaning before `step`
-  EXPECT_EQ(reuse("false"), JacobianReuseType::kNone);
+  EXPECT_FALSE(ParseScene(kGood, "scene.yaml").analysis.jacobian_reuse.has_value());
+  EXPECT_EQ(reuse("step"), JacobianReuse::kStep);
+  EXPECT_EQ(reuse("steps"), JacobianReuse::kSteps);
+  EXPECT_EQ(reuse("none"), JacobianReuse::kNone);
+  EXPECT_EQ(reuse("true"), JacobianReuse::kSteps);  // the boolean's meaning before `step`
+  EXPECT_EQ(reuse("false"), JacobianReuse::kNone);
   const std::string bad = Error(kGood, {"analysis.jacobian_reuse=sometimes"});
   EXPECT_NE(bad.find("jacobian_reuse"), std::string::npos) << bad;
   EXPECT_NE(bad.find("expected step, steps, none, true or false, got 'sometimes'"), std::string::npos) << bad;

@@ -81,7 +81,7 @@ Outcome Simulate(const std::string& name, const std::string& scene, const std::m
   options.end_time = a.end_time;
   options.rho_inf = a.rho_inf;
   options.tolerance = a.tolerance;
-  if (a.integrator == IntegratorType::kMidpoint) options.integrator = Integrator::kMidpoint;
+  options.integrator = a.integrator;
   if (tweak) tweak(options);
   const DynamicStepReport r0 = Measure(s.model, state);
   const double E0 = r0.kinetic_energy + r0.elastic_energy;

@@ -77,7 +77,7 @@ TEST(ImportedModel, EveryFormatRoundTripsToTheNativeSuperelement) {
   WriteText(dir / "native.yaml",
             test::Replace(kBar, "{shape: box, size: [1.0, 0.05, 0.05]}", "{file: calculix/bar.inp}"));
   for (const std::string format : {"calculix", "abaqus", "matrix_market"}) {
-    ExportPartMatrices(part, format, (dir / format).string());
+    ExportPartMatrices(part, *KindOf<MatrixFormat>(format), (dir / format).string());
   }
   const Superelement native = ReduceFile(dir / "native.yaml");
   for (const std::string format : {"calculix", "abaqus", "matrix_market"}) {
@@ -105,7 +105,7 @@ TEST(ImportedModel, EveryFormatRoundTripsToTheNativeSuperelement) {
     EXPECT_NEAR(imported.mass_properties.mass, native.mass_properties.mass, 1e-10 * native.mass_properties.mass);
     EXPECT_EQ(imported.provenance.element_type, "imported " + format);
     ASSERT_TRUE(imported.visualization.has_value());
-    EXPECT_EQ(imported.visualization->cell_type, "tet10");
+    EXPECT_EQ(imported.visualization->cell_type, CellType::kTet10);
     EXPECT_LT(shapes, 1e-8) << format;
     EXPECT_FALSE(imported.stress.has_value());
   }
@@ -120,7 +120,7 @@ TEST(ImportedModel, BeamWithRotationalDofsRoundTrips) {
                              "[{name: A}, {name: B}]", "reduction: {internal_modes: 5, floating_frame: mean_axes}\n");
   WriteText(dir / "rod.yaml", beam);
   const PartSpec part = ReadPartFile((dir / "rod.yaml").string());
-  ExportPartMatrices(part, "calculix", dir.string());
+  ExportPartMatrices(part, MatrixFormat::kCalculix, dir.string());
   const Superelement native = ReduceFile(dir / "rod.yaml");
   const std::string name = part.name;
   WriteText(dir / "imported.yaml",
@@ -153,7 +153,7 @@ TEST(ImportedModel, BeamWithRotationalDofsRoundTrips) {
     std::printf("[ info ] beam: inertia invariants %.2e\n", error / scale);
     EXPECT_LT(error, 1e-8 * scale);
   }
-  EXPECT_EQ(imported.visualization->cell_type, "line2");
+  EXPECT_EQ(imported.visualization->cell_type, CellType::kLine2);
   fs::remove_all(dir);
 }
 
@@ -165,7 +165,7 @@ TEST(ImportedModel, CalculixAssemblyMatchesFembsOwn) {
     GTEST_SKIP() << "ccx not installed (apt-get install calculix-ccx)";
   const fs::path dir = TempDir("ccx");
   WriteText(dir / "bar.yaml", kBar);
-  ExportPartMatrices(ReadPartFile((dir / "bar.yaml").string()), "calculix", (dir / "mesh").string());
+  ExportPartMatrices(ReadPartFile((dir / "bar.yaml").string()), MatrixFormat::kCalculix, (dir / "mesh").string());
   WriteText(dir / "job.inp",
             "*INCLUDE, INPUT=mesh/bar.inp\n*MATERIAL, NAME=STEEL\n*ELASTIC\n2.1e11, 0.3\n*DENSITY\n7850.\n"
             "*SOLID SECTION, ELSET=EALL, MATERIAL=STEEL\n*STEP\n*FREQUENCY, SOLVER=MATRIXSTORAGE\n*END STEP\n");
@@ -190,7 +190,7 @@ TEST(ImportedModel, CalculixAssemblyMatchesFembsOwn) {
 TEST(ImportedModel, BadMatricesAreOneLineEach) {
   const fs::path dir = TempDir("bad");
   WriteText(dir / "bar.yaml", kBar);
-  ExportPartMatrices(ReadPartFile((dir / "bar.yaml").string()), "calculix", dir.string());
+  ExportPartMatrices(ReadPartFile((dir / "bar.yaml").string()), MatrixFormat::kCalculix, dir.string());
   const std::string sti = ReadText(dir / "bar.sti"), dof = ReadText(dir / "bar.dof");
   const std::string first = sti.substr(0, sti.find('\n'));  // "1 1 value"
   const double k11 = std::stod(first.substr(4));
@@ -242,10 +242,10 @@ TEST(ImportedModel, GeneralBasisFromAFileMatchesFreeInterface) {
       "reduction: {method: free_interface, internal_modes: 8, floating_frame: mean_axes}\n");
   WriteText(dir / "rod.yaml", rod);
   const PartSpec part = ReadPartFile((dir / "rod.yaml").string());
-  ExportPartMatrices(part, "calculix", dir.string());
+  ExportPartMatrices(part, MatrixFormat::kCalculix, dir.string());
   const std::string name = part.name;
   MatricesSpec spec;
-  spec.format = "calculix";
+  spec.format = MatrixFormat::kCalculix;
   spec.stiffness = (dir / (name + ".sti")).string();
   spec.mass = (dir / (name + ".mas")).string();
   spec.dofs = (dir / (name + ".dof")).string();

@@ -139,7 +139,7 @@ TEST(NonlinearSolid, SlenderCantileverMatchesTheElasticaUnderALargeTipLoad) {
   // beam; shear (0.15% of the deflection at L/h = 20) and the 3D end regions make up the rest.
   // Tolerance: 1% of the tip displacement at every load step.
   MeshRequest request;
-  request.shape = "box";
+  request.shape = SolidShape::kBox;
   request.size = Eigen::Vector3d(1.0, 0.05, 0.05);
   request.element_size = 0.025;
   request.order = 2;

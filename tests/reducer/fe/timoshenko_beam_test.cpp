@@ -16,7 +16,7 @@ MaterialSpec Steel() { return {2.1e11, 0.3, 7850.0}; }
 
 SectionProperties Rect() {
   BeamSectionSpec s;
-  s.shape = "rectangle";
+  s.shape = SectionShape::kRectangle;
   s.width = 0.02;
   s.height = 0.05;
   return ComputeSectionProperties(s, 0.3);
@@ -124,7 +124,7 @@ TEST(TimoshenkoBeam, InterpolationReproducesNodesAndHasConstantShearStrain) {
 
 TEST(BeamSection, NamedShapes) {
   BeamSectionSpec tube;
-  tube.shape = "tube";
+  tube.shape = SectionShape::kTube;
   tube.outer_radius = 0.01;
   tube.wall = 0.001;
   const SectionProperties t = ComputeSectionProperties(tube, 0.3);
@@ -134,7 +134,7 @@ TEST(BeamSection, NamedShapes) {
   // Thin-walled limit of Cowper's factor: 2(1+nu)/(4+3nu) = 0.5306 for nu = 0.3; a 10% wall is close.
   EXPECT_NEAR(t.ky, 0.53, 0.01);
   BeamSectionSpec sq;
-  sq.shape = "rectangle";
+  sq.shape = SectionShape::kRectangle;
   sq.width = sq.height = 0.01;
   // Square torsion constant 0.1406 a^4 (Roark).
   EXPECT_NEAR(ComputeSectionProperties(sq, 0.3).J / 1e-8, 0.1406, 0.0005);

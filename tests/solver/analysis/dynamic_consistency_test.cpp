@@ -438,7 +438,7 @@ void ResumedRunTakesTheSameSteps(const Scene& scene, DynamicOptions o, double t_
   // Through the checkpoint file, as femb-solve --restart reads it.
   const std::string dir = ::testing::TempDir() + "resume_checkpoint";
   std::filesystem::create_directories(dir);
-  WriteCheckpoint(dir, scene, ModelSignature(scene), saved.state, "dynamic", &saved);
+  WriteCheckpoint(dir, scene, ModelSignature(scene), saved.state, AnalysisType::kDynamic, &saved);
   DynamicResume read;
   ASSERT_TRUE(ReadResume(dir, scene, read));
   DynamicOptions second = o;

@@ -54,7 +54,7 @@ struct Files {
     dir = fs::temp_directory_path() / ("femb_spinning_part_" + std::to_string(::getpid()));
     fs::remove_all(dir);
     fs::create_directories(dir);
-    ExportPartMatrices(ParsePart(kBar, "bar.yaml"), "calculix", dir.string());
+    ExportPartMatrices(ParsePart(kBar, "bar.yaml"), MatrixFormat::kCalculix, dir.string());
     Write("native.yaml", test::Replace(kBar, "{shape: box, size: [1.0, 0.05, 0.05]}", "{file: bar.inp}"));
     Write("imported.yaml",
           "name: bar\ntype: imported\nunits: SI\ngeometry: {file: bar.inp}\n"
