@@ -133,13 +133,14 @@ int main(int argc, char** argv) {
       const bool s = b.has_inertia_stiffening();
       femb::InertiaLoadFactors load;
       Eigen::VectorXd f_int, f_in, f_acc;
-      if (s) load = b.InertiaLoads(d, p->w, p->wdot, g);
+      if (s) b.InertiaLoads(d, p->w, p->wdot, g, load);
       b.ElasticForce(d, &f_int, nullptr, s ? &load : nullptr);
       b.InertiaForce(d, p->w, p->wdot, &f_in, nullptr, nullptr, &f_acc);
-      const Eigen::VectorXd f_grav = b.GravityForce(d, g);
+      Eigen::VectorXd f_grav;
+      b.GravityForce(d, g, f_grav);
       sink += f_int.sum() + f_in.sum() + f_acc.sum() + f_grav.sum();
       if (stages < 2) return;
-      Eigen::MatrixXd K, M, C, d_load;
+      Eigen::MatrixXd K, M, C, d_load, K_inertia;
       b.ElasticForce(d, nullptr, &K, s ? &load : nullptr, s ? &d_load : nullptr);
       if (stages < 3) return;
       b.InertiaForce(d, p->w, p->wdot, nullptr, &M, &C);
@@ -148,7 +149,8 @@ int main(int argc, char** argv) {
         C.noalias() += d_load * load.d_w;
       }
       if (stages < 4) return;
-      K += b.InertiaConfigurationTangent(d, p->w, p->wdot, false);
+      b.InertiaConfigurationTangent(d, p->w, p->wdot, false, K_inertia);
+      K += K_inertia;
       sink += K.sum() + M.sum() + C.sum();
     };
     works.push_back([p] {

@@ -183,3 +183,48 @@ Eigen::MatrixXd femb::test::StaticTangentByDifferences(const SystemModel& model,
   }
   return K;
 }
+
+namespace femb::test {
+
+InertiaLoadFactors InertiaLoadsOf(const SuperelementBody& body, const SuperelementBody::Data& d, const BodyVelocity& w,
+                                  const BodyVelocity& wdot, const Eigen::Vector3d& gravity) {
+  InertiaLoadFactors out;
+  body.InertiaLoads(d, w, wdot, gravity, out);
+  return out;
+}
+
+Eigen::VectorXd GravityForceOf(const SuperelementBody& body, const SuperelementBody::Data& d,
+                               const Eigen::Vector3d& g) {
+  Eigen::VectorXd f;
+  body.GravityForce(d, g, f);
+  return f;
+}
+
+Eigen::MatrixXd InertiaConfigurationTangentOf(const SuperelementBody& body, const SuperelementBody::Data& d,
+                                              const BodyVelocity& w, const BodyVelocity& wdot, bool quadratic) {
+  Eigen::MatrixXd tangent;
+  body.InertiaConfigurationTangent(d, w, wdot, quadratic, tangent);
+  return tangent;
+}
+
+BodyVelocityMaps MapsAt(const SuperelementBody& body, const BodyConfiguration& c, const FrameSolution& frame) {
+  return body.MapsOf(body.Evaluate(c, frame));
+}
+
+Eigen::MatrixXd MomentumDerivativeOf(const SuperelementBody& body, const BodyVelocityMaps& maps,
+                                     const BodyVelocity& w) {
+  Eigen::MatrixXd D;
+  BodyScratch scratch;
+  body.MomentumDerivative(maps, w, D, scratch);
+  return D;
+}
+
+Eigen::VectorXd MomentumSourceOf(const SuperelementBody& body, const BodyVelocityMaps& maps, const BodyVelocity& w,
+                                 const Eigen::VectorXd& p) {
+  Eigen::VectorXd out;
+  BodyScratch scratch;
+  body.MomentumSource(maps, w, p, out, scratch);
+  return out;
+}
+
+}  // namespace femb::test

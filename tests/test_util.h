@@ -55,6 +55,19 @@ Eigen::MatrixXd StaticTangentByDifferences(const SystemModel& model, const DofMa
 /// `text` with its first `from` replaced by `to`; fails the calling test when `from` is missing.
 std::string Replace(std::string text, const std::string& from, const std::string& to);
 
+/// A body's kernels as values, for tests that compare them in expressions (the product has the
+/// in-place forms only; these call them).
+InertiaLoadFactors InertiaLoadsOf(const SuperelementBody& body, const SuperelementBody::Data& d, const BodyVelocity& w,
+                                  const BodyVelocity& wdot, const Eigen::Vector3d& gravity);
+Eigen::VectorXd GravityForceOf(const SuperelementBody& body, const SuperelementBody::Data& d, const Eigen::Vector3d& g);
+Eigen::MatrixXd InertiaConfigurationTangentOf(const SuperelementBody& body, const SuperelementBody::Data& d,
+                                              const BodyVelocity& w, const BodyVelocity& wdot, bool quadratic);
+/// The corotational velocity maps at (c, frame) (SuperelementBody::MapsOf).
+BodyVelocityMaps MapsAt(const SuperelementBody& body, const BodyConfiguration& c, const FrameSolution& frame);
+Eigen::MatrixXd MomentumDerivativeOf(const SuperelementBody& body, const BodyVelocityMaps& maps, const BodyVelocity& w);
+Eigen::VectorXd MomentumSourceOf(const SuperelementBody& body, const BodyVelocityMaps& maps, const BodyVelocity& w,
+                                 const Eigen::VectorXd& p);
+
 /// Parses and reduces; fails the calling test on error.
 Superelement Reduce(const std::string& yaml, const std::vector<std::string>& overrides = {});
 

@@ -139,7 +139,8 @@ SystemForces AssembleStatic(const SystemModel& model, const DofMap& dofs, System
     if (gravity_on && body.has_inertia_stiffening()) {
       // The stress of the body's own weight stiffens it (load factors -R_j^T g at rest).
       const Eigen::VectorXd zero = Eigen::VectorXd::Zero(body.n_coordinates());
-      const InertiaLoadFactors load = body.InertiaLoads(data, zero, zero, ramp * model.gravity);
+      InertiaLoadFactors load;
+      body.InertiaLoads(data, zero, zero, ramp * model.gravity, load);
       body.ElasticForce(data, &f, with_tangent ? &K : nullptr, &load);
     } else {
       body.ElasticForce(data, &f, with_tangent ? &K : nullptr);
@@ -157,7 +158,8 @@ SystemForces AssembleStatic(const SystemModel& model, const DofMap& dofs, System
     ScatterBody(map, &minus_f, with_tangent ? &K : nullptr, &out.residual, with_tangent ? &tangent : nullptr);
     AddBodyNodeForces(model, int(b), minus_f, node_forces);
     if (gravity_on) {
-      const Eigen::VectorXd f_grav = body.GravityForce(data, ramp * model.gravity);
+      Eigen::VectorXd f_grav;
+      body.GravityForce(data, ramp * model.gravity, f_grav);
       ScatterBody(map, &f_grav, nullptr, &gravity, nullptr);
       AddBodyNodeForces(model, int(b), f_grav, node_forces);
     }

@@ -60,14 +60,6 @@ void SuperelementBody::VelocityMapRate(const Eigen::MatrixXd& U, const BodyVeloc
   }
 }
 
-Eigen::VectorXd SuperelementBody::QuadraticInertia(const Eigen::MatrixXd& U, const Eigen::MatrixXd& Mg,
-                                                   const BodyVelocity& w) const {
-  Eigen::VectorXd out;
-  BodyScratch scratch;
-  QuadraticInertia(U, Mg, w, out, scratch);
-  return out;
-}
-
 void SuperelementBody::QuadraticInertia(const Eigen::MatrixXd& U, const Eigen::MatrixXd& Mg, const BodyVelocity& w,
                                         Eigen::VectorXd& out, BodyScratch& scratch) const {
   // G = VelocityMapRate(U, w) is never formed: its rows are xdot_a~ U (and omega_a~ U, option A;
@@ -183,21 +175,6 @@ double SuperelementBody::KineticEnergy(const Data& d, const BodyVelocity& w) con
   return 0.5 * w.dot(MassTimes(d, w));
 }
 
-BodyVelocityMaps SuperelementBody::Maps(const BodyConfiguration& c, const FrameSolution& frame) const {
-  return MapsOf(Evaluate(c, frame));
-}
-
-Eigen::VectorXd SuperelementBody::GeneralizedMomentum(const BodyVelocityMaps& maps, const BodyVelocity& w) const {
-  return maps.Mg * w;
-}
-
-Eigen::MatrixXd SuperelementBody::MomentumDerivative(const BodyVelocityMaps& maps, const BodyVelocity& w) const {
-  Eigen::MatrixXd D;
-  BodyScratch scratch;
-  MomentumDerivative(maps, w, D, scratch);
-  return D;
-}
-
 void SuperelementBody::MomentumDerivative(const BodyVelocityMaps& maps, const BodyVelocity& w, Eigen::MatrixXd& D,
                                           BodyScratch& scratch) const {
   const Eigen::MatrixXd& U = maps.U;
@@ -234,13 +211,6 @@ void SuperelementBody::MomentumDerivative(const BodyVelocityMaps& maps, const Bo
 }
 
 void SuperelementBody::MomentumSourceDerivatives(const BodyVelocityMaps& maps, const BodyVelocity& w,
-                                                 const Eigen::VectorXd& p, Eigen::MatrixXd* d_w,
-                                                 Eigen::MatrixXd* d_p) const {
-  BodyScratch scratch;
-  MomentumSourceDerivatives(maps, w, p, *d_w, *d_p, scratch);
-}
-
-void SuperelementBody::MomentumSourceDerivatives(const BodyVelocityMaps& maps, const BodyVelocity& w,
                                                  const Eigen::VectorXd& p, Eigen::MatrixXd& d_w, Eigen::MatrixXd& d_p,
                                                  BodyScratch& scratch) const {
   const int n = n_coordinates();
@@ -263,14 +233,6 @@ void SuperelementBody::MomentumSourceDerivatives(const BodyVelocityMaps& maps, c
     }
     // Option B: the node's own G block (p_pi~ e) and Omega_hat(e) p (-p_pi~ e) cancel.
   }
-}
-
-Eigen::VectorXd SuperelementBody::MomentumSource(const BodyVelocityMaps& maps, const BodyVelocity& w,
-                                                 const Eigen::VectorXd& p) const {
-  Eigen::VectorXd out;
-  BodyScratch scratch;
-  MomentumSource(maps, w, p, out, scratch);
-  return out;
 }
 
 void SuperelementBody::MomentumSource(const BodyVelocityMaps& maps, const BodyVelocity& w, const Eigen::VectorXd& p,

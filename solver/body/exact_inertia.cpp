@@ -77,13 +77,6 @@ SuperelementBody::LocalMotion SuperelementBody::LocalRates(const Data& data, con
   return out;
 }
 
-Eigen::VectorXd SuperelementBody::ExactInertiaForce(const Data& data, const BodyVelocity& w, const BodyVelocity& wdot,
-                                                    Eigen::VectorXd* f_acc) const {
-  Eigen::VectorXd f;
-  ExactInertiaForce(data, w, wdot, f, f_acc);
-  return f;
-}
-
 // Every temporary in data.exact_scratch (ExactScratch), each product into its own vector before
 // the sums: no allocation once sized, and the same numbers as the expressions they replace.
 void SuperelementBody::ExactInertiaForce(const Data& data, const BodyVelocity& w, const BodyVelocity& wdot,
@@ -414,11 +407,12 @@ Eigen::MatrixXd SuperelementBody::ExactInertiaConfigurationTangent(const Data& d
   const int n = n_coordinates();
   const Eigen::VectorXd& w_used = w;
   Eigen::MatrixXd tangent(n, n);
+  Eigen::VectorXd f_plus, f_minus;
   for (int i = 0; i < n; ++i) {
     double step = 0.0;
     const BodyConfiguration plus = Perturbed(d.c, i, 1.0, &step), minus = Perturbed(d.c, i, -1.0, &step);
-    const Eigen::VectorXd f_plus = ExactInertiaForce(Evaluate(plus, SolveFrame(plus, d.frame)), w_used, wdot);
-    const Eigen::VectorXd f_minus = ExactInertiaForce(Evaluate(minus, SolveFrame(minus, d.frame)), w_used, wdot);
+    ExactInertiaForce(Evaluate(plus, SolveFrame(plus, d.frame)), w_used, wdot, f_plus, nullptr);
+    ExactInertiaForce(Evaluate(minus, SolveFrame(minus, d.frame)), w_used, wdot, f_minus, nullptr);
     tangent.col(i) = (f_plus - f_minus) / (2 * step);
   }
   return tangent;

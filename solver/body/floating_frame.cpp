@@ -13,12 +13,6 @@ namespace {
 constexpr double kMaxLocalRotation = 2.0;
 }  // namespace
 
-Eigen::VectorXd SuperelementBody::LocalCoordinates(const BodyConfiguration& c, const FrameSolution& frame) const {
-  Eigen::VectorXd q;
-  LocalCoordinates(c, frame, q);
-  return q;
-}
-
 void SuperelementBody::LocalCoordinates(const BodyConfiguration& c, const FrameSolution& frame,
                                         Eigen::VectorXd& q) const {
   q.resize(n_coordinates());
@@ -51,25 +45,20 @@ FrameSolution SuperelementBody::GuessFrame(const BodyConfiguration& c) const {
   return frame;
 }
 
-FrameSolution SuperelementBody::SolveFrameFrom(const BodyConfiguration& c, const FrameSolution& last) const {
-  Eigen::VectorXd q;
-  return SolveFrameFrom(c, last, q);
-}
-
 FrameSolution SuperelementBody::SolveFrameFrom(const BodyConfiguration& c, const FrameSolution& last,
-                                               Eigen::VectorXd& q, const Eigen::Matrix<double, 6, 6>* S_inv) const {
-  FrameSolution frame = SolveFrame(c, last, q, S_inv);
-  if (!frame.ok && S_inv) frame = SolveFrame(c, last, q);
-  return frame.ok ? frame : SolveFrame(c, GuessFrame(c), q);
+                                               Eigen::VectorXd* q_scratch,
+                                               const Eigen::Matrix<double, 6, 6>* S_inv) const {
+  Eigen::VectorXd own;
+  Eigen::VectorXd& q = q_scratch ? *q_scratch : own;
+  FrameSolution frame = SolveFrame(c, last, &q, S_inv);
+  if (!frame.ok && S_inv) frame = SolveFrame(c, last, &q);
+  return frame.ok ? frame : SolveFrame(c, GuessFrame(c), &q);
 }
 
-FrameSolution SuperelementBody::SolveFrame(const BodyConfiguration& c, const FrameSolution& guess) const {
-  Eigen::VectorXd q;
-  return SolveFrame(c, guess, q);
-}
-
-FrameSolution SuperelementBody::SolveFrame(const BodyConfiguration& c, const FrameSolution& guess, Eigen::VectorXd& q,
-                                           const Eigen::Matrix<double, 6, 6>* S_inv) const {
+FrameSolution SuperelementBody::SolveFrame(const BodyConfiguration& c, const FrameSolution& guess,
+                                           Eigen::VectorXd* q_scratch, const Eigen::Matrix<double, 6, 6>* S_inv) const {
+  Eigen::VectorXd own;
+  Eigen::VectorXd& q = q_scratch ? *q_scratch : own;
   FrameSolution frame = guess;
   frame.ok = false;
   // Translations relative to the body size, plus the round-off of the absolute positions (a

@@ -274,13 +274,6 @@ void SuperelementBody::LocalTangent(const Data& d, const InertiaLoadFactors* loa
   }
 }
 
-InertiaLoadFactors SuperelementBody::InertiaLoads(const Data& d, const BodyVelocity& w, const BodyVelocity& wdot,
-                                                  const Eigen::Vector3d& gravity) const {
-  InertiaLoadFactors out;
-  InertiaLoads(d, w, wdot, gravity, out);
-  return out;
-}
-
 void SuperelementBody::InertiaLoads(const Data& d, const BodyVelocity& w, const BodyVelocity& wdot,
                                     const Eigen::Vector3d& gravity, InertiaLoadFactors& out) const {
   const int n = n_coordinates();
@@ -497,13 +490,6 @@ void SuperelementBody::InertiaForce(const Data& d, const BodyVelocity& w, const 
   }
 }
 
-Eigen::MatrixXd SuperelementBody::InertiaConfigurationTangent(const Data& d, const BodyVelocity& w,
-                                                              const BodyVelocity& wdot, bool quadratic) const {
-  Eigen::MatrixXd tangent;
-  InertiaConfigurationTangent(d, w, wdot, quadratic, tangent);
-  return tangent;
-}
-
 void SuperelementBody::InertiaConfigurationTangent(const Data& d, const BodyVelocity& w, const BodyVelocity& wdot,
                                                    bool quadratic, Eigen::MatrixXd& tangent) const {
   // Exact inertia: the whole force by central differences with `quadratic`; without, the
@@ -516,6 +502,7 @@ void SuperelementBody::InertiaConfigurationTangent(const Data& d, const BodyVelo
   MomentumDerivative(MapsOf(d), wdot, tangent, d.scratch);
   if (!quadratic || !options_.quadratic_velocity_terms) return;
   const int n = n_coordinates();
+  BodyScratch scratch;
   for (int i = 0; i < n; ++i) {
     Eigen::VectorXd g[2];
     double step = 1e-7;
@@ -523,7 +510,7 @@ void SuperelementBody::InertiaConfigurationTangent(const Data& d, const BodyVelo
       const BodyConfiguration p = Perturbed(d.c, i, side == 0 ? 1.0 : -1.0, &step);
       const Data dp = Evaluate(p, SolveFrame(p, d.frame));
       const BodyVelocityMaps& maps = MapsOf(dp);
-      g[side] = QuadraticInertia(maps.U, maps.Mg, w);
+      QuadraticInertia(maps.U, maps.Mg, w, g[side], scratch);
     }
     tangent.col(i) += (g[0] - g[1]) / (2 * step);
   }
@@ -579,21 +566,11 @@ void SuperelementBody::MomentumFrom(const Data& d, const Eigen::VectorXd& p, Eig
   }
 }
 
-Eigen::Vector3d SuperelementBody::CenterOfMass(const BodyConfiguration& c, const FrameSolution& frame) const {
-  return CenterOfMass(LocalCoordinates(c, frame), frame);
-}
-
 Eigen::Vector3d SuperelementBody::CenterOfMass(const Eigen::VectorXd& q_loc, const FrameSolution& frame) const {
   Eigen::Vector3d moment;
   moment.noalias() = first_moment_map_ * q_loc;
   moment += first_moment0_;
   return frame.x + frame.R * (mass_ > 0 ? Eigen::Vector3d(moment / mass_) : Eigen::Vector3d::Zero());
-}
-
-Eigen::VectorXd SuperelementBody::GravityForce(const Data& data, const Eigen::Vector3d& g) const {
-  Eigen::VectorXd f;
-  GravityForce(data, g, f);
-  return f;
 }
 
 void SuperelementBody::GravityForce(const Data& data, const Eigen::Vector3d& g, Eigen::VectorXd& f) const {
@@ -628,17 +605,21 @@ Eigen::MatrixXd SuperelementBody::GravityTangent(const Data& d, const Eigen::Vec
     // (P wdot_g = Phi_rig0 [R_j^T g; 0]): its configuration derivative is MomentumDerivative's.
     BodyVelocity wdot_g = Eigen::VectorXd::Zero(n);
     for (int a = 0; a < n_nodes_; ++a) wdot_g.segment<3>(6 * a) = g;
-    return MomentumDerivative(MapsOf(d), wdot_g);
+    Eigen::MatrixXd D;
+    BodyScratch scratch;
+    MomentumDerivative(MapsOf(d), wdot_g, D, scratch);
+    return D;
   }
   // The exact inertia's field: central differences with the frame re-solved, as for its inertia
   // force (ExactInertiaConfigurationTangent).
   Eigen::MatrixXd tangent(n, n);
+  Eigen::VectorXd f_plus, f_minus;
   for (int i = 0; i < n; ++i) {
     double step = 0.0;
     const BodyConfiguration plus = Perturbed(d.c, i, 1.0, &step), minus = Perturbed(d.c, i, -1.0, &step);
-    tangent.col(i) = (GravityForce(Evaluate(plus, SolveFrame(plus, d.frame)), g) -
-                      GravityForce(Evaluate(minus, SolveFrame(minus, d.frame)), g)) /
-                     (2 * step);
+    GravityForce(Evaluate(plus, SolveFrame(plus, d.frame)), g, f_plus);
+    GravityForce(Evaluate(minus, SolveFrame(minus, d.frame)), g, f_minus);
+    tangent.col(i) = (f_plus - f_minus) / (2 * step);
   }
   return tangent;
 }

@@ -216,27 +216,25 @@ class SuperelementBody {
   FrameSolution GuessFrame(const BodyConfiguration& c) const;
 
   /// Newton on Phi_CB q_loc(x_j, R_j) = 0 from `guess` (thesis 4.2). ok = false when the
-  /// residual does not fall below 1e-12 (relative) in 30 iterations.
-  FrameSolution SolveFrame(const BodyConfiguration& c, const FrameSolution& guess) const;
-  /// SolveFrame from the last frame, and failing that from GuessFrame (ok = false if both fail).
-  FrameSolution SolveFrameFrom(const BodyConfiguration& c, const FrameSolution& last) const;
-  /// The same with `q` as its scratch for the local coordinates (no allocation once sized). With
+  /// residual does not fall below 1e-12 (relative) in 30 iterations. `q`: scratch for the local
+  /// coordinates (no allocation once sized; on return they are the solution's), or none. With
   /// `S_inv` (the inverse frame matrix of a nearby configuration of this body, e.g. its last
-  /// Kinematics::S_inv) the first attempt iterates with it instead of factoring the frame matrix
-  /// at every iterate: S depends on the deformation only, so it converges as fast while it costs
-  /// a 6 x 6 product per iteration; the fallbacks are full Newton.
-  FrameSolution SolveFrameFrom(const BodyConfiguration& c, const FrameSolution& last, Eigen::VectorXd& q,
-                               const Eigen::Matrix<double, 6, 6>* S_inv = nullptr) const;
-  FrameSolution SolveFrame(const BodyConfiguration& c, const FrameSolution& guess, Eigen::VectorXd& q,
+  /// Kinematics::S_inv) the iteration uses it instead of factoring the frame matrix at every
+  /// iterate: S depends on the deformation only, so it converges as fast while it costs a 6 x 6
+  /// product per iteration.
+  FrameSolution SolveFrame(const BodyConfiguration& c, const FrameSolution& guess, Eigen::VectorXd* q = nullptr,
                            const Eigen::Matrix<double, 6, 6>* S_inv = nullptr) const;
+  /// SolveFrame from the last frame (with `S_inv` first, then full Newton), and failing that
+  /// from GuessFrame (ok = false if every attempt fails).
+  FrameSolution SolveFrameFrom(const BodyConfiguration& c, const FrameSolution& last, Eigen::VectorXd* q = nullptr,
+                               const Eigen::Matrix<double, 6, 6>* S_inv = nullptr) const;
 
-  /// Local coordinates q_loc (6N + m).
-  Eigen::VectorXd LocalCoordinates(const BodyConfiguration& c, const FrameSolution& frame) const;
   /// The coordinates the modal stresses are taken at: q_loc, or with the geometric stiffening's
   /// condensed polynomial its eps = q + K^+ A z (formats/reduced_polynomial.h).
   Eigen::VectorXd StressCoordinates(const Eigen::VectorXd& q) const {
     return polynomial_ ? femb::StressCoordinates(*polynomial_, q) : q;
   }
+  /// Local coordinates q_loc (6N + m) into `q`.
   void LocalCoordinates(const BodyConfiguration& c, const FrameSolution& frame, Eigen::VectorXd& q) const;
 
   /// Elastic force f (6N + m; per node force then moment, global axes; then modal forces) and,
@@ -245,11 +243,6 @@ class SuperelementBody {
   /// (InertiaLoads); `d_load` (n x 12) then receives df/da at fixed configuration.
   void ElasticForce(const Data& d, Eigen::VectorXd* f, Eigen::MatrixXd* tangent,
                     const InertiaLoadFactors* load = nullptr, Eigen::MatrixXd* d_load = nullptr) const;
-  void ElasticForce(const BodyConfiguration& c, const FrameSolution& frame, Eigen::VectorXd* f,
-                    Eigen::MatrixXd* tangent, const InertiaLoadFactors* load = nullptr,
-                    Eigen::MatrixXd* d_load = nullptr) const {
-    ElasticForce(Evaluate(c, frame), f, tangent, load, d_load);
-  }
 
   /// Thesis 8.2 case 4: a basis that moves only m < 6N interface directions holds the others
   /// with the file's C q_int = 0 (formats/superelement.h interface_constraint; r rows, lengths).
@@ -279,21 +272,12 @@ class SuperelementBody {
   /// and R_j^T omegadot_k = alpha, so [a_j; alpha] = Z (Rbar^T wdot - c(omega)),
   /// c_k = omega x (omega x r_k) on node k's translation rows. d_w and d_wdot are exact at fixed
   /// configuration (the configuration dependence of R_j and Z is left out of the tangent).
-  InertiaLoadFactors InertiaLoads(const Data& d, const BodyVelocity& w, const BodyVelocity& wdot,
-                                  const Eigen::Vector3d& gravity) const;
-  /// The same into `out` (its storage reused).
+  /// Into `out` (its storage reused).
   void InertiaLoads(const Data& d, const BodyVelocity& w, const BodyVelocity& wdot, const Eigen::Vector3d& gravity,
                     InertiaLoadFactors& out) const;
-  InertiaLoadFactors InertiaLoads(const BodyConfiguration& c, const FrameSolution& frame, const BodyVelocity& w,
-                                  const BodyVelocity& wdot, const Eigen::Vector3d& gravity) const {
-    return InertiaLoads(Evaluate(c, frame), w, wdot, gravity);
-  }
 
   /// Strain energy q_loc^T K q_loc / 2.
   double ElasticEnergy(const Data& d) const;
-  double ElasticEnergy(const BodyConfiguration& c, const FrameSolution& frame) const {
-    return ElasticEnergy(Evaluate(c, frame));
-  }
 
   /// True when the body uses the exact kinetic energy (file invariants and option exact_inertia).
   ///
@@ -346,25 +330,13 @@ class SuperelementBody {
   /// `f_acc` (optional) receives the part linear in wdot, M_g wdot.
   void InertiaForce(const Data& d, const BodyVelocity& w, const BodyVelocity& wdot, Eigen::VectorXd* f_in,
                     Eigen::MatrixXd* mass, Eigen::MatrixXd* gyroscopic, Eigen::VectorXd* f_acc = nullptr) const;
-  void InertiaForce(const BodyConfiguration& c, const FrameSolution& frame, const BodyVelocity& w,
-                    const BodyVelocity& wdot, Eigen::VectorXd* f_in, Eigen::MatrixXd* mass,
-                    Eigen::MatrixXd* gyroscopic) const {
-    InertiaForce(Evaluate(c, frame), w, wdot, f_in, mass, gyroscopic);
-  }
 
   /// d f_in / dq at fixed (w, wdot): d(M_g wdot)/dq = MomentumDerivative(c, frame, wdot)
   /// (exact), plus with `quadratic` the configuration derivative of the quadratic velocity terms
   /// by central differences (2n evaluations with the frame re-solved; steps 1e-7 of the body
-  /// size, 1e-7 rad, 1e-7 of the modal scale).
-  Eigen::MatrixXd InertiaConfigurationTangent(const Data& d, const BodyVelocity& w, const BodyVelocity& wdot,
-                                              bool quadratic) const;
-  /// The same into `tangent` (its storage reused).
+  /// size, 1e-7 rad, 1e-7 of the modal scale). Into `tangent` (its storage reused).
   void InertiaConfigurationTangent(const Data& d, const BodyVelocity& w, const BodyVelocity& wdot, bool quadratic,
                                    Eigen::MatrixXd& tangent) const;
-  Eigen::MatrixXd InertiaConfigurationTangent(const BodyConfiguration& c, const FrameSolution& frame,
-                                              const BodyVelocity& w, const BodyVelocity& wdot, bool quadratic) const {
-    return InertiaConfigurationTangent(Evaluate(c, frame), w, wdot, quadratic);
-  }
 
   /// Modal damping force 2 zeta omega_i etadot_i on the internal-mode rows and its derivative
   /// with respect to w (added to `f` and `C`).
@@ -376,22 +348,11 @@ class SuperelementBody {
   const Eigen::MatrixXd& Mass(const Data& d) const { return has_exact_inertia() ? ExactMass(d) : MapsOf(d).Mg; }
   /// Kinetic energy v^T M v / 2.
   double KineticEnergy(const Data& d, const BodyVelocity& w) const;
-  double KineticEnergy(const BodyConfiguration& c, const FrameSolution& frame, const BodyVelocity& w) const {
-    return KineticEnergy(Evaluate(c, frame), w);
-  }
-
-  /// Velocity maps at a configuration (BodyVelocityMaps), shared by the momentum terms below.
-  BodyVelocityMaps Maps(const BodyConfiguration& c, const FrameSolution& frame) const;
-
-  /// Generalized momentum p = M_g w = P^T M P w (per node: linear momentum, spatial angular
-  /// momentum about the node; then the modal momenta).
-  Eigen::VectorXd GeneralizedMomentum(const BodyVelocityMaps& maps, const BodyVelocity& w) const;
 
   /// d p / d q at fixed w (n x n; per node (dx, dpi) spatial, then d eta): the configuration
   /// derivative of the generalized momentum (midpoint iteration matrix; with w = wdot, the
-  /// configuration derivative of M_g wdot).
-  Eigen::MatrixXd MomentumDerivative(const BodyVelocityMaps& maps, const BodyVelocity& w) const;
-  /// The same into `D` with the temporaries in `scratch` (no allocation once sized).
+  /// configuration derivative of M_g wdot). The maps are MapsOf's (BodyVelocityMaps); into `D`
+  /// with the temporaries in `scratch` (no allocation once sized).
   void MomentumDerivative(const BodyVelocityMaps& maps, const BodyVelocity& w, Eigen::MatrixXd& D,
                           BodyScratch& scratch) const;
 
@@ -401,8 +362,7 @@ class SuperelementBody {
   /// any vector (the midpoint scheme passes the momenta of the step's ends). For every p, s has
   /// no resultant and its moment about the origin is sum_k p_x,k x xdot_k: this is what makes the
   /// midpoint scheme of dynamic_analysis.h conserve linear and angular momentum exactly.
-  Eigen::VectorXd MomentumSource(const BodyVelocityMaps& maps, const BodyVelocity& w, const Eigen::VectorXd& p) const;
-  /// The same into `out` with the temporaries in `scratch` (no allocation once sized).
+  /// Into `out` with the temporaries in `scratch` (no allocation once sized).
   void MomentumSource(const BodyVelocityMaps& maps, const BodyVelocity& w, const Eigen::VectorXd& p,
                       Eigen::VectorXd& out, BodyScratch& scratch) const;
   /// The whole source at `d` for the body's own kinetic energy: with the exact inertia
@@ -427,10 +387,7 @@ class SuperelementBody {
   /// differences that are exact up to round-off (the term is quadratic in w).
   void AddLocalSourceVelocityDerivative(const Data& d, const BodyVelocity& w, Eigen::MatrixXd& d_w) const;
   /// Derivatives of MomentumSource s(q, w, p) with respect to w and to p (both n x n; s is
-  /// bilinear in w and p).
-  void MomentumSourceDerivatives(const BodyVelocityMaps& maps, const BodyVelocity& w, const Eigen::VectorXd& p,
-                                 Eigen::MatrixXd* d_w, Eigen::MatrixXd* d_p) const;
-  /// The same with the temporaries in `scratch` (no allocation once d_w, d_p are sized).
+  /// bilinear in w and p), with the temporaries in `scratch` (no allocation once d_w, d_p are sized).
   void MomentumSourceDerivatives(const BodyVelocityMaps& maps, const BodyVelocity& w, const Eigen::VectorXd& p,
                                  Eigen::MatrixXd& d_w, Eigen::MatrixXd& d_p, BodyScratch& scratch) const;
 
@@ -439,27 +396,17 @@ class SuperelementBody {
   void Momentum(const Data& d, const BodyVelocity& w, Eigen::Vector3d* linear, Eigen::Vector3d* angular) const;
   /// The same from the generalized momentum p = M_g w (MassTimes).
   void MomentumFrom(const Data& d, const Eigen::VectorXd& p, Eigen::Vector3d* linear, Eigen::Vector3d* angular) const;
-  void Momentum(const BodyConfiguration& c, const FrameSolution& frame, const BodyVelocity& w, Eigen::Vector3d* linear,
-                Eigen::Vector3d* angular) const {
-    Momentum(Evaluate(c, frame), w, linear, angular);
-  }
 
   /// The deformed body's centre of mass (global): x_j + R_j (s_0 + C q_loc) / m, s_0 the first
   /// moment of the undeformed body about the frame origin, C = int rho Phi (the translation rows
-  /// of Phi_rig0^T M), m the mass.
-  Eigen::Vector3d CenterOfMass(const BodyConfiguration& c, const FrameSolution& frame) const;
-  /// The same from the local coordinates q_loc = LocalCoordinates(c, frame).
+  /// of Phi_rig0^T M), m the mass; from the local coordinates q_loc = LocalCoordinates(c, frame).
   Eigen::Vector3d CenterOfMass(const Eigen::VectorXd& q_loc, const FrameSolution& frame) const;
   /// The body's mass.
   double mass() const { return mass_; }
 
   /// Generalized force of a uniform acceleration field g (gravity): P^T M Phi_rig0 [R_j^T g; 0].
-  Eigen::VectorXd GravityForce(const Data& d, const Eigen::Vector3d& g) const;
-  /// The same into `f` (its storage reused).
+  /// Into `f` (its storage reused).
   void GravityForce(const Data& d, const Eigen::Vector3d& g, Eigen::VectorXd& f) const;
-  Eigen::VectorXd GravityForce(const BodyConfiguration& c, const FrameSolution& frame, const Eigen::Vector3d& g) const {
-    return GravityForce(Evaluate(c, frame), g);
-  }
   /// d GravityForce / dq (n x n): the weight's distribution over the nodes and modes turns with
   /// the floating frame. Corotational inertia: GravityForce = M_g wdot_g (wdot_g = g on the node
   /// translations), so MomentumDerivative(maps, wdot_g), exact; exact inertia: central
@@ -477,7 +424,6 @@ class SuperelementBody {
   // G of d(P w) = P G dq at fixed w (n x n, into G), from U and the velocities.
   void VelocityMapRate(const Eigen::MatrixXd& U, const BodyVelocity& w, Eigen::MatrixXd& G) const;
   // The quadratic part of f_in: M_g G w + (Omega_P - Omega_hat) p - G^T p.
-  Eigen::VectorXd QuadraticInertia(const Eigen::MatrixXd& U, const Eigen::MatrixXd& Mg, const BodyVelocity& w) const;
   void QuadraticInertia(const Eigen::MatrixXd& U, const Eigen::MatrixXd& Mg, const BodyVelocity& w,
                         Eigen::VectorXd& out, BodyScratch& scratch) const;
   // Its derivative by w (exact, O(n^2) products), into D.
@@ -492,8 +438,6 @@ class SuperelementBody {
   // force, the mass matrix M_g.
   void Exact(const Eigen::VectorXd& q, const Kinematics& kin, ExactData& d) const;
   // With `f_acc`, also the part linear in wdot alone (M_g wdot) from the same products.
-  Eigen::VectorXd ExactInertiaForce(const Data& d, const BodyVelocity& w, const BodyVelocity& wdot,
-                                    Eigen::VectorXd* f_acc = nullptr) const;
   void ExactInertiaForce(const Data& d, const BodyVelocity& w, const BodyVelocity& wdot, Eigen::VectorXd& f,
                          Eigen::VectorXd* f_acc) const;
   // M Y and H^T Y of d.exact, made on the first call.

@@ -36,7 +36,7 @@ void AssembleDynamicResidual(const SystemModel& model, const DofMap& dofs, Dynam
     // correction or a step earlier); its local coordinates stay in pass.data.q.
     const bool kinematics = pass.data.kin.W.cols() == body.n_coordinates();
     const FrameSolution frame =
-        body.SolveFrameFrom(c, s.config.frames[b], pass.data.q, kinematics ? &pass.data.kin.S_inv : nullptr);
+        body.SolveFrameFrom(c, s.config.frames[b], &pass.data.q, kinematics ? &pass.data.kin.S_inv : nullptr);
     if (!frame.ok) {
       r.frame_ok = false;
       return;

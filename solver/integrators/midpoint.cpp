@@ -298,8 +298,8 @@ void MidpointBodyTerms(const SystemModel& model, const DofMap& dofs, const Dynam
   r.frame_ok = true;
   BodyConfigurationOf(model, s1.config, b, d1.c);
   BodyConfigurationOf(model, k.mid, b, dm.c);
-  const FrameSolution f1 = body.SolveFrameFrom(d1.c, s1.config.frames[b], d1.q);
-  const FrameSolution fm = f1.ok ? body.SolveFrameFrom(dm.c, s0.config.frames[b], dm.q) : FrameSolution{};
+  const FrameSolution f1 = body.SolveFrameFrom(d1.c, s1.config.frames[b], &d1.q);
+  const FrameSolution fm = f1.ok ? body.SolveFrameFrom(dm.c, s0.config.frames[b], &dm.q) : FrameSolution{};
   if (!f1.ok || !fm.ok) {
     r.frame_ok = false;
     return;

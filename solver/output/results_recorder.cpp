@@ -202,12 +202,12 @@ class ResultsRecorder::OutputStep {
     NodeAccelerations();
     double g = dynamic ? 1.0 : 0.0;
     if (!dynamic && model_.static_gravity_end > 0) g = std::min(t_ / model_.static_gravity_end, 1.0);
-    r_.factors_[b] =
-        model_.bodies[b]
-            .InertiaLoads(BodyConfigurationOf(model_, state_, int(b)), state_.frames[b],
-                          GatherBody(model_, r_.dofs_, state_, int(b), V_),
-                          GatherBodyAcceleration(model_, r_.dofs_, int(b), node_acc_, A_), g * model_.gravity)
-            .a;
+    const SuperelementBody& body = model_.bodies[b];
+    InertiaLoadFactors load;
+    body.InertiaLoads(body.Evaluate(BodyConfigurationOf(model_, state_, int(b)), state_.frames[b]),
+                      GatherBody(model_, r_.dofs_, state_, int(b), V_),
+                      GatherBodyAcceleration(model_, r_.dofs_, int(b), node_acc_, A_), g * model_.gravity, load);
+    r_.factors_[b] = load.a;
     r_.has_factors_[b] = 1;
     return &r_.factors_[b];
   }

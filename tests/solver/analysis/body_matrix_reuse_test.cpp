@@ -35,7 +35,7 @@ BodyMatrices MatricesAt(const SuperelementBody& body, const BodyConfiguration& c
   const SuperelementBody::Data d = body.Evaluate(c, f);
   BodyMatrices m;
   if (body.has_inertia_stiffening()) {
-    const InertiaLoadFactors load = body.InertiaLoads(d, w, wdot, Eigen::Vector3d::Zero());
+    const InertiaLoadFactors load = test::InertiaLoadsOf(body, d, w, wdot, Eigen::Vector3d::Zero());
     Eigen::MatrixXd d_load;
     body.ElasticForce(d, nullptr, &m.K, &load, &d_load);
     m.K_load_w = d_load * load.d_w;
@@ -44,7 +44,7 @@ BodyMatrices MatricesAt(const SuperelementBody& body, const BodyConfiguration& c
     body.ElasticForce(d, nullptr, &m.K);
   }
   body.InertiaForce(d, w, wdot, nullptr, &m.M, &m.G);
-  m.K_inertia = body.InertiaConfigurationTangent(d, w, wdot, false);
+  m.K_inertia = test::InertiaConfigurationTangentOf(body, d, w, wdot, false);
   return m;
 }
 

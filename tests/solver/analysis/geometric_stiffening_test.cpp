@@ -59,7 +59,7 @@ TEST(GeometricStiffening, InertiaLoadFactorsAndTheirDerivativesMatchFiniteDiffer
   ASSERT_TRUE(frame.ok);
   const Eigen::VectorXd w = Eigen::VectorXd::LinSpaced(n, -3.0, 5.0), wdot = Eigen::VectorXd::LinSpaced(n, 40.0, -20.0);
   const Eigen::Vector3d g(0, 0, -9.81);
-  const InertiaLoadFactors load = body.InertiaLoads(c, frame, w, wdot, g);
+  const InertiaLoadFactors load = test::InertiaLoadsOf(body, body.Evaluate(c, frame), w, wdot, g);
   // A rigid rotation about z through the frame origin at Omega: a = (0, 0, 0 | 0 | Omega^2 products).
   {
     const double Omega = 7.0;
@@ -72,7 +72,8 @@ TEST(GeometricStiffening, InertiaLoadFactorsAndTheirDerivativesMatchFiniteDiffer
       wr.segment<3>(6 * k + 3) = Eigen::Vector3d(0, 0, Omega);
       wr_dot.segment<3>(6 * k) = Eigen::Vector3d(0, 0, Omega).cross(Eigen::Vector3d(wr.segment<3>(6 * k)));
     }
-    const InertiaLoadFactors rot = body.InertiaLoads(c0, f0, wr, wr_dot, Eigen::Vector3d::Zero());
+    const InertiaLoadFactors rot =
+        test::InertiaLoadsOf(body, body.Evaluate(c0, f0), wr, wr_dot, Eigen::Vector3d::Zero());
     Eigen::Matrix<double, 12, 1> expected = Eigen::Matrix<double, 12, 1>::Zero();
     expected[8] = Omega * Omega;
     EXPECT_LT((rot.a - expected).norm(), 1e-9 * Omega * Omega) << rot.a.transpose();
@@ -81,12 +82,12 @@ TEST(GeometricStiffening, InertiaLoadFactorsAndTheirDerivativesMatchFiniteDiffer
   for (int i = 0; i < n; ++i) {
     const double h = 1e-4;  // a is linear in wdot and quadratic in w: central differences are exact up to round-off
     const Eigen::VectorXd e = Eigen::VectorXd::Unit(n, i);
-    d_w.col(i) =
-        (body.InertiaLoads(c, frame, w + h * e, wdot, g).a - body.InertiaLoads(c, frame, w - h * e, wdot, g).a) /
-        (2 * h);
-    d_wdot.col(i) =
-        (body.InertiaLoads(c, frame, w, wdot + h * e, g).a - body.InertiaLoads(c, frame, w, wdot - h * e, g).a) /
-        (2 * h);
+    d_w.col(i) = (test::InertiaLoadsOf(body, body.Evaluate(c, frame), w + h * e, wdot, g).a -
+                  test::InertiaLoadsOf(body, body.Evaluate(c, frame), w - h * e, wdot, g).a) /
+                 (2 * h);
+    d_wdot.col(i) = (test::InertiaLoadsOf(body, body.Evaluate(c, frame), w, wdot + h * e, g).a -
+                     test::InertiaLoadsOf(body, body.Evaluate(c, frame), w, wdot - h * e, g).a) /
+                    (2 * h);
   }
   EXPECT_LT((load.d_w - d_w).norm(), 1e-9 * d_w.norm());
   EXPECT_LT((load.d_wdot - d_wdot).norm(), 1e-9 * d_wdot.norm());
@@ -94,7 +95,7 @@ TEST(GeometricStiffening, InertiaLoadFactorsAndTheirDerivativesMatchFiniteDiffer
   // configuration at fixed a).
   Eigen::VectorXd f;
   Eigen::MatrixXd K, d_load;
-  body.ElasticForce(c, frame, &f, &K, &load, &d_load);
+  body.ElasticForce(body.Evaluate(c, frame), &f, &K, &load, &d_load);
   Eigen::MatrixXd d_load_fd(n, 12);
   for (int k = 0; k < 12; ++k) {
     InertiaLoadFactors plus = load, minus = load;
@@ -102,8 +103,8 @@ TEST(GeometricStiffening, InertiaLoadFactorsAndTheirDerivativesMatchFiniteDiffer
     plus.a[k] += h;
     minus.a[k] -= h;
     Eigen::VectorXd fp, fm;
-    body.ElasticForce(c, frame, &fp, nullptr, &plus);
-    body.ElasticForce(c, frame, &fm, nullptr, &minus);
+    body.ElasticForce(body.Evaluate(c, frame), &fp, nullptr, &plus);
+    body.ElasticForce(body.Evaluate(c, frame), &fm, nullptr, &minus);
     d_load_fd.col(k) = (fp - fm) / (2 * h);
   }
   EXPECT_LT((d_load - d_load_fd).norm(), 1e-8 * d_load.norm());
@@ -125,7 +126,7 @@ TEST(GeometricStiffening, InertiaLoadFactorsAndTheirDerivativesMatchFiniteDiffer
       }
       const FrameSolution pf = body.SolveFrame(p, frame);
       ASSERT_TRUE(pf.ok);
-      body.ElasticForce(p, pf, &fs[side], nullptr, &load);
+      body.ElasticForce(body.Evaluate(p, pf), &fs[side], nullptr, &load);
     }
     K_fd.col(i) = (fs[0] - fs[1]) / (2 * h);
   }
