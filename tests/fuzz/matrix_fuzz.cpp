@@ -50,7 +50,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       (void)femb::ReadShapeMatrix(paths[0], long(parts[1].size() % 64) + 1);
     } else {
       femb::MatricesSpec spec;
-      spec.format = reader == 0 ? "calculix" : reader == 1 ? "abaqus" : "matrix_market";
+      spec.format = reader == 0   ? femb::MatrixFormat::kCalculix
+                    : reader == 1 ? femb::MatrixFormat::kAbaqus
+                                  : femb::MatrixFormat::kMatrixMarket;
       spec.stiffness = paths[0];
       spec.mass = paths[1];
       spec.dofs = reader == 1 ? "" : paths[2];
