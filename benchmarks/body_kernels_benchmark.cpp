@@ -128,7 +128,7 @@ int main(int argc, char** argv) {
     // 3 + mass and gyroscopic, 4 + configuration tangent.
     auto iteration = [p, g, &sink](int stages) {
       const femb::SuperelementBody& b = *p->body;
-      const femb::SuperelementBody::Data d = b.Evaluate(p->c, p->frame);
+      femb::SuperelementBody::Data d = b.Evaluate(p->c, p->frame);
       if (stages < 1) return;
       const bool s = b.has_inertia_stiffening();
       femb::InertiaLoadFactors load;

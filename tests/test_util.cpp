@@ -186,21 +186,20 @@ Eigen::MatrixXd femb::test::StaticTangentByDifferences(const SystemModel& model,
 
 namespace femb::test {
 
-InertiaLoadFactors InertiaLoadsOf(const SuperelementBody& body, const SuperelementBody::Data& d, const BodyVelocity& w,
+InertiaLoadFactors InertiaLoadsOf(const SuperelementBody& body, SuperelementBody::Data d, const BodyVelocity& w,
                                   const BodyVelocity& wdot, const Eigen::Vector3d& gravity) {
   InertiaLoadFactors out;
   body.InertiaLoads(d, w, wdot, gravity, out);
   return out;
 }
 
-Eigen::VectorXd GravityForceOf(const SuperelementBody& body, const SuperelementBody::Data& d,
-                               const Eigen::Vector3d& g) {
+Eigen::VectorXd GravityForceOf(const SuperelementBody& body, SuperelementBody::Data d, const Eigen::Vector3d& g) {
   Eigen::VectorXd f;
   body.GravityForce(d, g, f);
   return f;
 }
 
-Eigen::MatrixXd InertiaConfigurationTangentOf(const SuperelementBody& body, const SuperelementBody::Data& d,
+Eigen::MatrixXd InertiaConfigurationTangentOf(const SuperelementBody& body, SuperelementBody::Data d,
                                               const BodyVelocity& w, const BodyVelocity& wdot, bool quadratic) {
   Eigen::MatrixXd tangent;
   body.InertiaConfigurationTangent(d, w, wdot, quadratic, tangent);
@@ -208,7 +207,8 @@ Eigen::MatrixXd InertiaConfigurationTangentOf(const SuperelementBody& body, cons
 }
 
 BodyVelocityMaps MapsAt(const SuperelementBody& body, const BodyConfiguration& c, const FrameSolution& frame) {
-  return body.MapsOf(body.Evaluate(c, frame));
+  SuperelementBody::Data d = body.Evaluate(c, frame);
+  return body.MapsOf(d);
 }
 
 Eigen::MatrixXd MomentumDerivativeOf(const SuperelementBody& body, const BodyVelocityMaps& maps,

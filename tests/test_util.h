@@ -55,12 +55,20 @@ Eigen::MatrixXd StaticTangentByDifferences(const SystemModel& model, const DofMa
 /// `text` with its first `from` replaced by `to`; fails the calling test when `from` is missing.
 std::string Replace(std::string text, const std::string& from, const std::string& to);
 
+/// A temporary as an lvalue until the end of the full expression: a body's kernels write their
+/// scratch into the data they are given, so `body.ElasticForce(test::Lvalue(body.Evaluate(c,
+/// frame)), ...)` evaluates the body for one call.
+template <class T>
+T& Lvalue(T&& value) {
+  return value;
+}
+
 /// A body's kernels as values, for tests that compare them in expressions (the product has the
-/// in-place forms only; these call them).
-InertiaLoadFactors InertiaLoadsOf(const SuperelementBody& body, const SuperelementBody::Data& d, const BodyVelocity& w,
+/// in-place forms only; these call them with their own copy of the data).
+InertiaLoadFactors InertiaLoadsOf(const SuperelementBody& body, SuperelementBody::Data d, const BodyVelocity& w,
                                   const BodyVelocity& wdot, const Eigen::Vector3d& gravity);
-Eigen::VectorXd GravityForceOf(const SuperelementBody& body, const SuperelementBody::Data& d, const Eigen::Vector3d& g);
-Eigen::MatrixXd InertiaConfigurationTangentOf(const SuperelementBody& body, const SuperelementBody::Data& d,
+Eigen::VectorXd GravityForceOf(const SuperelementBody& body, SuperelementBody::Data d, const Eigen::Vector3d& g);
+Eigen::MatrixXd InertiaConfigurationTangentOf(const SuperelementBody& body, SuperelementBody::Data d,
                                               const BodyVelocity& w, const BodyVelocity& wdot, bool quadratic);
 /// The corotational velocity maps at (c, frame) (SuperelementBody::MapsOf).
 BodyVelocityMaps MapsAt(const SuperelementBody& body, const BodyConfiguration& c, const FrameSolution& frame);

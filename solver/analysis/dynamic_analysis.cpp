@@ -244,10 +244,10 @@ std::string UnresolvedModesWarning(const SystemModel& model, double h) {
 
 // The step's measures with `passes` the converged iteration's (nothing evaluated: each body's
 // share on the threads into `work.measures`, then summed in body order, the same bits for any
-// number of threads), or, without them (passes of another size, or no `measures`), each body
-// evaluated here.
+// number of threads), or, without them (none, passes of another size, or no `measures`), each
+// body evaluated here.
 DynamicStepReport MeasureWith(const SystemModel& model, const DofMap& dofs, const DynamicState& s,
-                              const std::vector<BodyPass>& passes, BodyThreads* threads = nullptr,
+                              std::vector<BodyPass>* passes, BodyThreads* threads = nullptr,
                               std::vector<BodyMeasure>* measures = nullptr) {
   DynamicStepReport r;
   r.t = s.t;
@@ -258,7 +258,7 @@ DynamicStepReport MeasureWith(const SystemModel& model, const DofMap& dofs, cons
     AddSpringDampers(model, s.config, s.W, unused, nullptr, nullptr, &r.elastic_energy);  // spring energy
   }
   const int n_bodies = int(model.bodies.size());
-  const auto measure = [&](int b, const SuperelementBody::Data& data, const Eigen::VectorXd& w, BodyMeasure& m) {
+  const auto measure = [&](int b, SuperelementBody::Data& data, const Eigen::VectorXd& w, BodyMeasure& m) {
     const SuperelementBody& body = model.bodies[size_t(b)];
     const Eigen::VectorXd& p = body.MassTimes(data, w);  // M_g w, once for the energy and the momenta
     m.kinetic = 0.5 * w.dot(p);
@@ -271,17 +271,20 @@ DynamicStepReport MeasureWith(const SystemModel& model, const DofMap& dofs, cons
     r.linear_momentum += m.linear;
     r.angular_momentum += m.angular;
   };
-  if (passes.size() == model.bodies.size() && measures) {
+  if (passes && passes->size() == model.bodies.size() && measures) {
     measures->resize(size_t(n_bodies));
-    ForEachBody(threads, n_bodies,
-                [&](int b) { measure(b, passes[size_t(b)].data, passes[size_t(b)].w, (*measures)[size_t(b)]); });
+    ForEachBody(threads, n_bodies, [&](int b) {
+      BodyPass& pass = (*passes)[size_t(b)];
+      measure(b, pass.data, pass.w, (*measures)[size_t(b)]);
+    });
     for (const BodyMeasure& m : *measures) add(m);
     return r;
   }
   for (int b = 0; b < n_bodies; ++b) {
     BodyMeasure m;
-    measure(b, model.bodies[size_t(b)].Evaluate(BodyConfigurationOf(model, s.config, b), s.config.frames[b]),
-            BodyVelocityOf(model, dofs, s, b), m);
+    SuperelementBody::Data data =
+        model.bodies[size_t(b)].Evaluate(BodyConfigurationOf(model, s.config, b), s.config.frames[b]);
+    measure(b, data, BodyVelocityOf(model, dofs, s, b), m);
     add(m);
   }
   return r;
@@ -296,7 +299,9 @@ double EnergyNoise(double mass, const SystemState& config, double h) {
 }
 }  // namespace
 
-DynamicStepReport Measure(const SystemModel& model, DynamicState& s) { return MeasureWith(model, model.dofs(), s, {}); }
+DynamicStepReport Measure(const SystemModel& model, DynamicState& s) {
+  return MeasureWith(model, model.dofs(), s, nullptr);
+}
 
 namespace {
 
@@ -593,9 +598,8 @@ class DynamicRun {
 
   // The step's report: energies and momenta from the converged pass where the step kept it.
   DynamicStepReport Report(const StepOutcome& step, bool output) {
-    static const std::vector<BodyPass> kNone;
     DynamicStepReport r =
-        MeasureWith(model_, dofs_, state_, step.passes_kept ? work_.passes : kNone, &threads_, &work_.measures);
+        MeasureWith(model_, dofs_, state_, step.passes_kept ? &work_.passes : nullptr, &threads_, &work_.measures);
     r.h = h_;
     r.iterations = step.iterations;
     r.rejected = result_.rejected_by_error + result_.newton_cuts;

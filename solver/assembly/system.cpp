@@ -130,7 +130,7 @@ SystemForces AssembleStatic(const SystemModel& model, const DofMap& dofs, System
       return out;
     }
     state.frames[b] = frame;
-    const SuperelementBody::Data data = body.Evaluate(c, frame);
+    SuperelementBody::Data data = body.Evaluate(c, frame);
     Eigen::VectorXd f;
     Eigen::MatrixXd K;
     // Gravity in a static analysis, ramped to full at pseudo-time static_gravity_end.

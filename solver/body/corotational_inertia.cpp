@@ -13,7 +13,7 @@ namespace femb {
 using body_blocks::TurnColBlocks;
 using body_blocks::TurnRowBlocks;
 
-const BodyVelocityMaps& SuperelementBody::MapsOf(const Data& d) const {
+const BodyVelocityMaps& SuperelementBody::MapsOf(Data& d) const {
   if (!d.has_maps) {
     BodyVelocityMaps& maps = d.maps;
     VelocityMaps(d, &maps.P, &maps.U);
@@ -27,7 +27,7 @@ const BodyVelocityMaps& SuperelementBody::MapsOf(const Data& d) const {
   return d.maps;
 }
 
-void SuperelementBody::VelocityMaps(const Data& d, Eigen::MatrixXd* P, Eigen::MatrixXd* U) const {
+void SuperelementBody::VelocityMaps(Data& d, Eigen::MatrixXd* P, Eigen::MatrixXd* U) const {
   const int n = n_coordinates();
   const BodyConfiguration& c = d.c;
   const FrameSolution& frame = d.frame;
@@ -157,7 +157,7 @@ void SuperelementBody::QuadraticInertiaDerivative(const Eigen::MatrixXd& U, cons
   }
 }
 
-const Eigen::VectorXd& SuperelementBody::MassTimes(const Data& d, const BodyVelocity& w) const {
+const Eigen::VectorXd& SuperelementBody::MassTimes(Data& d, const BodyVelocity& w) const {
   Eigen::VectorXd& p = d.scratch.v1;
   if (has_exact_inertia()) {
     // The exact inertia force's acceleration part at w: M_g w in O(n^2) (the n x n ExactMass
@@ -171,9 +171,7 @@ const Eigen::VectorXd& SuperelementBody::MassTimes(const Data& d, const BodyVelo
   return p;
 }
 
-double SuperelementBody::KineticEnergy(const Data& d, const BodyVelocity& w) const {
-  return 0.5 * w.dot(MassTimes(d, w));
-}
+double SuperelementBody::KineticEnergy(Data& d, const BodyVelocity& w) const { return 0.5 * w.dot(MassTimes(d, w)); }
 
 void SuperelementBody::MomentumDerivative(const BodyVelocityMaps& maps, const BodyVelocity& w, Eigen::MatrixXd& D,
                                           BodyScratch& scratch) const {
@@ -247,7 +245,7 @@ void SuperelementBody::MomentumSource(const BodyVelocityMaps& maps, const BodyVe
   }
 }
 
-void SuperelementBody::MomentumSource(const Data& d, const BodyVelocity& w, const Eigen::VectorXd& p,
+void SuperelementBody::MomentumSource(Data& d, const BodyVelocity& w, const Eigen::VectorXd& p,
                                       Eigen::VectorXd& out) const {
   MomentumSource(MapsOf(d), w, p, out, d.scratch);
   if (!has_exact_inertia()) return;

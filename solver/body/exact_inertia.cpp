@@ -32,8 +32,8 @@ void SuperelementBody::GammaColumns(const Eigen::VectorXd& v, Eigen::MatrixXd& o
   Eigen::Map<Eigen::VectorXd>(out.data(), Eigen::Index(n_coordinates()) * 3).noalias() = Gamma_stack_ * v;
 }
 
-const SuperelementBody::ExactData& SuperelementBody::ExactProducts(const Data& data) const {
-  const ExactData& d = *data.exact;
+const SuperelementBody::ExactData& SuperelementBody::ExactProducts(Data& data) const {
+  ExactData& d = *data.exact;
   if (!d.has_products) {
     d.MY.noalias() = M_ * d.Y;
     d.HtY.noalias() = d.H.transpose() * d.Y;
@@ -53,7 +53,7 @@ void SuperelementBody::SubtractRateTerms(const Eigen::VectorXd& q, const Eigen::
   }
 }
 
-SuperelementBody::LocalMotion SuperelementBody::LocalRates(const Data& data, const BodyVelocity& w,
+SuperelementBody::LocalMotion SuperelementBody::LocalRates(Data& data, const BodyVelocity& w,
                                                            const BodyVelocity* wdot) const {
   const int blocks = 2 * n_nodes_;
   const Eigen::Matrix3d Rt = data.frame.R.transpose();
@@ -79,7 +79,7 @@ SuperelementBody::LocalMotion SuperelementBody::LocalRates(const Data& data, con
 
 // Every temporary in data.exact_scratch (ExactScratch), each product into its own vector before
 // the sums: no allocation once sized, and the same numbers as the expressions they replace.
-void SuperelementBody::ExactInertiaForce(const Data& data, const BodyVelocity& w, const BodyVelocity& wdot,
+void SuperelementBody::ExactInertiaForce(Data& data, const BodyVelocity& w, const BodyVelocity& wdot,
                                          Eigen::VectorXd& f, Eigen::VectorXd* f_acc) const {
   const int blocks = 2 * n_nodes_;
   const ExactData& d = *data.exact;
@@ -149,7 +149,7 @@ void SuperelementBody::ExactInertiaForce(const Data& data, const BodyVelocity& w
 
 // The force at w = 0 for the acceleration Rbar r (r = Rbar^T wdot; xi = qd = y = 0): M_g wdot,
 // in O(n^2) (s.y, s.pi_q_dot and s.t1 are overwritten).
-void SuperelementBody::ExactMassTimesTurned(const Data& data, const Eigen::VectorXd& r, Eigen::VectorXd& out) const {
+void SuperelementBody::ExactMassTimesTurned(Data& data, const Eigen::VectorXd& r, Eigen::VectorXd& out) const {
   const ExactData& d = *data.exact;
   ExactScratch& s = data.exact_scratch;
   const Eigen::MatrixXd& Z = data.kin.Z;
@@ -173,7 +173,7 @@ void SuperelementBody::ExactMassTimesTurned(const Data& data, const Eigen::Vecto
   TurnBlocksInto(data.frame.R, out, 2 * n_nodes_, out);
 }
 
-void SuperelementBody::ExactMomentumSource(const Data& data, const BodyVelocity& w, Eigen::VectorXd& out) const {
+void SuperelementBody::ExactMomentumSource(Data& data, const BodyVelocity& w, Eigen::VectorXd& out) const {
   // T(q, w) = T_hat(q_loc, Rbar^T w) (T is invariant under rigid motions), so at fixed w
   // dT/dq = G^T p (the frame's turning, as for the corotational inertia) + Rbar B^T g with
   // g = dT_hat/dq_loc at fixed w_hat = Rbar^T w. T_hat = T_L(xi(q_loc), q_loc, qdot(q_loc)) with
@@ -230,7 +230,7 @@ void SuperelementBody::ExactMomentumSource(const Data& data, const BodyVelocity&
   TurnBlocksInto(data.frame.R, out, blocks, out);
 }
 
-void SuperelementBody::ExactGyroscopic(const Data& data, const BodyVelocity& w, Eigen::MatrixXd& G) const {
+void SuperelementBody::ExactGyroscopic(Data& data, const BodyVelocity& w, Eigen::MatrixXd& G) const {
   // ExactInertiaForce is A(q) wdot + g(q, w), g quadratic in w with no wdot: its derivative by
   // w is that of g. Forward mode by hand: every quantity of the force that depends on w carries
   // its n columns d/dw (prefix d), in the order of ExactInertiaForce. The temporaries are
@@ -380,7 +380,7 @@ void SuperelementBody::ExactGyroscopic(const Data& data, const BodyVelocity& w, 
   TurnRowBlocks(G, blocks, [&](int) { return R; });
 }
 
-const Eigen::MatrixXd& SuperelementBody::ExactMass(const Data& data) const {
+const Eigen::MatrixXd& SuperelementBody::ExactMass(Data& data) const {
   if (data.has_exact_mass) return data.exact_mass;
   const ExactData& d = ExactProducts(data);
   const Eigen::Matrix3d& R = data.frame.R;
@@ -401,7 +401,7 @@ const Eigen::MatrixXd& SuperelementBody::ExactMass(const Data& data) const {
   return Mg;
 }
 
-Eigen::MatrixXd SuperelementBody::ExactInertiaConfigurationTangent(const Data& d, const BodyVelocity& w,
+Eigen::MatrixXd SuperelementBody::ExactInertiaConfigurationTangent(Data& d, const BodyVelocity& w,
                                                                    const BodyVelocity& wdot) const {
   // Central differences of the whole force at fixed (w, wdot), the frame re-solved.
   const int n = n_coordinates();
@@ -411,15 +411,16 @@ Eigen::MatrixXd SuperelementBody::ExactInertiaConfigurationTangent(const Data& d
   for (int i = 0; i < n; ++i) {
     double step = 0.0;
     const BodyConfiguration plus = Perturbed(d.c, i, 1.0, &step), minus = Perturbed(d.c, i, -1.0, &step);
-    ExactInertiaForce(Evaluate(plus, SolveFrame(plus, d.frame)), w_used, wdot, f_plus, nullptr);
-    ExactInertiaForce(Evaluate(minus, SolveFrame(minus, d.frame)), w_used, wdot, f_minus, nullptr);
+    Data at_plus = Evaluate(plus, SolveFrame(plus, d.frame));
+    ExactInertiaForce(at_plus, w_used, wdot, f_plus, nullptr);
+    Data at_minus = Evaluate(minus, SolveFrame(minus, d.frame));
+    ExactInertiaForce(at_minus, w_used, wdot, f_minus, nullptr);
     tangent.col(i) = (f_plus - f_minus) / (2 * step);
   }
   return tangent;
 }
 
-void SuperelementBody::AddLocalSourceVelocityDerivative(const Data& d, const BodyVelocity& w,
-                                                        Eigen::MatrixXd& d_w) const {
+void SuperelementBody::AddLocalSourceVelocityDerivative(Data& d, const BodyVelocity& w, Eigen::MatrixXd& d_w) const {
   if (!has_exact_inertia()) return;
   // c(w) = Q(w, w): c(w + e) - c(w - e) = 4 Q(w, e) = 2 (dc/dw) e for any step e.
   Eigen::VectorXd &wp = d.scratch.v2, &plus = d.scratch.v3, &minus = d.scratch.v4;
@@ -434,7 +435,7 @@ void SuperelementBody::AddLocalSourceVelocityDerivative(const Data& d, const Bod
   }
 }
 
-void SuperelementBody::MomentumConfigurationTangent(const Data& d, const BodyVelocity& w, Data& side,
+void SuperelementBody::MomentumConfigurationTangent(Data& d, const BodyVelocity& w, Data& side,
                                                     Eigen::MatrixXd& D) const {
   if (!has_exact_inertia()) {
     MomentumDerivative(MapsOf(d), w, D, d.scratch);

@@ -216,7 +216,7 @@ double SuperelementBody::RoundOffForce(const BodyConfiguration& c, double inerti
          (16.0 * std::sqrt(double(n_coordinates())) * k_max_ + 4.0 * inertia_factor * m_max_);
 }
 
-const Eigen::MatrixXd& SuperelementBody::SigmaProducts(const Data& d) const {
+const Eigen::MatrixXd& SuperelementBody::SigmaProducts(Data& d) const {
   if (!d.has_sigma_q) {
     const int n = n_coordinates();
     // The stacked product K_sigma q (12 n) is the n x 12 matrix column by column.
@@ -228,7 +228,7 @@ const Eigen::MatrixXd& SuperelementBody::SigmaProducts(const Data& d) const {
   return d.sigma_q;
 }
 
-const Eigen::VectorXd& SuperelementBody::LocalForce(const Data& d, const InertiaLoadFactors* load) const {
+const Eigen::VectorXd& SuperelementBody::LocalForce(Data& d, const InertiaLoadFactors* load) const {
   // The load factors the force is for (all zero without inertia stiffening: K q alone).
   const Eigen::Matrix<double, 12, 1> a =
       load && !K_sigma_.empty() ? load->a : Eigen::Matrix<double, 12, 1>::Zero().eval();
@@ -251,7 +251,7 @@ const Eigen::VectorXd& SuperelementBody::LocalForce(const Data& d, const Inertia
   return kept.Q;
 }
 
-const Eigen::VectorXd& SuperelementBody::Condensed(const Data& d) const {
+const Eigen::VectorXd& SuperelementBody::Condensed(Data& d) const {
   if (!d.has_eps) {
     CondensedCoordinates(*polynomial_, d.q, d.eps, d.polynomial_scratch);
     d.has_eps = true;
@@ -259,7 +259,7 @@ const Eigen::VectorXd& SuperelementBody::Condensed(const Data& d) const {
   return d.eps;
 }
 
-void SuperelementBody::LocalTangent(const Data& d, const InertiaLoadFactors* load, Eigen::MatrixXd& K) const {
+void SuperelementBody::LocalTangent(Data& d, const InertiaLoadFactors* load, Eigen::MatrixXd& K) const {
   const Eigen::VectorXd& q = d.q;
   if (!polynomial_) {
     K = K_;
@@ -274,7 +274,7 @@ void SuperelementBody::LocalTangent(const Data& d, const InertiaLoadFactors* loa
   }
 }
 
-void SuperelementBody::InertiaLoads(const Data& d, const BodyVelocity& w, const BodyVelocity& wdot,
+void SuperelementBody::InertiaLoads(Data& d, const BodyVelocity& w, const BodyVelocity& wdot,
                                     const Eigen::Vector3d& gravity, InertiaLoadFactors& out) const {
   const int n = n_coordinates();
   out.d_w.setZero(12, n);
@@ -313,7 +313,7 @@ void SuperelementBody::InertiaLoads(const Data& d, const BodyVelocity& w, const 
   out.d_w.bottomRows<6>().noalias() = d_products * d_omega;
 }
 
-double SuperelementBody::ElasticEnergy(const Data& d) const {
+double SuperelementBody::ElasticEnergy(Data& d) const {
   const Eigen::VectorXd& q = d.q;
   if (polynomial_ && polynomial_->cubic()) return PolynomialEnergy(K_, *polynomial_, q);
   // Linear: q^T K q / 2; the condensed polynomial: eps^T K eps / 2 with the data's eps.
@@ -323,7 +323,7 @@ double SuperelementBody::ElasticEnergy(const Data& d) const {
   return 0.5 * e.dot(Ke);
 }
 
-void SuperelementBody::AddGeometricTangent(const Data& d, const Eigen::VectorXd& Q, const Eigen::VectorXd& Qhat,
+void SuperelementBody::AddGeometricTangent(Data& d, const Eigen::VectorXd& Q, const Eigen::VectorXd& Qhat,
                                            bool approximated, Eigen::MatrixXd& Kt) const {
   const int n = n_coordinates();
   const Eigen::VectorXd& q = d.q;
@@ -367,7 +367,7 @@ void SuperelementBody::AddGeometricTangent(const Data& d, const Eigen::VectorXd&
   }
 }
 
-void SuperelementBody::ElasticForce(const Data& d, Eigen::VectorXd* f, Eigen::MatrixXd* tangent,
+void SuperelementBody::ElasticForce(Data& d, Eigen::VectorXd* f, Eigen::MatrixXd* tangent,
                                     const InertiaLoadFactors* load, Eigen::MatrixXd* d_load) const {
   const int n = n_coordinates();
   const Kinematics& kin = d.kin;
@@ -418,7 +418,7 @@ void SuperelementBody::ElasticForce(const Data& d, Eigen::VectorXd* f, Eigen::Ma
   TurnNodeBlocks(Kt, 2 * n_nodes_, frame.R);
 }
 
-void SuperelementBody::InterfaceConstraint(const Data& d, Eigen::VectorXd* g, Eigen::MatrixXd* G,
+void SuperelementBody::InterfaceConstraint(Data& d, Eigen::VectorXd* g, Eigen::MatrixXd* G,
                                            const Eigen::VectorXd* lambda, Eigen::MatrixXd* H) const {
   const int n = n_coordinates(), r = n_constraints(), nb = 6 * n_nodes_;
   const Eigen::Matrix3d R = d.frame.R, Rt = d.frame.R.transpose();
@@ -446,9 +446,8 @@ void SuperelementBody::InterfaceConstraint(const Data& d, Eigen::VectorXd* g, Ei
   TurnNodeBlocks(*H, 2 * n_nodes_, R);
 }
 
-void SuperelementBody::InertiaForce(const Data& d, const BodyVelocity& w, const BodyVelocity& wdot,
-                                    Eigen::VectorXd* f_in, Eigen::MatrixXd* mass, Eigen::MatrixXd* gyroscopic,
-                                    Eigen::VectorXd* f_acc) const {
+void SuperelementBody::InertiaForce(Data& d, const BodyVelocity& w, const BodyVelocity& wdot, Eigen::VectorXd* f_in,
+                                    Eigen::MatrixXd* mass, Eigen::MatrixXd* gyroscopic, Eigen::VectorXd* f_acc) const {
   const int n = n_coordinates();
   if (has_exact_inertia()) {
     Eigen::VectorXd& zero = d.scratch.v4;
@@ -490,7 +489,7 @@ void SuperelementBody::InertiaForce(const Data& d, const BodyVelocity& w, const 
   }
 }
 
-void SuperelementBody::InertiaConfigurationTangent(const Data& d, const BodyVelocity& w, const BodyVelocity& wdot,
+void SuperelementBody::InertiaConfigurationTangent(Data& d, const BodyVelocity& w, const BodyVelocity& wdot,
                                                    bool quadratic, Eigen::MatrixXd& tangent) const {
   // Exact inertia: the whole force by central differences with `quadratic`; without, the
   // corotational d(M_g wdot)/dq, which has its leading part (the turning of the frame; the exact
@@ -508,7 +507,7 @@ void SuperelementBody::InertiaConfigurationTangent(const Data& d, const BodyVelo
     double step = 1e-7;
     for (int side = 0; side < 2; ++side) {
       const BodyConfiguration p = Perturbed(d.c, i, side == 0 ? 1.0 : -1.0, &step);
-      const Data dp = Evaluate(p, SolveFrame(p, d.frame));
+      Data dp = Evaluate(p, SolveFrame(p, d.frame));
       const BodyVelocityMaps& maps = MapsOf(dp);
       QuadraticInertia(maps.U, maps.Mg, w, g[side], scratch);
     }
@@ -550,12 +549,12 @@ void SuperelementBody::AddModalDamping(const BodyVelocity& w, Eigen::VectorXd& f
   }
 }
 
-void SuperelementBody::Momentum(const Data& d, const BodyVelocity& w, Eigen::Vector3d* linear,
+void SuperelementBody::Momentum(Data& d, const BodyVelocity& w, Eigen::Vector3d* linear,
                                 Eigen::Vector3d* angular) const {
   MomentumFrom(d, MassTimes(d, w), linear, angular);
 }
 
-void SuperelementBody::MomentumFrom(const Data& d, const Eigen::VectorXd& p, Eigen::Vector3d* linear,
+void SuperelementBody::MomentumFrom(Data& d, const Eigen::VectorXd& p, Eigen::Vector3d* linear,
                                     Eigen::Vector3d* angular) const {
   const BodyConfiguration& c = d.c;
   linear->setZero();
@@ -573,7 +572,7 @@ Eigen::Vector3d SuperelementBody::CenterOfMass(const Eigen::VectorXd& q_loc, con
   return frame.x + frame.R * (mass_ > 0 ? Eigen::Vector3d(moment / mass_) : Eigen::Vector3d::Zero());
 }
 
-void SuperelementBody::GravityForce(const Data& data, const Eigen::Vector3d& g, Eigen::VectorXd& f) const {
+void SuperelementBody::GravityForce(Data& data, const Eigen::Vector3d& g, Eigen::VectorXd& f) const {
   const FrameSolution& frame = data.frame;
   Eigen::VectorXd& yg = data.scratch.v1;
   const Eigen::Vector3d g_frame = frame.R.transpose() * g;
@@ -598,7 +597,7 @@ void SuperelementBody::GravityForce(const Data& data, const Eigen::Vector3d& g, 
     f.segment<3>(3 * a) = P.block<3, 3>(3 * a, 3 * a).transpose() * Eigen::Vector3d(f.segment<3>(3 * a));
 }
 
-Eigen::MatrixXd SuperelementBody::GravityTangent(const Data& d, const Eigen::Vector3d& g) const {
+Eigen::MatrixXd SuperelementBody::GravityTangent(Data& d, const Eigen::Vector3d& g) const {
   const int n = n_coordinates();
   if (!has_exact_inertia()) {
     // GravityForce = P^T M P wdot_g = M_g wdot_g with wdot_g = g on every node's translation rows
@@ -617,8 +616,9 @@ Eigen::MatrixXd SuperelementBody::GravityTangent(const Data& d, const Eigen::Vec
   for (int i = 0; i < n; ++i) {
     double step = 0.0;
     const BodyConfiguration plus = Perturbed(d.c, i, 1.0, &step), minus = Perturbed(d.c, i, -1.0, &step);
-    GravityForce(Evaluate(plus, SolveFrame(plus, d.frame)), g, f_plus);
-    GravityForce(Evaluate(minus, SolveFrame(minus, d.frame)), g, f_minus);
+    Data at_plus = Evaluate(plus, SolveFrame(plus, d.frame)), at_minus = Evaluate(minus, SolveFrame(minus, d.frame));
+    GravityForce(at_plus, g, f_plus);
+    GravityForce(at_minus, g, f_minus);
     tangent.col(i) = (f_plus - f_minus) / (2 * step);
   }
   return tangent;

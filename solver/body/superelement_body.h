@@ -132,25 +132,28 @@ class SuperelementBody {
     Eigen::Matrix3d Xq;  ///< q^T Xi_ab q
     /// For the matrices only (ExactMass, ExactGyroscopic), made when first asked (has_products):
     /// M Y and H^T Y (3 x n).
-    mutable Eigen::MatrixXd MY, HtY;
+    Eigen::MatrixXd MY, HtY;
     // No default member initializer: clang then finds ExactData not default-constructible while
     // SuperelementBody is incomplete (std::optional<ExactData> in Data). Exact sets it.
-    mutable bool has_products;
+    bool has_products;
     Eigen::VectorXd xq;  ///< scratch of Exact
   };
   /// Everything one configuration of the body determines, computed once (Evaluate) and passed to
   /// every force, matrix and energy evaluated there: an assembly pass evaluates each body's
-  /// kinematics once instead of once per term (the model / data split).
+  /// kinematics once instead of once per term (the model / data split). The body (the model) is
+  /// const; the kernels take the data by reference and leave in it what they computed for the
+  /// next kernel at the same configuration (the maps, the exact mass, the local force, the
+  /// stiffening's products, each with its flag, cleared by Evaluate) and their temporaries.
   struct Data {
     BodyConfiguration c;
     FrameSolution frame;
     Eigen::VectorXd q;  ///< q_loc
     Kinematics kin;
     std::optional<ExactData> exact;  ///< with the exact inertia (kept: its storage reused)
-    mutable BodyVelocityMaps maps;   ///< the corotational maps, made when first asked (has_maps)
-    mutable bool has_maps = false;
-    mutable Eigen::MatrixXd exact_mass;  ///< M_g of the exact inertia, made when first asked (has_exact_mass)
-    mutable bool has_exact_mass = false;
+    BodyVelocityMaps maps;           ///< the corotational maps, made when first asked (has_maps)
+    bool has_maps = false;
+    Eigen::MatrixXd exact_mass;  ///< M_g of the exact inertia, made when first asked (has_exact_mass)
+    bool has_exact_mass = false;
     /// The local force Q (LocalForce) of the last load factors asked for, and with inertia
     /// stiffening the products K_sigma,k q_loc (n x 12): the residual and the matrix passes of an
     /// iteration share them.
@@ -159,14 +162,14 @@ class SuperelementBody {
       Eigen::VectorXd Q;
       bool valid = false;
     };
-    mutable LocalForceOf local_force;
-    mutable Eigen::MatrixXd sigma_q;  ///< when has_sigma_q
-    mutable bool has_sigma_q = false;
-    mutable Eigen::VectorXd eps;  ///< the condensed polynomial's q + K^+ A z, made when first asked (has_eps)
-    mutable bool has_eps = false;
-    mutable PolynomialScratch polynomial_scratch;
-    mutable BodyScratch scratch;         ///< the kernels' temporaries (BodyScratch)
-    mutable ExactScratch exact_scratch;  ///< the exact inertia's (ExactScratch)
+    LocalForceOf local_force;
+    Eigen::MatrixXd sigma_q;  ///< when has_sigma_q
+    bool has_sigma_q = false;
+    Eigen::VectorXd eps;  ///< the condensed polynomial's q + K^+ A z, made when first asked (has_eps)
+    bool has_eps = false;
+    PolynomialScratch polynomial_scratch;
+    BodyScratch scratch;         ///< the kernels' temporaries (BodyScratch)
+    ExactScratch exact_scratch;  ///< the exact inertia's (ExactScratch)
   };
   /// The body's quantities at configuration `c` with its solved floating frame.
   Data Evaluate(const BodyConfiguration& c, const FrameSolution& frame) const;
@@ -177,7 +180,7 @@ class SuperelementBody {
   /// for this c and frame): they are not computed again.
   void EvaluateSolved(const BodyConfiguration& c, const FrameSolution& frame, Data& d) const;
   /// The velocity maps of `d` (computed on the first call).
-  const BodyVelocityMaps& MapsOf(const Data& d) const;
+  const BodyVelocityMaps& MapsOf(Data& d) const;
 
   int n_nodes() const { return n_nodes_; }
   int n_modes() const { return n_modes_; }
@@ -241,8 +244,8 @@ class SuperelementBody {
   /// if `tangent` is not null, its derivative with respect to (dx_k, dpi_k, d eta).
   /// With `load` (and a file with inertia stiffening) the local stiffness is K + K_sigma(a)
   /// (InertiaLoads); `d_load` (n x 12) then receives df/da at fixed configuration.
-  void ElasticForce(const Data& d, Eigen::VectorXd* f, Eigen::MatrixXd* tangent,
-                    const InertiaLoadFactors* load = nullptr, Eigen::MatrixXd* d_load = nullptr) const;
+  void ElasticForce(Data& d, Eigen::VectorXd* f, Eigen::MatrixXd* tangent, const InertiaLoadFactors* load = nullptr,
+                    Eigen::MatrixXd* d_load = nullptr) const;
 
   /// Thesis 8.2 case 4: a basis that moves only m < 6N interface directions holds the others
   /// with the file's C q_int = 0 (formats/superelement.h interface_constraint; r rows, lengths).
@@ -252,7 +255,7 @@ class SuperelementBody {
   /// local map of the file comment); with `lambda`, H = d(G^T lambda)/dq (n x n). G^T lambda is
   /// the elastic force's form Rbar B^T Q with the local force Q = [C^T lambda; 0], which does not
   /// depend on the configuration: H is that force's K2 + K3 + K4 (tangent stiffness paper).
-  void InterfaceConstraint(const Data& d, Eigen::VectorXd* g, Eigen::MatrixXd* G, const Eigen::VectorXd* lambda,
+  void InterfaceConstraint(Data& d, Eigen::VectorXd* g, Eigen::MatrixXd* G, const Eigen::VectorXd* lambda,
                            Eigen::MatrixXd* H) const;
 
   /// True when the body uses the geometric stiffness of inertia load cases (file and option).
@@ -273,11 +276,11 @@ class SuperelementBody {
   /// c_k = omega x (omega x r_k) on node k's translation rows. d_w and d_wdot are exact at fixed
   /// configuration (the configuration dependence of R_j and Z is left out of the tangent).
   /// Into `out` (its storage reused).
-  void InertiaLoads(const Data& d, const BodyVelocity& w, const BodyVelocity& wdot, const Eigen::Vector3d& gravity,
+  void InertiaLoads(Data& d, const BodyVelocity& w, const BodyVelocity& wdot, const Eigen::Vector3d& gravity,
                     InertiaLoadFactors& out) const;
 
   /// Strain energy q_loc^T K q_loc / 2.
-  double ElasticEnergy(const Data& d) const;
+  double ElasticEnergy(Data& d) const;
 
   /// True when the body uses the exact kinetic energy (file invariants and option exact_inertia).
   ///
@@ -319,7 +322,7 @@ class SuperelementBody {
     Eigen::Vector3d Vdot = Eigen::Vector3d::Zero(), Omegadot = Eigen::Vector3d::Zero();
     Eigen::VectorXd qdot, qddot;
   };
-  LocalMotion LocalRates(const Data& d, const BodyVelocity& w, const BodyVelocity* wdot) const;
+  LocalMotion LocalRates(Data& d, const BodyVelocity& w, const BodyVelocity* wdot) const;
 
   /// Inertia force from the corotational kinetic energy T = v^T M v / 2, v = P w (thesis 3.22,
   /// 4.9; DESIGN.md "Inertia"), P = blockdiag(R_j^T ... , 1) (option A) or with R_k^T on the
@@ -328,14 +331,14 @@ class SuperelementBody {
   ///   f_in = M_g wdot + M_g G w + (Omega_P - Omega_hat) p - G^T p,  M_g = P^T M P, p = M_g w.
   /// `mass` receives M_g, `gyroscopic` d f_in / d w (exact: f_in is quadratic in w).
   /// `f_acc` (optional) receives the part linear in wdot, M_g wdot.
-  void InertiaForce(const Data& d, const BodyVelocity& w, const BodyVelocity& wdot, Eigen::VectorXd* f_in,
+  void InertiaForce(Data& d, const BodyVelocity& w, const BodyVelocity& wdot, Eigen::VectorXd* f_in,
                     Eigen::MatrixXd* mass, Eigen::MatrixXd* gyroscopic, Eigen::VectorXd* f_acc = nullptr) const;
 
   /// d f_in / dq at fixed (w, wdot): d(M_g wdot)/dq = MomentumDerivative(c, frame, wdot)
   /// (exact), plus with `quadratic` the configuration derivative of the quadratic velocity terms
   /// by central differences (2n evaluations with the frame re-solved; steps 1e-7 of the body
   /// size, 1e-7 rad, 1e-7 of the modal scale). Into `tangent` (its storage reused).
-  void InertiaConfigurationTangent(const Data& d, const BodyVelocity& w, const BodyVelocity& wdot, bool quadratic,
+  void InertiaConfigurationTangent(Data& d, const BodyVelocity& w, const BodyVelocity& wdot, bool quadratic,
                                    Eigen::MatrixXd& tangent) const;
 
   /// Modal damping force 2 zeta omega_i etadot_i on the internal-mode rows and its derivative
@@ -343,11 +346,11 @@ class SuperelementBody {
   void AddModalDamping(const BodyVelocity& w, Eigen::VectorXd& f, Eigen::MatrixXd* C) const;
 
   /// M_g w, into d.scratch.v1 (the exact inertia: without forming M_g).
-  const Eigen::VectorXd& MassTimes(const Data& d, const BodyVelocity& w) const;
+  const Eigen::VectorXd& MassTimes(Data& d, const BodyVelocity& w) const;
   /// The mass matrix d^2 T / dw^2 at `d`: the exact one or the corotational M_g (MapsOf).
-  const Eigen::MatrixXd& Mass(const Data& d) const { return has_exact_inertia() ? ExactMass(d) : MapsOf(d).Mg; }
+  const Eigen::MatrixXd& Mass(Data& d) const { return has_exact_inertia() ? ExactMass(d) : MapsOf(d).Mg; }
   /// Kinetic energy v^T M v / 2.
-  double KineticEnergy(const Data& d, const BodyVelocity& w) const;
+  double KineticEnergy(Data& d, const BodyVelocity& w) const;
 
   /// d p / d q at fixed w (n x n; per node (dx, dpi) spatial, then d eta): the configuration
   /// derivative of the generalized momentum (midpoint iteration matrix; with w = wdot, the
@@ -373,7 +376,7 @@ class SuperelementBody {
   /// moment: the midpoint scheme keeps conserving momentum. Here p is the exact momentum
   /// MassTimes(d, w) for the G^T p part only where the caller passes it so; the local term
   /// takes the momentum of w at d itself. Without the exact inertia: MomentumSource(MapsOf(d)).
-  void MomentumSource(const Data& d, const BodyVelocity& w, const Eigen::VectorXd& p, Eigen::VectorXd& out) const;
+  void MomentumSource(Data& d, const BodyVelocity& w, const Eigen::VectorXd& p, Eigen::VectorXd& out) const;
 
   /// d p / d q at fixed w of the body's own momentum p = MassTimes(d, w) (the midpoint scheme's
   /// iteration matrix): MomentumDerivative for the corotational inertia; for the exact one the
@@ -381,11 +384,11 @@ class SuperelementBody {
   /// Rbar (d p_hat / d q_loc) B Rbar^T, the middle factor by central differences in q_loc (that
   /// share turns the torsion of a spinning bar, whose inertia is small, as much as the frame's:
   /// without it Newton stalled there). `side`: the perturbed data (storage reused).
-  void MomentumConfigurationTangent(const Data& d, const BodyVelocity& w, Data& side, Eigen::MatrixXd& D) const;
+  void MomentumConfigurationTangent(Data& d, const BodyVelocity& w, Data& side, Eigen::MatrixXd& D) const;
   /// With the exact inertia: adds to `d_w` the derivative of the source's local term (the
   /// MomentumSource at `d` beyond G^T p + Omega_hat p) with respect to w, by central
   /// differences that are exact up to round-off (the term is quadratic in w).
-  void AddLocalSourceVelocityDerivative(const Data& d, const BodyVelocity& w, Eigen::MatrixXd& d_w) const;
+  void AddLocalSourceVelocityDerivative(Data& d, const BodyVelocity& w, Eigen::MatrixXd& d_w) const;
   /// Derivatives of MomentumSource s(q, w, p) with respect to w and to p (both n x n; s is
   /// bilinear in w and p), with the temporaries in `scratch` (no allocation once d_w, d_p are sized).
   void MomentumSourceDerivatives(const BodyVelocityMaps& maps, const BodyVelocity& w, const Eigen::VectorXd& p,
@@ -393,9 +396,9 @@ class SuperelementBody {
 
   /// Linear momentum and angular momentum about the global origin (Noether: sums of the
   /// generalized momenta p = M_g w of the nodes).
-  void Momentum(const Data& d, const BodyVelocity& w, Eigen::Vector3d* linear, Eigen::Vector3d* angular) const;
+  void Momentum(Data& d, const BodyVelocity& w, Eigen::Vector3d* linear, Eigen::Vector3d* angular) const;
   /// The same from the generalized momentum p = M_g w (MassTimes).
-  void MomentumFrom(const Data& d, const Eigen::VectorXd& p, Eigen::Vector3d* linear, Eigen::Vector3d* angular) const;
+  void MomentumFrom(Data& d, const Eigen::VectorXd& p, Eigen::Vector3d* linear, Eigen::Vector3d* angular) const;
 
   /// The deformed body's centre of mass (global): x_j + R_j (s_0 + C q_loc) / m, s_0 the first
   /// moment of the undeformed body about the frame origin, C = int rho Phi (the translation rows
@@ -406,13 +409,13 @@ class SuperelementBody {
 
   /// Generalized force of a uniform acceleration field g (gravity): P^T M Phi_rig0 [R_j^T g; 0].
   /// Into `f` (its storage reused).
-  void GravityForce(const Data& d, const Eigen::Vector3d& g, Eigen::VectorXd& f) const;
+  void GravityForce(Data& d, const Eigen::Vector3d& g, Eigen::VectorXd& f) const;
   /// d GravityForce / dq (n x n): the weight's distribution over the nodes and modes turns with
   /// the floating frame. Corotational inertia: GravityForce = M_g wdot_g (wdot_g = g on the node
   /// translations), so MomentumDerivative(maps, wdot_g), exact; exact inertia: central
   /// differences (steps as in InertiaConfigurationTangent). A pendulum hanging from a pin owes
   /// its whole restoring stiffness to it.
-  Eigen::MatrixXd GravityTangent(const Data& d, const Eigen::Vector3d& g) const;
+  Eigen::MatrixXd GravityTangent(Data& d, const Eigen::Vector3d& g) const;
 
  private:
   // Into `k`, reusing its storage.
@@ -420,7 +423,7 @@ class SuperelementBody {
   // S = Phi_CB D Phi_rig alone (the floating frame's Newton iteration), node block by node block.
   Eigen::Matrix<double, 6, 6> FrameMatrix(const Eigen::VectorXd& q_loc) const;
   // P (system velocities -> local velocities) and the frame's angular velocity map U (3 x n).
-  void VelocityMaps(const Data& d, Eigen::MatrixXd* P, Eigen::MatrixXd* U) const;
+  void VelocityMaps(Data& d, Eigen::MatrixXd* P, Eigen::MatrixXd* U) const;
   // G of d(P w) = P G dq at fixed w (n x n, into G), from U and the velocities.
   void VelocityMapRate(const Eigen::MatrixXd& U, const BodyVelocity& w, Eigen::MatrixXd& G) const;
   // The quadratic part of f_in: M_g G w + (Omega_P - Omega_hat) p - G^T p.
@@ -438,18 +441,17 @@ class SuperelementBody {
   // force, the mass matrix M_g.
   void Exact(const Eigen::VectorXd& q, const Kinematics& kin, ExactData& d) const;
   // With `f_acc`, also the part linear in wdot alone (M_g wdot) from the same products.
-  void ExactInertiaForce(const Data& d, const BodyVelocity& w, const BodyVelocity& wdot, Eigen::VectorXd& f,
+  void ExactInertiaForce(Data& d, const BodyVelocity& w, const BodyVelocity& wdot, Eigen::VectorXd& f,
                          Eigen::VectorXd* f_acc) const;
   // M Y and H^T Y of d.exact, made on the first call.
-  const ExactData& ExactProducts(const Data& d) const;
-  const Eigen::MatrixXd& ExactMass(const Data& d) const;  // computed once per Data
+  const ExactData& ExactProducts(Data& d) const;
+  const Eigen::MatrixXd& ExactMass(Data& d) const;  // computed once per Data
   // d f_in / d w of the exact inertia force (forward mode, exact).
-  void ExactGyroscopic(const Data& d, const BodyVelocity& w, Eigen::MatrixXd& G) const;
-  void ExactMassTimesTurned(const Data& data, const Eigen::VectorXd& r, Eigen::VectorXd& out) const;
-  // c = Rbar B^T g, g = dT/dq_loc at fixed Rbar^T w (MomentumSource(const Data&, ...)), into out.
-  void ExactMomentumSource(const Data& data, const BodyVelocity& w, Eigen::VectorXd& out) const;
-  Eigen::MatrixXd ExactInertiaConfigurationTangent(const Data& d, const BodyVelocity& w,
-                                                   const BodyVelocity& wdot) const;
+  void ExactGyroscopic(Data& d, const BodyVelocity& w, Eigen::MatrixXd& G) const;
+  void ExactMassTimesTurned(Data& data, const Eigen::VectorXd& r, Eigen::VectorXd& out) const;
+  // c = Rbar B^T g, g = dT/dq_loc at fixed Rbar^T w (MomentumSource(Data&, ...)), into out.
+  void ExactMomentumSource(Data& data, const BodyVelocity& w, Eigen::VectorXd& out) const;
+  Eigen::MatrixXd ExactInertiaConfigurationTangent(Data& d, const BodyVelocity& w, const BodyVelocity& wdot) const;
   BodyConfiguration Perturbed(const BodyConfiguration& c, int i, double sign, double* step) const;
   // r -= c(Omega, Rbar^T w, qdot_loc) at local coordinates q (LocalRates, ExactInertiaForce).
   void SubtractRateTerms(const Eigen::VectorXd& q, const Eigen::Vector3d& Om, const Eigen::VectorXd& Rw,
@@ -467,18 +469,18 @@ class SuperelementBody {
   Eigen::MatrixXd C_;  ///< interface constraint (r x 6N; no rows: none)
   // K2 + K3 + K4 of a local force Q (Qhat = B^T Q, or T0^T Q when `approximated`: K3 alone),
   // added to the local Kt (not turned by Rbar).
-  void AddGeometricTangent(const Data& d, const Eigen::VectorXd& Q, const Eigen::VectorXd& Qhat, bool approximated,
+  void AddGeometricTangent(Data& d, const Eigen::VectorXd& Q, const Eigen::VectorXd& Qhat, bool approximated,
                            Eigen::MatrixXd& Kt) const;
   std::optional<PolynomialStiffness> polynomial_;  ///< set when the file has it and the option is on
   // Local internal force and its tangent: K q or the polynomial's.
   // The force is kept in d (Data::local_force) for the next call with the same load factors.
-  const Eigen::VectorXd& LocalForce(const Data& d, const InertiaLoadFactors* load = nullptr) const;
+  const Eigen::VectorXd& LocalForce(Data& d, const InertiaLoadFactors* load = nullptr) const;
   // Into K.
-  void LocalTangent(const Data& d, const InertiaLoadFactors* load, Eigen::MatrixXd& K) const;
+  void LocalTangent(Data& d, const InertiaLoadFactors* load, Eigen::MatrixXd& K) const;
   // The condensed polynomial's eps at d (geometric stiffening without modal derivatives), kept in d.
-  const Eigen::VectorXd& Condensed(const Data& d) const;
+  const Eigen::VectorXd& Condensed(Data& d) const;
   // K_sigma,k q_loc for the 12 load cases (n x 12), kept in d.
-  const Eigen::MatrixXd& SigmaProducts(const Data& d) const;
+  const Eigen::MatrixXd& SigmaProducts(Data& d) const;
   std::vector<Eigen::MatrixXd> K_sigma_;  ///< the 12 inertia load case geometric stiffnesses, or none
   Eigen::MatrixXd K_sigma_stack_;         ///< the same stacked (12n x n)
   std::vector<Eigen::Vector3d> X_;        ///< node positions relative to the frame origin, frame axes

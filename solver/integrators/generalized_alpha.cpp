@@ -103,7 +103,7 @@ void DecideKeptMatrices(const SystemModel& model, int every, bool all_kept, Body
 
 // One body's K, C and M of the dynamic residual at its pass (computed, or kept and turned with the
 // frame), into r; with `combine` K + c_C C + c_M M into r.K.
-void BodyDynamicMatrices(const SuperelementBody& body, const BodyPass& pass, const Eigen::Vector3d& gravity,
+void BodyDynamicMatrices(const SuperelementBody& body, BodyPass& pass, const Eigen::Vector3d& gravity,
                          bool full_inertia_tangent, const MatrixCombination* combine, bool all_kept,
                          BodyWorkspace::BodyMatrices& r) {
   const bool stiffening = body.has_inertia_stiffening();
@@ -178,7 +178,7 @@ void AddDynamicMatrices(const SystemModel& model, const DofMap& dofs, const Dyna
                         BodyWorkspace& work, bool full_inertia_tangent, Assembly& out, BodyThreads* threads,
                         const MatrixCombination* combine, int every, BodyMatricesKept which) {
   const int n_bodies = int(model.bodies.size());
-  const std::vector<BodyPass>& passes = work.passes;
+  std::vector<BodyPass>& passes = work.passes;
   std::vector<BodyWorkspace::BodyMatrices>& results = work.matrices;
   results.resize(static_cast<size_t>(n_bodies));
   const bool all_kept = which == BodyMatricesKept::kAll;

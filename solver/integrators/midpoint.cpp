@@ -205,12 +205,12 @@ void AddDiscreteGradientCorrection(const SystemModel& model, const DofMap& dofs,
 // r.f_acc): the change of its momenta over the step less the momentum source. d1, w1, maps1: the
 // body's data, velocities and corotational velocity maps at the end of the step.
 void MidpointInertia(const SystemModel& model, const DynamicState& s0, double h, const DynamicState& s1, int b,
-                     const SuperelementBody::Data& d1, const Eigen::VectorXd& w1, const BodyVelocityMaps& maps1,
+                     SuperelementBody::Data& d1, const Eigen::VectorXd& w1, const BodyVelocityMaps& maps1,
                      MidpointWorkspace& mw, BodyTerms& r) {
   const SuperelementBody& body = model.bodies[b];
   const MidpointKinematics& k = mw.k;
   MidpointBody& m = mw.bodies[size_t(b)];
-  const SuperelementBody::Data& dm = m.dm;
+  SuperelementBody::Data& dm = m.dm;
   const Eigen::VectorXd& wm = m.wm;
   const bool exact = body.has_exact_inertia();
   Eigen::VectorXd &f_in = r.f_in, &f_acc = r.f_acc;
@@ -263,7 +263,7 @@ void MidpointGravity(const SystemModel& model, double h, int b, const Eigen::Vec
                      MidpointWorkspace& mw, Eigen::VectorXd& f_grav) {
   const SuperelementBody& body = model.bodies[b];
   MidpointBody& m = mw.bodies[size_t(b)];
-  const SuperelementBody::Data& dm = m.dm;
+  SuperelementBody::Data& dm = m.dm;
   const Eigen::VectorXd& wm = m.wm;
   if (model.gravity.squaredNorm() > 0) {
     body.GravityForce(dm, model.gravity, f_grav);
@@ -408,7 +408,7 @@ const SystemMatrix& MidpointMatrix(const SystemModel& model, const DofMap& dofs,
   work.matrices.resize(size_t(n_bodies));
   ForEachBody(threads, n_bodies, [&](int b) {
     const SuperelementBody& body = model.bodies[b];
-    const BodyPass& pass = work.passes[size_t(b)];
+    BodyPass& pass = work.passes[size_t(b)];
     MidpointBody& m = mw.bodies[size_t(b)];
     BodyWorkspace::BodyMatrices& r = work.matrices[size_t(b)];
     const bool stiffening = body.has_inertia_stiffening();

@@ -29,8 +29,8 @@ std::optional<SuperelementBody::Data> BodyDataAt(const SystemModel& model, const
 
 // Body b's data at `state`: the given one, or evaluated into `own`; null when its frame does not
 // converge.
-const SuperelementBody::Data* BodyDataFor(const SystemModel& model, const SystemState& state, int b,
-                                          const BodyDataAtState* data, std::optional<SuperelementBody::Data>& own) {
+SuperelementBody::Data* BodyDataFor(const SystemModel& model, const SystemState& state, int b,
+                                    const BodyDataAtState* data, std::optional<SuperelementBody::Data>& own) {
   if (data && size_t(b) < data->size() && (*data)[size_t(b)]) return (*data)[size_t(b)];
   own = BodyDataAt(model, state, b);
   return own ? &*own : nullptr;
@@ -51,7 +51,7 @@ void AddBodyConstraints(const SystemModel& model, const DofMap& dofs, const Syst
     const int r = body.n_constraints();
     if (r == 0) continue;
     std::optional<SuperelementBody::Data> own;
-    const SuperelementBody::Data* d = BodyDataFor(model, state, int(b), data, own);
+    SuperelementBody::Data* d = BodyDataFor(model, state, int(b), data, own);
     if (!d) continue;
     const int first = dofs.body_multiplier_first(int(b));
     lambda = state.lambda.segment(first - dofs.first_multiplier(), r);
@@ -246,7 +246,7 @@ double LoopViolation(const SystemModel& model, const SystemState& state, int* wo
     const SuperelementBody& body = model.bodies[b];
     if (body.n_constraints() == 0) continue;
     std::optional<SuperelementBody::Data> own;
-    const SuperelementBody::Data* d = BodyDataFor(model, state, int(b), data, own);
+    SuperelementBody::Data* d = BodyDataFor(model, state, int(b), data, own);
     thread_local Eigen::VectorXd g;                                      // (kept: no allocation with `data`)
     if (d) body.InterfaceConstraint(*d, &g, nullptr, nullptr, nullptr);  // lengths
     const double v = d ? g.lpNorm<Eigen::Infinity>() : std::numeric_limits<double>::infinity();

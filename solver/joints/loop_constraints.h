@@ -25,7 +25,7 @@ namespace femb {
 /// null), the bodies' interface constraints take them instead of solving the body's frame and
 /// evaluating it again; the step then allocates nothing for them.
 enum LoopBlocks { kLoopRows = 1, kLoopColumns = 2, kLoopHessian = 4, kLoopAll = 7 };
-using BodyDataAtState = std::vector<const SuperelementBody::Data*>;
+using BodyDataAtState = std::vector<SuperelementBody::Data*>;
 void AddLoopConstraints(const SystemModel& model, const DofMap& dofs, const SystemState& state,
                         Eigen::VectorXd* residual, Triplets* tangent, NodeForces* node_forces,
                         Triplets* jacobian = nullptr, int blocks = kLoopAll, const BodyDataAtState* data = nullptr);

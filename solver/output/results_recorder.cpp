@@ -204,8 +204,8 @@ class ResultsRecorder::OutputStep {
     if (!dynamic && model_.static_gravity_end > 0) g = std::min(t_ / model_.static_gravity_end, 1.0);
     const SuperelementBody& body = model_.bodies[b];
     InertiaLoadFactors load;
-    body.InertiaLoads(body.Evaluate(BodyConfigurationOf(model_, state_, int(b)), state_.frames[b]),
-                      GatherBody(model_, r_.dofs_, state_, int(b), V_),
+    SuperelementBody::Data data = body.Evaluate(BodyConfigurationOf(model_, state_, int(b)), state_.frames[b]);
+    body.InertiaLoads(data, GatherBody(model_, r_.dofs_, state_, int(b), V_),
                       GatherBodyAcceleration(model_, r_.dofs_, int(b), node_acc_, A_), g * model_.gravity, load);
     r_.factors_[b] = load.a;
     r_.has_factors_[b] = 1;

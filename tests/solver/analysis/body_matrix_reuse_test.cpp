@@ -32,7 +32,7 @@ struct BodyMatrices {
 
 BodyMatrices MatricesAt(const SuperelementBody& body, const BodyConfiguration& c, const FrameSolution& f,
                         const Eigen::VectorXd& w, const Eigen::VectorXd& wdot) {
-  const SuperelementBody::Data d = body.Evaluate(c, f);
+  SuperelementBody::Data d = body.Evaluate(c, f);
   BodyMatrices m;
   if (body.has_inertia_stiffening()) {
     const InertiaLoadFactors load = test::InertiaLoadsOf(body, d, w, wdot, Eigen::Vector3d::Zero());

@@ -78,26 +78,30 @@ TEST(ExactInertia, ForceIsTheLagrangianDerivativeAndMatchesItsMatrices) {
             ExpSO3(Eigen::Vector3d(h * w.segment<3>(6 * k + 3) + 0.5 * h * h * wdot.segment<3>(6 * k + 3))) * p.R[k];
       }
       p.eta += h * w.tail(body.n_modes()) + 0.5 * h * h * wdot.tail(body.n_modes());
-      return body.KineticEnergy(body.Evaluate(p, body.SolveFrame(p, f0)), w + h * wdot);
+      return body.KineticEnergy(test::Lvalue(body.Evaluate(p, body.SolveFrame(p, f0))), w + h * wdot);
     };
     auto rate = [&](double h) { return (at(h) - at(-h)) / (2 * h); };
     const double dTdt = (4 * rate(1e-5) - rate(2e-5)) / 3;  // Richardson: O(h^4)
     Eigen::VectorXd f_in;
     Eigen::MatrixXd mass, gyroscopic;
-    body.InertiaForce(body.Evaluate(c, f0), w, wdot, &f_in, &mass, &gyroscopic);
+    body.InertiaForce(test::Lvalue(body.Evaluate(c, f0)), w, wdot, &f_in, &mass, &gyroscopic);
     std::printf("[ info ] %s: dT/dt %.10e, w . f_in %.10e\n", frame, dTdt, w.dot(f_in));
     EXPECT_NEAR(dTdt, w.dot(f_in), 1e-8 * std::abs(w.dot(f_in)));
     // T = w^T M_g w / 2.
-    EXPECT_NEAR(body.KineticEnergy(body.Evaluate(c, f0), w), 0.5 * w.dot(mass * w), 1e-12 * w.dot(mass * w));
+    EXPECT_NEAR(body.KineticEnergy(test::Lvalue(body.Evaluate(c, f0)), w), 0.5 * w.dot(mass * w),
+                1e-12 * w.dot(mass * w));
     // d f / d wdot = M_g (f is linear in wdot), d f / d w = the gyroscopic matrix (quadratic).
     Eigen::MatrixXd fd_mass(n, n), fd_gyro(n, n);
     for (int i = 0; i < n; ++i) {
       Eigen::VectorXd plus, minus;
-      body.InertiaForce(body.Evaluate(c, f0), w, wdot + Eigen::VectorXd::Unit(n, i), &plus, nullptr, nullptr);
+      body.InertiaForce(test::Lvalue(body.Evaluate(c, f0)), w, wdot + Eigen::VectorXd::Unit(n, i), &plus, nullptr,
+                        nullptr);
       fd_mass.col(i) = plus - f_in;
       const double h = 1e-3;
-      body.InertiaForce(body.Evaluate(c, f0), w + h * Eigen::VectorXd::Unit(n, i), wdot, &plus, nullptr, nullptr);
-      body.InertiaForce(body.Evaluate(c, f0), w - h * Eigen::VectorXd::Unit(n, i), wdot, &minus, nullptr, nullptr);
+      body.InertiaForce(test::Lvalue(body.Evaluate(c, f0)), w + h * Eigen::VectorXd::Unit(n, i), wdot, &plus, nullptr,
+                        nullptr);
+      body.InertiaForce(test::Lvalue(body.Evaluate(c, f0)), w - h * Eigen::VectorXd::Unit(n, i), wdot, &minus, nullptr,
+                        nullptr);
       fd_gyro.col(i) = (plus - minus) / (2 * h);
     }
     EXPECT_LT((fd_mass - mass).norm(), 1e-9 * mass.norm()) << frame;
@@ -129,8 +133,8 @@ TEST(ExactInertia, RigidMotionHasTheRigidBodyKineticEnergy) {
   const double mass = se.mass_properties.mass;
   const Eigen::Vector3d Om_body = f0.R.transpose() * omega;
   const double expected = 0.5 * mass * v_o.squaredNorm() + 0.5 * Om_body.dot(se.mass_properties.inertia_com * Om_body);
-  EXPECT_NEAR(exact.KineticEnergy(exact.Evaluate(c, f0), w), expected, 1e-9 * expected);
-  EXPECT_NEAR(corotational.KineticEnergy(corotational.Evaluate(c, f0), w), expected, 1e-9 * expected);
+  EXPECT_NEAR(exact.KineticEnergy(test::Lvalue(exact.Evaluate(c, f0)), w), expected, 1e-9 * expected);
+  EXPECT_NEAR(corotational.KineticEnergy(test::Lvalue(corotational.Evaluate(c, f0)), w), expected, 1e-9 * expected);
 }
 
 // The body's equations about the steady rotation at Omega about z of its root node A (held at
@@ -163,8 +167,8 @@ double LinearizedOmega(const SuperelementBody& body, double Omega, bool in_plane
     const InertiaLoadFactors load =
         test::InertiaLoadsOf(body, body.Evaluate(c, frame), w, wdot, Eigen::Vector3d::Zero());
     Eigen::VectorXd f_in, f_el;
-    body.InertiaForce(body.Evaluate(c, frame), w, wdot, &f_in, nullptr, nullptr);
-    body.ElasticForce(body.Evaluate(c, frame), &f_el, nullptr, &load);
+    body.InertiaForce(test::Lvalue(body.Evaluate(c, frame)), w, wdot, &f_in, nullptr, nullptr);
+    body.ElasticForce(test::Lvalue(body.Evaluate(c, frame)), &f_el, nullptr, &load);
     const Eigen::VectorXd f = f_in + f_el;
     Eigen::VectorXd r(nf);
     if (hinged) r[0] = f[5];

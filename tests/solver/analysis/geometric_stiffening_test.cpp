@@ -95,7 +95,7 @@ TEST(GeometricStiffening, InertiaLoadFactorsAndTheirDerivativesMatchFiniteDiffer
   // configuration at fixed a).
   Eigen::VectorXd f;
   Eigen::MatrixXd K, d_load;
-  body.ElasticForce(body.Evaluate(c, frame), &f, &K, &load, &d_load);
+  body.ElasticForce(test::Lvalue(body.Evaluate(c, frame)), &f, &K, &load, &d_load);
   Eigen::MatrixXd d_load_fd(n, 12);
   for (int k = 0; k < 12; ++k) {
     InertiaLoadFactors plus = load, minus = load;
@@ -103,8 +103,8 @@ TEST(GeometricStiffening, InertiaLoadFactorsAndTheirDerivativesMatchFiniteDiffer
     plus.a[k] += h;
     minus.a[k] -= h;
     Eigen::VectorXd fp, fm;
-    body.ElasticForce(body.Evaluate(c, frame), &fp, nullptr, &plus);
-    body.ElasticForce(body.Evaluate(c, frame), &fm, nullptr, &minus);
+    body.ElasticForce(test::Lvalue(body.Evaluate(c, frame)), &fp, nullptr, &plus);
+    body.ElasticForce(test::Lvalue(body.Evaluate(c, frame)), &fm, nullptr, &minus);
     d_load_fd.col(k) = (fp - fm) / (2 * h);
   }
   EXPECT_LT((d_load - d_load_fd).norm(), 1e-8 * d_load.norm());
@@ -126,7 +126,7 @@ TEST(GeometricStiffening, InertiaLoadFactorsAndTheirDerivativesMatchFiniteDiffer
       }
       const FrameSolution pf = body.SolveFrame(p, frame);
       ASSERT_TRUE(pf.ok);
-      body.ElasticForce(body.Evaluate(p, pf), &fs[side], nullptr, &load);
+      body.ElasticForce(test::Lvalue(body.Evaluate(p, pf)), &fs[side], nullptr, &load);
     }
     K_fd.col(i) = (fs[0] - fs[1]) / (2 * h);
   }

@@ -77,8 +77,8 @@ Evaluation Evaluate(const SuperelementBody& body, const BodyConfiguration& c, Fr
   const FrameSolution frame = body.SolveFrame(c, guess);
   EXPECT_TRUE(frame.ok);
   Evaluation e;
-  body.ElasticForce(body.Evaluate(c, frame), &e.f, nullptr);
-  e.energy = body.ElasticEnergy(body.Evaluate(c, frame));
+  body.ElasticForce(test::Lvalue(body.Evaluate(c, frame)), &e.f, nullptr);
+  e.energy = body.ElasticEnergy(test::Lvalue(body.Evaluate(c, frame)));
   return e;
 }
 
@@ -89,7 +89,7 @@ void CheckAgainstFiniteDifferences(const Superelement& se, const SuperelementOpt
   ASSERT_TRUE(frame.ok);
   Eigen::VectorXd f;
   Eigen::MatrixXd K;
-  body.ElasticForce(body.Evaluate(c, frame), &f, &K);
+  body.ElasticForce(test::Lvalue(body.Evaluate(c, frame)), &f, &K);
   const int n = body.n_coordinates();
   Eigen::MatrixXd K_fd(n, n);
   Eigen::VectorXd f_fd(n);
@@ -158,8 +158,8 @@ TEST(SuperelementBody, PolynomialInternalForceTangentMatchesFiniteDifferences) {
   const BodyConfiguration c = Deformed(with, 0.05, 3);
   const FrameSolution frame = with.SolveFrame(c, with.GuessFrame(c));
   Eigen::VectorXd f1, f2;
-  with.ElasticForce(with.Evaluate(c, frame), &f1, nullptr);
-  without.ElasticForce(without.Evaluate(c, frame), &f2, nullptr);
+  with.ElasticForce(test::Lvalue(with.Evaluate(c, frame)), &f1, nullptr);
+  without.ElasticForce(test::Lvalue(without.Evaluate(c, frame)), &f2, nullptr);
   EXPECT_GT((f1 - f2).norm(), 1e-3 * f2.norm());
 }
 
@@ -170,7 +170,7 @@ TEST(SuperelementBody, TangentIsSymmetricAtEquilibriumFreeConfiguration) {
   const FrameSolution frame = body.SolveFrame(c, body.GuessFrame(c));
   Eigen::VectorXd f;
   Eigen::MatrixXd K;
-  body.ElasticForce(body.Evaluate(c, frame), &f, &K);
+  body.ElasticForce(test::Lvalue(body.Evaluate(c, frame)), &f, &K);
   // A Hessian on SO(3) with spatial variations is symmetric up to the term (f_moment x) — the
   // asymmetric part is bounded by the moments: check it is small relative to K.
   EXPECT_LT((K - K.transpose()).norm(), 1e-3 * K.norm());
@@ -181,7 +181,7 @@ TEST(SuperelementBody, RigidMotionsAreForceFreeAndForcesRotateWithTheBody) {
   const SuperelementBody body(se, {false, true});
   BodyConfiguration c0 = body.InitialConfiguration();
   Eigen::VectorXd f;
-  body.ElasticForce(body.Evaluate(c0, body.SolveFrame(c0, body.InitialFrame())), &f, nullptr);
+  body.ElasticForce(test::Lvalue(body.Evaluate(c0, body.SolveFrame(c0, body.InitialFrame()))), &f, nullptr);
   EXPECT_LT(f.norm(), 1e-12);
   // Rigid motion of the undeformed body: still no force; frame follows.
   const Eigen::Matrix3d Rr = ExpSO3(Eigen::Vector3d(2.0, -0.5, 1.0));
@@ -193,7 +193,7 @@ TEST(SuperelementBody, RigidMotionsAreForceFreeAndForcesRotateWithTheBody) {
   }
   const FrameSolution frame = body.SolveFrame(moved, body.GuessFrame(moved));
   ASSERT_TRUE(frame.ok);
-  body.ElasticForce(body.Evaluate(moved, frame), &f, nullptr);
+  body.ElasticForce(test::Lvalue(body.Evaluate(moved, frame)), &f, nullptr);
   EXPECT_LT(f.norm(), 1e-14 * se.K.cwiseAbs().maxCoeff());  // round-off of positions ~3 m
   EXPECT_LT((frame.R - Rr).norm(), 1e-12);
   EXPECT_LT((frame.x - (Rr * body.InitialFrame().x + t)).norm(), 1e-12);
@@ -206,10 +206,11 @@ TEST(SuperelementBody, RigidMotionsAreForceFreeAndForcesRotateWithTheBody) {
   }
   Eigen::VectorXd fd, fdm;
   const FrameSolution a = body.SolveFrame(d, body.GuessFrame(d)), b = body.SolveFrame(dm, body.GuessFrame(dm));
-  body.ElasticForce(body.Evaluate(d, a), &fd, nullptr);
-  body.ElasticForce(body.Evaluate(dm, b), &fdm, nullptr);
-  EXPECT_NEAR(body.ElasticEnergy(body.Evaluate(d, a)), body.ElasticEnergy(body.Evaluate(dm, b)),
-              1e-10 * body.ElasticEnergy(body.Evaluate(d, a)));
+  body.ElasticForce(test::Lvalue(body.Evaluate(d, a)), &fd, nullptr);
+  body.ElasticForce(test::Lvalue(body.Evaluate(dm, b)), &fdm, nullptr);
+  EXPECT_NEAR(body.ElasticEnergy(test::Lvalue(body.Evaluate(d, a))),
+              body.ElasticEnergy(test::Lvalue(body.Evaluate(dm, b))),
+              1e-10 * body.ElasticEnergy(test::Lvalue(body.Evaluate(d, a))));
   for (int k = 0; k < 2 * body.n_nodes(); ++k) {
     EXPECT_LT((Rr * fd.segment<3>(3 * k) - fdm.segment<3>(3 * k)).norm(), 1e-9 * fd.norm());
   }
@@ -232,7 +233,7 @@ TEST(SuperelementBody, SmallDeformationsReproduceTheReducedStiffness) {
   const BodyConfiguration c = body.InitialConfiguration();
   Eigen::MatrixXd Kt;
   Eigen::VectorXd f;
-  body.ElasticForce(body.Evaluate(c, body.SolveFrame(c, body.InitialFrame())), &f, &Kt);
+  body.ElasticForce(test::Lvalue(body.Evaluate(c, body.SolveFrame(c, body.InitialFrame()))), &f, &Kt);
   const int n = body.n_coordinates();
   Eigen::MatrixXd Rbar = Eigen::MatrixXd::Identity(n, n);
   for (int a = 0; a < 2 * body.n_nodes(); ++a) Rbar.block<3, 3>(3 * a, 3 * a) = Rp;
@@ -257,23 +258,28 @@ TEST(SuperelementBody, GyroscopicMatrixMatchesFiniteDifferencesAndMassIsPtMP) {
     }
     Eigen::VectorXd f;
     Eigen::MatrixXd Mg, C;
-    body.InertiaForce(body.Evaluate(c, frame), w, wdot, &f, &Mg, &C);
+    body.InertiaForce(test::Lvalue(body.Evaluate(c, frame)), w, wdot, &f, &Mg, &C);
     Eigen::MatrixXd C_fd(n, n), M_fd(n, n);
     for (int i = 0; i < n; ++i) {
       const double h = 1e-6;
       Eigen::VectorXd fp, fm;
-      body.InertiaForce(body.Evaluate(c, frame), w + h * Eigen::VectorXd::Unit(n, i), wdot, &fp, nullptr, nullptr);
-      body.InertiaForce(body.Evaluate(c, frame), w - h * Eigen::VectorXd::Unit(n, i), wdot, &fm, nullptr, nullptr);
+      body.InertiaForce(test::Lvalue(body.Evaluate(c, frame)), w + h * Eigen::VectorXd::Unit(n, i), wdot, &fp, nullptr,
+                        nullptr);
+      body.InertiaForce(test::Lvalue(body.Evaluate(c, frame)), w - h * Eigen::VectorXd::Unit(n, i), wdot, &fm, nullptr,
+                        nullptr);
       C_fd.col(i) = (fp - fm) / (2 * h);
-      body.InertiaForce(body.Evaluate(c, frame), w, wdot + h * Eigen::VectorXd::Unit(n, i), &fp, nullptr, nullptr);
-      body.InertiaForce(body.Evaluate(c, frame), w, wdot - h * Eigen::VectorXd::Unit(n, i), &fm, nullptr, nullptr);
+      body.InertiaForce(test::Lvalue(body.Evaluate(c, frame)), w, wdot + h * Eigen::VectorXd::Unit(n, i), &fp, nullptr,
+                        nullptr);
+      body.InertiaForce(test::Lvalue(body.Evaluate(c, frame)), w, wdot - h * Eigen::VectorXd::Unit(n, i), &fm, nullptr,
+                        nullptr);
       M_fd.col(i) = (fp - fm) / (2 * h);
     }
     EXPECT_LT((C - C_fd).norm(), 1e-6 * C.norm()) << "option B " << option_b;
     EXPECT_LT((Mg - M_fd).norm(), 1e-6 * Mg.norm());
     EXPECT_GT(C.norm(), 0.0);
     // The kinetic energy is w^T M_g w / 2.
-    EXPECT_NEAR(body.KineticEnergy(body.Evaluate(c, frame), w), 0.5 * w.dot(Mg * w), 1e-12 * w.dot(Mg * w));
+    EXPECT_NEAR(body.KineticEnergy(test::Lvalue(body.Evaluate(c, frame)), w), 0.5 * w.dot(Mg * w),
+                1e-12 * w.dot(Mg * w));
   }
 }
 
@@ -331,8 +337,10 @@ TEST(SuperelementBody, MomentumDerivativesMatchFiniteDifferences) {
         const Eigen::VectorXd e = Eigen::VectorXd::Unit(n, i);
         const BodyConfiguration cp = Perturb(c, e, eps), cm = Perturb(c, e, -eps);
         Eigen::VectorXd fp, fm;
-        body.InertiaForce(body.Evaluate(cp, body.SolveFrame(cp, frame)), full ? w : zero, wdot, &fp, nullptr, nullptr);
-        body.InertiaForce(body.Evaluate(cm, body.SolveFrame(cm, frame)), full ? w : zero, wdot, &fm, nullptr, nullptr);
+        body.InertiaForce(test::Lvalue(body.Evaluate(cp, body.SolveFrame(cp, frame))), full ? w : zero, wdot, &fp,
+                          nullptr, nullptr);
+        body.InertiaForce(test::Lvalue(body.Evaluate(cm, body.SolveFrame(cm, frame))), full ? w : zero, wdot, &fm,
+                          nullptr, nullptr);
         fd_in.col(i) = (fp - fm) / (2 * eps);
       }
       EXPECT_LT((K_in - fd_in).norm(), 1e-5 * fd_in.norm())
@@ -353,7 +361,7 @@ TEST(SuperelementBody, ExactMomentumConfigurationTangentMatchesFiniteDifferences
   const int n = body.n_coordinates();
   std::mt19937 rng(3);
   const Eigen::VectorXd w = Uniform(n, rng);
-  const SuperelementBody::Data d = body.Evaluate(c, frame);
+  SuperelementBody::Data d = body.Evaluate(c, frame);
   SuperelementBody::Data side;
   Eigen::MatrixXd D;
   body.MomentumConfigurationTangent(d, w, side, D);
@@ -362,8 +370,8 @@ TEST(SuperelementBody, ExactMomentumConfigurationTangentMatchesFiniteDifferences
   for (int i = 0; i < n; ++i) {
     const Eigen::VectorXd e = Eigen::VectorXd::Unit(n, i);
     const BodyConfiguration cp = Perturb(c, e, eps), cm = Perturb(c, e, -eps);
-    const SuperelementBody::Data dp = body.Evaluate(cp, body.SolveFrame(cp, frame));
-    const SuperelementBody::Data dm = body.Evaluate(cm, body.SolveFrame(cm, frame));
+    SuperelementBody::Data dp = body.Evaluate(cp, body.SolveFrame(cp, frame));
+    SuperelementBody::Data dm = body.Evaluate(cm, body.SolveFrame(cm, frame));
     fd.col(i) = (body.MassTimes(dp, w) - body.MassTimes(dm, w)) / (2 * eps);
   }
   std::printf("[ info ] exact momentum's configuration tangent against differences: %.2e\n",
@@ -406,7 +414,7 @@ TEST(SuperelementBody, InertiaForceIsTheLagrangianDerivativeAlongAMotion) {
     };
     auto energy = [&](double t) {
       const BodyConfiguration c = config(t);
-      return body.KineticEnergy(body.Evaluate(c, body.SolveFrame(c, body.GuessFrame(c))), velocity(t));
+      return body.KineticEnergy(test::Lvalue(body.Evaluate(c, body.SolveFrame(c, body.GuessFrame(c)))), velocity(t));
     };
     const double t = 0.01, dt = 1e-4;
     const double power_fd = (energy(t + dt) - energy(t - dt)) / (2 * dt);
@@ -414,18 +422,19 @@ TEST(SuperelementBody, InertiaForceIsTheLagrangianDerivativeAlongAMotion) {
     const Eigen::VectorXd w = velocity(t);
     const Eigen::VectorXd wdot = (velocity(t + dt) - velocity(t - dt)) / (2 * dt);
     Eigen::VectorXd f_in;
-    body.InertiaForce(body.Evaluate(c, body.SolveFrame(c, body.GuessFrame(c))), w, wdot, &f_in, nullptr, nullptr);
+    body.InertiaForce(test::Lvalue(body.Evaluate(c, body.SolveFrame(c, body.GuessFrame(c)))), w, wdot, &f_in, nullptr,
+                      nullptr);
     EXPECT_NEAR(w.dot(f_in), power_fd, 1e-5 * std::abs(power_fd)) << (exact ? "exact" : "corotational");
     if (exact) {
       // The exact inertia's momentum form (the midpoint scheme with the exact inertia):
       // p = MassTimes (dT/dw), s = MomentumSource at the body's data, with its local term.
       auto momentum_exact = [&](double time) {
         const BodyConfiguration ct = config(time);
-        const SuperelementBody::Data data = body.Evaluate(ct, body.SolveFrame(ct, body.GuessFrame(ct)));
+        SuperelementBody::Data data = body.Evaluate(ct, body.SolveFrame(ct, body.GuessFrame(ct)));
         return Eigen::VectorXd(body.MassTimes(data, velocity(time)));
       };
       const Eigen::VectorXd pdot_exact = (momentum_exact(t + dt) - momentum_exact(t - dt)) / (2 * dt);
-      const SuperelementBody::Data d = body.Evaluate(c, body.SolveFrame(c, body.GuessFrame(c)));
+      SuperelementBody::Data d = body.Evaluate(c, body.SolveFrame(c, body.GuessFrame(c)));
       const Eigen::VectorXd p = body.MassTimes(d, w);
       Eigen::VectorXd source;
       body.MomentumSource(d, w, p, source);
