@@ -334,7 +334,7 @@ class SuperelementBody {
   void InertiaForce(Data& d, const BodyVelocity& w, const BodyVelocity& wdot, Eigen::VectorXd* f_in,
                     Eigen::MatrixXd* mass, Eigen::MatrixXd* gyroscopic, Eigen::VectorXd* f_acc = nullptr) const;
 
-  /// d f_in / dq at fixed (w, wdot): d(M_g wdot)/dq = MomentumDerivative(c, frame, wdot)
+  /// d f_in / dq at fixed (w, wdot): d(M_g wdot)/dq = MomentumDerivative(MapsOf(d), wdot)
   /// (exact), plus with `quadratic` the configuration derivative of the quadratic velocity terms
   /// by central differences (2n evaluations with the frame re-solved; steps 1e-7 of the body
   /// size, 1e-7 rad, 1e-7 of the modal scale). Into `tangent` (its storage reused).

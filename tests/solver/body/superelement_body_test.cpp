@@ -285,7 +285,7 @@ TEST(SuperelementBody, GyroscopicMatrixMatchesFiniteDifferencesAndMassIsPtMP) {
 
 TEST(SuperelementBody, MomentumDerivativesMatchFiniteDifferences) {
   // d(M_g w)/dq at fixed spatial velocities w, options A and B, against central differences of
-  // GeneralizedMomentum (the frame re-solved at each perturbed configuration); the derivatives
+  // the momentum M_g w (the frame re-solved at each perturbed configuration); the derivatives
   // of MomentumSource in w and p likewise, and the inertia force's configuration derivative.
   for (bool option_b : {false, true}) {
     SuperelementOptions options;
