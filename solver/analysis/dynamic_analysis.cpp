@@ -273,10 +273,8 @@ DynamicStepReport MeasureWith(const SystemModel& model, const DofMap& dofs, cons
   };
   if (passes && passes->size() == model.bodies.size() && measures) {
     measures->resize(size_t(n_bodies));
-    ForEachBody(threads, n_bodies, [&](int b) {
-      BodyPass& pass = (*passes)[size_t(b)];
-      measure(b, pass.data, pass.w, (*measures)[size_t(b)]);
-    });
+    std::vector<BodyPass>& kept = *passes;
+    ForEachBody(threads, n_bodies, [&](int b) { measure(b, kept[size_t(b)].data, kept[size_t(b)].w, (*measures)[b]); });
     for (const BodyMeasure& m : *measures) add(m);
     return r;
   }
@@ -299,9 +297,7 @@ double EnergyNoise(double mass, const SystemState& config, double h) {
 }
 }  // namespace
 
-DynamicStepReport Measure(const SystemModel& model, DynamicState& s) {
-  return MeasureWith(model, model.dofs(), s, nullptr);
-}
+DynamicStepReport Measure(const SystemModel& model, DynamicState& s) { return MeasureWith(model, model.dofs(), s, {}); }
 
 namespace {
 
