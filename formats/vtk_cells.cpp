@@ -11,14 +11,15 @@ struct CellCodes {
   int vtk;
   const char* xdmf;
   int mixed;
+  int nodes;
 };
 
 constexpr CellCodes kCellCodes[] = {
-    {CellType::kLine2, 3, "Polyline", 2},         {CellType::kTet4, 10, "Tetrahedron", 6},
-    {CellType::kHex8, 12, "Hexahedron", 9},       {CellType::kTet10, 24, "Tetrahedron_10", 38},
-    {CellType::kHex20, 25, "Hexahedron_20", 48},  {CellType::kTri3, 5, "Triangle", 4},
-    {CellType::kQuad4, 9, "Quadrilateral", 5},    {CellType::kTri6, 22, "Triangle_6", 36},
-    {CellType::kQuad8, 23, "Quadrilateral_8", 37}};
+    {CellType::kLine2, 3, "Polyline", 2, 2},         {CellType::kTet4, 10, "Tetrahedron", 6, 4},
+    {CellType::kHex8, 12, "Hexahedron", 9, 8},       {CellType::kTet10, 24, "Tetrahedron_10", 38, 10},
+    {CellType::kHex20, 25, "Hexahedron_20", 48, 20}, {CellType::kTri3, 5, "Triangle", 4, 3},
+    {CellType::kQuad4, 9, "Quadrilateral", 5, 4},    {CellType::kTri6, 22, "Triangle_6", 36, 6},
+    {CellType::kQuad8, 23, "Quadrilateral_8", 37, 8}};
 
 const CellCodes& CodesOf(CellType type) {
   for (const CellCodes& c : kCellCodes) {
@@ -34,6 +35,8 @@ int VtkCellType(CellType type) { return CodesOf(type).vtk; }
 const char* XdmfTopology(CellType type) { return CodesOf(type).xdmf; }
 
 int XdmfMixedCode(CellType type) { return CodesOf(type).mixed; }
+
+int CellNodeCount(CellType type) { return CodesOf(type).nodes; }
 
 Eigen::MatrixXi ToVtkOrder(CellType type, const Eigen::MatrixXi& cells) {
   std::vector<int> order;

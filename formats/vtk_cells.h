@@ -31,6 +31,9 @@ const char* XdmfTopology(CellType type);
 /// hex8 9, tet10 38, hex20 48, tri3 4, quad4 5, tri6 36, quad8 37.
 int XdmfMixedCode(CellType type);
 
+/// Nodes of one cell: line2 2, tri3 3, tri6 6, quad4 4, quad8 8, tet4 4, tet10 10, hex8 8, hex20 20.
+int CellNodeCount(CellType type);
+
 /// cells (gmsh order) -> cells in VTK/XDMF node order (they differ for tet10 and hex20).
 Eigen::MatrixXi ToVtkOrder(CellType type, const Eigen::MatrixXi& cells);
 

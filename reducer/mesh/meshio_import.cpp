@@ -10,7 +10,6 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <map>
 #include <sstream>
 
 #include "formats/input_error.h"
@@ -122,12 +121,9 @@ ForeignMesh ReadWithMeshio(const std::string& path, const std::string& where, bo
   for (long i = 0; i < n; ++i)
     if (!(in >> mesh.ids[size_t(i)])) fail("node id " + std::to_string(i));
   if (!(in >> word >> type >> m >> k) || word != "cells") fail("no cell block");
-  const std::map<CellType, long> node_counts = {{CellType::kTet4, 4},   {CellType::kTet10, 10}, {CellType::kHex8, 8},
-                                                {CellType::kHex20, 20}, {CellType::kTri3, 3},   {CellType::kTri6, 6},
-                                                {CellType::kQuad4, 4},  {CellType::kQuad8, 8},  {CellType::kLine2, 2}};
   const std::optional<CellType> cell_type = KindOf<CellType>(type);
   if (!cell_type) fail("cell type '" + type + "'");  // it once fell back to hex20 silently
-  if (m <= 0 || k != node_counts.at(*cell_type)) fail(type + " cells with " + std::to_string(k) + " nodes");
+  if (m <= 0 || k != CellNodeCount(*cell_type)) fail(type + " cells with " + std::to_string(k) + " nodes");
   mesh.cell_type = *cell_type;
   mesh.cells.resize(m, k);
   for (long e = 0; e < m; ++e)

@@ -103,10 +103,14 @@ TEST(VtkCells, EveryCellHasVtksAndXdmfsCodes) {
 TEST(VtkCells, SolidElementsAndCellsCorrespond) {
   for (SolidType t : {SolidType::kTet4, SolidType::kTet10, SolidType::kHex8, SolidType::kHex20}) {
     EXPECT_EQ(SolidTypeOf(CellOf(t)), t);
+    EXPECT_EQ(CellNodeCount(CellOf(t)), SolidNodeCount(t));
     EXPECT_EQ(SolidTypeName(t), Name(CellOf(t)));
   }
-  for (CellType c : {CellType::kLine2, CellType::kTri3, CellType::kTri6, CellType::kQuad4, CellType::kQuad8}) {
+  const std::pair<CellType, int> surface[] = {
+      {CellType::kLine2, 2}, {CellType::kTri3, 3}, {CellType::kTri6, 6}, {CellType::kQuad4, 4}, {CellType::kQuad8, 8}};
+  for (const auto& [c, nodes] : surface) {
     EXPECT_FALSE(SolidTypeOf(c).has_value()) << Name(c);
+    EXPECT_EQ(CellNodeCount(c), nodes) << Name(c);
   }
 }
 
