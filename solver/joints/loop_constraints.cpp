@@ -11,6 +11,7 @@
 #include <limits>
 #include <optional>
 
+#include "formats/input_error.h"
 #include "solver/assembly/system.h"
 
 namespace femb {
@@ -142,19 +143,18 @@ void AddLoopConstraints(const SystemModel& model, const DofMap& dofs, const Syst
 
 namespace {
 
-// Per kept equation of the cut joints, in order: how independent it is of the ones before it that
-// are (Gram-Schmidt on the rows of the constraint Jacobian over the coordinates solved for,
-// columns scaled to unit size so that units do not matter): the relative remainder, 1 for an
-// equation orthogonal to the others, 0 for a repeated one; independent above `tolerance`.
-std::vector<double> EquationRemainders(const SystemModel& model, const DofMap& dofs, const SystemState& state,
-                                       double tolerance) {
+// The rows of the cut joints' kept equations in the constraint Jacobian, over the coordinates
+// solved for (`prescribed` false) or over the prescribed ones (true), each column scaled to unit
+// size so that units do not matter.
+Eigen::MatrixXd ConstraintRows(const SystemModel& model, const DofMap& dofs, const SystemState& state,
+                               bool prescribed) {
   Triplets entries;
   AddLoopConstraints(model, dofs, state, nullptr, nullptr, nullptr, &entries);
   const int m = dofs.n_multipliers(), first = dofs.first_multiplier();
   std::vector<int> column(size_t(dofs.n_dofs()), -1);
   int n = 0;
-  for (int j : dofs.solved())
-    if (!dofs.multiplier(j)) column[size_t(j)] = n++;
+  for (int j = 0; j < first; ++j)
+    if (dofs.prescribed(j) == prescribed) column[size_t(j)] = n++;
   Eigen::MatrixXd G = Eigen::MatrixXd::Zero(m, n);
   for (const Eigen::Triplet<double>& e : entries)
     if (e.row() >= first && e.col() < first && column[size_t(e.col())] >= 0)
@@ -163,13 +163,22 @@ std::vector<double> EquationRemainders(const SystemModel& model, const DofMap& d
     const double size = G.col(c).cwiseAbs().maxCoeff();
     if (size > 0) G.col(c) /= size;
   }
+  return G;
+}
+
+// Per kept equation of the cut joints, in order: how independent it is of the ones before it that
+// are (Gram-Schmidt on the rows of ConstraintRows over the coordinates solved for): the relative
+// remainder, 1 for an equation orthogonal to the others, 0 for a repeated one; independent above
+// `tolerance`.
+std::vector<double> EquationRemainders(const Eigen::MatrixXd& G, double tolerance) {
+  const Eigen::Index m = G.rows();
   std::vector<Eigen::VectorXd> basis;
   std::vector<double> remainder(size_t(m), 0.0);
   // A row at the round-off of the others is zero: normalized, it would look independent of
   // every row (a planar loop in a tilted plane: its out-of-plane translation's row was 3e-17 and
   // was kept instead of an in-plane one, leaving [M G^T; G 0] singular).
-  const double largest = m > 0 && n > 0 ? G.rowwise().norm().maxCoeff() : 0.0;
-  for (int i = 0; i < m; ++i) {
+  const double largest = m > 0 && G.cols() > 0 ? G.rowwise().norm().maxCoeff() : 0.0;
+  for (Eigen::Index i = 0; i < m; ++i) {
     const double size = G.row(i).norm();
     if (size <= tolerance * largest) continue;
     Eigen::VectorXd v = G.row(i).transpose() / size;
@@ -181,13 +190,65 @@ std::vector<double> EquationRemainders(const SystemModel& model, const DofMap& d
   return remainder;
 }
 
+// A drive that a loop locks: an equation that is a combination y of the kept ones over the
+// coordinates solved for (so it is dropped: the mechanism's free motion keeps it) but not the
+// same combination over the prescribed coordinates moves it with the drive, which would open the
+// loop (a block driven about one pin and held by a second one; both cranks of a four-bar driven).
+// Dropped, such an equation would let the loop open without a word: refused instead, naming the
+// cut joint, its equation and the driven nodes.
+void RequireDrivesFree(const SystemModel& model, const DofMap& dofs, const Eigen::MatrixXd& G_s,
+                       const Eigen::MatrixXd& G_p, const std::vector<double>& remainder) {
+  if (G_p.cols() == 0) return;
+  std::vector<Eigen::Index> kept;
+  for (size_t i = 0; i < remainder.size(); ++i)
+    if (remainder[i] > 1e-8) kept.push_back(Eigen::Index(i));
+  Eigen::MatrixXd Ks(G_s.cols(), Eigen::Index(kept.size())), Kp(G_p.cols(), Eigen::Index(kept.size()));
+  for (size_t k = 0; k < kept.size(); ++k) {
+    Ks.col(Eigen::Index(k)) = G_s.row(kept[k]).transpose();
+    Kp.col(Eigen::Index(k)) = G_p.row(kept[k]).transpose();
+  }
+  std::optional<Eigen::ColPivHouseholderQR<Eigen::MatrixXd>> qr;
+  if (!kept.empty()) qr.emplace(Ks);  // (kept rows exist only over some solved coordinate)
+  for (Eigen::Index i = 0; i < G_s.rows(); ++i) {
+    if (remainder[size_t(i)] > 1e-8) continue;
+    Eigen::VectorXd left = G_p.row(i).transpose();
+    if (qr) left -= Kp * Eigen::VectorXd(qr->solve(G_s.row(i).transpose()));
+    if (left.lpNorm<Eigen::Infinity>() <= 1e-8) continue;
+    // Equation i: its cut joint and its place in the joint's set.
+    size_t c = 0;
+    while (c + 1 < model.cut_joints.size() &&
+           i >= Eigen::Index(dofs.multiplier_first(int(c) + 1) - dofs.first_multiplier()))
+      ++c;
+    const CutJoint& cut = model.cut_joints[c];
+    const int equation = cut.equations[size_t(i - (dofs.multiplier_first(int(c)) - dofs.first_multiplier()))];
+    std::string driven;
+    int column = 0;
+    for (int j = 0; j < dofs.first_multiplier(); ++j) {
+      if (!dofs.prescribed(j)) continue;
+      if (std::abs(left[column++]) <= 1e-8) continue;
+      for (const SystemModel::Prescribed& p : model.prescribed) {
+        if (dofs.prescribed_index(p) != j) continue;
+        const std::string name = "'" + model.node_names[size_t(p.node)] + "'";
+        if (driven.find(name) == std::string::npos) driven += (driven.empty() ? "" : ", ") + name;
+      }
+    }
+    throw InputError(cut.name + ": the loop it closes locks the drive of node " + driven + " (its " +
+                     ConstraintName(cut.joint, equation) +
+                     " moves with the drive and with no free coordinate): a driven loop needs a coordinate free "
+                     "to follow the drive; remove the drive or this joint, or free a joint of the loop");
+  }
+}
+
 }  // namespace
 
 std::vector<std::string> DropRedundantEquations(SystemModel& model) {
   std::vector<std::string> notes(model.cut_joints.size());
   if (model.cut_joints.empty()) return notes;
   const DofMap& dofs = model.dofs();
-  const std::vector<double> remainder = EquationRemainders(model, dofs, InitialState(model), 1e-8);
+  const SystemState state = InitialState(model);
+  const Eigen::MatrixXd G_s = ConstraintRows(model, dofs, state, false);
+  const std::vector<double> remainder = EquationRemainders(G_s, 1e-8);
+  RequireDrivesFree(model, dofs, G_s, ConstraintRows(model, dofs, state, true), remainder);
   const int first = dofs.first_multiplier();
   for (size_t c = 0; c < model.cut_joints.size(); ++c) {
     CutJoint& cut = model.cut_joints[c];
@@ -209,7 +270,7 @@ std::vector<std::string> DropRedundantEquations(SystemModel& model) {
 std::string LoopSingularity(const SystemModel& model, const SystemState& state) {
   if (model.cut_joints.empty()) return "";
   const DofMap& dofs = model.dofs();
-  const std::vector<double> remainder = EquationRemainders(model, dofs, state, 1e-8);
+  const std::vector<double> remainder = EquationRemainders(ConstraintRows(model, dofs, state, false), 1e-8);
   double least = 1.0;
   int worst = -1, equation = -1;
   for (size_t c = 0; c < model.cut_joints.size(); ++c) {

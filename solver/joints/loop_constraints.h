@@ -52,7 +52,9 @@ bool LoopsClosed(const SystemModel& model, const SystemState& state, double tole
 /// it is independent of those kept before it (Gram-Schmidt, relative remainder above 1e-8).
 /// Returns per cut joint what its dropped equations held ("" when none). The reactions of a
 /// redundant loop are then one of many that balance it (statically indeterminate), as in any
-/// multibody code.
+/// multibody code. An equation that the coordinates solved for cannot move but the prescribed ones
+/// do (a loop that locks its drive: no coordinate left to follow it) throws InputError naming the
+/// cut joint, the equation and the driven nodes: dropped, it would let the loop open.
 std::vector<std::string> DropRedundantEquations(SystemModel& model);
 
 /// Closed loops at `state`: the cut joint whose kept equation is nearest to depending on the
