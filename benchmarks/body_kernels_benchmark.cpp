@@ -77,14 +77,14 @@ bool MakeSetup(int kind, int modes, Setup& u) {
   const femb::SuperelementBody& body = *u.body;
   const int n = body.n_coordinates();
   // A deformed, turned configuration and a spinning, accelerating motion.
-  u.c = body.InitialConfiguration();
+  u.c = InitialConfiguration(body);
   const Eigen::Matrix3d turn = femb::ExpSO3(Eigen::Vector3d(0.3, -0.2, 0.5));
   for (size_t k = 0; k < u.c.x.size(); ++k) {
     u.c.x[k] = turn * u.c.x[k] + Eigen::Vector3d(0.01 * double(k), -0.02, 0.005 * double(k));
     u.c.R[k] = femb::ExpSO3(Eigen::Vector3d(0.02 * double(k), 0.01, -0.03 * double(k))) * turn * u.c.R[k];
   }
   for (int i = 0; i < u.c.eta.size(); ++i) u.c.eta[i] = 1e-3 * (i + 1);
-  u.frame = body.SolveFrame(u.c, body.GuessFrame(u.c));
+  u.frame = SolveFrame(body, u.c, GuessFrame(body, u.c));
   if (!u.frame.ok) return false;
   u.w.resize(n);
   u.wdot.resize(n);
@@ -128,33 +128,33 @@ int main(int argc, char** argv) {
     // 3 + mass and gyroscopic, 4 + configuration tangent.
     auto iteration = [p, g, &sink](int stages) {
       const femb::SuperelementBody& b = *p->body;
-      femb::SuperelementBody::Data d = b.Evaluate(p->c, p->frame);
+      femb::BodyData d = Evaluate(b, p->c, p->frame);
       if (stages < 1) return;
       const bool s = b.has_inertia_stiffening();
       femb::InertiaLoadFactors load;
       Eigen::VectorXd f_int, f_in, f_acc;
-      if (s) b.InertiaLoads(d, p->w, p->wdot, g, load);
-      b.ElasticForce(d, &f_int, nullptr, s ? &load : nullptr);
-      b.InertiaForce(d, p->w, p->wdot, &f_in, nullptr, nullptr, &f_acc);
+      if (s) InertiaLoads(b, d, p->w, p->wdot, g, load);
+      ElasticForce(b, d, &f_int, nullptr, s ? &load : nullptr);
+      InertiaForce(b, d, p->w, p->wdot, &f_in, nullptr, nullptr, &f_acc);
       Eigen::VectorXd f_grav;
-      b.GravityForce(d, g, f_grav);
+      GravityForce(b, d, g, f_grav);
       sink += f_int.sum() + f_in.sum() + f_acc.sum() + f_grav.sum();
       if (stages < 2) return;
       Eigen::MatrixXd K, M, C, d_load, K_inertia;
-      b.ElasticForce(d, nullptr, &K, s ? &load : nullptr, s ? &d_load : nullptr);
+      ElasticForce(b, d, nullptr, &K, s ? &load : nullptr, s ? &d_load : nullptr);
       if (stages < 3) return;
-      b.InertiaForce(d, p->w, p->wdot, nullptr, &M, &C);
+      InertiaForce(b, d, p->w, p->wdot, nullptr, &M, &C);
       if (s) {
         M.noalias() += d_load * load.d_wdot;
         C.noalias() += d_load * load.d_w;
       }
       if (stages < 4) return;
-      b.InertiaConfigurationTangent(d, p->w, p->wdot, false, K_inertia);
+      InertiaConfigurationTangent(b, d, p->w, p->wdot, false, K_inertia);
       K += K_inertia;
       sink += K.sum() + M.sum() + C.sum();
     };
     works.push_back([p] {
-      const femb::FrameSolution f = p->body->SolveFrame(p->c, p->frame);
+      const femb::FrameSolution f = SolveFrame(*p->body, p->c, p->frame);
       if (!f.ok) std::abort();
     });
     for (int stages = 0; stages <= 4; ++stages) works.push_back([iteration, stages] { iteration(stages); });

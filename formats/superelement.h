@@ -89,7 +89,7 @@ struct ModalStress {
   /// each case's static field with the interfaces held, less its internal-mode part, (6 n_points)
   /// x 12, and for beams its section forces (12 n_cells) x 12. The body's stress is then
   /// sum_i q_i modes_i + sum_k a_k inertia_modes_k with the frame's load factors a_k
-  /// (SuperelementBody::InertiaLoads): the quasi-static part of the distributed inertia load's
+  /// (InertiaLoads, solver/body/inertia_stiffening.h): the quasi-static part of the distributed inertia load's
   /// stress that the basis does not carry (a mode-acceleration correction); empty otherwise.
   Eigen::MatrixXf inertia_modes;
   Eigen::MatrixXf inertia_section_forces;
@@ -155,7 +155,7 @@ struct Superelement {
   /// With modal derivatives: the quadratic and cubic coefficients of the reduced Green-Lagrange
   /// internal force (reduced_polynomial.h); the solver then uses it in place of K q.
   std::optional<PolynomialStiffness> polynomial;
-  /// Geometric stiffening from rigid-body inertia loads (SuperelementBody::InertiaLoads):
+  /// Geometric stiffening from rigid-body inertia loads (InertiaLoads, solver/body/inertia_stiffening.h):
   /// K_sigma,k = Phi^T G(sigma_k) Phi (n x n, symmetric) of the stress sigma_k of unit inertia
   /// load case k (kInertiaLoadCases) with the interfaces held; empty when not computed.
   std::vector<Eigen::MatrixXd> inertia_stiffness;
@@ -171,7 +171,7 @@ struct Superelement {
   /// general): C (r x 6N, r = 6N - m) with C q_int = 0 on the local interface coordinates of the
   /// floating frame (translations, rotations). Its rows have unit length after the rotation
   /// columns are divided by the part's size, so C q_int is a length. femb-solve enforces it with
-  /// Lagrange multipliers (SuperelementBody::InterfaceConstraint). No rows: none.
+  /// Lagrange multipliers (InterfaceConstraint, solver/body/elastic_force.h). No rows: none.
   Eigen::MatrixXd interface_constraint;
   std::optional<Visualization> visualization;
   std::optional<ModalStress> stress;  ///< only with the visualization mesh

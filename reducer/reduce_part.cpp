@@ -410,7 +410,7 @@ void LinearContent(const PartSpec& part, const FeModel& model, const CraigBampto
 // modal derivatives the cubic polynomial of reduced_polynomial.h; for the geometric stiffening
 // alone its quadratic part (the geometric stiffness of the stress of each basis vector). Its
 // linear part equals K_r. With stiffening also the geometric stiffness of the inertia load cases'
-// stresses (SuperelementBody::InertiaLoads, solver/body/superelement_body.h), about the frame
+// stresses (InertiaLoads, solver/body/inertia_stiffening.h), about the frame
 // origin o: a field about o is the one about the part origin minus the translation it has at o;
 // those fields on the mesh go to `stress_fields` for their stresses. false with result.message
 // when the polynomial's linear part is not K_r.

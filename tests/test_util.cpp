@@ -186,36 +186,36 @@ Eigen::MatrixXd femb::test::StaticTangentByDifferences(const SystemModel& model,
 
 namespace femb::test {
 
-InertiaLoadFactors InertiaLoadsOf(const SuperelementBody& body, SuperelementBody::Data d, const BodyVelocity& w,
+InertiaLoadFactors InertiaLoadsOf(const SuperelementBody& body, BodyData d, const BodyVelocity& w,
                                   const BodyVelocity& wdot, const Eigen::Vector3d& gravity) {
   InertiaLoadFactors out;
-  body.InertiaLoads(d, w, wdot, gravity, out);
+  InertiaLoads(body, d, w, wdot, gravity, out);
   return out;
 }
 
-Eigen::VectorXd GravityForceOf(const SuperelementBody& body, SuperelementBody::Data d, const Eigen::Vector3d& g) {
+Eigen::VectorXd GravityForceOf(const SuperelementBody& body, BodyData d, const Eigen::Vector3d& g) {
   Eigen::VectorXd f;
-  body.GravityForce(d, g, f);
+  GravityForce(body, d, g, f);
   return f;
 }
 
-Eigen::MatrixXd InertiaConfigurationTangentOf(const SuperelementBody& body, SuperelementBody::Data d,
-                                              const BodyVelocity& w, const BodyVelocity& wdot, bool quadratic) {
+Eigen::MatrixXd InertiaConfigurationTangentOf(const SuperelementBody& body, BodyData d, const BodyVelocity& w,
+                                              const BodyVelocity& wdot, bool quadratic) {
   Eigen::MatrixXd tangent;
-  body.InertiaConfigurationTangent(d, w, wdot, quadratic, tangent);
+  InertiaConfigurationTangent(body, d, w, wdot, quadratic, tangent);
   return tangent;
 }
 
 BodyVelocityMaps MapsAt(const SuperelementBody& body, const BodyConfiguration& c, const FrameSolution& frame) {
-  SuperelementBody::Data d = body.Evaluate(c, frame);
-  return body.MapsOf(d);
+  BodyData d = Evaluate(body, c, frame);
+  return MapsOf(body, d);
 }
 
 Eigen::MatrixXd MomentumDerivativeOf(const SuperelementBody& body, const BodyVelocityMaps& maps,
                                      const BodyVelocity& w) {
   Eigen::MatrixXd D;
   BodyScratch scratch;
-  body.MomentumDerivative(maps, w, D, scratch);
+  MomentumDerivative(body, maps, w, D, scratch);
   return D;
 }
 
@@ -223,7 +223,7 @@ Eigen::VectorXd MomentumSourceOf(const SuperelementBody& body, const BodyVelocit
                                  const Eigen::VectorXd& p) {
   Eigen::VectorXd out;
   BodyScratch scratch;
-  body.MomentumSource(maps, w, p, out, scratch);
+  MomentumSource(body, maps, w, p, out, scratch);
   return out;
 }
 

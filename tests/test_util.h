@@ -56,7 +56,7 @@ Eigen::MatrixXd StaticTangentByDifferences(const SystemModel& model, const DofMa
 std::string Replace(std::string text, const std::string& from, const std::string& to);
 
 /// A temporary as an lvalue until the end of the full expression: a body's kernels write their
-/// scratch into the data they are given, so `body.ElasticForce(test::Lvalue(body.Evaluate(c,
+/// scratch into the data they are given, so `ElasticForce(body, test::Lvalue(Evaluate(body, c,
 /// frame)), ...)` evaluates the body for one call.
 template <class T>
 T& Lvalue(T&& value) {
@@ -65,12 +65,12 @@ T& Lvalue(T&& value) {
 
 /// A body's kernels as values, for tests that compare them in expressions (the product has the
 /// in-place forms only; these call them with their own copy of the data).
-InertiaLoadFactors InertiaLoadsOf(const SuperelementBody& body, SuperelementBody::Data d, const BodyVelocity& w,
+InertiaLoadFactors InertiaLoadsOf(const SuperelementBody& body, BodyData d, const BodyVelocity& w,
                                   const BodyVelocity& wdot, const Eigen::Vector3d& gravity);
-Eigen::VectorXd GravityForceOf(const SuperelementBody& body, SuperelementBody::Data d, const Eigen::Vector3d& g);
-Eigen::MatrixXd InertiaConfigurationTangentOf(const SuperelementBody& body, SuperelementBody::Data d,
-                                              const BodyVelocity& w, const BodyVelocity& wdot, bool quadratic);
-/// The corotational velocity maps at (c, frame) (SuperelementBody::MapsOf).
+Eigen::VectorXd GravityForceOf(const SuperelementBody& body, BodyData d, const Eigen::Vector3d& g);
+Eigen::MatrixXd InertiaConfigurationTangentOf(const SuperelementBody& body, BodyData d, const BodyVelocity& w,
+                                              const BodyVelocity& wdot, bool quadratic);
+/// The corotational velocity maps at (c, frame) (MapsOf).
 BodyVelocityMaps MapsAt(const SuperelementBody& body, const BodyConfiguration& c, const FrameSolution& frame);
 Eigen::MatrixXd MomentumDerivativeOf(const SuperelementBody& body, const BodyVelocityMaps& maps, const BodyVelocity& w);
 Eigen::VectorXd MomentumSourceOf(const SuperelementBody& body, const BodyVelocityMaps& maps, const BodyVelocity& w,

@@ -18,10 +18,10 @@
 //         that every row is a length); its left singular vectors past the rank, U_2, give the
 //         constraint C q_int = 0 with C = E L (r x 6N, r = 6N - m; E the reduced row echelon
 //         form of U_2^T with unit rows, so that each row involves few coordinates), stored in the file for femb-solve
-//         to enforce with multipliers (SuperelementBody::InterfaceConstraint). Phi0 = V (L Phi_IP)^+ L moves the
-//         spanned directions; the constrained ones get the static constraint modes' field Psi_c L^-1 U_2 U_2^T L (when
-//         `static_modes` are given; else none): it never deforms the body (the constraint holds their coordinates at
-//         zero) but keeps K and M regular outside the constraint, so that every check and analysis of a file applies
+//         to enforce with multipliers (InterfaceConstraint, solver/body/elastic_force.h). Phi0 = V (L Phi_IP)^+ L moves
+//         the spanned directions; the constrained ones get the static constraint modes' field Psi_c L^-1 U_2 U_2^T L
+//         (when `static_modes` are given; else none): it never deforms the body (the constraint holds their coordinates
+//         at zero) but keeps K and M regular outside the constraint, so that every check and analysis of a file applies
 //         unchanged;
 //  3. Phi is condensed within the basis, Phi = Phi0 - Psi0 (Psi0^T K Psi0)^-1 Psi0^T K Phi0: the
 //     least-strain-energy field of span V for each unit interface motion. The pseudo-inverse of

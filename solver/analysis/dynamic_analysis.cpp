@@ -258,12 +258,12 @@ DynamicStepReport MeasureWith(const SystemModel& model, const DofMap& dofs, cons
     AddSpringDampers(model, s.config, s.W, unused, nullptr, nullptr, &r.elastic_energy);  // spring energy
   }
   const int n_bodies = int(model.bodies.size());
-  const auto measure = [&](int b, SuperelementBody::Data& data, const Eigen::VectorXd& w, BodyMeasure& m) {
+  const auto measure = [&](int b, BodyData& data, const Eigen::VectorXd& w, BodyMeasure& m) {
     const SuperelementBody& body = model.bodies[size_t(b)];
-    const Eigen::VectorXd& p = body.MassTimes(data, w);  // M_g w, once for the energy and the momenta
+    const Eigen::VectorXd& p = MassTimes(body, data, w);  // M_g w, once for the energy and the momenta
     m.kinetic = 0.5 * w.dot(p);
-    body.MomentumFrom(data, p, &m.linear, &m.angular);
-    m.elastic = body.ElasticEnergy(data);
+    MomentumFrom(body, data, p, &m.linear, &m.angular);
+    m.elastic = ElasticEnergy(body, data);
   };
   const auto add = [&](const BodyMeasure& m) {
     r.kinetic_energy += m.kinetic;
@@ -280,8 +280,7 @@ DynamicStepReport MeasureWith(const SystemModel& model, const DofMap& dofs, cons
   }
   for (int b = 0; b < n_bodies; ++b) {
     BodyMeasure m;
-    SuperelementBody::Data data =
-        model.bodies[size_t(b)].Evaluate(BodyConfigurationOf(model, s.config, b), s.config.frames[b]);
+    BodyData data = Evaluate(model.bodies[size_t(b)], BodyConfigurationOf(model, s.config, b), s.config.frames[b]);
     measure(b, data, BodyVelocityOf(model, dofs, s, b), m);
     add(m);
   }
@@ -438,7 +437,7 @@ class DynamicRun {
     r.frame_S_inv.assign(size_t(n_bodies_), Eigen::Matrix<double, 6, 6>::Zero());
     r.has_frame_S_inv.assign(size_t(n_bodies_), 0);
     for (int b = 0; b < n_bodies_ && size_t(b) < work_.passes.size(); ++b) {
-      const SuperelementBody::Kinematics& kin = work_.passes[size_t(b)].data.kin;
+      const BodyKinematics& kin = work_.passes[size_t(b)].data.kin;
       if (kin.W.cols() != model_.bodies[size_t(b)].n_coordinates()) continue;
       r.frame_S_inv[size_t(b)] = kin.S_inv;
       r.has_frame_S_inv[size_t(b)] = 1;

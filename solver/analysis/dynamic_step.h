@@ -74,7 +74,7 @@ void ForEachBody(BodyThreads* threads, int n, const F& f) {
 
 // What the residual pass keeps of one body for the iteration matrix (AddDynamicMatrices).
 struct BodyPass {
-  SuperelementBody::Data data;
+  BodyData data;
   Eigen::VectorXd w, wdot;
   InertiaLoadFactors load;
 };
@@ -147,12 +147,12 @@ void AddRotationColumns(const std::vector<MapEntry>& map, const Eigen::MatrixXd&
 
 // One body's storage in a midpoint step (its data at q_n+1 is the BodyWorkspace's pass).
 struct MidpointBody {
-  SuperelementBody::Data d0, dm;                   // at q_n (once per step) and at q_m
+  BodyData d0, dm;                                 // at q_n (once per step) and at q_m
   Eigen::Vector3d com0 = Eigen::Vector3d::Zero();  // the centre of mass at q_n
   Eigen::VectorXd w0, p0, p1, p_mean, wm, w_first, w_second, dw, wdot, s_first, s_second, u, Du;
   Eigen::MatrixXd d_w, d_p;
-  Eigen::MatrixXd S_b;          // the body's combined iteration matrix (MidpointMatrix)
-  SuperelementBody::Data side;  // the exact inertia: MomentumConfigurationTangent's perturbed data
+  Eigen::MatrixXd S_b;  // the body's combined iteration matrix (MidpointMatrix)
+  BodyData side;        // the exact inertia: MomentumConfigurationTangent's perturbed data
   InertiaLoadFactors load;
 };
 

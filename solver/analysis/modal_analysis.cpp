@@ -20,8 +20,8 @@ ModalResult LinearizedModes(const SystemModel& model, SystemState& state, double
     const BodyConfiguration c = BodyConfigurationOf(model, state, int(b));
     Eigen::MatrixXd Mb;
     const Eigen::VectorXd w = Eigen::VectorXd::Zero(model.bodies[b].n_coordinates());
-    SuperelementBody::Data data = model.bodies[b].Evaluate(c, state.frames[b]);
-    model.bodies[b].InertiaForce(data, w, w, nullptr, &Mb, nullptr);
+    BodyData data = Evaluate(model.bodies[b], c, state.frames[b]);
+    InertiaForce(model.bodies[b], data, w, w, nullptr, &Mb, nullptr);
     ScatterBody(BodyMap(model, dofs, state, int(b)), nullptr, &Mb, nullptr, &M_entries);
   }
   // The tangent on SO(3) with spatial increments is symmetric at equilibrium up to the load

@@ -123,14 +123,14 @@ SystemForces AssembleStatic(const SystemModel& model, const DofMap& dofs, System
   for (size_t b = 0; b < model.bodies.size(); ++b) {
     const SuperelementBody& body = model.bodies[b];
     const BodyConfiguration c = BodyConfigurationOf(model, state, int(b));
-    const FrameSolution frame = body.SolveFrameFrom(c, state.frames[b]);
+    const FrameSolution frame = SolveFrameFrom(body, c, state.frames[b]);
     if (!frame.ok) {
       out.ok = false;
       out.message = "floating frame of body " + std::to_string(b) + " did not converge";
       return out;
     }
     state.frames[b] = frame;
-    SuperelementBody::Data data = body.Evaluate(c, frame);
+    BodyData data = Evaluate(body, c, frame);
     Eigen::VectorXd f;
     Eigen::MatrixXd K;
     // Gravity in a static analysis, ramped to full at pseudo-time static_gravity_end.
@@ -140,18 +140,18 @@ SystemForces AssembleStatic(const SystemModel& model, const DofMap& dofs, System
       // The stress of the body's own weight stiffens it (load factors -R_j^T g at rest).
       const Eigen::VectorXd zero = Eigen::VectorXd::Zero(body.n_coordinates());
       InertiaLoadFactors load;
-      body.InertiaLoads(data, zero, zero, ramp * model.gravity, load);
-      body.ElasticForce(data, &f, with_tangent ? &K : nullptr, &load);
+      InertiaLoads(body, data, zero, zero, ramp * model.gravity, load);
+      ElasticForce(body, data, &f, with_tangent ? &K : nullptr, &load);
     } else {
-      body.ElasticForce(data, &f, with_tangent ? &K : nullptr);
+      ElasticForce(body, data, &f, with_tangent ? &K : nullptr);
     }
-    out.elastic_energy += body.ElasticEnergy(data);
+    out.elastic_energy += ElasticEnergy(body, data);
     const double scale = std::max(body.ForceNorm(f), body.force_floor());
     out.force_scale = std::max(out.force_scale, scale);
-    out.roundoff += body.RoundOffForce(c);
+    out.roundoff += RoundOffForce(body, c);
     // The weight's configuration derivative in the tangent (S = -dr/dq: minus GravityTangent; the
     // dynamic iteration matrix takes it with the inertia's, generalized_alpha.cpp).
-    if (with_tangent && gravity_on && ramp > 0) K -= body.GravityTangent(data, ramp * model.gravity);
+    if (with_tangent && gravity_on && ramp > 0) K -= GravityTangent(body, data, ramp * model.gravity);
     const std::vector<MapEntry> map = BodyMap(model, dofs, state, int(b));
     AddBodyScale(map, scale, out.dof_scale);
     const Eigen::VectorXd minus_f = -f;
@@ -159,7 +159,7 @@ SystemForces AssembleStatic(const SystemModel& model, const DofMap& dofs, System
     AddBodyNodeForces(model, int(b), minus_f, node_forces);
     if (gravity_on) {
       Eigen::VectorXd f_grav;
-      body.GravityForce(data, ramp * model.gravity, f_grav);
+      GravityForce(body, data, ramp * model.gravity, f_grav);
       ScatterBody(map, &f_grav, nullptr, &gravity, nullptr);
       AddBodyNodeForces(model, int(b), f_grav, node_forces);
     }

@@ -138,7 +138,7 @@ class DofMap {
   int n_multipliers() const { return n_dofs_ - first_multiplier_; }
   int multiplier_first(int c) const { return multiplier_first_[c]; }
   /// After the cut joints': body b's multipliers of its interface constraint (thesis 8.2 case 4,
-  /// SuperelementBody::InterfaceConstraint), n_constraints() of them; -1 when it has none.
+  /// InterfaceConstraint), n_constraints() of them; -1 when it has none.
   int body_multiplier_first(int b) const { return body_multiplier_first_[b]; }
   int first_multiplier() const { return first_multiplier_; }
   bool multiplier(int j) const { return j >= first_multiplier_; }

@@ -1,7 +1,12 @@
-// The exact inertia of the reduced field in the floating frame (superelement_body.h, "Exact
-// inertia"): per-configuration products, force, mass matrix, gyroscopic matrix and the
-// configuration tangent by central differences.
+// The exact inertia from the file's invariants: per-configuration products, force, mass,
+// gyroscopic matrix, configuration tangent and the momentum source's local term.
+#include "solver/body/exact_inertia.h"
+
 #include <Eigen/Dense>
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
 
 #include "solver/body/body_blocks.h"
 #include "solver/body/superelement_body.h"
@@ -12,77 +17,54 @@ namespace femb {
 using body_blocks::QuadraticDerivative;
 using body_blocks::TurnBlocksInto;
 using body_blocks::TurnColBlocks;
+using body_blocks::TurnNodeBlocks;
 using body_blocks::TurnRowBlocks;
 
-void SuperelementBody::Exact(const Eigen::VectorXd& q, const Kinematics& kin, ExactData& d) const {
-  const int n = n_coordinates();
+void Exact(const SuperelementBody& body, const Eigen::VectorXd& q, const BodyKinematics& kin, ExactInertiaData& d) {
+  const int n = body.n_coordinates();
   d.Y = kin.B;
-  d.Y.noalias() += Phi_rig0_ * kin.Z;
-  GammaColumns(q, d.H);
+  d.Y.noalias() += body.Phi_rig0_ * kin.Z;
+  GammaColumns(body, q, d.H);
   // The stacked product Xi q (9 n) is the n x 9 matrix XQ column by column.
   d.XQ.resize(n, 9);
-  Eigen::Map<Eigen::VectorXd>(d.XQ.data(), Eigen::Index(n) * 9).noalias() = Xi_stack_ * q;
+  Eigen::Map<Eigen::VectorXd>(d.XQ.data(), Eigen::Index(n) * 9).noalias() = body.Xi_stack_ * q;
   for (int a = 0; a < 3; ++a)
     for (int b = 0; b < 3; ++b) d.Xq(a, b) = q.dot(d.XQ.col(3 * a + b));
   d.has_products = false;
 }
 
-void SuperelementBody::GammaColumns(const Eigen::VectorXd& v, Eigen::MatrixXd& out) const {
-  out.resize(n_coordinates(), 3);
-  Eigen::Map<Eigen::VectorXd>(out.data(), Eigen::Index(n_coordinates()) * 3).noalias() = Gamma_stack_ * v;
+void GammaColumns(const SuperelementBody& body, const Eigen::VectorXd& v, Eigen::MatrixXd& out) {
+  out.resize(body.n_coordinates(), 3);
+  Eigen::Map<Eigen::VectorXd>(out.data(), Eigen::Index(body.n_coordinates()) * 3).noalias() = body.Gamma_stack_ * v;
 }
 
-const SuperelementBody::ExactData& SuperelementBody::ExactProducts(Data& data) const {
-  ExactData& d = *data.exact;
+const ExactInertiaData& ExactProducts(const SuperelementBody& body, BodyData& data) {
+  ExactInertiaData& d = *data.exact;
   if (!d.has_products) {
-    d.MY.noalias() = M_ * d.Y;
+    d.MY.noalias() = body.M_ * d.Y;
     d.HtY.noalias() = d.H.transpose() * d.Y;
     d.has_products = true;
   }
   return d;
 }
 
-void SuperelementBody::SubtractRateTerms(const Eigen::VectorXd& q, const Eigen::Vector3d& Om, const Eigen::VectorXd& Rw,
-                                         const Eigen::VectorXd& qd, Eigen::VectorXd& r) const {
+void SubtractRateTerms(const SuperelementBody& body, const Eigen::VectorXd& q, const Eigen::Vector3d& Om,
+                       const Eigen::VectorXd& Rw, const Eigen::VectorXd& qd, Eigen::VectorXd& r) {
   // c = Omega^ Rbar^T w + [Omega x udot_k; (d/dt J_l(theta_k)) thetadot_k] (header, "Exact inertia").
-  for (int a = 0; a < 2 * n_nodes_; ++a) r.segment<3>(3 * a) -= Om.cross(Eigen::Vector3d(Rw.segment<3>(3 * a)));
-  for (int k = 0; k < n_nodes_; ++k) {
+  for (int a = 0; a < 2 * body.n_nodes_; ++a) r.segment<3>(3 * a) -= Om.cross(Eigen::Vector3d(Rw.segment<3>(3 * a)));
+  for (int k = 0; k < body.n_nodes_; ++k) {
     r.segment<3>(6 * k) -= Om.cross(Eigen::Vector3d(qd.segment<3>(6 * k)));
     r.segment<3>(6 * k + 3) -=
         LeftJacobianRate(Eigen::Vector3d(q.segment<3>(6 * k + 3)), Eigen::Vector3d(qd.segment<3>(6 * k + 3)));
   }
 }
 
-SuperelementBody::LocalMotion SuperelementBody::LocalRates(Data& data, const BodyVelocity& w,
-                                                           const BodyVelocity* wdot) const {
-  const int blocks = 2 * n_nodes_;
-  const Eigen::Matrix3d Rt = data.frame.R.transpose();
-  Eigen::VectorXd Rw;
-  TurnBlocksInto(Rt, w, blocks, Rw);
-  LocalMotion out;
-  const Eigen::Matrix<double, 6, 1> xi = data.kin.Z * Rw;
-  out.V = xi.head<3>();
-  out.Omega = xi.tail<3>();
-  out.qdot = data.kin.B * Rw;
-  out.qddot.setZero(out.qdot.size());
-  if (wdot) {
-    Eigen::VectorXd r;
-    TurnBlocksInto(Rt, *wdot, blocks, r);
-    SubtractRateTerms(data.q, out.Omega, Rw, out.qdot, r);
-    const Eigen::Matrix<double, 6, 1> xidot = data.kin.Z * r;
-    out.Vdot = xidot.head<3>();
-    out.Omegadot = xidot.tail<3>();
-    out.qddot = data.kin.B * r;
-  }
-  return out;
-}
-
 // Every temporary in data.exact_scratch (ExactScratch), each product into its own vector before
 // the sums: no allocation once sized, and the same numbers as the expressions they replace.
-void SuperelementBody::ExactInertiaForce(Data& data, const BodyVelocity& w, const BodyVelocity& wdot,
-                                         Eigen::VectorXd& f, Eigen::VectorXd* f_acc) const {
-  const int blocks = 2 * n_nodes_;
-  const ExactData& d = *data.exact;
+void ExactInertiaForce(const SuperelementBody& body, BodyData& data, const BodyVelocity& w, const BodyVelocity& wdot,
+                       Eigen::VectorXd& f, Eigen::VectorXd* f_acc) {
+  const int blocks = 2 * body.n_nodes_;
+  const ExactInertiaData& d = *data.exact;
   ExactScratch& s = data.exact_scratch;
   const Eigen::Matrix3d& R = data.frame.R;
   const Eigen::Matrix3d Rt = R.transpose();
@@ -98,21 +80,21 @@ void SuperelementBody::ExactInertiaForce(Data& data, const BodyVelocity& w, cons
   // r = Rbar^T wdot - c (header): xidot = Z r, qddot_loc = B r, ydot = Y r.
   Eigen::VectorXd& r = s.r;
   TurnBlocksInto(Rt, wdot, blocks, r);
-  if (f_acc) ExactMassTimesTurned(data, r, *f_acc);
-  SubtractRateTerms(data.q, Om, Rw, qd, r);
+  if (f_acc) ExactMassTimesTurned(body, data, r, *f_acc);
+  SubtractRateTerms(body, data.q, Om, Rw, qd, r);
   Eigen::Vector3d Omd;
   Omd.noalias() = Z.bottomRows<3>() * r;
   Eigen::VectorXd &y = s.y, &yd = s.yd;
-  y.noalias() = Phi_rig0_ * xi;
+  y.noalias() = body.Phi_rig0_ * xi;
   y += qd;
   yd.noalias() = d.Y * r;
   Eigen::MatrixXd& Hd = s.Hd;
-  GammaColumns(qd, Hd);
+  GammaColumns(body, qd, Hd);
   Eigen::VectorXd &pi_q = s.pi_q, &pi_q_dot = s.pi_q_dot;
-  pi_q.noalias() = M_ * y;
+  pi_q.noalias() = body.M_ * y;
   s.t1.noalias() = d.H * Om;
   pi_q += s.t1;
-  pi_q_dot.noalias() = M_ * yd;
+  pi_q_dot.noalias() = body.M_ * yd;
   s.t1.noalias() = d.H * Omd;
   s.t2.noalias() = Hd * Om;
   pi_q_dot += s.t1;
@@ -125,7 +107,7 @@ void SuperelementBody::ExactInertiaForce(Data& data, const BodyVelocity& w, cons
   Hdty.noalias() = Hd.transpose() * y;
   Eigen::Vector3d h = Hty + d.Xq * Om, hd = Htyd + Hdty + d.Xq * Omd;
   for (int a = 0; a < 3; ++a) {
-    s.t1.noalias() = Gamma_[size_t(a)].transpose() * y;
+    s.t1.noalias() = body.Gamma_[size_t(a)].transpose() * y;
     f_q -= Om[a] * s.t1;
     for (int b = 0; b < 3; ++b) {
       f_q -= Om[a] * Om[b] * d.XQ.col(3 * a + b);
@@ -134,8 +116,8 @@ void SuperelementBody::ExactInertiaForce(Data& data, const BodyVelocity& w, cons
   }
   // pi_xi = Phi_rig0^T pi_q + [0; h]; f_xi = d/dt pi_xi + Kirchhoff's terms.
   Eigen::Matrix<double, 6, 1> pi_xi, f_xi;
-  pi_xi.noalias() = Phi_rig0_.transpose() * pi_q;
-  f_xi.noalias() = Phi_rig0_.transpose() * pi_q_dot;
+  pi_xi.noalias() = body.Phi_rig0_.transpose() * pi_q;
+  f_xi.noalias() = body.Phi_rig0_.transpose() * pi_q_dot;
   pi_xi.tail<3>() += h;
   f_xi.tail<3>() += hd;
   const Eigen::Vector3d pi_v = pi_xi.head<3>(), pi_w = pi_xi.tail<3>();
@@ -149,8 +131,9 @@ void SuperelementBody::ExactInertiaForce(Data& data, const BodyVelocity& w, cons
 
 // The force at w = 0 for the acceleration Rbar r (r = Rbar^T wdot; xi = qd = y = 0): M_g wdot,
 // in O(n^2) (s.y, s.pi_q_dot and s.t1 are overwritten).
-void SuperelementBody::ExactMassTimesTurned(Data& data, const Eigen::VectorXd& r, Eigen::VectorXd& out) const {
-  const ExactData& d = *data.exact;
+void ExactMassTimesTurned(const SuperelementBody& body, BodyData& data, const Eigen::VectorXd& r,
+                          Eigen::VectorXd& out) {
+  const ExactInertiaData& d = *data.exact;
   ExactScratch& s = data.exact_scratch;
   const Eigen::MatrixXd& Z = data.kin.Z;
   const Eigen::MatrixXd& B = data.kin.B;
@@ -159,21 +142,21 @@ void SuperelementBody::ExactMassTimesTurned(Data& data, const Eigen::VectorXd& r
   Eigen::VectorXd& yd0 = s.y;
   yd0.noalias() = d.Y * r;
   Eigen::VectorXd& pi_q_dot0 = s.pi_q_dot;
-  pi_q_dot0.noalias() = M_ * yd0;
+  pi_q_dot0.noalias() = body.M_ * yd0;
   s.t1.noalias() = d.H * Omd0;
   pi_q_dot0 += s.t1;
   Eigen::Matrix<double, 6, 1> f_xi0;
-  f_xi0.noalias() = Phi_rig0_.transpose() * pi_q_dot0;
+  f_xi0.noalias() = body.Phi_rig0_.transpose() * pi_q_dot0;
   Eigen::Vector3d Hty0;
   Hty0.noalias() = d.H.transpose() * yd0;
   f_xi0.tail<3>() += Hty0 + d.Xq * Omd0;
   out.noalias() = Z.transpose() * f_xi0;
   s.t1.noalias() = B.transpose() * pi_q_dot0;
   out += s.t1;
-  TurnBlocksInto(data.frame.R, out, 2 * n_nodes_, out);
+  TurnBlocksInto(data.frame.R, out, 2 * body.n_nodes_, out);
 }
 
-void SuperelementBody::ExactMomentumSource(Data& data, const BodyVelocity& w, Eigen::VectorXd& out) const {
+void ExactMomentumSource(const SuperelementBody& body, BodyData& data, const BodyVelocity& w, Eigen::VectorXd& out) {
   // T(q, w) = T_hat(q_loc, Rbar^T w) (T is invariant under rigid motions), so at fixed w
   // dT/dq = G^T p (the frame's turning, as for the corotational inertia) + Rbar B^T g with
   // g = dT_hat/dq_loc at fixed w_hat = Rbar^T w. T_hat = T_L(xi(q_loc), q_loc, qdot(q_loc)) with
@@ -184,8 +167,8 @@ void SuperelementBody::ExactMomentumSource(Data& data, const BodyVelocity& w, Ei
   //   dT_L/dq|explicit = sum_a Omega_a Gamma_a^T y + sum_ab Omega_a Omega_b Xi_ab q,
   //   node k's translation rows: a = Omega x delta u_k        -> p_hat_t,k x Omega,
   //   node k's rotation rows:    a = (dJ_l(theta_k)) thetadot -> d/dtheta [p_hat_r,k^T J_l thetadot_k].
-  const int blocks = 2 * n_nodes_;
-  const ExactData& d = *data.exact;
+  const int blocks = 2 * body.n_nodes_;
+  const ExactInertiaData& d = *data.exact;
   ExactScratch& s = data.exact_scratch;
   const Eigen::MatrixXd& Z = data.kin.Z;
   const Eigen::MatrixXd& B = data.kin.B;
@@ -196,13 +179,13 @@ void SuperelementBody::ExactMomentumSource(Data& data, const BodyVelocity& w, Ei
   const Eigen::Vector3d Om = xi.tail<3>();
   Eigen::VectorXd &qd = s.qd, &y = s.y, &pi_q = s.pi_q;
   qd.noalias() = B * Rw;
-  y.noalias() = Phi_rig0_ * xi;
+  y.noalias() = body.Phi_rig0_ * xi;
   y += qd;
-  pi_q.noalias() = M_ * y;
+  pi_q.noalias() = body.M_ * y;
   s.t1.noalias() = d.H * Om;
   pi_q += s.t1;
   Eigen::Matrix<double, 6, 1> pi_xi;
-  pi_xi.noalias() = Phi_rig0_.transpose() * pi_q;
+  pi_xi.noalias() = body.Phi_rig0_.transpose() * pi_q;
   Eigen::Vector3d Hty;
   Hty.noalias() = d.H.transpose() * y;
   pi_xi.tail<3>() += Hty + d.Xq * Om;
@@ -210,13 +193,13 @@ void SuperelementBody::ExactMomentumSource(Data& data, const BodyVelocity& w, Ei
   p_hat.noalias() = Z.transpose() * pi_xi;
   s.t1.noalias() = B.transpose() * pi_q;
   p_hat += s.t1;
-  g.setZero(n_coordinates());
+  g.setZero(body.n_coordinates());
   for (int a = 0; a < 3; ++a) {
-    s.t1.noalias() = Gamma_[size_t(a)].transpose() * y;
+    s.t1.noalias() = body.Gamma_[size_t(a)].transpose() * y;
     g += Om[a] * s.t1;
     for (int b = 0; b < 3; ++b) g += Om[a] * Om[b] * d.XQ.col(3 * a + b);
   }
-  for (int k = 0; k < n_nodes_; ++k) {
+  for (int k = 0; k < body.n_nodes_; ++k) {
     g.segment<3>(6 * k) -= Eigen::Vector3d(p_hat.segment<3>(6 * k)).cross(Om);
     // d/dtheta [p^T J_l(theta) v] = -(d/dtheta [J_l^-1(theta)^T J_l^T p])^T J_l v (d J_l =
     // -J_l d(J_l^-1) J_l), with J_l^T p and J_l v held.
@@ -230,13 +213,13 @@ void SuperelementBody::ExactMomentumSource(Data& data, const BodyVelocity& w, Ei
   TurnBlocksInto(data.frame.R, out, blocks, out);
 }
 
-void SuperelementBody::ExactGyroscopic(Data& data, const BodyVelocity& w, Eigen::MatrixXd& G) const {
+void ExactGyroscopic(const SuperelementBody& body, BodyData& data, const BodyVelocity& w, Eigen::MatrixXd& G) {
   // ExactInertiaForce is A(q) wdot + g(q, w), g quadratic in w with no wdot: its derivative by
   // w is that of g. Forward mode by hand: every quantity of the force that depends on w carries
   // its n columns d/dw (prefix d), in the order of ExactInertiaForce. The temporaries are
   // data.exact_scratch's, each product into its own before the sums (as ExactInertiaForce).
-  const int n = n_coordinates(), blocks = 2 * n_nodes_;
-  const ExactData& d = ExactProducts(data);
+  const int n = body.n_coordinates(), blocks = 2 * body.n_nodes_;
+  const ExactInertiaData& d = ExactProducts(body, data);
   ExactScratch& s = data.exact_scratch;
   const Eigen::Matrix3d& R = data.frame.R;
   const Eigen::MatrixXd& Z = data.kin.Z;
@@ -267,7 +250,7 @@ void SuperelementBody::ExactGyroscopic(Data& data, const BodyVelocity& w, Eigen:
     dr.middleRows<3>(3 * a).noalias() += Skew<double>(Eigen::Vector3d(Rw.segment<3>(3 * a))) * dOm;
     dr.block<3, 3>(3 * a, 3 * a) -= Om_x * Rt;
   }
-  for (int k = 0; k < n_nodes_; ++k) {
+  for (int k = 0; k < body.n_nodes_; ++k) {
     const Eigen::Matrix3d minus_qd_x = -Skew<double>(Eigen::Vector3d(qd.segment<3>(6 * k)));
     t3.noalias() = minus_qd_x * dOm;
     t4.noalias() = Om_x * dqd.middleRows<3>(6 * k);
@@ -282,23 +265,23 @@ void SuperelementBody::ExactGyroscopic(Data& data, const BodyVelocity& w, Eigen:
   Eigen::MatrixXd& dOmd = s.dOmd;
   dOmd.noalias() = Z.bottomRows<3>() * dr;
   Eigen::VectorXd& y = s.y;
-  y.noalias() = Phi_rig0_ * xi;
+  y.noalias() = body.Phi_rig0_ * xi;
   y += qd;
   Eigen::MatrixXd& dy = s.dy;
-  dy.noalias() = Phi_rig0_ * dxi;
+  dy.noalias() = body.Phi_rig0_ * dxi;
   dy += dqd;
   // Gamma(Om) = sum_a Om_a Gamma_a: the three Gamma_a dqd and Gamma_a^T dy products in one each;
   // the rows y^T Gamma_a dqd as (Gamma_a^T y)^T dqd.
   Eigen::MatrixXd& G_Om = s.G_Om;
-  G_Om = Om[0] * Gamma_[0];
-  for (int a = 1; a < 3; ++a) G_Om += Om[a] * Gamma_[size_t(a)];
+  G_Om = Om[0] * body.Gamma_[0];
+  for (int a = 1; a < 3; ++a) G_Om += Om[a] * body.Gamma_[size_t(a)];
   Eigen::MatrixXd& Hd = s.Hd;  // Gamma_a qd
-  GammaColumns(qd, Hd);
+  GammaColumns(body, qd, Hd);
   Eigen::MatrixXd& Gty = s.Gty;  // Gamma_a^T y
   Gty.resize(n, 3);
-  for (int a = 0; a < 3; ++a) Gty.col(a).noalias() = Gamma_[size_t(a)].transpose() * y;
+  for (int a = 0; a < 3; ++a) Gty.col(a).noalias() = body.Gamma_[size_t(a)].transpose() * y;
   Eigen::VectorXd& pi_q = s.pi_q;
-  pi_q.noalias() = M_ * y;
+  pi_q.noalias() = body.M_ * y;
   s.t1.noalias() = d.H * Om;
   pi_q += s.t1;
   // M dyd and H^T dyd with dyd = Y dr: (M Y) dr and (H^T Y) dr, M Y and H^T Y kept per configuration.
@@ -315,7 +298,7 @@ void SuperelementBody::ExactGyroscopic(Data& data, const BodyVelocity& w, Eigen:
     G_skew = G_Om - G_Om.transpose();
     df_q.noalias() += G_skew * dqd;
     Eigen::MatrixXd& GtP = s.GtP;  // n x 6
-    GtP.noalias() = G_Om.transpose() * Phi_rig0_;
+    GtP.noalias() = G_Om.transpose() * body.Phi_rig0_;
     df_q.noalias() -= GtP * dxi;
     df_q.noalias() -= Gty * dOm;
   }
@@ -347,19 +330,19 @@ void SuperelementBody::ExactGyroscopic(Data& data, const BodyVelocity& w, Eigen:
     }
   }
   Eigen::Matrix<double, 6, 1> pi_xi;
-  pi_xi.noalias() = Phi_rig0_.transpose() * pi_q;
+  pi_xi.noalias() = body.Phi_rig0_.transpose() * pi_q;
   pi_xi.tail<3>() += h;
   const Eigen::Vector3d pi_v = pi_xi.head<3>(), pi_w = pi_xi.tail<3>();
   // d pi_q = M dy + H dOm enters only through Phi_rig0^T: 6 rows.
   Eigen::MatrixXd& dpi_xi = s.dpi_xi;
-  dpi_xi.noalias() = PtM_ * dy;
-  s.PH.noalias() = Phi_rig0_.transpose() * d.H;
+  dpi_xi.noalias() = body.PtM_ * dy;
+  s.PH.noalias() = body.Phi_rig0_.transpose() * d.H;
   s.t8.noalias() = s.PH * dOm;  // 6 x n
   dpi_xi += s.t8;
   dpi_xi.bottomRows<3>() += dh;
   Eigen::MatrixXd& df_xi = s.df_xi;
-  df_xi.noalias() = Phi_rig0_.transpose() * base;
-  s.PG.noalias() = Phi_rig0_.transpose() * G_Om;
+  df_xi.noalias() = body.Phi_rig0_.transpose() * base;
+  s.PG.noalias() = body.Phi_rig0_.transpose() * G_Om;
   df_xi.noalias() += s.PG * dqd;
   df_xi.bottomRows<3>() += dhd;
   Eigen::MatrixXd &dpi_v = s.dpi_v, &dpi_w = s.dpi_w;
@@ -380,9 +363,9 @@ void SuperelementBody::ExactGyroscopic(Data& data, const BodyVelocity& w, Eigen:
   TurnRowBlocks(G, blocks, [&](int) { return R; });
 }
 
-const Eigen::MatrixXd& SuperelementBody::ExactMass(Data& data) const {
+const Eigen::MatrixXd& ExactMass(const SuperelementBody& body, BodyData& data) {
   if (data.has_exact_mass) return data.exact_mass;
-  const ExactData& d = ExactProducts(data);
+  const ExactInertiaData& d = ExactProducts(body, data);
   const Eigen::Matrix3d& R = data.frame.R;
   const auto Zr = data.kin.Z.bottomRows<3>();
   BodyScratch& s = data.scratch;
@@ -396,83 +379,28 @@ const Eigen::MatrixXd& SuperelementBody::ExactMass(Data& data) const {
   Mg += YHZ.transpose();
   Mg.noalias() += s.n3b * Zr;
   // Rbar Mbar Rbar^T block by block.
-  body_blocks::TurnNodeBlocks(Mg, 2 * n_nodes_, R);
+  body_blocks::TurnNodeBlocks(Mg, 2 * body.n_nodes_, R);
   data.has_exact_mass = true;
   return Mg;
 }
 
-Eigen::MatrixXd SuperelementBody::ExactInertiaConfigurationTangent(Data& d, const BodyVelocity& w,
-                                                                   const BodyVelocity& wdot) const {
+Eigen::MatrixXd ExactInertiaConfigurationTangent(const SuperelementBody& body, BodyData& d, const BodyVelocity& w,
+                                                 const BodyVelocity& wdot) {
   // Central differences of the whole force at fixed (w, wdot), the frame re-solved.
-  const int n = n_coordinates();
+  const int n = body.n_coordinates();
   const Eigen::VectorXd& w_used = w;
   Eigen::MatrixXd tangent(n, n);
   Eigen::VectorXd f_plus, f_minus;
   for (int i = 0; i < n; ++i) {
     double step = 0.0;
-    const BodyConfiguration plus = Perturbed(d.c, i, 1.0, &step), minus = Perturbed(d.c, i, -1.0, &step);
-    Data at_plus = Evaluate(plus, SolveFrame(plus, d.frame));
-    ExactInertiaForce(at_plus, w_used, wdot, f_plus, nullptr);
-    Data at_minus = Evaluate(minus, SolveFrame(minus, d.frame));
-    ExactInertiaForce(at_minus, w_used, wdot, f_minus, nullptr);
+    const BodyConfiguration plus = Perturbed(body, d.c, i, 1.0, &step), minus = Perturbed(body, d.c, i, -1.0, &step);
+    BodyData at_plus = Evaluate(body, plus, SolveFrame(body, plus, d.frame));
+    ExactInertiaForce(body, at_plus, w_used, wdot, f_plus, nullptr);
+    BodyData at_minus = Evaluate(body, minus, SolveFrame(body, minus, d.frame));
+    ExactInertiaForce(body, at_minus, w_used, wdot, f_minus, nullptr);
     tangent.col(i) = (f_plus - f_minus) / (2 * step);
   }
   return tangent;
-}
-
-void SuperelementBody::AddLocalSourceVelocityDerivative(Data& d, const BodyVelocity& w, Eigen::MatrixXd& d_w) const {
-  if (!has_exact_inertia()) return;
-  // c(w) = Q(w, w): c(w + e) - c(w - e) = 4 Q(w, e) = 2 (dc/dw) e for any step e.
-  Eigen::VectorXd &wp = d.scratch.v2, &plus = d.scratch.v3, &minus = d.scratch.v4;
-  wp = w;
-  for (int i = 0; i < n_coordinates(); ++i) {
-    wp[i] = w[i] + 1.0;
-    ExactMomentumSource(d, wp, plus);
-    wp[i] = w[i] - 1.0;
-    ExactMomentumSource(d, wp, minus);
-    wp[i] = w[i];
-    d_w.col(i) += 0.5 * (plus - minus);
-  }
-}
-
-void SuperelementBody::MomentumConfigurationTangent(Data& d, const BodyVelocity& w, Data& side,
-                                                    Eigen::MatrixXd& D) const {
-  if (!has_exact_inertia()) {
-    MomentumDerivative(MapsOf(d), w, D, d.scratch);
-    return;
-  }
-  // p = Rbar p_hat(q_loc, Rbar^T w): the frame's turning of p is MomentumDerivative's with the
-  // exact mass (dp = -p~ U dq + M_e G dq, option A), the local coordinates' share
-  // Rbar (d p_hat / d q_loc) B Rbar^T (delta q_loc = B Rbar^T dq), the first factor by central
-  // differences in q_loc at the frame of d (no frame solve; steps as Perturbed's).
-  const int n = n_coordinates(), blocks = 2 * n_nodes_;
-  BodyVelocityMaps& maps = side.maps;
-  maps = MapsOf(d);
-  maps.Mg = ExactMass(d);
-  MomentumDerivative(maps, w, D, side.scratch);
-  double size = 0.0;
-  for (const Eigen::Vector3d& X : X_) size = std::max(size, X.norm());
-  const double length = 1e-7 * std::max(size, 1e-3);
-  const double modal = length * std::sqrt(std::max(M_(0, 0), 1e-300));
-  Eigen::MatrixXd &P = side.exact_scratch.t3, &BR = side.exact_scratch.t4;
-  P.resize(n, n);
-  side.c = d.c;
-  side.q = d.q;
-  for (int i = 0; i < n; ++i) {
-    const double step = i >= 6 * n_nodes_ ? modal : i % 6 < 3 ? length : 1e-7;
-    side.q[i] = d.q[i] + step;
-    EvaluateSolved(side.c, d.frame, side);
-    P.col(i) = MassTimes(side, w);
-    side.q[i] = d.q[i] - step;
-    EvaluateSolved(side.c, d.frame, side);
-    P.col(i) -= MassTimes(side, w);
-    P.col(i) /= 2 * step;
-    side.q[i] = d.q[i];
-  }
-  BR = d.kin.B;
-  const Eigen::Matrix3d Rt = d.frame.R.transpose();
-  TurnColBlocks(BR, blocks, [&](int) { return Rt; });
-  D.noalias() += P.lazyProduct(BR);  // (no blocking workspace on the heap)
 }
 
 }  // namespace femb

@@ -36,29 +36,29 @@ void AssembleDynamicResidual(const SystemModel& model, const DofMap& dofs, Dynam
     // correction or a step earlier); its local coordinates stay in pass.data.q.
     const bool kinematics = pass.data.kin.W.cols() == body.n_coordinates();
     const FrameSolution frame =
-        body.SolveFrameFrom(c, s.config.frames[b], &pass.data.q, kinematics ? &pass.data.kin.S_inv : nullptr);
+        SolveFrameFrom(body, c, s.config.frames[b], &pass.data.q, kinematics ? &pass.data.kin.S_inv : nullptr);
     if (!frame.ok) {
       r.frame_ok = false;
       return;
     }
     s.config.frames[b] = frame;
-    body.EvaluateSolved(c, frame, pass.data);
+    EvaluateSolved(body, c, frame, pass.data);
     GatherBody(model, dofs, s.config, b, s.W, pass.w);
     GatherBodyAcceleration(model, dofs, b, node_acc, s.Wdot, pass.wdot);
     // Inertia stiffening: K + K_sigma(a), a from this iterate's frame motion; its
     // velocity and acceleration derivatives go into C and M of the iteration matrix.
     const bool stiffening = body.has_inertia_stiffening();
     if (stiffening) {
-      body.InertiaLoads(pass.data, pass.w, pass.wdot, model.gravity, pass.load);
+      InertiaLoads(body, pass.data, pass.w, pass.wdot, model.gravity, pass.load);
     } else {
       pass.load.a.setZero();
     }
     Eigen::VectorXd &f_int = r.f_int, &f_in = r.f_in, &f_acc = r.f_acc;
-    body.ElasticForce(pass.data, &f_int, nullptr, stiffening ? &pass.load : nullptr);
-    body.InertiaForce(pass.data, pass.w, pass.wdot, &f_in, nullptr, nullptr, &f_acc);
-    body.AddModalDamping(pass.w, f_in, nullptr);
+    ElasticForce(body, pass.data, &f_int, nullptr, stiffening ? &pass.load : nullptr);
+    InertiaForce(body, pass.data, pass.w, pass.wdot, &f_in, nullptr, nullptr, &f_acc);
+    AddModalDamping(body, pass.w, f_in, nullptr);
     if (model.gravity.squaredNorm() > 0) {
-      body.GravityForce(pass.data, model.gravity, r.f_grav);
+      GravityForce(body, pass.data, model.gravity, r.f_grav);
     } else {
       r.f_grav.setZero(body.n_coordinates());
     }
@@ -67,7 +67,7 @@ void AssembleDynamicResidual(const SystemModel& model, const DofMap& dofs, Dynam
     r.f_quadratic = f_in - f_acc;
     r.scale = std::max({body.ForceNorm(f_int), body.ForceNorm(f_in), body.ForceNorm(r.f_grav), body.force_floor(),
                         body.ForceNorm(f_acc), body.ForceNorm(r.f_quadratic)});
-    r.roundoff = body.RoundOffForce(c, work.inertia_factor);
+    r.roundoff = RoundOffForce(body, c, work.inertia_factor);
     BodyMap(model, dofs, s.config, b, r.map);
     r.r_b = r.f_grav - f_int - f_in;
   });
@@ -124,7 +124,7 @@ void BodyDynamicMatrices(const SuperelementBody& body, BodyPass& pass, const Eig
     return;
   }
   Eigen::MatrixXd& d_load = r.d_load;
-  body.ElasticForce(pass.data, nullptr, &r.K, stiffening ? &pass.load : nullptr, stiffening ? &d_load : nullptr);
+  ElasticForce(body, pass.data, nullptr, &r.K, stiffening ? &pass.load : nullptr, stiffening ? &d_load : nullptr);
   // The inertia force's mass and gyroscopic matrices (the exact inertia's are a body's most
   // expensive kernel): computed, or the kept ones turned. The inertia force is objective:
   // turning the whole body and its motion by Q turns every node block of the two matrices,
@@ -139,7 +139,7 @@ void BodyDynamicMatrices(const SuperelementBody& body, BodyPass& pass, const Eig
     turned(r.M, r.M_frame, R);
     turned(r.C, r.C_frame, R);
   } else {
-    body.InertiaForce(pass.data, pass.w, pass.wdot, nullptr, &r.M, &r.C);
+    InertiaForce(body, pass.data, pass.w, pass.wdot, nullptr, &r.M, &r.C);
     if (!all_kept && r.age == 0) {
       turned(r.M_frame, r.M, Rt);
       turned(r.C_frame, r.C, Rt);
@@ -157,13 +157,13 @@ void BodyDynamicMatrices(const SuperelementBody& body, BodyPass& pass, const Eig
   if (gravity.squaredNorm() > 0) {
     r.wdot = pass.wdot;
     for (int a = 0; a < body.n_nodes(); ++a) r.wdot.segment<3>(6 * a) -= gravity;
-    body.InertiaConfigurationTangent(pass.data, pass.w, r.wdot, full_inertia_tangent, r.inertia_K);
+    InertiaConfigurationTangent(body, pass.data, pass.w, r.wdot, full_inertia_tangent, r.inertia_K);
   } else {
-    body.InertiaConfigurationTangent(pass.data, pass.w, pass.wdot, full_inertia_tangent, r.inertia_K);
+    InertiaConfigurationTangent(body, pass.data, pass.w, pass.wdot, full_inertia_tangent, r.inertia_K);
   }
   r.K += r.inertia_K;
   r.unused.setZero(body.n_coordinates());
-  body.AddModalDamping(pass.w, r.unused, &r.C);
+  AddModalDamping(body, pass.w, r.unused, &r.C);
   if (all_kept && r.age == 0) {
     turned(r.K_frame, r.K, Rt);
     turned(r.C_frame, r.C, Rt);

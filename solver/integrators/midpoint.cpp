@@ -205,19 +205,19 @@ void AddDiscreteGradientCorrection(const SystemModel& model, const DofMap& dofs,
 // r.f_acc): the change of its momenta over the step less the momentum source. d1, w1, maps1: the
 // body's data, velocities and corotational velocity maps at the end of the step.
 void MidpointInertia(const SystemModel& model, const DynamicState& s0, double h, const DynamicState& s1, int b,
-                     SuperelementBody::Data& d1, const Eigen::VectorXd& w1, const BodyVelocityMaps& maps1,
-                     MidpointWorkspace& mw, BodyTerms& r) {
+                     BodyData& d1, const Eigen::VectorXd& w1, const BodyVelocityMaps& maps1, MidpointWorkspace& mw,
+                     BodyTerms& r) {
   const SuperelementBody& body = model.bodies[b];
   const MidpointKinematics& k = mw.k;
   MidpointBody& m = mw.bodies[size_t(b)];
-  SuperelementBody::Data& dm = m.dm;
+  BodyData& dm = m.dm;
   const Eigen::VectorXd& wm = m.wm;
   const bool exact = body.has_exact_inertia();
   Eigen::VectorXd &f_in = r.f_in, &f_acc = r.f_acc;
   m.dw = w1 - m.w0;
   f_acc.resize(body.n_coordinates());
   if (exact) {
-    f_acc = body.MassTimes(d1, m.dw);
+    f_acc = MassTimes(body, d1, m.dw);
   } else {
     f_acc.noalias() = maps1.Mg * m.dw;
   }
@@ -234,8 +234,8 @@ void MidpointInertia(const SystemModel& model, const DynamicState& s0, double h,
         m.w_second.segment<3>(6 * a) = 2.0 * (s1.config.x[node] - k.mid.x[node]) / h;
         m.w_first.segment<3>(6 * a) = 2.0 * (k.mid.x[node] - s0.config.x[node]) / h;
       }
-      body.MomentumSource(dm, m.w_second, m.p1, m.s_second);
-      body.MomentumSource(dm, m.w_first, m.p0, m.s_first);
+      MomentumSource(body, dm, m.w_second, m.p1, m.s_second);
+      MomentumSource(body, dm, m.w_first, m.p0, m.s_first);
       f_in = (m.p1 - m.p0) / h - 0.5 * (m.s_second + m.s_first);
     } else {
       // No free node: every node hangs on joints or supports. The source at the step's mean
@@ -246,7 +246,7 @@ void MidpointInertia(const SystemModel& model, const DynamicState& s0, double h,
       // no longer matches the change of sum x_k x p_k exactly, so a chain whose root floats
       // free keeps its angular momentum to O(h^2) only (a grounded chain has none to keep).
       // Energy is the invariant a mechanism on joints is judged by.
-      body.MomentumSource(dm, wm, m.p_mean, m.s_first);
+      MomentumSource(body, dm, wm, m.p_mean, m.s_first);
       f_in = (m.p1 - m.p0) / h - m.s_first;
     }
   } else {
@@ -263,13 +263,13 @@ void MidpointGravity(const SystemModel& model, double h, int b, const Eigen::Vec
                      MidpointWorkspace& mw, Eigen::VectorXd& f_grav) {
   const SuperelementBody& body = model.bodies[b];
   MidpointBody& m = mw.bodies[size_t(b)];
-  SuperelementBody::Data& dm = m.dm;
+  BodyData& dm = m.dm;
   const Eigen::VectorXd& wm = m.wm;
   if (model.gravity.squaredNorm() > 0) {
-    body.GravityForce(dm, model.gravity, f_grav);
+    GravityForce(body, dm, model.gravity, f_grav);
     Eigen::VectorXd &u = m.u, &Du = m.Du;
     u = h * wm;
-    const double dV = -body.mass() * model.gravity.dot(body.CenterOfMass(q1, f1) - m.com0);
+    const double dV = -body.mass() * model.gravity.dot(CenterOfMass(body, q1, f1) - m.com0);
     Du.setZero(u.size());
     for (int a = 0; a < body.n_nodes(); ++a) {
       Du.segment<3>(6 * a) = u.segment<3>(6 * a);
@@ -294,12 +294,12 @@ void MidpointBodyTerms(const SystemModel& model, const DofMap& dofs, const Dynam
   BodyTerms& r = work.terms[size_t(b)];
   BodyPass& pass = work.passes[size_t(b)];
   MidpointBody& m = mw.bodies[size_t(b)];
-  SuperelementBody::Data &d1 = pass.data, &dm = m.dm;
+  BodyData &d1 = pass.data, &dm = m.dm;
   r.frame_ok = true;
   BodyConfigurationOf(model, s1.config, b, d1.c);
   BodyConfigurationOf(model, k.mid, b, dm.c);
-  const FrameSolution f1 = body.SolveFrameFrom(d1.c, s1.config.frames[b], &d1.q);
-  const FrameSolution fm = f1.ok ? body.SolveFrameFrom(dm.c, s0.config.frames[b], &dm.q) : FrameSolution{};
+  const FrameSolution f1 = SolveFrameFrom(body, d1.c, s1.config.frames[b], &d1.q);
+  const FrameSolution fm = f1.ok ? SolveFrameFrom(body, dm.c, s0.config.frames[b], &dm.q) : FrameSolution{};
   if (!f1.ok || !fm.ok) {
     r.frame_ok = false;
     return;
@@ -307,19 +307,19 @@ void MidpointBodyTerms(const SystemModel& model, const DofMap& dofs, const Dynam
   s1.config.frames[b] = f1;
   k.mid.frames[b] = fm;
   // (the local coordinates are the frame solutions', at these frames)
-  body.EvaluateSolved(d1.c, f1, d1);
-  body.EvaluateSolved(dm.c, fm, dm);
+  EvaluateSolved(body, d1.c, f1, d1);
+  EvaluateSolved(body, dm.c, fm, dm);
   Eigen::VectorXd& w1 = pass.w;
   w1.resize(body.n_coordinates());
   for (int a = 0; a < body.n_nodes(); ++a) w1.segment<6>(6 * a) = k.node_w1[size_t(model.body_nodes[b][a])];
   w1.tail(body.n_modes()) = s1.W.segment(dofs.mode_dof(int(b)), body.n_modes());
   // Velocity maps at the end and at the mid configuration, shared by the momentum terms.
-  const BodyVelocityMaps& maps1 = body.MapsOf(d1);
+  const BodyVelocityMaps& maps1 = MapsOf(body, d1);
   // The momenta of the body's kinetic energy, p = dT/dw (the exact inertia's or M_g w).
   const bool exact = body.has_exact_inertia();
   m.p1.resize(body.n_coordinates());
   if (exact) {
-    m.p1 = body.MassTimes(d1, w1);
+    m.p1 = MassTimes(body, d1, w1);
   } else {
     m.p1.noalias() = maps1.Mg * w1;
   }
@@ -330,15 +330,15 @@ void MidpointBodyTerms(const SystemModel& model, const DofMap& dofs, const Dynam
   wm.tail(body.n_modes()) = (s1.config.eta[b] - s0.config.eta[b]) / h;
   Eigen::VectorXd &f_in = r.f_in, &f_int = r.f_int, &f_acc = r.f_acc;
   MidpointInertia(model, s0, h, s1, b, d1, w1, maps1, mw, r);
-  body.AddModalDamping(wm, f_in, nullptr);
+  AddModalDamping(body, wm, f_in, nullptr);
   if (body.has_inertia_stiffening()) {
     // Inertia stiffening at the mid configuration with the step's mean velocity and
     // acceleration.
     m.wdot = m.dw / h;
-    body.InertiaLoads(dm, wm, m.wdot, model.gravity, m.load);
-    body.ElasticForce(dm, &f_int, nullptr, &m.load);
+    InertiaLoads(body, dm, wm, m.wdot, model.gravity, m.load);
+    ElasticForce(body, dm, &f_int, nullptr, &m.load);
   } else {
-    body.ElasticForce(dm, &f_int, nullptr);
+    ElasticForce(body, dm, &f_int, nullptr);
   }
   Eigen::VectorXd& f_grav = r.f_grav;
   MidpointGravity(model, h, b, d1.q, f1, mw, f_grav);
@@ -346,7 +346,7 @@ void MidpointBodyTerms(const SystemModel& model, const DofMap& dofs, const Dynam
   // cancel; M_g (w_n+1 - w_n) / h is the size of the inertia force).
   r.scale = std::max(
       {body.ForceNorm(f_int), body.ForceNorm(f_in), body.ForceNorm(f_grav), body.force_floor(), body.ForceNorm(f_acc)});
-  r.roundoff = body.RoundOffForce(d1.c, work.inertia_factor);
+  r.roundoff = RoundOffForce(body, d1.c, work.inertia_factor);
   BodyMap(model, dofs, k.mid, int(b), r.map);
   r.r_b = f_grav - f_int - f_in;
 }
@@ -412,10 +412,10 @@ const SystemMatrix& MidpointMatrix(const SystemModel& model, const DofMap& dofs,
     MidpointBody& m = mw.bodies[size_t(b)];
     BodyWorkspace::BodyMatrices& r = work.matrices[size_t(b)];
     const bool stiffening = body.has_inertia_stiffening();
-    body.ElasticForce(m.dm, nullptr, &r.K, stiffening ? &m.load : nullptr, stiffening ? &r.d_load : nullptr);
+    ElasticForce(body, m.dm, nullptr, &r.K, stiffening ? &m.load : nullptr, stiffening ? &r.d_load : nullptr);
     // M_g at the end of the step: the 2/h^2 term of the iteration matrix is d p_n+1 / h; at
     // the mid configuration it would be off by O(omega h) and leave a 1/h error.
-    r.M = body.Mass(pass.data);
+    r.M = Mass(body, pass.data);
     if (body.options().quadratic_velocity_terms) {
       // With dp_n+1 = (M_g V + D) delta (V = d W_n+1 / d delta ~ 2/h, D = d p / dq at fixed w)
       // and dw_a ~ delta / h,
@@ -425,16 +425,16 @@ const SystemMatrix& MidpointMatrix(const SystemModel& model, const DofMap& dofs,
       // iteration, or worse on stiff, lightly inertial directions such as a tube's torsion.
       // The exact inertia: d p_n+1 / dq by differences (MomentumConfigurationTangent); the
       // source's local term's derivatives, O(omega h) of the rest, are left to the iterations.
-      body.MomentumSourceDerivatives(body.MapsOf(m.dm), m.wm, m.p_mean, m.d_w, m.d_p, m.dm.scratch);
-      body.AddLocalSourceVelocityDerivative(m.dm, m.wm, m.d_w);
-      body.MomentumConfigurationTangent(pass.data, pass.w, m.side, r.C);
+      MomentumSourceDerivatives(body, MapsOf(body, m.dm), m.wm, m.p_mean, m.d_w, m.d_p, m.dm.scratch);
+      AddLocalSourceVelocityDerivative(body, m.dm, m.wm, m.d_w);
+      MomentumConfigurationTangent(body, pass.data, pass.w, m.side, r.C);
       r.C -= m.d_w;
       r.C.noalias() -= m.d_p * r.M;
     } else {
       r.C.setZero(body.n_coordinates(), body.n_coordinates());
     }
     r.unused.setZero(body.n_coordinates());
-    body.AddModalDamping(m.wm, r.unused, &r.C);
+    AddModalDamping(body, m.wm, r.unused, &r.C);
     if (stiffening) {
       // The inertia loads' velocity and acceleration derivatives: d wm = delta / h (into C / h)
       // and d (w1 - w0) / h = V delta / h (into M V / h).
@@ -528,15 +528,15 @@ void StartMidpointStep(const SystemModel& model, const DofMap& dofs, const Dynam
     const SuperelementBody& body = model.bodies[b];
     MidpointBody& m = mw.bodies[size_t(b)];
     BodyConfigurationOf(model, state.config, b, m.d0.c);
-    body.Evaluate(m.d0.c, state.config.frames[b], m.d0);
+    Evaluate(body, m.d0.c, state.config.frames[b], m.d0);
     BodyVelocityOf(model, dofs, state, b, m.w0);
     m.p0.resize(body.n_coordinates());
     if (body.has_exact_inertia()) {
-      m.p0 = body.MassTimes(m.d0, m.w0);
+      m.p0 = MassTimes(body, m.d0, m.w0);
     } else {
-      m.p0.noalias() = body.MapsOf(m.d0).Mg * m.w0;
+      m.p0.noalias() = MapsOf(body, m.d0).Mg * m.w0;
     }
-    m.com0 = body.CenterOfMass(m.d0.q, state.config.frames[b]);
+    m.com0 = CenterOfMass(body, m.d0.q, state.config.frames[b]);
   });
 }
 

@@ -20,18 +20,18 @@ namespace {
 
 // Body b's data at `state`, its floating frame solved from the last one; none when the frame
 // does not converge (the body's own assembly reports that).
-std::optional<SuperelementBody::Data> BodyDataAt(const SystemModel& model, const SystemState& state, int b) {
+std::optional<BodyData> BodyDataAt(const SystemModel& model, const SystemState& state, int b) {
   const SuperelementBody& body = model.bodies[size_t(b)];
   const BodyConfiguration c = BodyConfigurationOf(model, state, b);
-  const FrameSolution frame = body.SolveFrameFrom(c, state.frames[size_t(b)]);
+  const FrameSolution frame = SolveFrameFrom(body, c, state.frames[size_t(b)]);
   if (!frame.ok) return std::nullopt;
-  return body.Evaluate(c, frame);
+  return Evaluate(body, c, frame);
 }
 
 // Body b's data at `state`: the given one, or evaluated into `own`; null when its frame does not
 // converge.
-SuperelementBody::Data* BodyDataFor(const SystemModel& model, const SystemState& state, int b,
-                                    const BodyDataAtState* data, std::optional<SuperelementBody::Data>& own) {
+BodyData* BodyDataFor(const SystemModel& model, const SystemState& state, int b, const BodyDataAtState* data,
+                      std::optional<BodyData>& own) {
   if (data && size_t(b) < data->size() && (*data)[size_t(b)]) return (*data)[size_t(b)];
   own = BodyDataAt(model, state, b);
   return own ? &*own : nullptr;
@@ -51,13 +51,13 @@ void AddBodyConstraints(const SystemModel& model, const DofMap& dofs, const Syst
     const SuperelementBody& body = model.bodies[b];
     const int r = body.n_constraints();
     if (r == 0) continue;
-    std::optional<SuperelementBody::Data> own;
-    SuperelementBody::Data* d = BodyDataFor(model, state, int(b), data, own);
+    std::optional<BodyData> own;
+    BodyData* d = BodyDataFor(model, state, int(b), data, own);
     if (!d) continue;
     const int first = dofs.body_multiplier_first(int(b));
     lambda = state.lambda.segment(first - dofs.first_multiplier(), r);
     const bool hessian = tangent && (blocks & kLoopHessian) && !lambda.isZero(0.0);
-    body.InterfaceConstraint(*d, &g, &G, hessian ? &lambda : nullptr, hessian ? &H : nullptr);
+    InterfaceConstraint(body, *d, &g, &G, hessian ? &lambda : nullptr, hessian ? &H : nullptr);
     minus_f.resize(body.n_coordinates());
     minus_f.noalias() = -G.transpose() * lambda;  // -G^T lambda on the body's coordinates
     if (node_forces) AddBodyNodeForces(model, int(b), minus_f, *node_forces);
@@ -306,10 +306,10 @@ double LoopViolation(const SystemModel& model, const SystemState& state, int* wo
   for (size_t b = 0; b < model.bodies.size(); ++b) {
     const SuperelementBody& body = model.bodies[b];
     if (body.n_constraints() == 0) continue;
-    std::optional<SuperelementBody::Data> own;
-    SuperelementBody::Data* d = BodyDataFor(model, state, int(b), data, own);
-    thread_local Eigen::VectorXd g;                                      // (kept: no allocation with `data`)
-    if (d) body.InterfaceConstraint(*d, &g, nullptr, nullptr, nullptr);  // lengths
+    std::optional<BodyData> own;
+    BodyData* d = BodyDataFor(model, state, int(b), data, own);
+    thread_local Eigen::VectorXd g;                                       // (kept: no allocation with `data`)
+    if (d) InterfaceConstraint(body, *d, &g, nullptr, nullptr, nullptr);  // lengths
     const double v = d ? g.lpNorm<Eigen::Infinity>() : std::numeric_limits<double>::infinity();
     if (v > largest) {
       largest = v;

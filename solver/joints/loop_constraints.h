@@ -15,7 +15,7 @@
 namespace femb {
 
 /// The cut joints' constraint equations and the bodies' interface constraints
-/// (SuperelementBody::InterfaceConstraint) at `state` with its multipliers lambda: the residual's
+/// (InterfaceConstraint, solver/body/elastic_force.h) at `state` with its multipliers lambda: the residual's
 /// coordinate rows get -G^T lambda and its multiplier rows -g (Newton's S delta = r then asks
 /// G dq = -g), the node forces -G_node^T lambda (so AddJointGeometricStiffness adds the tree
 /// joints' share of their stiffness). With `tangent`: G in the multipliers' rows, G^T in their
@@ -25,7 +25,7 @@ namespace femb {
 /// null), the bodies' interface constraints take them instead of solving the body's frame and
 /// evaluating it again; the step then allocates nothing for them.
 enum LoopBlocks { kLoopRows = 1, kLoopColumns = 2, kLoopHessian = 4, kLoopAll = 7 };
-using BodyDataAtState = std::vector<SuperelementBody::Data*>;
+using BodyDataAtState = std::vector<BodyData*>;
 void AddLoopConstraints(const SystemModel& model, const DofMap& dofs, const SystemState& state,
                         Eigen::VectorXd* residual, Triplets* tangent, NodeForces* node_forces,
                         Triplets* jacobian = nullptr, int blocks = kLoopAll, const BodyDataAtState* data = nullptr);

@@ -191,7 +191,7 @@ class ResultsRecorder::OutputStep {
     r_.has_stress_coordinates_[b] = 1;
     return r_.q_stress_[b];
   }
-  // The inertia load factors of body b's frame (SuperelementBody::InertiaLoads) when its modal
+  // The inertia load factors of body b's frame (InertiaLoads) when its modal
   // stresses include the inertia load cases: d'Alembert with gravity (static analyses: gravity
   // as ramped by the analysis, no motion). Null without them.
   const Eigen::VectorXd* Inertia(size_t b) {
@@ -204,23 +204,23 @@ class ResultsRecorder::OutputStep {
     if (!dynamic && model_.static_gravity_end > 0) g = std::min(t_ / model_.static_gravity_end, 1.0);
     const SuperelementBody& body = model_.bodies[b];
     InertiaLoadFactors load;
-    SuperelementBody::Data data = body.Evaluate(BodyConfigurationOf(model_, state_, int(b)), state_.frames[b]);
-    body.InertiaLoads(data, GatherBody(model_, r_.dofs_, state_, int(b), V_),
-                      GatherBodyAcceleration(model_, r_.dofs_, int(b), node_acc_, A_), g * model_.gravity, load);
+    BodyData data = Evaluate(body, BodyConfigurationOf(model_, state_, int(b)), state_.frames[b]);
+    InertiaLoads(body, data, GatherBody(model_, r_.dofs_, state_, int(b), V_),
+                 GatherBodyAcceleration(model_, r_.dofs_, int(b), node_acc_, A_), g * model_.gravity, load);
     r_.factors_[b] = load.a;
     r_.has_factors_[b] = 1;
     return &r_.factors_[b];
   }
-  // Body b's frame motion and the rates of its local coordinates (SuperelementBody::LocalRates).
-  const SuperelementBody::LocalMotion& MotionOf(int b) {
+  // Body b's frame motion and the rates of its local coordinates (LocalRates).
+  const LocalMotion& MotionOf(int b) {
     if (!motion_[size_t(b)]) {
       const SuperelementBody& body = model_.bodies[size_t(b)];
       // The local coordinates at this frame are q_loc_ already: not solved for again.
-      SuperelementBody::Data d;
+      BodyData d;
       d.q = r_.q_loc_[size_t(b)];
-      body.EvaluateSolved(BodyConfigurationOf(model_, state_, b), state_.frames[size_t(b)], d);
+      EvaluateSolved(body, BodyConfigurationOf(model_, state_, b), state_.frames[size_t(b)], d);
       const Eigen::VectorXd wdot = GatherBodyAcceleration(model_, r_.dofs_, b, NodeAccelerations(), A_);
-      motion_[size_t(b)] = body.LocalRates(d, GatherBody(model_, r_.dofs_, state_, b, V_), &wdot);
+      motion_[size_t(b)] = LocalRates(body, d, GatherBody(model_, r_.dofs_, state_, b, V_), &wdot);
     }
     return *motion_[size_t(b)];
   }
@@ -234,7 +234,7 @@ class ResultsRecorder::OutputStep {
   const Eigen::VectorXd& V_;
   const Eigen::VectorXd& A_;
   std::vector<Eigen::Matrix<double, 6, 1>> node_acc_;
-  std::vector<std::optional<SuperelementBody::LocalMotion>> motion_;
+  std::vector<std::optional<LocalMotion>> motion_;
 };
 
 void ResultsRecorder::Record(double t, const SystemState& state, const Eigen::VectorXd& W, double kinetic,
@@ -310,8 +310,8 @@ void ResultsRecorder::RecordBodies(const SystemState& state) {
     double* const modal = modal_[b].Append();
     for (int i = 0; i < modal_[b].width; ++i) modal[i] = state.eta[b][i];
     BodyConfigurationOf(model, state, int(b), config_);
-    body.LocalCoordinates(config_, state.frames[b], q_loc_[b]);
-    const Eigen::Vector3d com = body.CenterOfMass(q_loc_[b], state.frames[b]);
+    LocalCoordinates(body, config_, state.frames[b], q_loc_[b]);
+    const Eigen::Vector3d com = CenterOfMass(body, q_loc_[b], state.frames[b]);
     double* const f = frames_[b].Append();
     Eigen::Vector3d::Map(f) = state.frames[b].x + scene_.origin;
     Eigen::Vector4d::Map(f + 3) = Quaternion(state.frames[b].R);
@@ -399,7 +399,7 @@ void ResultsRecorder::WriteProbes(const SystemState& state, const NodeRows& node
 }
 
 // A point probe's quantities: the stress at its stress point; the material point s = s0 + u from
-// the frame origin in frame axes, u = shape q_loc (SuperelementBody::LocalRates for its velocity
+// the frame origin in frame axes, u = shape q_loc (LocalRates for its velocity
 // and acceleration).
 void ResultsRecorder::WritePointProbe(size_t pi, const SystemState& state, OutputStep& step, ProbeRow& row) {
   const SceneProbeSpec& p = scene_.spec.probes[pi];
@@ -423,11 +423,11 @@ void ResultsRecorder::WritePointProbe(size_t pi, const SystemState& state, Outpu
     if (q == ProbeQuantity::kPosition) put3(scene_.origin + body_frame.x + body_frame.R * r);
     if (q == ProbeQuantity::kDeformation) put3(body_frame.R * u);
     if (q == ProbeQuantity::kVelocity) {
-      const SuperelementBody::LocalMotion& m = step.MotionOf(b);
+      const LocalMotion& m = step.MotionOf(b);
       put3(body_frame.R * (m.V + m.Omega.cross(r) + point.shape * m.qdot));
     }
     if (q == ProbeQuantity::kAcceleration) {
-      const SuperelementBody::LocalMotion& m = step.MotionOf(b);
+      const LocalMotion& m = step.MotionOf(b);
       const Eigen::Vector3d ud = point.shape * m.qdot, udd = point.shape * m.qddot;
       put3(body_frame.R * (m.Vdot + m.Omega.cross(m.V) + m.Omegadot.cross(r) + m.Omega.cross(m.Omega.cross(r)) +
                            2.0 * m.Omega.cross(ud) + udd));

@@ -143,13 +143,13 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     femb::RequireValidSuperelement(loaded, path);
     const femb::SuperelementBody body(loaded, femb::SuperelementOptions{}, Eigen::Matrix3d::Identity(),
                                       Eigen::Vector3d::Zero());
-    const femb::BodyConfiguration c = body.InitialConfiguration();
-    const femb::FrameSolution frame = body.SolveFrame(c, body.GuessFrame(c));
+    const femb::BodyConfiguration c = InitialConfiguration(body);
+    const femb::FrameSolution frame = SolveFrame(body, c, GuessFrame(body, c));
     if (frame.ok) {
       Eigen::VectorXd f;
       Eigen::MatrixXd K;
-      femb::SuperelementBody::Data data = body.Evaluate(c, frame);
-      body.ElasticForce(data, &f, &K);
+      femb::BodyData data = Evaluate(body, c, frame);
+      ElasticForce(body, data, &f, &K);
       if (!f.allFinite() || !K.allFinite()) std::abort();  // a file that passed the checks
     }
   } catch (const femb::InputError&) {

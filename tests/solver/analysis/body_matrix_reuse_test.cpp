@@ -32,18 +32,18 @@ struct BodyMatrices {
 
 BodyMatrices MatricesAt(const SuperelementBody& body, const BodyConfiguration& c, const FrameSolution& f,
                         const Eigen::VectorXd& w, const Eigen::VectorXd& wdot) {
-  SuperelementBody::Data d = body.Evaluate(c, f);
+  BodyData d = Evaluate(body, c, f);
   BodyMatrices m;
   if (body.has_inertia_stiffening()) {
     const InertiaLoadFactors load = test::InertiaLoadsOf(body, d, w, wdot, Eigen::Vector3d::Zero());
     Eigen::MatrixXd d_load;
-    body.ElasticForce(d, nullptr, &m.K, &load, &d_load);
+    ElasticForce(body, d, nullptr, &m.K, &load, &d_load);
     m.K_load_w = d_load * load.d_w;
     m.K_load_wdot = d_load * load.d_wdot;
   } else {
-    body.ElasticForce(d, nullptr, &m.K);
+    ElasticForce(body, d, nullptr, &m.K);
   }
-  body.InertiaForce(d, w, wdot, nullptr, &m.M, &m.G);
+  InertiaForce(body, d, w, wdot, nullptr, &m.M, &m.G);
   m.K_inertia = test::InertiaConfigurationTangentOf(body, d, w, wdot, false);
   return m;
 }
@@ -57,7 +57,7 @@ TEST(BodyMatrices, TurnWithTheBody) {
     ASSERT_EQ(body.has_exact_inertia(), stiffened);
     const int n = body.n_coordinates(), N = body.n_nodes();
     // A deformed, turned body with node velocities and accelerations of a few m/s, rad/s.
-    BodyConfiguration c = body.InitialConfiguration();
+    BodyConfiguration c = InitialConfiguration(body);
     const Eigen::Matrix3d Rg = ExpSO3(Eigen::Vector3d(0.3, -0.2, 0.5));
     for (int k = 0; k < N; ++k) {
       c.x[k] = Rg * c.x[k] + Eigen::Vector3d(0.1, 0.2, -0.3) + 2e-3 * Eigen::Vector3d(k, -k, 2 * k);
@@ -77,7 +77,7 @@ TEST(BodyMatrices, TurnWithTheBody) {
       wq.segment<3>(3 * a) = Q * w.segment<3>(3 * a);
       wdotq.segment<3>(3 * a) = Q * wdot.segment<3>(3 * a);
     }
-    const FrameSolution f = body.SolveFrame(c, body.GuessFrame(c)), fq = body.SolveFrame(cq, body.GuessFrame(cq));
+    const FrameSolution f = SolveFrame(body, c, GuessFrame(body, c)), fq = SolveFrame(body, cq, GuessFrame(body, cq));
     ASSERT_TRUE(f.ok && fq.ok);
     EXPECT_LT((fq.R - Q * f.R).norm(), 1e-12);
     Eigen::MatrixXd Qbar = Eigen::MatrixXd::Identity(n, n);

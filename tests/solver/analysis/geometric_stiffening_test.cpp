@@ -48,23 +48,23 @@ TEST(GeometricStiffening, InertiaLoadFactorsAndTheirDerivativesMatchFiniteDiffer
   const SuperelementBody body(se, SuperelementOptions{});
   const int n = body.n_coordinates();
   // A body turned and displaced, slightly deformed, moving.
-  BodyConfiguration c = body.InitialConfiguration();
+  BodyConfiguration c = InitialConfiguration(body);
   const Eigen::Matrix3d Rg = ExpSO3(Eigen::Vector3d(0.3, -0.2, 0.5));
   for (int k = 0; k < body.n_nodes(); ++k) {
     c.x[k] = Rg * c.x[k] + Eigen::Vector3d(0.1, 0.2, -0.3) + 1e-3 * Eigen::Vector3d(k, -k, 2 * k);
     c.R[k] = ExpSO3(Eigen::Vector3d(0.01 * k, 0.02, -0.01)) * Rg * c.R[k];
   }
   c.eta.setConstant(1e-4);
-  const FrameSolution frame = body.SolveFrame(c, body.GuessFrame(c));
+  const FrameSolution frame = SolveFrame(body, c, GuessFrame(body, c));
   ASSERT_TRUE(frame.ok);
   const Eigen::VectorXd w = Eigen::VectorXd::LinSpaced(n, -3.0, 5.0), wdot = Eigen::VectorXd::LinSpaced(n, 40.0, -20.0);
   const Eigen::Vector3d g(0, 0, -9.81);
-  const InertiaLoadFactors load = test::InertiaLoadsOf(body, body.Evaluate(c, frame), w, wdot, g);
+  const InertiaLoadFactors load = test::InertiaLoadsOf(body, Evaluate(body, c, frame), w, wdot, g);
   // A rigid rotation about z through the frame origin at Omega: a = (0, 0, 0 | 0 | Omega^2 products).
   {
     const double Omega = 7.0;
-    BodyConfiguration c0 = body.InitialConfiguration();
-    const FrameSolution f0 = body.SolveFrame(c0, body.GuessFrame(c0));
+    BodyConfiguration c0 = InitialConfiguration(body);
+    const FrameSolution f0 = SolveFrame(body, c0, GuessFrame(body, c0));
     Eigen::VectorXd wr = Eigen::VectorXd::Zero(n), wr_dot = Eigen::VectorXd::Zero(n);
     for (int k = 0; k < body.n_nodes(); ++k) {
       const Eigen::Vector3d r = c0.x[k] - f0.x;
@@ -73,7 +73,7 @@ TEST(GeometricStiffening, InertiaLoadFactorsAndTheirDerivativesMatchFiniteDiffer
       wr_dot.segment<3>(6 * k) = Eigen::Vector3d(0, 0, Omega).cross(Eigen::Vector3d(wr.segment<3>(6 * k)));
     }
     const InertiaLoadFactors rot =
-        test::InertiaLoadsOf(body, body.Evaluate(c0, f0), wr, wr_dot, Eigen::Vector3d::Zero());
+        test::InertiaLoadsOf(body, Evaluate(body, c0, f0), wr, wr_dot, Eigen::Vector3d::Zero());
     Eigen::Matrix<double, 12, 1> expected = Eigen::Matrix<double, 12, 1>::Zero();
     expected[8] = Omega * Omega;
     EXPECT_LT((rot.a - expected).norm(), 1e-9 * Omega * Omega) << rot.a.transpose();
@@ -82,11 +82,11 @@ TEST(GeometricStiffening, InertiaLoadFactorsAndTheirDerivativesMatchFiniteDiffer
   for (int i = 0; i < n; ++i) {
     const double h = 1e-4;  // a is linear in wdot and quadratic in w: central differences are exact up to round-off
     const Eigen::VectorXd e = Eigen::VectorXd::Unit(n, i);
-    d_w.col(i) = (test::InertiaLoadsOf(body, body.Evaluate(c, frame), w + h * e, wdot, g).a -
-                  test::InertiaLoadsOf(body, body.Evaluate(c, frame), w - h * e, wdot, g).a) /
+    d_w.col(i) = (test::InertiaLoadsOf(body, Evaluate(body, c, frame), w + h * e, wdot, g).a -
+                  test::InertiaLoadsOf(body, Evaluate(body, c, frame), w - h * e, wdot, g).a) /
                  (2 * h);
-    d_wdot.col(i) = (test::InertiaLoadsOf(body, body.Evaluate(c, frame), w, wdot + h * e, g).a -
-                     test::InertiaLoadsOf(body, body.Evaluate(c, frame), w, wdot - h * e, g).a) /
+    d_wdot.col(i) = (test::InertiaLoadsOf(body, Evaluate(body, c, frame), w, wdot + h * e, g).a -
+                     test::InertiaLoadsOf(body, Evaluate(body, c, frame), w, wdot - h * e, g).a) /
                     (2 * h);
   }
   EXPECT_LT((load.d_w - d_w).norm(), 1e-9 * d_w.norm());
@@ -95,7 +95,7 @@ TEST(GeometricStiffening, InertiaLoadFactorsAndTheirDerivativesMatchFiniteDiffer
   // configuration at fixed a).
   Eigen::VectorXd f;
   Eigen::MatrixXd K, d_load;
-  body.ElasticForce(test::Lvalue(body.Evaluate(c, frame)), &f, &K, &load, &d_load);
+  ElasticForce(body, test::Lvalue(Evaluate(body, c, frame)), &f, &K, &load, &d_load);
   Eigen::MatrixXd d_load_fd(n, 12);
   for (int k = 0; k < 12; ++k) {
     InertiaLoadFactors plus = load, minus = load;
@@ -103,8 +103,8 @@ TEST(GeometricStiffening, InertiaLoadFactorsAndTheirDerivativesMatchFiniteDiffer
     plus.a[k] += h;
     minus.a[k] -= h;
     Eigen::VectorXd fp, fm;
-    body.ElasticForce(test::Lvalue(body.Evaluate(c, frame)), &fp, nullptr, &plus);
-    body.ElasticForce(test::Lvalue(body.Evaluate(c, frame)), &fm, nullptr, &minus);
+    ElasticForce(body, test::Lvalue(Evaluate(body, c, frame)), &fp, nullptr, &plus);
+    ElasticForce(body, test::Lvalue(Evaluate(body, c, frame)), &fm, nullptr, &minus);
     d_load_fd.col(k) = (fp - fm) / (2 * h);
   }
   EXPECT_LT((d_load - d_load_fd).norm(), 1e-8 * d_load.norm());
@@ -124,9 +124,9 @@ TEST(GeometricStiffening, InertiaLoadFactorsAndTheirDerivativesMatchFiniteDiffer
       } else {
         p.eta[i - 6 * body.n_nodes()] += e;
       }
-      const FrameSolution pf = body.SolveFrame(p, frame);
+      const FrameSolution pf = SolveFrame(body, p, frame);
       ASSERT_TRUE(pf.ok);
-      body.ElasticForce(test::Lvalue(body.Evaluate(p, pf)), &fs[side], nullptr, &load);
+      ElasticForce(body, test::Lvalue(Evaluate(body, p, pf)), &fs[side], nullptr, &load);
     }
     K_fd.col(i) = (fs[0] - fs[1]) / (2 * h);
   }

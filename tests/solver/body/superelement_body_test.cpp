@@ -46,7 +46,7 @@ Eigen::VectorXd Uniform(int n, std::mt19937& rng) {
 BodyConfiguration Deformed(const SuperelementBody& body, double size, unsigned seed) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
-  BodyConfiguration c = body.InitialConfiguration();
+  BodyConfiguration c = InitialConfiguration(body);
   const Eigen::Matrix3d Rr = ExpSO3(Eigen::Vector3d(0.7, -1.1, 0.4));
   const Eigen::Vector3d tr(0.3, -0.2, 1.5);
   for (int k = 0; k < body.n_nodes(); ++k) {
@@ -73,23 +73,23 @@ struct Evaluation {
   double energy;
 };
 
-Evaluation Evaluate(const SuperelementBody& body, const BodyConfiguration& c, FrameSolution guess) {
-  const FrameSolution frame = body.SolveFrame(c, guess);
+Evaluation ElasticAt(const SuperelementBody& body, const BodyConfiguration& c, FrameSolution guess) {
+  const FrameSolution frame = SolveFrame(body, c, guess);
   EXPECT_TRUE(frame.ok);
   Evaluation e;
-  body.ElasticForce(test::Lvalue(body.Evaluate(c, frame)), &e.f, nullptr);
-  e.energy = body.ElasticEnergy(test::Lvalue(body.Evaluate(c, frame)));
+  ElasticForce(body, test::Lvalue(Evaluate(body, c, frame)), &e.f, nullptr);
+  e.energy = ElasticEnergy(body, test::Lvalue(Evaluate(body, c, frame)));
   return e;
 }
 
 void CheckAgainstFiniteDifferences(const Superelement& se, const SuperelementOptions& options, double size) {
   const SuperelementBody body(se, options);
   const BodyConfiguration c = Deformed(body, size, 42);
-  const FrameSolution frame = body.SolveFrame(c, body.GuessFrame(c));
+  const FrameSolution frame = SolveFrame(body, c, GuessFrame(body, c));
   ASSERT_TRUE(frame.ok);
   Eigen::VectorXd f;
   Eigen::MatrixXd K;
-  body.ElasticForce(test::Lvalue(body.Evaluate(c, frame)), &f, &K);
+  ElasticForce(body, test::Lvalue(Evaluate(body, c, frame)), &f, &K);
   const int n = body.n_coordinates();
   Eigen::MatrixXd K_fd(n, n);
   Eigen::VectorXd f_fd(n);
@@ -104,8 +104,8 @@ void CheckAgainstFiniteDifferences(const Superelement& se, const SuperelementOpt
       extent = std::max(extent, (node.position - se.mass_properties.center_of_mass).norm());
     const double h = (i < se.n_interface_dofs() ? 1e-6 : 1e-6 * extent * std::sqrt(se.mass_properties.mass)) /
                      std::max(1.0, se.floating_frame.Phi_CB.col(i).norm());
-    const Evaluation plus = Evaluate(body, Perturb(c, e, h), frame);
-    const Evaluation minus = Evaluate(body, Perturb(c, e, -h), frame);
+    const Evaluation plus = ElasticAt(body, Perturb(c, e, h), frame);
+    const Evaluation minus = ElasticAt(body, Perturb(c, e, -h), frame);
     K_fd.col(i) = (plus.f - minus.f) / (2 * h);
     f_fd[i] = (plus.energy - minus.energy) / (2 * h);
   }
@@ -156,10 +156,10 @@ TEST(SuperelementBody, PolynomialInternalForceTangentMatchesFiniteDifferences) {
   linear.polynomial_force = false;
   const SuperelementBody with(se, {}), without(se, linear);
   const BodyConfiguration c = Deformed(with, 0.05, 3);
-  const FrameSolution frame = with.SolveFrame(c, with.GuessFrame(c));
+  const FrameSolution frame = SolveFrame(with, c, GuessFrame(with, c));
   Eigen::VectorXd f1, f2;
-  with.ElasticForce(test::Lvalue(with.Evaluate(c, frame)), &f1, nullptr);
-  without.ElasticForce(test::Lvalue(without.Evaluate(c, frame)), &f2, nullptr);
+  ElasticForce(with, test::Lvalue(Evaluate(with, c, frame)), &f1, nullptr);
+  ElasticForce(without, test::Lvalue(Evaluate(without, c, frame)), &f2, nullptr);
   EXPECT_GT((f1 - f2).norm(), 1e-3 * f2.norm());
 }
 
@@ -167,10 +167,10 @@ TEST(SuperelementBody, TangentIsSymmetricAtEquilibriumFreeConfiguration) {
   // The exact force is a gradient, so its derivative (a Hessian) is symmetric everywhere.
   const SuperelementBody body(Rod("center_of_mass"), {false, true});
   const BodyConfiguration c = Deformed(body, 0.2, 7);
-  const FrameSolution frame = body.SolveFrame(c, body.GuessFrame(c));
+  const FrameSolution frame = SolveFrame(body, c, GuessFrame(body, c));
   Eigen::VectorXd f;
   Eigen::MatrixXd K;
-  body.ElasticForce(test::Lvalue(body.Evaluate(c, frame)), &f, &K);
+  ElasticForce(body, test::Lvalue(Evaluate(body, c, frame)), &f, &K);
   // A Hessian on SO(3) with spatial variations is symmetric up to the term (f_moment x) — the
   // asymmetric part is bounded by the moments: check it is small relative to K.
   EXPECT_LT((K - K.transpose()).norm(), 1e-3 * K.norm());
@@ -179,9 +179,9 @@ TEST(SuperelementBody, TangentIsSymmetricAtEquilibriumFreeConfiguration) {
 TEST(SuperelementBody, RigidMotionsAreForceFreeAndForcesRotateWithTheBody) {
   const Superelement se = Rod("center_of_mass");
   const SuperelementBody body(se, {false, true});
-  BodyConfiguration c0 = body.InitialConfiguration();
+  BodyConfiguration c0 = InitialConfiguration(body);
   Eigen::VectorXd f;
-  body.ElasticForce(test::Lvalue(body.Evaluate(c0, body.SolveFrame(c0, body.InitialFrame()))), &f, nullptr);
+  ElasticForce(body, test::Lvalue(Evaluate(body, c0, SolveFrame(body, c0, body.InitialFrame()))), &f, nullptr);
   EXPECT_LT(f.norm(), 1e-12);
   // Rigid motion of the undeformed body: still no force; frame follows.
   const Eigen::Matrix3d Rr = ExpSO3(Eigen::Vector3d(2.0, -0.5, 1.0));
@@ -191,9 +191,9 @@ TEST(SuperelementBody, RigidMotionsAreForceFreeAndForcesRotateWithTheBody) {
     moved.x[k] = Rr * c0.x[k] + t;
     moved.R[k] = Rr * c0.R[k];
   }
-  const FrameSolution frame = body.SolveFrame(moved, body.GuessFrame(moved));
+  const FrameSolution frame = SolveFrame(body, moved, GuessFrame(body, moved));
   ASSERT_TRUE(frame.ok);
-  body.ElasticForce(test::Lvalue(body.Evaluate(moved, frame)), &f, nullptr);
+  ElasticForce(body, test::Lvalue(Evaluate(body, moved, frame)), &f, nullptr);
   EXPECT_LT(f.norm(), 1e-14 * se.K.cwiseAbs().maxCoeff());  // round-off of positions ~3 m
   EXPECT_LT((frame.R - Rr).norm(), 1e-12);
   EXPECT_LT((frame.x - (Rr * body.InitialFrame().x + t)).norm(), 1e-12);
@@ -205,12 +205,12 @@ TEST(SuperelementBody, RigidMotionsAreForceFreeAndForcesRotateWithTheBody) {
     dm.R[k] = Rr * d.R[k];
   }
   Eigen::VectorXd fd, fdm;
-  const FrameSolution a = body.SolveFrame(d, body.GuessFrame(d)), b = body.SolveFrame(dm, body.GuessFrame(dm));
-  body.ElasticForce(test::Lvalue(body.Evaluate(d, a)), &fd, nullptr);
-  body.ElasticForce(test::Lvalue(body.Evaluate(dm, b)), &fdm, nullptr);
-  EXPECT_NEAR(body.ElasticEnergy(test::Lvalue(body.Evaluate(d, a))),
-              body.ElasticEnergy(test::Lvalue(body.Evaluate(dm, b))),
-              1e-10 * body.ElasticEnergy(test::Lvalue(body.Evaluate(d, a))));
+  const FrameSolution a = SolveFrame(body, d, GuessFrame(body, d)), b = SolveFrame(body, dm, GuessFrame(body, dm));
+  ElasticForce(body, test::Lvalue(Evaluate(body, d, a)), &fd, nullptr);
+  ElasticForce(body, test::Lvalue(Evaluate(body, dm, b)), &fdm, nullptr);
+  EXPECT_NEAR(ElasticEnergy(body, test::Lvalue(Evaluate(body, d, a))),
+              ElasticEnergy(body, test::Lvalue(Evaluate(body, dm, b))),
+              1e-10 * ElasticEnergy(body, test::Lvalue(Evaluate(body, d, a))));
   for (int k = 0; k < 2 * body.n_nodes(); ++k) {
     EXPECT_LT((Rr * fd.segment<3>(3 * k) - fdm.segment<3>(3 * k)).norm(), 1e-9 * fd.norm());
   }
@@ -230,10 +230,10 @@ TEST(SuperelementBody, SmallDeformationsReproduceTheReducedStiffness) {
   const Superelement se = Rod("center_of_mass");
   const Eigen::Matrix3d Rp = ExpSO3(Eigen::Vector3d(0.3, 0.2, -0.4));
   const SuperelementBody body(se, {false, true}, Rp, Eigen::Vector3d(1, 0, 0));
-  const BodyConfiguration c = body.InitialConfiguration();
+  const BodyConfiguration c = InitialConfiguration(body);
   Eigen::MatrixXd Kt;
   Eigen::VectorXd f;
-  body.ElasticForce(test::Lvalue(body.Evaluate(c, body.SolveFrame(c, body.InitialFrame()))), &f, &Kt);
+  ElasticForce(body, test::Lvalue(Evaluate(body, c, SolveFrame(body, c, body.InitialFrame()))), &f, &Kt);
   const int n = body.n_coordinates();
   Eigen::MatrixXd Rbar = Eigen::MatrixXd::Identity(n, n);
   for (int a = 0; a < 2 * body.n_nodes(); ++a) Rbar.block<3, 3>(3 * a, 3 * a) = Rp;
@@ -246,7 +246,7 @@ TEST(SuperelementBody, GyroscopicMatrixMatchesFiniteDifferencesAndMassIsPtMP) {
     options.cardona_option_b = option_b;
     const SuperelementBody body(Tee(), options);
     const BodyConfiguration c = Deformed(body, 0.2, 11);
-    const FrameSolution frame = body.SolveFrame(c, body.GuessFrame(c));
+    const FrameSolution frame = SolveFrame(body, c, GuessFrame(body, c));
     ASSERT_TRUE(frame.ok);
     std::mt19937 rng(5);
     std::uniform_real_distribution<double> u(-1.0, 1.0);
@@ -258,27 +258,27 @@ TEST(SuperelementBody, GyroscopicMatrixMatchesFiniteDifferencesAndMassIsPtMP) {
     }
     Eigen::VectorXd f;
     Eigen::MatrixXd Mg, C;
-    body.InertiaForce(test::Lvalue(body.Evaluate(c, frame)), w, wdot, &f, &Mg, &C);
+    InertiaForce(body, test::Lvalue(Evaluate(body, c, frame)), w, wdot, &f, &Mg, &C);
     Eigen::MatrixXd C_fd(n, n), M_fd(n, n);
     for (int i = 0; i < n; ++i) {
       const double h = 1e-6;
       Eigen::VectorXd fp, fm;
-      body.InertiaForce(test::Lvalue(body.Evaluate(c, frame)), w + h * Eigen::VectorXd::Unit(n, i), wdot, &fp, nullptr,
-                        nullptr);
-      body.InertiaForce(test::Lvalue(body.Evaluate(c, frame)), w - h * Eigen::VectorXd::Unit(n, i), wdot, &fm, nullptr,
-                        nullptr);
+      InertiaForce(body, test::Lvalue(Evaluate(body, c, frame)), w + h * Eigen::VectorXd::Unit(n, i), wdot, &fp,
+                   nullptr, nullptr);
+      InertiaForce(body, test::Lvalue(Evaluate(body, c, frame)), w - h * Eigen::VectorXd::Unit(n, i), wdot, &fm,
+                   nullptr, nullptr);
       C_fd.col(i) = (fp - fm) / (2 * h);
-      body.InertiaForce(test::Lvalue(body.Evaluate(c, frame)), w, wdot + h * Eigen::VectorXd::Unit(n, i), &fp, nullptr,
-                        nullptr);
-      body.InertiaForce(test::Lvalue(body.Evaluate(c, frame)), w, wdot - h * Eigen::VectorXd::Unit(n, i), &fm, nullptr,
-                        nullptr);
+      InertiaForce(body, test::Lvalue(Evaluate(body, c, frame)), w, wdot + h * Eigen::VectorXd::Unit(n, i), &fp,
+                   nullptr, nullptr);
+      InertiaForce(body, test::Lvalue(Evaluate(body, c, frame)), w, wdot - h * Eigen::VectorXd::Unit(n, i), &fm,
+                   nullptr, nullptr);
       M_fd.col(i) = (fp - fm) / (2 * h);
     }
     EXPECT_LT((C - C_fd).norm(), 1e-6 * C.norm()) << "option B " << option_b;
     EXPECT_LT((Mg - M_fd).norm(), 1e-6 * Mg.norm());
     EXPECT_GT(C.norm(), 0.0);
     // The kinetic energy is w^T M_g w / 2.
-    EXPECT_NEAR(body.KineticEnergy(test::Lvalue(body.Evaluate(c, frame)), w), 0.5 * w.dot(Mg * w),
+    EXPECT_NEAR(KineticEnergy(body, test::Lvalue(Evaluate(body, c, frame)), w), 0.5 * w.dot(Mg * w),
                 1e-12 * w.dot(Mg * w));
   }
 }
@@ -293,7 +293,7 @@ TEST(SuperelementBody, MomentumDerivativesMatchFiniteDifferences) {
     options.exact_inertia = false;  // the corotational inertia's momentum (thesis 3.22) is what is checked
     const SuperelementBody body(Tee(), options);
     const BodyConfiguration c = Deformed(body, 0.1, 5);
-    const FrameSolution frame = body.SolveFrame(c, body.GuessFrame(c));
+    const FrameSolution frame = SolveFrame(body, c, GuessFrame(body, c));
     const int n = body.n_coordinates();
     std::mt19937 rng(3);
     const Eigen::VectorXd w = Uniform(n, rng);
@@ -303,8 +303,8 @@ TEST(SuperelementBody, MomentumDerivativesMatchFiniteDifferences) {
     for (int i = 0; i < n; ++i) {
       const Eigen::VectorXd e = Eigen::VectorXd::Unit(n, i);
       const BodyConfiguration cp = Perturb(c, e, eps), cm = Perturb(c, e, -eps);
-      fd.col(i) = (test::MapsAt(body, cp, body.SolveFrame(cp, frame)).Mg * w -
-                   test::MapsAt(body, cm, body.SolveFrame(cm, frame)).Mg * w) /
+      fd.col(i) = (test::MapsAt(body, cp, SolveFrame(body, cp, frame)).Mg * w -
+                   test::MapsAt(body, cm, SolveFrame(body, cm, frame)).Mg * w) /
                   (2 * eps);
     }
     EXPECT_LT((D - fd).norm(), 1e-6 * fd.norm()) << (option_b ? "option B" : "option A");
@@ -315,7 +315,7 @@ TEST(SuperelementBody, MomentumDerivativesMatchFiniteDifferences) {
     Eigen::MatrixXd d_w, d_p, fd_w(n, n), fd_p(n, n);
     const BodyVelocityMaps maps = test::MapsAt(body, c, frame);
     BodyScratch scratch;
-    body.MomentumSourceDerivatives(test::MapsAt(body, c, frame), w, p, d_w, d_p, scratch);
+    MomentumSourceDerivatives(body, test::MapsAt(body, c, frame), w, p, d_w, d_p, scratch);
     for (int i = 0; i < n; ++i) {
       const Eigen::VectorXd e = Eigen::VectorXd::Unit(n, i);
       fd_w.col(i) = (test::MomentumSourceOf(body, maps, w + e, p) - test::MomentumSourceOf(body, maps, w - e, p)) / 2.0;
@@ -331,16 +331,16 @@ TEST(SuperelementBody, MomentumDerivativesMatchFiniteDifferences) {
     const Eigen::VectorXd zero = Eigen::VectorXd::Zero(n);
     for (bool full : {false, true}) {
       const Eigen::MatrixXd K_in =
-          test::InertiaConfigurationTangentOf(body, body.Evaluate(c, frame), full ? w : zero, wdot, full);
+          test::InertiaConfigurationTangentOf(body, Evaluate(body, c, frame), full ? w : zero, wdot, full);
       Eigen::MatrixXd fd_in(n, n);
       for (int i = 0; i < n; ++i) {
         const Eigen::VectorXd e = Eigen::VectorXd::Unit(n, i);
         const BodyConfiguration cp = Perturb(c, e, eps), cm = Perturb(c, e, -eps);
         Eigen::VectorXd fp, fm;
-        body.InertiaForce(test::Lvalue(body.Evaluate(cp, body.SolveFrame(cp, frame))), full ? w : zero, wdot, &fp,
-                          nullptr, nullptr);
-        body.InertiaForce(test::Lvalue(body.Evaluate(cm, body.SolveFrame(cm, frame))), full ? w : zero, wdot, &fm,
-                          nullptr, nullptr);
+        InertiaForce(body, test::Lvalue(Evaluate(body, cp, SolveFrame(body, cp, frame))), full ? w : zero, wdot, &fp,
+                     nullptr, nullptr);
+        InertiaForce(body, test::Lvalue(Evaluate(body, cm, SolveFrame(body, cm, frame))), full ? w : zero, wdot, &fm,
+                     nullptr, nullptr);
         fd_in.col(i) = (fp - fm) / (2 * eps);
       }
       EXPECT_LT((K_in - fd_in).norm(), 1e-5 * fd_in.norm())
@@ -357,22 +357,22 @@ TEST(SuperelementBody, ExactMomentumConfigurationTangentMatchesFiniteDifferences
   const SuperelementBody body(Tee(), SuperelementOptions{});
   ASSERT_TRUE(body.has_exact_inertia());
   const BodyConfiguration c = Deformed(body, 0.1, 5);
-  const FrameSolution frame = body.SolveFrame(c, body.GuessFrame(c));
+  const FrameSolution frame = SolveFrame(body, c, GuessFrame(body, c));
   const int n = body.n_coordinates();
   std::mt19937 rng(3);
   const Eigen::VectorXd w = Uniform(n, rng);
-  SuperelementBody::Data d = body.Evaluate(c, frame);
-  SuperelementBody::Data side;
+  BodyData d = Evaluate(body, c, frame);
+  BodyData side;
   Eigen::MatrixXd D;
-  body.MomentumConfigurationTangent(d, w, side, D);
+  MomentumConfigurationTangent(body, d, w, side, D);
   Eigen::MatrixXd fd(n, n);
   const double eps = 1e-6;
   for (int i = 0; i < n; ++i) {
     const Eigen::VectorXd e = Eigen::VectorXd::Unit(n, i);
     const BodyConfiguration cp = Perturb(c, e, eps), cm = Perturb(c, e, -eps);
-    SuperelementBody::Data dp = body.Evaluate(cp, body.SolveFrame(cp, frame));
-    SuperelementBody::Data dm = body.Evaluate(cm, body.SolveFrame(cm, frame));
-    fd.col(i) = (body.MassTimes(dp, w) - body.MassTimes(dm, w)) / (2 * eps);
+    BodyData dp = Evaluate(body, cp, SolveFrame(body, cp, frame));
+    BodyData dm = Evaluate(body, cm, SolveFrame(body, cm, frame));
+    fd.col(i) = (MassTimes(body, dp, w) - MassTimes(body, dm, w)) / (2 * eps);
   }
   std::printf("[ info ] exact momentum's configuration tangent against differences: %.2e\n",
               (D - fd).norm() / fd.norm());
@@ -414,7 +414,8 @@ TEST(SuperelementBody, InertiaForceIsTheLagrangianDerivativeAlongAMotion) {
     };
     auto energy = [&](double t) {
       const BodyConfiguration c = config(t);
-      return body.KineticEnergy(test::Lvalue(body.Evaluate(c, body.SolveFrame(c, body.GuessFrame(c)))), velocity(t));
+      return KineticEnergy(body, test::Lvalue(Evaluate(body, c, SolveFrame(body, c, GuessFrame(body, c)))),
+                           velocity(t));
     };
     const double t = 0.01, dt = 1e-4;
     const double power_fd = (energy(t + dt) - energy(t - dt)) / (2 * dt);
@@ -422,22 +423,22 @@ TEST(SuperelementBody, InertiaForceIsTheLagrangianDerivativeAlongAMotion) {
     const Eigen::VectorXd w = velocity(t);
     const Eigen::VectorXd wdot = (velocity(t + dt) - velocity(t - dt)) / (2 * dt);
     Eigen::VectorXd f_in;
-    body.InertiaForce(test::Lvalue(body.Evaluate(c, body.SolveFrame(c, body.GuessFrame(c)))), w, wdot, &f_in, nullptr,
-                      nullptr);
+    InertiaForce(body, test::Lvalue(Evaluate(body, c, SolveFrame(body, c, GuessFrame(body, c)))), w, wdot, &f_in,
+                 nullptr, nullptr);
     EXPECT_NEAR(w.dot(f_in), power_fd, 1e-5 * std::abs(power_fd)) << (exact ? "exact" : "corotational");
     if (exact) {
       // The exact inertia's momentum form (the midpoint scheme with the exact inertia):
       // p = MassTimes (dT/dw), s = MomentumSource at the body's data, with its local term.
       auto momentum_exact = [&](double time) {
         const BodyConfiguration ct = config(time);
-        SuperelementBody::Data data = body.Evaluate(ct, body.SolveFrame(ct, body.GuessFrame(ct)));
-        return Eigen::VectorXd(body.MassTimes(data, velocity(time)));
+        BodyData data = Evaluate(body, ct, SolveFrame(body, ct, GuessFrame(body, ct)));
+        return Eigen::VectorXd(MassTimes(body, data, velocity(time)));
       };
       const Eigen::VectorXd pdot_exact = (momentum_exact(t + dt) - momentum_exact(t - dt)) / (2 * dt);
-      SuperelementBody::Data d = body.Evaluate(c, body.SolveFrame(c, body.GuessFrame(c)));
-      const Eigen::VectorXd p = body.MassTimes(d, w);
+      BodyData d = Evaluate(body, c, SolveFrame(body, c, GuessFrame(body, c)));
+      const Eigen::VectorXd p = MassTimes(body, d, w);
       Eigen::VectorXd source;
-      body.MomentumSource(d, w, p, source);
+      MomentumSource(body, d, w, p, source);
       const Eigen::VectorXd balance = pdot_exact - source;
       std::printf("[ info ] exact inertia: momentum form against f_in %.2e (relative)\n",
                   (balance - f_in).norm() / f_in.norm());
@@ -450,10 +451,10 @@ TEST(SuperelementBody, InertiaForceIsTheLagrangianDerivativeAlongAMotion) {
     // s = MomentumSource; dp/dt by central differences along the same motion.
     auto momentum = [&](double time) -> Eigen::VectorXd {
       const BodyConfiguration ct = config(time);
-      return test::MapsAt(body, ct, body.SolveFrame(ct, body.GuessFrame(ct))).Mg * velocity(time);
+      return test::MapsAt(body, ct, SolveFrame(body, ct, GuessFrame(body, ct))).Mg * velocity(time);
     };
     const Eigen::VectorXd pdot = (momentum(t + dt) - momentum(t - dt)) / (2 * dt);
-    const FrameSolution frame = body.SolveFrame(c, body.GuessFrame(c));
+    const FrameSolution frame = SolveFrame(body, c, GuessFrame(body, c));
     const BodyVelocityMaps maps = test::MapsAt(body, c, frame);
     const Eigen::VectorXd balance = pdot - test::MomentumSourceOf(body, maps, w, maps.Mg * w);
     EXPECT_LT((balance - f_in).norm(), 1e-5 * f_in.norm())

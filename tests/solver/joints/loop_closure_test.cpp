@@ -340,8 +340,8 @@ Swing SwingUnderGravity(double h, bool open = false) {
     double V = 0.0;
     for (size_t b = 0; b < model.bodies.size(); ++b) {
       const SuperelementBody& body = model.bodies[b];
-      V -= body.mass() * model.gravity.dot(body.CenterOfMass(
-                             body.Evaluate(BodyConfigurationOf(model, st.config, int(b)), st.config.frames[b]).q,
+      V -= body.mass() * model.gravity.dot(CenterOfMass(
+                             body, Evaluate(body, BodyConfigurationOf(model, st.config, int(b)), st.config.frames[b]).q,
                              st.config.frames[b]));
     }
     if (first) E0 = rep.kinetic_energy + V;
