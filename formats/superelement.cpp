@@ -52,19 +52,22 @@ std::string ReducedCoordinateLabel(const Superelement& se, int i) {
   return buffer;
 }
 
+Eigen::Matrix<double, 6, 6> NodeRigidBodyModes(const Eigen::Vector3d& x) {
+  // thesis (3.12): [1, -x~; 0, 1] with x the node position relative to the frame origin.
+  Eigen::Matrix<double, 6, 6> block = Eigen::Matrix<double, 6, 6>::Identity();
+  block(0, 4) = x.z();
+  block(0, 5) = -x.y();
+  block(1, 3) = -x.z();
+  block(1, 5) = x.x();
+  block(2, 3) = x.y();
+  block(2, 4) = -x.x();
+  return block;
+}
+
 Eigen::MatrixXd RigidBodyModes(const Superelement& se, const Eigen::Vector3d& origin) {
   Eigen::MatrixXd Phi_rig0 = Eigen::MatrixXd::Zero(se.n_reduced_dofs(), 6);
   for (int k = 0; k < se.n_interface_nodes(); ++k) {
-    // thesis (3.12): [1, -x~; 0, 1] with x the node position relative to the frame origin.
-    const Eigen::Vector3d x = se.interfaces[k].position - origin;
-    auto block = Phi_rig0.block(6 * k, 0, 6, 6);
-    block.setIdentity();
-    block(0, 4) = x.z();
-    block(0, 5) = -x.y();
-    block(1, 3) = -x.z();
-    block(1, 5) = x.x();
-    block(2, 3) = x.y();
-    block(2, 4) = -x.x();
+    Phi_rig0.block(6 * k, 0, 6, 6) = NodeRigidBodyModes(se.interfaces[k].position - origin);
   }
   return Phi_rig0;
 }

@@ -197,6 +197,8 @@ std::string ReducedCoordinateLabel(const Superelement& se, int i);
 /// Rigid-body modes of the interface coordinates about `origin` (thesis 3.20):
 /// Phi_rig0 (n_reduced x 6), rows of the internal modes zero.
 Eigen::MatrixXd RigidBodyModes(const Superelement& se, const Eigen::Vector3d& origin);
+/// One node's block of them, [1, -x~; 0, 1] for the node at x from the origin (thesis 3.12).
+Eigen::Matrix<double, 6, 6> NodeRigidBodyModes(const Eigen::Vector3d& x);
 
 }  // namespace femb
 

@@ -1,4 +1,5 @@
-// The superelement body model from its file: the matrices, invariants and constants the kernels read.
+// The body model from a superelement file or a rigid body's inertia: the matrices, invariants and
+// constants the kernels read.
 #include "solver/body/body_model.h"
 
 #include <Eigen/Dense>
@@ -40,31 +41,7 @@ SuperelementBody::SuperelementBody(const Superelement& se, const SuperelementOpt
     R0_.push_back(node.orientation);
   }
   Phi_rig0_ = RigidBodyModes(se, se.floating_frame.origin);
-  {
-    // CenterOfMass's constants. Phi_rig0^T M Phi_rig0 = [m 1, -s~; s~, J]: the first moment s
-    // from its (translation, rotation) block -s~ (entry (b, 3 + a) = e_b . (e_a x s)).
-    const Eigen::MatrixXd MPhi = M_ * Phi_rig0_;
-    const Eigen::Matrix<double, 6, 6> M_rig = Phi_rig0_.transpose() * MPhi;
-    mass_ = M_rig(0, 0);
-    first_moment0_ = Eigen::Vector3d(-M_rig(2, 4), -M_rig(0, 5), -M_rig(1, 3));
-    first_moment_map_ = MPhi.leftCols<3>().transpose();
-  }
-  T0_ = Eigen::MatrixXd::Identity(n_coordinates(), n_coordinates()) - Phi_rig0_ * Phi_CB_;
-  double size = 0.0;
-  for (const Eigen::Vector3d& X : X_) size = std::max(size, X.norm());
-  // Force units in any unit system (ForceNorm): moments over a length of the body (its size, or
-  // for a one-node body its radius of gyration), modal forces times sqrt(mass).
-  const double mass = (Phi_rig0_.col(0).transpose() * M_ * Phi_rig0_.col(0))(0, 0);
-  const Eigen::Matrix<double, 6, 6> M_rig = Phi_rig0_.transpose() * M_ * Phi_rig0_;
-  const double gyration = mass > 0 ? std::sqrt(M_rig.bottomRightCorner<3, 3>().diagonal().maxCoeff() / mass) : 0.0;
-  const double length = size > 0 ? size : (gyration > 0 ? gyration : 1.0);
-  force_weights_ = Eigen::VectorXd::Ones(n_coordinates());
-  for (int k = 0; k < n_nodes_; ++k) force_weights_.segment<3>(6 * k + 3).setConstant(1.0 / length);
-  modal_weight_ = std::sqrt(std::max(mass, 0.0));
-  force_weights_.tail(n_modes_).setConstant(modal_weight_);
-  k_max_ = (force_weights_.asDiagonal() * K_ * force_weights_.asDiagonal()).cwiseAbs().maxCoeff();
-  m_max_ = (force_weights_.asDiagonal() * M_ * force_weights_.asDiagonal()).cwiseAbs().maxCoeff();
-  force_floor_ = 1e-4 * k_max_ * length;
+  DeriveConstants();
   // A file's polynomial is the modal derivatives' cubic force (option polynomial_force) or,
   // without derivatives, the geometric stiffening's quadratic force (option geometric_stiffening).
   if (se.polynomial && (se.polynomial->cubic() ? options_.polynomial_force : options_.geometric_stiffening)) {
@@ -98,6 +75,56 @@ SuperelementBody::SuperelementBody(const Superelement& se, const SuperelementOpt
       }
     PtM_ = Phi_rig0_.transpose() * M_;
   }
+}
+
+SuperelementBody SuperelementBody::Rigid(const MassProperties& p, const Eigen::Matrix3d& placement_R,
+                                         const Eigen::Vector3d& placement_x) {
+  SuperelementBody body;
+  body.kind_ = BodyKind::kRigid;
+  body.n_nodes_ = 1;
+  body.n_modes_ = 0;
+  body.K_ = Eigen::MatrixXd::Zero(6, 6);
+  body.M_ = Eigen::MatrixXd::Zero(6, 6);
+  body.M_.topLeftCorner(3, 3) = p.mass * Eigen::Matrix3d::Identity();
+  body.M_.bottomRightCorner(3, 3) = p.inertia_com;
+  body.Phi_CB_ = Eigen::MatrixXd::Identity(6, 6);  // the frame is the node's
+  body.C_ = Eigen::MatrixXd(0, 6);
+  body.placement_R_ = placement_R;
+  body.placement_x_ = placement_x;
+  body.origin_part_ = p.center_of_mass;
+  body.X_ = {Eigen::Vector3d::Zero()};
+  body.R0_ = {Eigen::Matrix3d::Identity()};
+  body.Phi_rig0_ = NodeRigidBodyModes(Eigen::Vector3d::Zero());  // the node at the frame origin
+  body.DeriveConstants();
+  return body;
+}
+
+void SuperelementBody::DeriveConstants() {
+  {
+    // CenterOfMass's constants. Phi_rig0^T M Phi_rig0 = [m 1, -s~; s~, J]: the first moment s
+    // from its (translation, rotation) block -s~ (entry (b, 3 + a) = e_b . (e_a x s)).
+    const Eigen::MatrixXd MPhi = M_ * Phi_rig0_;
+    const Eigen::Matrix<double, 6, 6> M_rig = Phi_rig0_.transpose() * MPhi;
+    mass_ = M_rig(0, 0);
+    first_moment0_ = Eigen::Vector3d(-M_rig(2, 4), -M_rig(0, 5), -M_rig(1, 3));
+    first_moment_map_ = MPhi.leftCols<3>().transpose();
+  }
+  T0_ = Eigen::MatrixXd::Identity(n_coordinates(), n_coordinates()) - Phi_rig0_ * Phi_CB_;
+  double size = 0.0;
+  for (const Eigen::Vector3d& X : X_) size = std::max(size, X.norm());
+  // Force units in any unit system (ForceNorm): moments over a length of the body (its size, or
+  // for a one-node body its radius of gyration), modal forces times sqrt(mass).
+  const double mass = (Phi_rig0_.col(0).transpose() * M_ * Phi_rig0_.col(0))(0, 0);
+  const Eigen::Matrix<double, 6, 6> M_rig = Phi_rig0_.transpose() * M_ * Phi_rig0_;
+  const double gyration = mass > 0 ? std::sqrt(M_rig.bottomRightCorner<3, 3>().diagonal().maxCoeff() / mass) : 0.0;
+  const double length = size > 0 ? size : (gyration > 0 ? gyration : 1.0);
+  force_weights_ = Eigen::VectorXd::Ones(n_coordinates());
+  for (int k = 0; k < n_nodes_; ++k) force_weights_.segment<3>(6 * k + 3).setConstant(1.0 / length);
+  modal_weight_ = std::sqrt(std::max(mass, 0.0));
+  force_weights_.tail(n_modes_).setConstant(modal_weight_);
+  k_max_ = (force_weights_.asDiagonal() * K_ * force_weights_.asDiagonal()).cwiseAbs().maxCoeff();
+  m_max_ = (force_weights_.asDiagonal() * M_ * force_weights_.asDiagonal()).cwiseAbs().maxCoeff();
+  force_floor_ = 1e-4 * k_max_ * length;
   initial_frame_.x = placement_x_ + placement_R_ * origin_part_;
   initial_frame_.R = placement_R_;
   initial_frame_.ok = true;

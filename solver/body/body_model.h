@@ -157,15 +157,26 @@ struct LocalMotion {
   Eigen::VectorXd qdot, qddot;
 };
 
-/// Immutable model of one superelement (from its file) plus its placement in the scene. The
-/// kernels read its data members; nothing changes them after the constructor (the system model
-/// holds it const).
+/// What a body is: a superelement from its file, or a rigid body given by its mass, centre of
+/// mass and inertia.
+enum class BodyKind { kSuperelement, kRigid };
+
+/// Immutable model of one body (a superelement from its file, or a rigid body) plus its placement
+/// in the scene. The kernels read its data members; nothing changes them after the constructor
+/// (the system model holds it const).
 class SuperelementBody {
  public:
   /// `placement_R`, `placement_x` map part coordinates to global ones (x = p + R_p X).
   SuperelementBody(const Superelement& se, const SuperelementOptions& options,
                    const Eigen::Matrix3d& placement_R = Eigen::Matrix3d::Identity(),
                    const Eigen::Vector3d& placement_x = Eigen::Vector3d::Zero());
+  /// A rigid body: one node at the centre of mass (its own frame: Phi_CB = 1) carrying the 6 x 6
+  /// mass [m 1, 0; 0, J_com] in body axes, no stiffness, no modes. Body axes are the part axes of
+  /// `p` placed by `placement_R`, `placement_x`.
+  static SuperelementBody Rigid(const MassProperties& p, const Eigen::Matrix3d& placement_R,
+                                const Eigen::Vector3d& placement_x);
+
+  BodyKind kind() const { return kind_; }
 
   int n_nodes() const { return n_nodes_; }
   int n_modes() const { return n_modes_; }
@@ -203,6 +214,7 @@ class SuperelementBody {
   double mass() const { return mass_; }
 
   // The model's data (set by the constructor, read by the kernels).
+  BodyKind kind_ = BodyKind::kSuperelement;
   Eigen::MatrixXd Phi_rig0_;
   // CenterOfMass: the mass m, the undeformed first moment s_0 about the frame origin, and C.
   double mass_ = 0.0;
@@ -231,6 +243,12 @@ class SuperelementBody {
   double m_max_ = 0.0;             ///< max|D M D|: force per acceleration
   Eigen::VectorXd force_weights_;  ///< see ForceNorm
   double modal_weight_ = 1.0;
+
+ private:
+  SuperelementBody() = default;  // (Rigid)
+  // The constants derived from the matrices, the nodes and the placement: mass and first moment,
+  // T0, the force weights and floor, the initial frame.
+  void DeriveConstants();
 };
 
 }  // namespace femb

@@ -20,7 +20,6 @@
 namespace femb {
 
 namespace {
-Units UnitSystemOf(const std::string& name) { return UnitSystem(name, "units"); }
 
 // Node k's first joint coordinate follows the time function f (value, rate, acceleration).
 SystemModel::Prescribed PrescribedBy(const TimeFunctionSpec& f, int k) {
@@ -104,21 +103,9 @@ struct Placement {
 // A rigid body: one node at the centre of mass carrying the 6 x 6 rigid mass, no stiffness; its
 // attachment points are rigid offsets (dependent nodes) of that node. `b` placed relative to the
 // scene's origin.
-void AddRigidBody(const SceneSpec& spec, const SceneBodySpec& b, Scene& scene, Placement& placement) {
+void AddRigidBody(const SceneBodySpec& b, Scene& scene, Placement& placement) {
   SystemModel& model = scene.model;
   auto& placed = placement.placed;
-  Superelement se;
-  se.name = b.name;
-  se.units = UnitSystemOf(spec.units);
-  se.interfaces.push_back({"com", b.center_of_mass, Eigen::Matrix3d::Identity()});
-  se.K = Eigen::MatrixXd::Zero(6, 6);
-  se.M = Eigen::MatrixXd::Zero(6, 6);
-  se.M.topLeftCorner(3, 3) = b.mass * Eigen::Matrix3d::Identity();
-  se.M.bottomRightCorner(3, 3) = b.inertia;
-  se.floating_frame.type = "interface:com";
-  se.floating_frame.origin = b.center_of_mass;
-  se.floating_frame.Phi_CB = Eigen::MatrixXd::Identity(6, 6);
-  se.mass_properties = {b.mass, b.center_of_mass, b.inertia};
   const Eigen::Matrix3d R = ExpSO3(b.rotation);
   const std::string com_node = b.nodes.at("com");
   if (scene.node_index.count(com_node)) {
@@ -128,7 +115,7 @@ void AddRigidBody(const SceneSpec& spec, const SceneBodySpec& b, Scene& scene, P
   const int com = AddNode(model, com_node, b.position + R * b.center_of_mass, R);
   scene.node_index[com_node] = com;
   placed[com_node] = {model.node_x0[com], b.name};
-  model.bodies.emplace_back(se, SuperelementOptions{}, R, b.position);
+  model.bodies.push_back(SuperelementBody::Rigid({b.mass, b.center_of_mass, b.inertia}, R, b.position));
   model.body_nodes.push_back({com});
   scene.body_names.push_back(b.name);
   model.body_names.push_back(b.name);
@@ -556,7 +543,7 @@ Scene BuildScene(const SceneSpec& spec) {
     SceneBodySpec b = b_spec;
     b.position -= scene.origin;
     if (b.type == BodyType::kRigid) {
-      AddRigidBody(spec, b, scene, placement);
+      AddRigidBody(b, scene, placement);
     } else {
       AddSuperelementBody(spec, b, scene, placement);
     }
