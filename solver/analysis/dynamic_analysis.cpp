@@ -38,18 +38,17 @@ Assembly StartAssembly(const SystemModel& model, const DofMap& dofs, AssemblyPar
 
 void FinishAssembly(const SystemModel& model, const DofMap& dofs, const SystemState& config, double t,
                     const Eigen::VectorXd& W, bool matrices, AssemblyParts& parts, Assembly& out) {
-  // The scratch vectors of this thread (kept: an assembly allocates nothing once they have their size).
-  thread_local Eigen::VectorXd loads, springs, weights;
+  Eigen::VectorXd &loads = parts.loads, &springs = parts.springs, &weights = parts.weights;
   const int n = dofs.n_dofs();
   loads.setZero(n);
   AddNodeLoads(model, config, t, loads, matrices ? &parts.K : nullptr, &parts.node_forces);
   out.residual += loads;
   out.f_ext += loads;
   springs.setZero(n);
-  AddSpringDampers(model, config, W, springs, matrices ? &parts.K : nullptr, matrices ? &parts.C : nullptr, nullptr,
-                   &parts.node_forces);
+  AddSpringDampers(model, config, W, &springs, matrices ? &parts.K : nullptr, matrices ? &parts.C : nullptr, nullptr,
+                   &parts.node_forces, &parts.scratch);
   out.residual += springs;
-  if (matrices) AddJointGeometricStiffness(model, dofs, config, parts.node_forces, parts.K);
+  if (matrices) AddJointGeometricStiffness(model, dofs, config, parts.node_forces, parts.K, &parts.scratch);
   ResidualWeights(model, dofs, weights);
   const double applied = std::max((weights.asDiagonal() * springs).norm(), (weights.asDiagonal() * loads).norm());
   out.scale = std::max({out.scale, applied, 1e-300});
@@ -248,14 +247,12 @@ std::string UnresolvedModesWarning(const SystemModel& model, double h) {
 // body evaluated here.
 DynamicStepReport MeasureWith(const SystemModel& model, const DofMap& dofs, const DynamicState& s,
                               std::vector<BodyPass>* passes, BodyThreads* threads = nullptr,
-                              std::vector<BodyMeasure>* measures = nullptr) {
+                              std::vector<BodyMeasure>* measures = nullptr, SystemScratch* scratch = nullptr) {
   DynamicStepReport r;
   r.t = s.t;
   r.external_work = s.external_work;
   if (!model.springs.empty()) {
-    thread_local Eigen::VectorXd unused;  // (kept: a step allocates nothing)
-    unused.setZero(dofs.n_dofs());
-    AddSpringDampers(model, s.config, s.W, unused, nullptr, nullptr, &r.elastic_energy);  // spring energy
+    AddSpringDampers(model, s.config, s.W, nullptr, nullptr, nullptr, &r.elastic_energy, nullptr, scratch);  // springs
   }
   const int n_bodies = int(model.bodies.size());
   const auto measure = [&](int b, BodyData& data, const Eigen::VectorXd& w, BodyMeasure& m) {
@@ -578,7 +575,7 @@ class DynamicRun {
     if (cuts_ > 0 && first_cut_time_ < 0) first_cut_time_ = state_.t;
     state_ = next_;
     if (options_.adaptive && control_.at_breakpoint()) {
-      ApplyPrescribed(model_, dofs_, state_.t, state_.config, &state_.W, &state_.Wdot);
+      ApplyPrescribed(model_, dofs_, state_.t, state_.config, &state_.W, &state_.Wdot, &work_.parts.scratch);
       if (options_.integrator == Integrator::kGeneralizedAlpha) work_.a_n = state_.a - state_.Wdot;
       ConsistentAccelerations(model_, dofs_, state_);
       if (options_.integrator == Integrator::kGeneralizedAlpha) {
@@ -593,8 +590,8 @@ class DynamicRun {
 
   // The step's report: energies and momenta from the converged pass where the step kept it.
   DynamicStepReport Report(const StepOutcome& step, bool output) {
-    DynamicStepReport r =
-        MeasureWith(model_, dofs_, state_, step.passes_kept ? &work_.passes : nullptr, &threads_, &work_.measures);
+    DynamicStepReport r = MeasureWith(model_, dofs_, state_, step.passes_kept ? &work_.passes : nullptr, &threads_,
+                                      &work_.measures, &work_.parts.scratch);
     r.h = h_;
     r.iterations = step.iterations;
     r.rejected = result_.rejected_by_error + result_.newton_cuts;

@@ -5,8 +5,8 @@
 //
 // Storage: a step of either integrator allocates nothing once the first steps have
 // sized everything (tests/solver/analysis/allocation_free_test.cpp counts it). Everything a step or an iteration needs
-// lives in the BodyWorkspace (the midpoint scheme's in its MidpointWorkspace), in each body's Data (its scratch) or in
-// thread_local scratch of the joint-tree and force functions, and is written in place: no Eigen object
+// lives in the BodyWorkspace (the midpoint scheme's in its MidpointWorkspace; the system-level functions' scratch in
+// its parts, SystemScratch), in each body's BodyData (its scratch), and is written in place: no Eigen object
 // returned by value, no product of dynamic-size blocks assigned without noalias() or a fixed-size
 // holder, no std::function built per call (BodyTask), no std::optional reset that frees.
 #pragma once
@@ -47,10 +47,14 @@ inline bool ResidualSmall(const DofMap& dofs, const Assembly& a, const Eigen::Ve
   return r_norm <= a.roundoff || ScaledFreeNorm(dofs, a.residual, weights, a.dof_scale) <= tolerance;
 }
 
-// The triplets of an assembly in progress and the node forces for the joints' stiffness.
+// The triplets of an assembly in progress and the node forces for the joints' stiffness; the
+// loads' and springs' vectors and the weights of FinishAssembly, and the system-level functions'
+// scratch (storage kept: an assembly allocates nothing once they have their sizes).
 struct AssemblyParts {
   Triplets K, C, M;
   NodeForces node_forces;
+  Eigen::VectorXd loads, springs, weights;
+  SystemScratch scratch;
 };
 
 // Starts an assembly in `out` (residual and f_ext zero, parts emptied): storage reused.

@@ -168,7 +168,7 @@ SystemForces AssembleStatic(const SystemModel& model, const DofMap& dofs, System
   AddNodeLoads(model, state, lambda, loads, with_tangent ? &tangent : nullptr, &node_forces);
   loads += gravity;
   out.loads = loads;
-  AddSpringDampers(model, state, Eigen::VectorXd(), loads, with_tangent ? &tangent : nullptr, nullptr,
+  AddSpringDampers(model, state, Eigen::VectorXd(), &loads, with_tangent ? &tangent : nullptr, nullptr,
                    &out.elastic_energy, &node_forces);
   out.residual += loads;
   const double applied = (ResidualWeights(model, dofs).asDiagonal() * loads).norm();
@@ -209,11 +209,13 @@ void AddNodeLoads(const SystemModel& model, const SystemState& state, double t, 
 }
 
 void AddSpringDampers(const SystemModel& model, const SystemState& state, const Eigen::VectorXd& W,
-                      Eigen::VectorXd& residual, Triplets* K, Triplets* C, double* energy, NodeForces* node_forces) {
-  // This thread's scratch (kept: a time step allocates nothing once it has its sizes).
-  thread_local std::vector<MapEntry> map;  // the 6 translational components (a, b) -> coordinates
-  thread_local Eigen::VectorXd fv;
-  thread_local Eigen::MatrixXd Km, Cm;
+                      Eigen::VectorXd* residual, Triplets* K, Triplets* C, double* energy, NodeForces* node_forces,
+                      SystemScratch* scratch) {
+  SystemScratch own;
+  SystemScratch& s = scratch ? *scratch : own;
+  std::vector<MapEntry>& map = s.map;  // the 6 translational components (a, b) -> coordinates
+  Eigen::VectorXd& fv = s.fv;
+  Eigen::MatrixXd &Km = s.Km, &Cm = s.Cm;
   for (const SpringDamper& s : model.springs) {
     Eigen::Vector3d x[2], v[2];
     const int nodes[2] = {s.node_a, s.node_b};
@@ -242,7 +244,7 @@ void AddSpringDampers(const SystemModel& model, const SystemState& state, const 
     fv = f.f;
     Km = f.K;
     Cm = f.C;
-    ScatterBody(map, &fv, K ? &Km : nullptr, &residual, K);
+    ScatterBody(map, &fv, K ? &Km : nullptr, residual, K);
     if (C) ScatterBody(map, nullptr, &Cm, nullptr, C);
   }
 }

@@ -41,10 +41,10 @@ void AddNodeLoads(const SystemModel& model, const SystemState& state, double t, 
                   Triplets* tangent, NodeForces* node_forces = nullptr);
 
 /// Spring-damper forces added to `residual` (as applied forces), their stiffness and damping
-/// (of -f) to `K`, `C` when not null, their energy to `energy`. W may be empty (static).
+/// (of -f) to `K`, `C`, their energy to `energy`, each when not null. W may be empty (static).
 void AddSpringDampers(const SystemModel& model, const SystemState& state, const Eigen::VectorXd& W,
-                      Eigen::VectorXd& residual, Triplets* K, Triplets* C, double* energy,
-                      NodeForces* node_forces = nullptr);
+                      Eigen::VectorXd* residual, Triplets* K, Triplets* C, double* energy,
+                      NodeForces* node_forces = nullptr, SystemScratch* scratch = nullptr);
 
 /// Gathers body b's velocities (xdot, omega per interface node, then etadot) from the
 /// coordinate velocities W.
@@ -61,13 +61,6 @@ void GatherBodyAcceleration(const SystemModel& model, const DofMap& dofs, int b,
                             const std::vector<Eigen::Matrix<double, 6, 1>>& node_acc, const Eigen::VectorXd& Wdot,
                             Eigen::VectorXd& w);
 
-/// The linear map from coordinates to body b's local coordinate increments as (local index,
-/// coordinate, coefficient) entries: dq_b[i] = sum c dz[j].
-struct MapEntry {
-  int local;
-  int coordinate;
-  double coefficient;
-};
 std::vector<MapEntry> BodyMap(const SystemModel& model, const DofMap& dofs, const SystemState& state, int b);
 /// The same into `map` (its storage reused).
 void BodyMap(const SystemModel& model, const DofMap& dofs, const SystemState& state, int b, std::vector<MapEntry>& map);

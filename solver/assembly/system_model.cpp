@@ -205,9 +205,10 @@ void ApplyIncrement(const SystemModel& model, const DofMap& dofs, const Eigen::V
 }
 
 void ApplyPrescribed(const SystemModel& model, const DofMap& dofs, double t, SystemState& state, Eigen::VectorXd* W,
-                     Eigen::VectorXd* Wdot) {
+                     Eigen::VectorXd* Wdot, SystemScratch* scratch) {
   if (model.prescribed.empty()) return;
-  thread_local Eigen::VectorXd delta;  // kept: its storage is reused
+  SystemScratch own;
+  Eigen::VectorXd& delta = (scratch ? *scratch : own).delta;
   delta.setZero(dofs.n_dofs());
   for (const auto& p : model.prescribed) {
     const int j = dofs.prescribed_index(p);

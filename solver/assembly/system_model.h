@@ -103,6 +103,37 @@ inline constexpr double kRoundOffTolerance = 1e-13;
 /// dq_k = J_k dz for one node: sparse columns (coordinate, 6-vector).
 using NodeJacobian = std::vector<std::pair<int, Eigen::Matrix<double, 6, 1>>>;
 
+/// The linear map from coordinates to body b's local coordinate increments as (local index,
+/// coordinate, coefficient) entries: dq_b[i] = sum c dz[j].
+struct MapEntry {
+  int local;
+  int coordinate;
+  double coefficient;
+};
+
+/// The temporaries of the system-level functions (the joint tree's accelerations, derivatives and
+/// geometric stiffness, the loops' and bodies' constraints, the spring-dampers, the prescribed
+/// motions), kept by the caller from call to call so that a time step allocates nothing once they
+/// have their sizes (the dynamic analysis keeps one in its workspace). Their contents mean nothing
+/// between calls; a function given none makes its own (and allocates).
+struct SystemScratch {
+  using Vec6 = Eigen::Matrix<double, 6, 1>;
+  std::vector<Vec6> convective, transmitted, vel, acc;  ///< per node (joint_tree)
+  /// Per node, a coordinate's derivatives of its velocity and acceleration
+  /// (NodeAccelerationConfigurationDerivative).
+  struct RateColumn {
+    int col;
+    Vec6 dvel, dacc;
+  };
+  std::vector<std::vector<RateColumn>> rate_columns;
+  std::vector<int> cols;
+  Eigen::VectorXd lambda, g, minus_f, delta;  ///< the bodies' constraints; prescribed increments
+  Eigen::MatrixXd G, H;
+  std::vector<MapEntry> map;  ///< a body's or a spring's map (never both at once)
+  Eigen::VectorXd fv;         ///< a spring's force, stiffness and damping
+  Eigen::MatrixXd Km, Cm;
+};
+
 struct SystemState {
   std::vector<Eigen::VectorXd> z;  ///< per node: accumulated coordinates (joint values)
   std::vector<NodeJacobian> J;     ///< per node, at this configuration
@@ -196,7 +227,7 @@ SystemState InitialState(const SystemModel& model);
 /// Sets the prescribed coordinates to their values at t: configuration (through the node's
 /// basis), and, when W / Wdot are given, their rates and accelerations.
 void ApplyPrescribed(const SystemModel& model, const DofMap& dofs, double t, SystemState& state, Eigen::VectorXd* W,
-                     Eigen::VectorXd* Wdot);
+                     Eigen::VectorXd* Wdot, SystemScratch* scratch = nullptr);
 
 /// The diagonal of the bounding box of points (node positions): the model's size; 0 for fewer
 /// than two points.

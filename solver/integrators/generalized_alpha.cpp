@@ -23,7 +23,7 @@ void AssembleDynamicResidual(const SystemModel& model, const DofMap& dofs, Dynam
   results.resize(static_cast<size_t>(n_bodies));
   work.pass_data.resize(size_t(n_bodies));
   for (int b = 0; b < n_bodies; ++b) work.pass_data[size_t(b)] = &passes[size_t(b)].data;
-  NodeAccelerations(model, dofs, s.config, s.W, s.Wdot, work.node_acc);
+  NodeAccelerations(model, dofs, s.config, s.W, s.Wdot, work.node_acc, &work.parts.scratch);
   const std::vector<Eigen::Matrix<double, 6, 1>>& node_acc = work.node_acc;
   ForEachBody(threads, n_bodies, [&](int b) {
     const SuperelementBody& body = model.bodies[b];
@@ -74,7 +74,7 @@ void AssembleDynamicResidual(const SystemModel& model, const DofMap& dofs, Dynam
   if (!AddBodyTerms(model, results, parts, out)) return;
   FinishAssembly(model, dofs, s.config, t, s.W, false, parts, out);
   AddLoopConstraints(model, dofs, s.config, &out.residual, nullptr, &out.node_forces, nullptr, kLoopAll,
-                     &work.pass_data);
+                     &work.pass_data, &work.parts.scratch);
 }
 
 Assembly AssembleDynamicResidual(const SystemModel& model, const DofMap& dofs, DynamicState& s, double t,
@@ -199,7 +199,7 @@ void AddDynamicMatrices(const SystemModel& model, const DofMap& dofs, const Dyna
       std::any_of(model.joints.begin(), model.joints.end(), [](const NodeJoint& j) { return !ConstantMaps(j); });
   if (chains) {
     ConvectiveVelocityDerivative(model, dofs, s.config, s.W, work.dc);
-    NodeAccelerationConfigurationDerivative(model, dofs, s.config, s.W, s.Wdot, work.dacc);
+    NodeAccelerationConfigurationDerivative(model, dofs, s.config, s.W, s.Wdot, work.dacc, &work.parts.scratch);
   }
   const std::vector<NodeJacobian>& dc = work.dc;
   const std::vector<NodeJacobian>& dacc = work.dacc;
@@ -239,9 +239,10 @@ void AddDynamicMatrices(const SystemModel& model, const DofMap& dofs, const Dyna
   Eigen::VectorXd& unused = work.unused;
   unused.setZero(n);
   AddNodeLoads(model, s.config, t, unused, &K);
-  AddSpringDampers(model, s.config, s.W, unused, &K, &C, nullptr);
-  AddLoopConstraints(model, dofs, s.config, nullptr, &K, nullptr, nullptr, kLoopAll, &work.pass_data);
-  AddJointGeometricStiffness(model, dofs, s.config, out.node_forces, K);
+  AddSpringDampers(model, s.config, s.W, nullptr, &K, &C, nullptr, nullptr, &work.parts.scratch);
+  AddLoopConstraints(model, dofs, s.config, nullptr, &K, nullptr, nullptr, kLoopAll, &work.pass_data,
+                     &work.parts.scratch);
+  AddJointGeometricStiffness(model, dofs, s.config, out.node_forces, K, &work.parts.scratch);
   if (combine) {
     for (const Eigen::Triplet<double>& e : C) K.emplace_back(e.row(), e.col(), combine->c_C * e.value());
     out.K = work.K_build.Build(n, K);
@@ -292,7 +293,7 @@ StepOutcome GeneralizedAlphaStep(const SystemModel& model, const DofMap& dofs, c
   next.W = state.W + h * (1 - gamma) * a_n + h * gamma * next.a;
   work.dq = h * (state.W + h * (0.5 - beta) * a_n + h * beta * next.a);
   ApplyIncrement(model, dofs, work.dq, next.config);
-  ApplyPrescribed(model, dofs, t_new, next.config, &next.W, &next.Wdot);
+  ApplyPrescribed(model, dofs, t_new, next.config, &next.W, &next.Wdot, &work.parts.scratch);
   const double gamma_p = gamma / (beta * h), beta_p = (1 - alpha_m) / (beta * h * h * (1 - alpha_f));
   work.inertia_factor = beta_p;
   StepOutcome out;
@@ -308,7 +309,7 @@ StepOutcome GeneralizedAlphaStep(const SystemModel& model, const DofMap& dofs, c
     // Converged: the residual below the tolerance relative to the forces on each unknown (or
     // at the round-off of the positions), after at least one correction.
     if (ResidualSmall(dofs, a, weights, r_norm, tolerance) && out.iterations > 0 &&
-        LoopsClosed(model, next.config, tolerance, &work.pass_data)) {
+        LoopsClosed(model, next.config, tolerance, &work.pass_data, &work.parts.scratch)) {
       out.converged = true;
       next.a =
           (alpha_f * state.Wdot + (1 - alpha_f) * next.Wdot - alpha_m * a_n) / (1 - alpha_m);  // (the same relation)
@@ -321,8 +322,8 @@ StepOutcome GeneralizedAlphaStep(const SystemModel& model, const DofMap& dofs, c
       out.passes_kept = true;
       return out;
     }
-    if (divergence.Diverged(r_norm,
-                            !model.has_constraints() || LoopsClosed(model, next.config, tolerance, &work.pass_data))) {
+    if (divergence.Diverged(r_norm, !model.has_constraints() || LoopsClosed(model, next.config, tolerance,
+                                                                            &work.pass_data, &work.parts.scratch))) {
       return out;
     }
     bool built = false;

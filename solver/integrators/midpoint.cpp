@@ -374,7 +374,8 @@ void AssembleMidpoint(const SystemModel& model, const DofMap& dofs, const Dynami
   // over the step, lambda . G(q_m) Delta, is lambda . (g_n+1 - g_n) = 0 up to O(h^3)); the
   // equations themselves hold at the end of the step (MidpointStep).
   k.mid.lambda = s1.config.lambda;
-  AddLoopConstraints(model, dofs, k.mid, &out.residual, nullptr, &parts.node_forces, nullptr, kLoopAll, &mw.mid_data);
+  AddLoopConstraints(model, dofs, k.mid, &out.residual, nullptr, &parts.node_forces, nullptr, kLoopAll, &mw.mid_data,
+                     &parts.scratch);
   // Loads at the mid time and configuration, spring-dampers at the mean rates Delta / h.
   mw.rates = k.delta / h;
   FinishAssembly(model, dofs, k.mid, s0.t + 0.5 * h, mw.rates, false, parts, out);
@@ -463,19 +464,22 @@ const SystemMatrix& MidpointMatrix(const SystemModel& model, const DofMap& dofs,
   C.clear();
   mw.unused.setZero(dofs.n_dofs());
   AddNodeLoads(model, k.mid, s0.t + 0.5 * h, mw.unused, &K);
-  AddSpringDampers(model, k.mid, mw.rates, mw.unused, &K, &C, nullptr);
-  AddJointGeometricStiffness(model, dofs, k.mid, a.node_forces, K);
+  AddSpringDampers(model, k.mid, mw.rates, nullptr, &K, &C, nullptr, nullptr, &work.parts.scratch);
+  AddJointGeometricStiffness(model, dofs, k.mid, a.node_forces, K, &work.parts.scratch);
   AddTimesColumns(K, 1.0, k.T, triples, mw.triple_of, S);
   for (const Eigen::Triplet<double>& e : C) S.emplace_back(e.row(), e.col(), e.value() / h);
   if (dofs.n_multipliers() > 0) {
     // Loops: d(-G_m^T lambda)/d delta = H_m T, its lambda columns G_m^T, the rows G_n+1.
     mw.loop_mid.clear();
-    AddLoopConstraints(model, dofs, k.mid, nullptr, &mw.loop_mid, nullptr, nullptr, kLoopHessian, &mw.mid_data);
+    AddLoopConstraints(model, dofs, k.mid, nullptr, &mw.loop_mid, nullptr, nullptr, kLoopHessian, &mw.mid_data,
+                       &work.parts.scratch);
     AddTimesColumns(mw.loop_mid, 1.0, k.T, triples, mw.triple_of, S);
     mw.loop_mid.clear();
     mw.loop_end.clear();
-    AddLoopConstraints(model, dofs, k.mid, nullptr, &mw.loop_mid, nullptr, nullptr, kLoopColumns, &mw.mid_data);
-    AddLoopConstraints(model, dofs, s1.config, nullptr, &mw.loop_end, nullptr, nullptr, kLoopRows, &work.pass_data);
+    AddLoopConstraints(model, dofs, k.mid, nullptr, &mw.loop_mid, nullptr, nullptr, kLoopColumns, &mw.mid_data,
+                       &work.parts.scratch);
+    AddLoopConstraints(model, dofs, s1.config, nullptr, &mw.loop_end, nullptr, nullptr, kLoopRows, &work.pass_data,
+                       &work.parts.scratch);
     S.insert(S.end(), mw.loop_end.begin(), mw.loop_end.end());
     S.insert(S.end(), mw.loop_mid.begin(), mw.loop_mid.end());
   }
@@ -569,7 +573,7 @@ StepOutcome MidpointStep(const SystemModel& model, const DofMap& dofs, const Dyn
   work.dq = h * state.W + 0.5 * h * h * state.Wdot;
   work.inertia_factor = 2.0 / (h * h);  // S_b = K / 2 + C / h + 2 M / h^2
   ApplyIncrement(model, dofs, work.dq, next.config);
-  ApplyPrescribed(model, dofs, t_new, next.config, &next.W, &next.Wdot);
+  ApplyPrescribed(model, dofs, t_new, next.config, &next.W, &next.Wdot, &work.parts.scratch);
   StepOutcome out;
   const double tolerance = std::max(options.tolerance, kRoundOffTolerance);
   DivergenceTest divergence;
@@ -583,14 +587,15 @@ StepOutcome MidpointStep(const SystemModel& model, const DofMap& dofs, const Dyn
     if (n_lambda > 0) {
       // The loop equations at the end of the step: residual rows -g(q_n+1).
       mw.end.setZero(dofs.n_dofs());
-      AddLoopConstraints(model, dofs, next.config, &mw.end, nullptr, nullptr, nullptr, kLoopAll, &work.pass_data);
+      AddLoopConstraints(model, dofs, next.config, &mw.end, nullptr, nullptr, nullptr, kLoopAll, &work.pass_data,
+                         &work.parts.scratch);
       a.residual.tail(n_lambda) = mw.end.tail(n_lambda);
     }
     const double r_norm = FreeNorm(dofs, a.residual, weights);
     // Converged: the residual below the tolerance relative to the forces on each unknown (or
     // at the round-off of the positions), after at least one correction.
     if (ResidualSmall(dofs, a, weights, r_norm, tolerance) && out.iterations > 0 &&
-        LoopsClosed(model, next.config, tolerance, &work.pass_data)) {
+        LoopsClosed(model, next.config, tolerance, &work.pass_data, &work.parts.scratch)) {
       out.converged = true;
       next.t = t_new;
       // a: the mean acceleration over the step (t_n+1/2); Wdot: extrapolated to t_n+1 from
@@ -611,8 +616,8 @@ StepOutcome MidpointStep(const SystemModel& model, const DofMap& dofs, const Dyn
       out.passes_kept = true;
       return out;
     }
-    if (divergence.Diverged(r_norm,
-                            !model.has_constraints() || LoopsClosed(model, next.config, tolerance, &work.pass_data))) {
+    if (divergence.Diverged(r_norm, !model.has_constraints() || LoopsClosed(model, next.config, tolerance,
+                                                                            &work.pass_data, &work.parts.scratch))) {
       return out;
     }
     // Newton's increment at n+1, with the iteration matrix built only when it is factored.

@@ -54,8 +54,10 @@ std::vector<Eigen::Matrix<double, 6, 1>> NodeAccelerations(const SystemModel& mo
 }
 
 void NodeAccelerations(const SystemModel& model, const DofMap& dofs, const SystemState& state, const Eigen::VectorXd& W,
-                       const Eigen::VectorXd& Wdot, std::vector<Eigen::Matrix<double, 6, 1>>& acc) {
-  thread_local std::vector<Eigen::Matrix<double, 6, 1>> convective;  // kept: its storage is reused
+                       const Eigen::VectorXd& Wdot, std::vector<Eigen::Matrix<double, 6, 1>>& acc,
+                       SystemScratch* scratch) {
+  SystemScratch own;
+  std::vector<Eigen::Matrix<double, 6, 1>>& convective = (scratch ? *scratch : own).convective;
   acc.assign(size_t(model.n_nodes()), Eigen::Matrix<double, 6, 1>::Zero());
   convective.assign(size_t(model.n_nodes()), Eigen::Matrix<double, 6, 1>::Zero());
   for (int k : dofs.order()) {
@@ -80,10 +82,11 @@ NodeForces ZeroNodeForces(const SystemModel& model) {
 }
 
 void AddJointGeometricStiffness(const SystemModel& model, const DofMap& dofs, const SystemState& state,
-                                const NodeForces& forces, Triplets& tangent) {
+                                const NodeForces& forces, Triplets& tangent, SystemScratch* scratch) {
   if (model.joints.empty()) return;
   // Transmitted forces, children before parents: t_p += A^T t_c.
-  thread_local std::vector<Eigen::Matrix<double, 6, 1>> t;  // kept: its storage is reused
+  SystemScratch own;
+  std::vector<Eigen::Matrix<double, 6, 1>>& t = (scratch ? *scratch : own).transmitted;
   t = forces.f;
   const std::vector<int>& order = dofs.order();
   for (auto it = order.rbegin(); it != order.rend(); ++it) {

@@ -29,7 +29,8 @@ std::vector<Eigen::Matrix<double, 6, 1>> NodeAccelerations(const SystemModel& mo
                                                            const Eigen::VectorXd& Wdot);
 /// The same into `acc` (its storage reused).
 void NodeAccelerations(const SystemModel& model, const DofMap& dofs, const SystemState& state, const Eigen::VectorXd& W,
-                       const Eigen::VectorXd& Wdot, std::vector<Eigen::Matrix<double, 6, 1>>& acc);
+                       const Eigen::VectorXd& Wdot, std::vector<Eigen::Matrix<double, 6, 1>>& acc,
+                       SystemScratch* scratch = nullptr);
 
 /// The derivative of the joints' convective accelerations (NodeAccelerations) with respect to
 /// the coordinate velocities W, per node as sparse columns (coordinate, 6-vector); empty for
@@ -47,7 +48,7 @@ void ConvectiveVelocityDerivative(const SystemModel& model, const DofMap& dofs, 
 /// Into `out` (its storage reused).
 void NodeAccelerationConfigurationDerivative(const SystemModel& model, const DofMap& dofs, const SystemState& state,
                                              const Eigen::VectorXd& W, const Eigen::VectorXd& Wdot,
-                                             std::vector<NodeJacobian>& out);
+                                             std::vector<NodeJacobian>& out, SystemScratch* scratch = nullptr);
 
 /// Places the dependent nodes from their parents and recomputes the node Jacobians.
 void UpdateKinematics(const SystemModel& model, const DofMap& dofs, SystemState& state);
@@ -61,7 +62,7 @@ struct NodeForces {
 NodeForces ZeroNodeForces(const SystemModel& model);
 /// tangent -= d(sum_k J_k^T f_k)/dz at fixed f (the joint maps' configuration dependence).
 void AddJointGeometricStiffness(const SystemModel& model, const DofMap& dofs, const SystemState& state,
-                                const NodeForces& forces, Triplets& tangent);
+                                const NodeForces& forces, Triplets& tangent, SystemScratch* scratch = nullptr);
 
 /// Support and joint reactions at a converged state: for every node held by something (a
 /// support: a joint to the ground; or a parent node through a joint), the force

@@ -42,11 +42,13 @@ BodyData* BodyDataFor(const SystemModel& model, const SystemState& state, int b,
 // d(G^T lambda)/dq, in the same blocks as the cut joints'.
 void AddBodyConstraints(const SystemModel& model, const DofMap& dofs, const SystemState& state,
                         Eigen::VectorXd* residual, Triplets* tangent, NodeForces* node_forces, Triplets* jacobian,
-                        int blocks, const BodyDataAtState* data) {
-  // This thread's scratch (kept: with `data`, a time step allocates nothing here).
-  thread_local Eigen::VectorXd lambda, g, minus_f;
-  thread_local Eigen::MatrixXd G, H;
-  thread_local std::vector<MapEntry> map;
+                        int blocks, const BodyDataAtState* data, SystemScratch* scratch) {
+  // (With `data` and `scratch`, a time step allocates nothing here.)
+  SystemScratch own;
+  SystemScratch& s = scratch ? *scratch : own;
+  Eigen::VectorXd &lambda = s.lambda, &g = s.g, &minus_f = s.minus_f;
+  Eigen::MatrixXd &G = s.G, &H = s.H;
+  std::vector<MapEntry>& map = s.map;
   for (size_t b = 0; b < model.bodies.size(); ++b) {
     const SuperelementBody& body = model.bodies[b];
     const int r = body.n_constraints();
@@ -86,7 +88,7 @@ void AddBodyConstraints(const SystemModel& model, const DofMap& dofs, const Syst
 
 void AddLoopConstraints(const SystemModel& model, const DofMap& dofs, const SystemState& state,
                         Eigen::VectorXd* residual, Triplets* tangent, NodeForces* node_forces, Triplets* jacobian,
-                        int blocks, const BodyDataAtState* data) {
+                        int blocks, const BodyDataAtState* data, SystemScratch* scratch) {
   for (size_t c = 0; c < model.cut_joints.size(); ++c) {
     const CutJoint& cut = model.cut_joints[c];
     const NodeJoint& j = cut.joint;
@@ -138,7 +140,7 @@ void AddLoopConstraints(const SystemModel& model, const DofMap& dofs, const Syst
       }
     }
   }
-  AddBodyConstraints(model, dofs, state, residual, tangent, node_forces, jacobian, blocks, data);
+  AddBodyConstraints(model, dofs, state, residual, tangent, node_forces, jacobian, blocks, data, scratch);
 }
 
 namespace {
@@ -286,7 +288,8 @@ std::string LoopSingularity(const SystemModel& model, const SystemState& state) 
          "point: its " + ConstraintName(model.cut_joints[size_t(worst)].joint, equation) + buffer + ")";
 }
 
-double LoopViolation(const SystemModel& model, const SystemState& state, int* worst, const BodyDataAtState* data) {
+double LoopViolation(const SystemModel& model, const SystemState& state, int* worst, const BodyDataAtState* data,
+                     SystemScratch* scratch) {
   double L = BoundingDiagonal(model.node_x0);
   if (!(L > 0)) L = 1.0;
   double largest = 0.0;
@@ -308,7 +311,8 @@ double LoopViolation(const SystemModel& model, const SystemState& state, int* wo
     if (body.n_constraints() == 0) continue;
     std::optional<BodyData> own;
     BodyData* d = BodyDataFor(model, state, int(b), data, own);
-    thread_local Eigen::VectorXd g;                                       // (kept: no allocation with `data`)
+    SystemScratch own_scratch;  // (no allocation with `data` and `scratch`)
+    Eigen::VectorXd& g = (scratch ? *scratch : own_scratch).g;
     if (d) InterfaceConstraint(body, *d, &g, nullptr, nullptr, nullptr);  // lengths
     const double v = d ? g.lpNorm<Eigen::Infinity>() : std::numeric_limits<double>::infinity();
     if (v > largest) {
@@ -334,9 +338,10 @@ std::vector<Eigen::Matrix<double, 6, 1>> CutJointReactions(const SystemModel& mo
   return out;
 }
 
-bool LoopsClosed(const SystemModel& model, const SystemState& state, double tolerance, const BodyDataAtState* data) {
-  return !model.has_constraints() ||
-         LoopViolation(model, state, nullptr, data) <= tolerance * std::max(BoundingDiagonal(model.node_x0), 1e-300);
+bool LoopsClosed(const SystemModel& model, const SystemState& state, double tolerance, const BodyDataAtState* data,
+                 SystemScratch* scratch) {
+  return !model.has_constraints() || LoopViolation(model, state, nullptr, data, scratch) <=
+                                         tolerance * std::max(BoundingDiagonal(model.node_x0), 1e-300);
 }
 
 }  // namespace femb

@@ -28,13 +28,14 @@ enum LoopBlocks { kLoopRows = 1, kLoopColumns = 2, kLoopHessian = 4, kLoopAll = 
 using BodyDataAtState = std::vector<BodyData*>;
 void AddLoopConstraints(const SystemModel& model, const DofMap& dofs, const SystemState& state,
                         Eigen::VectorXd* residual, Triplets* tangent, NodeForces* node_forces,
-                        Triplets* jacobian = nullptr, int blocks = kLoopAll, const BodyDataAtState* data = nullptr);
+                        Triplets* jacobian = nullptr, int blocks = kLoopAll, const BodyDataAtState* data = nullptr,
+                        SystemScratch* scratch = nullptr);
 /// The largest violation of the kept equations: positions in length units, rotations (dot
 /// products) times the model's size L so that both are lengths, and the bodies' interface
 /// constraints (lengths); 0 without any. `worst`: the cut joint with it, or cut_joints.size() + b
 /// for body b's constraint (-1 without any).
 double LoopViolation(const SystemModel& model, const SystemState& state, int* worst = nullptr,
-                     const BodyDataAtState* data = nullptr);
+                     const BodyDataAtState* data = nullptr, SystemScratch* scratch = nullptr);
 /// Per cut joint, the force and moment (global axes, moment about the child node) that the
 /// joint's parent node, or the ground, exerts on its child node through the joint: -G_c^T lambda,
 /// G_c the child's columns of the kept equations. Along a dropped (redundant) direction the
@@ -43,7 +44,7 @@ std::vector<Eigen::Matrix<double, 6, 1>> CutJointReactions(const SystemModel& mo
 /// Newton's test on the loops: no constraints, or LoopViolation <= tolerance times the model's
 /// size (BoundingDiagonal of the nodes), the same relative tolerance as the forces'.
 bool LoopsClosed(const SystemModel& model, const SystemState& state, double tolerance,
-                 const BodyDataAtState* data = nullptr);
+                 const BodyDataAtState* data = nullptr, SystemScratch* scratch = nullptr);
 
 /// Drops the cut joints' equations that repeat others at the initial state (an over-constrained
 /// mechanism: a planar four-bar of spatial revolute joints has 3 of its 5 closure equations

@@ -74,7 +74,7 @@ void ConvectiveVelocityDerivative(const SystemModel& model, const DofMap& dofs, 
 
 void NodeAccelerationConfigurationDerivative(const SystemModel& model, const DofMap& dofs, const SystemState& state,
                                              const Eigen::VectorXd& W, const Eigen::VectorXd& Wdot,
-                                             std::vector<NodeJacobian>& out) {
+                                             std::vector<NodeJacobian>& out, SystemScratch* scratch) {
   using Vec6 = Eigen::Matrix<double, 6, 1>;
   const int n = model.n_nodes();
   // Down the tree, per node: velocity and acceleration, and per coordinate their derivatives.
@@ -83,14 +83,12 @@ void NodeAccelerationConfigurationDerivative(const SystemModel& model, const Dof
   // a coordinate turns the parent (dpi_p, its column of J_p), moves the parent's velocity and
   // acceleration (their derivatives), and its own joint coordinates: d rho = dpi_p x rho + g ds,
   // d g = dpi_p x g (universal: d g2 = dpi_p x g2 + dphi1 g1 x g2), d(A v) = [v_w x d rho; 0].
-  struct Column {
-    int col;
-    Vec6 dvel, dacc;
-  };
-  // This thread's scratch, kept from call to call (its storage reused: no allocation once sized).
-  thread_local std::vector<std::vector<Column>> d;
-  thread_local std::vector<Vec6> vel, acc;
-  thread_local std::vector<int> cols;
+  using Column = SystemScratch::RateColumn;
+  SystemScratch own;
+  SystemScratch& s = scratch ? *scratch : own;
+  std::vector<std::vector<Column>>& d = s.rate_columns;
+  std::vector<Vec6>&vel = s.vel, &acc = s.acc;
+  std::vector<int>& cols = s.cols;
   d.resize(static_cast<size_t>(n));
   for (std::vector<Column>& column : d) column.clear();
   vel.resize(static_cast<size_t>(n));
