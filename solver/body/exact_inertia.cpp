@@ -213,23 +213,33 @@ void ExactMomentumSource(const SuperelementBody& body, BodyData& data, const Bod
   TurnBlocksInto(data.frame.R, out, blocks, out);
 }
 
-void ExactGyroscopic(const SuperelementBody& body, BodyData& data, const BodyVelocity& w, Eigen::MatrixXd& G) {
-  // ExactInertiaForce is A(q) wdot + g(q, w), g quadratic in w with no wdot: its derivative by
-  // w is that of g. Forward mode by hand: every quantity of the force that depends on w carries
-  // its n columns d/dw (prefix d), in the order of ExactInertiaForce. The temporaries are
-  // data.exact_scratch's, each product into its own before the sums (as ExactInertiaForce).
+namespace {
+
+// ExactGyroscopic's stages. They are inlined into it: the compiler then sees the same statements
+// in the same order as in one function, and contracts the same products into fused
+// multiply-adds (-march=native), so the matrix is the same to the bit.
+
+// The frame's motion xi = (v, Omega) and Omega~ of ExactGyroscopic.
+struct GyroscopicMotion {
+  Eigen::Matrix<double, 6, 1> xi;
+  Eigen::Vector3d v, Om;
+  Eigen::Matrix3d Om_x;
+};
+
+// The kinematic quantities of the force and their w-derivatives: Rbar^T w, xi (dxi = Z Rbar^T),
+// qdot_loc (dqd = B Rbar^T), dr = -dc, dOmegadot = Z_r dr, y = Phi_rig0 xi + qdot_loc and dy.
+[[gnu::always_inline]] inline void GyroscopicKinematics(const SuperelementBody& body, BodyData& data,
+                                                        const BodyVelocity& w, GyroscopicMotion& m) {
   const int n = body.n_coordinates(), blocks = 2 * body.n_nodes_;
-  const ExactInertiaData& d = ExactProducts(body, data);
   ExactScratch& s = data.exact_scratch;
-  const Eigen::Matrix3d& R = data.frame.R;
   const Eigen::MatrixXd& Z = data.kin.Z;
   const Eigen::MatrixXd& B = data.kin.B;
-  const Eigen::Matrix3d Rt = R.transpose();
+  const Eigen::Matrix3d Rt = data.frame.R.transpose();
   Eigen::VectorXd& Rw = s.Rw;
   TurnBlocksInto(Rt, w, blocks, Rw);
-  Eigen::Matrix<double, 6, 1> xi;
-  xi.noalias() = Z * Rw;
-  const Eigen::Vector3d v = xi.head<3>(), Om = xi.tail<3>();
+  m.xi.noalias() = Z * Rw;
+  m.v = m.xi.head<3>();
+  m.Om = m.xi.tail<3>();
   Eigen::MatrixXd& dxi = s.dxi;  // Z Rbar^T
   dxi = Z;
   TurnColBlocks(dxi, blocks, [&](int) { return Rt; });
@@ -244,8 +254,9 @@ void ExactGyroscopic(const SuperelementBody& body, BodyData& data, const BodyVel
   // r = Rbar^T wdot - c(w): dr = -dc. d(Rbar^T w) = Rbar^T: block a is R^T at column block a.
   Eigen::MatrixXd& dr = s.dr;
   dr.setZero(n, n);
-  const Eigen::Matrix3d Om_x = Skew<double>(Om);
-  Eigen::MatrixXd &t3 = s.t3, &t4 = s.t4, &t5 = s.t5, &t6 = s.t6;
+  m.Om_x = Skew<double>(m.Om);
+  const Eigen::Matrix3d& Om_x = m.Om_x;
+  Eigen::MatrixXd &t3 = s.t3, &t4 = s.t4;
   for (int a = 0; a < blocks; ++a) {
     dr.middleRows<3>(3 * a).noalias() += Skew<double>(Eigen::Vector3d(Rw.segment<3>(3 * a))) * dOm;
     dr.block<3, 3>(3 * a, 3 * a) -= Om_x * Rt;
@@ -262,58 +273,70 @@ void ExactGyroscopic(const SuperelementBody& body, BodyData& data, const BodyVel
     t3.noalias() = DL * dqd.middleRows<3>(6 * k + 3);
     dr.middleRows<3>(6 * k + 3) -= t3;
   }
-  Eigen::MatrixXd& dOmd = s.dOmd;
-  dOmd.noalias() = Z.bottomRows<3>() * dr;
+  s.dOmd.noalias() = Z.bottomRows<3>() * dr;
   Eigen::VectorXd& y = s.y;
-  y.noalias() = body.Phi_rig0_ * xi;
+  y.noalias() = body.Phi_rig0_ * m.xi;
   y += qd;
   Eigen::MatrixXd& dy = s.dy;
   dy.noalias() = body.Phi_rig0_ * dxi;
   dy += dqd;
+}
+
+// The local coordinates' force f_q's derivative df_q, up to its Xi terms (the Gamma terms with
+// M dyd and H^T dyd, dyd = Y dr, from M Y and H^T Y kept per configuration), and what the frame's
+// force needs of it: Gamma(Omega), Gamma_a qd, Gamma_a^T y, pi_q and `base`.
+[[gnu::always_inline]] inline void GyroscopicLocalForce(const SuperelementBody& body, const ExactInertiaData& d,
+                                                        ExactScratch& s, const GyroscopicMotion& m) {
+  const int n = body.n_coordinates();
   // Gamma(Om) = sum_a Om_a Gamma_a: the three Gamma_a dqd and Gamma_a^T dy products in one each;
   // the rows y^T Gamma_a dqd as (Gamma_a^T y)^T dqd.
   Eigen::MatrixXd& G_Om = s.G_Om;
-  G_Om = Om[0] * body.Gamma_[0];
-  for (int a = 1; a < 3; ++a) G_Om += Om[a] * body.Gamma_[size_t(a)];
-  Eigen::MatrixXd& Hd = s.Hd;  // Gamma_a qd
-  GammaColumns(body, qd, Hd);
-  Eigen::MatrixXd& Gty = s.Gty;  // Gamma_a^T y
+  G_Om = m.Om[0] * body.Gamma_[0];
+  for (int a = 1; a < 3; ++a) G_Om += m.Om[a] * body.Gamma_[size_t(a)];
+  GammaColumns(body, s.qd, s.Hd);  // Gamma_a qd
+  Eigen::MatrixXd& Gty = s.Gty;    // Gamma_a^T y
   Gty.resize(n, 3);
-  for (int a = 0; a < 3; ++a) Gty.col(a).noalias() = body.Gamma_[size_t(a)].transpose() * y;
+  for (int a = 0; a < 3; ++a) Gty.col(a).noalias() = body.Gamma_[size_t(a)].transpose() * s.y;
   Eigen::VectorXd& pi_q = s.pi_q;
-  pi_q.noalias() = body.M_ * y;
-  s.t1.noalias() = d.H * Om;
+  pi_q.noalias() = body.M_ * s.y;
+  s.t1.noalias() = d.H * m.Om;
   pi_q += s.t1;
-  // M dyd and H^T dyd with dyd = Y dr: (M Y) dr and (H^T Y) dr, M Y and H^T Y kept per configuration.
   // d pi_qdot = base + G_Om dqd and df_q = d pi_qdot - G_Om^T dy - Gty dOm with
   // dy = Phi_rig0 dxi + dqd: the two n x n products with G_Om as one, (G_Om - G_Om^T) dqd.
   Eigen::MatrixXd& base = s.base;
-  base.noalias() = d.MY * dr;
-  base.noalias() += d.H * dOmd;
-  base.noalias() += Hd * dOm;
+  base.noalias() = d.MY * s.dr;
+  base.noalias() += d.H * s.dOmd;
+  base.noalias() += s.Hd * s.dOm;
   Eigen::MatrixXd& df_q = s.df_q;
   df_q = base;
-  {
-    Eigen::MatrixXd& G_skew = s.G_skew;
-    G_skew = G_Om - G_Om.transpose();
-    df_q.noalias() += G_skew * dqd;
-    Eigen::MatrixXd& GtP = s.GtP;  // n x 6
-    GtP.noalias() = G_Om.transpose() * body.Phi_rig0_;
-    df_q.noalias() -= GtP * dxi;
-    df_q.noalias() -= Gty * dOm;
-  }
+  Eigen::MatrixXd& G_skew = s.G_skew;
+  G_skew = G_Om - G_Om.transpose();
+  df_q.noalias() += G_skew * s.dqd;
+  Eigen::MatrixXd& GtP = s.GtP;  // n x 6
+  GtP.noalias() = G_Om.transpose() * body.Phi_rig0_;
+  df_q.noalias() -= GtP * s.dxi;
+  df_q.noalias() -= Gty * s.dOm;
+}
+
+// The frame's force f_xi's derivative df_xi (Kirchhoff's equations: d/dt dT/dxi and the
+// Omega x terms), with the Xi terms of df_q and of the angular momentum's rate.
+[[gnu::always_inline]] inline void GyroscopicFrameForce(const SuperelementBody& body, const ExactInertiaData& d,
+                                                        ExactScratch& s, const GyroscopicMotion& m) {
+  const Eigen::Vector3d& Om = m.Om;
+  const Eigen::MatrixXd &dOm = s.dOm, &dqd = s.dqd, &dy = s.dy;
+  Eigen::MatrixXd &t3 = s.t3, &t4 = s.t4, &t5 = s.t5, &t6 = s.t6;
   Eigen::Vector3d Hty;
-  Hty.noalias() = d.H.transpose() * y;
+  Hty.noalias() = d.H.transpose() * s.y;
   const Eigen::Vector3d h = Hty + d.Xq * Om;
   Eigen::MatrixXd& dh = s.dh;
   t3.noalias() = d.H.transpose() * dy;
   t4.noalias() = d.Xq * dOm;
   dh = t3 + t4;
   Eigen::MatrixXd& dhd = s.dhd;
-  dhd.noalias() = d.HtY * dr;
-  t3.noalias() = d.Xq * dOmd;
-  t4.noalias() = Gty.transpose() * dqd;
-  t5.noalias() = Hd.transpose() * dy;
+  dhd.noalias() = d.HtY * s.dr;
+  t3.noalias() = d.Xq * s.dOmd;
+  t4.noalias() = s.Gty.transpose() * dqd;
+  t5.noalias() = s.Hd.transpose() * dy;
   dhd += t3;
   dhd += t4;
   dhd += t5;
@@ -323,14 +346,14 @@ void ExactGyroscopic(const SuperelementBody& body, BodyData& data, const BodyVel
     for (int b = 0; b < 3; ++b) {
       const auto XQab = d.XQ.col(3 * a + b);
       row = Om[b] * dOm.row(a) + Om[a] * dOm.row(b);
-      df_q.noalias() -= XQab * row;
+      s.df_q.noalias() -= XQab * row;
       S_ab = XQab + d.XQ.col(3 * b + a);
       row2.noalias() = S_ab.transpose() * dqd;
-      dhd.row(a) += qd.dot(S_ab) * dOm.row(b) + Om[b] * row2;
+      dhd.row(a) += s.qd.dot(S_ab) * dOm.row(b) + Om[b] * row2;
     }
   }
   Eigen::Matrix<double, 6, 1> pi_xi;
-  pi_xi.noalias() = body.Phi_rig0_.transpose() * pi_q;
+  pi_xi.noalias() = body.Phi_rig0_.transpose() * s.pi_q;
   pi_xi.tail<3>() += h;
   const Eigen::Vector3d pi_v = pi_xi.head<3>(), pi_w = pi_xi.tail<3>();
   // d pi_q = M dy + H dOm enters only through Phi_rig0^T: 6 rows.
@@ -341,8 +364,8 @@ void ExactGyroscopic(const SuperelementBody& body, BodyData& data, const BodyVel
   dpi_xi += s.t8;
   dpi_xi.bottomRows<3>() += dh;
   Eigen::MatrixXd& df_xi = s.df_xi;
-  df_xi.noalias() = body.Phi_rig0_.transpose() * base;
-  s.PG.noalias() = body.Phi_rig0_.transpose() * G_Om;
+  df_xi.noalias() = body.Phi_rig0_.transpose() * s.base;
+  s.PG.noalias() = body.Phi_rig0_.transpose() * s.G_Om;
   df_xi.noalias() += s.PG * dqd;
   df_xi.bottomRows<3>() += dhd;
   Eigen::MatrixXd &dpi_v = s.dpi_v, &dpi_w = s.dpi_w;
@@ -350,17 +373,33 @@ void ExactGyroscopic(const SuperelementBody& body, BodyData& data, const BodyVel
   dpi_w = dpi_xi.bottomRows<3>();
   const Eigen::Matrix3d minus_pi_v_x = -Skew<double>(pi_v), minus_pi_w_x = -Skew<double>(pi_w);
   t3.noalias() = minus_pi_v_x * dOm;
-  t4.noalias() = Om_x * dpi_v;
+  t4.noalias() = m.Om_x * dpi_v;
   df_xi.topRows<3>() += t3 + t4;
   t3.noalias() = minus_pi_w_x * dOm;
-  t4.noalias() = Om_x * dpi_w;
-  t5.noalias() = Skew<double>(pi_v) * dv;
-  t6.noalias() = Skew<double>(v) * dpi_v;
+  t4.noalias() = m.Om_x * dpi_w;
+  t5.noalias() = Skew<double>(pi_v) * s.dv;
+  t6.noalias() = Skew<double>(m.v) * dpi_v;
   df_xi.bottomRows<3>() += t3 + t4 - t5 + t6;
-  G.noalias() = Z.transpose() * df_xi;
-  s.t7.noalias() = B.transpose() * df_q;
+}
+
+}  // namespace
+
+void ExactGyroscopic(const SuperelementBody& body, BodyData& data, const BodyVelocity& w, Eigen::MatrixXd& G) {
+  // ExactInertiaForce is A(q) wdot + g(q, w), g quadratic in w with no wdot: its derivative by
+  // w is that of g. Forward mode by hand: every quantity of the force that depends on w carries
+  // its n columns d/dw (prefix d), in the order of ExactInertiaForce. The temporaries are
+  // data.exact_scratch's, each product into its own before the sums (as ExactInertiaForce).
+  const ExactInertiaData& d = ExactProducts(body, data);
+  ExactScratch& s = data.exact_scratch;
+  GyroscopicMotion m;
+  GyroscopicKinematics(body, data, w, m);
+  GyroscopicLocalForce(body, d, s, m);
+  GyroscopicFrameForce(body, d, s, m);
+  // G = Rbar (Z^T df_xi + B^T df_q).
+  G.noalias() = data.kin.Z.transpose() * s.df_xi;
+  s.t7.noalias() = data.kin.B.transpose() * s.df_q;
   G += s.t7;
-  TurnRowBlocks(G, blocks, [&](int) { return R; });
+  TurnRowBlocks(G, 2 * body.n_nodes_, [&](int) { return data.frame.R; });
 }
 
 const Eigen::MatrixXd& ExactMass(const SuperelementBody& body, BodyData& data) {
