@@ -9,7 +9,7 @@ closing brace, both included; lambdas and local classes count as part of the fun
 them. Comments and string literals are skipped when matching braces. A file counts all its lines.
 
 usage: function_lengths.py [--max 120] [--file-max 700] [--allow NAME]...
-  NAME: a function's name as it is declared (e.g. SuperelementBody::ExactGyroscopic).
+  NAME: a function's name as it is declared (e.g. ExactGyroscopic, or Class::Method).
 """
 import argparse
 import re
