@@ -6,7 +6,11 @@
 # nonlinear leaf; the midpoint scheme's rigid four-bar under gravity and its step-control
 # convergence, 40 s each, whose paths the triple pendulum and the generalized-alpha step control
 # take too): the point here is memory and UB errors in the library code, which the other tests
-# exercise on the same paths.
+# exercise on the same paths. Also left out: the tilted four-bar's restart-at-a-breakpoint bound
+# (error-controlled steps with a flexible coupler, 3e-2 of the reactions' peak): its step sequence
+# follows the round-off, and clang -O1 without -march=native takes another one than the release
+# build (502 steps and 3.4e-2 against 435 and 1.6e-2 on the same machine, at the same commit), so
+# the bound tests the compiler's rounding, not memory; the resumed-run tests take the same path.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 source scripts/sanitizer_tree.sh
@@ -18,4 +22,4 @@ export OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1
 # Leaks: gmsh and OpenBLAS keep global buffers until exit; only errors are fatal here.
 export ASAN_OPTIONS=detect_leaks=0:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 cd build-asan && ctest --output-on-failure -j 2 \
-  -E '^(cli_|example_)|Over1e5Steps|FollowsItsClosedFormKinematics|SpinUpBeam|OneBodyWithModalDerivativesMatchesTheFullNonlinearModel|RigidFourBarUnderGravityKeepsItsEnergyWithTheMidpointScheme|MidpointErrorFallsWithTheTolerance'
+  -E '^(cli_|example_)|Over1e5Steps|FollowsItsClosedFormKinematics|SpinUpBeam|OneBodyWithModalDerivativesMatchesTheFullNonlinearModel|RigidFourBarUnderGravityKeepsItsEnergyWithTheMidpointScheme|MidpointErrorFallsWithTheTolerance|RestartAtTheBreakpointLeavesASmoothRun'

@@ -4,11 +4,23 @@
 #include <Eigen/Core>
 #include <string>
 
+#include "formats/input_error.h"
 #include "formats/part_file.h"
 #include "formats/superelement.h"
 #include "solver/assembly/system.h"
 
 namespace femb::test {
+
+/// The message of the InputError that f() throws ("" when it throws none).
+template <class F>
+std::string ErrorOf(const F& f) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
 
 /// x with 17 significant digits (round-trips through YAML).
 std::string Number(double x);

@@ -9,17 +9,10 @@
 #include <limits>
 
 #include "formats/input_error.h"
-#include "solver/body/body_blocks.h"
 #include "solver/body/superelement_body.h"
 #include "solver/rotation.h"
 
 namespace femb {
-
-using body_blocks::QuadraticDerivative;
-using body_blocks::TurnBlocksInto;
-using body_blocks::TurnColBlocks;
-using body_blocks::TurnNodeBlocks;
-using body_blocks::TurnRowBlocks;
 
 SuperelementBody::SuperelementBody(const Superelement& se, const SuperelementOptions& options,
                                    const Eigen::Matrix3d& placement_R, const Eigen::Vector3d& placement_x)

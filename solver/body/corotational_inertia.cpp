@@ -14,10 +14,7 @@
 
 namespace femb {
 
-using body_blocks::QuadraticDerivative;
-using body_blocks::TurnBlocksInto;
 using body_blocks::TurnColBlocks;
-using body_blocks::TurnNodeBlocks;
 using body_blocks::TurnRowBlocks;
 
 const BodyVelocityMaps& MapsOf(const SuperelementBody& body, BodyData& d) {

@@ -14,7 +14,6 @@
 
 namespace femb {
 
-using body_blocks::QuadraticDerivative;
 using body_blocks::TurnBlocksInto;
 using body_blocks::TurnColBlocks;
 using body_blocks::TurnNodeBlocks;

@@ -14,11 +14,7 @@
 
 namespace femb {
 
-using body_blocks::QuadraticDerivative;
 using body_blocks::TurnBlocksInto;
-using body_blocks::TurnColBlocks;
-using body_blocks::TurnNodeBlocks;
-using body_blocks::TurnRowBlocks;
 
 namespace {
 // Local (elastic) rotations are small in this theory; beyond 2 rad a frame is rejected.

@@ -13,11 +13,7 @@
 
 namespace femb {
 
-using body_blocks::QuadraticDerivative;
 using body_blocks::TurnBlocksInto;
-using body_blocks::TurnColBlocks;
-using body_blocks::TurnNodeBlocks;
-using body_blocks::TurnRowBlocks;
 
 void InertiaForce(const SuperelementBody& body, BodyData& d, const BodyVelocity& w, const BodyVelocity& wdot,
                   Eigen::VectorXd* f_in, Eigen::MatrixXd* mass, Eigen::MatrixXd* gyroscopic, Eigen::VectorXd* f_acc) {

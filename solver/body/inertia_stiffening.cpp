@@ -7,17 +7,10 @@
 #include <cmath>
 #include <limits>
 
-#include "solver/body/body_blocks.h"
 #include "solver/body/superelement_body.h"
 #include "solver/rotation.h"
 
 namespace femb {
-
-using body_blocks::QuadraticDerivative;
-using body_blocks::TurnBlocksInto;
-using body_blocks::TurnColBlocks;
-using body_blocks::TurnNodeBlocks;
-using body_blocks::TurnRowBlocks;
 
 const Eigen::MatrixXd& SigmaProducts(const SuperelementBody& body, BodyData& d) {
   if (!d.has_sigma_q) {

@@ -13,11 +13,7 @@
 
 namespace femb {
 
-using body_blocks::QuadraticDerivative;
-using body_blocks::TurnBlocksInto;
 using body_blocks::TurnColBlocks;
-using body_blocks::TurnNodeBlocks;
-using body_blocks::TurnRowBlocks;
 
 void MomentumSource(const SuperelementBody& body, const BodyVelocityMaps& maps, const BodyVelocity& w,
                     const Eigen::VectorXd& p, Eigen::VectorXd& out, BodyScratch& scratch) {

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "formats/input_error.h"
+#include "test_util.h"
 
 namespace femb {
 namespace {
@@ -24,17 +25,6 @@ namespace fs = std::filesystem;
 
 std::string TempPath(const std::string& name) {
   return (fs::temp_directory_path() / ("femb_hdf5_test_" + std::to_string(::getpid()) + "_" + name)).string();
-}
-
-// The message of the InputError `f` throws ("" when it throws none).
-template <class F>
-std::string ErrorOf(const F& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "";
 }
 
 // A dataset's shape, type class and filters as HDF5 itself reports them (no femb code).
@@ -207,7 +197,7 @@ TEST(Hdf5File, CopyFromKeepsDataAndFilters) {
   EXPECT_EQ(StoredAs(to, "/frame").filters, StoredAs(from, "/frame").filters);
   {
     h5::Writer w(TempPath("to2.h5"));
-    const std::string message = ErrorOf([&] { w.CopyFrom(from, {"/absent"}); });
+    const std::string message = test::ErrorOf([&] { w.CopyFrom(from, {"/absent"}); });
     EXPECT_NE(message.find("cannot copy /absent from " + from), std::string::npos) << message;
   }
   fs::remove(from);
@@ -231,27 +221,27 @@ TEST(Hdf5File, WrongRequestsNameFileAndObject) {
     EXPECT_EQ(message.rfind(path + ": ", 0), 0u) << message;
     EXPECT_NE(message.find(what), std::string::npos) << message;
   };
-  expect(ErrorOf([&] { r.Matrix("/B"); }), "missing dataset /B");
-  expect(ErrorOf([&] { r.Vector("/A"); }), "dataset /A must be 1-dimensional, got rank 2");
-  expect(ErrorOf([&] { r.Matrix("/v"); }), "dataset /v must be 2-dimensional, got rank 1");
-  expect(ErrorOf([&] { r.Scalar("/v"); }), "dataset /v must hold one number");
-  expect(ErrorOf([&] { r.Matrix("/names"); }), "/names");
-  expect(ErrorOf([&] { r.StringAttribute("/", "title"); }), "missing attribute /@title");
-  expect(ErrorOf([&] { r.StringAttribute("/", "count"); }), "attribute /@count must be a fixed-length string");
-  expect(ErrorOf([&] { r.IntAttribute("/A", "count"); }), "missing attribute /A@count");
+  expect(test::ErrorOf([&] { r.Matrix("/B"); }), "missing dataset /B");
+  expect(test::ErrorOf([&] { r.Vector("/A"); }), "dataset /A must be 1-dimensional, got rank 2");
+  expect(test::ErrorOf([&] { r.Matrix("/v"); }), "dataset /v must be 2-dimensional, got rank 1");
+  expect(test::ErrorOf([&] { r.Scalar("/v"); }), "dataset /v must hold one number");
+  expect(test::ErrorOf([&] { r.Matrix("/names"); }), "/names");
+  expect(test::ErrorOf([&] { r.StringAttribute("/", "title"); }), "missing attribute /@title");
+  expect(test::ErrorOf([&] { r.StringAttribute("/", "count"); }), "attribute /@count must be a fixed-length string");
+  expect(test::ErrorOf([&] { r.IntAttribute("/A", "count"); }), "missing attribute /A@count");
   // Not a file, and not an HDF5 file.
   const std::string none = TempPath("none.h5");
-  EXPECT_NE(ErrorOf([&] { h5::Reader bad(none); }).find(none), std::string::npos);
+  EXPECT_NE(test::ErrorOf([&] { h5::Reader bad(none); }).find(none), std::string::npos);
   const std::string text = TempPath("text.h5");
   {
     std::FILE* f = std::fopen(text.c_str(), "w");
     std::fputs("not hdf5\n", f);
     std::fclose(f);
   }
-  EXPECT_NE(ErrorOf([&] { h5::Reader bad(text); }).find(text), std::string::npos);
+  EXPECT_NE(test::ErrorOf([&] { h5::Reader bad(text); }).find(text), std::string::npos);
   // A writer into a folder that does not exist.
   const std::string nowhere = TempPath("no_such_dir") + "/x.h5";
-  EXPECT_NE(ErrorOf([&] { h5::Writer bad(nowhere); }).find(nowhere), std::string::npos);
+  EXPECT_NE(test::ErrorOf([&] { h5::Writer bad(nowhere); }).find(nowhere), std::string::npos);
   fs::remove(path);
   fs::remove(text);
 }

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "formats/input_error.h"
+#include "test_util.h"
 
 namespace femb {
 namespace {
@@ -24,16 +25,6 @@ const char* kText =
     "  items:\n"                 // 9
     "    - {x: 1}\n"             // 10
     "    - {x: 2, extra: 5}\n";  // 11
-
-template <class F>
-std::string ErrorOf(const F& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "";
-}
 
 TEST(YamlReader, TypedValuesAndTheirPlaces) {
   const YamlDocument doc = YamlDocument::LoadString(kText, "part.yaml");
@@ -65,29 +56,29 @@ TEST(YamlReader, EachWrongValueIsOneLineWithItsPlace) {
     EXPECT_NE(message.find(what), std::string::npos) << message;
     EXPECT_EQ(message.find('\n'), std::string::npos) << message;
   };
-  expect(ErrorOf([&] { root.Required("name").Number(); }), "part.yaml:1: name", "bar");
-  expect(ErrorOf([&] { root.Required("nested").Map().Required("depth").NonNegativeInteger(); }),
+  expect(test::ErrorOf([&] { root.Required("name").Number(); }), "part.yaml:1: name", "bar");
+  expect(test::ErrorOf([&] { root.Required("nested").Map().Required("depth").NonNegativeInteger(); }),
          "part.yaml:8: nested.depth", "-3");
-  expect(ErrorOf([&] { root.Required("size").Integer(); }), "part.yaml:2: size", "0.25");
-  expect(ErrorOf([&] {
+  expect(test::ErrorOf([&] { root.Required("size").Integer(); }), "part.yaml:2: size", "0.25");
+  expect(test::ErrorOf([&] {
            root.Required("shape").OneOf({"box", "tube"});
          }),
          "part.yaml:6: shape", "expected box or tube, got 'circle'");
-  expect(ErrorOf([&] { root.Required("count").Vector3(); }), "part.yaml:3: count", "");
-  expect(ErrorOf([&] { root.Required("missing"); }), "part.yaml", "missing");
+  expect(test::ErrorOf([&] { root.Required("count").Vector3(); }), "part.yaml:3: count", "");
+  expect(test::ErrorOf([&] { root.Required("missing"); }), "part.yaml", "missing");
   // Unknown keys: named with their line once the known ones were asked for.
   const YamlMap item = root.Required("nested").Map().Required("items").List()[1].Map();
   item.Required("x");
-  expect(ErrorOf([&] { item.CheckNoUnknownKeys(); }), "part.yaml:11", "extra");
+  expect(test::ErrorOf([&] { item.CheckNoUnknownKeys(); }), "part.yaml:11", "extra");
   const YamlMap first = root.Required("nested").Map().Required("items").List()[0].Map();
   first.Required("x");
-  EXPECT_EQ(ErrorOf([&] { first.CheckNoUnknownKeys(); }), "");
+  EXPECT_EQ(test::ErrorOf([&] { first.CheckNoUnknownKeys(); }), "");
   // A syntax error names the file, line and column.
-  const std::string syntax = ErrorOf([] { YamlDocument::LoadString("a: [1, 2\nb: 3\n", "bad.yaml"); });
+  const std::string syntax = test::ErrorOf([] { YamlDocument::LoadString("a: [1, 2\nb: 3\n", "bad.yaml"); });
   EXPECT_EQ(syntax.rfind("bad.yaml:", 0), 0u) << syntax;
   EXPECT_NE(syntax.find("YAML syntax error"), std::string::npos) << syntax;
   // A file that is not there.
-  EXPECT_NE(ErrorOf([] { YamlDocument::LoadFile("/nonexistent/part.yaml"); }).find("/nonexistent/part.yaml"),
+  EXPECT_NE(test::ErrorOf([] { YamlDocument::LoadFile("/nonexistent/part.yaml"); }).find("/nonexistent/part.yaml"),
             std::string::npos);
 }
 
@@ -104,14 +95,14 @@ TEST(YamlReader, SetOverridesAndSaysSo) {
   EXPECT_EQ(nested.Required("new_key").List().size(), 3u);
   // A wrong value given by --set is named as such.
   doc.Set("count=seven");
-  const std::string message = ErrorOf([&] { doc.Root().Required("count").Integer(); });
+  const std::string message = test::ErrorOf([&] { doc.Root().Required("count").Integer(); });
   EXPECT_EQ(message.rfind("--set count", 0), 0u) << message;
   // Malformed assignments.
-  EXPECT_NE(ErrorOf([&] { doc.Set("size"); }).find("expected key.path=value"), std::string::npos);
-  EXPECT_NE(ErrorOf([&] { doc.Set("=1"); }).find("expected key.path=value"), std::string::npos);
-  EXPECT_NE(ErrorOf([&] { doc.Set("nested.items[x].x=1"); }).find("malformed list index"), std::string::npos);
-  EXPECT_NE(ErrorOf([&] { doc.Set("a..b=1"); }).find("empty key"), std::string::npos);
-  EXPECT_NE(ErrorOf([&] { doc.Set("nested.items[5].x=1"); }), "");
+  EXPECT_NE(test::ErrorOf([&] { doc.Set("size"); }).find("expected key.path=value"), std::string::npos);
+  EXPECT_NE(test::ErrorOf([&] { doc.Set("=1"); }).find("expected key.path=value"), std::string::npos);
+  EXPECT_NE(test::ErrorOf([&] { doc.Set("nested.items[x].x=1"); }).find("malformed list index"), std::string::npos);
+  EXPECT_NE(test::ErrorOf([&] { doc.Set("a..b=1"); }).find("empty key"), std::string::npos);
+  EXPECT_NE(test::ErrorOf([&] { doc.Set("nested.items[5].x=1"); }), "");
 }
 
 }  // namespace
