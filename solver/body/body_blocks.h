@@ -1,4 +1,4 @@
-// Block helpers of the superelement body's kernels (superelement_body.cpp, exact_inertia.cpp):
+// Block helpers of the superelement body's kernels (solver/body/*.cpp):
 // node vectors and matrices turned by 3 x 3 blocks, the exact derivative of a quadratic function.
 // Internal to the solver: solver/body, and generalized-alpha's kept inertia matrices.
 #pragma once
