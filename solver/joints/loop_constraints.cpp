@@ -146,26 +146,30 @@ void AddLoopConstraints(const SystemModel& model, const DofMap& dofs, const Syst
 namespace {
 
 // The rows of the cut joints' kept equations in the constraint Jacobian, over the coordinates
-// solved for (`prescribed` false) or over the prescribed ones (true), each column scaled to unit
-// size so that units do not matter.
-Eigen::MatrixXd ConstraintRows(const SystemModel& model, const DofMap& dofs, const SystemState& state,
-                               bool prescribed) {
+// solved for (`solved`) and, when `prescribed` is given, over the prescribed ones, each column
+// scaled to unit size so that units do not matter; one assembly of the equations for both.
+void ConstraintRows(const SystemModel& model, const DofMap& dofs, const SystemState& state, Eigen::MatrixXd& solved,
+                    Eigen::MatrixXd* prescribed = nullptr) {
   Triplets entries;
   AddLoopConstraints(model, dofs, state, nullptr, nullptr, nullptr, &entries);
   const int m = dofs.n_multipliers(), first = dofs.first_multiplier();
   std::vector<int> column(size_t(dofs.n_dofs()), -1);
-  int n = 0;
-  for (int j = 0; j < first; ++j)
-    if (dofs.prescribed(j) == prescribed) column[size_t(j)] = n++;
-  Eigen::MatrixXd G = Eigen::MatrixXd::Zero(m, n);
-  for (const Eigen::Triplet<double>& e : entries)
-    if (e.row() >= first && e.col() < first && column[size_t(e.col())] >= 0)
-      G(e.row() - first, column[size_t(e.col())]) += e.value();
-  for (int c = 0; c < n; ++c) {
-    const double size = G.col(c).cwiseAbs().maxCoeff();
-    if (size > 0) G.col(c) /= size;
+  int n_s = 0, n_p = 0;
+  for (int j = 0; j < first; ++j) column[size_t(j)] = dofs.prescribed(j) ? n_p++ : n_s++;
+  solved = Eigen::MatrixXd::Zero(m, n_s);
+  if (prescribed) *prescribed = Eigen::MatrixXd::Zero(m, n_p);
+  for (const Eigen::Triplet<double>& e : entries) {
+    if (e.row() < first || e.col() >= first) continue;
+    Eigen::MatrixXd* G = dofs.prescribed(e.col()) ? prescribed : &solved;
+    if (G) (*G)(e.row() - first, column[size_t(e.col())]) += e.value();
   }
-  return G;
+  for (Eigen::MatrixXd* G : {&solved, prescribed}) {
+    if (!G) continue;
+    for (Eigen::Index c = 0; c < G->cols(); ++c) {
+      const double size = G->col(c).cwiseAbs().maxCoeff();
+      if (size > 0) G->col(c) /= size;
+    }
+  }
 }
 
 // Per kept equation of the cut joints, in order: how independent it is of the ones before it that
@@ -248,9 +252,10 @@ std::vector<std::string> DropRedundantEquations(SystemModel& model) {
   if (model.cut_joints.empty()) return notes;
   const DofMap& dofs = model.dofs();
   const SystemState state = InitialState(model);
-  const Eigen::MatrixXd G_s = ConstraintRows(model, dofs, state, false);
+  Eigen::MatrixXd G_s, G_p;
+  ConstraintRows(model, dofs, state, G_s, &G_p);
   const std::vector<double> remainder = EquationRemainders(G_s, 1e-8);
-  RequireDrivesFree(model, dofs, G_s, ConstraintRows(model, dofs, state, true), remainder);
+  RequireDrivesFree(model, dofs, G_s, G_p, remainder);
   const int first = dofs.first_multiplier();
   for (size_t c = 0; c < model.cut_joints.size(); ++c) {
     CutJoint& cut = model.cut_joints[c];
@@ -272,7 +277,9 @@ std::vector<std::string> DropRedundantEquations(SystemModel& model) {
 std::string LoopSingularity(const SystemModel& model, const SystemState& state) {
   if (model.cut_joints.empty()) return "";
   const DofMap& dofs = model.dofs();
-  const std::vector<double> remainder = EquationRemainders(ConstraintRows(model, dofs, state, false), 1e-8);
+  Eigen::MatrixXd G;
+  ConstraintRows(model, dofs, state, G);
+  const std::vector<double> remainder = EquationRemainders(G, 1e-8);
   double least = 1.0;
   int worst = -1, equation = -1;
   for (size_t c = 0; c < model.cut_joints.size(); ++c) {
