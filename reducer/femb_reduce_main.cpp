@@ -9,11 +9,9 @@
 #include "formats/command_line.h"
 #include "formats/input_error.h"
 #include "formats/part_file.h"
-#include "formats/superelement_checks.h"
-#include "formats/superelement_file.h"
 #include "reducer/fe/imported_model.h"
 #include "reducer/linalg/sparse_cholesky.h"
-#include "reducer/reduce_part.h"
+#include "reducer/reduce_file.h"
 
 namespace {
 
@@ -82,35 +80,12 @@ int main(int argc, char** argv) {
       if (!quiet) std::printf("femb-reduce: wrote %zu files to %s\n", written.size(), export_dir.c_str());
       return 0;
     }
-    femb::ReduceResult result = femb::ReducePart(part, progress);
-    if (!result.ok && result.too_big) {
-      std::fprintf(stderr, "femb-reduce: %s: refused: %s (no output written)\n", part_path.c_str(),
-                   result.message.c_str());
-      return 4;
+    const femb::ReduceFileOutcome result = femb::ReduceToFile(
+        part, output, progress, [](const std::string& line) { std::printf("femb-reduce: %s\n", line.c_str()); });
+    if (result.exit_code != 0) {
+      std::fprintf(stderr, "femb-reduce: %s\n", result.error.c_str());
+      return result.exit_code;
     }
-    if (!result.ok) {
-      std::fprintf(stderr, "femb-reduce: %s: numerical failure: %s (no output written)\n", part_path.c_str(),
-                   result.message.c_str());
-      return 3;
-    }
-    for (const std::string& w : result.warnings)
-      std::printf("femb-reduce: warning: %s: %s\n", part_path.c_str(), w.c_str());
-    // The file's contract (formats/superelement_checks.h): a model that fails it is not written.
-    femb::Stopwatch check_clock;
-    const femb::SuperelementChecks checks = femb::CheckSuperelement(result.superelement);
-    if (const femb::Check* c = checks.first_failure()) {
-      std::fprintf(stderr,
-                   "femb-reduce: %s: numerical failure: the reduced model fails check %s: %s; the part may be "
-                   "nearly a mechanism (a region held by a connection many orders of magnitude softer than the "
-                   "rest) or ill-conditioned (no output written)\n",
-                   part_path.c_str(), c->name.c_str(), c->detail.c_str());
-      return 3;
-    }
-    progress("checks", check_clock.Seconds(), std::to_string(checks.checks.size()) + " checks passed");
-    progress("dynamics", 0.0, femb::DynamicsSummary(result.superelement));
-    femb::Stopwatch write_clock;
-    femb::WriteSuperelementFile(result.superelement, output);
-    progress("write", write_clock.Seconds(), output);
     if (!quiet) {
       std::printf("femb-reduce: wrote %s (%d reduced DOFs from %ld) in %.3f s, peak memory %.3g GB\n", output.c_str(),
                   result.superelement.n_reduced_dofs(), result.superelement.n_full_dofs, total.Seconds(),

@@ -55,7 +55,7 @@ Eigen::MatrixXd ResultsRecorder::Rows::Matrix() const {
 }
 
 ResultsRecorder::ResultsRecorder(const Scene& scene, const std::string& directory)
-    : scene_(scene), dofs_(scene.model.dofs()), directory_(directory) {
+    : scene_(scene), dofs_(scene.model.dofs()), files_(!directory.empty()), directory_(directory) {
   flush_every_ = scene.spec.flush_every;
   flush_every_steps_ = scene.spec.flush_every_steps;
   // Animation frames: as asked, or about kAutoFrames per run (the output steps the analysis will
@@ -98,20 +98,22 @@ ResultsRecorder::ResultsRecorder(const Scene& scene, const std::string& director
   factors_.resize(n_bodies);
   has_stress_coordinates_.assign(n_bodies, 0);
   has_factors_.assign(n_bodies, 0);
-  std::error_code ec;
-  std::filesystem::create_directories(directory, ec);
-  if (ec) throw InputError(directory + ": cannot create output folder (" + ec.message() + ")");
-  csv_path_ = (std::filesystem::path(directory) / "probes.csv").string();
-  h5_path_ = (std::filesystem::path(directory) / "results.h5").string();
-  csv_tmp_ = csv_path_ + ".tmp." + std::to_string(::getpid());
-  csv_.open(csv_tmp_);
-  if (!csv_) throw InputError(csv_tmp_ + ": cannot write");
-  csv_ << "time";
+  if (files_) {
+    std::error_code ec;
+    std::filesystem::create_directories(directory, ec);
+    if (ec) throw InputError(directory + ": cannot create output folder (" + ec.message() + ")");
+    csv_path_ = (std::filesystem::path(directory) / "probes.csv").string();
+    h5_path_ = (std::filesystem::path(directory) / "results.h5").string();
+    csv_tmp_ = csv_path_ + ".tmp." + std::to_string(::getpid());
+    csv_.open(csv_tmp_);
+    if (!csv_) throw InputError(csv_tmp_ + ": cannot write");
+    csv_ << "time";
+  }
   static const char* xyz[3] = {"x", "y", "z"};
   static const char* wxyz[4] = {"w", "x", "y", "z"};
   // Every probe column: in probes.csv's header and results.h5's /probes/names.
   const auto column = [&](const std::string& name) {
-    csv_ << "," << name;
+    if (files_) csv_ << "," << name;
     probe_columns_.push_back(name);
   };
   for (const SceneProbeSpec& p : scene.spec.probes) {
@@ -161,7 +163,7 @@ ResultsRecorder::ResultsRecorder(const Scene& scene, const std::string& director
       }
     }
   }
-  csv_ << ",kinetic_energy,elastic_energy,external_work\n";
+  if (files_) csv_ << ",kinetic_energy,elastic_energy,external_work\n";
   probe_values_.width = int(probe_columns_.size());
 }
 
@@ -249,14 +251,14 @@ void ResultsRecorder::Record(double t, const SystemState& state, const Eigen::Ve
   const bool frame = AnimationFrame(t);
   OutputStep step(*this, t, state, W, accelerations);
   QueueFields(state, frame, step);
-  Put(csv_, t);
+  if (files_) Put(csv_, t);
   double* const probe_row = probe_values_.Append();
   ProbeRow row{probe_row, 0};
   WriteProbes(state, nodes, reactions, step, row);
   PutProbe(row, kinetic);
   PutProbe(row, elastic);
   PutProbe(row, external_work);
-  csv_.put('\n');
+  if (files_) csv_.put('\n');
 }
 
 ResultsRecorder::NodeRows ResultsRecorder::RecordSeries(double t, const SystemState& state, const Eigen::VectorXd& W,
@@ -337,6 +339,7 @@ void ResultsRecorder::RecordJoints(const SystemState& state) {
 // Whether the output step just recorded at t is an animation frame: every animation_every-th
 // output step, or the first at or after each frame_interval.
 bool ResultsRecorder::AnimationFrame(double t) {
+  if (!files_) return false;  // the animation is a file
   bool frame = (time_.size() - 1) % size_t(animation_every_) == 0;
   if (frame_interval_ > 0) {
     frame = t >= next_frame_time_ - 1e-9 * frame_interval_;
@@ -381,8 +384,10 @@ void ResultsRecorder::QueueFields(const SystemState& state, bool frame, OutputSt
 // One value of the probes' row: into probes.csv, and into results.h5's /probes/values while the
 // row has room.
 void ResultsRecorder::PutProbe(ProbeRow& row, double v) {
-  csv_.put(',');
-  Put(csv_, v);
+  if (files_) {
+    csv_.put(',');
+    Put(csv_, v);
+  }
   if (row.column < probe_values_.width) row.values[row.column++] = v;
 }
 
@@ -533,6 +538,7 @@ ResultsRecorder::~ResultsRecorder() {
 }
 
 bool ResultsRecorder::FlushDue() const {
+  if (!files_) return false;
   if (flush_every_steps_ > 0 && outputs_since_flush_ >= flush_every_steps_) return true;
   if (outputs_since_flush_ == 0) return false;
   const auto now = std::chrono::steady_clock::now();
@@ -552,6 +558,7 @@ bool ResultsRecorder::FlushDue() const {
 void ResultsRecorder::Flush(const std::string& status) {
   const auto start = std::chrono::steady_clock::now();
   MakePending();
+  if (!files_) return;
   const auto made = std::chrono::steady_clock::now();
   // probes.csv (the stream so far, copied whole to a temporary name and renamed) before
   // results.h5: killed between the two renames, probes.csv holds the newer steps and results.h5
@@ -577,105 +584,13 @@ void ResultsRecorder::Flush(const std::string& status) {
 
 void ResultsRecorder::Finish(const std::string& status) {
   MakePending();
+  if (!files_) return;
   csv_.close();
   std::error_code ec;
   std::filesystem::rename(csv_tmp_, csv_path_, ec);
   if (ec) throw InputError(csv_path_ + ": cannot rename into place (" + ec.message() + ")");
   WriteResults(status);
   FinishAnimation();
-}
-
-void ResultsRecorder::WriteResults(const std::string& status) {
-  std::error_code ec;
-  const std::string tmp = h5_path_ + ".tmp." + std::to_string(::getpid());
-  {
-    const SystemModel& model = scene_.model;
-    const int n = model.n_nodes();
-    h5::Writer w(tmp);
-    w.Attribute("/", "format", "femb-results");
-    w.Attribute("/", "format_version", "1.0");
-    w.Attribute("/", "scene", scene_.spec.file);
-    w.Attribute("/", "analysis", std::string(Name(scene_.spec.analysis.type)));
-    w.Attribute("/", "status", status);
-    w.Attribute("/", "units", scene_.spec.units);
-    w.Vector("/time", Eigen::Map<const Eigen::VectorXd>(time_.data(), long(time_.size())));
-    if (probe_values_.width > 0) {
-      // probes.csv's columns in full precision (the CSV keeps 10 significant digits).
-      w.CreateGroup("/probes");
-      w.Strings("/probes/names", probe_columns_);
-      w.Matrix("/probes/values", probe_values_.Matrix());
-    }
-    if (steps_taken_ >= 0) {
-      w.Attribute("/", "steps", steps_taken_);
-      w.Attribute("/", "rejected_steps_error", rejected_by_error_);
-      w.Attribute("/", "rejected_steps_newton", newton_cuts_);
-    }
-    if (step_size_.size() == time_.size()) {
-      w.Vector("/step_size", Eigen::Map<const Eigen::VectorXd>(step_size_.data(), long(step_size_.size())));
-    }
-    if (!all_steps_t_.empty()) {
-      w.CreateGroup("/steps");
-      w.Vector("/steps/time", Eigen::Map<const Eigen::VectorXd>(all_steps_t_.data(), long(all_steps_t_.size())));
-      w.Vector("/steps/size", Eigen::Map<const Eigen::VectorXd>(all_steps_h_.data(), long(all_steps_h_.size())));
-    }
-    if (!model.cut_joints.empty()) {
-      w.CreateGroup("/loops");
-      std::vector<std::string> names;
-      for (const CutJoint& cut : model.cut_joints) names.push_back(cut.name);
-      w.Strings("/loops/cut_joints", names);
-      w.Vector("/loops/violation",
-               Eigen::Map<const Eigen::VectorXd>(loop_violation_.data(), long(loop_violation_.size())));
-      if (loop_reactions_.count > 0) w.Matrix("/loops/reaction", loop_reactions_.Matrix());
-    }
-    w.CreateGroup("/nodes");
-    w.Strings("/nodes/names", model.node_names);
-    w.Matrix("/nodes/position", positions_.Matrix());
-    w.Matrix("/nodes/quaternion", quaternions_.Matrix());
-    w.Matrix("/nodes/velocity", velocities_.Matrix());
-    w.Matrix("/nodes/angular_velocity", angular_velocities_.Matrix());
-    if (reactions_.count > 0) w.Matrix("/nodes/reaction", reactions_.Matrix());
-    std::vector<std::string> labels;
-    const DofMap& dofs = model.dofs();
-    for (int k = 0; k < n; ++k) {
-      if (!JointNode(k)) continue;
-      for (int i = 0; i < dofs.node_count(k); ++i) labels.push_back(model.node_names[k] + "." + std::to_string(i));
-    }
-    w.Strings("/nodes/joint_coordinate_labels", labels);
-    w.Matrix("/nodes/joint_coordinates", joints_.Matrix());
-    w.CreateGroup("/energy");
-    w.Vector("/energy/kinetic", Eigen::Map<const Eigen::VectorXd>(kinetic_.data(), long(kinetic_.size())));
-    w.Vector("/energy/elastic", Eigen::Map<const Eigen::VectorXd>(elastic_.data(), long(elastic_.size())));
-    w.Vector("/energy/external_work", Eigen::Map<const Eigen::VectorXd>(work_.data(), long(work_.size())));
-    const Eigen::MatrixXd momentum = momentum_.Matrix();
-    w.Matrix("/energy/linear_momentum", momentum.leftCols(3));
-    w.Matrix("/energy/angular_momentum", momentum.rightCols(3));
-    w.CreateGroup("/bodies");
-    for (size_t b = 0; b < model.bodies.size(); ++b) {
-      const std::string g = "/bodies/" + scene_.body_names[b];
-      w.CreateGroup(g);
-      w.Matrix(g + "/modal_coordinates", modal_[b].Matrix());
-      const Eigen::MatrixXd frame_and_com = frames_[b].Matrix();
-      w.Matrix(g + "/floating_frame", frame_and_com.leftCols(7));
-      w.Matrix(g + "/center_of_mass", frame_and_com.rightCols(3));
-      std::vector<std::string> nodes;
-      for (int k : model.body_nodes[b]) nodes.push_back(model.node_names[k]);
-      w.Strings(g + "/nodes", nodes);
-      if (b < max_von_mises_.size() && !max_von_mises_[b].empty()) {
-        // The largest von Mises stress of the body per output step, its mesh node and where that
-        // node is in part axes.
-        const std::vector<double>& v = max_von_mises_[b];
-        w.Vector(g + "/max_von_mises", Eigen::Map<const Eigen::VectorXd>(v.data(), long(v.size())));
-        w.IntVector(g + "/max_von_mises_node", max_von_mises_node_[b]);
-        Eigen::MatrixXd where(long(v.size()), 3);
-        for (size_t s = 0; s < v.size(); ++s)
-          where.row(long(s)) = scene_.meshes[b]->nodes.row(max_von_mises_node_[b][s]);
-        w.Matrix(g + "/max_von_mises_point", where);
-      }
-    }
-    w.Close();
-  }
-  std::filesystem::rename(tmp, h5_path_, ec);
-  if (ec) throw InputError(h5_path_ + ": cannot rename into place (" + ec.message() + ")");
 }
 
 }  // namespace femb

@@ -25,9 +25,42 @@
 
 namespace femb {
 
+/// A run's results in memory, what results.h5 holds (formats/SCENE_FORMAT.md): a row per output
+/// step. Empty matrices where the run records nothing (reactions not asked for, no cut joints).
+struct RecordedResults {
+  Eigen::VectorXd time;
+  Eigen::VectorXd step_size;  ///< the step that reached each output step (dynamic; else empty)
+  std::vector<std::string> probe_names;
+  Eigen::MatrixXd probes;                                         ///< a column per probe name, full precision
+  Eigen::VectorXd steps_time, steps_size;                         ///< every step taken (dynamic)
+  long steps_taken = -1, rejected_by_error = 0, newton_cuts = 0;  ///< -1: not counted (static)
+  std::vector<std::string> cut_joints;
+  Eigen::VectorXd loop_violation;  ///< with cut joints: a length
+  Eigen::MatrixXd loop_reaction;   ///< with reactions: 6 per cut joint
+  std::vector<std::string> node_names;
+  /// Per node: 3, 4, 3, 3 and 6 columns (world axes; quaternions w, x, y, z).
+  Eigen::MatrixXd position, quaternion, velocity, angular_velocity, reaction;
+  std::vector<std::string> joint_coordinate_labels;
+  Eigen::MatrixXd joint_coordinates;
+  Eigen::VectorXd kinetic, elastic, external_work;
+  Eigen::MatrixXd linear_momentum, angular_momentum;  ///< 3 columns each (about the origin)
+  struct Body {
+    std::string name;
+    std::vector<std::string> nodes;
+    Eigen::MatrixXd modal_coordinates;
+    Eigen::MatrixXd floating_frame;  ///< x (3), quaternion (4)
+    Eigen::MatrixXd center_of_mass;
+    Eigen::VectorXd max_von_mises;  ///< with stresses: per output step, and its mesh node and point
+    std::vector<int> max_von_mises_node;
+    Eigen::MatrixXd max_von_mises_point;
+  };
+  std::vector<Body> bodies;
+};
+
 class ResultsRecorder {
  public:
-  /// Creates `directory` if needed; opens results.h5 (at Finish) and probes.csv (streamed).
+  /// Creates `directory` if needed; opens results.h5 (at Finish) and probes.csv (streamed). An
+  /// empty `directory`: the results are kept in memory only (no animation).
   ResultsRecorder(const Scene& scene, const std::string& directory);
   /// Without Finish (an input error before or during the run): the temporary CSV is removed.
   ~ResultsRecorder();
@@ -98,6 +131,8 @@ class ResultsRecorder {
   /// when and where ("body 'bar': largest von Mises stress 45.7 MPa at t = 1, mesh node 12 at
   /// (0.05, 0.05, 0.026) in part axes").
   std::vector<std::string> StressSummary() const;
+  /// The results recorded so far.
+  RecordedResults Results() const;
   /// Closed loops: the largest violation of the cut joints' equations over the recorded steps
   /// (LoopViolation: a length); 0 without loops.
   double max_loop_violation() const { return max_loop_violation_; }
@@ -136,6 +171,7 @@ class ResultsRecorder {
 
   const Scene& scene_;
   const DofMap dofs_;          ///< the scene model's numbering (the model does not change while recording)
+  const bool files_;           ///< results written to files (else kept in memory only)
   int animation_every_ = 1;    ///< one animation frame per this many output steps (spec, or auto)
   double frame_interval_ = 0;  ///< > 0: one animation frame per this much time (auto, with step: auto)
   double next_frame_time_ = 0;

@@ -1,0 +1,233 @@
+// femb._core: the C++ library as the Python package femb sees it (python/femb/__init__.py builds
+// the user's API on it). The three jobs as the programs do them: ReduceToFile (femb-reduce),
+// the superelement file read and checked (femb-inspect), SolveRun (femb-solve). Input errors
+// raise femb.InputError with the program's one line; numerical failures femb.NumericalError.
+// Matrices come back as numpy arrays that own the Eigen data moved into them (no copy).
+#include <pybind11/eigen.h>
+#include <pybind11/functional.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <atomic>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "formats/input_error.h"
+#include "formats/part_file.h"
+#include "formats/scene_file.h"
+#include "formats/superelement.h"
+#include "formats/superelement_file.h"
+#include "inspect/report.h"
+#include "inspect/superelement_checks.h"
+#include "inspect/vtu_writer.h"
+#include "reducer/reduce_file.h"
+#include "solver/run/solve_run.h"
+
+namespace py = pybind11;
+
+namespace {
+
+// A femb error raised in Python: the class, and the message (the program's line).
+struct PythonError {
+  PyObject* type;
+  std::string message;
+};
+
+PyObject* g_numerical_error = nullptr;
+PyObject* g_refused_error = nullptr;
+
+[[noreturn]] void Raise(PyObject* type, const std::string& message) {
+  PyErr_SetString(type, message.c_str());
+  throw py::error_already_set();
+}
+
+// A Python callable as the library's line sink: called with the GIL held (the run releases it);
+// an exception it raises is kept and raised again when the run returns.
+std::function<void(const std::string&)> LineSink(const py::object& callback) {
+  if (callback.is_none()) return nullptr;
+  return [callback](const std::string& line) {
+    py::gil_scoped_acquire gil;
+    try {
+      callback(line);
+    } catch (py::error_already_set& e) {
+      e.discard_as_unraisable("femb progress callback");
+    }
+  };
+}
+
+// femb.reduce: the part (its text and the name its lines are reported under, a path whose
+// folder relative paths start from) reduced and written to `output`.
+femb::Superelement Reduce(const std::string& text, const std::string& name, const std::vector<std::string>& overrides,
+                          const std::string& output, const py::object& progress, const py::object& warning) {
+  const femb::PartSpec part = femb::ParsePart(text, name, overrides);
+  const auto say = LineSink(progress), warn = LineSink(warning);
+  femb::ProgressFn stages;
+  if (say) {
+    stages = [say](const std::string& stage, double seconds, const std::string& detail) {
+      char buffer[96];
+      std::snprintf(buffer, sizeof buffer, "%-16s %8.3f s  ", stage.c_str(), seconds);
+      say(buffer + detail);
+    };
+  }
+  femb::ReduceFileOutcome outcome;
+  {
+    py::gil_scoped_release release;
+    outcome = femb::ReduceToFile(part, output.empty() ? part.name + ".h5" : output, stages, warn);
+  }
+  if (outcome.exit_code == 4) Raise(g_refused_error, outcome.error);
+  if (outcome.exit_code != 0) Raise(g_numerical_error, outcome.error);
+  return std::move(outcome.superelement);
+}
+
+// A scene run: its results in memory, and in `output` when one is given.
+struct RunResult {
+  int exit_code = 0;
+  std::string status, error;
+  femb::RecordedResults results;
+  Eigen::VectorXd frequencies_hz;
+  std::string analysis;
+};
+
+RunResult Run(const std::string& text, const std::string& name, const std::vector<std::string>& overrides,
+              const std::string& output, int threads, const py::object& progress, const py::object& warning) {
+  femb::SolveRunOptions options;
+  options.in_memory = output.empty();
+  options.output = output;
+  if (threads > 0) options.threads = threads;
+  options.progress = LineSink(progress);
+  options.warning = LineSink(warning);
+  femb::SolveRun run(femb::ParseScene(text, name, overrides), std::move(options));
+  RunResult r;
+  {
+    py::gil_scoped_release release;
+    r.exit_code = run.Run();
+  }
+  r.status = run.status();
+  r.error = run.error();
+  r.results = std::as_const(run).recorder().Results();
+  r.frequencies_hz = run.frequencies_hz();
+  r.analysis = femb::Name(run.spec().analysis.type);
+  return r;
+}
+
+void BindResults(py::module_& m) {
+  using B = femb::RecordedResults::Body;
+  py::class_<B>(m, "BodySeries")
+      .def_readonly("name", &B::name)
+      .def_readonly("nodes", &B::nodes)
+      .def_readonly("modal_coordinates", &B::modal_coordinates)
+      .def_readonly("floating_frame", &B::floating_frame)
+      .def_readonly("center_of_mass", &B::center_of_mass)
+      .def_readonly("max_von_mises", &B::max_von_mises)
+      .def_readonly("max_von_mises_node", &B::max_von_mises_node)
+      .def_readonly("max_von_mises_point", &B::max_von_mises_point);
+  using R = femb::RecordedResults;
+  py::class_<R>(m, "RecordedResults")
+      .def_readonly("time", &R::time)
+      .def_readonly("step_size", &R::step_size)
+      .def_readonly("probe_names", &R::probe_names)
+      .def_readonly("probes", &R::probes)
+      .def_readonly("steps_time", &R::steps_time)
+      .def_readonly("steps_size", &R::steps_size)
+      .def_readonly("steps_taken", &R::steps_taken)
+      .def_readonly("rejected_by_error", &R::rejected_by_error)
+      .def_readonly("newton_cuts", &R::newton_cuts)
+      .def_readonly("cut_joints", &R::cut_joints)
+      .def_readonly("loop_violation", &R::loop_violation)
+      .def_readonly("loop_reaction", &R::loop_reaction)
+      .def_readonly("node_names", &R::node_names)
+      .def_readonly("position", &R::position)
+      .def_readonly("quaternion", &R::quaternion)
+      .def_readonly("velocity", &R::velocity)
+      .def_readonly("angular_velocity", &R::angular_velocity)
+      .def_readonly("reaction", &R::reaction)
+      .def_readonly("joint_coordinate_labels", &R::joint_coordinate_labels)
+      .def_readonly("joint_coordinates", &R::joint_coordinates)
+      .def_readonly("kinetic", &R::kinetic)
+      .def_readonly("elastic", &R::elastic)
+      .def_readonly("external_work", &R::external_work)
+      .def_readonly("linear_momentum", &R::linear_momentum)
+      .def_readonly("angular_momentum", &R::angular_momentum)
+      .def_readonly("bodies", &R::bodies);
+  py::class_<RunResult>(m, "RunResult")
+      .def_readonly("exit_code", &RunResult::exit_code)
+      .def_readonly("status", &RunResult::status)
+      .def_readonly("error", &RunResult::error)
+      .def_readonly("results", &RunResult::results)
+      .def_readonly("frequencies_hz", &RunResult::frequencies_hz)
+      .def_readonly("analysis", &RunResult::analysis);
+}
+
+void BindSuperelement(py::module_& m) {
+  py::class_<femb::MassProperties>(m, "MassProperties")
+      .def_readonly("mass", &femb::MassProperties::mass)
+      .def_readonly("center_of_mass", &femb::MassProperties::center_of_mass)
+      .def_readonly("inertia_com", &femb::MassProperties::inertia_com);
+  py::class_<femb::InterfaceNode>(m, "InterfaceNode")
+      .def_readonly("name", &femb::InterfaceNode::name)
+      .def_readonly("position", &femb::InterfaceNode::position)
+      .def_readonly("orientation", &femb::InterfaceNode::orientation);
+  using S = femb::Superelement;
+  py::class_<S>(m, "SuperelementData")
+      .def_readonly("name", &S::name)
+      .def_readonly("K", &S::K)
+      .def_readonly("M", &S::M)
+      .def_readonly("interfaces", &S::interfaces)
+      .def_readonly("internal_frequencies_hz", &S::internal_frequencies_hz)
+      .def_readonly("full_free_free_frequencies_hz", &S::full_free_free_frequencies_hz)
+      .def_property_readonly("n_reduced_dofs", &S::n_reduced_dofs)
+      .def_property_readonly("labels",
+                             [](const S& se) {
+                               std::vector<std::string> labels;
+                               for (int i = 0; i < se.n_reduced_dofs(); ++i)
+                                 labels.push_back(femb::ReducedCoordinateLabel(se, i));
+                               return labels;
+                             })
+      .def_property_readonly("mass_properties", &femb::ComputeMassProperties)
+      .def_property_readonly("has_mesh", [](const S& se) { return se.visualization.has_value(); })
+      .def_property_readonly("mesh_nodes",
+                             [](const S& se) { return se.visualization ? se.visualization->nodes : Eigen::MatrixXd(); })
+      .def_property_readonly("mesh_cells",
+                             [](const S& se) { return se.visualization ? se.visualization->cells : Eigen::MatrixXi(); })
+      .def_property_readonly("mesh_dofs_per_node",
+                             [](const S& se) { return se.visualization ? se.visualization->dofs_per_node : 0; })
+      .def_property_readonly(
+          "mesh_shapes", [](const S& se) { return se.visualization ? se.visualization->shapes : Eigen::MatrixXd(); })
+      .def("checks_json", [](const S& se) { return femb::JsonSummary(se, femb::AnalyzeSuperelement(se)).dump(); })
+      .def("write_vtu", &femb::WriteModeShapesVtu);
+  m.def("read_superelement", [](const std::string& path) { return femb::ReadSuperelementFile(path); });
+}
+
+}  // namespace
+
+PYBIND11_MODULE(_core, m) {
+  m.doc() = "femb's C++ core; use the package femb.";
+  static py::exception<femb::InputError> femb_error(m, "FembError", PyExc_RuntimeError);
+  static py::exception<femb::InputError> input_error(m, "InputError", femb_error.ptr());
+  static py::exception<std::runtime_error> numerical_error(m, "NumericalError", femb_error.ptr());
+  static py::exception<std::runtime_error> refused_error(m, "RefusedError", femb_error.ptr());
+  g_numerical_error = numerical_error.ptr();
+  g_refused_error = refused_error.ptr();
+  py::register_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const femb::InputError& e) {
+      PyErr_SetString(input_error.ptr(), e.what());
+    } catch (const femb::ResourceLimitError& e) {
+      PyErr_SetString(refused_error.ptr(), e.what());
+    }
+  });
+  BindSuperelement(m);
+  BindResults(m);
+  m.def("reduce", &Reduce, py::arg("text"), py::arg("name"), py::arg("overrides"), py::arg("output"),
+        py::arg("progress"), py::arg("warning"));
+  m.def("run", &Run, py::arg("text"), py::arg("name"), py::arg("overrides"), py::arg("output"), py::arg("threads"),
+        py::arg("progress"), py::arg("warning"));
+  m.def("check_scene", [](const std::string& text, const std::string& name, const std::vector<std::string>& overrides) {
+    femb::ParseScene(text, name, overrides);
+  });
+  m.def("check_part", [](const std::string& text, const std::string& name, const std::vector<std::string>& overrides) {
+    femb::ParsePart(text, name, overrides);
+  });
+}

@@ -1,0 +1,47 @@
+#include "reducer/reduce_file.h"
+
+#include "formats/input_error.h"
+#include "formats/superelement_checks.h"
+#include "formats/superelement_file.h"
+#include "reducer/linalg/sparse_cholesky.h"
+#include "reducer/reduce_part.h"
+
+namespace femb {
+
+ReduceFileOutcome ReduceToFile(const PartSpec& part, const std::string& output, const ProgressFn& progress,
+                               const std::function<void(const std::string&)>& warning) {
+  ReduceFileOutcome out;
+  const auto refuse = [&](int code, const std::string& what) {
+    out.exit_code = code;
+    out.error = part.file + ": " + what + " (no output written)";
+    return out;
+  };
+  ReduceResult result;
+  try {
+    result = ReducePart(part, progress);
+  } catch (const ResourceLimitError& e) {
+    return refuse(4, std::string("refused: ") + e.what());
+  }
+  if (!result.ok && result.too_big) return refuse(4, "refused: " + result.message);
+  if (!result.ok) return refuse(3, "numerical failure: " + result.message);
+  for (const std::string& w : result.warnings)
+    if (warning) warning("warning: " + part.file + ": " + w);
+  Stopwatch check_clock;
+  const SuperelementChecks checks = CheckSuperelement(result.superelement);
+  if (const Check* c = checks.first_failure()) {
+    return refuse(3, "numerical failure: the reduced model fails check " + c->name + ": " + c->detail +
+                         "; the part may be nearly a mechanism (a region held by a connection many orders of "
+                         "magnitude softer than the rest) or ill-conditioned");
+  }
+  if (progress) {
+    progress("checks", check_clock.Seconds(), std::to_string(checks.checks.size()) + " checks passed");
+    progress("dynamics", 0.0, DynamicsSummary(result.superelement));
+  }
+  Stopwatch write_clock;
+  WriteSuperelementFile(result.superelement, output);
+  if (progress) progress("write", write_clock.Seconds(), output);
+  out.superelement = std::move(result.superelement);
+  return out;
+}
+
+}  // namespace femb
