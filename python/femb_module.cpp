@@ -5,11 +5,15 @@
 // Matrices come back as numpy arrays that own the Eigen data moved into them (no copy).
 #include <pybind11/eigen.h>
 #include <pybind11/functional.h>
+#include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
 #include <atomic>
+#include <cmath>
+#include <memory>
 #include <string>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -80,6 +84,72 @@ femb::Superelement Reduce(const std::string& text, const std::string& name, cons
   return std::move(outcome.superelement);
 }
 
+// A Python function as a UserNodeForce: called with the GIL (the run releases it) as
+// function(t, position, rotation, velocity, angular_velocity) -> f (6: force, moment about the
+// node, world axes), or with `jacobian` -> (f, K, C), K = df/d(x, theta), C = df/d(v, omega) (6 x
+// 6). Whatever goes wrong (an exception, a wrong shape, a value not finite) is a UserForceError
+// naming the force and the time.
+femb::UserNodeForce PythonForce(const std::string& name, const py::object& function, bool jacobian) {
+  // The function's reference is released with the GIL held, wherever the last copy goes.
+  const auto held = std::shared_ptr<py::object>(new py::object(function), [](py::object* o) {
+    py::gil_scoped_acquire gil;
+    delete o;
+  });
+  femb::UserNodeForce force;
+  force.name = name;
+  force.evaluate = [held, name, jacobian](double t, const Eigen::Vector3d& x, const Eigen::Matrix3d& R,
+                                          const Eigen::Vector3d& v, const Eigen::Vector3d& w,
+                                          femb::UserNodeForce::Vector6& f, femb::UserNodeForce::Matrix6* K,
+                                          femb::UserNodeForce::Matrix6* C) {
+    py::gil_scoped_acquire gil;
+    char where[160];
+    std::snprintf(where, sizeof where, "force '%s' at t = %.9g: ", name.c_str(), t);
+    using Array = py::array_t<double, py::array::c_style | py::array::forcecast>;
+    const auto take = [&](const py::handle& value, long rows, long cols, const char* what, double* out) {
+      Array a;
+      try {
+        a = Array::ensure(value);
+      } catch (py::error_already_set&) {
+      }
+      if (!a || a.size() != rows * cols || (cols > 1 && (a.ndim() != 2 || a.shape(0) != rows))) {
+        throw femb::UserForceError(std::string(where) + what + " must be " + std::to_string(rows) +
+                                   (cols > 1 ? " x " + std::to_string(cols) : std::string(" numbers")) + ", got " +
+                                   std::string(py::str(value.attr("__repr__")())).substr(0, 80));
+      }
+      for (long i = 0; i < rows * cols; ++i) {
+        out[i] = a.data()[i];
+        if (!std::isfinite(out[i])) throw femb::UserForceError(std::string(where) + what + " is not finite");
+      }
+    };
+    py::object value;
+    try {
+      value = (*held)(t, x, R, v, w);
+    } catch (py::error_already_set& e) {
+      throw femb::UserForceError(std::string(where) + "raised " + e.what());
+    }
+    if (!jacobian) {
+      take(value, 6, 1, "the force (fx, fy, fz, mx, my, mz)", f.data());
+      return false;
+    }
+    if (!py::isinstance<py::tuple>(value) || py::len(value) != 3) {
+      throw femb::UserForceError(std::string(where) + "with jacobian=True, return (f, K, C)");
+    }
+    const py::tuple triple = value.cast<py::tuple>();
+    take(triple[0], 6, 1, "the force (fx, fy, fz, mx, my, mz)", f.data());
+    Eigen::Matrix<double, 6, 6, Eigen::RowMajor> m;
+    if (K) {
+      take(triple[1], 6, 6, "K = df/d(x, theta)", m.data());
+      *K = m;
+    }
+    if (C) {
+      take(triple[2], 6, 6, "C = df/d(v, omega)", m.data());
+      *C = m;
+    }
+    return true;
+  };
+  return force;
+}
+
 // A scene run: its results in memory, and in `output` when one is given.
 struct RunResult {
   int exit_code = 0;
@@ -87,16 +157,23 @@ struct RunResult {
   femb::RecordedResults results;
   Eigen::VectorXd frequencies_hz;
   std::string analysis;
+  long steps = 0, iterations = 0;
 };
 
 RunResult Run(const std::string& text, const std::string& name, const std::vector<std::string>& overrides,
-              const std::string& output, int threads, const py::object& progress, const py::object& warning) {
+              const std::string& output, int threads, const py::object& progress, const py::object& warning,
+              const py::list& forces) {
   femb::SolveRunOptions options;
   options.in_memory = output.empty();
   options.output = output;
   if (threads > 0) options.threads = threads;
   options.progress = LineSink(progress);
   options.warning = LineSink(warning);
+  for (const py::handle item : forces) {
+    const auto [node, force_name, function, jacobian] =
+        item.cast<std::tuple<std::string, std::string, py::object, bool>>();
+    options.user_forces.push_back({node, PythonForce(force_name, function, jacobian)});
+  }
   femb::SolveRun run(femb::ParseScene(text, name, overrides), std::move(options));
   RunResult r;
   {
@@ -108,6 +185,8 @@ RunResult Run(const std::string& text, const std::string& name, const std::vecto
   r.results = std::as_const(run).recorder().Results();
   r.frequencies_hz = run.frequencies_hz();
   r.analysis = femb::Name(run.spec().analysis.type);
+  r.steps = run.steps();
+  r.iterations = run.iterations();
   return r;
 }
 
@@ -156,7 +235,9 @@ void BindResults(py::module_& m) {
       .def_readonly("error", &RunResult::error)
       .def_readonly("results", &RunResult::results)
       .def_readonly("frequencies_hz", &RunResult::frequencies_hz)
-      .def_readonly("analysis", &RunResult::analysis);
+      .def_readonly("analysis", &RunResult::analysis)
+      .def_readonly("steps", &RunResult::steps)
+      .def_readonly("iterations", &RunResult::iterations);
 }
 
 void BindSuperelement(py::module_& m) {
@@ -223,7 +304,7 @@ PYBIND11_MODULE(_core, m) {
   m.def("reduce", &Reduce, py::arg("text"), py::arg("name"), py::arg("overrides"), py::arg("output"),
         py::arg("progress"), py::arg("warning"));
   m.def("run", &Run, py::arg("text"), py::arg("name"), py::arg("overrides"), py::arg("output"), py::arg("threads"),
-        py::arg("progress"), py::arg("warning"));
+        py::arg("progress"), py::arg("warning"), py::arg("forces"));
   m.def("check_scene", [](const std::string& text, const std::string& name, const std::vector<std::string>& overrides) {
     femb::ParseScene(text, name, overrides);
   });

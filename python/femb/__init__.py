@@ -176,6 +176,7 @@ class Scene:
     def __init__(self, spec, base_dir=None):
         self._text, self._name = _document(spec, "scene", base_dir)
         self._set = {}
+        self._forces = []
         _core.check_scene(self._text, self._name, [])
 
     @classmethod
@@ -194,6 +195,24 @@ class Scene:
         self._set = trial
         return self
 
+    def add_force(self, node, function, jacobian=False, name=None):
+        """Adds a force written in Python on a node of the scene. Returns the scene.
+
+        function(t, position, rotation, velocity, angular_velocity) returns the force and the
+        moment about the node, (fx, fy, fz, mx, my, mz), in world axes and the scene's units, of
+        the time t [s] (statics: the load factor, at rest) and the node's position (3), rotation
+        (3 x 3, node axes in world axes), velocity (3) and angular velocity (3, world axes). With
+        jacobian=True it returns (f, K, C): K = df/d(position, theta) with theta the rotation
+        increment in world axes (rotation -> exp(theta~) rotation), C = df/d(velocity,
+        angular_velocity), each 6 x 6; without, femb differences the function (12 more calls
+        whenever the iteration matrix is built). It enters Newton's residual and matrix like the
+        built-in loads, the reactions and the energy balance's external work, with either
+        integrator, statics and step: auto. An exception, a wrong shape or a value that is not
+        finite stops the run with NumericalError naming the force and the time (results kept).
+        """
+        self._forces.append((str(node), name or getattr(function, "__name__", "force"), function, bool(jacobian)))
+        return self
+
     def run(self, output=None, threads=1, progress=None):
         """Runs the scene's analysis and returns its Results.
 
@@ -204,7 +223,7 @@ class Scene:
         A numerical failure raises NumericalError with the results up to it in `.results`.
         """
         r = _core.run(self._text, self._name, _overrides(self._set), os.fspath(output) if output else "",
-                      int(threads), progress, _warn)
+                      int(threads), progress, _warn, self._forces)
         results = Results(r)
         if r.exit_code != 0:
             error = NumericalError(r.error)
@@ -235,7 +254,8 @@ class Results:
     time; probes: {column: values} with probes.csv's column names in full precision;
     energy: {"kinetic", "elastic", "external_work", "linear_momentum", "angular_momentum"};
     node(name) and body(name): their series; frequencies: a modes analysis' [Hz];
-    steps: every step taken {"time", "size"}; status: "completed" or what stopped the run.
+    steps: every step taken {"time", "size"}; step_count and newton_iterations over the run;
+    status: "completed" or what stopped the run.
     """
 
     def __init__(self, run_result):
@@ -244,6 +264,8 @@ class Results:
         self.status = run_result.status
         self.analysis = run_result.analysis
         self.ok = run_result.exit_code == 0
+        self.step_count = run_result.steps
+        self.newton_iterations = run_result.iterations
         self.time = r.time
         probes = r.probes
         self.probes = {name: probes[:, i] for i, name in enumerate(r.probe_names)}

@@ -42,6 +42,8 @@ void FinishAssembly(const SystemModel& model, const DofMap& dofs, const SystemSt
   const int n = dofs.n_dofs();
   loads.setZero(n);
   AddNodeLoads(model, config, t, loads, matrices ? &parts.K : nullptr, &parts.node_forces);
+  AddUserForces(model, config, W, t, &loads, matrices ? &parts.K : nullptr, matrices ? &parts.C : nullptr,
+                &parts.node_forces);
   out.residual += loads;
   out.f_ext += loads;
   springs.setZero(n);

@@ -166,6 +166,8 @@ SystemForces AssembleStatic(const SystemModel& model, const DofMap& dofs, System
   }
   Eigen::VectorXd loads = Eigen::VectorXd::Zero(n);
   AddNodeLoads(model, state, lambda, loads, with_tangent ? &tangent : nullptr, &node_forces);
+  AddUserForces(model, state, Eigen::VectorXd(), lambda, &loads, with_tangent ? &tangent : nullptr, nullptr,
+                &node_forces);
   loads += gravity;
   out.loads = loads;
   AddSpringDampers(model, state, Eigen::VectorXd(), &loads, with_tangent ? &tangent : nullptr, nullptr,
@@ -212,10 +214,10 @@ void AddSpringDampers(const SystemModel& model, const SystemState& state, const 
                       Eigen::VectorXd* residual, Triplets* K, Triplets* C, double* energy, NodeForces* node_forces,
                       SystemScratch* scratch) {
   SystemScratch own;
-  SystemScratch& s = scratch ? *scratch : own;
-  std::vector<MapEntry>& map = s.map;  // the 6 translational components (a, b) -> coordinates
-  Eigen::VectorXd& fv = s.fv;
-  Eigen::MatrixXd &Km = s.Km, &Cm = s.Cm;
+  SystemScratch& work = scratch ? *scratch : own;
+  std::vector<MapEntry>& map = work.map;  // the 6 translational components (a, b) -> coordinates
+  Eigen::VectorXd& fv = work.fv;
+  Eigen::MatrixXd &Km = work.Km, &Cm = work.Cm;
   for (const SpringDamper& s : model.springs) {
     Eigen::Vector3d x[2], v[2];
     const int nodes[2] = {s.node_a, s.node_b};

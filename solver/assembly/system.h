@@ -40,6 +40,13 @@ SystemForces AssembleStatic(const SystemModel& model, const DofMap& dofs, System
 void AddNodeLoads(const SystemModel& model, const SystemState& state, double t, Eigen::VectorXd& residual,
                   Triplets* tangent, NodeForces* node_forces = nullptr);
 
+/// The user's forces (SystemModel::user_forces, solver/forces/user_force.h) at time t (statics:
+/// the load factor) added to `residual` (as applied forces), -d f / dq to `K` and -d f / dv to
+/// `C` and the forces to `node_forces`, each when not null. W may be empty (at rest). A user
+/// function's failure throws UserForceError.
+void AddUserForces(const SystemModel& model, const SystemState& state, const Eigen::VectorXd& W, double t,
+                   Eigen::VectorXd* residual, Triplets* K, Triplets* C, NodeForces* node_forces);
+
 /// Spring-damper forces added to `residual` (as applied forces), their stiffness and damping
 /// (of -f) to `K`, `C`, their energy to `energy`, each when not null. W may be empty (static).
 void AddSpringDampers(const SystemModel& model, const SystemState& state, const Eigen::VectorXd& W,

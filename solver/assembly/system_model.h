@@ -26,6 +26,7 @@
 
 #include "solver/body/superelement_body.h"
 #include "solver/forces/spring_damper.h"
+#include "solver/forces/user_force.h"
 #include "solver/joints/loop_closure.h"
 #include "solver/joints/node_joint.h"
 
@@ -67,6 +68,7 @@ struct SystemModel {
   std::vector<std::string> body_names;       ///< for messages (may be empty)
   std::vector<NodeLoad> loads;
   std::vector<SpringDamper> springs;
+  std::vector<UserNodeForce> user_forces;             ///< written by the user (the Python module)
   Eigen::Vector3d gravity = Eigen::Vector3d::Zero();  ///< uniform acceleration field
   /// Static analyses: gravity grows linearly with the pseudo-time to full at this value (the
   /// analysis' end_time); 0: no gravity in AssembleStatic (dynamic analyses add it themselves).

@@ -239,6 +239,7 @@ void AddDynamicMatrices(const SystemModel& model, const DofMap& dofs, const Dyna
   Eigen::VectorXd& unused = work.unused;
   unused.setZero(n);
   AddNodeLoads(model, s.config, t, unused, &K);
+  AddUserForces(model, s.config, s.W, t, nullptr, &K, &C, nullptr);
   AddSpringDampers(model, s.config, s.W, nullptr, &K, &C, nullptr, nullptr, &work.parts.scratch);
   AddLoopConstraints(model, dofs, s.config, nullptr, &K, nullptr, nullptr, kLoopAll, &work.pass_data,
                      &work.parts.scratch);

@@ -387,10 +387,11 @@ void AssembleMidpoint(const SystemModel& model, const DofMap& dofs, const Dynami
 double StepExternalWork(const SystemModel& model, const DofMap& dofs, double t_mid, MidpointWorkspace& mw) {
   double work = 0.0;
   for (double w : mw.gravity_work) work += w;
-  if (model.loads.empty()) return work;
+  if (model.loads.empty() && model.user_forces.empty()) return work;
   mw.loads.f.assign(size_t(model.n_nodes()), Eigen::Matrix<double, 6, 1>::Zero());
   mw.unused.setZero(dofs.n_dofs());
   AddNodeLoads(model, mw.k.mid, t_mid, mw.unused, nullptr, &mw.loads);
+  AddUserForces(model, mw.k.mid, mw.rates, t_mid, nullptr, nullptr, nullptr, &mw.loads);
   for (int node = 0; node < model.n_nodes(); ++node) work += mw.k.node_step[size_t(node)].dot(mw.loads.f[size_t(node)]);
   return work;
 }
@@ -464,6 +465,7 @@ const SystemMatrix& MidpointMatrix(const SystemModel& model, const DofMap& dofs,
   C.clear();
   mw.unused.setZero(dofs.n_dofs());
   AddNodeLoads(model, k.mid, s0.t + 0.5 * h, mw.unused, &K);
+  AddUserForces(model, k.mid, mw.rates, s0.t + 0.5 * h, nullptr, &K, &C, nullptr);
   AddSpringDampers(model, k.mid, mw.rates, nullptr, &K, &C, nullptr, nullptr, &work.parts.scratch);
   AddJointGeometricStiffness(model, dofs, k.mid, a.node_forces, K, &work.parts.scratch);
   AddTimesColumns(K, 1.0, k.T, triples, mw.triple_of, S);

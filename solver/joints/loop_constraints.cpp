@@ -53,8 +53,8 @@ void AddBodyConstraints(const SystemModel& model, const DofMap& dofs, const Syst
     const SuperelementBody& body = model.bodies[b];
     const int r = body.n_constraints();
     if (r == 0) continue;
-    std::optional<BodyData> own;
-    BodyData* d = BodyDataFor(model, state, int(b), data, own);
+    std::optional<BodyData> evaluated;
+    BodyData* d = BodyDataFor(model, state, int(b), data, evaluated);
     if (!d) continue;
     const int first = dofs.body_multiplier_first(int(b));
     lambda = state.lambda.segment(first - dofs.first_multiplier(), r);
@@ -316,8 +316,8 @@ double LoopViolation(const SystemModel& model, const SystemState& state, int* wo
   for (size_t b = 0; b < model.bodies.size(); ++b) {
     const SuperelementBody& body = model.bodies[b];
     if (body.n_constraints() == 0) continue;
-    std::optional<BodyData> own;
-    BodyData* d = BodyDataFor(model, state, int(b), data, own);
+    std::optional<BodyData> evaluated;
+    BodyData* d = BodyDataFor(model, state, int(b), data, evaluated);
     SystemScratch own_scratch;  // (no allocation with `data` and `scratch`)
     Eigen::VectorXd& g = (scratch ? *scratch : own_scratch).g;
     if (d) InterfaceConstraint(body, *d, &g, nullptr, nullptr, nullptr);  // lengths

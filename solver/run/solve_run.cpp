@@ -59,10 +59,27 @@ DynamicState AtRest(const SystemState& config, double t) {
   return s;
 }
 
+// The scene with the caller's forces on its nodes (one line for a node it does not have).
+Scene WithUserForces(Scene scene, const std::vector<UserForceSpec>& forces) {
+  for (const UserForceSpec& spec : forces) {
+    const auto k = scene.node_index.find(spec.node);
+    if (k == scene.node_index.end()) {
+      throw InputError(scene.spec.file + ": force '" + spec.force.name + "': no node '" + spec.node + "' in the scene");
+    }
+    UserNodeForce force = spec.force;
+    force.node = k->second;
+    scene.model.user_forces.push_back(std::move(force));
+  }
+  return scene;
+}
+
 }  // namespace
 
 SolveRun::SolveRun(SceneSpec spec, SolveRunOptions options)
-    : options_(std::move(options)), wall_(options_.started), spec_(std::move(spec)), scene_(BuildScene(spec_)) {}
+    : options_(std::move(options)),
+      wall_(options_.started),
+      spec_(std::move(spec)),
+      scene_(WithUserForces(BuildScene(spec_), options_.user_forces)) {}
 
 void SolveRun::Say(const char* format, ...) const {
   if (!options_.progress) return;
@@ -90,11 +107,19 @@ int SolveRun::Run() {
   if (resume_) ResumeRecorder();
   read_seconds_ = Seconds(wall_);  // scene, superelement files, model
   if (!quiet()) PrintSummary();
-  if (spec_.analysis.type == AnalysisType::kModes) return RunModes();
-  if (spec_.analysis.type == AnalysisType::kStatic) {
-    RunStatic();
-  } else {
-    RunDynamic();
+  try {
+    if (spec_.analysis.type == AnalysisType::kModes) return RunModes();
+    if (spec_.analysis.type == AnalysisType::kStatic) {
+      RunStatic();
+    } else {
+      RunDynamic();
+    }
+  } catch (const UserForceError& e) {
+    // A user function failed (raised, NaN, a wrong shape): a numerical failure with the results
+    // recorded up to it; the state it failed in is no state to continue from.
+    ok_ = false;
+    status_ = e.what();
+    no_checkpoint_ = true;
   }
   return Finish();
 }
@@ -219,7 +244,7 @@ void SolveRun::Take(const DynamicStepReport& report) {
   saved_steps_ = step_count_, saved_iterations_ = total_iterations_;
 }
 void SolveRun::SaveCheckpoint(const DynamicState& state) {
-  if (options_.in_memory) return;
+  if (options_.in_memory || no_checkpoint_) return;
   const AnalysisType kind = is_static() ? AnalysisType::kStatic : AnalysisType::kDynamic;
   if (!saved_) return WriteCheckpoint(options_.output, scene_, signature_, state, kind);
   WriteCheckpoint(options_.output, scene_, signature_, saved_->state, kind, &*saved_, [&](h5::Writer& w) {

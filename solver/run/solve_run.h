@@ -20,6 +20,12 @@
 
 namespace femb {
 
+/// A force the caller writes (UserNodeForce), on a node named as in the scene.
+struct UserForceSpec {
+  std::string node;
+  UserNodeForce force;
+};
+
 /// How a scene is run and where its words go.
 struct SolveRunOptions {
   /// The output folder; empty: out/<scene name>, or none with `in_memory`.
@@ -36,6 +42,8 @@ struct SolveRunOptions {
   std::function<void(const std::string&)> warning;
   /// Set (to a signal's number) to stop the run at the end of its step; null: never.
   const std::atomic<int>* stop = nullptr;
+  /// Forces the caller writes, added to the scene's loads.
+  std::vector<UserForceSpec> user_forces;
   /// When the run began (its reading time counts from here: the scene file was read before).
   std::chrono::steady_clock::time_point started = std::chrono::steady_clock::now();
 };
@@ -60,6 +68,9 @@ class SolveRun {
   const Scene& scene() const { return scene_; }
   /// The results recorded (after Run).
   const ResultsRecorder& recorder() const { return *recorder_; }
+  /// Steps taken (static: load steps) and Newton iterations over them.
+  long steps() const { return step_count_; }
+  long iterations() const { return total_iterations_; }
   /// modes analysis: the frequencies found (Hz).
   const Eigen::VectorXd& frequencies_hz() const { return frequencies_hz_; }
 
@@ -103,9 +114,10 @@ class SolveRun {
   double last_print_ = -1.0;
   std::string status_ = "completed", error_;
   bool ok_ = true;
-  int stopped_ = 0;           ///< the signal that stopped the analysis, or 0
-  double stopped_at_ = 0.0;   ///< the time (static: load factor) it stopped at
-  DynamicState final_state_;  ///< the state the analysis ended in (static: at rest)
+  bool no_checkpoint_ = false;  ///< a user function failed: no state to continue from
+  int stopped_ = 0;             ///< the signal that stopped the analysis, or 0
+  double stopped_at_ = 0.0;     ///< the time (static: load factor) it stopped at
+  DynamicState final_state_;    ///< the state the analysis ended in (static: at rest)
   Eigen::VectorXd frequencies_hz_;
   // What a restart continues from (Take), with the results' mark and the counts there.
   std::optional<DynamicResume> saved_;
