@@ -11,8 +11,12 @@
 
 #include <atomic>
 #include <cmath>
+#include <condition_variable>
+#include <csignal>
 #include <memory>
+#include <mutex>
 #include <string>
+#include <thread>
 #include <tuple>
 #include <utility>
 #include <vector>
@@ -26,6 +30,7 @@
 #include "inspect/superelement_checks.h"
 #include "inspect/vtu_writer.h"
 #include "reducer/reduce_file.h"
+#include "solver/joints/joint_tree.h"
 #include "solver/run/solve_run.h"
 
 namespace py = pybind11;
@@ -150,6 +155,23 @@ femb::UserNodeForce PythonForce(const std::string& name, const py::object& funct
   return force;
 }
 
+// The options of a run from Python: in memory unless `output`, the caller's words and forces.
+femb::SolveRunOptions RunOptions(const std::string& output, int threads, const py::object& progress,
+                                 const py::object& warning, const py::list& forces) {
+  femb::SolveRunOptions options;
+  options.in_memory = output.empty();
+  options.output = output;
+  if (threads > 0) options.threads = threads;
+  options.progress = LineSink(progress);
+  options.warning = LineSink(warning);
+  for (const py::handle item : forces) {
+    const auto [node, force_name, function, jacobian] =
+        item.cast<std::tuple<std::string, std::string, py::object, bool>>();
+    options.user_forces.push_back({node, PythonForce(force_name, function, jacobian)});
+  }
+  return options;
+}
+
 // A scene run: its results in memory, and in `output` when one is given.
 struct RunResult {
   int exit_code = 0;
@@ -163,18 +185,7 @@ struct RunResult {
 RunResult Run(const std::string& text, const std::string& name, const std::vector<std::string>& overrides,
               const std::string& output, int threads, const py::object& progress, const py::object& warning,
               const py::list& forces) {
-  femb::SolveRunOptions options;
-  options.in_memory = output.empty();
-  options.output = output;
-  if (threads > 0) options.threads = threads;
-  options.progress = LineSink(progress);
-  options.warning = LineSink(warning);
-  for (const py::handle item : forces) {
-    const auto [node, force_name, function, jacobian] =
-        item.cast<std::tuple<std::string, std::string, py::object, bool>>();
-    options.user_forces.push_back({node, PythonForce(force_name, function, jacobian)});
-  }
-  femb::SolveRun run(femb::ParseScene(text, name, overrides), std::move(options));
+  femb::SolveRun run(femb::ParseScene(text, name, overrides), RunOptions(output, threads, progress, warning, forces));
   RunResult r;
   {
     py::gil_scoped_release release;
@@ -189,6 +200,134 @@ RunResult Run(const std::string& text, const std::string& name, const std::vecto
   r.iterations = run.iterations();
   return r;
 }
+
+// A dynamic run stepped under the caller's control: the run goes on a thread of its own and waits
+// after each step that reaches the time asked for (StepTo), so that the caller reads the state
+// (and changes what its forces read) between steps. The run is SolveRun's, the same steps and
+// results as Run's to the bit.
+class Simulation {
+ public:
+  Simulation(const std::string& text, const std::string& name, const std::vector<std::string>& overrides,
+             const std::string& output, int threads, const py::object& progress, const py::object& warning,
+             const py::list& forces) {
+    femb::SolveRunOptions options = RunOptions(output, threads, progress, warning, forces);
+    options.stop = &stop_;
+    options.after_step = [this](const femb::DynamicState& s) { Pause(s); };
+    femb::SceneSpec spec = femb::ParseScene(text, name, overrides);
+    if (spec.analysis.type != femb::AnalysisType::kDynamic) {
+      throw femb::InputError(spec.file + ": start() steps a dynamic analysis; run() the " +
+                             femb::Name(spec.analysis.type) + " one");
+    }
+    run_ = std::make_unique<femb::SolveRun>(std::move(spec), std::move(options));
+  }
+  Simulation(const Simulation&) = delete;
+  Simulation& operator=(const Simulation&) = delete;
+  ~Simulation() { Close(); }
+
+  /// Steps until the first step that ends at or after t (or the run's end); returns that time.
+  double StepTo(double t) {
+    {
+      py::gil_scoped_release release;
+      std::unique_lock<std::mutex> lock(mutex_);
+      if (!done_) {
+        target_ = t;
+        if (!worker_.joinable()) {
+          worker_ = std::thread([this] { Work(); });
+        } else {
+          paused_ = false;
+          changed_.notify_all();
+        }
+        changed_.wait(lock, [this] { return paused_ || done_; });
+      }
+    }
+    if (error_) std::rethrow_exception(error_);
+    return time_;
+  }
+  /// Stops the run at its next step's end (its results so far kept) and waits for it.
+  void Close() {
+    py::gil_scoped_release release;
+    {
+      std::unique_lock<std::mutex> lock(mutex_);
+      if (!worker_.joinable()) return;
+      if (!done_) {
+        stop_ = SIGTERM;
+        paused_ = false;
+        changed_.notify_all();
+      }
+    }
+    worker_.join();
+  }
+  double time() const { return time_; }
+  bool done() const { return done_; }
+  /// A node's position, rotation, velocity and angular velocity at the last pause (world axes).
+  py::dict Node(const std::string& name) const {
+    std::unique_lock<std::mutex> lock(mutex_);
+    const femb::Scene& scene = run_->scene();
+    const auto k = scene.node_index.find(name);
+    if (k == scene.node_index.end()) throw femb::InputError("no node '" + name + "' in the scene");
+    if (!has_state_) throw femb::InputError("no state yet: step_to() a time first");
+    const femb::SystemState& c = state_.config;
+    const Eigen::Matrix<double, 6, 1> motion = femb::NodeMotion(c, k->second, state_.W);
+    py::dict out;
+    out["position"] = Eigen::Vector3d(c.x[size_t(k->second)] + scene.origin);
+    out["rotation"] = c.R[size_t(k->second)];
+    out["velocity"] = Eigen::Vector3d(motion.head<3>());
+    out["angular_velocity"] = Eigen::Vector3d(motion.tail<3>());
+    return out;
+  }
+  /// The results so far (paused or done).
+  RunResult Results() const {
+    std::unique_lock<std::mutex> lock(mutex_);
+    RunResult r;
+    r.exit_code = done_ ? exit_code_ : 0;
+    r.status = done_ ? run_->status() : "paused";
+    r.error = run_->error();
+    if (worker_.joinable() || done_) r.results = std::as_const(*run_).recorder().Results();
+    r.analysis = femb::Name(run_->spec().analysis.type);
+    r.steps = run_->steps();
+    r.iterations = run_->iterations();
+    return r;
+  }
+
+ private:
+  void Work() {
+    int code = 1;
+    std::exception_ptr error;
+    try {
+      code = run_->Run();
+    } catch (...) {
+      error = std::current_exception();
+    }
+    std::unique_lock<std::mutex> lock(mutex_);
+    exit_code_ = code;
+    error_ = error;
+    done_ = true;
+    changed_.notify_all();
+  }
+  // After each step: go on below the target; else keep the state for the caller and wait.
+  void Pause(const femb::DynamicState& s) {
+    std::unique_lock<std::mutex> lock(mutex_);
+    time_ = s.t;
+    const double slack = std::isfinite(target_) ? 1e-12 * std::max(1.0, std::abs(target_)) : 0.0;
+    if (stop_ != 0 || s.t < target_ - slack) return;
+    state_ = s;
+    has_state_ = true;
+    paused_ = true;
+    changed_.notify_all();
+    changed_.wait(lock, [this] { return !paused_; });
+  }
+
+  std::unique_ptr<femb::SolveRun> run_;
+  std::thread worker_;
+  mutable std::mutex mutex_;
+  std::condition_variable changed_;
+  std::atomic<int> stop_{0};
+  double target_ = 0.0, time_ = 0.0;
+  bool paused_ = false, done_ = false, has_state_ = false;
+  int exit_code_ = 0;
+  std::exception_ptr error_;
+  femb::DynamicState state_;
+};
 
 void BindResults(py::module_& m) {
   using B = femb::RecordedResults::Body;
@@ -305,6 +444,15 @@ PYBIND11_MODULE(_core, m) {
         py::arg("progress"), py::arg("warning"));
   m.def("run", &Run, py::arg("text"), py::arg("name"), py::arg("overrides"), py::arg("output"), py::arg("threads"),
         py::arg("progress"), py::arg("warning"), py::arg("forces"));
+  py::class_<Simulation>(m, "Simulation")
+      .def(py::init<const std::string&, const std::string&, const std::vector<std::string>&, const std::string&, int,
+                    const py::object&, const py::object&, const py::list&>())
+      .def("step_to", &Simulation::StepTo)
+      .def("close", &Simulation::Close)
+      .def_property_readonly("time", &Simulation::time)
+      .def_property_readonly("done", &Simulation::done)
+      .def("node", &Simulation::Node)
+      .def("results", &Simulation::Results);
   m.def("check_scene", [](const std::string& text, const std::string& name, const std::vector<std::string>& overrides) {
     femb::ParseScene(text, name, overrides);
   });

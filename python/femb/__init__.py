@@ -9,6 +9,10 @@ femb-reduce, femb-inspect and femb-solve, and the results as numpy arrays.
     scene.set("analysis.end_time", 0.03)        # the --set key paths
     results = scene.run()                       # in memory; run(output="out/dir") also writes files
     results.probes["rod_mid.position.y"]        # numpy, one value per output step
+    scene.add_force("rod_mid", lambda t, x, R, v, w: [0, -1.0 * x[1], 0, 0, 0, 0])   # a force in Python
+    with scene.start() as sim:                  # stepping under your control
+        sim.step_to(0.01)
+        sim.node("rod_mid")["position"]
 
 Units are the part's and the scene's (`units:`, SI by default). Errors: a bad input raises
 femb.InputError whose message is the program's line (file, line, key); a numerical failure
@@ -26,7 +30,7 @@ from ._core import FembError, InputError, NumericalError, RefusedError
 
 from .sweep import sweep
 
-__all__ = ["reduce", "Superelement", "Scene", "Results", "sweep", "FembError", "InputError", "NumericalError",
+__all__ = ["reduce", "Superelement", "Scene", "Simulation", "Results", "sweep", "FembError", "InputError", "NumericalError",
            "RefusedError", "FembWarning"]
 
 
@@ -213,6 +217,13 @@ class Scene:
         self._forces.append((str(node), name or getattr(function, "__name__", "force"), function, bool(jacobian)))
         return self
 
+    def start(self, output=None, threads=1, progress=None):
+        """A dynamic analysis to step under your control: a Simulation (see its step_to). The
+        arguments as run()'s."""
+        return Simulation(_core.Simulation(self._text, self._name, _overrides(self._set),
+                                           os.fspath(output) if output else "", int(threads), progress, _warn,
+                                           self._forces))
+
     def run(self, output=None, threads=1, progress=None):
         """Runs the scene's analysis and returns its Results.
 
@@ -246,6 +257,72 @@ def _plain(series):
 
     names = [n for n in dir(series) if not n.startswith("_")]
     return types.SimpleNamespace(**{n: copy(getattr(series, n)) for n in names})
+
+
+class Simulation:
+    """A dynamic run stepped under the caller's control (Scene.start): step_to(t) takes the
+    scene's steps up to the first that ends at or after t; between steps the caller reads the
+    state (node(name), time, results()) and may change what its forces read, for co-simulation
+    and controllers. The same steps and results as run()'s. A context manager; close() (or the
+    end of a with block) stops an unfinished run.
+
+        with scene.start() as sim:
+            for t in np.arange(0.001, 0.1, 0.001):
+                sim.step_to(t)
+                controller.update(sim.node("tip")["position"])
+            results = sim.finish()
+    """
+
+    def __init__(self, core):
+        self._core = core
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+    @property
+    def time(self):
+        """The time the run has reached [s]."""
+        return self._core.time
+
+    @property
+    def done(self):
+        return self._core.done
+
+    def step_to(self, t):
+        """Steps to the first step end at or after t (at most to the analysis' end_time); returns
+        the time reached. A numerical failure raises NumericalError with the results so far."""
+        reached = self._core.step_to(float(t))
+        if self._core.done:
+            self._raise_if_failed()
+        return reached
+
+    def node(self, name):
+        """The node's position, rotation (3 x 3), velocity and angular velocity (world axes) now."""
+        return self._core.node(name)
+
+    def results(self):
+        """The results recorded so far."""
+        return Results(self._core.results())
+
+    def finish(self):
+        """Runs to the analysis' end_time and returns the Results."""
+        self._core.step_to(float("inf"))
+        self._raise_if_failed()
+        return self.results()
+
+    def close(self):
+        """Stops an unfinished run at its next step's end (the results so far are kept)."""
+        self._core.close()
+
+    def _raise_if_failed(self):
+        r = self._core.results()
+        if r.exit_code == 3:
+            error = NumericalError(r.error)
+            error.results = Results(r)
+            raise error
 
 
 class Results:

@@ -435,6 +435,7 @@ void SolveRun::RunDynamic() {
         }
         if (s.last) Take(s);
         Progress(s.t, false);
+        if (options_.after_step) options_.after_step(st);
       });
   ok_ = r.ok;
   if (!ok_) status_ = r.message;

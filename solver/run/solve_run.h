@@ -42,6 +42,9 @@ struct SolveRunOptions {
   std::function<void(const std::string&)> warning;
   /// Set (to a signal's number) to stop the run at the end of its step; null: never.
   const std::atomic<int>* stop = nullptr;
+  /// Dynamic analyses: called after each step is taken and recorded, with the state it reached
+  /// (the Python module's stepping under the caller's control waits here).
+  std::function<void(const DynamicState&)> after_step;
   /// Forces the caller writes, added to the scene's loads.
   std::vector<UserForceSpec> user_forces;
   /// When the run began (its reading time counts from here: the scene file was read before).
