@@ -1,7 +1,8 @@
 #!/usr/bin/python3
 """What the Python route costs: the 10-body slider-crank (examples/slider_crank_2d with its rod
-in 10 superelements, 10 us steps, 0.126 s) run by femb-solve and by femb.Scene.run, best of 3
-interleaved runs, one thread; and a force written in Python, its cost per call.
+in 10 superelements, 10 us steps, 0.126 s) run by femb-solve, by femb.Scene.run and stepped by
+Simulation.step_to (reading a node at each pause), best of 3 interleaved runs, one thread; and a
+force written in Python, its cost per call.
 
 usage: PYTHONPATH=build/python /usr/bin/python3 benchmarks/python_overhead.py [BIN] [--repeat N]
 Prints what it measured on this run.
@@ -40,7 +41,8 @@ def main():
         subprocess.run([os.path.join(binary, "femb-reduce"), "-q", os.path.join(variant, "rod_10.yaml"), "-o",
                         os.path.join(variant, "rod_10.h5")], check=True)
         scene_file = os.path.join(variant, "scene.yaml")
-        times = {"femb-solve -o DIR": [], "Scene.run(output=DIR)": [], "Scene.run() in memory": []}
+        times = {"femb-solve -o DIR": [], "Scene.run(output=DIR)": [], "Scene.run() in memory": [],
+                 "Scene.start(), step_to every 1 ms, in memory": [], "Scene.start(), step_to every step, in memory": []}
         for _ in range(args.repeat):
             start = time.perf_counter()
             subprocess.run([os.path.join(binary, "femb-solve"), "-q", scene_file, "-o", os.path.join(work, "cli"),
@@ -52,6 +54,15 @@ def main():
             start = time.perf_counter()
             results = femb.Scene.load(scene_file).run()
             times["Scene.run() in memory"].append(time.perf_counter() - start)
+            for every, route in ((1e-3, "Scene.start(), step_to every 1 ms, in memory"),
+                                 (1e-5, "Scene.start(), step_to every step, in memory")):
+                start = time.perf_counter()
+                with femb.Scene.load(scene_file).start() as sim:
+                    for k in range(1, int(round(0.126 / every)) + 1):
+                        sim.step_to(k * every)
+                        sim.node("rod_mid")
+                    sim.finish()
+                times[route].append(time.perf_counter() - start)
         steps = results.step_count
         base = min(times["femb-solve -o DIR"])
         print(f"python_overhead: 10-body slider-crank, {steps} steps, one thread, best of {args.repeat} (this run)")

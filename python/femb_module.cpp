@@ -453,6 +453,8 @@ PYBIND11_MODULE(_core, m) {
       .def_property_readonly("done", &Simulation::done)
       .def("node", &Simulation::Node)
       .def("results", &Simulation::Results);
+  m.def("write_results", &femb::WriteResultsFile, py::arg("results"), py::arg("status"), py::arg("path"));
+  m.def("write_probes_csv", &femb::WriteProbesCsv, py::arg("results"), py::arg("path"));
   m.def("check_scene", [](const std::string& text, const std::string& name, const std::vector<std::string>& overrides) {
     femb::ParseScene(text, name, overrides);
   });

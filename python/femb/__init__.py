@@ -397,6 +397,21 @@ class Results:
                 return out
         raise KeyError(f"no body '{name}' (bodies: {', '.join(self.bodies)})")
 
+    def write(self, directory):
+        """Writes results.h5 and probes.csv into `directory` (created if needed), as femb-solve
+        writes them (the animation only run(output=...) writes: its frames are not kept in
+        memory). Returns the two paths."""
+        if not isinstance(self._r, _core.RecordedResults):
+            raise FembError("results that came from another process are written where they were made "
+                            "(run(output=...) there)")
+        directory = os.fspath(directory)
+        os.makedirs(directory, exist_ok=True)
+        h5 = os.path.join(directory, "results.h5")
+        csv = os.path.join(directory, "probes.csv")
+        _core.write_probes_csv(self._r, csv)
+        _core.write_results(self._r, self.status, h5)
+        return h5, csv
+
     @property
     def loops(self):
         """Closed loops: cut_joints, violation (a length per output step), reaction (6 per cut joint)."""

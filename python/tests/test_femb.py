@@ -111,6 +111,20 @@ def test_scene_run_equals_femb_solve(slider_crank, tmp_path):
     assert np.array_equal(results.node("rod_mid")["position"], position[:, 3 * k:3 * k + 3])
     assert results.energy["kinetic"].shape == results.time.shape
     assert results.body("rod0")["modal_coordinates"].shape[0] == len(results.time)
+    # Written afterwards, the same files as femb-solve's (its probes.csv byte for byte; its
+    # results.h5 dataset by dataset).
+    h5, csv = results.write(tmp_path / "later")
+    with open(csv) as a, open(tmp_path / "cli" / "probes.csv") as b:
+        assert a.read() == b.read()
+    with h5py.File(h5) as a, h5py.File(tmp_path / "cli" / "results.h5") as b:
+        names = []
+        b.visit(names.append)
+        for name in names:
+            if isinstance(b[name], h5py.Dataset):
+                assert np.array_equal(a[name][()], b[name][()]), name
+        # The scene attribute names the file as it was given: here a full path, there a relative one.
+        assert {k: v for k, v in a.attrs.items() if k != "scene"} == {k: v for k, v in b.attrs.items() if k != "scene"}
+        assert a.attrs["scene"].decode().endswith("/scene.yaml")
     # No files unless asked: the scene's folder holds what it held.
     assert sorted(os.listdir(slider_crank)) == sorted(
         ["crank.yaml", "slider.yaml", "rod_2.yaml", "scene.yaml", "crank.h5", "slider.h5", "rod_2.h5"])

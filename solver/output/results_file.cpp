@@ -1,7 +1,10 @@
-// results.h5: the recorded series gathered (ResultsRecorder::Results) and written whole.
+// results.h5 and probes.csv: the recorded series gathered (ResultsRecorder::Results) and written
+// whole.
 #include <unistd.h>
 
+#include <charconv>
 #include <filesystem>
+#include <fstream>
 
 #include "formats/hdf5_file.h"
 #include "formats/input_error.h"
@@ -13,6 +16,9 @@ RecordedResults ResultsRecorder::Results() const {
   using Vector = Eigen::Map<const Eigen::VectorXd>;
   const SystemModel& model = scene_.model;
   RecordedResults r;
+  r.scene = scene_.spec.file;
+  r.analysis = Name(scene_.spec.analysis.type);
+  r.units = scene_.spec.units;
   r.time = Vector(time_.data(), long(time_.size()));
   if (step_size_.size() == time_.size()) r.step_size = Vector(step_size_.data(), long(step_size_.size()));
   r.probe_names = probe_columns_;
@@ -64,18 +70,19 @@ RecordedResults ResultsRecorder::Results() const {
   return r;
 }
 
-void ResultsRecorder::WriteResults(const std::string& status) {
+void ResultsRecorder::WriteResults(const std::string& status) { WriteResultsFile(Results(), status, h5_path_); }
+
+void WriteResultsFile(const RecordedResults& r, const std::string& status, const std::string& path) {
   std::error_code ec;
-  const std::string tmp = h5_path_ + ".tmp." + std::to_string(::getpid());
+  const std::string tmp = path + ".tmp." + std::to_string(::getpid());
   {
-    const RecordedResults r = Results();
     h5::Writer w(tmp);
     w.Attribute("/", "format", "femb-results");
     w.Attribute("/", "format_version", "1.0");
-    w.Attribute("/", "scene", scene_.spec.file);
-    w.Attribute("/", "analysis", std::string(Name(scene_.spec.analysis.type)));
+    w.Attribute("/", "scene", r.scene);
+    w.Attribute("/", "analysis", r.analysis);
     w.Attribute("/", "status", status);
-    w.Attribute("/", "units", scene_.spec.units);
+    w.Attribute("/", "units", r.units);
     w.Vector("/time", r.time);
     if (!r.probe_names.empty()) {
       // probes.csv's columns in full precision (the CSV keeps 10 significant digits).
@@ -131,8 +138,40 @@ void ResultsRecorder::WriteResults(const std::string& status) {
     }
     w.Close();
   }
-  std::filesystem::rename(tmp, h5_path_, ec);
-  if (ec) throw InputError(h5_path_ + ": cannot rename into place (" + ec.message() + ")");
+  std::filesystem::rename(tmp, path, ec);
+  if (ec) throw InputError(path + ": cannot rename into place (" + ec.message() + ")");
+}
+
+void WriteProbesCsv(const RecordedResults& r, const std::string& path) {
+  const std::string tmp = path + ".tmp." + std::to_string(::getpid());
+  {
+    std::ofstream out(tmp);
+    if (!out) throw InputError(tmp + ": cannot write");
+    out << "time";
+    for (const std::string& name : r.probe_names) out << "," << name;
+    out << ",kinetic_energy,elastic_energy,external_work\n";
+    char buffer[32];
+    const auto put = [&](double v) {
+      const std::to_chars_result c = std::to_chars(buffer, buffer + sizeof buffer, v, std::chars_format::general, 10);
+      out.write(buffer, c.ptr - buffer);
+    };
+    for (long s = 0; s < r.time.size(); ++s) {
+      put(r.time[s]);
+      for (long c = 0; c < r.probes.cols(); ++c) {
+        out.put(',');
+        put(r.probes(s, c));
+      }
+      for (const Eigen::VectorXd* e : {&r.kinetic, &r.elastic, &r.external_work}) {
+        out.put(',');
+        put((*e)[s]);
+      }
+      out.put('\n');
+    }
+    if (!out) throw InputError(tmp + ": cannot write");
+  }
+  std::error_code ec;
+  std::filesystem::rename(tmp, path, ec);
+  if (ec) throw InputError(path + ": cannot rename into place (" + ec.message() + ")");
 }
 
 }  // namespace femb

@@ -28,6 +28,7 @@ namespace femb {
 /// A run's results in memory, what results.h5 holds (formats/SCENE_FORMAT.md): a row per output
 /// step. Empty matrices where the run records nothing (reactions not asked for, no cut joints).
 struct RecordedResults {
+  std::string scene, analysis, units;  ///< the scene file, the analysis' type, the unit system
   Eigen::VectorXd time;
   Eigen::VectorXd step_size;  ///< the step that reached each output step (dynamic; else empty)
   std::vector<std::string> probe_names;
@@ -56,6 +57,13 @@ struct RecordedResults {
   };
   std::vector<Body> bodies;
 };
+
+/// Writes `results` as results.h5 (formats/SCENE_FORMAT.md) to `path` with the run's `status`,
+/// under a temporary name and renamed.
+void WriteResultsFile(const RecordedResults& results, const std::string& status, const std::string& path);
+/// Writes `results`' probes as probes.csv (time, the probe columns, the energies; 10 significant
+/// digits) to `path`, under a temporary name and renamed.
+void WriteProbesCsv(const RecordedResults& results, const std::string& path);
 
 class ResultsRecorder {
  public:
