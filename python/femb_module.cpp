@@ -89,68 +89,102 @@ femb::Superelement Reduce(const std::string& text, const std::string& name, cons
   return std::move(outcome.superelement);
 }
 
-// A Python function as a UserNodeForce: called with the GIL (the run releases it) as
-// function(t, position, rotation, velocity, angular_velocity) -> f (6: force, moment about the
-// node, world axes), or with `jacobian` -> (f, K, C), K = df/d(x, theta), C = df/d(v, omega) (6 x
-// 6). Whatever goes wrong (an exception, a wrong shape, a value not finite) is a UserForceError
+// A Python function behind a force: its reference released with the GIL held, wherever the last
+// copy of the force goes; called with the GIL (the run releases it); what it returns checked.
+// Whatever goes wrong (an exception, a wrong shape, a value not finite) is a UserForceError
 // naming the force and the time.
+class PythonFunction {
+ public:
+  PythonFunction(const std::string& name, const py::object& function)
+      : name_(name), function_(new py::object(function), [](py::object* o) {
+          py::gil_scoped_acquire gil;
+          delete o;
+        }) {}
+
+  template <typename... Args>
+  py::object Call(double t, const Args&... args) const {
+    try {
+      return (*function_)(t, args...);
+    } catch (py::error_already_set& e) {
+      throw femb::UserForceError(Where(t) + "raised " + e.what());
+    }
+  }
+  // `value` as rows x cols numbers (row-major) into `out`.
+  void Take(double t, const py::handle& value, long rows, long cols, const char* what, double* out) const {
+    using Array = py::array_t<double, py::array::c_style | py::array::forcecast>;
+    Array a;
+    try {
+      a = Array::ensure(value);
+    } catch (py::error_already_set&) {
+    }
+    if (!a || a.size() != rows * cols || (cols > 1 && (a.ndim() != 2 || a.shape(0) != rows))) {
+      throw femb::UserForceError(Where(t) + what + " must be " + std::to_string(rows) +
+                                 (cols > 1 ? " x " + std::to_string(cols) : std::string(" numbers")) + ", got " +
+                                 std::string(py::str(value.attr("__repr__")())).substr(0, 80));
+    }
+    for (long i = 0; i < rows * cols; ++i) {
+      out[i] = a.data()[i];
+      if (!std::isfinite(out[i])) throw femb::UserForceError(Where(t) + what + " is not finite");
+    }
+  }
+  std::string Where(double t) const {
+    char where[160];
+    std::snprintf(where, sizeof where, "force '%s' at t = %.9g: ", name_.c_str(), t);
+    return where;
+  }
+
+ private:
+  std::string name_;
+  std::shared_ptr<py::object> function_;
+};
+
+constexpr const char* kForceWhat = "the force (fx, fy, fz, mx, my, mz)";
+
+// A Python function as a UserNodeForce: function(t, position, rotation, velocity,
+// angular_velocity) -> f (6: force, moment about the node, world axes), or with `jacobian` ->
+// (f, K, C), K = df/d(x, theta), C = df/d(v, omega) (6 x 6).
 femb::UserNodeForce PythonForce(const std::string& name, const py::object& function, bool jacobian) {
-  // The function's reference is released with the GIL held, wherever the last copy goes.
-  const auto held = std::shared_ptr<py::object>(new py::object(function), [](py::object* o) {
-    py::gil_scoped_acquire gil;
-    delete o;
-  });
+  const PythonFunction fn(name, function);
   femb::UserNodeForce force;
   force.name = name;
-  force.evaluate = [held, name, jacobian](double t, const Eigen::Vector3d& x, const Eigen::Matrix3d& R,
-                                          const Eigen::Vector3d& v, const Eigen::Vector3d& w,
-                                          femb::UserNodeForce::Vector6& f, femb::UserNodeForce::Matrix6* K,
-                                          femb::UserNodeForce::Matrix6* C) {
+  force.evaluate = [fn, jacobian](double t, const Eigen::Vector3d& x, const Eigen::Matrix3d& R,
+                                  const Eigen::Vector3d& v, const Eigen::Vector3d& w, femb::UserNodeForce::Vector6& f,
+                                  femb::UserNodeForce::Matrix6* K, femb::UserNodeForce::Matrix6* C) {
     py::gil_scoped_acquire gil;
-    char where[160];
-    std::snprintf(where, sizeof where, "force '%s' at t = %.9g: ", name.c_str(), t);
-    using Array = py::array_t<double, py::array::c_style | py::array::forcecast>;
-    const auto take = [&](const py::handle& value, long rows, long cols, const char* what, double* out) {
-      Array a;
-      try {
-        a = Array::ensure(value);
-      } catch (py::error_already_set&) {
-      }
-      if (!a || a.size() != rows * cols || (cols > 1 && (a.ndim() != 2 || a.shape(0) != rows))) {
-        throw femb::UserForceError(std::string(where) + what + " must be " + std::to_string(rows) +
-                                   (cols > 1 ? " x " + std::to_string(cols) : std::string(" numbers")) + ", got " +
-                                   std::string(py::str(value.attr("__repr__")())).substr(0, 80));
-      }
-      for (long i = 0; i < rows * cols; ++i) {
-        out[i] = a.data()[i];
-        if (!std::isfinite(out[i])) throw femb::UserForceError(std::string(where) + what + " is not finite");
-      }
-    };
-    py::object value;
-    try {
-      value = (*held)(t, x, R, v, w);
-    } catch (py::error_already_set& e) {
-      throw femb::UserForceError(std::string(where) + "raised " + e.what());
-    }
+    const py::object value = fn.Call(t, x, R, v, w);
     if (!jacobian) {
-      take(value, 6, 1, "the force (fx, fy, fz, mx, my, mz)", f.data());
+      fn.Take(t, value, 6, 1, kForceWhat, f.data());
       return false;
     }
     if (!py::isinstance<py::tuple>(value) || py::len(value) != 3) {
-      throw femb::UserForceError(std::string(where) + "with jacobian=True, return (f, K, C)");
+      throw femb::UserForceError(fn.Where(t) + "with jacobian=True, return (f, K, C)");
     }
     const py::tuple triple = value.cast<py::tuple>();
-    take(triple[0], 6, 1, "the force (fx, fy, fz, mx, my, mz)", f.data());
+    fn.Take(t, triple[0], 6, 1, kForceWhat, f.data());
     Eigen::Matrix<double, 6, 6, Eigen::RowMajor> m;
     if (K) {
-      take(triple[1], 6, 6, "K = df/d(x, theta)", m.data());
+      fn.Take(t, triple[1], 6, 6, "K = df/d(x, theta)", m.data());
       *K = m;
     }
     if (C) {
-      take(triple[2], 6, 6, "C = df/d(v, omega)", m.data());
+      fn.Take(t, triple[2], 6, 6, "C = df/d(v, omega)", m.data());
       *C = m;
     }
     return true;
+  };
+  return force;
+}
+
+// A Python function as a force between two nodes (UserNodeForce::evaluate_pair):
+// function(t, x, R, v, w, x_other, R_other, v_other, w_other) -> f (6) on the node.
+femb::UserNodeForce PythonPairForce(const std::string& name, const py::object& function) {
+  const PythonFunction fn(name, function);
+  femb::UserNodeForce force;
+  force.name = name;
+  force.evaluate_pair = [fn](double t, const femb::UserForceMotion& a, const femb::UserForceMotion& b,
+                             femb::UserNodeForce::Vector6& f) {
+    py::gil_scoped_acquire gil;
+    fn.Take(t, fn.Call(t, a.x, a.R, a.v, a.w, b.x, b.R, b.v, b.w), 6, 1, kForceWhat, f.data());
   };
   return force;
 }
@@ -165,9 +199,15 @@ femb::SolveRunOptions RunOptions(const std::string& output, int threads, const p
   options.progress = LineSink(progress);
   options.warning = LineSink(warning);
   for (const py::handle item : forces) {
-    const auto [node, force_name, function, jacobian] =
-        item.cast<std::tuple<std::string, std::string, py::object, bool>>();
-    options.user_forces.push_back({node, PythonForce(force_name, function, jacobian)});
+    const auto [node, other, force_name, function, jacobian] =
+        item.cast<std::tuple<std::string, std::string, std::string, py::object, bool>>();
+    if (!other.empty() && jacobian) {
+      throw femb::InputError("force '" + force_name +
+                             "': a force between two nodes takes no Jacobian (femb differences it)");
+    }
+    options.user_forces.push_back(
+        {node, other,
+         other.empty() ? PythonForce(force_name, function, jacobian) : PythonPairForce(force_name, function)});
   }
   return options;
 }

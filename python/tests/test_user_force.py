@@ -189,3 +189,60 @@ def test_close_stops_an_unfinished_run():
     assert sim.done
     with pytest.raises(femb.InputError, match="start.. steps a dynamic analysis"):
         femb.Scene(bar(True, ANALYSES["static"])).start()
+
+
+def two_bars(spring, gravity=True, analysis=None):
+    """Two bars: `bar` hinged at the origin along +x, `bar2` hinged at (0.8, 0, 0) along -x (tips
+    0.2 m apart); with `spring` the built-in spring-damper between the tips."""
+    spec = bar(False, analysis)
+    spec["bodies"].append(dict(spec["bodies"][0], name="bar2", nodes={"P": "pivot2", "T": "tip2"},
+                               placement={"position": [0.8, 0, 0], "rotation": [0, 0, math.pi]}))
+    spec["joints"].append({"type": "revolute", "node": "pivot2", "axis": [0, 0, 1]})
+    spec["outputs"]["probes"].append({"name": "tip2", "node": "tip2", "quantities": ["position", "reaction"]})
+    if not gravity:
+        spec["loads"] = []
+    if spring:
+        spec["loads"].append({"type": "spring", "node": "tip", "node_b": "tip2", "stiffness": K, "damping": C,
+                              "free_length": L0})
+    return spec
+
+
+def pair_spring(t, x, R, v, w, xo, Ro, vo, wo):
+    d = x - xo
+    length = np.linalg.norm(d)
+    e = d / length
+    tension = K * (length - L0) + C * e.dot(v - vo)
+    return np.concatenate([-tension * e, np.zeros(3)])
+
+
+@pytest.mark.parametrize("analysis", ["generalized_alpha", "midpoint", "static"])
+def test_a_force_between_two_nodes_equals_the_built_in_spring(analysis):
+    builtin = femb.Scene(two_bars(True, analysis=ANALYSES[analysis])).run()
+    python = femb.Scene(two_bars(False, analysis=ANALYSES[analysis])).add_force("tip", pair_spring, other="tip2").run()
+    assert np.ptp(builtin.probes["tip2.position.y"]) > 0.02
+    for name, values in builtin.probes.items():
+        assert np.abs(python.probes[name] - values).max() <= 1e-8, (name, np.abs(python.probes[name] - values).max())
+
+
+def test_a_force_between_two_nodes_balances():
+    # Two hinged bars, no gravity, tied tip to tip by a force that is not central (a linear spring
+    # with a rest vector, f = k (x_other - x - d0)) and a moment: in equilibrium the hinges'
+    # reactions must balance each other, force and moment about the origin (to Newton's
+    # tolerance), as they do when the tie's reaction on the other node carries the opposite
+    # moment about that node; without the moment of the force about the line between the nodes
+    # they would be off by |(x - x_other) x f|, about 1 N m here.
+    d0 = np.array([-0.15, 0.05, 0.02])
+
+    def tie(t, x, R, v, w, xo, Ro, vo, wo):
+        return t * np.concatenate([50.0 * (xo - x - d0), [0.0, 0.0, 0.05]])
+
+    spec = two_bars(False, gravity=False, analysis=dict(ANALYSES["static"], tolerance=1e-12))
+    spec["outputs"]["probes"].append({"name": "pivot2", "node": "pivot2", "quantities": ["reaction"]})
+    r = femb.Scene(spec).add_force("tip", tie, other="tip2").run()
+    force = np.array([[r.probes[f"{p}.reaction.f{c}"][-1] for c in "xyz"] for p in ("pivot", "pivot2")])
+    moment = np.array([[r.probes[f"{p}.reaction.m{c}"][-1] for c in "xyz"] for p in ("pivot", "pivot2")])
+    pivots = np.array([[0.0, 0.0, 0.0], [0.8, 0.0, 0.0]])
+    assert np.abs(force).max() > 1.0  # the tie pulls
+    assert np.abs(force.sum(axis=0)).max() <= 1e-9 * np.abs(force).max(), force
+    total = moment.sum(axis=0) + np.cross(pivots, force).sum(axis=0)
+    assert np.abs(total).max() <= 1e-9 * np.abs(force).max(), total

@@ -26,6 +26,72 @@ void DifferenceUserForce(const UserNodeForce& force, double t, const Eigen::Vect
   }
 }
 
+namespace {
+
+using Vector12 = Eigen::Matrix<double, 12, 1>;
+using Matrix12 = Eigen::Matrix<double, 12, 12>;
+
+// A force between two nodes: on (node, other), the force and its reaction (UserNodeForce::other).
+Vector12 PairForces(const UserNodeForce& force, double t, const UserForceMotion (&m)[2]) {
+  UserNodeForce::Vector6 f;
+  force.evaluate_pair(t, m[0], m[1], f);
+  Vector12 g;
+  g.head<6>() = f;
+  g.segment<3>(6) = -f.head<3>();
+  g.tail<3>() = -f.tail<3>() - (m[0].x - m[1].x).cross(f.head<3>());
+  return g;
+}
+
+// The pair's forces into the residual (the virtual work through both nodes' Jacobians), their
+// derivatives by forward differences (steps as DifferenceUserForce's) into K and C.
+void AddPairForce(const UserNodeForce& force, const SystemState& state, const Eigen::VectorXd& W, double t,
+                  double length, Eigen::VectorXd* residual, Triplets* K, Triplets* C, NodeForces* node_forces) {
+  const int nodes[2] = {force.node, force.other};
+  UserForceMotion m[2];
+  for (int e = 0; e < 2; ++e) {
+    const Eigen::Matrix<double, 6, 1> motion = NodeMotion(state, nodes[e], W);
+    m[e] = {state.x[nodes[e]], motion.head<3>(), motion.tail<3>(), state.R[nodes[e]]};
+  }
+  const Vector12 g = PairForces(force, t, m);
+  Matrix12 dq = Matrix12::Zero(), dv = Matrix12::Zero();
+  if (K || C) {
+    constexpr double kStep = 1e-7;
+    for (int e = 0; e < 2; ++e) {
+      for (int i = 0; i < 3; ++i) {
+        const Eigen::Vector3d u = Eigen::Vector3d::Unit(i);
+        const double hx = kStep * length, hv = kStep * std::max(m[e].v.norm(), length);
+        const double hw = kStep * std::max(m[e].w.norm(), 1.0);
+        UserForceMotion p[2] = {m[0], m[1]};
+        p[e].x += hx * u;
+        dq.col(6 * e + i) = (PairForces(force, t, p) - g) / hx;
+        p[e] = m[e];
+        p[e].R = ExpSO3(kStep * u) * m[e].R;
+        dq.col(6 * e + 3 + i) = (PairForces(force, t, p) - g) / kStep;
+        p[e] = m[e];
+        p[e].v += hv * u;
+        dv.col(6 * e + i) = (PairForces(force, t, p) - g) / hv;
+        p[e] = m[e];
+        p[e].w += hw * u;
+        dv.col(6 * e + 3 + i) = (PairForces(force, t, p) - g) / hw;
+      }
+    }
+  }
+  for (int e = 0; e < 2; ++e) {
+    if (node_forces) node_forces->Add(nodes[e], g.segment<6>(6 * e));
+    for (const auto& [ci, vi] : state.J[nodes[e]]) {
+      if (residual) (*residual)[ci] += vi.dot(g.segment<6>(6 * e));
+      for (int e2 = 0; e2 < 2; ++e2) {
+        for (const auto& [cj, vj] : state.J[nodes[e2]]) {
+          if (K) K->emplace_back(ci, cj, -vi.dot(dq.block<6, 6>(6 * e, 6 * e2) * vj));
+          if (C) C->emplace_back(ci, cj, -vi.dot(dv.block<6, 6>(6 * e, 6 * e2) * vj));
+        }
+      }
+    }
+  }
+}
+
+}  // namespace
+
 // Each force's node: its motion from the velocities W (zero at rest: W empty), its force into
 // the residual by the node Jacobian (the virtual work of force and moment: J^T f), -K and -C into
 // the matrices, as the spring-dampers' (AddSpringDampers).
@@ -37,6 +103,10 @@ void AddUserForces(const SystemModel& model, const SystemState& state, const Eig
   UserNodeForce::Vector6 f;
   UserNodeForce::Matrix6 dfdq, dfdv;
   for (const UserNodeForce& force : model.user_forces) {
+    if (force.other >= 0) {
+      AddPairForce(force, state, W, t, length, residual, K, C, node_forces);
+      continue;
+    }
     const int k = force.node;
     const Eigen::Matrix<double, 6, 1> motion = NodeMotion(state, k, W);
     const Eigen::Vector3d v = motion.head<3>(), w = motion.tail<3>();

@@ -18,11 +18,25 @@ class UserForceError : public std::runtime_error {
   explicit UserForceError(const std::string& message) : std::runtime_error(message) {}
 };
 
+/// A node's motion as a user function sees it (world axes).
+struct UserForceMotion {
+  Eigen::Vector3d x, v, w;
+  Eigen::Matrix3d R;
+};
+
 struct UserNodeForce {
   using Vector6 = Eigen::Matrix<double, 6, 1>;
   using Matrix6 = Eigen::Matrix<double, 6, 6>;
   int node = -1;
+  /// A force between two nodes: the node the force's reaction acts on, or -1 (a force on `node`
+  /// alone). Then `evaluate_pair` gives the force on `node`, and `other` takes its opposite and
+  /// the opposite moment about itself, -M - (x_node - x_other) x F: the pair's forces balance, its
+  /// momentum is kept.
+  int other = -1;
   std::string name;  ///< for messages ("force 'bump_stop' on node 'tip'")
+  /// f = (force, moment about `node`) on `node` from the motions of `node` and `other`; femb
+  /// differences it for the matrices. Throws UserForceError.
+  std::function<void(double t, const UserForceMotion& node, const UserForceMotion& other, Vector6& f)> evaluate_pair;
   /// f = (force, moment about the node) in world axes, at time t of the node's position x,
   /// rotation R (node axes in world axes), velocity v and angular velocity w (world axes). With K
   /// and C not null it may also give K = d f / d (x, theta) and C = d f / d (v, w), theta the

@@ -68,6 +68,14 @@ Scene WithUserForces(Scene scene, const std::vector<UserForceSpec>& forces) {
     }
     UserNodeForce force = spec.force;
     force.node = k->second;
+    if (!spec.other.empty()) {
+      const auto other = scene.node_index.find(spec.other);
+      if (other == scene.node_index.end() || other->second == k->second) {
+        throw InputError(scene.spec.file + ": force '" + spec.force.name + "': no other node '" + spec.other +
+                         "' in the scene (a force between two nodes needs two)");
+      }
+      force.other = other->second;
+    }
     scene.model.user_forces.push_back(std::move(force));
   }
   return scene;

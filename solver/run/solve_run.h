@@ -23,6 +23,7 @@ namespace femb {
 /// A force the caller writes (UserNodeForce), on a node named as in the scene.
 struct UserForceSpec {
   std::string node;
+  std::string other;  ///< a force between two nodes: the one its reaction acts on ("": none)
   UserNodeForce force;
 };
 
