@@ -189,9 +189,44 @@ femb::UserNodeForce PythonPairForce(const std::string& name, const py::object& f
   return force;
 }
 
+// A Python function as a UserModalForce: function(t, q, qdot) -> Q (n), or with `jacobian` ->
+// (Q, K, C), K = dQ/dq, C = dQ/dqdot (n x n).
+femb::UserModalForce PythonModalForce(const std::string& name, const py::object& function, bool jacobian) {
+  const PythonFunction fn(name, function);
+  femb::UserModalForce force;
+  force.name = name;
+  force.evaluate = [fn, jacobian](double t, const Eigen::VectorXd& q, const Eigen::VectorXd& qdot, Eigen::VectorXd& Q,
+                                  Eigen::MatrixXd* K, Eigen::MatrixXd* C) {
+    py::gil_scoped_acquire gil;
+    const long n = q.size();
+    const py::object value = fn.Call(t, q, qdot);
+    Q.resize(n);
+    if (!jacobian) {
+      fn.Take(t, value, n, 1, "the generalized force Q", Q.data());
+      return false;
+    }
+    if (!py::isinstance<py::tuple>(value) || py::len(value) != 3) {
+      throw femb::UserForceError(fn.Where(t) + "with jacobian=True, return (Q, K, C)");
+    }
+    const py::tuple triple = value.cast<py::tuple>();
+    fn.Take(t, triple[0], n, 1, "the generalized force Q", Q.data());
+    Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> m(n, n);
+    if (K) {
+      fn.Take(t, triple[1], n, n, "K = dQ/dq", m.data());
+      *K = m;
+    }
+    if (C) {
+      fn.Take(t, triple[2], n, n, "C = dQ/dqdot", m.data());
+      *C = m;
+    }
+    return true;
+  };
+  return force;
+}
+
 // The options of a run from Python: in memory unless `output`, the caller's words and forces.
 femb::SolveRunOptions RunOptions(const std::string& output, int threads, const py::object& progress,
-                                 const py::object& warning, const py::list& forces) {
+                                 const py::object& warning, const py::list& forces, const py::list& modal_forces) {
   femb::SolveRunOptions options;
   options.in_memory = output.empty();
   options.output = output;
@@ -209,6 +244,11 @@ femb::SolveRunOptions RunOptions(const std::string& output, int threads, const p
         {node, other,
          other.empty() ? PythonForce(force_name, function, jacobian) : PythonPairForce(force_name, function)});
   }
+  for (const py::handle item : modal_forces) {
+    const auto [body, force_name, function, jacobian] =
+        item.cast<std::tuple<std::string, std::string, py::object, bool>>();
+    options.user_modal_forces.push_back({body, PythonModalForce(force_name, function, jacobian)});
+  }
   return options;
 }
 
@@ -224,8 +264,9 @@ struct RunResult {
 
 RunResult Run(const std::string& text, const std::string& name, const std::vector<std::string>& overrides,
               const std::string& output, int threads, const py::object& progress, const py::object& warning,
-              const py::list& forces) {
-  femb::SolveRun run(femb::ParseScene(text, name, overrides), RunOptions(output, threads, progress, warning, forces));
+              const py::list& forces, const py::list& modal_forces) {
+  femb::SolveRun run(femb::ParseScene(text, name, overrides),
+                     RunOptions(output, threads, progress, warning, forces, modal_forces));
   RunResult r;
   {
     py::gil_scoped_release release;
@@ -249,8 +290,8 @@ class Simulation {
  public:
   Simulation(const std::string& text, const std::string& name, const std::vector<std::string>& overrides,
              const std::string& output, int threads, const py::object& progress, const py::object& warning,
-             const py::list& forces) {
-    femb::SolveRunOptions options = RunOptions(output, threads, progress, warning, forces);
+             const py::list& forces, const py::list& modal_forces) {
+    femb::SolveRunOptions options = RunOptions(output, threads, progress, warning, forces, modal_forces);
     options.stop = &stop_;
     options.after_step = [this](const femb::DynamicState& s) { Pause(s); };
     femb::SceneSpec spec = femb::ParseScene(text, name, overrides);
@@ -483,10 +524,10 @@ PYBIND11_MODULE(_core, m) {
   m.def("reduce", &Reduce, py::arg("text"), py::arg("name"), py::arg("overrides"), py::arg("output"),
         py::arg("progress"), py::arg("warning"));
   m.def("run", &Run, py::arg("text"), py::arg("name"), py::arg("overrides"), py::arg("output"), py::arg("threads"),
-        py::arg("progress"), py::arg("warning"), py::arg("forces"));
+        py::arg("progress"), py::arg("warning"), py::arg("forces"), py::arg("modal_forces"));
   py::class_<Simulation>(m, "Simulation")
       .def(py::init<const std::string&, const std::string&, const std::vector<std::string>&, const std::string&, int,
-                    const py::object&, const py::object&, const py::list&>())
+                    const py::object&, const py::object&, const py::list&, const py::list&>())
       .def("step_to", &Simulation::StepTo)
       .def("close", &Simulation::Close)
       .def_property_readonly("time", &Simulation::time)

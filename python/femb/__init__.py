@@ -181,6 +181,7 @@ class Scene:
         self._text, self._name = _document(spec, "scene", base_dir)
         self._set = {}
         self._forces = []
+        self._modal_forces = []
         _core.check_scene(self._text, self._name, [])
 
     @classmethod
@@ -224,12 +225,27 @@ class Scene:
                              name or getattr(function, "__name__", "force"), function, bool(jacobian)))
         return self
 
+    def add_modal_force(self, body, function, jacobian=False, name=None):
+        """Adds a generalized force written in Python on a flexible body's modal coordinates (the
+        internal coordinates of its superelement, results.body(name)["modal_coordinates"]).
+        Returns the scene.
+
+        function(t, q, qdot) returns Q, one value per modal coordinate (the virtual work Q . dq:
+        units of force times the coordinate's), e.g. an actuator, a damper or a control force on
+        the modes. With jacobian=True it returns (Q, K, C), K = dQ/dq, C = dQ/dqdot; without, femb
+        differences it (2 n calls more per matrix). It enters the residual, the iteration matrix
+        and the external work like the node forces.
+        """
+        self._modal_forces.append((str(body), name or getattr(function, "__name__", "modal_force"), function,
+                                   bool(jacobian)))
+        return self
+
     def start(self, output=None, threads=1, progress=None):
         """A dynamic analysis to step under your control: a Simulation (see its step_to). The
         arguments as run()'s."""
         return Simulation(_core.Simulation(self._text, self._name, _overrides(self._set),
                                            os.fspath(output) if output else "", int(threads), progress, _warn,
-                                           self._forces))
+                                           self._forces, self._modal_forces))
 
     def run(self, output=None, threads=1, progress=None):
         """Runs the scene's analysis and returns its Results.
@@ -241,7 +257,7 @@ class Scene:
         A numerical failure raises NumericalError with the results up to it in `.results`.
         """
         r = _core.run(self._text, self._name, _overrides(self._set), os.fspath(output) if output else "",
-                      int(threads), progress, _warn, self._forces)
+                      int(threads), progress, _warn, self._forces, self._modal_forces)
         results = Results(r)
         if r.exit_code != 0:
             error = NumericalError(r.error)

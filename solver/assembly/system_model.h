@@ -69,6 +69,7 @@ struct SystemModel {
   std::vector<NodeLoad> loads;
   std::vector<SpringDamper> springs;
   std::vector<UserNodeForce> user_forces;             ///< written by the user (the Python module)
+  std::vector<UserModalForce> user_modal_forces;      ///< the same, on bodies' modal coordinates
   Eigen::Vector3d gravity = Eigen::Vector3d::Zero();  ///< uniform acceleration field
   /// Static analyses: gravity grows linearly with the pseudo-time to full at this value (the
   /// analysis' end_time); 0: no gravity in AssembleStatic (dynamic analyses add it themselves).

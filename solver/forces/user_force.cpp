@@ -90,6 +90,42 @@ void AddPairForce(const UserNodeForce& force, const SystemState& state, const Ei
   }
 }
 
+// A modal force's Q, and its derivatives (given, or by forward differences of 1e-7 of the
+// largest |q| or |qdot|, at least 1e-6) into the modal rows and columns of body b.
+void AddModalForce(const UserModalForce& force, const DofMap& dofs, const SystemState& state, const Eigen::VectorXd& W,
+                   double t, Eigen::VectorXd* residual, Triplets* K, Triplets* C) {
+  const int b = force.body, first = dofs.mode_dof(b);
+  const Eigen::VectorXd& q = state.eta[size_t(b)];
+  const long n = q.size();
+  const Eigen::VectorXd qdot = W.size() ? Eigen::VectorXd(W.segment(first, n)) : Eigen::VectorXd::Zero(n);
+  Eigen::VectorXd Q, g;
+  Eigen::MatrixXd dq(n, n), dv(n, n);
+  const bool matrices = K || C;
+  const bool given = force.evaluate(t, q, qdot, Q, matrices ? &dq : nullptr, matrices ? &dv : nullptr);
+  if (matrices && !given) {
+    constexpr double kStep = 1e-7;
+    const double hq = kStep * std::max(q.cwiseAbs().maxCoeff(), 1e-6);
+    const double hv = kStep * std::max(qdot.cwiseAbs().maxCoeff(), 1e-6);
+    for (long i = 0; i < n; ++i) {
+      Eigen::VectorXd p = q;
+      p[i] += hq;
+      force.evaluate(t, p, qdot, g, nullptr, nullptr);
+      dq.col(i) = (g - Q) / hq;
+      p = qdot;
+      p[i] += hv;
+      force.evaluate(t, q, p, g, nullptr, nullptr);
+      dv.col(i) = (g - Q) / hv;
+    }
+  }
+  if (residual) residual->segment(first, n) += Q;
+  for (long i = 0; i < n; ++i) {
+    for (long j = 0; j < n; ++j) {
+      if (K) K->emplace_back(first + int(i), first + int(j), -dq(i, j));
+      if (C) C->emplace_back(first + int(i), first + int(j), -dv(i, j));
+    }
+  }
+}
+
 }  // namespace
 
 // Each force's node: its motion from the velocities W (zero at rest: W empty), its force into
@@ -97,6 +133,8 @@ void AddPairForce(const UserNodeForce& force, const SystemState& state, const Ei
 // the matrices, as the spring-dampers' (AddSpringDampers).
 void AddUserForces(const SystemModel& model, const SystemState& state, const Eigen::VectorXd& W, double t,
                    Eigen::VectorXd* residual, Triplets* K, Triplets* C, NodeForces* node_forces) {
+  for (const UserModalForce& force : model.user_modal_forces)
+    AddModalForce(force, model.dofs(), state, W, t, residual, K, C);
   if (model.user_forces.empty()) return;
   double length = BoundingDiagonal(model.node_x0);
   if (!(length > 0)) length = 1.0;

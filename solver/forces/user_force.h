@@ -47,6 +47,19 @@ struct UserNodeForce {
       evaluate;
 };
 
+/// A generalized force the user writes on a flexible body's modal coordinates q (the internal
+/// coordinates of its reduced basis, as in results.h5's modal_coordinates): Q (one per
+/// coordinate) of time and q, qdot, entering the residual as applied forces (virtual work Q . dq).
+struct UserModalForce {
+  int body = -1;
+  std::string name;
+  /// Q at (t, q, qdot); with K and C not null it may also give K = dQ/dq and C = dQ/dqdot (n x n)
+  /// and returns whether it did (else femb differences Q). Throws UserForceError.
+  std::function<bool(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& qdot, Eigen::VectorXd& Q,
+                     Eigen::MatrixXd* K, Eigen::MatrixXd* C)>
+      evaluate;
+};
+
 /// K = d f / d (x, theta) and C = d f / d (v, w) of `force` at (t, x, R, v, w), f its value
 /// there, by forward differences (12 more evaluations): steps of 1e-7 of `length` in x, 1e-7
 /// rad in theta, and 1e-7 of max(|v|, length / 1 s) and max(|w|, 1 rad/s) in the rates.

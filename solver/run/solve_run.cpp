@@ -1,5 +1,6 @@
 #include "solver/run/solve_run.h"
 
+#include <algorithm>
 #include <cmath>
 #include <csignal>
 #include <cstdarg>
@@ -60,7 +61,19 @@ DynamicState AtRest(const SystemState& config, double t) {
 }
 
 // The scene with the caller's forces on its nodes (one line for a node it does not have).
-Scene WithUserForces(Scene scene, const std::vector<UserForceSpec>& forces) {
+Scene WithUserForces(Scene scene, const std::vector<UserForceSpec>& forces,
+                     const std::vector<UserModalForceSpec>& modal_forces) {
+  for (const UserModalForceSpec& spec : modal_forces) {
+    const auto b = std::find(scene.body_names.begin(), scene.body_names.end(), spec.body);
+    const std::string where = scene.spec.file + ": modal force '" + spec.force.name + "': ";
+    if (b == scene.body_names.end()) throw InputError(where + "no body '" + spec.body + "' in the scene");
+    UserModalForce force = spec.force;
+    force.body = int(b - scene.body_names.begin());
+    if (scene.model.bodies[size_t(force.body)].n_modes() == 0) {
+      throw InputError(where + "body '" + spec.body + "' has no modal coordinates");
+    }
+    scene.model.user_modal_forces.push_back(std::move(force));
+  }
   for (const UserForceSpec& spec : forces) {
     const auto k = scene.node_index.find(spec.node);
     if (k == scene.node_index.end()) {
@@ -87,7 +100,7 @@ SolveRun::SolveRun(SceneSpec spec, SolveRunOptions options)
     : options_(std::move(options)),
       wall_(options_.started),
       spec_(std::move(spec)),
-      scene_(WithUserForces(BuildScene(spec_), options_.user_forces)) {}
+      scene_(WithUserForces(BuildScene(spec_), options_.user_forces, options_.user_modal_forces)) {}
 
 void SolveRun::Say(const char* format, ...) const {
   if (!options_.progress) return;

@@ -27,6 +27,12 @@ struct UserForceSpec {
   UserNodeForce force;
 };
 
+/// A generalized force the caller writes (UserModalForce), on a body named as in the scene.
+struct UserModalForceSpec {
+  std::string body;
+  UserModalForce force;
+};
+
 /// How a scene is run and where its words go.
 struct SolveRunOptions {
   /// The output folder; empty: out/<scene name>, or none with `in_memory`.
@@ -48,6 +54,7 @@ struct SolveRunOptions {
   std::function<void(const DynamicState&)> after_step;
   /// Forces the caller writes, added to the scene's loads.
   std::vector<UserForceSpec> user_forces;
+  std::vector<UserModalForceSpec> user_modal_forces;
   /// When the run began (its reading time counts from here: the scene file was read before).
   std::chrono::steady_clock::time_point started = std::chrono::steady_clock::now();
 };
