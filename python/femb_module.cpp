@@ -10,11 +10,13 @@
 #include <pybind11/stl.h>
 
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <condition_variable>
 #include <csignal>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 #include <tuple>
@@ -262,16 +264,52 @@ struct RunResult {
   long steps = 0, iterations = 0;
 };
 
+// Ctrl-C in a dynamic run: every 64 steps (and at most every 0.1 s) the run takes the GIL and
+// lets Python run its signal handlers; a KeyboardInterrupt (or any exception a handler raises)
+// stops the run at the end of its step, its results kept in `output` when there is one, and is
+// raised when the run returns.
+class Interruption {
+ public:
+  void Check() {
+    if (++steps_ % 64 != 0) return;
+    const auto now = std::chrono::steady_clock::now();
+    if (now - last_ < std::chrono::milliseconds(100)) return;
+    last_ = now;
+    py::gil_scoped_acquire gil;
+    if (PyErr_CheckSignals() == 0) return;
+    error_.emplace();  // fetches the exception the handler raised
+    stop_ = SIGINT;
+  }
+  const std::atomic<int>* stop() const { return &stop_; }
+  // With the GIL held: the exception a handler raised, raised again.
+  void RaiseIfInterrupted() {
+    if (!error_) return;
+    py::error_already_set error = std::move(*error_);
+    error_.reset();
+    throw error;
+  }
+
+ private:
+  long steps_ = 0;
+  std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
+  std::atomic<int> stop_{0};
+  std::optional<py::error_already_set> error_;
+};
+
 RunResult Run(const std::string& text, const std::string& name, const std::vector<std::string>& overrides,
               const std::string& output, int threads, const py::object& progress, const py::object& warning,
               const py::list& forces, const py::list& modal_forces) {
-  femb::SolveRun run(femb::ParseScene(text, name, overrides),
-                     RunOptions(output, threads, progress, warning, forces, modal_forces));
+  Interruption interruption;
+  femb::SolveRunOptions options = RunOptions(output, threads, progress, warning, forces, modal_forces);
+  options.stop = interruption.stop();
+  options.after_step = [&interruption](const femb::DynamicState&) { interruption.Check(); };
+  femb::SolveRun run(femb::ParseScene(text, name, overrides), std::move(options));
   RunResult r;
   {
     py::gil_scoped_release release;
     r.exit_code = run.Run();
   }
+  interruption.RaiseIfInterrupted();
   r.status = run.status();
   r.error = run.error();
   r.results = std::as_const(run).recorder().Results();

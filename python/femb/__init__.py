@@ -255,6 +255,8 @@ class Scene:
         threads: for the bodies' forces and matrices (the same bits for any number).
         progress: a callable taking femb-solve's progress lines (e.g. print); none by default.
         A numerical failure raises NumericalError with the results up to it in `.results`.
+        Ctrl-C stops a dynamic run at the end of its step (within 0.1 s and 64 steps) and raises
+        KeyboardInterrupt; with `output` the results up to there are in the folder.
         """
         r = _core.run(self._text, self._name, _overrides(self._set), os.fspath(output) if output else "",
                       int(threads), progress, _warn, self._forces, self._modal_forces)

@@ -318,3 +318,33 @@ def test_a_modal_damper_and_the_energy_balance(rod):
     total = e["kinetic"] + e["elastic"]
     after = r.time >= 1e-3
     assert total[after][-1] < total[after][0]
+
+
+def test_ctrl_c_stops_a_run_and_keeps_its_results(tmp_path):
+    # A long run interrupted by SIGINT after 0.5 s (in a process of its own): KeyboardInterrupt
+    # within a second, and the results up to the step it stopped at in the output folder.
+    import os
+    import subprocess
+    import sys
+    import h5py
+    script = f"""
+import os, signal, sys, threading, time
+sys.path.insert(0, {os.path.dirname(os.path.abspath(__file__))!r})
+import femb, test_user_force as t
+scene = femb.Scene(t.bar(True, {{"type": "dynamic", "end_time": 1000.0, "step": 1e-4, "rho_inf": 0.9}}))
+threading.Timer(0.5, lambda: os.kill(os.getpid(), signal.SIGINT)).start()
+start = time.perf_counter()
+try:
+    scene.run(output={str(tmp_path / "out")!r})
+    print("not interrupted")
+except KeyboardInterrupt:
+    print(f"interrupted after {{time.perf_counter() - start:.2f}} s")
+"""
+    p = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120)
+    assert "interrupted after" in p.stdout, p.stdout + p.stderr
+    assert float(p.stdout.split("interrupted after ")[1].split(" s")[0]) < 1.5, p.stdout
+    with h5py.File(tmp_path / "out" / "results.h5") as f:
+        status = f.attrs["status"]
+        status = status.decode() if isinstance(status, bytes) else status
+        assert status.startswith("stopped by SIGINT at t ="), status
+        assert 0 < f["time"][-1] < 1000.0
