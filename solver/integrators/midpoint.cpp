@@ -387,20 +387,18 @@ void AssembleMidpoint(const SystemModel& model, const DofMap& dofs, const Dynami
 double StepExternalWork(const SystemModel& model, const DofMap& dofs, double t_mid, MidpointWorkspace& mw) {
   double work = 0.0;
   for (double w : mw.gravity_work) work += w;
-  if (!model.user_modal_forces.empty()) {
-    // The modal forces' work over the step: Q at the midpoint times the modal coordinates' step.
-    mw.unused.setZero(dofs.n_dofs());
-    AddUserForces(model, mw.k.mid, mw.rates, t_mid, &mw.unused, nullptr, nullptr, nullptr);
-    for (size_t b = 0; b < model.bodies.size(); ++b) {
-      const int first = dofs.mode_dof(int(b)), n = model.bodies[b].n_modes();
-      if (n > 0) work += mw.unused.segment(first, n).dot(mw.k.delta.segment(first, n));
-    }
-  }
-  if (model.loads.empty() && model.user_forces.empty()) return work;
+  const bool modal = !model.user_modal_forces.empty();
+  if (model.loads.empty() && model.user_forces.empty() && !modal) return work;
   mw.loads.f.assign(size_t(model.n_nodes()), Eigen::Matrix<double, 6, 1>::Zero());
   mw.unused.setZero(dofs.n_dofs());
+  // The user's forces evaluated once: on nodes into mw.loads, on modal coordinates into their rows
+  // of mw.unused, whose work is Q at the midpoint times the modal coordinates' step.
+  AddUserForces(model, mw.k.mid, mw.rates, t_mid, modal ? &mw.unused : nullptr, nullptr, nullptr, &mw.loads);
+  for (size_t b = 0; modal && b < model.bodies.size(); ++b) {
+    const int first = dofs.mode_dof(int(b)), n = model.bodies[b].n_modes();
+    if (n > 0) work += mw.unused.segment(first, n).dot(mw.k.delta.segment(first, n));
+  }
   AddNodeLoads(model, mw.k.mid, t_mid, mw.unused, nullptr, &mw.loads);
-  AddUserForces(model, mw.k.mid, mw.rates, t_mid, nullptr, nullptr, nullptr, &mw.loads);
   for (int node = 0; node < model.n_nodes(); ++node) work += mw.k.node_step[size_t(node)].dot(mw.loads.f[size_t(node)]);
   return work;
 }
