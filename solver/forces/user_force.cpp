@@ -7,23 +7,45 @@
 
 namespace femb {
 
+namespace {
+
+// Forward differences of value(motion) in the motion's x, theta (R -> exp(theta~) R), v and w,
+// with value0 = value(m), into columns first..first+5 of dq (x, theta) and dv (v, w): steps of
+// 1e-7 of `length` in x, 1e-7 rad in theta, and 1e-7 of max(|v|, length / 1 s) and max(|w|,
+// 1 rad/s) in the rates.
+template <typename Vector, typename Matrix, typename Value>
+void DifferenceMotion(const UserForceMotion& m, double length, const Vector& value0, const Value& value, int first,
+                      Matrix& dq, Matrix& dv) {
+  constexpr double kStep = 1e-7;
+  const double hx = kStep * length, hv = kStep * std::max(m.v.norm(), length), hw = kStep * std::max(m.w.norm(), 1.0);
+  for (int i = 0; i < 3; ++i) {
+    const Eigen::Vector3d u = Eigen::Vector3d::Unit(i);
+    UserForceMotion p = m;
+    p.x += hx * u;
+    dq.col(first + i) = (value(p) - value0) / hx;
+    p = m;
+    p.R = ExpSO3(kStep * u) * m.R;
+    dq.col(first + 3 + i) = (value(p) - value0) / kStep;
+    p = m;
+    p.v += hv * u;
+    dv.col(first + i) = (value(p) - value0) / hv;
+    p = m;
+    p.w += hw * u;
+    dv.col(first + 3 + i) = (value(p) - value0) / hw;
+  }
+}
+
+}  // namespace
+
 void DifferenceUserForce(const UserNodeForce& force, double t, const Eigen::Vector3d& x, const Eigen::Matrix3d& R,
                          const Eigen::Vector3d& v, const Eigen::Vector3d& w, const UserNodeForce::Vector6& f,
                          double length, UserNodeForce::Matrix6& K, UserNodeForce::Matrix6& C) {
-  constexpr double kStep = 1e-7;
-  UserNodeForce::Vector6 g;
-  for (int i = 0; i < 3; ++i) {
-    const Eigen::Vector3d e = Eigen::Vector3d::Unit(i);
-    const double hx = kStep * length, hv = kStep * std::max(v.norm(), length), hw = kStep * std::max(w.norm(), 1.0);
-    force.evaluate(t, x + hx * e, R, v, w, g, nullptr, nullptr);
-    K.col(i) = (g - f) / hx;
-    force.evaluate(t, x, ExpSO3(kStep * e) * R, v, w, g, nullptr, nullptr);
-    K.col(3 + i) = (g - f) / kStep;
-    force.evaluate(t, x, R, v + hv * e, w, g, nullptr, nullptr);
-    C.col(i) = (g - f) / hv;
-    force.evaluate(t, x, R, v, w + hw * e, g, nullptr, nullptr);
-    C.col(3 + i) = (g - f) / hw;
-  }
+  const auto value = [&](const UserForceMotion& p) {
+    UserNodeForce::Vector6 g;
+    force.evaluate(t, p.x, p.R, p.v, p.w, g, nullptr, nullptr);
+    return g;
+  };
+  DifferenceMotion(UserForceMotion{x, v, w, R}, length, f, value, 0, K, C);
 }
 
 namespace {
@@ -43,7 +65,7 @@ Vector12 PairForces(const UserNodeForce& force, double t, const UserForceMotion 
 }
 
 // The pair's forces into the residual (the virtual work through both nodes' Jacobians), their
-// derivatives by forward differences (steps as DifferenceUserForce's) into K and C.
+// derivatives by forward differences (DifferenceMotion) into K and C.
 void AddPairForce(const UserNodeForce& force, const SystemState& state, const Eigen::VectorXd& W, double t,
                   double length, Eigen::VectorXd* residual, Triplets* K, Triplets* C, NodeForces* node_forces) {
   const int nodes[2] = {force.node, force.other};
@@ -55,25 +77,13 @@ void AddPairForce(const UserNodeForce& force, const SystemState& state, const Ei
   const Vector12 g = PairForces(force, t, m);
   Matrix12 dq = Matrix12::Zero(), dv = Matrix12::Zero();
   if (K || C) {
-    constexpr double kStep = 1e-7;
     for (int e = 0; e < 2; ++e) {
-      for (int i = 0; i < 3; ++i) {
-        const Eigen::Vector3d u = Eigen::Vector3d::Unit(i);
-        const double hx = kStep * length, hv = kStep * std::max(m[e].v.norm(), length);
-        const double hw = kStep * std::max(m[e].w.norm(), 1.0);
-        UserForceMotion p[2] = {m[0], m[1]};
-        p[e].x += hx * u;
-        dq.col(6 * e + i) = (PairForces(force, t, p) - g) / hx;
-        p[e] = m[e];
-        p[e].R = ExpSO3(kStep * u) * m[e].R;
-        dq.col(6 * e + 3 + i) = (PairForces(force, t, p) - g) / kStep;
-        p[e] = m[e];
-        p[e].v += hv * u;
-        dv.col(6 * e + i) = (PairForces(force, t, p) - g) / hv;
-        p[e] = m[e];
-        p[e].w += hw * u;
-        dv.col(6 * e + 3 + i) = (PairForces(force, t, p) - g) / hw;
-      }
+      const auto value = [&](const UserForceMotion& p) {
+        UserForceMotion q[2] = {m[0], m[1]};
+        q[e] = p;
+        return PairForces(force, t, q);
+      };
+      DifferenceMotion(m[e], length, g, value, 6 * e, dq, dv);
     }
   }
   for (int e = 0; e < 2; ++e) {
