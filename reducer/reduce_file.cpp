@@ -1,5 +1,7 @@
 #include "reducer/reduce_file.h"
 
+#include <filesystem>
+
 #include "formats/input_error.h"
 #include "formats/superelement_checks.h"
 #include "formats/superelement_file.h"
@@ -16,6 +18,13 @@ ReduceFileOutcome ReduceToFile(const PartSpec& part, const std::string& output, 
     out.error = part.file + ": " + what + " (no output written)";
     return out;
   };
+  // The output's folder is made (or found unwritable) before the work, not after it.
+  const std::filesystem::path folder = std::filesystem::path(output).parent_path();
+  if (!folder.empty()) {
+    std::error_code ec;
+    std::filesystem::create_directories(folder, ec);
+    if (ec) throw InputError(output + ": cannot create the folder " + folder.string() + " (" + ec.message() + ")");
+  }
   ReduceResult result;
   try {
     result = ReducePart(part, progress);

@@ -6,6 +6,16 @@ bin=$1
 src=$2
 source "$(dirname "$0")/test_lib.sh"
 
+# The output's folder is made when missing; a folder that cannot be made is one line, exit 2, and
+# refused before the work (no stage line).
+"$bin/femb-reduce" -q "$src/examples/beam_rod/part.yaml" -o "$work/new/nested/rod.h5" && [ -s "$work/new/nested/rod.h5" ] \
+  && ok || fail "reduce into a missing folder"
+touch "$work/plain_file"
+"$bin/femb-reduce" "$src/examples/beam_rod/part.yaml" -o "$work/plain_file/rod.h5" > "$work/out.txt" 2> "$work/err.txt"
+code=$?
+[ $code = 2 ] && [ "$(wc -l < "$work/err.txt")" = 1 ] && grep -q "cannot create the folder" "$work/err.txt" \
+  && ! grep -q "factorize" "$work/out.txt" && ok || fail "unwritable folder: exit $code, $(cat "$work/err.txt")"
+
 # --help on every program.
 for p in femb-reduce femb-inspect; do
   "$bin/$p" --help | grep -q "usage: $p" && ok || fail "$p --help"
