@@ -71,7 +71,7 @@ class SpinningBeam:
     name, title = "spinning_beam", "beam on a spherical joint"
     ylabel = "RMS error of the base angular velocity (2 ms average) [% of peak]"
     ex = os.path.join(EXAMPLES, "spinning_beam")
-    base = dict(n=2, step=2e-5, modes=4, options="{inertia_option: B}")
+    base = dict(n=2, step=2e-5, modes=4, options="")
     reference = dict(n=10, step=2.5e-6, modes=2, options="")
 
     def setup(self, bin_dir):
@@ -87,8 +87,9 @@ class SpinningBeam:
         s += [("modes", f"{m} modes", dict(modes=m), []) for m in (0, 2, 8)]
         s += [("step", f"h = {h * 1e6:g} us", dict(step=h), []) for h in (4e-5, 1e-5)]
         s += [("rho_inf", f"rho_inf = {r}", {}, [f"analysis.rho_inf={r}"]) for r in (0.2, 0.8)]
-        s += [("inertia option", "option A", dict(options="{inertia_option: A}"), [])]
-        return s + [(g, label, dict(options="{inertia_option: B, " + o[1:] if o else self.base["options"]), sets)
+        s += [("inertia", f"corotational, option {o}", dict(options=f"{{inertia: corotational, inertia_option: {o}}}"), [])
+              for o in "BA"]
+        return s + [(g, label, dict(options=o or self.base["options"]), sets)
                     for g, label, o, sets in common_settings(raw=True)]
 
     def error(self, run_dir, ref_dir):
@@ -178,6 +179,7 @@ def main():
     ap.add_argument("--work", default="/tmp/femb_error_vs_time")
     ap.add_argument("--png-prefix", default="error_vs_time_")
     a = ap.parse_args()
+    a.bin_dir = os.path.abspath(a.bin_dir)
     cases = {c.name: c for c in (SliderCrank(), SpinningBeam())}
     for name in a.cases.split(","):
         if name not in cases:

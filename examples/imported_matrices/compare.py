@@ -3,7 +3,8 @@
 from the two superelement files, and the small-bore pin's lag behind the rigid rotation in the
 spin-up (scene.yaml), in the hub frame: RMS of the difference relative to the lag's peak.
 Exit 1 above the tolerances (frequencies 5e-4: the two codes integrate the TET10 elements
-differently, measured 1.2e-4 on this 6 mm mesh and 6e-6 on finer ones; lag 1%).
+differently, measured 1.2e-4 on this 6 mm mesh and 6e-6 on finer ones; lag 2.5e-4: measured
+2.5e-5, both parts stiffened by femb's elements on the same mesh).
 
 usage: compare.py OUT_DIR RUN_DIR
 """
@@ -51,8 +52,8 @@ def main(out, run):
     peak = max(abs(v) for v in w2)
     rms = math.sqrt(sum((a - b) ** 2 for a, b in zip(w1, w2)) / len(w1))
     print(f"pin lag in the hub frame: peak {peak * 1e6:.2f} um (femb), RMS difference {rms * 1e6:.4f} um = "
-          f"{rms / peak:.2e} of the peak (tolerance 1e-2)")
-    if rms > 1e-2 * peak:
+          f"{rms / peak:.2e} of the peak (tolerance 2.5e-4)")
+    if rms > 2.5e-4 * peak:
         print("the lags differ by more than 1% of the peak", file=sys.stderr)
         ok = False
     return 0 if ok else 1
