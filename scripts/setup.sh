@@ -5,7 +5,7 @@
 set -euo pipefail
 packages=(cmake g++ make pkg-config libeigen3-dev libspectra-dev libsuitesparse-dev libmetis-dev
   libhdf5-dev zlib1g-dev libgmsh-dev gmsh libyaml-cpp-dev nlohmann-json3-dev libgtest-dev libopenblas-dev
-  python3-dev pybind11-dev python3-pytest python3-yaml python3-distributed python3-h5py python3-numpy python3-scipy python3-meshio python3-matplotlib calculix-ccx "$@")
+  python3-dev pybind11-dev python3-pytest python3-yaml python3-distributed python3-h5py python3-numpy python3-scipy python3-meshio python3-matplotlib python3-sphinx python3-myst-parser calculix-ccx "$@")
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

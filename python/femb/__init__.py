@@ -289,7 +289,7 @@ class Simulation:
     scene's steps up to the first that ends at or after t; between steps the caller reads the
     state (node(name), time, results()) and may change what its forces read, for co-simulation
     and controllers. The same steps and results as run()'s. A context manager; close() (or the
-    end of a with block) stops an unfinished run.
+    end of a with block) stops an unfinished run::
 
         with scene.start() as sim:
             for t in np.arange(0.001, 0.1, 0.001):
