@@ -6,7 +6,8 @@
 - every repository path named in backticks in those files exists (e.g. `solver/body/exact_inertia.cpp`);
 - every example folder's README.md and every formats/*.md is included by a page of the manual;
 - every option each program's --help prints is in docs/reference/cli.md;
-- no page speaks of development history: "issue <number>", "session", "until this session".
+- no page speaks of development history ("issue <number>", "session"), and no tracked source file
+  names an issue number.
 Prints each finding as FILE:LINE: what; exit 1 if any. Usage: check_docs.py [--bin build/bin]"""
 import argparse
 import glob
@@ -70,6 +71,19 @@ def check_history(path, lines, say):
             say(path, n, f"development history in the product: '{m.group(0)}'")
 
 
+def check_sources(say):
+    """No tracked source, script or build file names an issue number."""
+    files = subprocess.run(["git", "ls-files"], capture_output=True, text=True).stdout.split()
+    pattern = re.compile(r"\bissues? #?[0-9]+", re.IGNORECASE)
+    for path in files:
+        if not path.endswith((".cpp", ".h", ".py", ".sh", ".txt", ".yaml", ".geo", ".md")) or not os.path.isfile(path):
+            continue
+        with open(path, encoding="utf-8", errors="replace") as f:
+            for n, line in enumerate(f, 1):
+                if pattern.search(line) and path != "scripts/check_docs.py":
+                    say(path, n, "names an issue number")
+
+
 def check_reachable(say):
     pages = "\n".join(open(p, encoding="utf-8").read() for p in glob.glob("docs/**/*.md", recursive=True))
     for readme in sorted(glob.glob("examples/*/README.md")):
@@ -115,6 +129,7 @@ def main():
         check_links(path, lines, say)
         check_history(path, lines, say)
     check_reachable(say)
+    check_sources(say)
     check_cli(os.path.abspath(args.bin), say)
     for line in findings:
         print(line)

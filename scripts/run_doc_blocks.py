@@ -1,9 +1,11 @@
 #!/usr/bin/env python3
 """Runs every code block of a Markdown page as written: ```sh blocks with bash, ```python blocks
 with /usr/bin/python3, in order, as one script (an `export` carries over to later blocks), from a
-scratch folder that looks like the repository's root (build/ linked, examples/ copied, so the
-blocks' outputs stay out of the source tree). A block preceded by an HTML comment that starts with
-"not run by the test" is skipped (the page says why). Exit 0 when every block succeeds.
+scratch folder that looks like the repository's root (build/ linked, examples/ copied without the
+superelement files other runs write there, so that the blocks' outputs stay out of the source
+tree and a test running beside it cannot hand it a half-written file). A block preceded by an
+HTML comment that starts with "not run by the test" is skipped (the page says why). Exit 0 when
+every block succeeds.
 
 Usage: run_doc_blocks.py PAGE.md [--build DIR] [--keep]"""
 import argparse
@@ -64,7 +66,7 @@ def main():
     try:
         os.symlink(build, os.path.join(work, "build"))
         shutil.copytree(os.path.join(root, "examples"), os.path.join(work, "examples"),
-                        ignore=shutil.ignore_patterns("out", "__pycache__"))
+                        ignore=shutil.ignore_patterns("out", "__pycache__", "*.h5", "*.tmp*"))
         os.symlink(os.path.join(root, "scripts"), os.path.join(work, "scripts"))
         result = subprocess.run(["bash", "-c", script(args.page, found)], cwd=work)
         print(f"run_doc_blocks: {len(found)} blocks of {args.page}: "
