@@ -8,7 +8,8 @@ deflection gathered and plotted against the diameter.
 --check also runs the 16 designs one after another in this process and says whether the peaks
 are the same; --broken adds a 17th design whose rod cannot be reduced (a negative diameter): its
 error comes back in its place while the others finish. Against a cluster, pass its scheduler's
-address as FEMB_DASK_SCHEDULER (every worker must see femb and OUTDIR at the same paths).
+address as FEMB_DASK_SCHEDULER (every worker must see femb and OUTDIR at the same paths; the
+model's module, slider_crank.py, is sent to the workers).
 """
 
 import argparse
@@ -28,9 +29,9 @@ os.environ["PYTHONPATH"] = os.pathsep.join(p for p in (HERE, os.environ.get("PYT
 import slider_crank  # noqa: E402  (the model, beside this file)
 
 
-def peak_deflection(diameter, crank, slider, out, end_time):
+def peak_deflection(diameter, crank, slider, out, end_time, parts):
     """One design: its rod reduced, the slider-crank run in memory, the peak deflection [m]."""
-    rod = slider_crank.reduce_rod(out, diameter)
+    rod = slider_crank.reduce_rod(out, diameter, parts=parts)
     results = slider_crank.scene(crank, slider, rod, end_time=end_time).run()
     return float(np.abs(slider_crank.midpoint_deflection(results)).max())
 
@@ -48,14 +49,17 @@ def main():
     diameters = list(np.linspace(0.004, 0.010, 16))
     if args.broken:
         diameters.append(-0.006)
-    jobs = [functools.partial(peak_deflection, d, files["crank"], files["slider"], out, args.end_time)
-            for d in diameters]
+    jobs = [functools.partial(peak_deflection, d, files["crank"], files["slider"], out, args.end_time,
+                              slider_crank.PARTS) for d in diameters]
 
     from dask.distributed import Client, LocalCluster
     start = time.perf_counter()
     scheduler = os.environ.get("FEMB_DASK_SCHEDULER")
     if scheduler:
         client, cluster = Client(scheduler), None
+        # A cluster's workers started elsewhere do not have this folder on their path: send them
+        # the model's module (a LocalCluster's workers start with this environment).
+        client.upload_file(os.path.join(HERE, "slider_crank.py"))
     else:
         cluster = LocalCluster(n_workers=args.workers, threads_per_worker=1, processes=True,
                                dashboard_address=None)

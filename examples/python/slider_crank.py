@@ -14,7 +14,7 @@ import numpy as np
 import femb
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-PARTS = os.path.join(HERE, "..", "slider_crank_2d")
+PARTS = os.path.abspath(os.path.join(HERE, "..", "slider_crank_2d"))
 
 
 def reduce_parts(out, progress=None):
@@ -27,10 +27,11 @@ def reduce_parts(out, progress=None):
     return files
 
 
-def reduce_rod(out, diameter=0.006, progress=None):
-    """One of the rod's two segments (0.15 m, steel, 4 internal modes) of the given diameter [m]."""
+def reduce_rod(out, diameter=0.006, progress=None, parts=PARTS):
+    """One of the rod's two segments (0.15 m, steel, 4 internal modes) of the given diameter [m];
+    parts: the folder of the part files (a sweep's workers are given the client's)."""
     path = os.path.join(out, f"rod_{diameter * 1e3:.4g}mm.h5")
-    femb.reduce(os.path.join(PARTS, "rod_2.yaml"), path, set={"section.diameter": diameter}, progress=progress)
+    femb.reduce(os.path.join(parts, "rod_2.yaml"), path, set={"section.diameter": diameter}, progress=progress)
     return path
 
 
