@@ -23,6 +23,7 @@ factor would not fit in memory raises femb.RefusedError. Warnings go to Python's
 
 import json
 import os
+import shutil
 import warnings
 
 from . import _core
@@ -377,11 +378,14 @@ class Results:
         self.steps = {"time": r.steps_time, "size": r.steps_size}
         self.nodes = list(r.node_names)
         self.bodies = [b.name for b in r.bodies]
+        self._run = run_result  # the animation's frames of a run kept in memory (write_animation)
 
     def __getstate__(self):
-        # Sent between processes (a sweep's workers): the series as plain numpy arrays.
+        # Sent between processes (a sweep's workers): the series as plain numpy arrays, without
+        # the run (its model and animation frames stay where it ran).
         state = dict(self.__dict__)
         state["_r"] = _plain(self._r)
+        state["_run"] = None
         return state
 
     def __setstate__(self, state):
@@ -424,8 +428,7 @@ class Results:
 
     def write(self, directory):
         """Writes results.h5 and probes.csv into `directory` (created if needed), as femb-solve
-        writes them (the animation only run(output=...) writes: its frames are not kept in
-        memory). Returns the two paths."""
+        writes them; write_animation() adds the ParaView animation. Returns the two paths."""
         if not isinstance(self._r, _core.RecordedResults):
             raise FembError("results that came from another process are written where they were made "
                             "(run(output=...) there)")
@@ -436,6 +439,33 @@ class Results:
         _core.write_probes_csv(self._r, csv)
         _core.write_results(self._r, self.status, h5)
         return h5, csv
+
+    def write_animation(self, directory):
+        """Writes the run's ParaView animation (animation.xdmf and animation.h5, as femb-solve
+        writes them) into `directory` (created if needed) and returns the .xdmf's path. A run kept
+        in memory keeps its animation frames (a few numbers per body each, about 500 frames; the
+        outputs.animation* keys choose them) and makes them here; a run with an output folder
+        has written its animation there, which is copied. Results sent from another process have
+        neither: FembError."""
+        directory = os.fspath(directory)
+        xdmf = os.path.join(directory, "animation.xdmf")
+        run = self._run
+        if run is not None and run.write_animation(directory):
+            if not os.path.exists(xdmf):
+                raise FembError("the run has no animation (outputs.animation is false, or no body has a mesh or "
+                                "nodes to draw)")
+            return xdmf
+        if run is not None and run.output:
+            source = os.path.join(run.output, "animation.xdmf")
+            if not os.path.exists(source):
+                raise FembError(f"{source}: the run wrote no animation (outputs.animation, meshes in the files)")
+            os.makedirs(directory, exist_ok=True)
+            if os.path.abspath(run.output) != os.path.abspath(directory):
+                for name in ("animation.h5", "animation.xdmf"):
+                    shutil.copyfile(os.path.join(run.output, name), os.path.join(directory, name))
+            return xdmf
+        raise FembError("these results came from another process: their animation is written where they were "
+                        "made (write_animation() or run(output=...) there)")
 
     @property
     def loops(self):

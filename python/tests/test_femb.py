@@ -4,9 +4,11 @@ Run: PYTHONPATH=build/python FEMB_BIN=build/bin /usr/bin/python3 -m pytest -q py
 (ctest runs it as python_package)."""
 
 import os
+import pickle
 import shutil
 import subprocess
 
+import h5py
 import numpy as np
 import pytest
 
@@ -125,6 +127,18 @@ def test_scene_run_equals_femb_solve(slider_crank, tmp_path):
         # The scene attribute names the file as it was given: here a full path, there a relative one.
         assert {k: v for k, v in a.attrs.items() if k != "scene"} == {k: v for k, v in b.attrs.items() if k != "scene"}
         assert a.attrs["scene"].decode().endswith("/scene.yaml")
+    # The animation of the run kept in memory, made afterwards: femb-solve's, dataset by dataset
+    # (mesh, positions, deformation, displacement of every frame) and the same .xdmf.
+    xdmf = results.write_animation(tmp_path / "later")
+    with open(xdmf) as a, open(tmp_path / "cli" / "animation.xdmf") as b:
+        assert a.read() == b.read()
+    with h5py.File(tmp_path / "later" / "animation.h5") as a, h5py.File(tmp_path / "cli" / "animation.h5") as b:
+        names = []
+        b.visit(names.append)
+        assert len(names) > 10
+        for name in names:
+            if isinstance(b[name], h5py.Dataset):
+                assert np.array_equal(a[name][()], b[name][()]), name
     # No files unless asked: the scene's folder holds what it held.
     assert sorted(os.listdir(slider_crank)) == sorted(
         ["crank.yaml", "slider.yaml", "rod_2.yaml", "scene.yaml", "crank.h5", "slider.h5", "rod_2.h5"])
@@ -141,6 +155,20 @@ def test_scene_run_writes_the_programs_files(slider_crank, tmp_path):
         assert a.read() == b.read()
     assert os.path.exists(tmp_path / "py" / "checkpoint.h5")
     assert any(line.startswith("done in") for line in lines), lines
+    # The animation of a run with an output folder is copied from there; one stepped in memory is
+    # made from its kept frames and equals it; results sent between processes have none.
+    results = femb.Scene.load(slider_crank / "scene.yaml", set={"analysis.end_time": 0.005}).run(output=tmp_path / "o")
+    with open(results.write_animation(tmp_path / "copy")) as a, open(tmp_path / "cli" / "animation.xdmf") as b:
+        assert a.read() == b.read()
+    with femb.Scene.load(slider_crank / "scene.yaml", set={"analysis.end_time": 0.005}).start() as sim:
+        sim.step_to(0.002)
+        stepped = sim.finish()
+    with open(stepped.write_animation(tmp_path / "stepped")) as a, open(tmp_path / "cli" / "animation.xdmf") as b:
+        assert a.read() == b.read()
+    with h5py.File(tmp_path / "stepped" / "animation.h5") as a, h5py.File(tmp_path / "cli" / "animation.h5") as b:
+        assert all(np.array_equal(a[k][()], b[k][()]) for k in b.keys())
+    with pytest.raises(femb.FembError, match="another process"):
+        pickle.loads(pickle.dumps(stepped)).write_animation(tmp_path / "none")
 
 
 def test_modes_and_statics_in_memory(slider_crank):
@@ -192,10 +220,18 @@ def test_numerical_failure_keeps_the_results(tmp_path):
     assert not kept.ok and len(kept.time) > 1 and kept.time[-1] < 3.0
 
 
-def run_example(script, *args):
-    env = dict(os.environ, OMP_NUM_THREADS="1", PYTHONPATH=os.path.join(ROOT, "build", "python"))
+def example_env(extra=None):
+    """The environment of an example's process (and of a sweep's workers): femb importable."""
+    env = dict(os.environ, OMP_NUM_THREADS="1", OPENBLAS_NUM_THREADS="1",
+               PYTHONPATH=os.path.join(ROOT, "build", "python"))
     if "PYTHONPATH" in os.environ:
         env["PYTHONPATH"] = os.environ["PYTHONPATH"]
+    env.update(extra or {})
+    return env
+
+
+def run_example(script, *args, env=None):
+    env = example_env(env)
     p = subprocess.run(["/usr/bin/python3", os.path.join(EXAMPLES, "python", script), *args], capture_output=True,
                        text=True, env=env, timeout=600)
     assert p.returncode == 0, p.stdout + p.stderr
@@ -220,6 +256,33 @@ def test_dask_sweep_example(tmp_path):
     assert "d =  -6.000 mm: InputError: --set section.diameter: must be positive, got -0.006" in out, out
     assert "17 designs on 2 local workers" in out and "1 failed" in out, out
     assert "serial runs in" in out and "the same peaks" in out, out
+
+
+def test_dask_sweep_against_a_scheduler(tmp_path):
+    # The example's code against a cluster's scheduler (FEMB_DASK_SCHEDULER): a dask-scheduler
+    # process and a dask-worker process of 2 workers, reached over TCP as a cluster's are; the same
+    # peaks as the serial runs, the broken design's line in its place.
+    import socket
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    address = f"tcp://127.0.0.1:{port}"
+    env = example_env()
+    logs = open(tmp_path / "dask.log", "w")
+    scheduler = subprocess.Popen(["/usr/bin/python3", "-m", "distributed.cli.dask_scheduler", "--host", "127.0.0.1",
+                                  "--port", str(port), "--no-dashboard"], stdout=logs, stderr=logs, env=env)
+    worker = subprocess.Popen(["/usr/bin/python3", "-m", "distributed.cli.dask_worker", address, "--nworkers", "2",
+                               "--nthreads", "1", "--no-dashboard"], stdout=logs, stderr=logs, env=env)
+    try:
+        out = run_example("diameter_sweep.py", str(tmp_path / "out"), "--end-time", "0.005", "--check", "--broken",
+                          env={"FEMB_DASK_SCHEDULER": address})
+    finally:
+        worker.terminate(), scheduler.terminate()
+        worker.wait(30), scheduler.wait(30)
+        logs.close()
+    assert "17 designs on the cluster's workers" in out and "1 failed" in out, out
+    assert "the same peaks" in out, out
+    assert "InputError: --set section.diameter: must be positive, got -0.006" in out, out
 
 
 def test_sweep_returns_errors_in_place(slider_crank):

@@ -252,6 +252,15 @@ ResultsRecorder::PackedFrame ResultsRecorder::MakeFields(const PendingOutput& jo
 }
 
 void ResultsRecorder::MakePending() {
+  if (!files_ && !writing_memory_frames_) {
+    // Results kept in memory: the frames wait for WriteAnimation; only the stresses are made.
+    for (PendingOutput& job : pending_) {
+      if (job.frame < 0) continue;
+      memory_frames_.push_back(job);
+      job.frame = -1;
+    }
+    if (!scene_.spec.stresses) pending_.clear();
+  }
   if (pending_.empty()) return;
   if (scene_.spec.animation) Grid();  // (built here, read by the threads)
   // Each output step made by one thread, the steps spread over the machine's cores; frame 0
@@ -413,6 +422,26 @@ void ResultsRecorder::FinishAnimation() {
     const std::string file = entry.path().filename().string();
     if (file.rfind("animation.part-", 0) == 0) std::filesystem::remove(entry.path(), ec);
   }
+}
+
+void ResultsRecorder::WriteAnimation(const std::string& directory) {
+  if (files_) throw std::logic_error("ResultsRecorder::WriteAnimation: the run wrote its own animation");
+  std::error_code ec;
+  std::filesystem::create_directories(directory, ec);
+  if (ec) throw InputError(directory + ": cannot create output folder (" + ec.message() + ")");
+  directory_ = directory;
+  frames_written_ = 0;
+  frame_file_.clear(), frame_stress_fields_.clear(), packed_frames_.clear(), animation_parts_.clear();
+  pending_ = memory_frames_;
+  writing_memory_frames_ = true;
+  try {
+    MakePending();
+  } catch (...) {
+    writing_memory_frames_ = false;
+    throw;
+  }
+  writing_memory_frames_ = false;
+  FinishAnimation();
 }
 
 }  // namespace femb

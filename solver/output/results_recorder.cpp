@@ -337,9 +337,9 @@ void ResultsRecorder::RecordJoints(const SystemState& state) {
 }
 
 // Whether the output step just recorded at t is an animation frame: every animation_every-th
-// output step, or the first at or after each frame_interval.
+// output step, or the first at or after each frame_interval. (Kept in memory, a frame is a few
+// numbers per body until WriteAnimation makes it.)
 bool ResultsRecorder::AnimationFrame(double t) {
-  if (!files_) return false;  // the animation is a file
   bool frame = (time_.size() - 1) % size_t(animation_every_) == 0;
   if (frame_interval_ > 0) {
     frame = t >= next_frame_time_ - 1e-9 * frame_interval_;

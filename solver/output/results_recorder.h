@@ -109,6 +109,10 @@ class ResultsRecorder {
   /// Writes results.h5, probes.csv and animation.h5 in their final form. `status` is stored
   /// ("completed", the failure message, or where a signal stopped the run).
   void Finish(const std::string& status);
+  /// Results kept in memory (no directory given), after Finish: writes the ParaView animation of
+  /// the run (animation.xdmf and animation.h5, the same as a run into `directory` writes) from
+  /// the frames kept, a few numbers per body each. May be called again (another directory).
+  void WriteAnimation(const std::string& directory);
   /// What a restart needs of the results so far (femb-solve --restart), taken when the run's
   /// state is saved (DynamicStepReport::capture): the output steps, steps and animation frames
   /// recorded up to that state, and the probes' unwrapping of angles.
@@ -243,6 +247,9 @@ class ResultsRecorder {
     std::vector<Eigen::VectorXd> factors;   ///< and its inertia load factors (empty: none)
   };
   std::vector<PendingOutput> pending_;
+  /// Results kept in memory: the animation frames' jobs, made only when WriteAnimation asks.
+  std::vector<PendingOutput> memory_frames_;
+  bool writing_memory_frames_ = false;
   // A frame made and packed (compressed), waiting for its file.
   struct PackedFrame {
     std::vector<h5::PackedFloats> fields;

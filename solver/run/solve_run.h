@@ -79,6 +79,9 @@ class SolveRun {
   const Scene& scene() const { return scene_; }
   /// The results recorded (after Run).
   const ResultsRecorder& recorder() const { return *recorder_; }
+  /// A run whose results were kept in memory (no output folder), after Run: writes its ParaView
+  /// animation into `directory` (ResultsRecorder::WriteAnimation).
+  void WriteAnimation(const std::string& directory) { recorder_->WriteAnimation(directory); }
   /// Steps taken (static: load steps) and Newton iterations over them.
   long steps() const { return step_count_; }
   long iterations() const { return total_iterations_; }
