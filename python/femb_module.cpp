@@ -178,15 +178,37 @@ femb::UserNodeForce PythonForce(const std::string& name, const py::object& funct
 }
 
 // A Python function as a force between two nodes (UserNodeForce::evaluate_pair):
-// function(t, x, R, v, w, x_other, R_other, v_other, w_other) -> f (6) on the node.
-femb::UserNodeForce PythonPairForce(const std::string& name, const py::object& function) {
+// function(t, x, R, v, w, x_other, R_other, v_other, w_other) -> f (6) on the node, or with
+// `jacobian` -> (f, K, C), K = df/d(x, theta, x_other, theta_other), C = df/d(v, omega, v_other,
+// omega_other) (6 x 12).
+femb::UserNodeForce PythonPairForce(const std::string& name, const py::object& function, bool jacobian) {
   const PythonFunction fn(name, function);
   femb::UserNodeForce force;
   force.name = name;
-  force.evaluate_pair = [fn](double t, const femb::UserForceMotion& a, const femb::UserForceMotion& b,
-                             femb::UserNodeForce::Vector6& f) {
+  using M = femb::UserNodeForce::Matrix6x12;
+  force.evaluate_pair = [fn, jacobian](double t, const femb::UserForceMotion& a, const femb::UserForceMotion& b,
+                                       femb::UserNodeForce::Vector6& f, M* K, M* C) {
     py::gil_scoped_acquire gil;
-    fn.Take(t, fn.Call(t, a.x, a.R, a.v, a.w, b.x, b.R, b.v, b.w), 6, 1, kForceWhat, f.data());
+    const py::object value = fn.Call(t, a.x, a.R, a.v, a.w, b.x, b.R, b.v, b.w);
+    if (!jacobian) {
+      fn.Take(t, value, 6, 1, kForceWhat, f.data());
+      return false;
+    }
+    if (!py::isinstance<py::tuple>(value) || py::len(value) != 3) {
+      throw femb::UserForceError(fn.Where(t) + "with jacobian=True, return (f, K, C)");
+    }
+    const py::tuple triple = value.cast<py::tuple>();
+    fn.Take(t, triple[0], 6, 1, kForceWhat, f.data());
+    Eigen::Matrix<double, 6, 12, Eigen::RowMajor> m;
+    if (K) {
+      fn.Take(t, triple[1], 6, 12, "K = df/d(x, theta, x_other, theta_other)", m.data());
+      *K = m;
+    }
+    if (C) {
+      fn.Take(t, triple[2], 6, 12, "C = df/d(v, omega, v_other, omega_other)", m.data());
+      *C = m;
+    }
+    return true;
   };
   return force;
 }
@@ -238,13 +260,9 @@ femb::SolveRunOptions RunOptions(const std::string& output, int threads, const p
   for (const py::handle item : forces) {
     const auto [node, other, force_name, function, jacobian] =
         item.cast<std::tuple<std::string, std::string, std::string, py::object, bool>>();
-    if (!other.empty() && jacobian) {
-      throw femb::InputError("force '" + force_name +
-                             "': a force between two nodes takes no Jacobian (femb differences it)");
-    }
-    options.user_forces.push_back(
-        {node, other,
-         other.empty() ? PythonForce(force_name, function, jacobian) : PythonPairForce(force_name, function)});
+    options.user_forces.push_back({node, other,
+                                   other.empty() ? PythonForce(force_name, function, jacobian)
+                                                 : PythonPairForce(force_name, function, jacobian)});
   }
   for (const py::handle item : modal_forces) {
     const auto [body, force_name, function, jacobian] =

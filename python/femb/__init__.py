@@ -220,7 +220,10 @@ class Scene:
         function(t, position, rotation, velocity, angular_velocity, position_other,
         rotation_other, velocity_other, angular_velocity_other) gives the force and moment on
         `node`; `other` takes the opposite force and the opposite moment about itself, so the
-        pair keeps momentum. Differenced (24 calls more per matrix); no Jacobian.
+        pair keeps momentum. With jacobian=True it returns (f, K, C), K = df/d(position, theta,
+        position_other, theta_other) and C = df/d(velocity, angular_velocity, velocity_other,
+        angular_velocity_other), each 6 x 12 (femb derives the other node's from them); without,
+        femb differences the function (24 more calls per matrix).
         """
         self._forces.append((str(node), str(other) if other is not None else "",
                              name or getattr(function, "__name__", "force"), function, bool(jacobian)))

@@ -54,14 +54,31 @@ using Vector12 = Eigen::Matrix<double, 12, 1>;
 using Matrix12 = Eigen::Matrix<double, 12, 12>;
 
 // A force between two nodes: on (node, other), the force and its reaction (UserNodeForce::other).
-Vector12 PairForces(const UserNodeForce& force, double t, const UserForceMotion (&m)[2]) {
+// With dq and dv not null, also the pair's derivatives when the user function gives f's (returns
+// whether it did): the reaction's, -dF and -dM - (x - x_other) x dF - (dx - dx_other) x F.
+bool PairForces(const UserNodeForce& force, double t, const UserForceMotion (&m)[2], Vector12& g,
+                Matrix12* dq = nullptr, Matrix12* dv = nullptr) {
   UserNodeForce::Vector6 f;
-  force.evaluate_pair(t, m[0], m[1], f);
-  Vector12 g;
+  UserNodeForce::Matrix6x12 K, C;
+  const bool given = force.evaluate_pair(t, m[0], m[1], f, dq ? &K : nullptr, dv ? &C : nullptr);
+  const Eigen::Vector3d arm = m[0].x - m[1].x;
   g.head<6>() = f;
   g.segment<3>(6) = -f.head<3>();
-  g.tail<3>() = -f.tail<3>() - (m[0].x - m[1].x).cross(f.head<3>());
-  return g;
+  g.tail<3>() = -f.tail<3>() - arm.cross(f.head<3>());
+  if (!given) return false;
+  const auto reaction = [&](const UserNodeForce::Matrix6x12& D, Matrix12& out) {
+    out.topRows<6>() = D;
+    out.middleRows<3>(6) = -D.topRows<3>();
+    out.bottomRows<3>() = -D.bottomRows<3>() - Skew(arm) * D.topRows<3>();
+  };
+  if (dq) {
+    reaction(K, *dq);
+    const Eigen::Matrix3d F = Skew(Eigen::Vector3d(f.head<3>()));  // (dx_other - dx) x F = F~ (dx - dx_other)
+    dq->block<3, 3>(9, 0) += F;
+    dq->block<3, 3>(9, 6) -= F;
+  }
+  if (dv) reaction(C, *dv);
+  return true;
 }
 
 // The pair's forces into the residual (the virtual work through both nodes' Jacobians), their
@@ -74,14 +91,18 @@ void AddPairForce(const UserNodeForce& force, const SystemState& state, const Ei
     const Eigen::Matrix<double, 6, 1> motion = NodeMotion(state, nodes[e], W);
     m[e] = {state.x[nodes[e]], motion.head<3>(), motion.tail<3>(), state.R[nodes[e]]};
   }
-  const Vector12 g = PairForces(force, t, m);
+  const bool matrices = K || C;
+  Vector12 g;
   Matrix12 dq = Matrix12::Zero(), dv = Matrix12::Zero();
-  if (K || C) {
+  const bool given = PairForces(force, t, m, g, matrices ? &dq : nullptr, matrices ? &dv : nullptr);
+  if (matrices && !given) {
     for (int e = 0; e < 2; ++e) {
       const auto value = [&](const UserForceMotion& p) {
         UserForceMotion q[2] = {m[0], m[1]};
         q[e] = p;
-        return PairForces(force, t, q);
+        Vector12 h;
+        PairForces(force, t, q, h);
+        return h;
       };
       DifferenceMotion(m[e], length, g, value, 6 * e, dq, dv);
     }

@@ -34,9 +34,14 @@ struct UserNodeForce {
   /// momentum is kept.
   int other = -1;
   std::string name;  ///< for messages ("force 'bump_stop' on node 'tip'")
-  /// f = (force, moment about `node`) on `node` from the motions of `node` and `other`; femb
-  /// differences it for the matrices. Throws UserForceError.
-  std::function<void(double t, const UserForceMotion& node, const UserForceMotion& other, Vector6& f)> evaluate_pair;
+  using Matrix6x12 = Eigen::Matrix<double, 6, 12>;
+  /// f = (force, moment about `node`) on `node` from the motions of `node` and `other`. With K
+  /// and C not null it may also give K = d f / d (x, theta, x_other, theta_other) and
+  /// C = d f / d (v, w, v_other, w_other), and returns whether it did; femb differences f where
+  /// it did not (the reaction's derivatives follow from f's). Throws UserForceError.
+  std::function<bool(double t, const UserForceMotion& node, const UserForceMotion& other, Vector6& f, Matrix6x12* K,
+                     Matrix6x12* C)>
+      evaluate_pair;
   /// f = (force, moment about the node) in world axes, at time t of the node's position x,
   /// rotation R (node axes in world axes), velocity v and angular velocity w (world axes). With K
   /// and C not null it may also give K = d f / d (x, theta) and C = d f / d (v, w), theta the
