@@ -9,6 +9,7 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -129,6 +130,31 @@ class PythonFunction {
       if (!std::isfinite(out[i])) throw femb::UserForceError(Where(t) + what + " is not finite");
     }
   }
+  // What the function returns: without a Jacobian the value (n numbers) into `value`, false;
+  // with one, the triple (value, K, C), K and C n x cols into *K and *C where asked, true. `names`
+  // says what each is ("the force ...", "K = ...", "C = ..."), `triple` how the triple reads.
+  template <typename Matrix>
+  bool TakeValue(double t, const py::object& result, bool jacobian, long n, long cols,
+                 const std::array<const char*, 3>& names, const char* triple, double* value, Matrix* K,
+                 Matrix* C) const {
+    if (!jacobian) {
+      Take(t, result, n, 1, names[0], value);
+      return false;
+    }
+    if (!py::isinstance<py::tuple>(result) || py::len(result) != 3) {
+      throw femb::UserForceError(Where(t) + "with jacobian=True, return " + triple);
+    }
+    const py::tuple parts = result.cast<py::tuple>();
+    Take(t, parts[0], n, 1, names[0], value);
+    Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> m(n, cols);
+    Matrix* out[2] = {K, C};
+    for (int i = 0; i < 2; ++i) {
+      if (!out[i]) continue;
+      Take(t, parts[i + 1], n, cols, names[size_t(i) + 1], m.data());
+      *out[i] = m;
+    }
+    return true;
+  }
   std::string Where(double t) const {
     char where[160];
     std::snprintf(where, sizeof where, "force '%s' at t = %.9g: ", name_.c_str(), t);
@@ -153,26 +179,8 @@ femb::UserNodeForce PythonForce(const std::string& name, const py::object& funct
                                   const Eigen::Vector3d& v, const Eigen::Vector3d& w, femb::UserNodeForce::Vector6& f,
                                   femb::UserNodeForce::Matrix6* K, femb::UserNodeForce::Matrix6* C) {
     py::gil_scoped_acquire gil;
-    const py::object value = fn.Call(t, x, R, v, w);
-    if (!jacobian) {
-      fn.Take(t, value, 6, 1, kForceWhat, f.data());
-      return false;
-    }
-    if (!py::isinstance<py::tuple>(value) || py::len(value) != 3) {
-      throw femb::UserForceError(fn.Where(t) + "with jacobian=True, return (f, K, C)");
-    }
-    const py::tuple triple = value.cast<py::tuple>();
-    fn.Take(t, triple[0], 6, 1, kForceWhat, f.data());
-    Eigen::Matrix<double, 6, 6, Eigen::RowMajor> m;
-    if (K) {
-      fn.Take(t, triple[1], 6, 6, "K = df/d(x, theta)", m.data());
-      *K = m;
-    }
-    if (C) {
-      fn.Take(t, triple[2], 6, 6, "C = df/d(v, omega)", m.data());
-      *C = m;
-    }
-    return true;
+    return fn.TakeValue(t, fn.Call(t, x, R, v, w), jacobian, 6, 6,
+                        {kForceWhat, "K = df/d(x, theta)", "C = df/d(v, omega)"}, "(f, K, C)", f.data(), K, C);
   };
   return force;
 }
@@ -189,26 +197,10 @@ femb::UserNodeForce PythonPairForce(const std::string& name, const py::object& f
   force.evaluate_pair = [fn, jacobian](double t, const femb::UserForceMotion& a, const femb::UserForceMotion& b,
                                        femb::UserNodeForce::Vector6& f, M* K, M* C) {
     py::gil_scoped_acquire gil;
-    const py::object value = fn.Call(t, a.x, a.R, a.v, a.w, b.x, b.R, b.v, b.w);
-    if (!jacobian) {
-      fn.Take(t, value, 6, 1, kForceWhat, f.data());
-      return false;
-    }
-    if (!py::isinstance<py::tuple>(value) || py::len(value) != 3) {
-      throw femb::UserForceError(fn.Where(t) + "with jacobian=True, return (f, K, C)");
-    }
-    const py::tuple triple = value.cast<py::tuple>();
-    fn.Take(t, triple[0], 6, 1, kForceWhat, f.data());
-    Eigen::Matrix<double, 6, 12, Eigen::RowMajor> m;
-    if (K) {
-      fn.Take(t, triple[1], 6, 12, "K = df/d(x, theta, x_other, theta_other)", m.data());
-      *K = m;
-    }
-    if (C) {
-      fn.Take(t, triple[2], 6, 12, "C = df/d(v, omega, v_other, omega_other)", m.data());
-      *C = m;
-    }
-    return true;
+    return fn.TakeValue(
+        t, fn.Call(t, a.x, a.R, a.v, a.w, b.x, b.R, b.v, b.w), jacobian, 6, 12,
+        {kForceWhat, "K = df/d(x, theta, x_other, theta_other)", "C = df/d(v, omega, v_other, omega_other)"},
+        "(f, K, C)", f.data(), K, C);
   };
   return force;
 }
@@ -223,27 +215,9 @@ femb::UserModalForce PythonModalForce(const std::string& name, const py::object&
                                   Eigen::MatrixXd* K, Eigen::MatrixXd* C) {
     py::gil_scoped_acquire gil;
     const long n = q.size();
-    const py::object value = fn.Call(t, q, qdot);
     Q.resize(n);
-    if (!jacobian) {
-      fn.Take(t, value, n, 1, "the generalized force Q", Q.data());
-      return false;
-    }
-    if (!py::isinstance<py::tuple>(value) || py::len(value) != 3) {
-      throw femb::UserForceError(fn.Where(t) + "with jacobian=True, return (Q, K, C)");
-    }
-    const py::tuple triple = value.cast<py::tuple>();
-    fn.Take(t, triple[0], n, 1, "the generalized force Q", Q.data());
-    Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> m(n, n);
-    if (K) {
-      fn.Take(t, triple[1], n, n, "K = dQ/dq", m.data());
-      *K = m;
-    }
-    if (C) {
-      fn.Take(t, triple[2], n, n, "C = dQ/dqdot", m.data());
-      *C = m;
-    }
-    return true;
+    return fn.TakeValue(t, fn.Call(t, q, qdot), jacobian, n, n,
+                        {"the generalized force Q", "K = dQ/dq", "C = dQ/dqdot"}, "(Q, K, C)", Q.data(), K, C);
   };
   return force;
 }
