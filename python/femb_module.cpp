@@ -519,9 +519,9 @@ void BindResults(py::module_& m) {
       .def_readonly("iterations", &RunResult::iterations)
       .def_readonly("output", &RunResult::output)
       .def("write_animation", [](RunResult& r, const std::string& directory) {
-        // A run kept in memory: its animation made from the frames kept. False: none kept.
+        // A run kept in memory: its animation made from the frames kept (holding the GIL: one
+        // call at a time on the run's recorder). False: none kept.
         if (!r.run) return false;
-        py::gil_scoped_release release;
         r.run->WriteAnimation(directory);
         return true;
       });
