@@ -124,7 +124,7 @@ int SolveRun::Run() {
   ReadRestart();
   ReadInitialState();
   recorder_.emplace(scene_, options_.output);
-  signature_ = ModelSignature(scene_);
+  if (!options_.in_memory) signature_ = ModelSignature(scene_);  // names the checkpoint's model (re-reads the files)
   if (resume_) ResumeRecorder();
   read_seconds_ = Seconds(wall_);  // scene, superelement files, model
   if (!quiet()) PrintSummary();
