@@ -176,7 +176,7 @@ namespace {
 
 // The checkpoint of `directory`, checked: a femb checkpoint of a version this femb reads,
 // written for `scene`'s model (else one line naming the first difference).
-h5::Reader OpenCheckpoint(const std::string& directory, const Scene& scene) {
+h5::Reader OpenCheckpoint(const std::string& directory, const Scene& scene, const std::string& signature) {
   const std::string path = (std::filesystem::path(directory) / "checkpoint.h5").string();
   if (!std::filesystem::exists(path)) {
     throw InputError(path + ": no checkpoint (a folder femb-solve wrote its results to holds one)");
@@ -189,7 +189,7 @@ h5::Reader OpenCheckpoint(const std::string& directory, const Scene& scene) {
   if (version.substr(0, version.find('.')) != std::string(kVersion).substr(0, 1)) {
     throw InputError(path + ": checkpoint format_version " + version + ", this femb reads " + kVersion);
   }
-  std::istringstream theirs(r.StringAttribute("/", "model")), ours(ModelSignature(scene));
+  std::istringstream theirs(r.StringAttribute("/", "model")), ours(signature);
   std::string a, b;
   while (true) {
     const bool more_a = bool(std::getline(theirs, a)), more_b = bool(std::getline(ours, b));
@@ -264,8 +264,9 @@ DynamicState ReadState(const h5::Reader& r, const std::string& g, const SystemMo
 
 }  // namespace
 
-DynamicState ReadCheckpoint(const std::string& directory, const Scene& scene, AnalysisType* analysis) {
-  const h5::Reader r = OpenCheckpoint(directory, scene);
+DynamicState ReadCheckpoint(const std::string& directory, const Scene& scene, const std::string& signature,
+                            AnalysisType* analysis) {
+  const h5::Reader r = OpenCheckpoint(directory, scene, signature);
   if (analysis) {
     const std::string word = r.StringAttribute("/", "analysis");
     const std::optional<AnalysisType> type = KindOf<AnalysisType>(word);
@@ -275,8 +276,8 @@ DynamicState ReadCheckpoint(const std::string& directory, const Scene& scene, An
   return ReadState(r, "/state", scene.model);
 }
 
-bool ReadResume(const std::string& directory, const Scene& scene, DynamicResume& resume) {
-  const h5::Reader r = OpenCheckpoint(directory, scene);
+bool ReadResume(const std::string& directory, const Scene& scene, const std::string& signature, DynamicResume& resume) {
+  const h5::Reader r = OpenCheckpoint(directory, scene, signature);
   if (!r.Exists("/resume")) return false;
   const SystemModel& model = scene.model;
   resume.state = ReadState(r, "/state", model);

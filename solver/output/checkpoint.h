@@ -30,12 +30,13 @@ void WriteCheckpoint(const std::string& directory, const Scene& scene, const std
 
 /// The state in `directory`/checkpoint.h5 for `scene`'s model, with its node Jacobians. Throws
 /// InputError (one line naming the file) when there is none, it is not a femb checkpoint, is
-/// truncated, or belongs to another model (the first difference named). `analysis`: the kind
-/// of run that wrote it.
-DynamicState ReadCheckpoint(const std::string& directory, const Scene& scene, AnalysisType* analysis = nullptr);
+/// truncated, or belongs to another model than `signature` (ModelSignature(scene); the first
+/// difference named). `analysis`: the kind of run that wrote it.
+DynamicState ReadCheckpoint(const std::string& directory, const Scene& scene, const std::string& signature,
+                            AnalysisType* analysis = nullptr);
 
 /// The checkpoint's /resume group (ReadCheckpoint's checks first), the state included, to the
 /// bit; false when the checkpoint has none (a static run's, or one written before the first step).
-bool ReadResume(const std::string& directory, const Scene& scene, DynamicResume& resume);
+bool ReadResume(const std::string& directory, const Scene& scene, const std::string& signature, DynamicResume& resume);
 
 }  // namespace femb

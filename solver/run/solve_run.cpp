@@ -124,7 +124,6 @@ int SolveRun::Run() {
   ReadRestart();
   ReadInitialState();
   recorder_.emplace(scene_, options_.output);
-  if (!options_.in_memory) signature_ = ModelSignature(scene_);  // names the checkpoint's model (re-reads the files)
   if (resume_) ResumeRecorder();
   read_seconds_ = Seconds(wall_);  // scene, superelement files, model
   if (!quiet()) PrintSummary();
@@ -169,7 +168,7 @@ void SolveRun::ReadRestart() {
                      "state with initial_state)");
   }
   resume_.emplace();
-  if (!ReadResume(restart, scene_, *resume_)) {
+  if (!ReadResume(restart, scene_, Signature(), *resume_)) {
     throw InputError(checkpoint +
                      ": holds no dynamic run to continue (a static run's state, or one written "
                      "before the first step: start anew, or from it with initial_state)");
@@ -200,7 +199,7 @@ void SolveRun::ReadInitialState() {
   std::filesystem::path dir(is.from);
   if (dir.is_relative()) dir = std::filesystem::path(spec_.file).parent_path() / dir;
   AnalysisType kind = AnalysisType::kStatic;
-  from_ = ReadCheckpoint(dir.string(), scene_, &kind);
+  from_ = ReadCheckpoint(dir.string(), scene_, Signature(), &kind);
   t0_ = is.time ? *is.time : kind == AnalysisType::kDynamic ? from_->t : 0.0;
   if (spec_.analysis.type == AnalysisType::kDynamic && !(spec_.analysis.end_time > t0_)) {
     char buffer[200];
@@ -264,11 +263,18 @@ void SolveRun::Take(const DynamicStepReport& report) {
   mark_ = recorder().TakeMark();
   saved_steps_ = step_count_, saved_iterations_ = total_iterations_;
 }
+// The model's signature (ModelSignature: it re-reads and hashes every superelement file), made
+// once, when a checkpoint is first read or written: a run kept in memory that starts from no
+// saved state never makes it.
+const std::string& SolveRun::Signature() {
+  if (signature_.empty()) signature_ = ModelSignature(scene_);
+  return signature_;
+}
 void SolveRun::SaveCheckpoint(const DynamicState& state) {
   if (options_.in_memory || no_checkpoint_) return;
   const AnalysisType kind = is_static() ? AnalysisType::kStatic : AnalysisType::kDynamic;
-  if (!saved_) return WriteCheckpoint(options_.output, scene_, signature_, state, kind);
-  WriteCheckpoint(options_.output, scene_, signature_, saved_->state, kind, &*saved_, [&](h5::Writer& w) {
+  if (!saved_) return WriteCheckpoint(options_.output, scene_, Signature(), state, kind);
+  WriteCheckpoint(options_.output, scene_, Signature(), saved_->state, kind, &*saved_, [&](h5::Writer& w) {
     recorder().WriteMark(w, mark_);
     w.CreateGroup("/run");
     w.Vector("/run/counts", Eigen::Vector2d(double(saved_steps_), double(saved_iterations_)));

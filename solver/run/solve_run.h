@@ -101,6 +101,7 @@ class SolveRun {
   void ResumeRecorder();
   void PrintSummary() const;
   void Take(const DynamicStepReport& report);
+  const std::string& Signature();  ///< ModelSignature(scene_), made once when first needed
   void SaveCheckpoint(const DynamicState& state);
   void Flush(const DynamicState& state, bool force, const DynamicStepReport* report = nullptr);
   void Progress(double t, bool force);
@@ -121,7 +122,7 @@ class SolveRun {
   std::optional<DynamicState> from_;     ///< initial_state
   double t0_ = 0.0;                      ///< the time the run starts at
   std::optional<ResultsRecorder> recorder_;
-  std::string signature_;
+  std::string signature_;  ///< Signature(): made on first use
   double read_seconds_ = 0.0;
   long step_count_ = 0, total_iterations_ = 0;
   long rejected_ = 0;  ///< steps rejected so far (step: auto)

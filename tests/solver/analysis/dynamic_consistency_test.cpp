@@ -440,7 +440,7 @@ void ResumedRunTakesTheSameSteps(const Scene& scene, DynamicOptions o, double t_
   std::filesystem::create_directories(dir);
   WriteCheckpoint(dir, scene, ModelSignature(scene), saved.state, AnalysisType::kDynamic, &saved);
   DynamicResume read;
-  ASSERT_TRUE(ReadResume(dir, scene, read));
+  ASSERT_TRUE(ReadResume(dir, scene, ModelSignature(scene), read));
   DynamicOptions second = o;
   second.resume = &read;
   DynamicState fresh = start();
