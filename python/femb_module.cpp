@@ -319,8 +319,8 @@ RunResult Run(const std::string& text, const std::string& name, const std::vecto
 // A dynamic run stepped under the caller's control: the run goes on a thread of its own and waits
 // after each step that reaches the time asked for (StepTo), so that the caller reads the state
 // (and changes what its forces read) between steps. The run is SolveRun's, the same steps and
-// results as Run's to the bit. Each side hands over to the other by a flag it spins on for a
-// while before it sleeps on the condition: a caller stepping at every step waits about one step
+// results as Run's to the bit. Each side hands over to the other by a flag it watches (yielding)
+// for a while before it sleeps on the condition: a caller stepping at every step waits about one step
 // (tens of microseconds) for the run, and the run waits for the caller's code between two
 // step_to calls, both far shorter than putting a thread to sleep and waking it again.
 class Simulation {

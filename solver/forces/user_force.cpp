@@ -82,7 +82,8 @@ bool PairForces(const UserNodeForce& force, double t, const UserForceMotion (&m)
 }
 
 // The pair's forces into the residual (the virtual work through both nodes' Jacobians), their
-// derivatives by forward differences (DifferenceMotion) into K and C.
+// derivatives into K and C: from the user function's (PairForces), or else by forward
+// differences (DifferenceMotion).
 void AddPairForce(const UserNodeForce& force, const SystemState& state, const Eigen::VectorXd& W, double t,
                   double length, Eigen::VectorXd* residual, Triplets* K, Triplets* C, NodeForces* node_forces) {
   const int nodes[2] = {force.node, force.other};
