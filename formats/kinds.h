@@ -136,11 +136,12 @@ struct Words<SelectionShape> {
 };
 
 /// Matrix files of other FE codes (`imported.format`, femb-reduce --matrix-format).
-enum class MatrixFormat { kCalculix, kAbaqus, kMatrixMarket };
+enum class MatrixFormat { kCalculix, kAbaqus, kAbaqusCoordinate, kMatrixMarket };
 template <>
 struct Words<MatrixFormat> {
   static constexpr KindWord<MatrixFormat> list[] = {{MatrixFormat::kCalculix, "calculix"},
                                                     {MatrixFormat::kAbaqus, "abaqus"},
+                                                    {MatrixFormat::kAbaqusCoordinate, "abaqus_coordinate"},
                                                     {MatrixFormat::kMatrixMarket, "matrix_market"}};
 };
 

@@ -313,7 +313,22 @@ void ParseImported(YamlMap& root, PartSpec& part) {
   x.format = m.Required("format").OneOfKinds<MatrixFormat>();
   x.stiffness = ResolvePath(m.Required("stiffness"), "stiffness matrix file", part.file);
   x.mass = ResolvePath(m.Required("mass"), "mass matrix file", part.file);
-  if (x.format != MatrixFormat::kAbaqus) {
+  const std::string extension = std::filesystem::path(part.solid.file).extension().string();
+  if (extension == ".inp" || extension == ".INP") x.deck = part.solid.file;
+  const bool abaqus = x.format == MatrixFormat::kAbaqus || x.format == MatrixFormat::kAbaqusCoordinate;
+  if (auto instance = m.Optional("instance")) {
+    if (!abaqus || x.deck.empty())
+      throw InputError(instance->Where() +
+                       ": instance names an instance of an Abaqus deck: it needs format abaqus "
+                       "(or abaqus_coordinate) and a geometry file .inp");
+    x.instance = instance->String();
+  }
+  if (x.format == MatrixFormat::kAbaqusCoordinate && x.deck.empty()) {
+    throw InputError(matrices.Where() +
+                     ": format abaqus_coordinate numbers equations, not nodes: the geometry file "
+                     "must be the Abaqus deck (.inp) the matrices were generated from");
+  }
+  if (!abaqus) {
     x.dofs = ResolvePath(m.Required("dofs"),
                          x.format == MatrixFormat::kCalculix ? "DOF map (job.dof)" : "DOF map (CSV: node, component)",
                          part.file);

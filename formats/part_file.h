@@ -154,6 +154,10 @@ struct MatricesSpec {
   MatrixFormat format = MatrixFormat::kCalculix;
   std::string stiffness, mass;  ///< resolved paths
   std::string dofs;             ///< calculix: job.dof; matrix_market: the row -> (node, component) CSV
+  /// abaqus: the deck the matrices came from (the geometry file), which numbers the equations of
+  /// the coordinate form (formats/abaqus_deck.h); "" when the geometry is not an Abaqus deck.
+  std::string deck;
+  std::string instance;  ///< abaqus: the deck's instance the part is (needed when it has several)
   std::string where;
 };
 

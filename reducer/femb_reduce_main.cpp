@@ -36,7 +36,10 @@ options:
                         (DIR/NAME.inp, node labels = matrix node numbers, named node sets), for
                         another FE code or for a part file of type 'imported'
   --matrix-format F     calculix (NAME.sti/.mas/.dof, default), abaqus (NAME_STIF1.mtx,
-                        NAME_MASS1.mtx) or matrix_market (NAME_K.mtx, NAME_M.mtx, NAME_dofs.csv)
+                        NAME_MASS1.mtx: node, dof, node, dof, value), abaqus_coordinate (the same
+                        files as row, column, value) or matrix_market (NAME_K.mtx, NAME_M.mtx,
+                        NAME_dofs.csv). The abaqus formats' deck has *Part, *Assembly, *Instance
+                        as Abaqus/CAE writes it; the others' a flat deck (CalculiX reads it)
   -q, --quiet           no progress lines
   -h, --help            this text
 

@@ -37,7 +37,7 @@ done
 printf '\x00\x01\x02\x03' > "$work/corpus_superelement_fuzz/seed"
 # matrix_fuzz: a reader byte, then its files cut by 0x01 (tests/fuzz/matrix_fuzz.cpp), from the
 # seed part's matrices exported in every format, and a small shapes file.
-for f in calculix abaqus matrix_market; do
+for f in calculix abaqus abaqus_coordinate matrix_market; do
   build/bin/femb-reduce -q examples/pendulum/rod.yaml --export-matrices "$work/export_$f" --matrix-format $f
 done
 m=$work/corpus_matrix_fuzz
@@ -45,6 +45,8 @@ e=$work/export_calculix
 { printf '\x00'; cat "$e"/*.sti; printf '\x01'; cat "$e"/*.mas; printf '\x01'; cat "$e"/*.dof; } > "$m/calculix"
 e=$work/export_abaqus
 { printf '\x01'; cat "$e"/*_STIF1.mtx; printf '\x01'; cat "$e"/*_MASS1.mtx; } > "$m/abaqus"
+e=$work/export_abaqus_coordinate
+{ printf '\x04'; cat "$e"/*.inp; printf '\x01'; cat "$e"/*_STIF1.mtx; printf '\x01'; cat "$e"/*_MASS1.mtx; } > "$m/abaqus_coordinate"
 e=$work/export_matrix_market
 { printf '\x02'; cat "$e"/*_K.mtx; printf '\x01'; cat "$e"/*_M.mtx; printf '\x01'; cat "$e"/*_dofs.csv; } > "$m/matrix_market"
 { printf '\x03%%%%MatrixMarket matrix array real general\n3 2\n1\n2\n3\n4\n5\n6\n\x01ab'; } > "$m/shapes"

@@ -17,6 +17,7 @@
 #include "reducer/fe/beam_model.h"
 #include "reducer/fe/solid_element.h"
 #include "reducer/fe/solid_model.h"
+#include "reducer/mesh/abaqus_mesh.h"
 #include "reducer/mesh/meshio_import.h"
 #include "reducer/mesh/node_selection.h"
 #include "reducer/reduction/craig_bampton.h"
@@ -181,11 +182,48 @@ std::pair<double, double> CheckFloats(const PartSpec& part, const FeModel& model
   return {residual, mass};
 }
 
+// The mesh of --export-matrices as an Abaqus deck: node labels 1..n = the matrices' node numbers.
+// Abaqus/CAE's layout (*Part, *Assembly, *Instance; the sets in the part) for the Abaqus formats,
+// which Abaqus and readers of its decks (Exudyn's FEMinterface) take; a flat deck (*NODE,
+// *ELEMENT at the top) for the others, which CalculiX reads.
+void WriteDeck(const std::string& path, const std::string& name, const Eigen::MatrixXd& nodes,
+               const Eigen::MatrixXi& cells, const std::string& element,
+               const std::map<std::string, std::vector<int>>& node_sets, bool parts) {
+  const std::string tmp = path + ".tmp" + std::to_string(::getpid());
+  std::ofstream out(tmp);
+  out.precision(13);  // CalculiX reads at most 20 characters per field ("-7.347880794884e-18" is 19)
+  out << "** " << name << ": mesh of femb-reduce --export-matrices (node labels = matrix node numbers)\n";
+  if (parts) out << "*Heading\n" << name << "\n*Part, name=" << name << '\n';
+  out << (parts ? "*Node\n" : "*NODE\n");
+  for (long s = 0; s < nodes.rows(); ++s)
+    out << s + 1 << ", " << nodes(s, 0) << ", " << nodes(s, 1) << ", " << nodes(s, 2) << '\n';
+  out << (parts ? "*Element, type=" : "*ELEMENT, TYPE=") << element << (parts ? ", elset=EALL\n" : ", ELSET=EALL\n");
+  // Abaqus takes at most 16 entries on a data line (a trailing comma continues it); CalculiX
+  // reads the flat deck's one line per element.
+  const long per_line = parts ? 16 : cells.cols() + 1;
+  for (long e = 0; e < cells.rows(); ++e) {
+    out << e + 1;
+    for (long a = 0; a < cells.cols(); ++a) out << ((a + 1) % per_line == 0 ? ",\n" : ", ") << cells(e, a) + 1;
+    out << '\n';
+  }
+  for (const auto& [set_name, set] : node_sets) {
+    out << (parts ? "*Nset, nset=" : "*NSET, NSET=") << set_name << '\n';
+    for (size_t i = 0; i < set.size(); ++i) out << set[i] + 1 << (i % 16 == 15 || i + 1 == set.size() ? "\n" : ", ");
+  }
+  if (parts) {
+    out << "*End Part\n*Assembly, name=Assembly\n*Instance, name=" << name << "-1, part=" << name
+        << "\n*End Instance\n*End Assembly\n";
+  }
+  if (!out) throw InputError(std::filesystem::path(path).parent_path().string() + ": cannot write " + path);
+  out.close();
+  std::filesystem::rename(tmp, path);
+}
+
 }  // namespace
 
 FeModel BuildImportedModel(const PartSpec& part, const ProgressFn& progress) {
   Stopwatch clock;
-  const ForeignMesh geometry = ReadWithMeshio(part.solid.file, part.solid.where, true);
+  const ForeignMesh geometry = ReadImportedGeometry(part.solid.file, part.matrices.instance, part.solid.where);
   const long n_nodes = geometry.nodes.rows();
   const Eigen::Vector3d lo = geometry.nodes.colwise().minCoeff(), hi = geometry.nodes.colwise().maxCoeff();
   CheckPartSize(part, (hi - lo).norm(), part.solid.where + " (" + part.solid.file + ")");
@@ -313,27 +351,8 @@ std::vector<std::string> ExportPartMatrices(const PartSpec& part, MatrixFormat f
   }
   std::vector<std::string> written = WriteMatrices(format, K, M, node, component, directory, part.name);
   const std::string mesh_path = (std::filesystem::path(directory) / (part.name + ".inp")).string();
-  {
-    const std::string tmp = mesh_path + ".tmp" + std::to_string(::getpid());
-    std::ofstream out(tmp);
-    out.precision(13);  // CalculiX reads at most 20 characters per field ("-7.347880794884e-18" is 19)
-    out << "** " << part.name << ": mesh of femb-reduce --export-matrices (node labels = matrix node numbers)\n*NODE\n";
-    for (long s = 0; s < nodes.rows(); ++s)
-      out << s + 1 << ", " << nodes(s, 0) << ", " << nodes(s, 1) << ", " << nodes(s, 2) << '\n';
-    out << "*ELEMENT, TYPE=" << element << ", ELSET=EALL\n";
-    for (long e = 0; e < cells.rows(); ++e) {
-      out << e + 1;
-      for (long a = 0; a < cells.cols(); ++a) out << ", " << cells(e, a) + 1;
-      out << '\n';
-    }
-    for (const auto& [name, set] : node_sets) {
-      out << "*NSET, NSET=" << name << '\n';
-      for (size_t i = 0; i < set.size(); ++i) out << set[i] + 1 << (i % 16 == 15 || i + 1 == set.size() ? "\n" : ", ");
-    }
-    if (!out) throw InputError(directory + ": cannot write " + mesh_path);
-    out.close();
-    std::filesystem::rename(tmp, mesh_path);
-  }
+  const bool abaqus = format == MatrixFormat::kAbaqus || format == MatrixFormat::kAbaqusCoordinate;
+  WriteDeck(mesh_path, part.name, nodes, cells, element, node_sets, abaqus);
   written.push_back(mesh_path);
   if (progress) {
     progress("export", clock.Seconds(),

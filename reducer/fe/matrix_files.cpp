@@ -4,7 +4,6 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -14,7 +13,9 @@
 #include <string_view>
 #include <unordered_map>
 
+#include "formats/abaqus_deck.h"
 #include "formats/input_error.h"
+#include "formats/text_lines.h"
 
 namespace femb {
 
@@ -33,75 +34,6 @@ struct Entry {
   double value;
   long line;
 };
-
-// Lines of a text file with their numbers; comment and blank lines skipped.
-class LineReader {
- public:
-  LineReader(const std::string& path, const std::string& what) : path_(path), in_(path) {
-    if (!in_) throw InputError(path + ": cannot open the " + what);
-  }
-  bool Next(std::string* line, const std::string& comment) {
-    while (std::getline(in_, *line)) {
-      ++number_;
-      const size_t first = line->find_first_not_of(" \t\r");
-      if (first == std::string::npos) continue;
-      if (!comment.empty() && line->compare(first, comment.size(), comment) == 0) continue;
-      return true;
-    }
-    return false;
-  }
-  [[noreturn]] void Fail(const std::string& what) const {
-    throw InputError(path_ + ":" + std::to_string(number_) + ": " + what);
-  }
-  long number() const { return number_; }
-
- private:
-  std::string path_;
-  std::ifstream in_;
-  long number_ = 0;
-};
-
-// Whitespace- or comma-separated fields, as views into `line` (no copies: a million-entry matrix
-// file is parsed in about a second).
-std::vector<std::string_view> Fields(const std::string& line) {
-  std::vector<std::string_view> out;
-  const char* p = line.data();
-  const char* end = p + line.size();
-  while (p < end) {
-    while (p < end && (*p == ' ' || *p == '\t' || *p == ',' || *p == '\r')) ++p;
-    const char* start = p;
-    while (p < end && !(*p == ' ' || *p == '\t' || *p == ',' || *p == '\r')) ++p;
-    if (p > start) out.emplace_back(start, size_t(p - start));
-  }
-  return out;
-}
-
-double NumberField(const LineReader& r, std::string_view text) {
-  if (!text.empty() && text.front() == '+') text.remove_prefix(1);
-  double v = 0.0;
-  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
-  if (ec != std::errc() || end != text.data() + text.size()) {
-    // Fortran exponents (1.5D+03) and whatever from_chars does not take: strtod on a copy.
-    std::string copy(text);
-    std::replace(copy.begin(), copy.end(), 'D', 'E');
-    std::replace(copy.begin(), copy.end(), 'd', 'e');
-    char* stop = nullptr;
-    v = std::strtod(copy.c_str(), &stop);
-    if (copy.empty() || *stop != '\0') r.Fail("'" + std::string(text) + "' is not a number");
-  }
-  if (!std::isfinite(v)) r.Fail("entry " + std::string(text) + " is not finite");
-  return v;
-}
-
-long IntegerField(const LineReader& r, std::string_view text) {
-  if (!text.empty() && text.front() == '+') text.remove_prefix(1);
-  long v = 0;
-  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
-  if (ec != std::errc() || end != text.data() + text.size() || text.empty()) {
-    r.Fail("'" + std::string(text) + "' is not an integer");
-  }
-  return v;
-}
 
 // One row of the DOF map: node label and component 1..6.
 void AddDof(const LineReader& r, long node, long c, ImportedMatrices* out) {
@@ -232,6 +164,73 @@ void ReadAbaqus(const MatricesSpec& spec, ImportedMatrices* out, std::vector<Ent
     for (const Raw& e : *raw) entries->push_back({index[{e.n1, int(e.d1 - 1)}], index[{e.n2, int(e.d2 - 1)}], e.v, 0});
 }
 
+// Abaqus FORMAT=COORDINATE: "row column value" on equation numbers, which the deck numbers
+// (formats/abaqus_deck.h); the rows of the part's instance are kept, the other instances' dropped.
+void ReadAbaqusCoordinate(const MatricesSpec& spec, ImportedMatrices* out, std::vector<Entry>* k,
+                          std::vector<Entry>* m) {
+  if (spec.deck.empty()) {
+    throw InputError(spec.stiffness +
+                     ": Abaqus' coordinate form (row, column, value) numbers equations, not nodes: make the part's "
+                     "geometry file the Abaqus deck (.inp) the matrices were generated from");
+  }
+  const AbaqusDeck deck = ReadAbaqusDeck(spec.deck);
+  const int chosen = PickInstance(deck, spec.instance, spec.where);
+  const std::vector<AbaqusEquation> equations = CoordinateEquations(deck);
+  const long n_all = long(equations.size());
+  std::vector<long> local(size_t(n_all), -1);
+  for (long e = 0; e < n_all; ++e) {
+    if (equations[size_t(e)].instance != chosen) continue;
+    local[size_t(e)] = long(out->node.size());
+    out->node.push_back(equations[size_t(e)].node);
+    out->component.push_back(equations[size_t(e)].component);
+  }
+  const std::string reference_points =
+      deck.assembly_nodes > 0 ? ", and its " + std::to_string(deck.assembly_nodes) + " reference points carry none"
+                              : "";
+  const std::string why =
+      "Abaqus adds equations for internal nodes of hybrid elements, MPCs and connectors: export a model without "
+      "them, or with FORMAT=MATRIX INPUT";
+  const std::string hint = " (the deck's nodes and elements give " + std::to_string(n_all) + " equations" +
+                           reference_points + "; " + why + ")";
+  std::string line;
+  for (auto [path, entries] : {std::pair{&spec.stiffness, k}, std::pair{&spec.mass, m}}) {
+    LineReader r(*path, "matrix file");
+    long largest = 0;
+    while (r.Next(&line, "*")) {
+      const std::vector<std::string_view> f = Fields(line);
+      if (f.size() != 3) r.Fail("expected 'row, column, value' (Abaqus coordinate form), got '" + line + "'");
+      const long i = IntegerField(r, f[0]), j = IntegerField(r, f[1]);
+      const double v = NumberField(r, f[2]);
+      if (i < 1 || j < 1 || i > n_all || j > n_all)
+        r.Fail("equation " + std::to_string(i < 1 || i > n_all ? i : j) + " is outside 1.." + std::to_string(n_all) +
+               hint);
+      largest = std::max({largest, i, j});
+      const long li = local[size_t(i - 1)], lj = local[size_t(j - 1)];
+      if (li < 0 && lj < 0) continue;  // another instance's block
+      if (li < 0 || lj < 0) {
+        if (v == 0.0) continue;
+        const AbaqusEquation& other = equations[size_t(li < 0 ? i - 1 : j - 1)];
+        r.Fail("the entry couples instance " + deck.instances[size_t(chosen)].name + " to node " +
+               std::to_string(other.node) + " of instance " + deck.instances[size_t(other.instance)].name +
+               ": export the part alone");
+      }
+      entries->push_back({li, lj, v, r.number()});
+    }
+    if (path == &spec.stiffness && largest != n_all) {
+      throw InputError(*path + ": the matrix numbers " + std::to_string(largest) + " equations, but " + spec.deck +
+                       "'s nodes and elements give " + std::to_string(n_all) + reference_points + "; " + why);
+    }
+  }
+}
+
+// The first data line of an Abaqus matrix file has 3 fields in the coordinate form, 5 in the
+// matrix input form.
+bool IsAbaqusCoordinate(const std::string& path) {
+  LineReader r(path, "matrix file");
+  std::string line;
+  return r.Next(&line, "*") && Fields(line).size() == 3;
+}
+
 // Matrix Market coordinate real (symmetric or general) and the CSV "node, component" map.
 void ReadMatrixMarket(const MatricesSpec& spec, ImportedMatrices* out, std::vector<Entry>* k, std::vector<Entry>* m) {
   LineReader dofs(spec.dofs, "DOF map");
@@ -282,6 +281,9 @@ ImportedMatrices ReadImportedMatrices(const MatricesSpec& spec) {
   std::vector<Entry> k, m;
   if (spec.format == MatrixFormat::kCalculix) {
     ReadCalculix(spec, &out, &k, &m);
+  } else if (spec.format == MatrixFormat::kAbaqusCoordinate ||
+             (spec.format == MatrixFormat::kAbaqus && IsAbaqusCoordinate(spec.stiffness))) {
+    ReadAbaqusCoordinate(spec, &out, &k, &m);
   } else if (spec.format == MatrixFormat::kAbaqus) {
     ReadAbaqus(spec, &out, &k, &m);
   } else {
@@ -407,6 +409,13 @@ std::vector<std::string> WriteMatrices(MatrixFormat format, const SparseMatrix& 
     write(stem + ".dof", [&](std::ostream& out) {
       for (size_t r = 0; r < node.size(); ++r) out << node[r] << '.' << component[r] + 1 << '\n';
     });
+  } else if (format == MatrixFormat::kAbaqusCoordinate) {
+    // Equation numbers: the rows in order, which is Abaqus' numbering for a deck whose nodes
+    // carry these DOFs (formats/abaqus_deck.h).
+    for (auto [suffix, A] : {std::pair{"_STIF1.mtx", &K}, std::pair{"_MASS1.mtx", &M}})
+      write(stem + suffix, [&, A = A](std::ostream& out) {
+        upper(*A, [&](long i, long j, double v) { out << i + 1 << ' ' << j + 1 << "  " << v << '\n'; });
+      });
   } else if (format == MatrixFormat::kAbaqus) {
     for (auto [suffix, A] : {std::pair{"_STIF1.mtx", &K}, std::pair{"_MASS1.mtx", &M}})
       write(stem + suffix, [&, A = A](std::ostream& out) {

@@ -63,7 +63,8 @@ std::string MatricesBlock(const std::string& format, const std::string& dir) {
   if (format == "calculix") {
     return "{format: calculix, stiffness: " + dir + "/bar.sti, mass: " + dir + "/bar.mas, dofs: " + dir + "/bar.dof}";
   }
-  if (format == "abaqus")
+  // Both Abaqus forms as `format: abaqus`: the coordinate form is recognized by its rows.
+  if (format == "abaqus" || format == "abaqus_coordinate")
     return "{format: abaqus, stiffness: " + dir + "/bar_STIF1.mtx, mass: " + dir + "/bar_MASS1.mtx}";
   return "{format: matrix_market, stiffness: " + dir + "/bar_K.mtx, mass: " + dir + "/bar_M.mtx, dofs: " + dir +
          "/bar_dofs.csv}";
@@ -76,11 +77,11 @@ TEST(ImportedModel, EveryFormatRoundTripsToTheNativeSuperelement) {
   // The native reference on the exported mesh (the same nodes in the same order).
   WriteText(dir / "native.yaml",
             test::Replace(kBar, "{shape: box, size: [1.0, 0.05, 0.05]}", "{file: calculix/bar.inp}"));
-  for (const std::string format : {"calculix", "abaqus", "matrix_market"}) {
+  for (const std::string format : {"calculix", "abaqus", "abaqus_coordinate", "matrix_market"}) {
     ExportPartMatrices(part, *KindOf<MatrixFormat>(format), (dir / format).string());
   }
   const Superelement native = ReduceFile(dir / "native.yaml");
-  for (const std::string format : {"calculix", "abaqus", "matrix_market"}) {
+  for (const std::string format : {"calculix", "abaqus", "abaqus_coordinate", "matrix_market"}) {
     WriteText(dir / "imported.yaml",
               "name: bar\ntype: imported\ngeometry: {file: " + format +
                   "/bar.inp}\nmatrices: " + MatricesBlock(format, format) +
@@ -103,12 +104,74 @@ TEST(ImportedModel, EveryFormatRoundTripsToTheNativeSuperelement) {
     EXPECT_LT(Relative(imported.K, native.K), 1e-8) << format;
     EXPECT_LT(m_static, 1e-8) << format;
     EXPECT_NEAR(imported.mass_properties.mass, native.mass_properties.mass, 1e-10 * native.mass_properties.mass);
-    EXPECT_EQ(imported.provenance.element_type, "imported " + format);
+    EXPECT_EQ(imported.provenance.element_type, "imported " + (format == "abaqus_coordinate" ? "abaqus" : format));
     ASSERT_TRUE(imported.visualization.has_value());
     EXPECT_EQ(imported.visualization->cell_type, CellType::kTet10);
     EXPECT_LT(shapes, 1e-8) << format;
     EXPECT_FALSE(imported.stress.has_value());
   }
+  fs::remove_all(dir);
+}
+
+// An Abaqus/CAE deck with two instances of the exported bar, the second moved 2 m along y, and
+// its coordinate-form matrices numbering both (the second's rows after the first's): the part of
+// instance bar-2 is the native bar where that instance puts it (the same reduced K and
+// frequencies, its interface at the moved root), and the deck's instances are named where one is
+// missing or unknown. (A turned instance's matrices are in turned axes; the deck test checks the
+// turn.)
+TEST(ImportedModel, AnAbaqusDeckWithInstancesGivesTheNamedOne) {
+  const fs::path dir = TempDir("instances");
+  WriteText(dir / "bar.yaml", kBar);
+  ExportPartMatrices(ReadPartFile((dir / "bar.yaml").string()), MatrixFormat::kAbaqusCoordinate, dir.string());
+  const Superelement native = ReduceFile(dir / "bar.yaml");
+  std::string deck = ReadText(dir / "bar.inp");
+  deck = test::Replace(deck, "*End Assembly",
+                       "*Instance, name=bar-2, part=bar\n0, 2, 0\n"
+                       "*End Instance\n*End Assembly");
+  WriteText(dir / "bar.inp", deck);
+  long n = 0;
+  for (const char* name : {"bar_STIF1.mtx", "bar_MASS1.mtx"}) {
+    std::istringstream in(ReadText(dir / name));
+    std::string both;
+    std::vector<std::tuple<long, long, std::string>> rows;
+    for (std::string line; std::getline(in, line);) {
+      std::istringstream f(line);
+      long i = 0, j = 0;
+      std::string v;
+      f >> i >> j >> v;
+      rows.emplace_back(i, j, v);
+      n = std::max(n, j);
+    }
+    for (int copy = 0; copy < 2; ++copy)
+      for (const auto& [i, j, v] : rows)
+        both += std::to_string(i + copy * n) + " " + std::to_string(j + copy * n) + "  " + v + "\n";
+    WriteText(dir / name, both);
+  }
+  const std::string part =
+      "name: bar\ntype: imported\ngeometry: {file: bar.inp}\n"
+      "matrices: {format: abaqus, stiffness: bar_STIF1.mtx, mass: bar_MASS1.mtx, instance: INSTANCE}\n"
+      "interfaces: [{name: root, group: xmin}, {name: tip, group: xmax, coupling: rbe3}]\n"
+      "reduction: {internal_modes: 6}\n";
+  WriteText(dir / "imported.yaml", test::Replace(part, "INSTANCE", "bar-2"));
+  const Superelement imported = ReduceFile(dir / "imported.yaml");
+  const double f = (imported.internal_frequencies_hz - native.internal_frequencies_hz).cwiseAbs().maxCoeff() /
+                   native.internal_frequencies_hz.minCoeff();
+  std::printf("[ info ] instance bar-2: frequencies %.2e, K_r %.2e, root at (%g, %g, %g)\n", f,
+              Relative(imported.K, native.K), imported.interfaces[0].position.x(), imported.interfaces[0].position.y(),
+              imported.interfaces[0].position.z());
+  EXPECT_LT(f, 1e-8);
+  EXPECT_LT(Relative(imported.K, native.K), 1e-8);
+  // The root face's centre (0, 0.025, 0.025) moved to (0, 2.025, 0.025).
+  EXPECT_LT((imported.interfaces[0].position - Eigen::Vector3d(0.0, 2.025, 0.025)).norm(), 1e-12);
+  auto expect = [&](const std::string& yaml, const std::string& part_of_message) {
+    WriteText(dir / "bad.yaml", yaml);
+    const std::string m = test::ThrownMessage([&] { ReduceFile(dir / "bad.yaml"); });
+    EXPECT_NE(m.find(part_of_message), std::string::npos) << m;
+    EXPECT_EQ(m.find('\n'), std::string::npos) << m;
+  };
+  expect(test::Replace(part, ", instance: INSTANCE", ""),
+         "has 2 instances (bar-1, bar-2): name one with matrices.instance");
+  expect(test::Replace(part, "INSTANCE", "bar-3"), "has no instance 'bar-3' (it has bar-1, bar-2)");
   fs::remove_all(dir);
 }
 

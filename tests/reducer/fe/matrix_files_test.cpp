@@ -130,5 +130,130 @@ TEST(MatrixFiles, ADamagedFileIsNamedWithItsLine) {
   fs::remove_all(dir);
 }
 
+// Two instances of a three-node bar (T3D2 elements: three DOFs per node, nine equations per
+// instance), written by hand as Abaqus documents each form: the coordinate form numbers the 18
+// equations instance by instance, node by node; the matrix input form labels node and DOF; Matrix
+// Market with its DOF map. Instance Bar-2's matrices read from each are the same to the bit.
+constexpr const char* kBarDeck = R"(*Part, name=Bar
+*Node
+1, 0., 0., 0.
+2, 1., 0., 0.
+3, 2., 0., 0.
+*Element, type=T3D2
+1, 1, 2
+2, 2, 3
+*End Part
+*Assembly, name=Assembly
+*Instance, name=Bar-1, part=Bar
+*End Instance
+*Instance, name=Bar-2, part=Bar
+ 0., 1., 0.
+*End Instance
+*End Assembly
+)";
+
+// The bar's K (or M, scaled) on its nine DOFs: a diagonal and each node's DOF coupled to the
+// next node's same DOF; `shift` changes the values per instance.
+double BarEntry(int i, int j, double shift) {
+  if (i == j) return 4.0e6 + 1000.0 * i + shift;
+  return -1.0e6 - 10.0 * std::min(i, j) - shift;
+}
+
+struct HandWritten {
+  fs::path dir;
+  MatricesSpec coordinate, labels, market;
+};
+
+HandWritten WriteBarForms(const std::string& name) {
+  HandWritten h;
+  h.dir = TempDir(name);
+  std::ofstream(h.dir / "bar.inp") << kBarDeck;
+  std::ofstream kc(h.dir / "c_STIF1.mtx"), mc(h.dir / "c_MASS1.mtx");
+  std::ofstream kl(h.dir / "l_STIF1.mtx"), ml(h.dir / "l_MASS1.mtx");
+  std::ofstream km(h.dir / "K.mtx"), mm(h.dir / "M.mtx"), map(h.dir / "dofs.csv");
+  kc.precision(17);
+  mc.precision(17);
+  kl.precision(17);
+  ml.precision(17);
+  km.precision(17);
+  mm.precision(17);
+  km << "%%MatrixMarket matrix coordinate real symmetric\n9 9 15\n";
+  mm << "%%MatrixMarket matrix coordinate real symmetric\n9 9 15\n";
+  map << "node,component\n";
+  for (int i = 0; i < 9; ++i) map << i / 3 + 1 << ", " << i % 3 + 1 << '\n';
+  for (int instance = 0; instance < 2; ++instance) {
+    const double shift = instance == 0 ? 777.0 : 0.0;  // Bar-1 differs: its rows must be dropped
+    for (int j = 0; j < 9; ++j)
+      for (int i : {j - 3, j}) {  // upper triangle, column by column
+        if (i < 0) continue;
+        const double k = BarEntry(i, j, shift), m = 1e-6 * BarEntry(i, j, shift);
+        kc << 9 * instance + i + 1 << ' ' << 9 * instance + j + 1 << "  " << k << '\n';
+        mc << 9 * instance + i + 1 << ' ' << 9 * instance + j + 1 << "  " << m << '\n';
+        if (instance == 0) continue;
+        kl << i / 3 + 1 << ", " << i % 3 + 1 << ", " << j / 3 + 1 << ", " << j % 3 + 1 << ", " << k << '\n';
+        ml << i / 3 + 1 << ", " << i % 3 + 1 << ", " << j / 3 + 1 << ", " << j % 3 + 1 << ", " << m << '\n';
+        km << j + 1 << ' ' << i + 1 << ' ' << k << '\n';
+        mm << j + 1 << ' ' << i + 1 << ' ' << m << '\n';
+      }
+  }
+  auto spec = [&](MatrixFormat format, const std::string& k, const std::string& m, const std::string& dofs) {
+    MatricesSpec s;
+    s.format = format;
+    s.where = "part.yaml:4: matrices";
+    s.stiffness = (h.dir / k).string();
+    s.mass = (h.dir / m).string();
+    if (!dofs.empty()) s.dofs = (h.dir / dofs).string();
+    s.deck = (h.dir / "bar.inp").string();
+    s.instance = "Bar-2";
+    return s;
+  };
+  h.coordinate = spec(MatrixFormat::kAbaqus, "c_STIF1.mtx", "c_MASS1.mtx", "");
+  h.labels = spec(MatrixFormat::kAbaqus, "l_STIF1.mtx", "l_MASS1.mtx", "");
+  h.market = spec(MatrixFormat::kMatrixMarket, "K.mtx", "M.mtx", "dofs.csv");
+  return h;
+}
+
+TEST(MatrixFiles, AbaqusCoordinateFormMatchesTheLabelledFormsToTheBit) {
+  const HandWritten h = WriteBarForms("coordinate");
+  const ImportedMatrices c = ReadImportedMatrices(h.coordinate);
+  MatricesSpec forced = h.coordinate;
+  forced.format = MatrixFormat::kAbaqusCoordinate;
+  for (const ImportedMatrices& other :
+       {ReadImportedMatrices(h.labels), ReadImportedMatrices(h.market), ReadImportedMatrices(forced)}) {
+    EXPECT_EQ(c.node, other.node);
+    EXPECT_EQ(c.component, other.component);
+    EXPECT_EQ((Eigen::MatrixXd(c.K) - Eigen::MatrixXd(other.K)).cwiseAbs().maxCoeff(), 0.0);
+    EXPECT_EQ((Eigen::MatrixXd(c.M) - Eigen::MatrixXd(other.M)).cwiseAbs().maxCoeff(), 0.0);
+  }
+  EXPECT_EQ(c.node, (std::vector<long>{1, 1, 1, 2, 2, 2, 3, 3, 3}));
+  EXPECT_EQ(c.K.coeff(0, 0), BarEntry(0, 0, 0.0));  // Bar-2's values, not Bar-1's
+  EXPECT_EQ(c.stored, "upper triangle");
+  fs::remove_all(h.dir);
+}
+
+TEST(MatrixFiles, AbaqusCoordinateFormThatDoesNotFitTheDeckIsOneLine) {
+  const HandWritten h = WriteBarForms("coordinate_bad");
+  auto message = [&](const std::string& extra, const std::string& instance = "Bar-2", bool deck = true) {
+    std::ofstream(h.coordinate.stiffness, std::ios::app) << extra;
+    MatricesSpec spec = h.coordinate;
+    spec.instance = instance;
+    if (!deck) spec.deck.clear();
+    const std::string m = test::ThrownMessage([&] { ReadImportedMatrices(spec); });
+    EXPECT_EQ(m.find('\n'), std::string::npos) << m;
+    return m;
+  };
+  auto has = [](const std::string& m, const std::string& part) { EXPECT_NE(m.find(part), std::string::npos) << m; };
+  has(message("", ""), "has 2 instances (Bar-1, Bar-2): name one with matrices.instance");
+  has(message("", "Bar-9"), "has no instance 'Bar-9'");
+  has(message("", "Bar-2", false), "numbers equations, not nodes");
+  has(message("9 10  5.0\n"), "c_STIF1.mtx:31: the entry couples instance Bar-2 to node 3 of instance Bar-1");
+  fs::remove_all(h.dir);
+  const HandWritten g = WriteBarForms("coordinate_count");
+  std::ofstream(g.coordinate.stiffness, std::ios::app) << "19 19  5.0\n";
+  has(test::ThrownMessage([&] { ReadImportedMatrices(g.coordinate); }),
+      "c_STIF1.mtx:31: equation 19 is outside 1..18 (the deck's nodes and elements give 18 equations; Abaqus adds");
+  fs::remove_all(g.dir);
+}
+
 }  // namespace
 }  // namespace femb
