@@ -136,13 +136,15 @@ struct Words<SelectionShape> {
 };
 
 /// Matrix files of other FE codes (`imported.format`, femb-reduce --matrix-format).
-enum class MatrixFormat { kCalculix, kAbaqus, kAbaqusCoordinate, kMatrixMarket };
+enum class MatrixFormat { kCalculix, kAbaqus, kAbaqusCoordinate, kMatrixMarket, kNastran, kAnsys };
 template <>
 struct Words<MatrixFormat> {
   static constexpr KindWord<MatrixFormat> list[] = {{MatrixFormat::kCalculix, "calculix"},
                                                     {MatrixFormat::kAbaqus, "abaqus"},
                                                     {MatrixFormat::kAbaqusCoordinate, "abaqus_coordinate"},
-                                                    {MatrixFormat::kMatrixMarket, "matrix_market"}};
+                                                    {MatrixFormat::kMatrixMarket, "matrix_market"},
+                                                    {MatrixFormat::kNastran, "nastran"},
+                                                    {MatrixFormat::kAnsys, "ansys"}};
 };
 
 // ---- scenes (formats/SCENE_FORMAT.md) and the solver ----

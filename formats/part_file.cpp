@@ -328,9 +328,11 @@ void ParseImported(YamlMap& root, PartSpec& part) {
                      ": format abaqus_coordinate numbers equations, not nodes: the geometry file "
                      "must be the Abaqus deck (.inp) the matrices were generated from");
   }
-  if (!abaqus) {
+  if (!abaqus && x.format != MatrixFormat::kNastran) {
     x.dofs = ResolvePath(m.Required("dofs"),
-                         x.format == MatrixFormat::kCalculix ? "DOF map (job.dof)" : "DOF map (CSV: node, component)",
+                         x.format == MatrixFormat::kCalculix ? "DOF map (job.dof)"
+                         : x.format == MatrixFormat::kAnsys  ? "DOF mapping file (HBMAT's Fname.mapping)"
+                                                             : "DOF map (CSV: node, component)",
                          part.file);
   }
   m.CheckNoUnknownKeys();

@@ -68,7 +68,11 @@ int main(int argc, char** argv) {
     const std::optional<femb::MatrixFormat> matrix_format = femb::KindOf<femb::MatrixFormat>(matrix_format_word);
     if (!matrix_format) {
       throw femb::InputError("--matrix-format: unknown format '" + matrix_format_word +
-                             "' (known: " + femb::JoinWords(femb::WordsOf<femb::MatrixFormat>()) + ")");
+                             "' (known: calculix, abaqus, abaqus_coordinate, matrix_market)");
+    }
+    if (*matrix_format == femb::MatrixFormat::kNastran || *matrix_format == femb::MatrixFormat::kAnsys) {
+      throw femb::InputError("--matrix-format: " + matrix_format_word +
+                             " is read, not written (write calculix, abaqus, abaqus_coordinate or matrix_market)");
     }
     const femb::PartSpec part = femb::ReadPartFile(part_path, overrides);
     if (output.empty()) output = part.name + ".h5";

@@ -50,6 +50,10 @@ e=$work/export_abaqus_coordinate
 e=$work/export_matrix_market
 { printf '\x02'; cat "$e"/*_K.mtx; printf '\x01'; cat "$e"/*_M.mtx; printf '\x01'; cat "$e"/*_dofs.csv; } > "$m/matrix_market"
 { printf '\x03%%%%MatrixMarket matrix array real general\n3 2\n1\n2\n3\n4\n5\n6\n\x01ab'; } > "$m/shapes"
+printf '\x05DMIG    KAAX           0       6       2       0\nDMIG    KAAX           1       1               1       14.+6\n+              2       1-1.+6\nDMIG*   MAAX                           0               6\n*       2               0\nDMIG,MAAX,1,1,,1,1,4.,\n+,2,1,-1.\n' > "$m/nastran"
+{ printf '\x06title                                                                   KEY\n             5             1             1             1             0\nRSA                        2             2             3             0\n(10I8)          (10I8)          (3E26.16)\n'
+  printf '       1       3       4\n       1       2       2\n'; printf '%26s%26s%26s\n' 4.0E+06 -1.0E+06 4.0E+06
+  printf '\x01%%%%MatrixMarket matrix coordinate real symmetric\n2 2 2\n1 1 1.0\n2 2 1.0\n\x01 Matrix Eqn   Node   DOF\n 1 1 UX\n 2 1 UY\n'; } > "$m/ansys"
 # Every input that once failed stays in the corpus (tests/fuzz/regressions/TARGET/).
 for t in "${targets[@]}"; do
   if [ -d "tests/fuzz/regressions/$t" ]; then cp "tests/fuzz/regressions/$t"/* "$work/corpus_$t/"; fi

@@ -13,9 +13,9 @@
 #include <string_view>
 #include <unordered_map>
 
-#include "formats/abaqus_deck.h"
 #include "formats/input_error.h"
 #include "formats/text_lines.h"
+#include "reducer/fe/matrix_readers.h"
 
 namespace femb {
 
@@ -29,47 +29,18 @@ namespace {
 
 constexpr const char* kComponentNames[6] = {"u_x", "u_y", "u_z", "theta_x", "theta_y", "theta_z"};
 
-struct Entry {
-  long row, col;  // 0-based
-  double value;
-  long line;
-};
-
-// One row of the DOF map: node label and component 1..6.
-void AddDof(const LineReader& r, long node, long c, ImportedMatrices* out) {
-  if (c < 1 || c > 6)
-    r.Fail("component " + std::to_string(c) + " is not 1..6 (u_x, u_y, u_z, theta_x, theta_y, theta_z)");
-  out->node.push_back(node);
-  out->component.push_back(int(c - 1));
-}
-
-// "row column value" lines (1-based) up to the end of the file, into 0-based entries.
-void ReadCoordinateEntries(LineReader* r, long rows, long cols, const std::string& range, std::vector<Entry>* entries,
-                           const std::string& comment = "") {
-  std::string line;
-  while (r->Next(&line, comment)) {
-    const std::vector<std::string_view> f = Fields(line);
-    if (f.size() != 3) r->Fail("expected 'row column value', got '" + line + "'");
-    const long i = IntegerField(*r, f[0]), j = IntegerField(*r, f[1]);
-    if (i < 1 || i > rows || j < 1 || j > cols) {
-      r->Fail("index (" + std::string(f[0]) + ", " + std::string(f[1]) + ") outside " + range);
-    }
-    entries->push_back({i - 1, j - 1, NumberField(*r, f[2]), r->number()});
-  }
-}
-
 std::string DofName(long node, int component) {
   return "node " + std::to_string(node) + " " + kComponentNames[component];
 }
 
 // Row/column entries (0-based) -> the symmetric matrix: one triangle is mirrored; both are
 // checked to be symmetric to 1e-8 of the largest entry.
-SparseMatrix Symmetric(const std::vector<Entry>& entries, long n, const std::string& path,
+SparseMatrix Symmetric(const std::vector<MatrixEntry>& entries, long n, const std::string& path,
                        const std::vector<long>& node, const std::vector<int>& component, std::string* stored) {
   std::vector<Eigen::Triplet<double>> t;
   t.reserve(entries.size());
   long upper = 0, lower = 0;
-  for (const Entry& e : entries) {
+  for (const MatrixEntry& e : entries) {
     t.emplace_back(int(e.row), int(e.col), e.value);
     upper += e.row < e.col;
     lower += e.row > e.col;
@@ -103,189 +74,19 @@ SparseMatrix Symmetric(const std::vector<Entry>& entries, long n, const std::str
   return SparseMatrix(A + At - diagonal);
 }
 
-// CalculiX: "row col value" lines, 1-based, and the .dof file "node.component".
-void ReadCalculix(const MatricesSpec& spec, ImportedMatrices* out, std::vector<Entry>* k, std::vector<Entry>* m) {
-  LineReader dofs(spec.dofs, "DOF map");
-  std::string line;
-  while (dofs.Next(&line, "")) {
-    const std::vector<std::string_view> f = Fields(line);
-    const size_t dot = f.empty() ? std::string::npos : f[0].find('.');
-    if (f.size() != 1 || dot == std::string::npos) dofs.Fail("expected node.component (e.g. 12.3), got '" + line + "'");
-    const long node = IntegerField(dofs, f[0].substr(0, dot));
-    const long c = IntegerField(dofs, f[0].substr(dot + 1));
-    AddDof(dofs, node, c, out);
-  }
-  if (out->node.empty()) throw InputError(spec.dofs + ": no DOFs");
-  const long n = long(out->node.size());
-  for (auto [path, entries] : {std::pair{&spec.stiffness, k}, std::pair{&spec.mass, m}}) {
-    LineReader r(*path, "matrix file");
-    ReadCoordinateEntries(&r, n, n, "the " + std::to_string(n) + " DOFs of " + spec.dofs, entries);
-  }
-}
-
-// Abaqus: "row node, row dof, column node, column dof, value"; rows numbered by (node, dof).
-void ReadAbaqus(const MatricesSpec& spec, ImportedMatrices* out, std::vector<Entry>* k, std::vector<Entry>* m) {
-  struct Raw {
-    long n1, d1, n2, d2;
-    double v;
-  };
-  std::map<std::pair<long, int>, long> index;
-  std::vector<Raw> raw_k, raw_m;
-  std::string line;
-  for (auto [path, raw] : {std::pair{&spec.stiffness, &raw_k}, std::pair{&spec.mass, &raw_m}}) {
-    LineReader r(*path, "matrix file");
-    while (r.Next(&line, "*")) {
-      const std::vector<std::string_view> f = Fields(line);
-      if (f.size() != 5) r.Fail("expected 'node, dof, node, dof, value', got '" + line + "'");
-      Raw e{IntegerField(r, f[0]), IntegerField(r, f[1]), IntegerField(r, f[2]), IntegerField(r, f[3]),
-            NumberField(r, f[4])};
-      for (long label : {e.n1, e.n2}) {
-        if (label <= 0) {
-          r.Fail("node " + std::to_string(label) +
-                 " is an Abaqus internal node (Lagrange multipliers of hybrid elements, "
-                 "MPCs or connectors): export a model without them");
-        }
-      }
-      for (long d : {e.d1, e.d2}) {
-        if (d < 1 || d > 6) r.Fail("dof " + std::to_string(d) + " is not 1..6 (only displacements and rotations)");
-      }
-      index[{e.n1, int(e.d1 - 1)}] = 0;
-      index[{e.n2, int(e.d2 - 1)}] = 0;
-      raw->push_back(e);
-    }
-  }
-  long row = 0;
-  for (auto& [key, value] : index) {
-    value = row++;
-    out->node.push_back(key.first);
-    out->component.push_back(key.second);
-  }
-  for (auto [raw, entries] : {std::pair{&raw_k, k}, std::pair{&raw_m, m}})
-    for (const Raw& e : *raw) entries->push_back({index[{e.n1, int(e.d1 - 1)}], index[{e.n2, int(e.d2 - 1)}], e.v, 0});
-}
-
-// Abaqus FORMAT=COORDINATE: "row column value" on equation numbers, which the deck numbers
-// (formats/abaqus_deck.h); the rows of the part's instance are kept, the other instances' dropped.
-void ReadAbaqusCoordinate(const MatricesSpec& spec, ImportedMatrices* out, std::vector<Entry>* k,
-                          std::vector<Entry>* m) {
-  if (spec.deck.empty()) {
-    throw InputError(spec.stiffness +
-                     ": Abaqus' coordinate form (row, column, value) numbers equations, not nodes: make the part's "
-                     "geometry file the Abaqus deck (.inp) the matrices were generated from");
-  }
-  const AbaqusDeck deck = ReadAbaqusDeck(spec.deck);
-  const int chosen = PickInstance(deck, spec.instance, spec.where);
-  const std::vector<AbaqusEquation> equations = CoordinateEquations(deck);
-  const long n_all = long(equations.size());
-  std::vector<long> local(size_t(n_all), -1);
-  for (long e = 0; e < n_all; ++e) {
-    if (equations[size_t(e)].instance != chosen) continue;
-    local[size_t(e)] = long(out->node.size());
-    out->node.push_back(equations[size_t(e)].node);
-    out->component.push_back(equations[size_t(e)].component);
-  }
-  const std::string reference_points =
-      deck.assembly_nodes > 0 ? ", and its " + std::to_string(deck.assembly_nodes) + " reference points carry none"
-                              : "";
-  const std::string why =
-      "Abaqus adds equations for internal nodes of hybrid elements, MPCs and connectors: export a model without "
-      "them, or with FORMAT=MATRIX INPUT";
-  const std::string hint = " (the deck's nodes and elements give " + std::to_string(n_all) + " equations" +
-                           reference_points + "; " + why + ")";
-  std::string line;
-  for (auto [path, entries] : {std::pair{&spec.stiffness, k}, std::pair{&spec.mass, m}}) {
-    LineReader r(*path, "matrix file");
-    long largest = 0;
-    while (r.Next(&line, "*")) {
-      const std::vector<std::string_view> f = Fields(line);
-      if (f.size() != 3) r.Fail("expected 'row, column, value' (Abaqus coordinate form), got '" + line + "'");
-      const long i = IntegerField(r, f[0]), j = IntegerField(r, f[1]);
-      const double v = NumberField(r, f[2]);
-      if (i < 1 || j < 1 || i > n_all || j > n_all)
-        r.Fail("equation " + std::to_string(i < 1 || i > n_all ? i : j) + " is outside 1.." + std::to_string(n_all) +
-               hint);
-      largest = std::max({largest, i, j});
-      const long li = local[size_t(i - 1)], lj = local[size_t(j - 1)];
-      if (li < 0 && lj < 0) continue;  // another instance's block
-      if (li < 0 || lj < 0) {
-        if (v == 0.0) continue;
-        const AbaqusEquation& other = equations[size_t(li < 0 ? i - 1 : j - 1)];
-        r.Fail("the entry couples instance " + deck.instances[size_t(chosen)].name + " to node " +
-               std::to_string(other.node) + " of instance " + deck.instances[size_t(other.instance)].name +
-               ": export the part alone");
-      }
-      entries->push_back({li, lj, v, r.number()});
-    }
-    if (path == &spec.stiffness && largest != n_all) {
-      throw InputError(*path + ": the matrix numbers " + std::to_string(largest) + " equations, but " + spec.deck +
-                       "'s nodes and elements give " + std::to_string(n_all) + reference_points + "; " + why);
-    }
-  }
-}
-
-// The first data line of an Abaqus matrix file has 3 fields in the coordinate form, 5 in the
-// matrix input form.
-bool IsAbaqusCoordinate(const std::string& path) {
-  LineReader r(path, "matrix file");
-  std::string line;
-  return r.Next(&line, "*") && Fields(line).size() == 3;
-}
-
-// Matrix Market coordinate real (symmetric or general) and the CSV "node, component" map.
-void ReadMatrixMarket(const MatricesSpec& spec, ImportedMatrices* out, std::vector<Entry>* k, std::vector<Entry>* m) {
-  LineReader dofs(spec.dofs, "DOF map");
-  std::string line;
-  bool first = true;
-  while (dofs.Next(&line, "#")) {
-    const std::vector<std::string_view> f = Fields(line);
-    if (first && !f.empty() && !std::isdigit(static_cast<unsigned char>(f[0][0]))) {  // a header line
-      first = false;
-      continue;
-    }
-    first = false;
-    if (f.size() != 2) dofs.Fail("expected 'node, component', got '" + line + "'");
-    const long node = IntegerField(dofs, f[0]), c = IntegerField(dofs, f[1]);
-    AddDof(dofs, node, c, out);
-  }
-  if (out->node.empty()) throw InputError(spec.dofs + ": no DOFs");
-  const long n = long(out->node.size());
-  for (auto [path, entries] : {std::pair{&spec.stiffness, k}, std::pair{&spec.mass, m}}) {
-    LineReader r(*path, "matrix file");
-    if (!r.Next(&line, "")) r.Fail("empty file");
-    std::string lower = line;
-    std::transform(lower.begin(), lower.end(), lower.begin(), ::tolower);
-    if (lower.rfind("%%matrixmarket", 0) != 0 || lower.find("coordinate") == std::string::npos ||
-        lower.find("real") == std::string::npos ||
-        (lower.find("symmetric") == std::string::npos && lower.find("general") == std::string::npos)) {
-      r.Fail("expected '%%MatrixMarket matrix coordinate real symmetric' (or general), got '" + line + "'");
-    }
-    if (!r.Next(&line, "%")) r.Fail("no size line");
-    const std::vector<std::string_view> size = Fields(line);
-    if (size.size() != 3) r.Fail("expected 'rows columns entries', got '" + line + "'");
-    const long rows = IntegerField(r, size[0]), cols = IntegerField(r, size[1]), nnz = IntegerField(r, size[2]);
-    if (rows != cols) r.Fail("the matrix is " + std::string(size[0]) + " x " + std::string(size[1]) + ", not square");
-    if (rows != n)
-      r.Fail("the matrix has " + std::string(size[0]) + " rows but " + spec.dofs + " maps " + std::to_string(n));
-    const size_t before = entries->size();
-    ReadCoordinateEntries(&r, n, n, "1.." + std::to_string(n), entries, "%");
-    const long count = long(entries->size() - before);
-    if (count != nnz)
-      r.Fail("the size line announces " + std::to_string(nnz) + " entries, the file has " + std::to_string(count));
-  }
-}
-
 }  // namespace
 
 ImportedMatrices ReadImportedMatrices(const MatricesSpec& spec) {
   ImportedMatrices out;
-  std::vector<Entry> k, m;
+  std::vector<MatrixEntry> k, m;
   if (spec.format == MatrixFormat::kCalculix) {
     ReadCalculix(spec, &out, &k, &m);
-  } else if (spec.format == MatrixFormat::kAbaqusCoordinate ||
-             (spec.format == MatrixFormat::kAbaqus && IsAbaqusCoordinate(spec.stiffness))) {
-    ReadAbaqusCoordinate(spec, &out, &k, &m);
-  } else if (spec.format == MatrixFormat::kAbaqus) {
+  } else if (spec.format == MatrixFormat::kAbaqus || spec.format == MatrixFormat::kAbaqusCoordinate) {
     ReadAbaqus(spec, &out, &k, &m);
+  } else if (spec.format == MatrixFormat::kNastran) {
+    ReadNastranDmig(spec, &out, &k, &m);
+  } else if (spec.format == MatrixFormat::kAnsys) {
+    ReadAnsys(spec, &out, &k, &m);
   } else {
     ReadMatrixMarket(spec, &out, &k, &m);
   }
@@ -362,10 +163,10 @@ Eigen::MatrixXd ReadShapeMatrix(const std::string& path, long rows) {
         V(i, j) = NumberField(r, f[0]);
       }
   } else {
-    std::vector<Entry> entries;
+    std::vector<MatrixEntry> entries;
     ReadCoordinateEntries(&r, n, m, "the " + std::string(size[0]) + " x " + std::string(size[1]) + " matrix", &entries,
                           "%");
-    for (const Entry& e : entries) V(e.row, e.col) = e.value;
+    for (const MatrixEntry& e : entries) V(e.row, e.col) = e.value;
   }
   return V;
 }
@@ -424,7 +225,9 @@ std::vector<std::string> WriteMatrices(MatrixFormat format, const SparseMatrix& 
               << component[size_t(j)] + 1 << ", " << v << '\n';
         });
       });
-  } else {  // kMatrixMarket
+  } else {
+    if (format != MatrixFormat::kMatrixMarket)
+      throw InputError(directory + ": matrices are not written in the " + std::string(Name(format)) + " format");
     // Symmetric storage is the lower triangle: entry (j, i) for each upper (i, j).
     for (auto [suffix, A] : {std::pair{"_K.mtx", &K}, std::pair{"_M.mtx", &M}})
       write(stem + suffix, [&, A = A](std::ostream& out) {

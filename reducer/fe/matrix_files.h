@@ -3,12 +3,16 @@
 // then checked to 1e-8 of the largest entry):
 //   calculix       *FREQUENCY, SOLVER=MATRIXSTORAGE (CalculiX 2.20): job.sti and job.mas hold
 //                  "row col value" (1-based, upper triangle), job.dof one "node.component" per row
-//   abaqus         *MATRIX GENERATE + *MATRIX OUTPUT (default, matrix input format):
-//                  "row node, row dof, column node, column dof, value"; rows numbered by
-//                  (node, dof) ascending
+//   abaqus         *MATRIX GENERATE + *MATRIX OUTPUT: the matrix input form "row node, row dof,
+//                  column node, column dof, value", rows numbered by (node, dof) ascending; or
+//                  FORMAT=COORDINATE "row column value" on the equations the deck numbers
+//                  (formats/abaqus_deck.h), recognized by its rows (abaqus_coordinate: always)
 //   matrix_market  coordinate real symmetric|general (any tool; e.g. scipy.io.mmwrite), with a
 //                  CSV "node, component" per row (component 1..6 = u_x, u_y, u_z, th_x, th_y, th_z)
-// These depend on the formats library alone (tests/fuzz/matrix_fuzz.cpp builds them by themselves).
+//   nastran        DMIG entries (small, large or free field); rows are (grid, component)
+//   ansys          HBMAT's Harwell-Boeing or *EXPORT's Matrix Market, with HBMAT's mapping file
+// The readers are in reducer/fe/matrix_readers.h. These depend on the formats library alone
+// (tests/fuzz/matrix_fuzz.cpp builds them by themselves).
 #pragma once
 
 #include <Eigen/Core>
@@ -42,7 +46,9 @@ Eigen::MatrixXd ReadShapeMatrix(const std::string& path, long rows);
 /// Writes K and M (both triangles given; the upper one is written) in `format` for the DOFs
 /// (node label, component 0..5): calculix -> DIR/STEM.sti, .mas, .dof; abaqus ->
 /// DIR/STEM_STIF1.mtx, DIR/STEM_MASS1.mtx; matrix_market -> DIR/STEM_K.mtx, DIR/STEM_M.mtx,
-/// DIR/STEM_dofs.csv. Returns the paths written. Throws InputError when DIR cannot be written.
+/// DIR/STEM_dofs.csv; abaqus_coordinate as abaqus with "row column value" on the rows' order (the
+/// equation numbers of a deck whose nodes carry these DOFs); nastran and ansys are read only.
+/// Returns the paths written. Throws InputError when DIR cannot be written.
 std::vector<std::string> WriteMatrices(MatrixFormat format, const SparseMatrix& K, const SparseMatrix& M,
                                        const std::vector<long>& node, const std::vector<int>& component,
                                        const std::string& directory, const std::string& stem);

@@ -385,7 +385,8 @@ assert [c.type for c in m.cells] == ["triangle"], m.cells
 PY
 expect_input_error "center of mass on a surface mesh" "has no volume cells to interpolate in" "$work/boxm/surface.yaml" \
   --set reduction.floating_frame=center_of_mass
-expect_input_error "matrix format" "--matrix-format: unknown format 'nastran'" "$good" --export-matrices "$work/x" --matrix-format nastran
+expect_input_error "matrix format" "--matrix-format: unknown format 'hdf'" "$good" --export-matrices "$work/x" --matrix-format hdf
+expect_input_error "read-only matrix format" "--matrix-format: nastran is read, not written" "$good" --export-matrices "$work/x" --matrix-format nastran
 sed 's/^1,1$/77777,1/' "$work/rod_mm/beam_rod_dofs.csv" > "$work/rod_mm/bad_dofs.csv"
 sed 's/beam_rod_dofs.csv/bad_dofs.csv/' "$work/rod_mm/imported.yaml" > "$work/rod_mm/bad.yaml"
 expect_input_error "node not in mesh" "node 77777 of the matrices is not in" "$work/rod_mm/bad.yaml"

@@ -175,6 +175,93 @@ TEST(ImportedModel, AnAbaqusDeckWithInstancesGivesTheNamedOne) {
   fs::remove_all(dir);
 }
 
+// The exported bar's matrices rewritten by the test in Nastran's DMIG (free field, the lower
+// triangle as PARAM,EXTOUT,DMIGPCH punches it) and in Ansys' HBMAT form (Harwell-Boeing RSA with
+// its mapping file) reduce to the superelement of the CalculiX files: K_r and M_r to 1e-12.
+TEST(ImportedModel, NastranAndAnsysFormsReduceToTheSameSuperelement) {
+  const fs::path dir = TempDir("nastran_ansys");
+  WriteText(dir / "bar.yaml", kBar);
+  ExportPartMatrices(ReadPartFile((dir / "bar.yaml").string()), MatrixFormat::kCalculix, dir.string());
+  MatricesSpec spec;
+  spec.format = MatrixFormat::kCalculix;
+  spec.stiffness = (dir / "bar.sti").string();
+  spec.mass = (dir / "bar.mas").string();
+  spec.dofs = (dir / "bar.dof").string();
+  const ImportedMatrices im = ReadImportedMatrices(spec);
+  const long n = long(im.node.size());
+  const char* labels[6] = {"UX", "UY", "UZ", "ROTX", "ROTY", "ROTZ"};
+  {
+    std::ofstream pch(dir / "bar.pch"), map(dir / "bar.mapping");
+    pch.precision(17);
+    map << " Matrix Eqn   Node   DOF\n";
+    for (long r = 0; r < n; ++r)
+      map << r + 1 << " " << im.node[size_t(r)] << " " << labels[im.component[size_t(r)]] << "\n";
+    for (const auto& [name, A] : {std::pair{"KAAX", &im.K}, std::pair{"MAAX", &im.M}}) {
+      pch << "DMIG," << name << ",0,6,2,0\n";
+      for (int j = 0; j < A->outerSize(); ++j) {
+        pch << "DMIG," << name << "," << im.node[size_t(j)] << "," << im.component[size_t(j)] + 1 << ",";
+        for (SparseMatrix::InnerIterator it(*A, j); it; ++it)
+          if (it.row() >= j)
+            pch << ",\n+," << im.node[size_t(it.row())] << "," << im.component[size_t(it.row())] + 1 << ","
+                << it.value();
+        pch << "\n";
+      }
+    }
+    for (const auto& [name, A] : {std::pair{"K.matrix", &im.K}, std::pair{"M.matrix", &im.M}}) {
+      std::vector<long> pointer{1}, index;
+      std::vector<double> value;
+      for (int j = 0; j < A->outerSize(); ++j) {
+        for (SparseMatrix::InnerIterator it(*A, j); it; ++it)
+          if (it.row() >= j) {
+            index.push_back(it.row() + 1);
+            value.push_back(it.value());
+          }
+        pointer.push_back(long(index.size()) + 1);
+      }
+      std::ofstream hb(dir / name);
+      char b[512];
+      std::snprintf(b, sizeof b,
+                    "%-72s%-8s\n%14d%14d%14d%14d%14d\nRSA           %14ld%14ld%14zu%14d\n%-16s%-16s%-20s\n", "bar",
+                    "KEY", 0, 0, 0, 0, 0, n, n, index.size(), 0, "(8I10)", "(8I10)", "(1P,3E26.16)");
+      hb << b;
+      for (const std::vector<long>* block : {&pointer, &index})
+        for (size_t k = 0; k < block->size(); ++k) {
+          std::snprintf(b, sizeof b, "%10ld", (*block)[k]);
+          hb << b << (k % 8 == 7 || k + 1 == block->size() ? "\n" : "");
+        }
+      for (size_t k = 0; k < value.size(); ++k) {
+        std::snprintf(b, sizeof b, "%26.16E", value[k]);
+        hb << b << (k % 3 == 2 || k + 1 == value.size() ? "\n" : "");
+      }
+    }
+  }
+  const std::string rest =
+      "\ninterfaces: [{name: root, group: xmin}, {name: tip, group: xmax, coupling: rbe3}]\n"
+      "reduction: {internal_modes: 6}\n";
+  WriteText(dir / "ccx.yaml",
+            "name: bar\ntype: imported\ngeometry: {file: bar.inp}\n"
+            "matrices: {format: calculix, stiffness: bar.sti, mass: bar.mas, dofs: bar.dof}" +
+                rest);
+  WriteText(dir / "nastran.yaml",
+            "name: bar\ntype: imported\ngeometry: {file: bar.inp}\n"
+            "matrices: {format: nastran, stiffness: bar.pch, mass: bar.pch}" +
+                rest);
+  WriteText(dir / "ansys.yaml",
+            "name: bar\ntype: imported\ngeometry: {file: bar.inp}\n"
+            "matrices: {format: ansys, stiffness: K.matrix, mass: M.matrix, dofs: bar.mapping}" +
+                rest);
+  const Superelement reference = ReduceFile(dir / "ccx.yaml");
+  for (const char* format : {"nastran", "ansys"}) {
+    const Superelement other = ReduceFile(dir / (std::string(format) + ".yaml"));
+    std::printf("[ info ] %s: K_r %.2e, M_r static block %.2e\n", format, Relative(other.K, reference.K),
+                Relative(other.M.topLeftCorner(12, 12), reference.M.topLeftCorner(12, 12)));
+    EXPECT_LT(Relative(other.K, reference.K), 1e-12) << format;
+    EXPECT_LT(Relative(other.M.topLeftCorner(12, 12), reference.M.topLeftCorner(12, 12)), 1e-12) << format;
+    EXPECT_EQ(other.provenance.element_type, std::string("imported ") + format);
+  }
+  fs::remove_all(dir);
+}
+
 // A beam: 6 DOFs per node (rotations), line cells, interfaces = named points of the part.
 TEST(ImportedModel, BeamWithRotationalDofsRoundTrips) {
   const fs::path dir = TempDir("beam");

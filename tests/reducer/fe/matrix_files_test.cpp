@@ -7,10 +7,14 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <charconv>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iomanip>
 #include <random>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "test_util.h"
@@ -253,6 +257,181 @@ TEST(MatrixFiles, AbaqusCoordinateFormThatDoesNotFitTheDeckIsOneLine) {
   has(test::ThrownMessage([&] { ReadImportedMatrices(g.coordinate); }),
       "c_STIF1.mtx:31: equation 19 is outside 1..18 (the deck's nodes and elements give 18 equations; Abaqus adds");
   fs::remove_all(g.dir);
+}
+
+// The shortest decimal text of v, with Nastran's exponent without a letter (4.001-6).
+std::string NastranText(double v) {
+  char b[64];
+  const auto [end, ec] = std::to_chars(b, b + sizeof b, v);
+  std::string t(b, end);
+  const size_t e = t.find('e');
+  if (e == std::string::npos) return t.find('.') == std::string::npos ? t + "." : t;
+  std::string mantissa = t.substr(0, e), exponent = t.substr(e + 1);
+  if (mantissa.find('.') == std::string::npos) mantissa += ".";
+  const char sign = exponent[0] == '-' ? '-' : '+';
+  exponent = exponent.substr(exponent[0] == '-' || exponent[0] == '+' ? 1 : 0);
+  exponent.erase(0, std::min(exponent.find_first_not_of('0'), exponent.size() - 1));
+  return mantissa + sign + exponent;
+}
+
+// Nastran's DMIG entries for Bar-2, written by hand to the Quick Reference Guide: the header in
+// small field; each column of K (lower triangle, as punched) in small field where its values fit
+// eight characters, else in large field (DMIG* and *); M in free field.
+void WriteBarDmig(const fs::path& path) {
+  std::ofstream out(path);
+  auto field8 = [](const std::string& s, bool right) {
+    std::string f =
+        s.size() >= 8 ? s : (right ? std::string(8 - s.size(), ' ') + s : s + std::string(8 - s.size(), ' '));
+    return f;
+  };
+  auto field16 = [](const std::string& s) { return s + std::string(16 - s.size(), ' '); };
+  out << "$ hand-written DMIG: KAAX in small and large field, MAAX in free field\n";
+  out << "DMIG    KAAX           0       6       2       0\n";
+  out << "DMIG,MAAX,0,6,2,0\n";
+  for (int j = 0; j < 9; ++j) {
+    std::vector<std::tuple<int, int, std::string, std::string>> rows;  // node, component, K, M
+    for (int i : {j, j + 3})
+      if (i < 9)
+        rows.emplace_back(i / 3 + 1, i % 3 + 1, NastranText(BarEntry(i, j, 0.0)),
+                          NastranText(1e-6 * BarEntry(i, j, 0.0)));
+    bool small = true;
+    for (const auto& row : rows) small = small && std::get<2>(row).size() <= 8;
+    const std::string gj = std::to_string(j / 3 + 1), cj = std::to_string(j % 3 + 1);
+    if (small) {
+      out << "DMIG    " << field8("KAAX", false) << field8(gj, true) << field8(cj, false) << field8("", false);
+      for (size_t r = 0; r < rows.size(); ++r) {
+        if (r == 1) out << "\n+       ";
+        out << field8(std::to_string(std::get<0>(rows[r])), true) << field8(std::to_string(std::get<1>(rows[r])), true)
+            << field8(std::get<2>(rows[r]), false) << (r == 0 ? field8("", false) : "");
+      }
+      out << "\n";
+    } else {
+      out << "DMIG*   " << field16("KAAX") << field16(gj) << field16(cj) << field16("") << "\n";
+      for (const auto& row : rows)
+        out << "*       " << field16(std::to_string(std::get<0>(row))) << field16(std::to_string(std::get<1>(row)))
+            << field16(std::get<2>(row)) << "\n";
+    }
+    out << "DMIG,MAAX," << gj << "," << cj << ",";
+    for (size_t r = 0; r < rows.size(); ++r) {
+      if (r == 1) out << ",\n+";
+      out << "," << std::get<0>(rows[r]) << "," << std::get<1>(rows[r]) << "," << std::get<3>(rows[r]);
+    }
+    out << "\n";
+  }
+}
+
+// Ansys' HBMAT output for Bar-2 written by hand to the Harwell-Boeing layout (RSA: the lower
+// triangle by columns; 10 pointers or indices of 8 characters and 3 values of 26 per line), with
+// the mapping file HBMAT writes beside it.
+void WriteBarAnsys(const fs::path& dir) {
+  std::ofstream map(dir / "bar.mapping");
+  map << " Matrix Eqn   Node   DOF\n";
+  const char* labels[3] = {"UX", "UY", "UZ"};
+  for (int i = 0; i < 9; ++i)
+    map << std::setw(8) << i + 1 << std::setw(8) << i / 3 + 1 << "     " << labels[i % 3] << '\n';
+  for (const auto& [name, scale] : {std::pair{"K.matrix", 1.0}, std::pair{"M.matrix", 1e-6}}) {
+    std::vector<int> pointer{1}, index;
+    std::vector<double> value;
+    for (int j = 0; j < 9; ++j) {
+      for (int i : {j, j + 3})
+        if (i < 9) {
+          index.push_back(i + 1);
+          value.push_back(scale * BarEntry(i, j, 0.0));
+        }
+      pointer.push_back(int(index.size()) + 1);
+    }
+    auto lines = [](size_t n, size_t per) { return (n + per - 1) / per; };
+    std::ofstream out(dir / name);
+    char b[128];
+    std::snprintf(b, sizeof b, "%-72s%-8s\n", "bar written by hand as HBMAT does", "KEY");
+    out << b;
+    const size_t p = lines(pointer.size(), 10), q = lines(index.size(), 10), v = lines(value.size(), 3);
+    std::snprintf(b, sizeof b, "%14zu%14zu%14zu%14zu%14d\n", p + q + v, p, q, v, 0);
+    out << b;
+    std::snprintf(b, sizeof b, "RSA           %14d%14d%14zu%14d\n", 9, 9, index.size(), 0);
+    out << b;
+    std::snprintf(b, sizeof b, "%-16s%-16s%-20s%-20s\n", "(10I8)", "(10I8)", "(3E26.16)", "");
+    out << b;
+    for (const std::vector<int>* block : {&pointer, &index})
+      for (size_t k = 0; k < block->size(); ++k)
+        out << std::setw(8) << (*block)[k] << (k % 10 == 9 || k + 1 == block->size() ? "\n" : "");
+    for (size_t k = 0; k < value.size(); ++k) {
+      std::snprintf(b, sizeof b, "%26.16E", value[k]);
+      out << b << (k % 3 == 2 || k + 1 == value.size() ? "\n" : "");
+    }
+  }
+}
+
+TEST(MatrixFiles, NastranDmigAndAnsysHarwellBoeingGiveTheSameMatricesToTheBit) {
+  const HandWritten h = WriteBarForms("nastran_ansys");
+  const ImportedMatrices reference = ReadImportedMatrices(h.labels);
+  WriteBarDmig(h.dir / "bar.pch");
+  WriteBarAnsys(h.dir);
+  MatricesSpec dmig;
+  dmig.format = MatrixFormat::kNastran;
+  dmig.where = "part.yaml:4: matrices";
+  dmig.stiffness = dmig.mass = (h.dir / "bar.pch").string();
+  MatricesSpec ansys = dmig;
+  ansys.format = MatrixFormat::kAnsys;
+  ansys.stiffness = (h.dir / "K.matrix").string();
+  ansys.mass = (h.dir / "M.matrix").string();
+  ansys.dofs = (h.dir / "bar.mapping").string();
+  MatricesSpec ansys_mm = ansys;  // *EXPORT,,MMF with the same mapping
+  ansys_mm.stiffness = h.market.stiffness;
+  ansys_mm.mass = h.market.mass;
+  for (const MatricesSpec& spec : {dmig, ansys, ansys_mm}) {
+    SCOPED_TRACE(spec.stiffness);
+    const ImportedMatrices read = ReadImportedMatrices(spec);
+    EXPECT_EQ(read.node, reference.node);
+    EXPECT_EQ(read.component, reference.component);
+    EXPECT_EQ((Eigen::MatrixXd(read.K) - Eigen::MatrixXd(reference.K)).cwiseAbs().maxCoeff(), 0.0);
+    EXPECT_EQ((Eigen::MatrixXd(read.M) - Eigen::MatrixXd(reference.M)).cwiseAbs().maxCoeff(), 0.0);
+  }
+  EXPECT_EQ(ReadImportedMatrices(dmig).stored, "lower triangle");
+  fs::remove_all(h.dir);
+}
+
+TEST(MatrixFiles, BadNastranAndAnsysFilesAreOneLine) {
+  const fs::path dir = TempDir("nastran_ansys_bad");
+  auto read = [&](MatrixFormat format, const std::string& k, const std::string& m, const std::string& map = "") {
+    std::ofstream(dir / "k.txt") << k;
+    std::ofstream(dir / "m.txt") << m;
+    std::ofstream(dir / "map.txt") << map;
+    MatricesSpec spec;
+    spec.format = format;
+    spec.where = "part.yaml:4: matrices";
+    spec.stiffness = (dir / "k.txt").string();
+    spec.mass = (dir / "m.txt").string();
+    spec.dofs = (dir / "map.txt").string();
+    const std::string message = test::ThrownMessage([&] { ReadImportedMatrices(spec); });
+    EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+    return message;
+  };
+  auto has = [](const std::string& m, const std::string& part) { EXPECT_NE(m.find(part), std::string::npos) << m; };
+  const std::string header = "DMIG,KAAX,0,6,2,0\n", mass = "DMIG,MAAX,0,6,2,0\nDMIG,MAAX,1,1,,1,1,1.0\n";
+  has(read(MatrixFormat::kNastran, "DMIG,KAAX,1,1,,1,1,1.0\n", mass),
+      "k.txt:1: DMIG KAAX has a column before its header");
+  has(read(MatrixFormat::kNastran, header + "DMIG,KAAX,1,1,,1,0,1.0\n", mass), "k.txt:2: component '0' of point 1");
+  has(read(MatrixFormat::kNastran, header + "DMIG,KAAX,1,1,,1,1,abc\n", mass), "k.txt:2: 'abc' is not a finite number");
+  has(read(MatrixFormat::kNastran, "DMIG,KAAX,0,9,2,0,,,3\n", mass), "has IFO '9'");
+  has(read(MatrixFormat::kNastran, "DMIG,KAAX,0,6,3,0\n", mass), "has TIN '3'");
+  has(read(MatrixFormat::kNastran, header + "DMIG,KBBX,0,6,2,0\n", mass),
+      "DMIG matrices KAAX, KBBX: expected one stiffness matrix");
+  const std::string map = " Matrix Eqn   Node   DOF\n 1 1 UX\n 2 1 UY\n";
+  const std::string mm = "%%MatrixMarket matrix coordinate real symmetric\n2 2 2\n1 1 1.0\n2 2 1.0\n";
+  has(read(MatrixFormat::kAnsys, mm, mm, " Matrix Eqn   Node   DOF\n 1 1 UX\n 2 1 TEMP\n"),
+      "map.txt:3: DOF label 'TEMP'");
+  has(read(MatrixFormat::kAnsys, mm, mm, " Matrix Eqn   Node   DOF\n 1 1 UX\n 3 1 UY\n"),
+      "map.txt:3: equation 3 where 2 comes next");
+  has(read(MatrixFormat::kAnsys, mm, mm, " Matrix Eqn   Node   DOF\n 1 1 UX\n"), "the matrix has 2 rows but");
+  has(read(MatrixFormat::kAnsys, "title\n 4 1 1 1 0\nCSA            2 2 2 0\n(10I8) (10I8) (3E26.16)\n", mm, map),
+      "matrix type 'CSA'");
+  has(read(MatrixFormat::kAnsys,
+           "title\n 4 1 1 1 0\nRSA                        2             2             2             0\n"
+           "(10I8)          (10I8)          (3E26.16)\n       1       2       4\n       1       2\n 1.0\n 1.0\n",
+           mm, map),
+      "column pointer 2 is not increasing");
+  fs::remove_all(dir);
 }
 
 }  // namespace
