@@ -71,6 +71,16 @@ done
 $py -c "
 import meshio; m = meshio.read('$work/vtu/beam_rod_013.vtu')
 assert m.cells[0].type == 'line' and set(m.point_data) == {'displacement', 'rotation', 'von_mises', 'stress'}" && ok || fail "vtu beam content"
+# --export-mbdyn: MBDyn's modal element file, the interfaces as FEM nodes (the mesh nodes too
+# with --mbdyn-mesh); an unwritable path is one line, exit 2, and no file (tests/inspect/
+# mbdyn_export_test.cpp checks the content).
+"$bin/femb-inspect" "$work/beam_rod.h5" --export-mbdyn "$work/rod.fem" > "$work/mbdyn.txt" \
+  && grep -q "wrote $work/rod.fem: 10 modes at 2 FEM nodes (interfaces: \"A\" \"B\")" "$work/mbdyn.txt" \
+  && grep -qx "REV0 2 10 0 0 0" "$work/rod.fem" && ok || fail "--export-mbdyn: $(cat "$work/mbdyn.txt")"
+"$bin/femb-inspect" "$work/beam_rod.h5" --export-mbdyn "$work/rod_mesh.fem" --mbdyn-mesh > /dev/null \
+  && [ "$(sed -n '/RECORD GROUP 1,/{n;n;p}' "$work/rod_mesh.fem" | cut -d' ' -f2)" -gt 2 ] && ok || fail "--export-mbdyn --mbdyn-mesh"
+"$bin/femb-inspect" "$work/beam_rod.h5" --export-mbdyn "$work/no/such/dir/rod.fem" 2> "$work/err.txt"
+[ $? = 2 ] && [ "$(wc -l < "$work/err.txt")" = 1 ] && grep -q "cannot write the MBDyn file" "$work/err.txt" && ok || fail "--export-mbdyn unwritable: $(cat "$work/err.txt")"
 "$bin/femb-reduce" -q "$src/examples/beam_rod/part.yaml" -o "$work/nomesh.h5" --set reduction.keep_mesh=false
 "$bin/femb-inspect" "$work/nomesh.h5" --vtu "$work/vtu2" 2> "$work/err.txt"; [ $? = 2 ] && grep -q "no mesh and mode shapes stored" "$work/err.txt" && ok || fail "--vtu without mesh"
 # A foreign mesh through the meshio bridge: an Abaqus .inp hex block with node sets.
