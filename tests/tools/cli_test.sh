@@ -253,6 +253,23 @@ YAML
 grep -q "B: 1 nodes by plane" "$work/imported.log" && grep -q "rigid-body residual" "$work/imported.log" && ok \
   || fail "imported progress lines: $(cat "$work/imported.log")"
 "$bin/femb-inspect" "$work/rod_imported.h5" --check > /dev/null && ok || fail "inspect --check imported"
+# Abaqus' coordinate form with its deck of parts and instances: read back to the same file as
+# Matrix Market; an equation the deck does not number, an unknown instance and a DOF map one row
+# short are one line each, exit 2, no output.
+"$bin/femb-reduce" -q "$src/examples/beam_rod/part.yaml" --export-matrices "$work/rod_abq" --matrix-format abaqus_coordinate \
+  && sed -e 's/matrix_market/abaqus/; s/beam_rod_K.mtx/beam_rod_STIF1.mtx/; s/beam_rod_M.mtx/beam_rod_MASS1.mtx/; s/, dofs: beam_rod_dofs.csv//' \
+       "$work/rod_mm/imported.yaml" > "$work/rod_abq/imported.yaml" \
+  && "$bin/femb-reduce" -q "$work/rod_abq/imported.yaml" -o "$work/rod_abq.h5" \
+  && "$bin/femb-inspect" "$work/rod_abq.h5" --dump K | tail -n +3 > "$work/k_abq.txt" \
+  && "$bin/femb-inspect" "$work/rod_imported.h5" --dump K | tail -n +3 > "$work/k_mm.txt" \
+  && cmp -s "$work/k_abq.txt" "$work/k_mm.txt" && ok || fail "abaqus coordinate form vs matrix market"
+cp "$work/rod_abq/beam_rod_STIF1.mtx" "$work/rod_abq/good_STIF1.mtx"
+echo "67 67  1.0" >> "$work/rod_abq/beam_rod_STIF1.mtx"
+expect_input_error "coordinate equations" "beam_rod_STIF1.mtx:$(wc -l < "$work/rod_abq/beam_rod_STIF1.mtx"): equation 67 is outside 1..66" "$work/rod_abq/imported.yaml"
+cp "$work/rod_abq/good_STIF1.mtx" "$work/rod_abq/beam_rod_STIF1.mtx"
+expect_input_error "unknown instance" "has no instance 'rod-2' (it has beam_rod-1)" "$work/rod_abq/imported.yaml" --set matrices.instance=rod-2
+head -n -1 "$work/rod_mm/beam_rod_dofs.csv" > "$work/rod_mm/short_dofs.csv"
+expect_input_error "DOF map one row short" "beam_rod_K.mtx:3: the matrix has 66 rows but" "$work/rod_mm/imported.yaml" --set matrices.dofs=short_dofs.csv
 # Imported matrices have no element stresses: no geometric stiffening by default, and asking
 # for it is one line with exit 2.
 "$bin/femb-inspect" "$work/rod_imported.h5" --json | $py -c "import json,sys; assert json.load(sys.stdin)['geometric_stiffening'] is False" \
