@@ -14,12 +14,6 @@
 namespace femb {
 namespace {
 
-std::string Upper(std::string_view s) {
-  std::string out(s);
-  for (char& c : out) c = char(std::toupper(static_cast<unsigned char>(c)));
-  return out;
-}
-
 // "*Element, type=C3D10, elset=ALL": the keyword in upper case with single spaces, and the
 // parameters (upper-case keys; values as written, quotes removed).
 struct Keyword {
@@ -35,14 +29,14 @@ struct Keyword {
 Keyword ParseKeyword(const std::string& line) {
   Keyword k;
   const std::vector<std::string_view> f = CommaFields(std::string_view(line).substr(1));
-  for (char c : Upper(f[0])) {
+  for (char c : UpperCase(f[0])) {
     if (c == ' ' && (k.name.empty() || k.name.back() == ' ')) continue;
     k.name.push_back(c);
   }
   for (size_t i = 1; i < f.size(); ++i) {
     if (f[i].empty()) continue;
     const size_t eq = f[i].find('=');
-    std::string key = Upper(f[i].substr(0, eq));
+    std::string key = UpperCase(f[i].substr(0, eq));
     key.erase(std::remove(key.begin(), key.end(), ' '), key.end());
     std::string value = eq == std::string_view::npos ? std::string() : std::string(f[i].substr(eq + 1));
     while (!value.empty() && value.front() == ' ') value.erase(value.begin());
@@ -119,7 +113,7 @@ class DeckParser {
   // Set names are matched in upper case; the sets keep the spelling of their first definition.
   std::map<std::string, std::string> spelling_;
   std::string Spell(const std::string& written) {
-    const std::string upper = Upper(written);
+    const std::string upper = UpperCase(written);
     if (!upper.empty()) spelling_.emplace(upper, written);
     return upper;
   }
@@ -137,7 +131,7 @@ void DeckParser::OnKeyword(const Keyword& k) {
   if (n == "PART") {
     if (!k.Has("NAME") || k.Get("NAME").empty()) r_.Fail("*Part without name=");
     parts_.push_back(Part{});
-    parts_.back().name = Upper(k.Get("NAME"));
+    parts_.back().name = UpperCase(k.Get("NAME"));
     part_ = int(parts_.size() - 1);
   } else if (n == "END PART") {
     part_ = -1;
@@ -150,7 +144,7 @@ void DeckParser::OnKeyword(const Keyword& k) {
       r_.Fail("*Instance without part= (an instance that defines its own mesh is not read)");
     Instance instance;
     instance.name = k.Get("NAME");
-    instance.part = Upper(k.Get("PART"));
+    instance.part = UpperCase(k.Get("PART"));
     instances_.push_back(instance);
     in_instance_ = int(instances_.size() - 1);
     data_ = Data::kInstance;
@@ -163,7 +157,7 @@ void DeckParser::OnKeyword(const Keyword& k) {
   } else if (n == "ELEMENT") {
     if (!k.Has("TYPE") || k.Get("TYPE").empty()) r_.Fail("*Element without type=");
     data_ = Data::kElement;
-    element_type_ = Upper(k.Get("TYPE"));
+    element_type_ = UpperCase(k.Get("TYPE"));
     element_set_ = Spell(k.Get("ELSET"));
   } else if (n == "NSET" || n == "ELSET") {
     const std::string key = n == "NSET" ? "NSET" : "ELSET";
@@ -171,7 +165,7 @@ void DeckParser::OnKeyword(const Keyword& k) {
       r_.Fail("*" + std::string(n == "NSET" ? "Nset" : "Elset") + " without " + (n == "NSET" ? "nset=" : "elset="));
     data_ = n == "NSET" ? Data::kNset : Data::kElset;
     set_name_ = Spell(k.Get(key));
-    set_instance_ = Upper(k.Get("INSTANCE"));
+    set_instance_ = UpperCase(k.Get("INSTANCE"));
     generate_ = k.Has("GENERATE");
   }
 }
@@ -182,7 +176,7 @@ void DeckParser::AddSetEntries(const std::vector<std::string_view>& f) {
   const bool node_set = data_ == Data::kNset;
   auto instance_named = [&](const std::string& name) -> Instance* {
     for (Instance& i : instances_)
-      if (Upper(i.name) == name) return &i;
+      if (UpperCase(i.name) == name) return &i;
     r_.Fail("no instance named '" + name + "' (defined before this line)");
   };
   Instance* scope = nullptr;
@@ -218,7 +212,7 @@ void DeckParser::AddSetEntries(const std::vector<std::string_view>& f) {
       target(scope).insert(IntegerField(r_, s));
       continue;
     }
-    const std::string word = Upper(s);
+    const std::string word = UpperCase(s);
     const size_t dot = word.find('.');
     if (in_assembly_ && scope == nullptr && dot != std::string::npos) {  // "Instance.label" or "Instance.SET"
       Instance* instance = instance_named(word.substr(0, dot));
@@ -435,13 +429,13 @@ int PickInstance(const AbaqusDeck& deck, const std::string& name, const std::str
                      names + "): name one with matrices.instance");
   }
   for (size_t i = 0; i < deck.instances.size(); ++i)
-    if (Upper(deck.instances[i].name) == Upper(name)) return int(i);
+    if (UpperCase(deck.instances[i].name) == UpperCase(name)) return int(i);
   throw InputError(where + ": " + deck.path + " has no instance '" + name + "'" +
                    (deck.assembly ? " (it has " + names + ")" : " (it has no *Instance: leave instance out)"));
 }
 
 unsigned ElementDofMask(const std::string& type) {
-  const std::string t = Upper(type);
+  const std::string t = UpperCase(type);
   auto starts = [&](const char* p) { return t.rfind(p, 0) == 0; };
   const bool hybrid = t.find('H', 3) != std::string::npos && (starts("C3D") || starts("B3"));
   if (hybrid) return 0;  // Lagrange multipliers on Abaqus internal nodes

@@ -36,6 +36,12 @@ std::vector<std::string_view> Fields(const std::string& line);
 /// three). Abaqus data lines.
 std::vector<std::string_view> CommaFields(std::string_view line);
 
+/// `s` in upper case (ASCII).
+std::string UpperCase(std::string_view s);
+
+/// `s` without leading and trailing blanks, tabs and carriage returns.
+std::string_view TrimBlanks(std::string_view s);
+
 /// A finite number (a leading '+' and Fortran exponents 1.5D+03 allowed); otherwise r.Fail.
 double NumberField(const LineReader& r, std::string_view text);
 

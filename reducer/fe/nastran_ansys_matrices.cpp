@@ -23,22 +23,10 @@
 namespace femb {
 namespace {
 
-std::string Upper(std::string_view s) {
-  std::string out(s);
-  for (char& c : out) c = char(std::toupper(static_cast<unsigned char>(c)));
-  return out;
-}
-
-std::string_view Trim(std::string_view s) {
-  while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
-  while (!s.empty() && (s.back() == ' ' || s.back() == '\t' || s.back() == '\r')) s.remove_suffix(1);
-  return s;
-}
-
 // A Fortran or Nastran real: 1.5, -2.E+3, 1.0D-4, and exponents without a letter (3.+5, 1.2-3);
 // nullopt for anything else or a value that is not finite.
 std::optional<double> FortranReal(std::string_view text) {
-  std::string t(Trim(text));
+  std::string t(TrimBlanks(text));
   for (size_t i = 1; i < t.size(); ++i) {
     const char before = t[i - 1];
     if ((t[i] == '+' || t[i] == '-') && (std::isdigit(static_cast<unsigned char>(before)) || before == '.')) {
@@ -56,7 +44,7 @@ std::optional<double> FortranReal(std::string_view text) {
 }
 
 std::optional<long> Integer(std::string_view text) {
-  const std::string t(Trim(text));
+  const std::string t(TrimBlanks(text));
   if (t.empty()) return std::nullopt;
   char* stop = nullptr;
   const long v = std::strtol(t.c_str(), &stop, 10);
@@ -80,18 +68,18 @@ std::pair<std::string, std::vector<std::string>> SplitBulkLine(const std::string
   const std::string_view text = std::string_view(line).substr(0, dollar);
   if (text.find(',') != std::string_view::npos) {  // free field
     const std::vector<std::string_view> f = CommaFields(text);
-    name = Upper(f[0]);
+    name = UpperCase(f[0]);
     const size_t count = name.find('*') != std::string::npos ? 4 : 8;
     for (size_t k = 1; k < f.size() && fields.size() < count; ++k) fields.emplace_back(f[k]);
     fields.resize(count);
     return {name, fields};
   }
-  name = Upper(Trim(text.substr(0, std::min<size_t>(8, text.size()))));
+  name = UpperCase(TrimBlanks(text.substr(0, std::min<size_t>(8, text.size()))));
   const bool large = name.find('*') != std::string::npos;
   const size_t width = large ? 16 : 8, count = large ? 4 : 8;
   for (size_t k = 0; k < count; ++k) {
     const size_t start = 8 + k * width;
-    fields.emplace_back(start < text.size() ? Trim(text.substr(start, width)) : std::string_view());
+    fields.emplace_back(start < text.size() ? TrimBlanks(text.substr(start, width)) : std::string_view());
   }
   return {name, fields};
 }
@@ -162,7 +150,7 @@ std::vector<DmigMatrix> ReadDmigFile(const std::string& path) {
       throw InputError(path + ":" + std::to_string(card.line) + ": " + what);
     };
     const std::vector<std::string>& f = card.fields;
-    const std::string name = Upper(f[0]);
+    const std::string name = UpperCase(f[0]);
     if (name.empty()) fail("DMIG without a matrix name");
     if (f[1] == "0") {  // header: NAME 0 IFO TIN TOUT POLAR - NCOL
       if (index.count(name)) fail("DMIG " + name + " has a second header");
@@ -217,7 +205,7 @@ void ReadAnsysMapping(const std::string& path, ImportedMatrices* out) {
     const long equation = IntegerField(r, f[0]), node = IntegerField(r, f[1]);
     if (equation != long(out->node.size()) + 1)
       r.Fail("equation " + std::to_string(equation) + " where " + std::to_string(out->node.size() + 1) + " comes next");
-    auto it = kLabels.find(Upper(f[2]));
+    auto it = kLabels.find(UpperCase(f[2]));
     if (it == kLabels.end()) {
       r.Fail("DOF label '" + std::string(f[2]) +
              "' is not UX, UY, UZ, ROTX, ROTY or ROTZ (warping, pressure, temperature and Lagrange multipliers have "
@@ -232,7 +220,7 @@ void ReadAnsysMapping(const std::string& path, ImportedMatrices* out) {
 // One Fortran edit descriptor of a Harwell-Boeing header: (8I10), (1P,4E20.12), (3D25.16): items
 // per line and their width.
 std::pair<int, int> FortranLayout(const LineReader& r, std::string_view format) {
-  std::string f = Upper(Trim(format));
+  std::string f = UpperCase(TrimBlanks(format));
   f.erase(std::remove_if(f.begin(), f.end(), [](char c) { return c == '(' || c == ')' || c == ' '; }), f.end());
   const size_t p = f.find('P');  // a scale factor (1P,) changes nothing on input with exponents
   if (p != std::string::npos) f = f.substr(f[p + 1] == ',' ? p + 2 : p + 1);
@@ -255,7 +243,7 @@ std::vector<std::string> FortranItems(LineReader* r, std::pair<int, int> layout,
     for (int k = 0; k < layout.first && long(items.size()) < n; ++k) {
       const size_t start = size_t(k) * size_t(layout.second);
       if (start >= line.size()) break;
-      items.emplace_back(Trim(std::string_view(line).substr(start, size_t(layout.second))));
+      items.emplace_back(TrimBlanks(std::string_view(line).substr(start, size_t(layout.second))));
     }
   }
   return items;
@@ -270,7 +258,7 @@ void ReadHarwellBoeing(const std::string& path, long n, const std::string& dofs,
   if (cards.size() < 4) r.Fail("expected 'TOTCRD PTRCRD INDCRD VALCRD [RHSCRD]', got '" + line + "'");
   const long rhs_cards = cards.size() > 4 ? IntegerField(r, cards[4]) : 0;
   if (!r.Next(&line, "")) r.Fail("no matrix type line");
-  const std::string type = Upper(line.substr(0, std::min<size_t>(3, line.size())));
+  const std::string type = UpperCase(line.substr(0, std::min<size_t>(3, line.size())));
   const std::vector<std::string_view> sizes = Fields(line.size() > 3 ? line.substr(3) : std::string());
   if (type != "RSA" && type != "RUA")
     r.Fail("matrix type '" + type +
