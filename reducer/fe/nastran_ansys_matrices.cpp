@@ -259,7 +259,8 @@ void ReadHarwellBoeing(const std::string& path, long n, const std::string& dofs,
   const long rhs_cards = cards.size() > 4 ? IntegerField(r, cards[4]) : 0;
   if (!r.Next(&line, "")) r.Fail("no matrix type line");
   const std::string type = UpperCase(line.substr(0, std::min<size_t>(3, line.size())));
-  const std::vector<std::string_view> sizes = Fields(line.size() > 3 ? line.substr(3) : std::string());
+  const std::string size_text = line.size() > 3 ? line.substr(3) : std::string();  // the views below point into it
+  const std::vector<std::string_view> sizes = Fields(size_text);
   if (type != "RSA" && type != "RUA")
     r.Fail("matrix type '" + type +
            "': a real assembled matrix (RSA or RUA) is read, not complex, pattern or elemental");
