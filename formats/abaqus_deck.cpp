@@ -272,9 +272,13 @@ void DeckParser::OnData(const std::string& line) {
   }
   Part& part = Current();
   if (data_ == Data::kNode) {
-    if (f.size() < 3 || f.size() > 4) r_.Fail("expected 'label, x, y[, z]', got '" + line + "'");
-    part.labels.push_back(IntegerField(r_, f[0]));
-    part.x.emplace_back(NumberField(r_, f[1]), NumberField(r_, f[2]), f.size() == 4 ? NumberField(r_, f[3]) : 0.0);
+    // "label, x, y[, z[, normal's three direction cosines]]"; a trailing comma is allowed.
+    std::vector<std::string_view> node = f;
+    while (!node.empty() && node.back().empty()) node.pop_back();
+    if (node.size() < 3 || node.size() > 7) r_.Fail("expected 'label, x, y[, z]', got '" + line + "'");
+    part.labels.push_back(IntegerField(r_, node[0]));
+    part.x.emplace_back(NumberField(r_, node[1]), NumberField(r_, node[2]),
+                        node.size() >= 4 ? NumberField(r_, node[3]) : 0.0);
     if (!node_set_.empty()) part.nsets[node_set_].insert(part.labels.back());
   } else if (data_ == Data::kElement) {
     for (std::string_view field : f)

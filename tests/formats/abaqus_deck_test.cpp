@@ -19,7 +19,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// A tetrahedron with a shell on one face (nodes 2, 3, 10 carry rotations), placed twice, and a
+// A tetrahedron with a shell on one face (nodes 2, 3, 10 carry rotations; node lines with a trailing
+// comma and with a normal), placed twice, and a
 // frame part of one S4R shell and one B31 beam; a reference point at the assembly level.
 constexpr const char* kDeck = R"(*Heading
  two blocks and a frame
@@ -27,8 +28,8 @@ constexpr const char* kDeck = R"(*Heading
 *Part, name=Block
 *Node
      10,  0.,  0.,  0.
-      2,  1.,  0.,  0.
-      3,  0.,  1.,  0.
+      2,  1.,  0.,  0.,
+      3,  0.,  1.,  0., 0., 0., 1.
       4,  0.,  0.,  1.
 *Element, type=C3D4, elset=Solid
 1, 10, 2, 3, 4
