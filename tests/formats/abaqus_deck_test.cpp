@@ -19,9 +19,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// A tetrahedron with a shell on one face (nodes 2, 3, 10 carry rotations; node lines with a trailing
-// comma and with a normal), placed twice, and a
-// frame part of one S4R shell and one B31 beam; a reference point at the assembly level.
+// A tetrahedron with a shell on one face (nodes 2, 3, 10 carry rotations; node lines with a
+// trailing comma and with a normal), placed twice, and a frame part of one S4R shell and one B31
+// beam; a reference point at the assembly level.
 constexpr const char* kDeck = R"(*Heading
  two blocks and a frame
 ** a comment line
