@@ -212,10 +212,13 @@ std::vector<std::string> WriteMatrices(MatrixFormat format, const SparseMatrix& 
     });
   } else if (format == MatrixFormat::kAbaqusCoordinate) {
     // Equation numbers: the rows in order, which is Abaqus' numbering for a deck whose nodes
-    // carry these DOFs (formats/abaqus_deck.h).
+    // carry these DOFs (formats/abaqus_deck.h). Both triangles, as Abaqus writes this form and
+    // as readers that take it as it is (Exudyn's FEMinterface: numpy.loadtxt) need it.
     for (auto [suffix, A] : {std::pair{"_STIF1.mtx", &K}, std::pair{"_MASS1.mtx", &M}})
       write(stem + suffix, [&, A = A](std::ostream& out) {
-        upper(*A, [&](long i, long j, double v) { out << i + 1 << ' ' << j + 1 << "  " << v << '\n'; });
+        for (int j = 0; j < A->outerSize(); ++j)
+          for (SparseMatrix::InnerIterator it(*A, j); it; ++it)
+            out << it.row() + 1 << ' ' << j + 1 << "  " << it.value() << '\n';
       });
   } else if (format == MatrixFormat::kAbaqus) {
     for (auto [suffix, A] : {std::pair{"_STIF1.mtx", &K}, std::pair{"_MASS1.mtx", &M}})

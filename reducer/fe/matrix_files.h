@@ -43,12 +43,13 @@ ImportedMatrices ReadImportedMatrices(const MatricesSpec& spec);
 /// Throws InputError naming the file and line.
 Eigen::MatrixXd ReadShapeMatrix(const std::string& path, long rows);
 
-/// Writes K and M (both triangles given; the upper one is written) in `format` for the DOFs
-/// (node label, component 0..5): calculix -> DIR/STEM.sti, .mas, .dof; abaqus ->
-/// DIR/STEM_STIF1.mtx, DIR/STEM_MASS1.mtx; matrix_market -> DIR/STEM_K.mtx, DIR/STEM_M.mtx,
-/// DIR/STEM_dofs.csv; abaqus_coordinate as abaqus with "row column value" on the rows' order (the
-/// equation numbers of a deck whose nodes carry these DOFs); nastran and ansys are read only.
-/// Returns the paths written. Throws InputError when DIR cannot be written.
+/// Writes K and M (both triangles given) in `format` for the DOFs (node label, component 0..5):
+/// calculix -> DIR/STEM.sti, .mas, .dof; abaqus -> DIR/STEM_STIF1.mtx, DIR/STEM_MASS1.mtx;
+/// abaqus_coordinate -> the same files as "row column value" on the rows' order (the equation
+/// numbers of a deck whose nodes carry these DOFs); matrix_market -> DIR/STEM_K.mtx,
+/// DIR/STEM_M.mtx, DIR/STEM_dofs.csv. The upper triangle is written, both for abaqus_coordinate;
+/// nastran and ansys are read only. Returns the paths written. Throws InputError when DIR cannot
+/// be written.
 std::vector<std::string> WriteMatrices(MatrixFormat format, const SparseMatrix& K, const SparseMatrix& M,
                                        const std::vector<long>& node, const std::vector<int>& component,
                                        const std::string& directory, const std::string& stem);
