@@ -1,5 +1,6 @@
 #include "formats/part_file.h"
 
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -313,8 +314,9 @@ void ParseImported(YamlMap& root, PartSpec& part) {
   x.format = m.Required("format").OneOfKinds<MatrixFormat>();
   x.stiffness = ResolvePath(m.Required("stiffness"), "stiffness matrix file", part.file);
   x.mass = ResolvePath(m.Required("mass"), "mass matrix file", part.file);
-  const std::string extension = std::filesystem::path(part.solid.file).extension().string();
-  if (extension == ".inp" || extension == ".INP") x.deck = part.solid.file;
+  std::string extension = std::filesystem::path(part.solid.file).extension().string();
+  for (char& c : extension) c = char(std::tolower(static_cast<unsigned char>(c)));
+  if (extension == ".inp") x.deck = part.solid.file;
   const bool abaqus = x.format == MatrixFormat::kAbaqus || x.format == MatrixFormat::kAbaqusCoordinate;
   if (auto instance = m.Optional("instance")) {
     if (!abaqus || x.deck.empty())
