@@ -200,7 +200,8 @@ void ReadAnsysMapping(const std::string& path, ImportedMatrices* out) {
   std::string line;
   while (r.Next(&line, "!")) {
     const std::vector<std::string_view> f = Fields(line);
-    if (!std::isdigit(static_cast<unsigned char>(f[0][0]))) continue;  // the header ("Matrix Eqn Node DOF")
+    if (!f.empty() && !std::isdigit(static_cast<unsigned char>(f[0][0])))
+      continue;  // the header ("Matrix Eqn Node DOF")
     if (f.size() != 3) r.Fail("expected 'equation node label', got '" + line + "'");
     const long equation = IntegerField(r, f[0]), node = IntegerField(r, f[1]);
     if (equation != long(out->node.size()) + 1)

@@ -424,6 +424,8 @@ TEST(MatrixFiles, BadNastranAndAnsysFilesAreOneLine) {
   has(read(MatrixFormat::kAnsys, mm, mm, " Matrix Eqn   Node   DOF\n 1 1 UX\n 3 1 UY\n"),
       "map.txt:3: equation 3 where 2 comes next");
   has(read(MatrixFormat::kAnsys, mm, mm, " Matrix Eqn   Node   DOF\n 1 1 UX\n"), "the matrix has 2 rows but");
+  has(read(MatrixFormat::kAnsys, mm, mm, " Matrix Eqn   Node   DOF\n 1 1 UX\n,,,\n"),
+      "map.txt:3: expected 'equation node label'");
   has(read(MatrixFormat::kAnsys, "title\n 4 1 1 1 0\nCSA            2 2 2 0\n(10I8) (10I8) (3E26.16)\n", mm, map),
       "matrix type 'CSA'");
   has(read(MatrixFormat::kAnsys,
