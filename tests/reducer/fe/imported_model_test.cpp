@@ -1,6 +1,7 @@
 // Imported FE matrices: a native part exported by femb-reduce's exporter in each
 // matrix format and read back as a part of type 'imported' reduces to the same superelement
-// (frequencies and reduced matrices to 1e-8); a beam with rotational DOFs too; CalculiX's own
+// (frequencies and reduced matrices to 1e-8 of the native part's, K_r, the static block of M_r
+// and the frequencies to 1e-12 of each other); a beam with rotational DOFs too; CalculiX's own
 // assembly of the same mesh agrees within the element-quadrature difference; bad matrices are
 // one line each, naming the file and line or the DOF.
 #include "reducer/fe/imported_model.h"
@@ -13,6 +14,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <sstream>
 
 #include "formats/superelement_checks.h"
@@ -81,6 +83,7 @@ TEST(ImportedModel, EveryFormatRoundTripsToTheNativeSuperelement) {
     ExportPartMatrices(part, *KindOf<MatrixFormat>(format), (dir / format).string());
   }
   const Superelement native = ReduceFile(dir / "native.yaml");
+  std::optional<Superelement> first;  // the CalculiX files' superelement
   for (const std::string format : {"calculix", "abaqus", "abaqus_coordinate", "matrix_market"}) {
     WriteText(dir / "imported.yaml",
               "name: bar\ntype: imported\ngeometry: {file: " + format +
@@ -109,6 +112,14 @@ TEST(ImportedModel, EveryFormatRoundTripsToTheNativeSuperelement) {
     EXPECT_EQ(imported.visualization->cell_type, CellType::kTet10);
     EXPECT_LT(shapes, 1e-8) << format;
     EXPECT_FALSE(imported.stress.has_value());
+    // The same matrices in another form: the same superelement as the CalculiX files give (what
+    // is unique of it, as above).
+    if (!first) first = imported;
+    EXPECT_LT(Relative(imported.K, first->K), 1e-12) << format;
+    EXPECT_LT(Relative(imported.M.topLeftCorner(12, 12), first->M.topLeftCorner(12, 12)), 1e-12) << format;
+    EXPECT_LT((imported.internal_frequencies_hz - first->internal_frequencies_hz).cwiseAbs().maxCoeff(),
+              1e-12 * first->internal_frequencies_hz.maxCoeff())
+        << format;
   }
   fs::remove_all(dir);
 }
