@@ -4,14 +4,14 @@
 //   by R <- exp(h dq~) R; Newton with the iteration matrix S = K_t + K_in + gamma' C_t + beta' M_g,
 //   K_in = d(M_g wdot)/dq (exact) plus, with full_inertia_tangent, the configuration derivative
 //   of the quadratic velocity terms (numerical); numerical damping by rho_inf.
-// - Momentum-conserving midpoint (dynamic_analysis.cpp; Simo & Wong 1991 for rigid bodies):
+// - Momentum-conserving midpoint (solver/integrators/midpoint.cpp; Simo & Wong 1991 for rigid bodies):
 //   the momentum balance over the step at the mid configuration, node rotations advanced by the
 //   mean convected angular velocity. Conserves linear and angular momentum exactly for free
 //   systems (flexible ones too) and, for rigid bodies, the kinetic energy; no numerical damping.
 // Both cut the step when Newton diverges. Steps are fixed, or error-controlled (`adaptive`):
 // the local error of the positions (and what the velocities' error moves them over a step) is
-// estimated from the accelerations of the steps taken (dynamic_analysis.cpp, "Error-controlled
-// steps") and kept below step_tolerance of the model's motion; steps land on the kinks and jumps of the loads and
+// estimated from the accelerations of the steps taken (step_control.h) and kept below
+// step_tolerance of the model's motion; steps land on the kinks and jumps of the loads and
 // drives and on output times.
 #pragma once
 
@@ -210,7 +210,7 @@ DynamicStepReport Measure(const SystemModel& model, DynamicState& state);
 /// as it is.
 DynamicState WithConsistentAccelerations(const SystemModel& model, const DynamicState& state);
 
-/// Support and joint reactions (JointReactions, system.h) at a state: the inertia forces with its
+/// Support and joint reactions (JointReactions, solver/joints/joint_tree.h) at a state: the inertia forces with its
 /// accelerations (give it WithConsistentAccelerations' state).
 std::vector<Eigen::Matrix<double, 6, 1>> DynamicReactions(const SystemModel& model, const DynamicState& state);
 

@@ -38,7 +38,7 @@ namespace femb {
 
 /// A joint closing a loop: the joint (child, parent, axes and initial placement as for a tree
 /// joint) and the equations kept (indices into the type's full set above; redundant ones of an
-/// over-constrained mechanism are dropped, see FindRedundantEquations in system.h).
+/// over-constrained mechanism are dropped, see DropRedundantEquations in loop_constraints.h).
 struct CutJoint {
   NodeJoint joint;
   std::string name;            ///< for messages, e.g. "revolute joint between nodes 'C' and 'D'"
