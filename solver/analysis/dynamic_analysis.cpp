@@ -30,12 +30,6 @@ void StartAssembly(const SystemModel& model, const DofMap& dofs, AssemblyParts& 
   parts.node_forces.f.assign(size_t(model.n_nodes()), Eigen::Matrix<double, 6, 1>::Zero());
 }
 
-Assembly StartAssembly(const SystemModel& model, const DofMap& dofs, AssemblyParts& parts) {
-  Assembly out;
-  StartAssembly(model, dofs, parts, out);
-  return out;
-}
-
 void FinishAssembly(const SystemModel& model, const DofMap& dofs, const SystemState& config, double t,
                     const Eigen::VectorXd& W, bool matrices, AssemblyParts& parts, Assembly& out) {
   Eigen::VectorXd &loads = parts.loads, &springs = parts.springs, &weights = parts.weights;

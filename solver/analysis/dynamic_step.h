@@ -59,7 +59,6 @@ struct AssemblyParts {
 
 // Starts an assembly in `out` (residual and f_ext zero, parts emptied): storage reused.
 void StartAssembly(const SystemModel& model, const DofMap& dofs, AssemblyParts& parts, Assembly& out);
-Assembly StartAssembly(const SystemModel& model, const DofMap& dofs, AssemblyParts& parts);
 
 // Nodal loads at t, spring-dampers at velocities W (both on `config`), and with `matrices` their
 // and the joints' geometric stiffness into parts.K and parts.C (the caller builds the matrices).
