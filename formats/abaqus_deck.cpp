@@ -99,6 +99,13 @@ class DeckParser {
     return node_set ? part.nsets : part.elsets;
   }
   AbaqusMesh Place(const Instance& instance) const;
+  // The part named `name` (upper case; "" is a flat deck's top level), the last one defined; null
+  // when the deck defines none of that name.
+  const Part* PartNamed(const std::string& name) const {
+    for (auto p = parts_.rbegin(); p != parts_.rend(); ++p)
+      if (p->name == name) return &*p;
+    return nullptr;
+  }
 
   LineReader r_;
   std::vector<Part> parts_{Part{}};  // parts_[0]: the top level of a flat deck
@@ -193,10 +200,7 @@ void DeckParser::AddSetEntries(const std::vector<std::string_view>& f) {
     const long step = f.size() == 3 && !f[2].empty() ? IntegerField(r_, f[2]) : 1;
     if (step <= 0 || last < first) r_.Fail("GENERATE expects an increasing range and a positive step");
     // Labels beyond the largest the part defines name nothing: the range stops there.
-    const Part* part = &Current();
-    if (scope)
-      for (const Part& p : parts_)
-        if (p.name == scope->part) part = &p;
+    const Part* part = scope && PartNamed(scope->part) ? PartNamed(scope->part) : &Current();
     long largest = 0;
     if (node_set) {
       for (long label : part->labels) largest = std::max(largest, label);
@@ -220,9 +224,8 @@ void DeckParser::AddSetEntries(const std::vector<std::string_view>& f) {
       if (!rest.empty() && std::isdigit(static_cast<unsigned char>(rest[0]))) {
         target(instance).insert(IntegerField(r_, rest));
       } else {
-        const Part* part = nullptr;
-        for (const Part& p : parts_)
-          if (p.name == instance->part) part = &p;
+        const Part* part = PartNamed(instance->part);
+        if (!part) r_.Fail("instance " + instance->name + " places part " + instance->part + ", which is not defined");
         const auto& sets = node_set ? part->nsets : part->elsets;
         auto it = sets.find(rest);
         if (it == sets.end()) r_.Fail("part " + instance->part + " has no set " + rest);
@@ -306,9 +309,7 @@ void DeckParser::OnData(const std::string& line) {
 }
 
 AbaqusMesh DeckParser::Place(const Instance& instance) const {
-  const Part* part = nullptr;
-  for (const Part& p : parts_)
-    if (p.name == instance.part) part = &p;
+  const Part* part = PartNamed(instance.part);
   if (!part)
     throw InputError(r_.path() + ": instance " + instance.name + " places part " + instance.part +
                      ", which the deck does not define");

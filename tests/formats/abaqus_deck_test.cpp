@@ -165,6 +165,9 @@ TEST(AbaqusDeck, BadDecksAreOneLineEach) {
   has(message("hybrid", nodes + "*Element, type=C3D4H\n1, 1, 2, 3, 4\n"), ".inp:6: element type C3D4H");
   has(message("part", "*Assembly, name=A\n*Instance, name=I, part=Nothing\n*End Instance\n*End Assembly\n"),
       "instance I places part NOTHING");
+  has(message("instance_set",
+              "*Assembly, name=A\n*Instance, name=I, part=Nothing\n*End Instance\n*Nset, nset=S\n I.SET\n"),
+      ".inp:5: instance I places part NOTHING, which is not defined");
   has(message("set", nodes + "*Nset, nset=S\n1, Other\n"), "'Other' is neither a label nor a set");
   has(message("short", nodes + "*Element, type=C3D4\n1, 1, 2, 3, 4\n*Element, type=C3D10\n2, 1, 2, 3\n"),
       "the file ends inside an element's data line");
