@@ -77,6 +77,17 @@ struct Words<ReductionMethod> {
                                                        {ReductionMethod::kGeneral, "general"}};
 };
 
+/// `reduction.solver`: the linear algebra of the reduction's interior (its one factor and the
+/// eigen solve). kCholmod: CHOLMOD's supernodal Cholesky and femb's block shift-invert Lanczos on
+/// one process; kPetsc: MUMPS' distributed Cholesky and SLEPc's Krylov-Schur over the MPI ranks
+/// femb-reduce runs on (mpirun).
+enum class ReductionSolver { kCholmod, kPetsc };
+template <>
+struct Words<ReductionSolver> {
+  static constexpr KindWord<ReductionSolver> list[] = {{ReductionSolver::kCholmod, "cholmod"},
+                                                       {ReductionSolver::kPetsc, "petsc"}};
+};
+
 /// `reduction.floating_frame`; kInterface is written `interface:<name>`.
 enum class FloatingFrameType { kCenterOfMass, kMeanAxes, kCardona, kInterface };
 template <>

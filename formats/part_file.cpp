@@ -524,6 +524,10 @@ void ParseReduction(const YamlValue& r, PartSpec& part) {
     part.reduction.full_modes_given = true;
   }
   if (auto v = m.Optional("memory_limit_gb")) part.reduction.memory_limit_gb = v->PositiveNumber();
+  if (auto v = m.Optional("solver")) {
+    part.reduction.solver = v->OneOfKinds<ReductionSolver>();
+    part.reduction.where_solver = v->Where();
+  }
   if (auto v = m.Optional("modal_derivatives")) ParseModalDerivatives(*v, part);
   m.CheckNoUnknownKeys();
   if (part.reduction.method != ReductionMethod::kCraigBampton &&
@@ -531,6 +535,12 @@ void ParseReduction(const YamlValue& r, PartSpec& part) {
     throw InputError(part.reduction.where_method +
                      ": modal derivatives and geometric stiffening are built on the "
                      "Craig-Bampton basis: use reduction.method: craig_bampton with them");
+  }
+  if (part.reduction.solver == ReductionSolver::kPetsc && part.reduction.method != ReductionMethod::kCraigBampton) {
+    throw InputError(part.reduction.where_solver +
+                     ": reduction.solver: petsc reduces by craig_bampton only (the free-interface and general "
+                     "bases are not distributed yet): use solver: cholmod with method: " +
+                     std::string(Name(part.reduction.method)));
   }
 }
 

@@ -144,7 +144,11 @@ struct ReductionSpec {
   int full_modes = 0;
   bool full_modes_given = false;
   static constexpr long kFullModesMaxDofs = 200000;
-  double memory_limit_gb = 0;  ///< refuse when the Cholesky factor would exceed it (0: MemAvailable)
+  double memory_limit_gb = 0;  ///< refuse when the Cholesky factor would exceed it (0: MemAvailable); with
+                               ///< the petsc solver, the limit of each rank's share
+  /// Unset: cholmod on one process, petsc when femb-reduce runs on more than one (mpirun -np N).
+  std::optional<ReductionSolver> solver;
+  std::string where_solver;
   std::string where_floating_frame;
 };
 

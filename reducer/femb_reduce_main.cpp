@@ -3,6 +3,7 @@
 #include <cstring>
 #include <filesystem>
 #include <iostream>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -10,8 +11,12 @@
 #include "formats/input_error.h"
 #include "formats/part_file.h"
 #include "reducer/fe/imported_model.h"
+#include "reducer/linalg/interior_solver.h"
 #include "reducer/linalg/sparse_cholesky.h"
 #include "reducer/reduce_file.h"
+#ifdef FEMB_WITH_PETSC
+#include "reducer/distributed/mpi_session.h"
+#endif
 
 namespace {
 
@@ -43,6 +48,10 @@ options:
   -q, --quiet           no progress lines
   -h, --help            this text
 
+on MPI: mpirun -np N femb-reduce PART.yaml [-o OUT.h5] reduces with reduction.solver: petsc (MUMPS'
+  distributed Cholesky and SLEPc's Krylov-Schur over the N ranks; --set reduction.solver=petsc
+  for one rank); every rank builds the model, rank 0 prints and writes the file
+
 exit codes: 0 success, 2 bad input (one line names the file, line and key), 3 numerical failure,
   4 refused: the Cholesky factor would not fit in memory (the line says how much it needs).
 )";
@@ -63,6 +72,12 @@ int main(int argc, char** argv) {
   cli.Switch({"-q", "--quiet"}, [&] { quiet = true; });
   if (!cli.Parse(argc, argv)) return cli.exit_code();
   const std::string part_path = cli.input();
+  // Under an MPI launcher the ranks meet the same input and the same errors: rank 0 says them.
+  const bool speaks = femb::LaunchedRank() == 0;
+  bool distributed = false;  // on several MPI ranks
+#ifdef FEMB_WITH_PETSC
+  std::optional<femb::MpiSession> mpi;  // (outlives everything that uses PETSc)
+#endif
   try {
     femb::Stopwatch total;
     const std::optional<femb::MatrixFormat> matrix_format = femb::KindOf<femb::MatrixFormat>(matrix_format_word);
@@ -76,6 +91,15 @@ int main(int argc, char** argv) {
     }
     const femb::PartSpec part = femb::ReadPartFile(part_path, overrides);
     if (output.empty()) output = part.name + ".h5";
+#ifdef FEMB_WITH_PETSC
+    if (femb::LaunchedRanks() > 0 || part.reduction.solver == femb::ReductionSolver::kPetsc) mpi.emplace();
+    distributed = mpi && mpi->size() > 1;
+#endif
+    if (!speaks) {
+      quiet = true;
+      // Only the petsc solver shares the work; anything else rank 0 does alone.
+      if (!export_dir.empty() || femb::ResolvedSolver(part.reduction.solver) != femb::ReductionSolver::kPetsc) return 0;
+    }
     auto progress = [&](const std::string& stage, double seconds, const std::string& detail) {
       if (quiet) return;
       std::printf("femb-reduce: [%8.3f s] %-16s %8.3f s  %s\n", total.Seconds(), stage.c_str(), seconds,
@@ -88,9 +112,13 @@ int main(int argc, char** argv) {
       return 0;
     }
     const femb::ReduceFileOutcome result = femb::ReduceToFile(
-        part, output, progress, [](const std::string& line) { std::printf("femb-reduce: %s\n", line.c_str()); });
+        part, output, progress,
+        [&](const std::string& line) {
+          if (speaks) std::printf("femb-reduce: %s\n", line.c_str());
+        },
+        speaks);
     if (result.exit_code != 0) {
-      std::fprintf(stderr, "femb-reduce: %s\n", result.error.c_str());
+      if (speaks) std::fprintf(stderr, "femb-reduce: %s\n", result.error.c_str());
       return result.exit_code;
     }
     if (!quiet) {
@@ -100,13 +128,17 @@ int main(int argc, char** argv) {
     }
     return 0;
   } catch (const femb::ResourceLimitError& e) {
-    std::fprintf(stderr, "femb-reduce: %s: refused: %s (no output written)\n", part_path.c_str(), e.what());
+    if (speaks) std::fprintf(stderr, "femb-reduce: %s: refused: %s (no output written)\n", part_path.c_str(), e.what());
     return 4;
   } catch (const femb::InputError& e) {
-    std::fprintf(stderr, "femb-reduce: %s\n", e.what());
+    if (speaks) std::fprintf(stderr, "femb-reduce: %s\n", e.what());
     return 2;
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "femb-reduce: internal error: %s\n", e.what());
-    return 1;
+    // A failure inside the distributed solver may be one rank's: that rank says it and ends all.
+    std::fprintf(stderr, "femb-reduce: %s: %s (no output written)\n", part_path.c_str(), e.what());
+#ifdef FEMB_WITH_PETSC
+    if (distributed) mpi->Abort(3);
+#endif
+    return 3;
   }
 }

@@ -11,7 +11,7 @@
 namespace femb {
 
 ReduceFileOutcome ReduceToFile(const PartSpec& part, const std::string& output, const ProgressFn& progress,
-                               const std::function<void(const std::string&)>& warning) {
+                               const std::function<void(const std::string&)>& warning, bool write) {
   ReduceFileOutcome out;
   const auto refuse = [&](int code, const std::string& what) {
     out.exit_code = code;
@@ -47,7 +47,7 @@ ReduceFileOutcome ReduceToFile(const PartSpec& part, const std::string& output, 
     progress("dynamics", 0.0, DynamicsSummary(result.superelement));
   }
   Stopwatch write_clock;
-  WriteSuperelementFile(result.superelement, output);
+  if (write) WriteSuperelementFile(result.superelement, output);
   if (progress) progress("write", write_clock.Seconds(), output);
   out.superelement = std::move(result.superelement);
   return out;

@@ -24,7 +24,8 @@ struct ReduceFileOutcome {
 /// Reduces `part` and writes it to `output`. Progress to `progress` (stages with their times,
 /// then "checks", "dynamics" and "write"); warnings to `warning`. Bad input throws InputError;
 /// nothing is written unless the outcome's exit code is 0.
+/// With `write` false (the ranks other than 0 of a distributed run), everything but the file.
 ReduceFileOutcome ReduceToFile(const PartSpec& part, const std::string& output, const ProgressFn& progress,
-                               const std::function<void(const std::string&)>& warning);
+                               const std::function<void(const std::string&)>& warning, bool write = true);
 
 }  // namespace femb

@@ -13,6 +13,7 @@
 #include "reducer/fe/nonlinear_beam.h"
 #include "reducer/fe/nonlinear_solid.h"
 #include "reducer/fe/solid_model.h"
+#include "reducer/linalg/interior_solver.h"
 #include "reducer/linalg/sparse_cholesky.h"
 #include "reducer/reduction/craig_bampton.h"
 #include "reducer/reduction/floating_frame.h"
@@ -636,7 +637,8 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
       part.reduction.method == ReductionMethod::kFreeInterface || part.reduction.method == ReductionMethod::kGeneral;
   CraigBamptonResult cb =
       CraigBamptonReduce(model, other_basis ? 0 : part.reduction.internal_modes, report, 200, budget.factor_bytes,
-                         request.pairs.empty() ? nullptr : &request, stiffening ? &inertia_fields : nullptr);
+                         request.pairs.empty() ? nullptr : &request, stiffening ? &inertia_fields : nullptr,
+                         ResolvedSolver(part.reduction.solver));
   if (!cb.ok) {
     result.too_big = cb.factorization.too_big;
     result.message = result.too_big ? TooBigMessage(budget, cb.message) : cb.message;

@@ -11,6 +11,7 @@
 
 #include "reducer/linalg/dense_products.h"
 #include "reducer/linalg/generalized_eigen.h"
+#include "reducer/linalg/interior_solver.h"
 
 namespace femb {
 namespace {
@@ -301,7 +302,7 @@ SparseMatrix Augmented(const SparseMatrix& K_ii, const SparseMatrix& Wt) {
 //   F x + W^T mu = z, W x = 0   =>   x = F^-1 z - Y S^-1 W F^-1 z,  Y = F^-1 W^T.
 class ConstrainedSolver {
  public:
-  ConstrainedSolver(SparseCholesky& factor, const SparseMatrix& Wt)
+  ConstrainedSolver(InteriorSolver& factor, const SparseMatrix& Wt)
       : factor_(factor),
         Wt_(Wt),
         Y_(Wt.cols() > 0 ? factor.Solve(Eigen::MatrixXd(Wt)) : Eigen::MatrixXd(Wt.rows(), 0)),
@@ -318,7 +319,7 @@ class ConstrainedSolver {
   }
 
  private:
-  SparseCholesky& factor_;
+  InteriorSolver& factor_;
   const SparseMatrix& Wt_;
   const Eigen::MatrixXd Y_;
   const Eigen::LDLT<Eigen::MatrixXd> S_;
@@ -439,7 +440,7 @@ std::string FactorizationDetail(const FactorizationInfo& f, int n_i) {
 
 CraigBamptonResult CraigBamptonReduce(const FeModel& model, int internal_modes, const ProgressFn& progress,
                                       long dense_limit, double memory_limit_bytes, const DerivativeRequest* derivatives,
-                                      const Eigen::MatrixXd* inertia_fields) {
+                                      const Eigen::MatrixXd* inertia_fields, ReductionSolver solver_kind) {
   CraigBamptonResult r;
   Stopwatch clock;
   InterfacePartition p;
@@ -456,8 +457,8 @@ CraigBamptonResult CraigBamptonReduce(const FeModel& model, int internal_modes, 
   clock.Restart();
   SparseMatrix F_augmented;
   if (p.n_b == 0) F_augmented = Augmented(K.ii, p.Wt);
-  SparseCholesky factor;
-  r.factorization = factor.Compute(p.n_b == 0 ? F_augmented : K.ii, memory_limit_bytes);
+  const std::unique_ptr<InteriorSolver> factor = MakeInteriorSolver(solver_kind);
+  r.factorization = factor->Factorize(p.n_b == 0 ? F_augmented : K.ii, memory_limit_bytes);
   const double t_factor = clock.Seconds();
   if (r.factorization.too_big) {
     r.message = r.factorization.message;
@@ -471,12 +472,12 @@ CraigBamptonResult CraigBamptonReduce(const FeModel& model, int internal_modes, 
   if (progress) progress("factorize K_ii", t_factor, FactorizationDetail(r.factorization, p.n_i));
 
   clock.Restart();
-  const ConstrainedSolver solver(factor, p.Wt);
+  const ConstrainedSolver solver(*factor, p.Wt);
   Eigen::MatrixXd Psi_b, Psi_c;
   StaticModes(model, p, K.ib, solver, Psi_b, Psi_c);
   if (progress) {
     progress("static modes", clock.Seconds(),
-             Format("%.0f constraint modes, %.0f linear solves", p.n_b + p.n_c, double(factor.solves())));
+             Format("%.0f constraint modes, %.0f linear solves", p.n_b + p.n_c, double(factor->solves())));
   }
 
   // Fixed-interface modes, shift-invert around 0 on the same factor, on W x = 0; one mode more
@@ -491,10 +492,13 @@ CraigBamptonResult CraigBamptonReduce(const FeModel& model, int internal_modes, 
   const Eigen::MatrixXd C = Eigen::MatrixXd(p.Wt.transpose());
   long passes = 0;
   const int nev = internal_modes > 0 && internal_modes + 1 <= p.n_i - p.n_c ? internal_modes + 1 : internal_modes;
-  EigenResult eig = p.n_i <= dense_limit || 2 * nev + 1 > p.n_i - p.n_c
-                        ? LowestConstrainedEigenpairs(K.ii, M.ii, C, nev, 0.0, solve, dense_limit)
-                        : BlockLanczosEigenpairs(K.ii, M.ii, C, nev, 0.0, constrained_solve, kLanczosBlock,
-                                                 kLanczosTolerance, &passes);
+  const bool dense = p.n_i <= dense_limit || 2 * nev + 1 > p.n_i - p.n_c;
+  std::optional<EigenResult> own =
+      dense ? std::nullopt : factor->Eigenpairs(K.ii, M.ii, nev, kLanczosTolerance, constrained_solve);
+  EigenResult eig = dense ? LowestConstrainedEigenpairs(K.ii, M.ii, C, nev, 0.0, solve, dense_limit)
+                    : own ? std::move(*own)
+                          : BlockLanczosEigenpairs(K.ii, M.ii, C, nev, 0.0, constrained_solve, kLanczosBlock,
+                                                   kLanczosTolerance, &passes);
   if (!eig.ok) {
     r.message = "fixed-interface eigen solve failed: " + eig.message;
     return r;
@@ -513,6 +517,7 @@ CraigBamptonResult CraigBamptonReduce(const FeModel& model, int internal_modes, 
              Format("%.0f fixed-interface modes, %.0f linear solves (%.1f per mode)", internal_modes,
                     double(eig.linear_solves), double(eig.linear_solves) / std::max(internal_modes, 1)) +
                  (eig.dense ? ", dense solver (small interior)"
+                  : own     ? ", " + factor->EigenDetail()
                             : Format(", block shift-invert Lanczos, %.0f passes over the factor", double(passes))));
   }
 

@@ -20,6 +20,7 @@
 #include <utility>
 #include <vector>
 
+#include "formats/kinds.h"
 #include "reducer/fe/fe_model.h"
 #include "reducer/linalg/sparse_cholesky.h"
 #include "reducer/progress.h"
@@ -58,11 +59,13 @@ struct CraigBamptonResult {
 
 /// `internal_modes` fixed-interface modes are kept. Reports stages through `progress`. With
 /// `memory_limit_bytes` > 0, refuses (factorization.too_big) when the factor of K_ii would not fit.
-/// `derivatives` (optional) appends modal derivatives to the basis.
+/// `derivatives` (optional) appends modal derivatives to the basis. `solver`: the interior's
+/// factor and eigen solver (linalg/interior_solver.h).
 CraigBamptonResult CraigBamptonReduce(const FeModel& model, int internal_modes, const ProgressFn& progress,
                                       long dense_limit = 200, double memory_limit_bytes = 0,
                                       const DerivativeRequest* derivatives = nullptr,
-                                      const Eigen::MatrixXd* inertia_fields = nullptr);
+                                      const Eigen::MatrixXd* inertia_fields = nullptr,
+                                      ReductionSolver solver = ReductionSolver::kCholmod);
 
 /// The six rigid-body motions (translations, rotations about the part origin) as fields on the
 /// model DOFs, n_dofs x 6.

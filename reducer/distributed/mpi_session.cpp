@@ -1,0 +1,52 @@
+#include "reducer/distributed/mpi_session.h"
+
+#include <dlfcn.h>
+#include <mpi.h>
+#include <slepcsys.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <stdexcept>
+#include <string>
+#include <thread>
+
+#include "reducer/distributed/petsc_interior.h"
+#include "reducer/linalg/interior_solver.h"
+
+namespace femb {
+MpiSession::MpiSession() {
+  // PETSc's signal handlers would print pages for a SIGINT; its error handler returns the code,
+  // which the solver turns into one line (petsc_interior.cpp).
+  PetscOptionsSetValue(nullptr, "-no_signal_handler", "true");
+  if (SlepcInitializeNoArguments() != 0) throw std::runtime_error("SLEPc (MPI, PETSc) did not start");
+  PetscPushErrorHandler(PetscReturnErrorHandler, nullptr);
+  MPI_Comm_rank(PETSC_COMM_WORLD, &rank_);
+  MPI_Comm_size(PETSC_COMM_WORLD, &size_);
+  // Ranks on one machine share its cores: one BLAS thread each (OpenBLAS, looked up at run time:
+  // libblas.so.3 may be another BLAS).
+  MPI_Comm node;
+  MPI_Comm_split_type(PETSC_COMM_WORLD, MPI_COMM_TYPE_SHARED, 0, MPI_INFO_NULL, &node);
+  int on_node = 1;
+  MPI_Comm_size(node, &on_node);
+  MPI_Comm_free(&node);
+  if (on_node > 1) {
+    using SetThreads = void (*)(int);
+    if (auto set = reinterpret_cast<SetThreads>(dlsym(RTLD_DEFAULT, "openblas_set_num_threads"))) {
+      const int cores = int(std::thread::hardware_concurrency());
+      set(std::max(1, cores / on_node));
+    }
+  }
+  RegisterDistributedSolver([] { return MakePetscInterior(); }, size_);
+}
+
+MpiSession::~MpiSession() {
+  RegisterDistributedSolver(nullptr, 1);
+  SlepcFinalize();
+}
+
+void MpiSession::Abort(int code) const {
+  MPI_Abort(PETSC_COMM_WORLD, code);
+  std::exit(code);
+}
+
+}  // namespace femb

@@ -1,0 +1,27 @@
+// femb-reduce on MPI ranks (mpirun -np N femb-reduce PART.yaml): the MPI, PETSc and SLEPc
+// session of the process, and what the launcher tells before it starts. Every rank runs the same
+// reduction on the same replicated model; the interior's factor and eigen solve are distributed
+// (petsc_interior.h); rank 0 alone prints and writes the file.
+#pragma once
+
+namespace femb {
+
+/// SlepcInitialize (which starts MPI and PETSc) on construction, SlepcFinalize on destruction;
+/// registers the petsc interior solver (linalg/interior_solver.h) and gives each rank one BLAS
+/// thread when several ranks share the machine's cores.
+class MpiSession {
+ public:
+  MpiSession();
+  ~MpiSession();
+  MpiSession(const MpiSession&) = delete;
+  MpiSession& operator=(const MpiSession&) = delete;
+  int rank() const { return rank_; }
+  int size() const { return size_; }
+  /// Ends every rank with `code` (a failure on some ranks only, which the others would wait on).
+  [[noreturn]] void Abort(int code) const;
+
+ private:
+  int rank_ = 0, size_ = 1;
+};
+
+}  // namespace femb

@@ -1,0 +1,328 @@
+#include "reducer/distributed/petsc_interior.h"
+
+#include <mpi.h>
+#include <petscmat.h>
+#include <slepceps.h>
+
+#include <cmath>
+#include <cstdio>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "reducer/progress.h"
+
+namespace femb {
+namespace {
+
+// A PETSc call that failed (PetscReturnErrorHandler: no trace printed) as one exception.
+void Check(PetscErrorCode code, const char* call) {
+  if (code == 0) return;
+  const char* text = nullptr;
+  PetscErrorMessage(code, &text, nullptr);
+  throw std::runtime_error(std::string("PETSc: ") + call + ": " + (text ? text : "error " + std::to_string(code)));
+}
+#define FEMB_PETSC(call) Check((call), #call)
+
+std::string Format(const char* fmt, double a, double b = 0, double c = 0) {
+  char buffer[256];
+  std::snprintf(buffer, sizeof buffer, fmt, a, b, c);
+  return buffer;
+}
+
+// The rows each rank owns of an n-row matrix or vector (PETSc's default split), with every
+// rank's count and first row for gathering.
+struct RowSplit {
+  PetscInt n = 0, first = 0, count = 0;
+  std::vector<int> counts, firsts;
+};
+
+RowSplit SplitRows(PetscInt n) {
+  RowSplit s;
+  s.n = n;
+  PetscInt local = PETSC_DECIDE, global = n;
+  FEMB_PETSC(PetscSplitOwnership(PETSC_COMM_WORLD, &local, &global));
+  s.count = local;
+  int size = 1;
+  MPI_Comm_size(PETSC_COMM_WORLD, &size);
+  s.counts.resize(size_t(size));
+  s.firsts.resize(size_t(size));
+  const int mine = int(local);
+  MPI_Allgather(&mine, 1, MPI_INT, s.counts.data(), 1, MPI_INT, PETSC_COMM_WORLD);
+  int rank = 0;
+  MPI_Comm_rank(PETSC_COMM_WORLD, &rank);
+  for (int r = 1; r < size; ++r) s.firsts[size_t(r)] = s.firsts[size_t(r - 1)] + s.counts[size_t(r - 1)];
+  s.first = s.firsts[size_t(rank)];
+  return s;
+}
+
+// This rank's rows of the replicated symmetric A (both triangles stored, so row j is column j)
+// as a distributed AIJ matrix.
+Mat DistributedMatrix(const SparseMatrix& A, const RowSplit& rows) {
+  std::vector<PetscInt> start(size_t(rows.count) + 1, 0), columns;
+  std::vector<PetscScalar> values;
+  for (PetscInt j = 0; j < rows.count; ++j) {
+    for (SparseMatrix::InnerIterator it(A, int(rows.first + j)); it; ++it) {
+      columns.push_back(PetscInt(it.row()));
+      values.push_back(it.value());
+    }
+    start[size_t(j) + 1] = PetscInt(columns.size());
+  }
+  Mat M = nullptr;
+  FEMB_PETSC(MatCreateMPIAIJWithArrays(PETSC_COMM_WORLD, rows.count, rows.count, rows.n, rows.n, start.data(),
+                                       columns.data(), values.data(), &M));
+  return M;
+}
+
+// Every rank must have built the same model (each builds it itself): the size, the entries'
+// count and two sums agree on all ranks, or the run stops with one line.
+void CheckSameMatrix(const SparseMatrix& A) {
+  double mine[4] = {double(A.rows()), double(A.nonZeros()), 0.0, 0.0};
+  for (int c = 0; c < A.outerSize(); ++c) {
+    for (SparseMatrix::InnerIterator it(A, c); it; ++it) {
+      mine[2] += it.value();
+      mine[3] += std::abs(it.value()) * double(1 + (it.row() + 3 * c) % 7);
+    }
+  }
+  double low[4], high[4];
+  MPI_Allreduce(mine, low, 4, MPI_DOUBLE, MPI_MIN, PETSC_COMM_WORLD);
+  MPI_Allreduce(mine, high, 4, MPI_DOUBLE, MPI_MAX, PETSC_COMM_WORLD);
+  for (int i = 0; i < 4; ++i) {
+    if (low[i] != high[i]) {
+      throw std::runtime_error(
+          "the MPI ranks built different interior matrices (each rank meshes and assembles the part itself; "
+          "a mesher or reader that is not deterministic across processes?)");
+    }
+  }
+}
+
+// A replicated n x k block from each rank's rows (column-major, `lda` apart).
+Eigen::MatrixXd Gather(const RowSplit& rows, const PetscScalar* local, PetscInt lda, int k) {
+  std::vector<double> mine(size_t(rows.count) * size_t(k));
+  for (int c = 0; c < k; ++c)
+    for (PetscInt i = 0; i < rows.count; ++i) mine[size_t(c) * size_t(rows.count) + size_t(i)] = local[c * lda + i];
+  std::vector<int> counts(rows.counts.size()), displacements(rows.counts.size());
+  for (size_t r = 0; r < counts.size(); ++r) {
+    counts[r] = rows.counts[r] * k;
+    displacements[r] = rows.firsts[r] * k;
+  }
+  std::vector<double> all(size_t(rows.n) * size_t(k));
+  MPI_Allgatherv(mine.data(), int(mine.size()), MPI_DOUBLE, all.data(), counts.data(), displacements.data(), MPI_DOUBLE,
+                 PETSC_COMM_WORLD);
+  Eigen::MatrixXd X(rows.n, k);
+  for (size_t r = 0; r < counts.size(); ++r)
+    for (int c = 0; c < k; ++c)
+      for (int i = 0; i < rows.counts[r]; ++i)
+        X(rows.firsts[r] + i, c) = all[size_t(displacements[r]) + size_t(c) * size_t(rows.counts[r]) + size_t(i)];
+  return X;
+}
+
+Eigen::VectorXd GatherVector(const RowSplit& rows, Vec v) {
+  const PetscScalar* local = nullptr;
+  FEMB_PETSC(VecGetArrayRead(v, &local));
+  Eigen::VectorXd x = Gather(rows, local, rows.count, 1).col(0);
+  FEMB_PETSC(VecRestoreArrayRead(v, &local));
+  return x;
+}
+
+void ScatterVector(const RowSplit& rows, const Eigen::VectorXd& x, Vec v) {
+  PetscScalar* local = nullptr;
+  FEMB_PETSC(VecGetArrayWrite(v, &local));
+  for (PetscInt i = 0; i < rows.count; ++i) local[i] = x[rows.first + i];
+  FEMB_PETSC(VecRestoreArrayWrite(v, &local));
+}
+
+// MUMPS' INFOG entries that count in millions when negative.
+double Count(PetscInt infog) { return infog < 0 ? -1e6 * double(infog) : double(infog); }
+
+// The shift-invert operator SLEPc applies (a PCSHELL in its KSP): the constrained solve on the
+// replicated vector.
+struct ShellContext {
+  const RowSplit* rows = nullptr;
+  const BlockShiftInvertFn* solve = nullptr;
+  long applications = 0;
+};
+
+PetscErrorCode ApplyShiftInvert(PC pc, Vec x, Vec y) {
+  ShellContext* context = nullptr;
+  PetscCall(PCShellGetContext(pc, &context));
+  try {
+    const Eigen::VectorXd z = (*context->solve)(GatherVector(*context->rows, x)).col(0);
+    ScatterVector(*context->rows, z, y);
+  } catch (const std::exception&) {
+    return PETSC_ERR_LIB;
+  }
+  ++context->applications;
+  return 0;
+}
+
+class PetscInterior : public InteriorSolver {
+ public:
+  ~PetscInterior() override {
+    MatDestroy(&F_);
+    MatDestroy(&A_);
+  }
+
+  FactorizationInfo Factorize(const SparseMatrix& A, double memory_limit_bytes) override {
+    FactorizationInfo info;
+    Stopwatch clock;
+    CheckSameMatrix(A);
+    rows_ = SplitRows(PetscInt(A.rows()));
+    A_ = DistributedMatrix(A, rows_);
+    FEMB_PETSC(MatSetOption(A_, MAT_SPD, PETSC_TRUE));
+    FEMB_PETSC(MatGetFactor(A_, MATSOLVERMUMPS, MAT_FACTOR_CHOLESKY, &F_));
+    FEMB_PETSC(MatMumpsSetIcntl(F_, 28, 1));  // sequential analysis ...
+    FEMB_PETSC(MatMumpsSetIcntl(F_, 7, 5));   // ... with METIS' nested dissection
+    MatFactorInfo factor_info;
+    FEMB_PETSC(MatFactorInfoInitialize(&factor_info));
+    FEMB_PETSC(MatCholeskyFactorSymbolic(F_, A_, nullptr, &factor_info));
+    info.analyze_seconds = clock.Seconds();
+    PetscInt largest_mb = 0, total_mb = 0, entries = 0;
+    FEMB_PETSC(MatMumpsGetInfog(F_, 16, &largest_mb));  // estimated memory, largest rank (MB)
+    FEMB_PETSC(MatMumpsGetInfog(F_, 17, &total_mb));    // ... all ranks
+    FEMB_PETSC(MatMumpsGetInfog(F_, 20, &entries));     // estimated entries of the factor
+    int size = 1;
+    MPI_Comm_size(PETSC_COMM_WORLD, &size);
+    info.ordering = Format("metis; MUMPS on %.0f ranks, estimated %.3g GB on the largest, %.3g GB in all", size,
+                           double(largest_mb) / 1e3, double(total_mb) / 1e3);
+    info.factor_entries = Count(entries);
+    info.factor_bytes = 8.0 * info.factor_entries;
+    if (memory_limit_bytes > 0 && 1e6 * double(largest_mb) > memory_limit_bytes) {
+      info.too_big = true;
+      info.message = Format("MUMPS' factorization of K_ii needs %.3g GB on its largest rank (%.3g GB in all)",
+                            double(largest_mb) / 1e3, double(total_mb) / 1e3) +
+                     Format(", more than the %.3g GB a rank may use", memory_limit_bytes / 1e9);
+      return info;
+    }
+    clock.Restart();
+    FEMB_PETSC(MatCholeskyFactorNumeric(F_, A_, &factor_info));
+    info.numeric_seconds = clock.Seconds();
+    MatFactorError error = MAT_FACTOR_NOERROR;
+    FEMB_PETSC(MatFactorGetError(F_, &error));
+    PetscInt status = 0;
+    FEMB_PETSC(MatMumpsGetInfog(F_, 1, &status));
+    if (error != MAT_FACTOR_NOERROR || status < 0) {
+      info.message = Format("MUMPS stopped with INFOG(1) = %.0f (not positive definite)", double(status));
+      return info;
+    }
+    PetscReal flops = 0;
+    FEMB_PETSC(MatMumpsGetRinfog(F_, 3, &flops));
+    info.flops = flops;
+    FEMB_PETSC(MatMumpsGetInfog(F_, 29, &entries));  // the factor's entries
+    info.factor_entries = Count(entries);
+    info.factor_bytes = 8.0 * info.factor_entries;
+    info.ok = true;
+    return info;
+  }
+
+  Eigen::MatrixXd Solve(const Eigen::MatrixXd& B) override {
+    const int k = int(B.cols());
+    solves_ += k;
+    if (k == 0) return Eigen::MatrixXd(B.rows(), 0);
+    Mat Bm = nullptr, Xm = nullptr;
+    FEMB_PETSC(MatCreateDense(PETSC_COMM_WORLD, rows_.count, PETSC_DECIDE, rows_.n, k, nullptr, &Bm));
+    PetscScalar* b = nullptr;
+    PetscInt lda = 0;
+    FEMB_PETSC(MatDenseGetLDA(Bm, &lda));
+    FEMB_PETSC(MatDenseGetArrayWrite(Bm, &b));
+    for (int c = 0; c < k; ++c)
+      for (PetscInt i = 0; i < rows_.count; ++i) b[c * lda + i] = B(rows_.first + i, c);
+    FEMB_PETSC(MatDenseRestoreArrayWrite(Bm, &b));
+    FEMB_PETSC(MatAssemblyBegin(Bm, MAT_FINAL_ASSEMBLY));
+    FEMB_PETSC(MatAssemblyEnd(Bm, MAT_FINAL_ASSEMBLY));
+    FEMB_PETSC(MatDuplicate(Bm, MAT_DO_NOT_COPY_VALUES, &Xm));
+    FEMB_PETSC(MatMatSolve(F_, Bm, Xm));
+    const PetscScalar* x = nullptr;
+    FEMB_PETSC(MatDenseGetLDA(Xm, &lda));
+    FEMB_PETSC(MatDenseGetArrayRead(Xm, &x));
+    Eigen::MatrixXd X = Gather(rows_, x, lda, k);
+    FEMB_PETSC(MatDenseRestoreArrayRead(Xm, &x));
+    MatDestroy(&Xm);
+    MatDestroy(&Bm);
+    return X;
+  }
+
+  long solves() const override { return solves_; }
+
+  std::optional<EigenResult> Eigenpairs(const SparseMatrix& K, const SparseMatrix& M, int nev, double tol,
+                                        const BlockShiftInvertFn& solve) override;
+
+  std::string EigenDetail() const override { return detail_; }
+
+ private:
+  RowSplit rows_;
+  Mat A_ = nullptr, F_ = nullptr;
+  long solves_ = 0;
+  std::string detail_;
+};
+
+// SLEPc's Krylov-Schur on K x = lambda M x (generalized Hermitian: M inner product) with
+// shift-and-invert at 0; the inversion is the constrained solve on this factor (a PCSHELL in a
+// preonly KSP), so no second factor is made. The start vector is the solve of M times ones (in
+// the constrained space, and the same for any number of ranks). Eigenvectors M-normalized,
+// ascending.
+std::optional<EigenResult> PetscInterior::Eigenpairs(const SparseMatrix& K, const SparseMatrix& M, int nev, double tol,
+                                                     const BlockShiftInvertFn& solve) {
+  EigenResult r;
+  Mat Kd = DistributedMatrix(K, rows_), Md = DistributedMatrix(M, rows_);
+  EPS eps = nullptr;
+  FEMB_PETSC(EPSCreate(PETSC_COMM_WORLD, &eps));
+  FEMB_PETSC(EPSSetOperators(eps, Kd, Md));
+  FEMB_PETSC(EPSSetProblemType(eps, EPS_GHEP));
+  FEMB_PETSC(EPSSetType(eps, EPSKRYLOVSCHUR));
+  ST st = nullptr;
+  FEMB_PETSC(EPSGetST(eps, &st));
+  FEMB_PETSC(STSetType(st, STSINVERT));
+  FEMB_PETSC(EPSSetTarget(eps, 0.0));
+  FEMB_PETSC(EPSSetWhichEigenpairs(eps, EPS_TARGET_MAGNITUDE));
+  KSP ksp = nullptr;
+  FEMB_PETSC(STGetKSP(st, &ksp));
+  FEMB_PETSC(KSPSetType(ksp, KSPPREONLY));
+  PC pc = nullptr;
+  FEMB_PETSC(KSPGetPC(ksp, &pc));
+  FEMB_PETSC(PCSetType(pc, PCSHELL));
+  ShellContext context{&rows_, &solve, 0};
+  FEMB_PETSC(PCShellSetContext(pc, &context));
+  FEMB_PETSC(PCShellSetApply(pc, ApplyShiftInvert));
+  FEMB_PETSC(EPSSetDimensions(eps, nev, PETSC_DEFAULT, PETSC_DEFAULT));
+  FEMB_PETSC(EPSSetTolerances(eps, tol, 1000));
+  Vec start = nullptr, x = nullptr;
+  FEMB_PETSC(MatCreateVecs(Kd, &start, &x));
+  const Eigen::VectorXd ones = Eigen::VectorXd::Ones(K.rows());
+  ScatterVector(rows_, solve(Eigen::MatrixXd(M * ones)).col(0), start);
+  FEMB_PETSC(EPSSetInitialSpace(eps, 1, &start));
+  FEMB_PETSC(EPSSolve(eps));
+  PetscInt converged = 0, iterations = 0;
+  FEMB_PETSC(EPSGetConverged(eps, &converged));
+  FEMB_PETSC(EPSGetIterationNumber(eps, &iterations));
+  if (converged < nev) {
+    r.message = Format("SLEPc's Krylov-Schur converged %.0f of %.0f eigenpairs in %.0f restarts", double(converged),
+                       nev, double(iterations));
+  } else {
+    r.lambda.resize(nev);
+    r.vectors.resize(K.rows(), nev);
+    for (int i = 0; i < nev; ++i) {
+      PetscScalar lambda = 0;
+      FEMB_PETSC(EPSGetEigenpair(eps, i, &lambda, nullptr, x, nullptr));
+      Eigen::VectorXd v = GatherVector(rows_, x);
+      v /= std::sqrt(v.dot(M * v));
+      r.lambda[i] = lambda;
+      r.vectors.col(i) = v;
+    }
+    r.ok = true;
+  }
+  r.linear_solves = context.applications + 1;
+  detail_ = Format("SLEPc Krylov-Schur, shift-and-invert on the MUMPS factor, %.0f restarts", double(iterations));
+  VecDestroy(&x);
+  VecDestroy(&start);
+  EPSDestroy(&eps);
+  MatDestroy(&Md);
+  MatDestroy(&Kd);
+  return r;
+}
+
+}  // namespace
+
+std::unique_ptr<InteriorSolver> MakePetscInterior() { return std::make_unique<PetscInterior>(); }
+
+}  // namespace femb

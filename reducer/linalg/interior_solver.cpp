@@ -1,0 +1,68 @@
+#include "reducer/linalg/interior_solver.h"
+
+#include <cstdlib>
+
+#include "formats/input_error.h"
+
+namespace femb {
+namespace {
+
+// CHOLMOD's supernodal factor (one process; BLAS threads inside).
+class CholmodInterior : public InteriorSolver {
+ public:
+  FactorizationInfo Factorize(const SparseMatrix& A, double memory_limit_bytes) override {
+    return factor_.Compute(A, memory_limit_bytes);
+  }
+  Eigen::MatrixXd Solve(const Eigen::MatrixXd& B) override { return factor_.Solve(B); }
+  long solves() const override { return factor_.solves(); }
+
+ private:
+  SparseCholesky factor_;
+};
+
+int EnvironmentInteger(const char* a, const char* b, int otherwise) {
+  for (const char* name : {a, b}) {
+    if (const char* v = std::getenv(name)) return std::atoi(v);
+  }
+  return otherwise;
+}
+
+struct Registry {
+  std::function<std::unique_ptr<InteriorSolver>()> make;
+  int ranks = 1;
+};
+
+Registry& TheRegistry() {
+  static Registry registry;
+  return registry;
+}
+
+}  // namespace
+
+std::unique_ptr<InteriorSolver> MakeInteriorSolver(ReductionSolver kind, const std::string& where) {
+  if (kind == ReductionSolver::kCholmod) return std::make_unique<CholmodInterior>();
+  if (!TheRegistry().make) {
+    throw InputError((where.empty() ? std::string("reduction.solver") : where) +
+                     ": the petsc solver (MUMPS and SLEPc over MPI) runs in femb-reduce built with PETSc and SLEPc "
+                     "(scripts/setup.sh installs them): start it as mpirun -np N femb-reduce PART.yaml");
+  }
+  return TheRegistry().make();
+}
+
+void RegisterDistributedSolver(std::function<std::unique_ptr<InteriorSolver>()> make, int ranks) {
+  TheRegistry().make = std::move(make);
+  TheRegistry().ranks = ranks;
+}
+
+int DistributedRanks() { return TheRegistry().ranks; }
+
+int LaunchedRanks() { return EnvironmentInteger("OMPI_COMM_WORLD_SIZE", "PMI_SIZE", 0); }
+
+int LaunchedRank() { return EnvironmentInteger("OMPI_COMM_WORLD_RANK", "PMI_RANK", 0); }
+
+ReductionSolver ResolvedSolver(const std::optional<ReductionSolver>& given) {
+  if (given) return *given;
+  return DistributedRanks() > 1 ? ReductionSolver::kPetsc : ReductionSolver::kCholmod;
+}
+
+}  // namespace femb

@@ -1,0 +1,66 @@
+// The linear algebra of a Craig-Bampton reduction's interior: one factor of K_ii (or of the
+// augmented matrix when every interface is distributing) with its solves, and optionally its own
+// eigen solver. CHOLMOD (sparse_cholesky.h) on one process is the default; a distributed solver
+// (MUMPS and SLEPc over MPI, reducer/distributed/) is registered by femb-reduce when it runs on
+// MPI ranks. Every rank of a distributed run holds the same replicated right-hand sides and
+// receives the same replicated solutions, so the code that calls these stays serial.
+#pragma once
+
+#include <Eigen/Core>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "formats/kinds.h"
+#include "reducer/fe/fe_model.h"
+#include "reducer/linalg/generalized_eigen.h"
+#include "reducer/linalg/sparse_cholesky.h"
+
+namespace femb {
+
+class InteriorSolver {
+ public:
+  virtual ~InteriorSolver() = default;
+  /// Factorizes the symmetric positive definite A (both triangles stored). With
+  /// `memory_limit_bytes` > 0, refuses (info.too_big) before the numeric factorization when the
+  /// factor (a distributed solver: its largest rank's share) would not fit.
+  virtual FactorizationInfo Factorize(const SparseMatrix& A, double memory_limit_bytes) = 0;
+  /// X = A^-1 B for a block of right-hand sides. Precondition: Factorize succeeded.
+  virtual Eigen::MatrixXd Solve(const Eigen::MatrixXd& B) = 0;
+  /// Right-hand sides solved so far.
+  virtual long solves() const = 0;
+  /// The lowest `nev` eigenpairs of K x = lambda M x on the space the constrained shift-invert
+  /// `solve` maps into (it applies the factor), residual tolerance `tol` relative to the
+  /// eigenvalue; empty when this solver has no eigen solver of its own (femb's block Lanczos then
+  /// runs on `solve`).
+  virtual std::optional<EigenResult> Eigenpairs(const SparseMatrix& K, const SparseMatrix& M, int nev, double tol,
+                                                const BlockShiftInvertFn& solve) {
+    (void)K, (void)M, (void)nev, (void)tol, (void)solve;
+    return std::nullopt;
+  }
+  /// How the eigen solve ran, for the progress line ("" when Eigenpairs has none).
+  virtual std::string EigenDetail() const { return ""; }
+};
+
+/// Makes the solver of a given kind. Throws InputError (naming `where`) for petsc when no
+/// distributed solver is registered in this program.
+std::unique_ptr<InteriorSolver> MakeInteriorSolver(ReductionSolver kind, const std::string& where = "");
+
+/// The distributed solver's maker and the number of MPI ranks, set by a program that runs on MPI
+/// (femb-reduce); ranks() is 1 until then.
+void RegisterDistributedSolver(std::function<std::unique_ptr<InteriorSolver>()> make, int ranks);
+int DistributedRanks();
+
+/// The number of ranks an MPI launcher started (OpenMPI's OMPI_COMM_WORLD_SIZE, MPICH's
+/// PMI_SIZE), 0 when the process was not started by one.
+int LaunchedRanks();
+/// This process's rank by the launcher's environment (0 when not launched by one): known before
+/// MPI starts, so that only rank 0 reports an input error.
+int LaunchedRank();
+
+/// The solver a part asks for: its reduction.solver, or cholmod on one process and petsc on
+/// more than one.
+ReductionSolver ResolvedSolver(const std::optional<ReductionSolver>& given);
+
+}  // namespace femb
