@@ -536,12 +536,6 @@ void ParseReduction(const YamlValue& r, PartSpec& part) {
                      ": modal derivatives and geometric stiffening are built on the "
                      "Craig-Bampton basis: use reduction.method: craig_bampton with them");
   }
-  if (part.reduction.solver == ReductionSolver::kPetsc && part.reduction.method != ReductionMethod::kCraigBampton) {
-    throw InputError(part.reduction.where_solver +
-                     ": reduction.solver: petsc reduces by craig_bampton only (the free-interface and general "
-                     "bases are not distributed yet): use solver: cholmod with method: " +
-                     std::string(Name(part.reduction.method)));
-  }
 }
 
 }  // namespace

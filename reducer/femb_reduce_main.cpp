@@ -78,6 +78,15 @@ int main(int argc, char** argv) {
 #ifdef FEMB_WITH_PETSC
   std::optional<femb::MpiSession> mpi;  // (outlives everything that uses PETSc)
 #endif
+  // An error's line and exit code. On MPI ranks before the distributed work, the ranks first agree
+  // (femb::AgreeOnStart): the lowest rank that failed says it, and the others, which may be
+  // waiting in the solver, stop with its code.
+  const auto fail = [&](int code, const std::string& line) {
+    bool say = speaks;
+    if (distributed && !femb::StartAgreed()) say = femb::AgreeOnStart(code).first_failed == femb::DistributedRank();
+    if (say) std::fprintf(stderr, "femb-reduce: %s\n", line.c_str());
+    return code;
+  };
   try {
     femb::Stopwatch total;
     const std::optional<femb::MatrixFormat> matrix_format = femb::KindOf<femb::MatrixFormat>(matrix_format_word);
@@ -89,16 +98,24 @@ int main(int argc, char** argv) {
       throw femb::InputError("--matrix-format: " + matrix_format_word +
                              " is read, not written (write calculix, abaqus, abaqus_coordinate or matrix_market)");
     }
+#ifdef FEMB_WITH_PETSC
+    // Started by mpirun: MPI first, so that the ranks agree on a failure from the start.
+    if (femb::LaunchedRanks() > 0) mpi.emplace();
+    distributed = mpi && mpi->size() > 1;
+#endif
     const femb::PartSpec part = femb::ReadPartFile(part_path, overrides);
     if (output.empty()) output = part.name + ".h5";
 #ifdef FEMB_WITH_PETSC
-    if (femb::LaunchedRanks() > 0 || part.reduction.solver == femb::ReductionSolver::kPetsc) mpi.emplace();
-    distributed = mpi && mpi->size() > 1;
+    if (!mpi && part.reduction.solver == femb::ReductionSolver::kPetsc) mpi.emplace();
 #endif
-    if (!speaks) {
-      quiet = true;
-      // Only the petsc solver shares the work; anything else rank 0 does alone.
-      if (!export_dir.empty() || femb::ResolvedSolver(part.reduction.solver) != femb::ReductionSolver::kPetsc) return 0;
+    if (!speaks) quiet = true;
+    if (distributed &&
+        (!export_dir.empty() || femb::ResolvedSolver(part.reduction.solver) != femb::ReductionSolver::kPetsc)) {
+      // Only the petsc solver shares the work; anything else rank 0 does alone, once every rank got
+      // here.
+      const femb::RankAgreement start = femb::AgreeOnStart(0);
+      if (start.code != 0) return start.code;
+      if (!speaks) return 0;
     }
     auto progress = [&](const std::string& stage, double seconds, const std::string& detail) {
       if (quiet) return;
@@ -117,28 +134,29 @@ int main(int argc, char** argv) {
           if (speaks) std::printf("femb-reduce: %s\n", line.c_str());
         },
         speaks);
-    if (result.exit_code != 0) {
-      if (speaks) std::fprintf(stderr, "femb-reduce: %s\n", result.error.c_str());
-      return result.exit_code;
-    }
+    if (result.exit_code != 0) return fail(result.exit_code, result.error);
     if (!quiet) {
       std::printf("femb-reduce: wrote %s (%d reduced DOFs from %ld) in %.3f s, peak memory %.3g GB\n", output.c_str(),
                   result.superelement.n_reduced_dofs(), result.superelement.n_full_dofs, total.Seconds(),
                   femb::PeakResidentBytes() / 1e9);
     }
     return 0;
+  } catch (const femb::RankFailure& e) {
+    if (e.said_here()) std::fprintf(stderr, "femb-reduce: %s: %s (no output written)\n", part_path.c_str(), e.what());
+    return e.code();
   } catch (const femb::ResourceLimitError& e) {
-    if (speaks) std::fprintf(stderr, "femb-reduce: %s: refused: %s (no output written)\n", part_path.c_str(), e.what());
-    return 4;
+    return fail(4, part_path + ": refused: " + e.what() + " (no output written)");
   } catch (const femb::InputError& e) {
-    if (speaks) std::fprintf(stderr, "femb-reduce: %s\n", e.what());
-    return 2;
+    return fail(2, e.what());
   } catch (const std::exception& e) {
-    // A failure inside the distributed solver may be one rank's: that rank says it and ends all.
-    std::fprintf(stderr, "femb-reduce: %s: %s (no output written)\n", part_path.c_str(), e.what());
+    // After the ranks' start, a failure inside the distributed solver may be one rank's: that
+    // rank says it and ends them all.
 #ifdef FEMB_WITH_PETSC
-    if (distributed) mpi->Abort(3);
+    if (distributed && femb::StartAgreed()) {
+      std::fprintf(stderr, "femb-reduce: %s: %s (no output written)\n", part_path.c_str(), e.what());
+      mpi->Abort(3);
+    }
 #endif
-    return 3;
+    return fail(3, part_path + ": " + e.what() + " (no output written)");
   }
 }

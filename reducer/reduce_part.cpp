@@ -236,8 +236,8 @@ std::string TooBigMessage(const Budget& budget, const std::string& message) {
   std::snprintf(why, sizeof why, " (%s; %.3g GB kept for the dense blocks of the reduction)",
                 budget.limit_given ? "reduction.memory_limit_gb" : "MemAvailable", budget.dense_bytes / 1e9);
   return message + why +
-         ": coarsen the mesh (mesh.size), use first-order elements (mesh.order: 1), or run on a "
-         "machine with more memory";
+         ": coarsen the mesh (mesh.size), use first-order elements (mesh.order: 1), share the factor over more "
+         "MPI ranks (mpirun -np N femb-reduce, reduction.solver: petsc), or run on a machine with more memory";
 }
 
 // The largest K_jj / M_jj over the DOFs with mass: an eigenvalue scale of the model, for the
@@ -627,6 +627,13 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
     prov.stage_seconds.emplace_back(stage, seconds);
     if (progress) progress(stage, seconds, detail);
   };
+  const ReductionSolver solver = ResolvedSolver(part.reduction.solver);
+  if (solver == ReductionSolver::kPetsc && part.reduction.method != ReductionMethod::kCraigBampton) {
+    throw InputError((part.reduction.where_solver.empty() ? part.file : part.reduction.where_solver) +
+                     ": reduction.solver: petsc reduces by craig_bampton only (the free-interface and general "
+                     "bases are not distributed yet): use solver: cholmod, on one process, with method: " +
+                     std::string(Name(part.reduction.method)));
+  }
   const FeModel model = BuildFeModel(part, report);
   const Budget budget = CheckBeforeFactorization(part, model);
   NonlinearModelOf nonlinear(part, model);
@@ -637,8 +644,7 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
       part.reduction.method == ReductionMethod::kFreeInterface || part.reduction.method == ReductionMethod::kGeneral;
   CraigBamptonResult cb =
       CraigBamptonReduce(model, other_basis ? 0 : part.reduction.internal_modes, report, 200, budget.factor_bytes,
-                         request.pairs.empty() ? nullptr : &request, stiffening ? &inertia_fields : nullptr,
-                         ResolvedSolver(part.reduction.solver));
+                         request.pairs.empty() ? nullptr : &request, stiffening ? &inertia_fields : nullptr, solver);
   if (!cb.ok) {
     result.too_big = cb.factorization.too_big;
     result.message = result.too_big ? TooBigMessage(budget, cb.message) : cb.message;

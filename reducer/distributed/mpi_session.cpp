@@ -36,7 +36,14 @@ MpiSession::MpiSession() {
       set(std::max(1, cores / on_node));
     }
   }
-  RegisterDistributedSolver([] { return MakePetscInterior(); }, size_);
+  const int size = size_, rank = rank_;
+  const auto agree = [size, rank](int code) {
+    int mine[2] = {code, code != 0 ? rank : size}, all[2] = {0, 0};
+    MPI_Allreduce(&mine[0], &all[0], 1, MPI_INT, MPI_MAX, PETSC_COMM_WORLD);
+    MPI_Allreduce(&mine[1], &all[1], 1, MPI_INT, MPI_MIN, PETSC_COMM_WORLD);
+    return RankAgreement{all[0], all[1] < size ? all[1] : -1};
+  };
+  RegisterDistributedSolver([] { return MakePetscInterior(); }, size_, agree, rank_);
 }
 
 MpiSession::~MpiSession() {

@@ -89,9 +89,11 @@ void CheckSameMatrix(const SparseMatrix& A) {
   MPI_Allreduce(mine, high, 4, MPI_DOUBLE, MPI_MAX, PETSC_COMM_WORLD);
   for (int i = 0; i < 4; ++i) {
     if (low[i] != high[i]) {
-      throw std::runtime_error(
+      throw RankFailure(
+          3,
           "the MPI ranks built different interior matrices (each rank meshes and assembles the part itself; "
-          "a mesher or reader that is not deterministic across processes?)");
+          "a mesher or reader that is not deterministic across processes?)",
+          DistributedRank() == 0);
     }
   }
 }
@@ -166,6 +168,9 @@ class PetscInterior : public InteriorSolver {
   FactorizationInfo Factorize(const SparseMatrix& A, double memory_limit_bytes) override {
     FactorizationInfo info;
     Stopwatch clock;
+    // The first collective step: a rank that failed before says so here (AgreeOnStart).
+    const RankAgreement start = AgreeOnStart(0);
+    if (start.code != 0) throw RankFailure(start.code, "another rank failed", false);
     CheckSameMatrix(A);
     rows_ = SplitRows(PetscInt(A.rows()));
     A_ = DistributedMatrix(A, rows_);
@@ -187,6 +192,8 @@ class PetscInterior : public InteriorSolver {
                            double(largest_mb) / 1e3, double(total_mb) / 1e3);
     info.factor_entries = Count(entries);
     info.factor_bytes = 8.0 * info.factor_entries;
+    // (each rank's limit may differ, MemAvailable read at another moment: the smallest holds)
+    MPI_Allreduce(MPI_IN_PLACE, &memory_limit_bytes, 1, MPI_DOUBLE, MPI_MIN, PETSC_COMM_WORLD);
     if (memory_limit_bytes > 0 && 1e6 * double(largest_mb) > memory_limit_bytes) {
       info.too_big = true;
       info.message = Format("MUMPS' factorization of K_ii needs %.3g GB on its largest rank (%.3g GB in all)",
@@ -264,6 +271,10 @@ class PetscInterior : public InteriorSolver {
 std::optional<EigenResult> PetscInterior::Eigenpairs(const SparseMatrix& K, const SparseMatrix& M, int nev, double tol,
                                                      const BlockShiftInvertFn& solve) {
   EigenResult r;
+  if (nev == 0) {
+    r.ok = true;
+    return r;
+  }
   Mat Kd = DistributedMatrix(K, rows_), Md = DistributedMatrix(M, rows_);
   EPS eps = nullptr;
   FEMB_PETSC(EPSCreate(PETSC_COMM_WORLD, &eps));

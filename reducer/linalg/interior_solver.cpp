@@ -29,7 +29,9 @@ int EnvironmentInteger(const char* a, const char* b, int otherwise) {
 
 struct Registry {
   std::function<std::unique_ptr<InteriorSolver>()> make;
-  int ranks = 1;
+  int ranks = 1, rank = 0;
+  std::function<RankAgreement(int)> agree;
+  bool agreed = false;
 };
 
 Registry& TheRegistry() {
@@ -49,10 +51,26 @@ std::unique_ptr<InteriorSolver> MakeInteriorSolver(ReductionSolver kind, const s
   return TheRegistry().make();
 }
 
-void RegisterDistributedSolver(std::function<std::unique_ptr<InteriorSolver>()> make, int ranks) {
-  TheRegistry().make = std::move(make);
-  TheRegistry().ranks = ranks;
+void RegisterDistributedSolver(std::function<std::unique_ptr<InteriorSolver>()> make, int ranks,
+                               std::function<RankAgreement(int)> agree, int rank) {
+  Registry& r = TheRegistry();
+  r.make = std::move(make);
+  r.ranks = ranks;
+  r.rank = rank;
+  r.agree = std::move(agree);
+  r.agreed = false;
 }
+
+RankAgreement AgreeOnStart(int code) {
+  Registry& r = TheRegistry();
+  r.agreed = true;
+  if (r.agree) return r.agree(code);
+  return {code, code != 0 ? 0 : -1};
+}
+
+bool StartAgreed() { return TheRegistry().agreed; }
+
+int DistributedRank() { return TheRegistry().rank; }
 
 int DistributedRanks() { return TheRegistry().ranks; }
 

@@ -10,6 +10,7 @@
 #include <functional>
 #include <memory>
 #include <optional>
+#include <stdexcept>
 #include <string>
 
 #include "formats/kinds.h"
@@ -43,13 +44,21 @@ class InteriorSolver {
   virtual std::string EigenDetail() const { return ""; }
 };
 
+/// What the ranks of a distributed run agree on (AgreeOnStart).
+struct RankAgreement {
+  int code = 0;
+  int first_failed = -1;
+};
+
 /// Makes the solver of a given kind. Throws InputError (naming `where`) for petsc when no
 /// distributed solver is registered in this program.
 std::unique_ptr<InteriorSolver> MakeInteriorSolver(ReductionSolver kind, const std::string& where = "");
 
 /// The distributed solver's maker and the number of MPI ranks, set by a program that runs on MPI
 /// (femb-reduce); ranks() is 1 until then.
-void RegisterDistributedSolver(std::function<std::unique_ptr<InteriorSolver>()> make, int ranks);
+/// `agree` (AgreeOnStart's collective) and this process's `rank` with them.
+void RegisterDistributedSolver(std::function<std::unique_ptr<InteriorSolver>()> make, int ranks,
+                               std::function<RankAgreement(int)> agree = nullptr, int rank = 0);
 int DistributedRanks();
 
 /// The number of ranks an MPI launcher started (OpenMPI's OMPI_COMM_WORLD_SIZE, MPICH's
@@ -58,6 +67,31 @@ int LaunchedRanks();
 /// This process's rank by the launcher's environment (0 when not launched by one): known before
 /// MPI starts, so that only rank 0 reports an input error.
 int LaunchedRank();
+
+/// Whether the ranks of a distributed run all reached the distributed work: each rank calls this
+/// once, with 0 at the solver's first step or with its exit code where it failed before (then the
+/// others stop with that code instead of waiting for it). The largest code and the lowest rank that
+/// failed (-1: none); {code, -1 or 0} on one process.
+RankAgreement AgreeOnStart(int code);
+/// True once AgreeOnStart ran (a failure after it is every rank's, or one rank's that ends all).
+bool StartAgreed();
+/// This process's MPI rank (0 on one process).
+int DistributedRank();
+
+/// A distributed run's failure that every rank meets together (another rank failed before the
+/// distributed work, or the ranks built different models): said by one rank, the same exit code
+/// on all.
+class RankFailure : public std::runtime_error {
+ public:
+  RankFailure(int code, const std::string& what, bool said_here)
+      : std::runtime_error(what), code_(code), said_here_(said_here) {}
+  int code() const { return code_; }
+  bool said_here() const { return said_here_; }
+
+ private:
+  int code_;
+  bool said_here_;
+};
 
 /// The solver a part asks for: its reduction.solver, or cholmod on one process and petsc on
 /// more than one.

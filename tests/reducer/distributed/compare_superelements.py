@@ -1,8 +1,8 @@
 """Compares two superelement files of one part reduced by different solvers (CHOLMOD and femb's
 Lanczos against MUMPS and SLEPc on MPI ranks): the same layout (every dataset of one is in the
 other, with its shape), the fixed-interface frequencies to 1e-9 relative, and the reduced K and M
-to 1e-8 relative to their largest entry once each internal mode's sign is taken from the
-reference (an eigenvector's sign is arbitrary). Prints the figures; exit 1 when one is exceeded.
+to 1e-8 relative to their largest entry once the sign of each internal mode and modal derivative
+is taken from the reference (an eigenvector's sign is arbitrary, and a derivative's follows). Prints the figures; exit 1 when one is exceeded.
 
 usage: compare_superelements.py REFERENCE.h5 OTHER.h5
 """
@@ -32,10 +32,14 @@ def main(reference_path, other_path):
     n = K_a.shape[0]
     first = 6 * len(a["interfaces/names"])  # the internal modes follow the interfaces' coordinates
     signs = np.ones(n)
-    # Each internal mode's sign: the one that makes its coupling to the interfaces in M match the
-    # reference's.
-    for j in range(first, first + n_modes):
-        signs[j] = 1.0 if np.dot(M_a[:first, j], M_b[:first, j]) >= 0 else -1.0
+    # The sign of each internal mode and modal derivative: the one that makes its coupling to the
+    # interfaces (whose coordinates have no sign to choose) in M, or else in K, match the reference's.
+    for j in range(first, n):
+        for X_a, X_b in ((M_a, M_b), (K_a, K_b)):
+            dot = np.dot(X_a[:first, j], X_b[:first, j])
+            if abs(dot) > 1e-6 * np.linalg.norm(X_a[:first, j]) * np.linalg.norm(X_b[:first, j]):
+                signs[j] = 1.0 if dot >= 0 else -1.0
+                break
     S = np.diag(signs)
     K_b, M_b = S @ K_b @ S, S @ M_b @ S
     K_error = np.max(np.abs(K_a - K_b)) / np.max(np.abs(K_a))

@@ -1,0 +1,92 @@
+#!/usr/bin/env bash
+# femb-reduce on MPI ranks (reduction.solver: petsc: MUMPS' distributed Cholesky and SLEPc's
+# Krylov-Schur) against the CHOLMOD path on the same part: the solid crank (TET10, 16 293 DOFs,
+# 12 fixed-interface modes) with an RBE3 and an RBE2 bore, with two RBE2 bores, with two RBE3
+# bores, and with the modal derivatives of 4 modes; np 1 and np 2 files equal to CHOLMOD's (frequencies 1e-9,
+# reduced K and M 1e-8 relative, compare_superelements.py) and femb-inspect's checks passing. Then
+# the faults: one rank's geometry unreadable, a rank killed during the run, the factor over the
+# per-rank memory limit, a distributed reduction of a basis that is not distributed: one line (or
+# mpirun's own report of the killed rank), a non-zero exit in bounded time, no file.
+# Usage: distributed_reduce_test.sh BIN_DIR SOURCE_DIR
+set -u
+bin=$1
+src=$(cd "$2" && pwd)
+source "$src/tests/tools/test_lib.sh"
+mpi="timeout 300 mpirun --allow-run-as-root --oversubscribe"
+compare="$py $src/tests/reducer/distributed/compare_superelements.py"
+
+crank() {  # crank NAME BIG_COUPLING SMALL_COUPLING [MODES [EXTRA REDUCTION KEYS]]
+  cat > "$work/$1.yaml" <<EOT
+name: $1
+type: solid
+units: SI
+material: {E: 2.1e11, nu: 0.3, rho: 7850}
+geometry: {file: $src/meshes/crank.geo}
+mesh: {size: 0.006, order: 2}
+interfaces:
+  - {name: big_bore, group: big_bore, coupling: $2}
+  - {name: small_bore, group: small_bore, coupling: $3}
+reduction: {internal_modes: ${4:-12}, full_modes: 0${5:-}}
+EOT
+}
+
+crank mixed rbe3 rbe2
+crank pins rbe2 rbe2
+crank seats rbe3 rbe3
+crank derivatives rbe3 rbe2 4 ", modal_derivatives: {of: internal}"
+for part in mixed pins seats derivatives; do
+  "$bin/femb-reduce" "$work/$part.yaml" -q -o "$work/${part}_cholmod.h5" && ok || fail "$part: serial reduction"
+  if [ "$part" = mixed ]; then
+    $mpi -np 1 "$bin/femb-reduce" "$work/$part.yaml" -q -o "$work/${part}_np1.h5" && ok || fail "$part: np 1"
+    $compare "$work/${part}_cholmod.h5" "$work/${part}_np1.h5" && ok || fail "$part: np 1 differs"
+  fi
+  $mpi -np 2 "$bin/femb-reduce" "$work/$part.yaml" -q -o "$work/${part}_np2.h5" > "$work/$part.log" 2>&1 &&
+    ok || fail "$part: np 2: $(cat "$work/$part.log")"
+  $compare "$work/${part}_cholmod.h5" "$work/${part}_np2.h5" && ok || fail "$part: np 2 differs"
+  "$bin/femb-inspect" "$work/${part}_np2.h5" --check > "$work/$part.check" && ok ||
+    fail "$part: femb-inspect --check: $(cat "$work/$part.check")"
+done
+# Without mpirun, reduction.solver: petsc runs on one rank.
+"$bin/femb-reduce" "$work/mixed.yaml" -q -o "$work/mixed_one.h5" --set reduction.solver=petsc && ok ||
+  fail "petsc without mpirun"
+$compare "$work/mixed_cholmod.h5" "$work/mixed_one.h5" > /dev/null && ok || fail "petsc without mpirun differs"
+
+# expect_failure NAME CODE TEXT COMMAND...: exit CODE, exactly one femb-reduce line holding TEXT, no file.
+expect_failure() {
+  local name=$1 code=$2 text=$3
+  shift 3
+  rm -f "$work/failed.h5"
+  "$@" > "$work/out.txt" 2>&1
+  local got=$?
+  [ "$got" = "$code" ] && ok || fail "$name: exit $got, expected $code: $(cat "$work/out.txt")"
+  [ "$(grep -c '^femb-reduce:' "$work/out.txt")" = 1 ] && grep -q -- "$text" "$work/out.txt" && ok ||
+    fail "$name: expected one line with '$text': $(cat "$work/out.txt")"
+  [ ! -e "$work/failed.h5" ] && ok || fail "$name: a file was written"
+}
+sed "s#$src/meshes/crank.geo#$work/nothing.geo#" "$work/mixed.yaml" > "$work/unreadable.yaml"
+expect_failure "one rank's geometry missing" 2 "nothing.geo' not found" \
+  $mpi -np 1 "$bin/femb-reduce" "$work/mixed.yaml" -q -o "$work/failed.h5" : \
+  -np 1 "$bin/femb-reduce" "$work/unreadable.yaml" -q -o "$work/failed.h5"
+expect_failure "every rank's geometry missing" 2 "nothing.geo' not found" \
+  $mpi -np 2 "$bin/femb-reduce" "$work/unreadable.yaml" -q -o "$work/failed.h5"
+expect_failure "factor over the per-rank limit" 4 "MUMPS' factorization of K_ii needs" \
+  $mpi -np 2 "$bin/femb-reduce" "$work/mixed.yaml" -q -o "$work/failed.h5" --set reduction.memory_limit_gb=0.02
+expect_failure "petsc with a free-interface basis" 2 "reduction.solver: petsc reduces by craig_bampton only" \
+  $mpi -np 2 "$bin/femb-reduce" "$work/mixed.yaml" -q -o "$work/failed.h5" --set reduction.method=free_interface
+
+# A rank killed once the reduction runs: mpirun ends the others, non-zero, no file.
+rm -f "$work/failed.h5"
+$mpi -np 2 "$bin/femb-reduce" "$work/mixed.yaml" -o "$work/failed.h5" > "$work/killed.txt" 2>&1 &
+job=$!
+for _ in $(seq 1 500); do grep -q "assembly" "$work/killed.txt" 2>/dev/null && break; sleep 0.02; done
+for p in $(pgrep -f "femb-reduce $work/mixed.yaml"); do
+  tr '\0' '\n' < "/proc/$p/environ" 2>/dev/null | grep -q "^OMPI_COMM_WORLD_RANK=1$" && kill -9 "$p"
+done
+start=$(date +%s)
+wait $job
+code=$?
+[ "$code" != 0 ] && [ $(($(date +%s) - start)) -lt 60 ] && ok || fail "killed rank: exit $code after $(($(date +%s) - start)) s"
+[ ! -e "$work/failed.h5" ] && ok || fail "killed rank: a file was written"
+
+echo "distributed reduction: $passed passed, $failed failed"
+[ "$failed" = 0 ]
