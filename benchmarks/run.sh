@@ -15,6 +15,9 @@ echo
 command -v ccx > /dev/null || apt-get install -y -q calculix-ccx > /dev/null
 /usr/bin/python3 benchmarks/solid_reduction_benchmark.py build/bin --sizes "${SOLID_SIZES:-1e5,3e5,1e6}"
 echo
+# femb-reduce on MPI ranks (MUMPS, SLEPc) against CHOLMOD, np 1 and 2 (about 5 minutes).
+/usr/bin/python3 benchmarks/distributed_reduction_benchmark.py build/bin --sizes "${MPI_SIZES:-1e5,3e5}"
+echo
 # Error vs run time on the 2D slider-crank and the spinning beam (about 8 minutes): tables, PNGs.
 mkdir -p out
 /usr/bin/python3 benchmarks/error_vs_time.py build/bin --png-prefix out/error_vs_time_

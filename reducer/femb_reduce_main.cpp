@@ -117,10 +117,27 @@ int main(int argc, char** argv) {
       if (start.code != 0) return start.code;
       if (!speaks) return 0;
     }
+    // Ranks that share the work also share their memory figures (every rank reports the same
+    // stages, so the collective in PeakMemory pairs up).
+    const bool shared = distributed && femb::ResolvedSolver(part.reduction.solver) == femb::ReductionSolver::kPetsc;
+    const auto memory = [&]() -> std::string {
+#ifdef FEMB_WITH_PETSC
+      if (shared) {
+        const auto [largest, all] = mpi->PeakMemory();
+        char buffer[96];
+        std::snprintf(buffer, sizeof buffer, "%.3g GB on the largest rank, %.3g GB in all", largest / 1e9, all / 1e9);
+        return buffer;
+      }
+#endif
+      char buffer[32];
+      std::snprintf(buffer, sizeof buffer, "%.3g GB", femb::PeakResidentBytes() / 1e9);
+      return buffer;
+    };
     auto progress = [&](const std::string& stage, double seconds, const std::string& detail) {
+      const std::string peak = shared ? "; peak memory " + memory() : "";
       if (quiet) return;
-      std::printf("femb-reduce: [%8.3f s] %-16s %8.3f s  %s\n", total.Seconds(), stage.c_str(), seconds,
-                  detail.c_str());
+      std::printf("femb-reduce: [%8.3f s] %-16s %8.3f s  %s%s\n", total.Seconds(), stage.c_str(), seconds,
+                  detail.c_str(), peak.c_str());
       std::fflush(stdout);
     };
     if (!export_dir.empty()) {
@@ -135,10 +152,10 @@ int main(int argc, char** argv) {
         },
         speaks);
     if (result.exit_code != 0) return fail(result.exit_code, result.error);
+    const std::string peak = memory();
     if (!quiet) {
-      std::printf("femb-reduce: wrote %s (%d reduced DOFs from %ld) in %.3f s, peak memory %.3g GB\n", output.c_str(),
-                  result.superelement.n_reduced_dofs(), result.superelement.n_full_dofs, total.Seconds(),
-                  femb::PeakResidentBytes() / 1e9);
+      std::printf("femb-reduce: wrote %s (%d reduced DOFs from %ld) in %.3f s, peak memory %s\n", output.c_str(),
+                  result.superelement.n_reduced_dofs(), result.superelement.n_full_dofs, total.Seconds(), peak.c_str());
     }
     return 0;
   } catch (const femb::RankFailure& e) {

@@ -12,6 +12,7 @@
 
 #include "reducer/distributed/petsc_interior.h"
 #include "reducer/linalg/interior_solver.h"
+#include "reducer/linalg/sparse_cholesky.h"
 
 namespace femb {
 MpiSession::MpiSession() {
@@ -49,6 +50,14 @@ MpiSession::MpiSession() {
 MpiSession::~MpiSession() {
   RegisterDistributedSolver(nullptr, 1);
   SlepcFinalize();
+}
+
+std::pair<double, double> MpiSession::PeakMemory() const {
+  const double mine = PeakResidentBytes();
+  double largest = 0.0, all = 0.0;
+  MPI_Allreduce(&mine, &largest, 1, MPI_DOUBLE, MPI_MAX, PETSC_COMM_WORLD);
+  MPI_Allreduce(&mine, &all, 1, MPI_DOUBLE, MPI_SUM, PETSC_COMM_WORLD);
+  return {largest, all};
 }
 
 void MpiSession::Abort(int code) const {

@@ -4,6 +4,8 @@
 // (petsc_interior.h); rank 0 alone prints and writes the file.
 #pragma once
 
+#include <utility>
+
 namespace femb {
 
 /// SlepcInitialize (which starts MPI and PETSc) on construction, SlepcFinalize on destruction;
@@ -17,6 +19,8 @@ class MpiSession {
   MpiSession& operator=(const MpiSession&) = delete;
   int rank() const { return rank_; }
   int size() const { return size_; }
+  /// The peak resident memory of the largest rank and of all ranks, bytes (collective).
+  std::pair<double, double> PeakMemory() const;
   /// Ends every rank with `code` (a failure on some ranks only, which the others would wait on).
   [[noreturn]] void Abort(int code) const;
 

@@ -139,22 +139,25 @@ double Count(PetscInt infog) { return infog < 0 ? -1e6 * double(infog) : double(
 
 // The shift-invert operator SLEPc applies (a PCSHELL in its KSP): the constrained solve on the
 // replicated vector.
+// Without constraints it is the factor's own solve on the distributed vectors.
 struct ShellContext {
   const RowSplit* rows = nullptr;
   const BlockShiftInvertFn* solve = nullptr;
+  Mat factor = nullptr;  ///< set: no constraints
   long applications = 0;
 };
 
 PetscErrorCode ApplyShiftInvert(PC pc, Vec x, Vec y) {
   ShellContext* context = nullptr;
   PetscCall(PCShellGetContext(pc, &context));
+  ++context->applications;
+  if (context->factor) return MatSolve(context->factor, x, y);
   try {
     const Eigen::VectorXd z = (*context->solve)(GatherVector(*context->rows, x)).col(0);
     ScatterVector(*context->rows, z, y);
   } catch (const std::exception&) {
     return PETSC_ERR_LIB;
   }
-  ++context->applications;
   return 0;
 }
 
@@ -252,7 +255,7 @@ class PetscInterior : public InteriorSolver {
   long solves() const override { return solves_; }
 
   std::optional<EigenResult> Eigenpairs(const SparseMatrix& K, const SparseMatrix& M, int nev, double tol,
-                                        const BlockShiftInvertFn& solve) override;
+                                        const BlockShiftInvertFn& solve, bool plain) override;
 
   std::string EigenDetail() const override { return detail_; }
 
@@ -269,7 +272,7 @@ class PetscInterior : public InteriorSolver {
 // the constrained space, and the same for any number of ranks). Eigenvectors M-normalized,
 // ascending.
 std::optional<EigenResult> PetscInterior::Eigenpairs(const SparseMatrix& K, const SparseMatrix& M, int nev, double tol,
-                                                     const BlockShiftInvertFn& solve) {
+                                                     const BlockShiftInvertFn& solve, bool plain) {
   EigenResult r;
   if (nev == 0) {
     r.ok = true;
@@ -292,7 +295,7 @@ std::optional<EigenResult> PetscInterior::Eigenpairs(const SparseMatrix& K, cons
   PC pc = nullptr;
   FEMB_PETSC(KSPGetPC(ksp, &pc));
   FEMB_PETSC(PCSetType(pc, PCSHELL));
-  ShellContext context{&rows_, &solve, 0};
+  ShellContext context{&rows_, &solve, plain ? F_ : nullptr, 0};
   FEMB_PETSC(PCShellSetContext(pc, &context));
   FEMB_PETSC(PCShellSetApply(pc, ApplyShiftInvert));
   FEMB_PETSC(EPSSetDimensions(eps, nev, PETSC_DEFAULT, PETSC_DEFAULT));
@@ -323,6 +326,7 @@ std::optional<EigenResult> PetscInterior::Eigenpairs(const SparseMatrix& K, cons
     r.ok = true;
   }
   r.linear_solves = context.applications + 1;
+  if (plain) solves_ += context.applications;  // (the constrained solve counts its own)
   detail_ = Format("SLEPc Krylov-Schur, shift-and-invert on the MUMPS factor, %.0f restarts", double(iterations));
   VecDestroy(&x);
   VecDestroy(&start);

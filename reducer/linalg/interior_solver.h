@@ -34,10 +34,11 @@ class InteriorSolver {
   /// The lowest `nev` eigenpairs of K x = lambda M x on the space the constrained shift-invert
   /// `solve` maps into (it applies the factor), residual tolerance `tol` relative to the
   /// eigenvalue; empty when this solver has no eigen solver of its own (femb's block Lanczos then
-  /// runs on `solve`).
+  /// runs on `solve`). `plain`: `solve` is the factor's own solve (no constraints), which the
+  /// solver may then apply in its own way.
   virtual std::optional<EigenResult> Eigenpairs(const SparseMatrix& K, const SparseMatrix& M, int nev, double tol,
-                                                const BlockShiftInvertFn& solve) {
-    (void)K, (void)M, (void)nev, (void)tol, (void)solve;
+                                                const BlockShiftInvertFn& solve, bool plain) {
+    (void)K, (void)M, (void)nev, (void)tol, (void)solve, (void)plain;
     return std::nullopt;
   }
   /// How the eigen solve ran, for the progress line ("" when Eigenpairs has none).

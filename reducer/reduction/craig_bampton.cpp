@@ -494,7 +494,7 @@ CraigBamptonResult CraigBamptonReduce(const FeModel& model, int internal_modes, 
   const int nev = internal_modes > 0 && internal_modes + 1 <= p.n_i - p.n_c ? internal_modes + 1 : internal_modes;
   const bool dense = p.n_i <= dense_limit || 2 * nev + 1 > p.n_i - p.n_c;
   std::optional<EigenResult> own =
-      dense ? std::nullopt : factor->Eigenpairs(K.ii, M.ii, nev, kLanczosTolerance, constrained_solve);
+      dense ? std::nullopt : factor->Eigenpairs(K.ii, M.ii, nev, kLanczosTolerance, constrained_solve, p.n_c == 0);
   EigenResult eig = dense ? LowestConstrainedEigenpairs(K.ii, M.ii, C, nev, 0.0, solve, dense_limit)
                     : own ? std::move(*own)
                           : BlockLanczosEigenpairs(K.ii, M.ii, C, nev, 0.0, constrained_solve, kLanczosBlock,
