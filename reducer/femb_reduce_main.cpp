@@ -15,7 +15,7 @@
 #include "reducer/linalg/sparse_cholesky.h"
 #include "reducer/reduce_file.h"
 #ifdef FEMB_WITH_PETSC
-#include "reducer/distributed/mpi_session.h"
+#include "reducer/distributed/mpi_ranks.h"
 #endif
 
 namespace {
@@ -76,7 +76,7 @@ int main(int argc, char** argv) {
   const bool speaks = femb::LaunchedRank() == 0;
   bool distributed = false;  // on several MPI ranks
 #ifdef FEMB_WITH_PETSC
-  std::optional<femb::MpiSession> mpi;  // (outlives everything that uses PETSc)
+  std::optional<femb::MpiRanks> mpi;  // (outlives everything that uses PETSc)
 #endif
   // An error's line and exit code. On MPI ranks before the distributed work, the ranks first agree
   // (femb::AgreeOnStart): the lowest rank that failed says it, and the others, which may be
@@ -117,8 +117,9 @@ int main(int argc, char** argv) {
       if (start.code != 0) return start.code;
       if (!speaks) return 0;
     }
-    // Ranks that share the work also share their memory figures (every rank reports the same
-    // stages, so the collective in PeakMemory pairs up).
+    // Ranks that share the work also share their memory figures once they agreed to start
+    // (AgreeOnStart must be their first collective; after it every rank reports the same stages,
+    // so the collective in PeakMemory pairs up).
     const bool shared = distributed && femb::ResolvedSolver(part.reduction.solver) == femb::ReductionSolver::kPetsc;
     const auto memory = [&]() -> std::string {
 #ifdef FEMB_WITH_PETSC
@@ -134,7 +135,7 @@ int main(int argc, char** argv) {
       return buffer;
     };
     auto progress = [&](const std::string& stage, double seconds, const std::string& detail) {
-      const std::string peak = shared ? "; peak memory " + memory() : "";
+      const std::string peak = shared && femb::StartAgreed() ? "; peak memory " + memory() : "";
       if (quiet) return;
       std::printf("femb-reduce: [%8.3f s] %-16s %8.3f s  %s%s\n", total.Seconds(), stage.c_str(), seconds,
                   detail.c_str(), peak.c_str());

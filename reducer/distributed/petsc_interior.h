@@ -14,7 +14,7 @@
 
 namespace femb {
 
-/// Needs a running MpiSession (mpi_session.h).
+/// Needs a running MpiRanks (mpi_ranks.h).
 std::unique_ptr<InteriorSolver> MakePetscInterior();
 
 }  // namespace femb

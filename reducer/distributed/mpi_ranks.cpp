@@ -1,4 +1,4 @@
-#include "reducer/distributed/mpi_session.h"
+#include "reducer/distributed/mpi_ranks.h"
 
 #include <dlfcn.h>
 #include <mpi.h>
@@ -15,7 +15,7 @@
 #include "reducer/linalg/sparse_cholesky.h"
 
 namespace femb {
-MpiSession::MpiSession() {
+MpiRanks::MpiRanks() {
   // PETSc's signal handlers would print pages for a SIGINT; its error handler returns the code,
   // which the solver turns into one line (petsc_interior.cpp).
   PetscOptionsSetValue(nullptr, "-no_signal_handler", "true");
@@ -47,12 +47,12 @@ MpiSession::MpiSession() {
   RegisterDistributedSolver([] { return MakePetscInterior(); }, size_, agree, rank_);
 }
 
-MpiSession::~MpiSession() {
+MpiRanks::~MpiRanks() {
   RegisterDistributedSolver(nullptr, 1);
   SlepcFinalize();
 }
 
-std::pair<double, double> MpiSession::PeakMemory() const {
+std::pair<double, double> MpiRanks::PeakMemory() const {
   const double mine = PeakResidentBytes();
   double largest = 0.0, all = 0.0;
   MPI_Allreduce(&mine, &largest, 1, MPI_DOUBLE, MPI_MAX, PETSC_COMM_WORLD);
@@ -60,7 +60,7 @@ std::pair<double, double> MpiSession::PeakMemory() const {
   return {largest, all};
 }
 
-void MpiSession::Abort(int code) const {
+void MpiRanks::Abort(int code) const {
   MPI_Abort(PETSC_COMM_WORLD, code);
   std::exit(code);
 }

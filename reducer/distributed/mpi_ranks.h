@@ -1,5 +1,5 @@
-// femb-reduce on MPI ranks (mpirun -np N femb-reduce PART.yaml): the MPI, PETSc and SLEPc
-// session of the process, and what the launcher tells before it starts. Every rank runs the same
+// femb-reduce on MPI ranks (mpirun -np N femb-reduce PART.yaml): MPI, PETSc and SLEPc started
+// and ended for the process. Every rank runs the same
 // reduction on the same replicated model; the interior's factor and eigen solve are distributed
 // (petsc_interior.h); rank 0 alone prints and writes the file.
 #pragma once
@@ -11,12 +11,12 @@ namespace femb {
 /// SlepcInitialize (which starts MPI and PETSc) on construction, SlepcFinalize on destruction;
 /// registers the petsc interior solver (linalg/interior_solver.h) and gives each rank one BLAS
 /// thread when several ranks share the machine's cores.
-class MpiSession {
+class MpiRanks {
  public:
-  MpiSession();
-  ~MpiSession();
-  MpiSession(const MpiSession&) = delete;
-  MpiSession& operator=(const MpiSession&) = delete;
+  MpiRanks();
+  ~MpiRanks();
+  MpiRanks(const MpiRanks&) = delete;
+  MpiRanks& operator=(const MpiRanks&) = delete;
   int rank() const { return rank_; }
   int size() const { return size_; }
   /// The peak resident memory of the largest rank and of all ranks, bytes (collective).
