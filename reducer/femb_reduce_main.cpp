@@ -175,6 +175,6 @@ int main(int argc, char** argv) {
       mpi->Abort(3);
     }
 #endif
-    return fail(3, part_path + ": " + e.what() + " (no output written)");
+    return fail(1, std::string("internal error: ") + e.what());
   }
 }

@@ -628,6 +628,7 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
     if (progress) progress(stage, seconds, detail);
   };
   const ReductionSolver solver = ResolvedSolver(part.reduction.solver);
+  RequireInteriorSolver(solver, part.reduction.where_solver.empty() ? part.file : part.reduction.where_solver);
   if (solver == ReductionSolver::kPetsc && part.reduction.method != ReductionMethod::kCraigBampton) {
     throw InputError((part.reduction.where_solver.empty() ? part.file : part.reduction.where_solver) +
                      ": reduction.solver: petsc reduces by craig_bampton only (the free-interface and general "

@@ -76,6 +76,15 @@ def test_reduce_from_a_dict_with_set(tmp_path):
     assert np.abs(se.K - femb.Superelement(tmp_path / "cli6.h5").K).max() <= 1e-14 * np.abs(se.K).max()
 
 
+def test_reduce_refuses_the_distributed_solver(tmp_path):
+    # The petsc solver runs in femb-reduce on MPI ranks: asked for here, one InputError naming the
+    # key, before any work, and no file.
+    with pytest.raises(femb.InputError, match="reduction.solver: the petsc solver .* mpirun -np N femb-reduce"):
+        femb.reduce(os.path.join(EXAMPLES, "beam_rod", "part.yaml"), tmp_path / "rod.h5",
+                    set={"reduction.solver": "petsc"})
+    assert not (tmp_path / "rod.h5").exists()
+
+
 def test_mode_shape_on_the_mesh(tmp_path):
     se = femb.reduce(os.path.join(EXAMPLES, "beam_rod", "part.yaml"), tmp_path / "rod.h5")
     nodes, cells = se.mesh

@@ -41,13 +41,17 @@ Registry& TheRegistry() {
 
 }  // namespace
 
-std::unique_ptr<InteriorSolver> MakeInteriorSolver(ReductionSolver kind, const std::string& where) {
-  if (kind == ReductionSolver::kCholmod) return std::make_unique<CholmodInterior>();
-  if (!TheRegistry().make) {
+void RequireInteriorSolver(ReductionSolver kind, const std::string& where) {
+  if (kind == ReductionSolver::kPetsc && !TheRegistry().make) {
     throw InputError((where.empty() ? std::string("reduction.solver") : where) +
                      ": the petsc solver (MUMPS and SLEPc over MPI) runs in femb-reduce built with PETSc and SLEPc "
                      "(scripts/setup.sh installs them): start it as mpirun -np N femb-reduce PART.yaml");
   }
+}
+
+std::unique_ptr<InteriorSolver> MakeInteriorSolver(ReductionSolver kind, const std::string& where) {
+  if (kind == ReductionSolver::kCholmod) return std::make_unique<CholmodInterior>();
+  RequireInteriorSolver(kind, where);
   return TheRegistry().make();
 }
 

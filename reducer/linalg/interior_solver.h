@@ -55,6 +55,10 @@ struct RankAgreement {
 /// distributed solver is registered in this program.
 std::unique_ptr<InteriorSolver> MakeInteriorSolver(ReductionSolver kind, const std::string& where = "");
 
+/// Throws the InputError of MakeInteriorSolver (naming `where`) when the kind cannot be made here:
+/// checked before the work.
+void RequireInteriorSolver(ReductionSolver kind, const std::string& where);
+
 /// The distributed solver's maker and the number of MPI ranks, set by a program that runs on MPI
 /// (femb-reduce); ranks() is 1 until then.
 /// `agree` (AgreeOnStart's collective) and this process's `rank` with them.

@@ -34,6 +34,7 @@ void ExpectWordsReadBack(const char* what) {
 TEST(Kinds, EveryWordReadsBackAsItsKind) {
   ExpectWordsReadBack<PartType>("PartType");
   ExpectWordsReadBack<ReductionMethod>("ReductionMethod");
+  ExpectWordsReadBack<ReductionSolver>("ReductionSolver");
   ExpectWordsReadBack<FloatingFrameType>("FloatingFrameType");
   ExpectWordsReadBack<DerivativePairs>("DerivativePairs");
   ExpectWordsReadBack<Coupling>("Coupling");

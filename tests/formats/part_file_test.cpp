@@ -41,6 +41,10 @@ TEST(PartFile, GoodFileParses) {
   EXPECT_EQ(p.interfaces[1].point, 1);
   EXPECT_EQ(p.reduction.internal_modes, 4);
   EXPECT_EQ(p.reduction.floating_frame, FloatingFrameType::kCenterOfMass);
+  EXPECT_FALSE(p.reduction.solver.has_value());  // cholmod on one process, petsc on several
+  const PartSpec mpi = ParsePart(kGood, "part.yaml", {"reduction.solver=petsc"});
+  EXPECT_EQ(mpi.reduction.solver, ReductionSolver::kPetsc);
+  EXPECT_EQ(mpi.reduction.where_solver, "--set reduction.solver");
 }
 
 TEST(PartFile, SetOverridesKeys) {
@@ -108,6 +112,8 @@ TEST(PartFile, BadInputNamesFileLineAndKey) {
        "part.yaml:1: missing required key 'section'"},
       {Replace(kGood, "elements: 10", "elements: 0"),
        "part.yaml:10: beam.segments[0].elements: a segment needs at least 1 element"},
+      {Replace(kGood, "  internal_modes: 4\n", "  solver: mumps\n"),
+       "part.yaml:15: reduction.solver: expected cholmod or petsc, got 'mumps'"},
       {Replace(kGood, "  internal_modes: 4\n", "  floating_frame: interface:Q\n"),
        "part.yaml:15: reduction.floating_frame: floating frame interface 'Q' is not one of the part's interfaces"},
   };
