@@ -8,7 +8,8 @@ each; at the first size also on 4 ranks, for the file only), and prints what thi
 largest rank and of all ranks, the factor's size and flops (MUMPS' own figures), and how far the
 MPI files are from CHOLMOD's (compare_superelements.py: frequencies, reduced K and M).
 
-At the first size it also shows the per-rank memory limit: a limit under which the one-process
+At the first size it also compares the files of 4 ranks and of a variant with two RBE3 bores, and
+shows the per-rank memory limit: a limit under which the one-process
 path refuses the part (exit 4) while 2 ranks, each within it, reduce it to the file the one-process
 path writes without a limit. Last, a projection of the factor's size and flops to 1e7 and 3e7 DOFs
 from MUMPS' figures of the sizes run (a power law fitted through them).
@@ -36,8 +37,8 @@ def run(cmd, env=None):
     return subprocess.run(cmd, env=env, capture_output=True, text=True)
 
 
-def part_file(work, msh, extra=""):
-    path = os.path.join(work, "part.yaml")
+def part_file(work, msh, extra="", coupling="rbe2", name="part"):
+    path = os.path.join(work, f"{name}.yaml")
     with open(path, "w") as f:
         f.write(f"""name: crank_mpi
 type: solid
@@ -45,8 +46,8 @@ units: SI
 material: {{E: 2.1e11, nu: 0.3, rho: 7850}}
 geometry: {{file: {msh}}}
 interfaces:
-  - {{name: big_bore, group: big_bore, coupling: rbe2}}
-  - {{name: small_bore, group: small_bore, coupling: rbe2}}
+  - {{name: big_bore, group: big_bore, coupling: {coupling}}}
+  - {{name: small_bore, group: small_bore, coupling: {coupling}}}
 reduction: {{internal_modes: {MODES}, keep_mesh: false, full_modes: 0, geometric_stiffening: false{extra}}}
 """)
     return path
@@ -150,6 +151,17 @@ def main():
             print(f"  MUMPS+SLEPc, np 4 (oversubscribed: its times mean nothing here) exit {four['code']}, against "
                   f"CHOLMOD: {c.stdout.strip().split(': ', 1)[-1]}{'' if c.returncode == 0 else '  EXCEEDS 1e-9 / 1e-8'}")
             limit_case(a.bin_dir, work, part, figures["CHOLMOD, 1 process"], two)
+            # Both bores distributing (RBE3): the constrained shift-invert, the augmented factor.
+            seats = part_file(work, msh, coupling="rbe3", name="seats")
+            for ranks in (0, 2, 4):
+                r = reduce(a.bin_dir, seats, os.path.join(work, f"seats_{ranks}.h5"), ranks)
+                if r["code"] != 0:
+                    sys.exit(f"[{name}] RBE3 bores on {ranks} ranks failed: {r['stderr'][-400:]}")
+            for ranks in (2, 4):
+                c = run(["/usr/bin/python3", COMPARE, os.path.join(work, "seats_0.h5"),
+                         os.path.join(work, f"seats_{ranks}.h5")])
+                print(f"  RBE3 bores, np {ranks} against CHOLMOD: {c.stdout.strip().split(': ', 1)[-1]}"
+                      f"{'' if c.returncode == 0 else '  EXCEEDS 1e-9 / 1e-8'}")
     if len(fits) >= 2:
         (n0, g0, f0, _), (n1, g1, f1, rate) = fits[0], fits[-1]
         a_mem, a_flop = math.log(g1 / g0) / math.log(n1 / n0), math.log(f1 / f0) / math.log(n1 / n0)
