@@ -127,7 +127,11 @@ Budget CheckBeforeFactorization(const PartSpec& part, const FeModel& model) {
   const int n_b = 6 * int(model.interface_names.size()), m = part.reduction.internal_modes;
   budget.dense_bytes = 8.0 * double(model.n_dofs()) * (2.0 * (n_b + m) + 2.0 * m + 20.0);
   budget.limit_given = part.reduction.memory_limit_gb > 0;
-  const double limit = budget.limit_given ? part.reduction.memory_limit_gb * 1e9 : AvailableMemoryBytes();
+  // (MemAvailable is shared by the MPI ranks on this machine that share the work; a given limit is
+  // each rank's)
+  const int sharing = ResolvedSolver(part.reduction.solver) == ReductionSolver::kPetsc ? RanksOnThisMachine() : 1;
+  const double limit =
+      budget.limit_given ? part.reduction.memory_limit_gb * 1e9 : AvailableMemoryBytes() / double(std::max(sharing, 1));
   budget.factor_bytes = limit > 0 ? std::max(limit - budget.dense_bytes, 0.1 * limit) : 0.0;
   return budget;
 }

@@ -44,7 +44,7 @@ MpiRanks::MpiRanks() {
     MPI_Allreduce(&mine[1], &all[1], 1, MPI_INT, MPI_MIN, PETSC_COMM_WORLD);
     return RankAgreement{all[0], all[1] < size ? all[1] : -1};
   };
-  RegisterDistributedSolver([] { return MakePetscInterior(); }, size_, agree, rank_);
+  RegisterDistributedSolver([] { return MakePetscInterior(); }, size_, agree, rank_, on_node);
 }
 
 MpiRanks::~MpiRanks() {

@@ -29,7 +29,7 @@ int EnvironmentInteger(const char* a, const char* b, int otherwise) {
 
 struct Registry {
   std::function<std::unique_ptr<InteriorSolver>()> make;
-  int ranks = 1, rank = 0;
+  int ranks = 1, rank = 0, on_machine = 1;
   std::function<RankAgreement(int)> agree;
   bool agreed = false;
 };
@@ -56,8 +56,9 @@ std::unique_ptr<InteriorSolver> MakeInteriorSolver(ReductionSolver kind, const s
 }
 
 void RegisterDistributedSolver(std::function<std::unique_ptr<InteriorSolver>()> make, int ranks,
-                               std::function<RankAgreement(int)> agree, int rank) {
+                               std::function<RankAgreement(int)> agree, int rank, int ranks_on_machine) {
   Registry& r = TheRegistry();
+  r.on_machine = ranks_on_machine;
   r.make = std::move(make);
   r.ranks = ranks;
   r.rank = rank;
@@ -75,6 +76,8 @@ RankAgreement AgreeOnStart(int code) {
 bool StartAgreed() { return TheRegistry().agreed; }
 
 int DistributedRank() { return TheRegistry().rank; }
+
+int RanksOnThisMachine() { return TheRegistry().on_machine; }
 
 int DistributedRanks() { return TheRegistry().ranks; }
 

@@ -61,9 +61,14 @@ void RequireInteriorSolver(ReductionSolver kind, const std::string& where);
 
 /// The distributed solver's maker and the number of MPI ranks, set by a program that runs on MPI
 /// (femb-reduce); ranks() is 1 until then.
-/// `agree` (AgreeOnStart's collective) and this process's `rank` with them.
+/// `agree` (AgreeOnStart's collective), this process's `rank` and the number of ranks on its
+/// machine with them.
 void RegisterDistributedSolver(std::function<std::unique_ptr<InteriorSolver>()> make, int ranks,
-                               std::function<RankAgreement(int)> agree = nullptr, int rank = 0);
+                               std::function<RankAgreement(int)> agree = nullptr, int rank = 0,
+                               int ranks_on_machine = 1);
+/// The ranks of a distributed run on this process's machine (1 on one process): they share its
+/// memory.
+int RanksOnThisMachine();
 int DistributedRanks();
 
 /// The number of ranks an MPI launcher started (OpenMPI's OMPI_COMM_WORLD_SIZE, MPICH's
