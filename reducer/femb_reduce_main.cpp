@@ -109,8 +109,8 @@ int main(int argc, char** argv) {
     if (!mpi && part.reduction.solver == femb::ReductionSolver::kPetsc) mpi.emplace();
 #endif
     if (!speaks) quiet = true;
-    if (distributed &&
-        (!export_dir.empty() || femb::ResolvedSolver(part.reduction.solver) != femb::ReductionSolver::kPetsc)) {
+    const bool petsc = femb::ResolvedSolver(part.reduction.solver) == femb::ReductionSolver::kPetsc;
+    if (distributed && (!export_dir.empty() || !petsc)) {
       // Only the petsc solver shares the work; anything else rank 0 does alone, once every rank got
       // here.
       const femb::RankAgreement start = femb::AgreeOnStart(0);
@@ -120,7 +120,7 @@ int main(int argc, char** argv) {
     // Ranks that share the work also share their memory figures once they agreed to start
     // (AgreeOnStart must be their first collective; after it every rank reports the same stages,
     // so the collective in PeakMemory pairs up).
-    const bool shared = distributed && femb::ResolvedSolver(part.reduction.solver) == femb::ReductionSolver::kPetsc;
+    const bool shared = distributed && petsc;
     const auto memory = [&]() -> std::string {
 #ifdef FEMB_WITH_PETSC
       if (shared) {

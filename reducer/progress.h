@@ -2,6 +2,7 @@
 #pragma once
 
 #include <chrono>
+#include <cstdio>
 #include <functional>
 #include <string>
 
@@ -9,6 +10,13 @@ namespace femb {
 
 /// Called once per finished stage with its wall time and a one-line detail.
 using ProgressFn = std::function<void(const std::string& stage, double seconds, const std::string& detail)>;
+
+/// A progress detail or message with up to four numbers: printf's `fmt` (double conversions only).
+inline std::string Format(const char* fmt, double a, double b = 0, double c = 0, double d = 0) {
+  char buffer[256];
+  std::snprintf(buffer, sizeof buffer, fmt, a, b, c, d);
+  return buffer;
+}
 
 /// Wall-clock stopwatch.
 class Stopwatch {

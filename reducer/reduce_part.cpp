@@ -632,9 +632,10 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
     if (progress) progress(stage, seconds, detail);
   };
   const ReductionSolver solver = ResolvedSolver(part.reduction.solver);
-  RequireInteriorSolver(solver, part.reduction.where_solver.empty() ? part.file : part.reduction.where_solver);
+  const std::string where_solver = part.reduction.where_solver.empty() ? part.file : part.reduction.where_solver;
+  RequireInteriorSolver(solver, where_solver);
   if (solver == ReductionSolver::kPetsc && part.reduction.method != ReductionMethod::kCraigBampton) {
-    throw InputError((part.reduction.where_solver.empty() ? part.file : part.reduction.where_solver) +
+    throw InputError(where_solver +
                      ": reduction.solver: petsc reduces by craig_bampton only (the free-interface and general "
                      "bases are not distributed yet): use solver: cholmod, on one process, with method: " +
                      std::string(Name(part.reduction.method)));

@@ -5,7 +5,6 @@
 #include <slepceps.h>
 
 #include <cmath>
-#include <cstdio>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -23,12 +22,6 @@ void Check(PetscErrorCode code, const char* call) {
   throw std::runtime_error(std::string("PETSc: ") + call + ": " + (text ? text : "error " + std::to_string(code)));
 }
 #define FEMB_PETSC(call) Check((call), #call)
-
-std::string Format(const char* fmt, double a, double b = 0, double c = 0) {
-  char buffer[256];
-  std::snprintf(buffer, sizeof buffer, fmt, a, b, c);
-  return buffer;
-}
 
 // The rows each rank owns of an n-row matrix or vector (PETSc's default split), with every
 // rank's count and first row for gathering.
@@ -177,6 +170,7 @@ class PetscInterior : public InteriorSolver {
     CheckSameMatrix(A);
     rows_ = SplitRows(PetscInt(A.rows()));
     A_ = DistributedMatrix(A, rows_);
+    factored_ = &A;
     FEMB_PETSC(MatSetOption(A_, MAT_SPD, PETSC_TRUE));
     FEMB_PETSC(MatGetFactor(A_, MATSOLVERMUMPS, MAT_FACTOR_CHOLESKY, &F_));
     FEMB_PETSC(MatMumpsSetIcntl(F_, 28, 1));  // sequential analysis ...
@@ -262,6 +256,7 @@ class PetscInterior : public InteriorSolver {
  private:
   RowSplit rows_;
   Mat A_ = nullptr, F_ = nullptr;
+  const SparseMatrix* factored_ = nullptr;  ///< the matrix A_ holds (K_ii itself unless augmented)
   long solves_ = 0;
   std::string detail_;
 };
@@ -278,7 +273,9 @@ std::optional<EigenResult> PetscInterior::Eigenpairs(const SparseMatrix& K, cons
     r.ok = true;
     return r;
   }
-  Mat Kd = DistributedMatrix(K, rows_), Md = DistributedMatrix(M, rows_);
+  // K_ii is distributed already when it is the matrix factored (not augmented): shared, not copied.
+  Mat Kd = &K == factored_ ? A_ : DistributedMatrix(K, rows_), Md = DistributedMatrix(M, rows_);
+  if (Kd == A_) FEMB_PETSC(PetscObjectReference(reinterpret_cast<PetscObject>(A_)));
   EPS eps = nullptr;
   FEMB_PETSC(EPSCreate(PETSC_COMM_WORLD, &eps));
   FEMB_PETSC(EPSSetOperators(eps, Kd, Md));

@@ -23,12 +23,6 @@ constexpr int kLanczosBlock = 8;
 // computed vectors whatever their accuracy.
 constexpr double kLanczosTolerance = 1e-8;
 
-std::string Format(const char* fmt, double a, double b = 0, double c = 0, double d = 0) {
-  char buffer[256];
-  std::snprintf(buffer, sizeof buffer, fmt, a, b, c, d);
-  return buffer;
-}
-
 // Splits A into the blocks named by the partition (-1: boundary position, else interior index).
 struct Blocks {
   SparseMatrix ii, ib;
