@@ -205,6 +205,13 @@ DynamicState InitialDynamicState(const SystemModel& model, const SystemState& co
   return s;
 }
 
+double HighestFrequency(const SuperelementBody& body) {
+  if (body.K().rows() == 0 || body.K().cwiseAbs().maxCoeff() == 0.0) return 0.0;  // rigid bodies
+  const Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> eig(body.K(), body.M(), Eigen::EigenvaluesOnly);
+  if (eig.info() != Eigen::Success) return 0.0;
+  return std::sqrt(std::max(eig.eigenvalues().maxCoeff(), 0.0));
+}
+
 namespace {
 // The midpoint scheme conserves energy: it damps no mode, and a mode whose period spans fewer
 // than 2 pi steps (omega h > 1) it does not resolve either; excited by the motion, such modes
@@ -217,22 +224,18 @@ std::string UnresolvedModesWarning(const SystemModel& model, double h) {
   double omega = 0.0;
   int worst = -1;
   for (size_t b = 0; b < model.bodies.size(); ++b) {
-    const SuperelementBody& body = model.bodies[b];
-    if (body.K().rows() == 0 || body.K().cwiseAbs().maxCoeff() == 0.0) continue;  // rigid bodies
-    const Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> eig(body.K(), body.M(), Eigen::EigenvaluesOnly);
-    if (eig.info() != Eigen::Success) continue;
-    const double w = std::sqrt(std::max(eig.eigenvalues().maxCoeff(), 0.0));
+    const double w = HighestFrequency(model.bodies[b]);
     if (w > omega) omega = w, worst = int(b);
   }
   if (worst < 0 || omega * h <= 1.0) return "";
   const std::string name = size_t(worst) < model.body_names.size() ? "'" + model.body_names[size_t(worst)] + "'"
                                                                    : "number " + std::to_string(worst + 1);
-  char buffer[600];
+  char buffer[700];
   std::snprintf(buffer, sizeof buffer,
                 "the midpoint integrator neither damps nor resolves body %s's highest mode, %.4g Hz, at steps of up to "
                 "%.3g s (omega h = %.3g, fewer than 2 pi steps a period): excited, such modes ring undamped in the "
-                "reactions and stresses. Use steps below %.3g s (omega h < 1), or analysis.integrator: "
-                "generalized_alpha, whose rho_inf damps them",
+                "reactions and stresses. Use steps below %.3g s (omega h < 1; step: auto without max_step keeps "
+                "them at 0.7 / omega), or analysis.integrator: generalized_alpha, whose rho_inf damps them",
                 name.c_str(), omega / (2 * M_PI), h, omega * h, 1.0 / omega);
   return buffer;
 }
@@ -576,6 +579,7 @@ class DynamicRun {
       ConsistentAccelerations(model_, dofs_, state_);
       if (options_.integrator == Integrator::kGeneralizedAlpha) {
         state_.a += work_.a_n;
+        state_.increments_kept = 0;  // the motion's third derivative jumps here
       } else {
         state_.h_last = 0.0;
       }

@@ -15,6 +15,7 @@
 // drives and on output times.
 #pragma once
 
+#include <array>
 #include <atomic>
 #include <functional>
 #include <optional>
@@ -121,6 +122,13 @@ struct DynamicState {
   /// Midpoint scheme only: every node's velocity (xdot, omega), carried by the scheme's own
   /// node kinematics rather than taken as J(q) W (see solver/integrators/midpoint.cpp). Empty: J(q) W.
   std::vector<Eigen::Matrix<double, 6, 1>> node_w;
+  /// Generalized-alpha with error-controlled steps: the increments Delta q of the last steps
+  /// (oldest first), their steps and how many are kept (none after a breakpoint), for the
+  /// velocities' offset at a change of step (solver/integrators/generalized_alpha.cpp).
+  static constexpr int kIncrements = 3;
+  std::array<Eigen::VectorXd, kIncrements> increments;
+  std::array<double, kIncrements> increment_steps{};
+  int increments_kept = 0;
 };
 
 struct DynamicStepReport {
@@ -176,6 +184,12 @@ struct DynamicResume {
   double travel = 0.0, last_error = 0.0;
   Eigen::VectorXd last_jerk;
   bool has_last_jerk = false;
+  /// ... and its plan: the step planned, the step of equal steps it gave, whether the step to
+  /// try is the controller's proposal after an accepted step, the steps since the plan last
+  /// changed (StepController::Fit).
+  double planned_step = 0.0, kept_step = 0.0;
+  bool proposal = false;
+  int settled = 0;
   FactorMemory factor;
   long factorizations = 0;
   /// Per body: the inverse frame matrix of its last evaluation (the next frame solve iterates
@@ -194,6 +208,10 @@ struct DynamicResume {
 /// open them (G W != 0) are replaced by the nearest that do not, in the kinetic-energy norm.
 DynamicState InitialDynamicState(const SystemModel& model, const SystemState& config, const Eigen::VectorXd& W,
                                  double t0 = 0.0);
+
+/// A body's highest natural frequency [rad/s] of its reduced K and M (free-free, in its
+/// interface coordinates); 0 for a rigid body.
+double HighestFrequency(const SuperelementBody& body);
 
 /// Energies and momenta of a state.
 DynamicStepReport Measure(const SystemModel& model, DynamicState& state);

@@ -205,7 +205,7 @@ struct BodyWorkspace {
   Assembly assembly;
   std::vector<Eigen::Matrix<double, 6, 1>> node_acc;
   std::vector<NodeJacobian> dc, dacc;
-  Eigen::VectorXd unused, column, weights, dq, delta, lie_delta, a_n;
+  Eigen::VectorXd unused, column, weights, dq, delta, lie_delta, a_n, W_n, velocity_change;
   // The factor of the mass in the step's iteration matrix (RoundOffForce; 0 outside a step).
   double inertia_factor = 0.0;
   // RotationNodes(model, dofs), set with the weights.

@@ -19,6 +19,8 @@ StepController::StepController(const SystemModel& model, const DofMap& dofs, con
     const double gamma = 0.5 + alpha_f - alpha_m, beta = 0.25 * (gamma + 0.5) * (gamma + 0.5);
     c_q_ = std::abs(1.0 / 6 - beta - 0.5 * (alpha_m - alpha_f)), c_v_ = 1.0 / 12;
   }
+  if (options.integrator == Integrator::kMidpoint && !(options.max_step > 0))
+    max_step_ = std::min(max_step_, MidpointResolvedStep(model));
   breakpoints_ = options.breakpoints;
   std::sort(breakpoints_.begin(), breakpoints_.end());
 }
@@ -40,10 +42,31 @@ double StepController::Fit(double t, double h) {
     output_ = std::abs(next_output - boundary_) <= eps || boundary_ == options_.end_time;
   }
   at_breakpoint_ = breakpoint;
-  lands_ = t + 1.01 * h >= boundary_;
-  if (lands_) return boundary_ - t;
-  if (t + 2 * h > boundary_) return 0.5 * (boundary_ - t);
-  return h;
+  // The plan: equal steps of at most planned_ to the boundary, made anew at the first step and
+  // after a rejection (from the step to retry), and from the proposal when that leaves [0.9, 1.25]
+  // of the step in use, at least kSettle steps after the last change or breakpoint, and only
+  // where it changes the step.
+  const double rest = boundary_ - t;
+  const auto equal_steps = [rest](double planned) { return rest / std::max(1.0, std::ceil(rest / planned - 1e-6)); };
+  if (proposal_) ++settled_;
+  if (!proposal_ || !(kept_ > 0)) {
+    planned_ = h;
+    settled_ = 0;
+  } else if ((h < 0.9 * kept_ || h > 1.25 * kept_) && settled_ >= kSettle && equal_steps(h) != equal_steps(planned_)) {
+    planned_ = h;
+    settled_ = 0;
+  }
+  proposal_ = false;
+  const double step = equal_steps(planned_);
+  lands_ = step == rest;
+  if (!lands_) kept_ = step;
+  return step;
+}
+
+double MidpointResolvedStep(const SystemModel& model) {
+  double omega = 0.0;
+  for (const SuperelementBody& body : model.bodies) omega = std::max(omega, HighestFrequency(body));
+  return omega > 0.0 ? 0.7 / omega : HUGE_VAL;
 }
 
 double StepController::Error(const DynamicState& s0, const DynamicState& s1, double h) {
@@ -69,6 +92,7 @@ double StepController::Error(const DynamicState& s0, const DynamicState& s1, dou
 
 double StepController::Accept(const DynamicState& s1, double h, double E, bool after_rejection) {
   has_jerk_prev_ = !at_breakpoint();
+  if (at_breakpoint()) settled_ = 0;
   if (has_jerk_prev_) jerk_prev_.swap(jerk_);  // jerk_ is written anew by the next Error
   for (size_t k = 0; k < x0_.size(); ++k) D_ = std::max(D_, (s1.config.x[k] - x0_[k]).norm());
   // PI control (Gustafsson 1991; Hairer & Wanner II, IV.2): the exponents 0.7/3 and 0.4/3 of
@@ -79,6 +103,7 @@ double StepController::Accept(const DynamicState& s1, double h, double E, bool a
   const double f =
       E_prev_ > 0 && E > 0 ? std::clamp(0.9 * std::pow(E, -0.7 / 3) * std::pow(E_prev_, 0.4 / 3), 0.2, 2.0) : Factor(E);
   E_prev_ = std::max(E, 1e-4);
+  proposal_ = true;
   return h * std::min(after_rejection ? 1.0 : 2.0, f);
 }
 

@@ -77,6 +77,19 @@ void WriteExactState(h5::Writer& w, const std::string& g, const DynamicState& s)
   for (size_t k = 0; k < s.node_w.size(); ++k) node_w.row(long(k)) = s.node_w[k].transpose();
   w.Matrix(g + "/node_velocities", node_w);
   w.Vector(g + "/numbers", (Eigen::VectorXd(4) << s.t, s.external_work, s.drive_work, s.h_last).finished());
+  if (s.increments_kept > 0) {
+    // Generalized-alpha's last increments (error-controlled steps), one row each, oldest first.
+    constexpr long N = DynamicState::kIncrements;
+    Eigen::MatrixXd increments(N, s.increments[N - 1].size());
+    Eigen::VectorXd steps(N + 1);
+    for (long i = 0; i < N; ++i) {
+      increments.row(i) = s.increments[size_t(i)].transpose();
+      steps[i] = s.increment_steps[size_t(i)];
+    }
+    steps[N] = double(s.increments_kept);
+    w.Matrix(g + "/increments", increments);
+    w.Vector(g + "/increment_steps", steps);
+  }
 }
 
 void WriteResume(h5::Writer& w, const DynamicResume& r) {
@@ -84,12 +97,13 @@ void WriteResume(h5::Writer& w, const DynamicResume& r) {
   WriteExactState(w, "/resume/state", r.state);
   const DynamicResult& x = r.result;
   w.Vector("/resume/numbers",
-           (Eigen::VectorXd(28) << r.t_start, r.h, r.t_base, r.last_output, r.E0, r.energy_scale, r.first_cut_time,
+           (Eigen::VectorXd(32) << r.t_start, r.h, r.t_base, r.last_output, r.E0, r.energy_scale, r.first_cut_time,
             double(r.n_nominal), double(r.cuts), double(r.warned), r.travel, r.last_error, double(r.has_last_jerk),
             double(r.factorizations), double(r.matrices_computed), double(r.matrices_turned), double(x.steps),
             double(x.rejected_by_error), double(x.newton_cuts), x.smallest_step, x.largest_step, x.smallest_step_time,
             double(x.newton_iterations), double(x.factorizations), double(x.pattern_analyses), double(x.pivoted),
-            double(x.body_matrices_computed), double(x.body_matrices_turned))
+            double(x.body_matrices_computed), double(x.body_matrices_turned), r.planned_step, r.kept_step,
+            double(r.proposal), double(r.settled))
                .finished());
   w.Strings("/resume/warnings", x.warnings);
   w.Vector("/resume/last_jerk", r.last_jerk);
@@ -258,6 +272,18 @@ DynamicState ReadState(const h5::Reader& r, const std::string& g, const SystemMo
   for (long k = 0; k < node_w.rows(); ++k) s.node_w.push_back(node_w.row(k).transpose());
   const Eigen::VectorXd numbers = r.Vector(g + "/numbers");
   s.t = numbers[0], s.external_work = numbers[1], s.drive_work = numbers[2], s.h_last = numbers[3];
+  if (r.Exists(g + "/increments")) {
+    constexpr long N = DynamicState::kIncrements;
+    need("/increments", N, n);
+    need("/increment_steps", N + 1, -1);
+    const Eigen::MatrixXd increments = r.Matrix(g + "/increments");
+    const Eigen::VectorXd steps = r.Vector(g + "/increment_steps");
+    for (long i = 0; i < N; ++i) {
+      s.increments[size_t(i)] = increments.row(i).transpose();
+      s.increment_steps[size_t(i)] = steps[i];
+    }
+    s.increments_kept = std::clamp(int(steps[N]), 0, int(N));
+  }
   UpdateKinematics(model, dofs, c);
   return s;
 }
@@ -282,8 +308,8 @@ bool ReadResume(const std::string& directory, const Scene& scene, const std::str
   const SystemModel& model = scene.model;
   resume.state = ReadState(r, "/state", model);
   const Eigen::VectorXd x = r.Vector("/resume/numbers");
-  if (x.size() != 28)
-    throw InputError(r.path() + ": dataset /resume/numbers has " + std::to_string(x.size()) + " values, not 28");
+  if (x.size() != 28 && x.size() != 32)  // (28: written before the step controller kept a plan)
+    throw InputError(r.path() + ": dataset /resume/numbers has " + std::to_string(x.size()) + " values, not 32");
   resume.t_start = x[0], resume.h = x[1], resume.t_base = x[2], resume.last_output = x[3], resume.E0 = x[4];
   resume.energy_scale = x[5], resume.first_cut_time = x[6], resume.n_nominal = long(x[7]), resume.cuts = int(x[8]);
   resume.warned = x[9] != 0, resume.travel = x[10], resume.last_error = x[11], resume.has_last_jerk = x[12] != 0;
@@ -293,6 +319,10 @@ bool ReadResume(const std::string& directory, const Scene& scene, const std::str
   result.smallest_step = x[19], result.largest_step = x[20], result.smallest_step_time = x[21];
   result.newton_iterations = long(x[22]), result.factorizations = long(x[23]), result.pattern_analyses = long(x[24]);
   result.pivoted = long(x[25]), result.body_matrices_computed = long(x[26]), result.body_matrices_turned = long(x[27]);
+  if (x.size() == 32) {
+    resume.planned_step = x[28], resume.kept_step = x[29], resume.proposal = x[30] != 0;
+    resume.settled = int(x[31]);
+  }
   result.warnings = r.Strings("/resume/warnings");
   resume.last_jerk = r.Vector("/resume/last_jerk");
   const Eigen::VectorXi outer = r.IntVector("/resume/factor_outer"), inner = r.IntVector("/resume/factor_inner");

@@ -12,6 +12,7 @@
 #include "formats/input_error.h"
 #include "solver/analysis/modal_analysis.h"
 #include "solver/analysis/static_analysis.h"
+#include "solver/analysis/step_control.h"
 #include "solver/output/checkpoint.h"
 
 namespace femb {
@@ -441,6 +442,15 @@ DynamicState SolveRun::InitialDynamicState() {
 void SolveRun::RunDynamic() {
   DynamicState state = InitialDynamicState();
   const DynamicOptions options = DynamicOptionsOf();
+  if (options.adaptive && options.integrator == Integrator::kMidpoint && !(options.max_step > 0)) {
+    const double h = MidpointResolvedStep(scene_.model);
+    if (h < 0.01 * (options.end_time - state.t)) {
+      Say("note: step: auto under the midpoint scheme keeps its steps at or below %.3g s, which resolve the "
+          "bodies' highest mode (%.4g Hz; the scheme damps none); analysis.max_step allows longer steps, with "
+          "that mode ringing undamped in the reactions and stresses",
+          h, 0.7 / h / (2 * M_PI));
+    }
+  }
   DynamicState output_state;
   const DynamicResult r =
       SolveDynamic(scene_.model, state, options, [&](const DynamicStepReport& s, const DynamicState& st) {

@@ -184,9 +184,13 @@ TEST_F(TiltedFourBarTest, TheLoopIsCutAtDWithFiveEquations) {
 // multipliers of the state there. The restart used to take the residual with the integrator's
 // accelerations in it as the right-hand side, so that it solved for their change and kept that
 // as the accelerations: the ground reactions jumped there and stayed off by 25% of their peak.
-// Here: the same run without the breakpoint (no restart), and each against a fixed-step run of
-// 5 us, before and after t = 0.1 s.
-void RestartLeavesASmoothRunUnchanged(const Scene& scene, Integrator integrator) {
+// Here: each run against a fixed-step run of 5 us, before and after t = 0.1 s, within 1e-3 of
+// each component's peak; with `smooth`, also the same run without the breakpoint (no restart).
+// Generalized-alpha was 1.2e-2..1.6e-2 off after the breakpoint, with or without the restart,
+// while its steps changed at almost every step (landing on the 1 ms output times) and its
+// velocities kept the offset of the last step (solver/analysis/step_control.h); the midpoint
+// scheme 0.2-1.8 times the peak, its coupler's unresolved modes ringing undamped.
+void RestartLeavesASmoothRunUnchanged(const Scene& scene, Integrator integrator, bool smooth) {
   const Reactions reference = Simulate(scene, [&] {
     DynamicOptions o = Options(integrator, 0.2);
     o.step = 5e-6;
@@ -196,40 +200,37 @@ void RestartLeavesASmoothRunUnchanged(const Scene& scene, Integrator integrator)
   for (double tolerance : {1e-4, 1e-5, 1e-6}) {
     DynamicOptions o = ErrorControlled(integrator, tolerance);
     const Reactions restarted = Simulate(scene, o);
-    o.breakpoints.clear();
-    const Reactions smooth = Simulate(scene, o);
     ASSERT_TRUE(restarted.result.ok) << restarted.result.message;
-    ASSERT_TRUE(smooth.result.ok) << smooth.result.message;
     const double before = restarted.Error(reference, 0, 0.1 - 1e-9),
                  after = restarted.Error(reference, 0.1 + 1e-9, 0.2);
-    const double smooth_after = smooth.Error(reference, 0.1 + 1e-9, 0.2);
+    const char* name = integrator == Integrator::kMidpoint ? "midpoint" : "generalized-alpha";
     std::printf(
         "[ info ] %s, step_tolerance %.0e: ground reactions against the fixed 5 us run, of each component's "
-        "peak: restarted at 0.1 s (%ld steps) %.2e before, %.2e after; without the breakpoint (%ld steps) "
-        "%.2e after\n",
-        integrator == Integrator::kMidpoint ? "midpoint" : "generalized-alpha", tolerance, restarted.steps, before,
-        after, smooth.steps, smooth_after);
-    // The restart adds nothing beyond the run's own error: after the breakpoint the restarted
-    // run is no further from the reference than 3 times the run without the breakpoint or its
-    // own error before it (the runs' error moves with their step sequence: with clang's build
-    // 8.2e-3 after against 3.6e-3 without the breakpoint at 1e-6, with gcc's 8.6e-3 and 7.3e-3).
-    // And the error is bounded (measured 1.6e-2 at the most; with the restart's defect, and the
-    // reactions computed the same way, 1.0).
-    EXPECT_LT(after, 3 * std::max({smooth_after, before, 1e-4}));
-    EXPECT_LT(std::max(before, after), 3e-2);
+        "peak: restarted at 0.1 s (%ld steps, %ld rejected) %.2e before, %.2e after\n",
+        name, tolerance, restarted.steps, restarted.result.rejected_by_error, before, after);
+    EXPECT_LT(std::max(before, after), 1e-3) << name << ", step_tolerance " << tolerance;
+    if (!smooth) continue;
+    o.breakpoints.clear();
+    const Reactions without = Simulate(scene, o);
+    ASSERT_TRUE(without.result.ok) << without.result.message;
+    const double without_after = without.Error(reference, 0.1 + 1e-9, 0.2);
+    std::printf("[ info ] %s, step_tolerance %.0e: without the breakpoint (%ld steps) %.2e after\n", name, tolerance,
+                without.steps, without_after);
+    // The restart adds nothing beyond the run's own error.
+    EXPECT_LT(after, 3 * std::max({without_after, before, 1e-4}));
+    EXPECT_LT(without_after, 1e-3);
   }
 }
 
-// An error-controlled run restarts at the spin-up's end (t = 0.1 s) with the accelerations and
-// multipliers of the state there. The restart used to take the residual with the integrator's
-// accelerations in it as the right-hand side, so that it solved for their change and kept that
-// as the accelerations: the ground reactions jumped there and stayed off by 25% of their peak.
-// Here: the same run without the breakpoint (no restart), and each against a fixed-step run of
-// 5 us, before and after t = 0.1 s. (The midpoint scheme is not held to this: with error-controlled
-// steps its reactions are 0.2-1.8 times their peak off its own fixed 5 us run, before the
-// breakpoint as after it: the coupler's unresolved modes ring undamped.)
 TEST_F(TiltedFourBarTest, RestartAtTheBreakpointLeavesASmoothRunUnchangedGeneralizedAlpha) {
-  RestartLeavesASmoothRunUnchanged(*scene_, Integrator::kGeneralizedAlpha);
+  RestartLeavesASmoothRunUnchanged(*scene_, Integrator::kGeneralizedAlpha, true);
+}
+
+// The midpoint scheme's error-controlled steps resolve the coupler's highest mode (11.7 kHz:
+// steps of at most 0.7 / omega = 9.5 us, StepController), so the same bound holds; its steps are
+// the same with and without the breakpoint.
+TEST_F(TiltedFourBarTest, RestartAtTheBreakpointLeavesASmoothRunUnchangedMidpoint) {
+  RestartLeavesASmoothRunUnchanged(*scene_, Integrator::kMidpoint, false);
 }
 
 // The same mechanism with a rigid coupler: femb keeps 2 of the cut joint's 5 equations (the

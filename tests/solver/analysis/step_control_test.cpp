@@ -17,6 +17,8 @@ SystemModel TwoNodes() {
   return model;
 }
 
+// Each stretch to the next boundary in equal steps of at most the step asked for (no Accept
+// here: every Fit plans anew).
 TEST(StepControl, StepsLandOnTheEndBreakpointsAndOutputTimes) {
   const SystemModel model = TwoNodes();
   const DofMap dofs(model);
@@ -27,17 +29,17 @@ TEST(StepControl, StepsLandOnTheEndBreakpointsAndOutputTimes) {
   options.breakpoints = {0.25, 0.7};
   StepController c(model, dofs, options, 0.0);
   EXPECT_DOUBLE_EQ(c.FirstStep(), 0.05);
-  EXPECT_DOUBLE_EQ(c.Fit(0.0, 0.1), 0.1);  // free flight
+  EXPECT_DOUBLE_EQ(c.Fit(0.0, 0.1), 0.25 / 3);  // three equal steps to the breakpoint
   EXPECT_FALSE(c.lands());
   EXPECT_DOUBLE_EQ(c.Fit(0.2, 0.1), 0.05);  // lands on the breakpoint
   EXPECT_TRUE(c.at_breakpoint());
   EXPECT_DOUBLE_EQ(c.boundary(), 0.25);
-  EXPECT_DOUBLE_EQ(c.Fit(0.25, 0.1), 0.1);    // the breakpoint it stands on is behind it
+  EXPECT_DOUBLE_EQ(c.Fit(0.25, 0.1), 0.09);   // the breakpoint it stands on is behind it: 5 steps to 0.7
   EXPECT_DOUBLE_EQ(c.Fit(0.55, 0.1), 0.075);  // two equal steps rather than a sliver
   EXPECT_FALSE(c.lands());
   EXPECT_DOUBLE_EQ(c.Fit(0.9, 0.5), 0.1);  // max_step, then the end
   EXPECT_TRUE(c.lands() && c.output() && !c.at_breakpoint());
-  EXPECT_DOUBLE_EQ(c.Fit(0.8, 1e-12), c.min_step());  // at least min_step (1e-8 of the span)
+  EXPECT_NEAR(c.Fit(0.8, 1e-12), c.min_step(), 1e-20);  // at least min_step (1e-8 of the span)
   EXPECT_DOUBLE_EQ(c.min_step(), 1e-8);
 
   options.output_step = 0.3;  // outputs at 0.3, 0.6, 0.9; a breakpoint is not an output
@@ -47,6 +49,32 @@ TEST(StepControl, StepsLandOnTheEndBreakpointsAndOutputTimes) {
   EXPECT_DOUBLE_EQ(o.Fit(0.25, 0.1), 0.05);
   EXPECT_TRUE(o.output() && !o.at_breakpoint());
   EXPECT_DOUBLE_EQ(o.boundary(), 0.3);
+}
+
+// The plan is kept while the controller's proposal after an accepted step stays within [0.9,
+// 1.25] of the step in use, or until 7 steps have passed since it was made; it is made anew
+// outside the band after that, and at once after a rejection.
+TEST(StepControl, TheStepChangesOnlyOutsideTheBandAndSeldom) {
+  const SystemModel model = TwoNodes();
+  const DofMap dofs(model);
+  DynamicOptions options;
+  options.end_time = 10.0;
+  options.step = 0.1;
+  options.max_step = 0.2;
+  StepController c(model, dofs, options, 0.0);
+  const DynamicState s = InitialDynamicState(model, InitialState(model), Eigen::VectorXd::Zero(dofs.n_dofs()));
+  EXPECT_DOUBLE_EQ(c.Fit(0.0, 0.1), 0.1);
+  const double slightly_less = c.Accept(s, 0.1, 1.0, false);  // 0.9 E^(-1/3): 0.09
+  EXPECT_DOUBLE_EQ(slightly_less, 0.09);
+  EXPECT_DOUBLE_EQ(c.Fit(0.1, slightly_less), 0.1);  // within the band: kept
+  double t = 0.2;
+  for (int k = 2; k <= 7; ++k, t += 0.1) {
+    const double much_more = c.Accept(s, 0.1, 0.01, false);
+    EXPECT_GT(much_more, 0.125);
+    const double rest = 10.0 - t, expected = k < 7 ? 0.1 : rest / std::ceil(rest / much_more - 1e-6);
+    EXPECT_NEAR(c.Fit(t, much_more), expected, 1e-12) << "proposal " << k;  // made anew after the 7th
+  }
+  EXPECT_NEAR(c.Fit(t, 0.095), (10.0 - t) / std::ceil((10.0 - t) / 0.095 - 1e-6), 1e-12);  // a retry: at once
 }
 
 // Node b's x accelerates linearly in time (jerk j): generalized-alpha's estimate is
