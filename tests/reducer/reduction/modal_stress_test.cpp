@@ -254,9 +254,9 @@ TEST(ModalStress, PrincipalStressesMatchTheIterativeSolver) {
   std::printf("principal stresses: largest difference %.2e of the deviator's size\n", worst);
 }
 
-// The largest and smallest principal stress with single-precision trigonometry (the animation's
+// The largest and smallest principal stress by Newton's method on the cubic (the animation's
 // fields) against Eigen's iterative solver on the same kinds of tensors: within 3e-7 of the
-// deviator's size, near double and triple roots too (float's sine and cosine: 6e-8 relative).
+// deviator's size (the fields are stored in single precision), near double and triple roots too.
 TEST(ModalStress, ExtremePrincipalStressesMatchTheIterativeSolver) {
   std::srand(11);
   double worst = 0;
