@@ -1,8 +1,9 @@
 #!/usr/bin/python3
 """What stress output costs: the solid cantilever (examples/solid_bar's steel bar, TET10, clamped
 at its root, a step force at its tip; 0.2 s at 1 ms: 201 output steps and animation frames) solved
-with outputs.stresses off and on, the animation written both times. Prints femb-solve's own
-figures (solving, writing, total; best of REPEATS runs on one thread) and the animation's size.
+with outputs.stresses off, on (the von Mises field), and on with outputs.principal_stresses, the
+animation written each time. Prints femb-solve's own figures (solving, writing, total; best of
+REPEATS runs on one thread) and the animation's size.
 With --base-bin, the same runs with another build's femb-solve (e.g. an earlier commit's, built by
 `git worktree add /tmp/base <commit>`): the ratios are the point on a noisy machine.
 
@@ -35,14 +36,19 @@ outputs:
 """
 
 
-def run(solve, work, stresses, repeats):
+# The settings compared: label, outputs.stresses, outputs.principal_stresses.
+SETTINGS = [("off", "false", "false"), ("on", "true", "false"), ("on, principal", "true", "true")]
+
+
+def run(solve, work, stresses, principal, repeats):
     """Best of `repeats`: (solving, writing, total) seconds from femb-solve's summary line, and
     the animation's size in bytes."""
     best = None
-    out = os.path.join(work, "out_%s" % stresses)
+    out = os.path.join(work, "out_%s_%s" % (stresses, principal))
     for _ in range(repeats):
         text = subprocess.run([solve, os.path.join(work, "scene.yaml"), "-o", out, "--threads", "1",
-                               "--set", "outputs.stresses=%s" % stresses],
+                               "--set", "outputs.stresses=%s" % stresses] +
+                              (["--set", "outputs.principal_stresses=%s" % principal] if principal else []),
                               check=True, capture_output=True, text=True).stdout
         m = re.search(r"done in ([0-9.]+) s \(reading [0-9.]+ s, solving ([0-9.]+) s, writing ([0-9.]+) s\)", text)
         times = (float(m.group(2)), float(m.group(3)), float(m.group(1)))
@@ -69,25 +75,31 @@ def main():
         print("Stress output on the solid cantilever: %d mesh nodes (TET10, mesh size %s m), 200 steps, "
               "201 output steps and frames; best of %d, one thread" % (n_nodes, a.mesh_size, a.repeats))
         print()
-        print("| femb-solve | stresses | solving [s] | writing [s] | total [s] | animation [MB] | bytes / node / frame |")
+        print("| femb-solve | stress output | solving [s] | writing [s] | total [s] | animation [MB] | bytes / node / frame |")
         print("|---|---|---:|---:|---:|---:|---:|")
         builds = [("this build", a.bin)] + ([("base", a.base_bin)] if a.base_bin else [])
         results = {}
         for label, bin_dir in builds:
-            for stresses in ("false", "true"):
-                (solving, writing, total), size = run(os.path.join(bin_dir, "femb-solve"), work, stresses, a.repeats)
-                results[(label, stresses)] = (solving, writing, total, size)
-                print("| %s | %s | %.3f | %.3f | %.3f | %.1f | %.1f |" % (label, "on" if stresses == "true" else "off",
-                                                                     solving, writing, total, size / 1e6,
-                                                                     size / (n_nodes * 201.0)))
+            # (a base build without outputs.principal_stresses writes them with every stress run)
+            settings = SETTINGS if label == "this build" else SETTINGS[:2]
+            for setting, stresses, principal in settings:
+                (solving, writing, total), size = run(os.path.join(bin_dir, "femb-solve"), work, stresses,
+                                                      principal if label == "this build" else None, a.repeats)
+                results[(label, setting)] = (solving, writing, total, size)
+                print("| %s | %s | %.3f | %.3f | %.3f | %.1f | %.1f |" % (label, setting, solving, writing, total,
+                                                                     size / 1e6, size / (n_nodes * 201.0)))
         print()
         for label, _ in builds:
-            off, on = results[(label, "false")], results[(label, "true")]
-            print("%s: stresses on / off: solving %.2fx, total %.2fx" % (label, on[0] / off[0], on[2] / off[2]))
+            off = results[(label, "off")]
+            for setting in ("on", "on, principal"):
+                if (label, setting) in results:
+                    on = results[(label, setting)]
+                    print("%s: stresses %s / off: solving %.2fx, total %.2fx" % (label, setting, on[0] / off[0],
+                                                                               on[2] / off[2]))
         if a.base_bin:
-            b, t = results[("base", "true")], results[("this build", "true")]
-            print("this build / base, stresses on: animation %.2fx the size (%.1f / %.1f MB), total time %.2fx"
-                  % (t[3] / b[3], t[3] / 1e6, b[3] / 1e6, t[2] / b[2]))
+            b, t = results[("base", "on")], results[("this build", "on, principal")]
+            print("this build with principal stresses / base: animation %.2fx the size (%.1f / %.1f MB), total "
+                  "time %.2fx" % (t[3] / b[3], t[3] / 1e6, b[3] / 1e6, t[2] / b[2]))
 
 
 if __name__ == "__main__":

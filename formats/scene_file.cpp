@@ -507,6 +507,11 @@ void ParseOutputs(const YamlValue& outputs, const NodeNames& nodes, SceneSpec& s
   if (auto v = m.Optional("animation_every")) scene.animation_every = int(v->NonNegativeInteger());
   if (auto v = m.Optional("reactions")) scene.reactions = scene.reactions || v->Bool();
   if (auto v = m.Optional("stresses")) scene.stresses = v->Bool();
+  if (auto v = m.Optional("principal_stresses")) {
+    scene.principal_stresses = v->Bool();
+    if (scene.principal_stresses && !scene.stresses)
+      v->Fail("principal_stresses: true needs stresses: true (the principal stresses are stress fields)");
+  }
   if (auto v = m.Optional("flush_every")) {
     scene.flush_every = v->Number();
     if (!(scene.flush_every >= 0)) v->Fail("flush_every must be >= 0 (seconds of wall time between writes)");

@@ -201,10 +201,13 @@ struct SceneSpec {
   /// asking for `reaction`): /nodes/reaction in results.h5.
   bool reactions = false;
   /// Stress recovery in every body whose superelement file has modal stresses (outputs.stresses):
-  /// von Mises, principal stresses and the tensor as node fields of the animation, and each
-  /// body's largest von Mises stress and where it is per output step in results.h5. Off by
-  /// default (no cost); stress probes work without it.
+  /// the von Mises stress as a node field of the animation, and each body's largest von Mises
+  /// stress and where it is per output step in results.h5. Off by default (no cost); stress
+  /// probes work without it.
   bool stresses = false;
+  /// With stresses: the largest and smallest principal stress as node fields of the animation
+  /// too (outputs.principal_stresses; they cost about as much again as the von Mises field).
+  bool principal_stresses = false;
   StressExcludeSpec stress_exclude;
   /// Results written during the run (outputs.flush_every, seconds of wall time; 0: at every
   /// output step) and every this many output steps (outputs.flush_every_steps; 0: off).

@@ -160,6 +160,14 @@ void ResultsRecorder::WriteMesh(h5::Writer& w) {
   w.IntVector("/node", g.node);
 }
 
+namespace {
+// The animation's stress fields (outputs.stresses; the principal ones with outputs.principal_stresses).
+std::vector<const char*> StressFields(bool principal) {
+  if (principal) return {"von_mises", "max_principal", "min_principal"};
+  return {"von_mises"};
+}
+}  // namespace
+
 // A thread's storage for MakeFields, kept from frame to frame.
 struct ResultsRecorder::FieldWorkspace {
   Eigen::MatrixXf x, d, displacement, stress;  // grid fields, column-major (a column a chunk)
@@ -175,7 +183,8 @@ ResultsRecorder::PackedFrame ResultsRecorder::MakeFields(const PendingOutput& jo
   out.stress = fields && stresses;
   if (fields) {
     ws.x.resize(g->n_nodes, 3), ws.d.resize(g->n_nodes, 3);
-    if (out.stress) ws.stress.setZero(g->n_nodes, 3);  // von Mises, largest and smallest principal
+    // von Mises, and with outputs.principal_stresses the largest and smallest principal stress
+    if (out.stress) ws.stress.setZero(g->n_nodes, scene_.spec.principal_stresses ? 3 : 1);
   }
   for (size_t b = 0; b < scene_.meshes.size(); ++b) {
     const long offset = fields ? g->offset[b] : 0;
@@ -215,8 +224,10 @@ ResultsRecorder::PackedFrame ResultsRecorder::MakeFields(const PendingOutput& jo
     if (!fields) continue;
     for (size_t j = 0; j < order->size(); ++j) {
       const int i = (*order)[j];
+      ws.stress(offset + long(j), 0) = float(ws.von_mises[i]);
+      if (!scene_.spec.principal_stresses) continue;
       const Eigen::Vector2d p = ExtremePrincipalStresses(ws.tensor.row(i).transpose());
-      ws.stress.row(offset + long(j)) << float(ws.von_mises[i]), float(p[0]), float(p[1]);
+      ws.stress(offset + long(j), 1) = float(p[0]), ws.stress(offset + long(j), 2) = float(p[1]);
     }
   }
   if (!fields) return out;
@@ -243,10 +254,12 @@ ResultsRecorder::PackedFrame ResultsRecorder::MakeFields(const PendingOutput& jo
   pack("/displacement_", ws.displacement.data(), 3);
   if (out.stress) {
     round(ws.stress.col(0), Resolution(ws.stress.col(0).maxCoeff(), 21));
-    round(ws.stress.rightCols(2), Resolution(ws.stress.rightCols(2).cwiseAbs().maxCoeff(), 12));
     pack("/von_mises_", ws.stress.col(0).data(), 1);
-    pack("/max_principal_", ws.stress.col(1).data(), 1);
-    pack("/min_principal_", ws.stress.col(2).data(), 1);
+    if (scene_.spec.principal_stresses) {
+      round(ws.stress.rightCols(2), Resolution(ws.stress.rightCols(2).cwiseAbs().maxCoeff(), 12));
+      pack("/max_principal_", ws.stress.col(1).data(), 1);
+      pack("/min_principal_", ws.stress.col(2).data(), 1);
+    }
   }
   return out;
 }
@@ -341,7 +354,7 @@ void ResultsRecorder::WriteXdmf(const std::string& mesh_file) {
         << n_nodes << " 3\" NumberType=\"Float\" Precision=\"4\" Format=\"HDF\">" << file << ":/displacement_" << s
         << "</DataItem>\n    </Attribute>\n";
     if (frame_stress_fields_[s]) {
-      for (const char* field : {"von_mises", "max_principal", "min_principal"}) {
+      for (const char* field : StressFields(scene_.spec.principal_stresses)) {
         out << "    <Attribute Name=\"" << field
             << "\" AttributeType=\"Scalar\" Center=\"Node\">\n     <DataItem Dimensions=\"" << n_nodes
             << " 1\" NumberType=\"Float\" Precision=\"4\" Format=\"HDF\">" << file << ":/" << field << "_" << s
@@ -402,8 +415,8 @@ void ResultsRecorder::FinishAnimation() {
         const std::string index = std::to_string(s);
         for (const char* field : {"/x_", "/deformation_", "/displacement_"}) names.push_back(field + index);
         if (frame_stress_fields_[s]) {
-          for (const char* field : {"/von_mises_", "/max_principal_", "/min_principal_"})
-            names.push_back(field + index);
+          for (const char* field : StressFields(scene_.spec.principal_stresses))
+            names.push_back("/" + std::string(field) + "_" + index);
         }
       }
       w.CopyFrom((dir / part).string(), names);

@@ -47,6 +47,7 @@ loads:
 analysis: {type: static, end_time: 1, steps: 2}
 outputs:
   stresses: true
+  principal_stresses: true
   probes:
     - {name: top, body: bar, point: [0.5, 0.05, 0.025], quantities: [stress]}
     - {name: tip, node: t, quantities: [position]}
@@ -96,8 +97,23 @@ assert vm2[k] == vm2.max(), (vm2[k], vm2.max())
 nodes = h5py.File(sys.argv[1] + "/../bar.h5", "r")["visualization/nodes"][...]
 assert np.abs(a["x_0"][...] - nodes[node]).max() < 1e-6
 PY
+# Without outputs.principal_stresses: the von Mises field alone, the same values.
+"$bin/femb-solve" -q "$work/scene.yaml" -o "$work/vm" --set outputs.principal_stresses=false && $py - "$work/vm" "$work/out" <<'PY' \
+  && ok || fail "von Mises alone"
+import sys, h5py, numpy as np
+a, b = (h5py.File(d + "/animation.h5", "r") for d in sys.argv[1:3])
+assert "von_mises_2" in a and "max_principal_2" not in a and "min_principal_2" not in a
+assert np.array_equal(a["von_mises_2"][...], b["von_mises_2"][...])
+xdmf = open(sys.argv[1] + "/animation.xdmf").read()
+assert "von_mises" in xdmf and "principal" not in xdmf
+PY
+# principal_stresses without stresses: one line, exit 2.
+"$bin/femb-solve" -q "$work/scene.yaml" -o "$work/bad" --set outputs.stresses=false > "$work/bad.txt" 2>&1
+[ $? = 2 ] && [ "$(wc -l < "$work/bad.txt")" = 1 ] && grep -q "principal_stresses: true needs stresses: true" "$work/bad.txt" \
+  && [ ! -e "$work/bad/results.h5" ] && ok || fail "principal without stresses: $(cat "$work/bad.txt")"
 # Without outputs.stresses: no fields, no maxima (the probe still works).
-"$bin/femb-solve" -q "$work/scene.yaml" -o "$work/plain" --set outputs.stresses=false && $py - "$work/plain" <<'PY' \
+"$bin/femb-solve" -q "$work/scene.yaml" -o "$work/plain" --set outputs.stresses=false \
+  --set outputs.principal_stresses=false && $py - "$work/plain" <<'PY' \
   && ok || fail "stresses off"
 import sys, h5py
 assert "max_von_mises" not in h5py.File(sys.argv[1] + "/results.h5", "r")["bodies/bar"]
