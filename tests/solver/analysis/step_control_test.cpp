@@ -17,15 +17,22 @@ SystemModel TwoNodes() {
   return model;
 }
 
+// Error-controlled steps from 0 to end_time: the first step tried and the largest.
+DynamicOptions Steps(double end_time, double step, double max_step) {
+  DynamicOptions options;
+  options.adaptive = true;
+  options.end_time = end_time;
+  options.step = step;
+  options.max_step = max_step;
+  return options;
+}
+
 // Each stretch to the next boundary in equal steps of at most the step asked for (no Accept
 // here: every Fit plans anew).
 TEST(StepControl, StepsLandOnTheEndBreakpointsAndOutputTimes) {
   const SystemModel model = TwoNodes();
   const DofMap dofs(model);
-  DynamicOptions options;
-  options.end_time = 1.0;
-  options.step = 0.05;
-  options.max_step = 0.2;
+  DynamicOptions options = Steps(1.0, 0.05, 0.2);
   options.breakpoints = {0.25, 0.7};
   StepController c(model, dofs, options, 0.0);
   EXPECT_DOUBLE_EQ(c.FirstStep(), 0.05);
@@ -57,10 +64,7 @@ TEST(StepControl, StepsLandOnTheEndBreakpointsAndOutputTimes) {
 TEST(StepControl, TheStepChangesOnlyOutsideTheBandAndSeldom) {
   const SystemModel model = TwoNodes();
   const DofMap dofs(model);
-  DynamicOptions options;
-  options.end_time = 10.0;
-  options.step = 0.1;
-  options.max_step = 0.2;
+  const DynamicOptions options = Steps(10.0, 0.1, 0.2);
   StepController c(model, dofs, options, 0.0);
   const DynamicState s = InitialDynamicState(model, InitialState(model), Eigen::VectorXd::Zero(dofs.n_dofs()));
   EXPECT_DOUBLE_EQ(c.Fit(0.0, 0.1), 0.1);
