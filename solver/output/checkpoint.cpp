@@ -308,7 +308,7 @@ bool ReadResume(const std::string& directory, const Scene& scene, const std::str
   const SystemModel& model = scene.model;
   resume.state = ReadState(r, "/state", model);
   const Eigen::VectorXd x = r.Vector("/resume/numbers");
-  if (x.size() != 28 && x.size() != 32)  // (28: written before the step controller kept a plan)
+  if (x.size() != 28 && x.size() != 32)  // (28: a checkpoint without the step controller's plan)
     throw InputError(r.path() + ": dataset /resume/numbers has " + std::to_string(x.size()) + " values, not 32");
   resume.t_start = x[0], resume.h = x[1], resume.t_base = x[2], resume.last_output = x[3], resume.E0 = x[4];
   resume.energy_scale = x[5], resume.first_cut_time = x[6], resume.n_nominal = long(x[7]), resume.cuts = int(x[8]);
