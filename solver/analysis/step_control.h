@@ -47,8 +47,8 @@
 // 57 649 steps instead of 2 716 at a tolerance of 1e-4); with a band of [0.9, 1.25] but no
 // settling, cantilever_transient took 67 000 steps instead of 3 361 at 1e-5; [0.7, 1.25] kept
 // the steps but let the error double at loose tolerances (benchmarks/step_control.py). Against
-// steps changed at every step this takes 0.85-1.5 times the steps (most cases 1.1-1.3) for
-// errors as small or smaller.
+// steps changed at every step this takes 0.85-1.5 times the steps (most cases 1.1-1.4), with
+// errors from half to twice as large, case by case.
 //
 // The midpoint scheme damps no mode, so its reactions and stresses carry every excited mode that
 // its steps do not resolve, whatever the motion's error: its steps stay at or below 0.7 / omega
