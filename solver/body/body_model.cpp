@@ -111,6 +111,7 @@ void SuperelementBody::DeriveConstants() {
   const Eigen::Matrix<double, 6, 6> M_rig = Phi_rig0_.transpose() * M_ * Phi_rig0_;
   const double gyration = mass > 0 ? std::sqrt(M_rig.bottomRightCorner<3, 3>().diagonal().maxCoeff() / mass) : 0.0;
   const double length = size > 0 ? size : (gyration > 0 ? gyration : 1.0);
+  length_ = length;
   force_weights_ = Eigen::VectorXd::Ones(n_coordinates());
   for (int k = 0; k < n_nodes_; ++k) force_weights_.segment<3>(6 * k + 3).setConstant(1.0 / length);
   modal_weight_ = std::sqrt(std::max(mass, 0.0));

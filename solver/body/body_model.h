@@ -212,12 +212,16 @@ class SuperelementBody {
   bool has_exact_inertia() const { return !Gamma_.empty(); }
   /// The body's mass.
   double mass() const { return mass_; }
+  /// The body's length: the farthest interface node from the frame origin, or for a one-node body
+  /// its radius of gyration (the moments' lever in ForceNorm).
+  double length() const { return length_; }
 
   // The model's data (set by the constructor, read by the kernels).
   BodyKind kind_ = BodyKind::kSuperelement;
   Eigen::MatrixXd Phi_rig0_;
   // CenterOfMass: the mass m, the undeformed first moment s_0 about the frame origin, and C.
   double mass_ = 0.0;
+  double length_ = 1.0;  ///< length()
   Eigen::Vector3d first_moment0_ = Eigen::Vector3d::Zero();
   Eigen::MatrixXd first_moment_map_;    ///< 3 x n
   std::vector<Eigen::MatrixXd> Gamma_;  ///< the file's inertia invariants Gamma_a (3), or none

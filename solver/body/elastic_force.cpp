@@ -20,7 +20,10 @@ using body_blocks::TurnNodeBlocks;
 using body_blocks::TurnRowBlocks;
 
 double RoundOffForce(const SuperelementBody& body, const BodyConfiguration& c, double inertia_factor) {
-  double x = 0.0;
+  // The positions' size, at least the body's own: a free body by one node at the origin would
+  // otherwise have no round-off at all (a torque-free body spinning about a principal axis under
+  // the midpoint scheme, whose forces are all round-off, stopped with "Newton diverged").
+  double x = body.length();
   for (const Eigen::Vector3d& xk : c.x) x = std::max(x, xk.norm());
   return std::numeric_limits<double>::epsilon() * x *
          (16.0 * std::sqrt(double(body.n_coordinates())) * body.k_max_ + 4.0 * inertia_factor * body.m_max_);
