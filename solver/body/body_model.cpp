@@ -118,6 +118,14 @@ void SuperelementBody::DeriveConstants() {
   force_weights_.tail(n_modes_).setConstant(modal_weight_);
   k_max_ = (force_weights_.asDiagonal() * K_ * force_weights_.asDiagonal()).cwiseAbs().maxCoeff();
   m_max_ = (force_weights_.asDiagonal() * M_ * force_weights_.asDiagonal()).cwiseAbs().maxCoeff();
+  // (the node coordinates' columns, every row: a basis other than Craig-Bampton's couples them
+  // to the modal rows)
+  const int n_node_coordinates = 6 * n_nodes_;
+  k_nodes_max_ = n_node_coordinates == 0 ? 0.0
+                                         : (force_weights_.asDiagonal() * K_.leftCols(n_node_coordinates) *
+                                            force_weights_.head(n_node_coordinates).asDiagonal())
+                                               .cwiseAbs()
+                                               .maxCoeff();
   force_floor_ = 1e-4 * k_max_ * length;
   initial_frame_.x = placement_x_ + placement_R_ * origin_part_;
   initial_frame_.R = placement_R_;

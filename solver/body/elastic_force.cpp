@@ -26,7 +26,7 @@ double RoundOffForce(const SuperelementBody& body, const BodyConfiguration& c, d
   double x = body.length();
   for (const Eigen::Vector3d& xk : c.x) x = std::max(x, xk.norm());
   return std::numeric_limits<double>::epsilon() * x *
-         (16.0 * std::sqrt(double(body.n_coordinates())) * body.k_max_ + 4.0 * inertia_factor * body.m_max_);
+         (16.0 * std::sqrt(double(body.n_coordinates())) * body.k_nodes_max_ + 4.0 * inertia_factor * body.m_max_);
 }
 
 const Eigen::VectorXd& LocalForce(const SuperelementBody& body, BodyData& d, const InertiaLoadFactors* load) {
