@@ -122,33 +122,28 @@ SystemForces AssembleStatic(const SystemModel& model, const DofMap& dofs, System
   Eigen::VectorXd gravity = Eigen::VectorXd::Zero(n);
   for (size_t b = 0; b < model.bodies.size(); ++b) {
     const SuperelementBody& body = model.bodies[b];
-    const BodyConfiguration c = BodyConfigurationOf(model, state, int(b));
-    const FrameSolution frame = SolveFrameFrom(body, c, state.frames[b]);
+    BodyData data;
+    BodyConfigurationOf(model, state, int(b), data.c);
+    const FrameSolution frame = PlaceBody(body, state.frames[b], data);
     if (!frame.ok) {
       out.ok = false;
       out.message = "floating frame of body " + std::to_string(b) + " did not converge";
       return out;
     }
     state.frames[b] = frame;
-    BodyData data = Evaluate(body, c, frame);
     Eigen::VectorXd f;
     Eigen::MatrixXd K;
     // Gravity in a static analysis, ramped to full at pseudo-time static_gravity_end.
     const bool gravity_on = model.static_gravity_end > 0 && model.gravity.squaredNorm() > 0;
     const double ramp = gravity_on ? std::min(lambda / model.static_gravity_end, 1.0) : 0.0;
-    if (gravity_on && body.has_inertia_stiffening()) {
-      // The stress of the body's own weight stiffens it (load factors -R_j^T g at rest).
-      const Eigen::VectorXd zero = Eigen::VectorXd::Zero(body.n_coordinates());
-      InertiaLoadFactors load;
-      InertiaLoads(body, data, zero, zero, ramp * model.gravity, load);
-      ElasticForce(body, data, &f, with_tangent ? &K : nullptr, &load);
-    } else {
-      ElasticForce(body, data, &f, with_tangent ? &K : nullptr);
-    }
+    // The stress of the body's own weight stiffens it (load factors -R_j^T g at rest).
+    const Eigen::VectorXd rest = Eigen::VectorXd::Zero(body.n_coordinates());
+    InertiaLoadFactors load;
+    StiffenedElasticForce(body, data, rest, rest, ramp * model.gravity, load, f, with_tangent ? &K : nullptr);
     out.elastic_energy += ElasticEnergy(body, data);
     const double scale = std::max(body.ForceNorm(f), body.force_floor());
     out.force_scale = std::max(out.force_scale, scale);
-    out.roundoff += RoundOffForce(body, c);
+    out.roundoff += RoundOffForce(body, data.c);
     // The weight's configuration derivative in the tangent (S = -dr/dq: minus GravityTangent; the
     // dynamic iteration matrix takes it with the inertia's, generalized_alpha.cpp).
     if (with_tangent && gravity_on && ramp > 0) K -= GravityTangent(body, data, ramp * model.gravity);

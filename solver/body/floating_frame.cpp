@@ -191,6 +191,13 @@ void Evaluate(const SuperelementBody& body, const BodyConfiguration& c, const Fr
   EvaluateSolved(body, c, frame, d);
 }
 
+FrameSolution PlaceBody(const SuperelementBody& body, const FrameSolution& last, BodyData& d, bool warm) {
+  const bool kinematics = warm && d.kin.W.cols() == body.n_coordinates();
+  const FrameSolution frame = SolveFrameFrom(body, d.c, last, &d.q, kinematics ? &d.kin.S_inv : nullptr);
+  if (frame.ok) EvaluateSolved(body, d.c, frame, d);
+  return frame;
+}
+
 void EvaluateSolved(const SuperelementBody& body, const BodyConfiguration& c, const FrameSolution& frame, BodyData& d) {
   if (&c != &d.c) d.c = c;
   d.frame = frame;

@@ -41,6 +41,12 @@ void Evaluate(const SuperelementBody& body, const BodyConfiguration& c, const Fr
 /// The same when d.q already holds the local coordinates at `frame` (SolveFrameFrom's output
 /// for this c and frame): they are not computed again.
 void EvaluateSolved(const SuperelementBody& body, const BodyConfiguration& c, const FrameSolution& frame, BodyData& d);
+/// The body at its configuration d.c: the frame solved from `last` (SolveFrameFrom; first with
+/// d's own S^-1 when `warm` and d holds this body's kinematics, as a Newton iteration's or a
+/// step's last evaluation does) and d evaluated at it. Every assembly pass (statics,
+/// generalized-alpha, the midpoint scheme) places its bodies here. The frame, ok = false when it
+/// did not converge (d is then not evaluated).
+FrameSolution PlaceBody(const SuperelementBody& body, const FrameSolution& last, BodyData& d, bool warm = false);
 
 /// The floating frame's motion and the rates of the local coordinates at `d` (LocalMotion, in
 /// body_model.h); the accelerations with `wdot`.

@@ -63,4 +63,16 @@ void InertiaLoads(const SuperelementBody& body, BodyData& d, const BodyVelocity&
   out.d_w.bottomRows<6>().noalias() = d_products * d_omega;
 }
 
+void StiffenedElasticForce(const SuperelementBody& body, BodyData& d, const BodyVelocity& w, const BodyVelocity& wdot,
+                           const Eigen::Vector3d& g, InertiaLoadFactors& load, Eigen::VectorXd& f,
+                           Eigen::MatrixXd* tangent) {
+  if (body.has_inertia_stiffening()) {
+    InertiaLoads(body, d, w, wdot, g, load);
+    ElasticForce(body, d, &f, tangent, &load);
+  } else {
+    load.a.setZero();
+    ElasticForce(body, d, &f, tangent);
+  }
+}
+
 }  // namespace femb

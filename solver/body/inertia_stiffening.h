@@ -24,6 +24,15 @@ namespace femb {
 void InertiaLoads(const SuperelementBody& body, BodyData& d, const BodyVelocity& w, const BodyVelocity& wdot,
                   const Eigen::Vector3d& gravity, InertiaLoadFactors& out);
 
+/// The elastic force f (and with `tangent` its derivative, ElasticForce) stiffened by the inertia
+/// loads of the frame's velocity w, acceleration wdot and the gravity field g, whose load factors
+/// go into `load`; a body without inertia stiffening gets K q alone and zero factors. Statics
+/// (w = wdot = 0, the ramped gravity), generalized-alpha (the iterate's motion) and the midpoint
+/// scheme (the step's mean motion at q_m) all take their elastic force from here.
+void StiffenedElasticForce(const SuperelementBody& body, BodyData& d, const BodyVelocity& w, const BodyVelocity& wdot,
+                           const Eigen::Vector3d& g, InertiaLoadFactors& load, Eigen::VectorXd& f,
+                           Eigen::MatrixXd* tangent = nullptr);
+
 // K_sigma,k q_loc for the 12 load cases (n x 12), kept in d.
 const Eigen::MatrixXd& SigmaProducts(const SuperelementBody& body, BodyData& d);
 

@@ -33,28 +33,19 @@ void AssembleDynamicResidual(const SystemModel& model, const DofMap& dofs, Dynam
     BodyConfiguration& c = pass.data.c;  // evaluated in place: the pass's storage is reused
     BodyConfigurationOf(model, s.config, b, c);
     // The frame from the last one, iterating with the last pass's S^-1 (the same body a Newton
-    // correction or a step earlier); its local coordinates stay in pass.data.q.
-    const bool kinematics = pass.data.kin.W.cols() == body.n_coordinates();
-    const FrameSolution frame =
-        SolveFrameFrom(body, c, s.config.frames[b], &pass.data.q, kinematics ? &pass.data.kin.S_inv : nullptr);
+    // correction or a step earlier).
+    const FrameSolution frame = PlaceBody(body, s.config.frames[b], pass.data, true);
     if (!frame.ok) {
       r.frame_ok = false;
       return;
     }
     s.config.frames[b] = frame;
-    EvaluateSolved(body, c, frame, pass.data);
     GatherBody(model, dofs, s.config, b, s.W, pass.w);
     GatherBodyAcceleration(model, dofs, b, node_acc, s.Wdot, pass.wdot);
     // Inertia stiffening: K + K_sigma(a), a from this iterate's frame motion; its
     // velocity and acceleration derivatives go into C and M of the iteration matrix.
-    const bool stiffening = body.has_inertia_stiffening();
-    if (stiffening) {
-      InertiaLoads(body, pass.data, pass.w, pass.wdot, model.gravity, pass.load);
-    } else {
-      pass.load.a.setZero();
-    }
     Eigen::VectorXd &f_int = r.f_int, &f_in = r.f_in, &f_acc = r.f_acc;
-    ElasticForce(body, pass.data, &f_int, nullptr, stiffening ? &pass.load : nullptr);
+    StiffenedElasticForce(body, pass.data, pass.w, pass.wdot, model.gravity, pass.load, f_int);
     InertiaForce(body, pass.data, pass.w, pass.wdot, &f_in, nullptr, nullptr, &f_acc);
     AddModalDamping(body, pass.w, f_in, nullptr);
     if (model.gravity.squaredNorm() > 0) {

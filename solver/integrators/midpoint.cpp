@@ -298,17 +298,14 @@ void MidpointBodyTerms(const SystemModel& model, const DofMap& dofs, const Dynam
   r.frame_ok = true;
   BodyConfigurationOf(model, s1.config, b, d1.c);
   BodyConfigurationOf(model, k.mid, b, dm.c);
-  const FrameSolution f1 = SolveFrameFrom(body, d1.c, s1.config.frames[b], &d1.q);
-  const FrameSolution fm = f1.ok ? SolveFrameFrom(body, dm.c, s0.config.frames[b], &dm.q) : FrameSolution{};
+  const FrameSolution f1 = PlaceBody(body, s1.config.frames[b], d1);
+  const FrameSolution fm = f1.ok ? PlaceBody(body, s0.config.frames[b], dm) : FrameSolution{};
   if (!f1.ok || !fm.ok) {
     r.frame_ok = false;
     return;
   }
   s1.config.frames[b] = f1;
   k.mid.frames[b] = fm;
-  // (the local coordinates are the frame solutions', at these frames)
-  EvaluateSolved(body, d1.c, f1, d1);
-  EvaluateSolved(body, dm.c, fm, dm);
   Eigen::VectorXd& w1 = pass.w;
   w1.resize(body.n_coordinates());
   for (int a = 0; a < body.n_nodes(); ++a) w1.segment<6>(6 * a) = k.node_w1[size_t(model.body_nodes[b][a])];
@@ -331,15 +328,9 @@ void MidpointBodyTerms(const SystemModel& model, const DofMap& dofs, const Dynam
   Eigen::VectorXd &f_in = r.f_in, &f_int = r.f_int, &f_acc = r.f_acc;
   MidpointInertia(model, s0, h, s1, b, d1, w1, maps1, mw, r);
   AddModalDamping(body, wm, f_in, nullptr);
-  if (body.has_inertia_stiffening()) {
-    // Inertia stiffening at the mid configuration with the step's mean velocity and
-    // acceleration.
-    m.wdot = m.dw / h;
-    InertiaLoads(body, dm, wm, m.wdot, model.gravity, m.load);
-    ElasticForce(body, dm, &f_int, nullptr, &m.load);
-  } else {
-    ElasticForce(body, dm, &f_int, nullptr);
-  }
+  // Inertia stiffening at the mid configuration with the step's mean velocity and acceleration.
+  m.wdot = m.dw / h;
+  StiffenedElasticForce(body, dm, wm, m.wdot, model.gravity, m.load, f_int);
   Eigen::VectorXd& f_grav = r.f_grav;
   MidpointGravity(model, h, b, d1.q, f1, mw, f_grav);
   // Scale: each term on its own (for a torque-free body the momentum change and the source
