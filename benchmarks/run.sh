@@ -30,7 +30,7 @@ echo
 /usr/bin/python3 benchmarks/step_control.py build/bin
 echo
 # Time to accuracy on the slider-crank compared with its peer: rigid crank and slider,
-# the rod in 2 stiffened bodies; steps, Newton tolerances, body_matrices_every (about 30 s).
+# the rod in 2 or 4 stiffened bodies along the step, least times against the peer's (about 15 s).
 /usr/bin/python3 benchmarks/peer_slider_crank.py build/bin --out out/peer_slider_crank
 echo
 # The solver's hot path against the commit before the allocation-free hot path (9db5b40; builds it once in
