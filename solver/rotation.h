@@ -6,15 +6,9 @@
 #include <Eigen/Geometry>
 #include <cmath>
 
-namespace femb {
+#include "formats/skew.h"
 
-/// a~ such that a~ b = a x b.
-template <typename S>
-Eigen::Matrix<S, 3, 3> Skew(const Eigen::Matrix<S, 3, 1>& a) {
-  Eigen::Matrix<S, 3, 3> m;
-  m << S(0), -a.z(), a.y(), a.z(), S(0), -a.x(), -a.y(), a.x(), S(0);
-  return m;
-}
+namespace femb {
 
 /// Rotation matrix exp(theta~) (Rodrigues).
 Eigen::Matrix3d ExpSO3(const Eigen::Vector3d& theta);

@@ -13,6 +13,7 @@
 #include <unordered_map>
 
 #include "formats/input_error.h"
+#include "formats/skew.h"
 #include "formats/vtk_cells.h"
 #include "reducer/fe/beam_model.h"
 #include "reducer/fe/solid_element.h"
@@ -23,12 +24,6 @@
 #include "reducer/reduction/craig_bampton.h"
 namespace femb {
 namespace {
-
-Eigen::Matrix3d Skew(const Eigen::Vector3d& a) {
-  Eigen::Matrix3d m;
-  m << 0, -a.z(), a.y(), a.z(), 0, -a.x(), -a.y(), a.x(), 0;
-  return m;
-}
 
 // Where each imported DOF sits: its mesh node (full_node), each mesh node's DOF per component
 // (full_dof, -1: none), and how many are rotations. Every node of the matrices must be a node of
@@ -118,7 +113,8 @@ SparseMatrix RigidCouplingMap(const PartSpec& part, const ForeignMesh& geometry,
     const size_t k = size_t(owner[size_t(s)]);
     t.emplace_back(int(r), base[k] + c, 1.0);
     if (c < 3) {
-      const Eigen::Matrix3d arm = -Skew(geometry.nodes.row(s).transpose() - model.interface_positions[k]);
+      const Eigen::Matrix3d arm =
+          -Skew<double>(Eigen::Vector3d(geometry.nodes.row(s).transpose() - model.interface_positions[k]));
       for (int j = 0; j < 3; ++j)
         if (arm(c, j) != 0.0) t.emplace_back(int(r), base[k] + 3 + j, arm(c, j));
     }

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "formats/skew.h"
 #include "reducer/linalg/dense_products.h"
 
 namespace femb {
@@ -162,17 +163,12 @@ std::vector<std::pair<int, Eigen::VectorXd>> InterfaceRotationCompletion(
   const int n = int(mesh_shapes.cols());
   const long n_nodes = mesh_nodes.rows();
   auto pair_index = [n](int j, int k) { return j * n - j * (j - 1) / 2 + (k - j); };  // j <= k
-  auto skew = [](const Eigen::Vector3d& v) {
-    Eigen::Matrix3d s;
-    s << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;
-    return s;
-  };
   std::vector<std::pair<int, Eigen::VectorXd>> fields;
   for (size_t k = 0; k < interface_points.size(); ++k) {
     const int first = 6 * int(k);
     for (int a = 0; a < 3; ++a)
       for (int b = a; b < 3; ++b) {
-        const Eigen::Matrix3d Ea = skew(Eigen::Vector3d::Unit(a)), Eb = skew(Eigen::Vector3d::Unit(b));
+        const Eigen::Matrix3d Ea = Skew<double>(Eigen::Vector3d::Unit(a)), Eb = Skew<double>(Eigen::Vector3d::Unit(b));
         const Eigen::Matrix3d C = 0.25 * (Ea * Eb + Eb * Ea);  // sym(e_a~ e_b~) / 2
         Eigen::VectorXd W = Eigen::VectorXd::Zero(dofs_per_node * n_nodes);
         for (long i = 0; i < n_nodes; ++i) {

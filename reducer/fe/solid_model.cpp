@@ -7,6 +7,7 @@
 #include <optional>
 
 #include "formats/input_error.h"
+#include "formats/skew.h"
 #include "reducer/fe/connectivity.h"
 #include "reducer/fe/solid_element.h"
 #include "reducer/mesh/gmsh_mesher.h"
@@ -15,12 +16,6 @@
 
 namespace femb {
 namespace {
-
-Eigen::Matrix3d SkewOf(const Eigen::Vector3d& a) {
-  Eigen::Matrix3d m;
-  m << 0, -a.z(), a.y(), a.z(), 0, -a.x(), -a.y(), a.x(), 0;
-  return m;
-}
 
 // Reference coordinates of x in element e, or false when outside (1e-9).
 bool Locate(const SolidMesh& mesh, int e, const Eigen::Vector3d& x, Eigen::Vector3d* xi) {
@@ -334,9 +329,9 @@ Eigen::MatrixXd Rbe3Weights(const Eigen::MatrixXd& nodes, const std::vector<int>
   Eigen::MatrixXd W = Eigen::MatrixXd::Zero(6, 3 * ns);
   for (int a = 0; a < ns; ++a) {
     const Eigen::Vector3d r = nodes.row(set[a]).transpose() - c;
-    const Eigen::Matrix3d Wtheta = Ainv * SkewOf(r);
+    const Eigen::Matrix3d Wtheta = Ainv * Skew<double>(r);
     W.block<3, 3>(3, 3 * a) = Wtheta;
-    W.block<3, 3>(0, 3 * a) = Eigen::Matrix3d::Identity() / ns - SkewOf(d) * Wtheta;
+    W.block<3, 3>(0, 3 * a) = Eigen::Matrix3d::Identity() / ns - Skew<double>(d) * Wtheta;
   }
   return W;
 }
@@ -456,7 +451,8 @@ SparseMatrix RigidCouplingMap(const PartSpec& part, const SolidMesh& mesh, const
   for (int s = 0; s < n_nodes; ++s) {
     if (owner[s] >= 0 && part.interfaces[owner[s]].coupling == Coupling::kRbe2) {
       const int base = rbe2_base[owner[s]];
-      const Eigen::Matrix3d arm = -SkewOf(mesh.nodes.row(s).transpose() - model.interface_positions[owner[s]]);
+      const Eigen::Matrix3d arm =
+          -Skew<double>(Eigen::Vector3d(mesh.nodes.row(s).transpose() - model.interface_positions[owner[s]]));
       for (int d = 0; d < 3; ++d) {
         t_entries.emplace_back(3 * s + d, base + d, 1.0);
         for (int c = 0; c < 3; ++c) {
@@ -498,7 +494,7 @@ SolidDofMap AssemblyMap(const PartSpec& part, const SolidMesh& mesh, const std::
   for (int s = 0; s < n_nodes; ++s) {
     if (kept[3 * s] >= 0) continue;
     map.model_node[s] = interface_node[owner[s]];
-    map.arm[s] = -SkewOf(mesh.nodes.row(s).transpose() - model.interface_positions[owner[s]]);
+    map.arm[s] = -Skew<double>(Eigen::Vector3d(mesh.nodes.row(s).transpose() - model.interface_positions[owner[s]]));
   }
   return map;
 }
