@@ -108,7 +108,7 @@ void ConsistentAccelerations(const SystemModel& model, const DofMap& dofs, Dynam
     Triplets G;
     AddLoopConstraints(model, dofs, s.config, nullptr, nullptr, nullptr, &G);
     M = b.M + ToMatrix(dofs.n_dofs(), G);
-    const double L = std::max(BoundingDiagonal(model.node_x0), 1e-300);
+    const double L = ModelSize(model);
     double speed = 0.0;
     for (int k = 0; k < model.n_nodes(); ++k)
       speed = std::max(

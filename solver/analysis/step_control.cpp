@@ -10,12 +10,9 @@ StepController::StepController(const SystemModel& model, const DofMap& dofs, con
   const double span = options.end_time - t0;
   min_step_ = options.min_step > 0 ? options.min_step : 1e-8 * span;
   max_step_ = options.max_step > 0 ? options.max_step : 0.01 * span;
-  // The model's size; with all nodes at one point (a free body by its centre of mass) the bodies'
-  // own (their radius of gyration): 0 made every error estimate infinite.
-  double size = BoundingDiagonal(model.node_x0);
-  if (!(size > 0))
-    for (const SuperelementBody& body : model.bodies) size = std::max(size, body.length());
-  D_ = 1e-3 * std::max(size, 1e-300);
+  // The model's size (with all nodes at one point the bodies' own: 0 made every error estimate
+  // infinite).
+  D_ = 1e-3 * ModelSize(model);
   if (options.integrator == Integrator::kMidpoint) {
     c_q_ = 1.0 / 12, c_v_ = 1.0 / 24;
   } else {

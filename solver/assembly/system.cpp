@@ -253,8 +253,7 @@ Eigen::VectorXd ResidualWeights(const SystemModel& model, const DofMap& dofs) {
 }
 
 void ResidualWeights(const SystemModel& model, const DofMap& dofs, Eigen::VectorXd& w) {
-  double L = BoundingDiagonal(model.node_x0);
-  if (!(L > 0)) L = 1.0;
+  const double L = ModelSize(model);
   w.setOnes(dofs.n_dofs());
   for (int k = 0; k < model.n_nodes(); ++k) {
     const int first = dofs.node_first(k), j = dofs.joint_of(k);

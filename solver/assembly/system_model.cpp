@@ -226,4 +226,11 @@ double BoundingDiagonal(const std::vector<Eigen::Vector3d>& points) {
   return (hi - lo).norm();
 }
 
+double ModelSize(const SystemModel& model) {
+  double size = BoundingDiagonal(model.node_x0);
+  if (!(size > 0))
+    for (const SuperelementBody& body : model.bodies) size = std::max(size, body.length());
+  return size > 0 ? size : 1.0;
+}
+
 }  // namespace femb

@@ -236,6 +236,13 @@ void ApplyPrescribed(const SystemModel& model, const DofMap& dofs, double t, Sys
 /// than two points.
 double BoundingDiagonal(const std::vector<Eigen::Vector3d>& points);
 
+/// The model's size, the length that every tolerance and weight in length units refers to (the
+/// rotations' weight in Newton's test, the loops' violation, the step controller's scale, the
+/// midpoint scheme's discrete gradients): the diagonal of the nodes' bounding box at placement;
+/// with all nodes at one point (a free body held by its centre of mass), the bodies' own size
+/// (SuperelementBody::length); 1 for a model with neither.
+double ModelSize(const SystemModel& model);
+
 /// Applies an increment of the unknowns: x += dx, R <- exp(dpi~) R, eta += d eta.
 void ApplyIncrement(const SystemModel& model, const DofMap& dofs, const Eigen::VectorXd& delta, SystemState& state);
 

@@ -168,8 +168,7 @@ void AddUserForces(const SystemModel& model, const SystemState& state, const Eig
   for (const UserModalForce& force : model.user_modal_forces)
     AddModalForce(force, model.dofs(), state, W, t, residual, K, C);
   if (model.user_forces.empty()) return;
-  double length = BoundingDiagonal(model.node_x0);
-  if (!(length > 0)) length = 1.0;
+  const double length = ModelSize(model);
   UserNodeForce::Vector6 f;
   UserNodeForce::Matrix6 dfdq, dfdv;
   for (const UserNodeForce& force : model.user_forces) {

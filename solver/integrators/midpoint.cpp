@@ -518,7 +518,7 @@ void StartMidpointStep(const SystemModel& model, const DofMap& dofs, const Dynam
   if (mw.triple_of.size() != size_t(dofs.n_dofs())) {
     // What depends on the model alone.
     TripleOf(dofs, triples, mw.triple_of);
-    mw.L2 = std::pow(std::max(BoundingDiagonal(model.node_x0), 1e-300), 2);
+    mw.L2 = std::pow(ModelSize(model), 2);
     // Bodies with a free node (6 own coordinates) keep the momentum-conserving source terms.
     mw.free_node.assign(model.bodies.size(), 0);
     for (size_t b = 0; b < model.bodies.size(); ++b) {

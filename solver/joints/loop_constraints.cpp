@@ -297,8 +297,7 @@ std::string LoopSingularity(const SystemModel& model, const SystemState& state) 
 
 double LoopViolation(const SystemModel& model, const SystemState& state, int* worst, const BodyDataAtState* data,
                      SystemScratch* scratch) {
-  double L = BoundingDiagonal(model.node_x0);
-  if (!(L > 0)) L = 1.0;
+  const double L = ModelSize(model);
   double largest = 0.0;
   if (worst) *worst = -1;
   for (size_t c = 0; c < model.cut_joints.size(); ++c) {
@@ -347,8 +346,8 @@ std::vector<Eigen::Matrix<double, 6, 1>> CutJointReactions(const SystemModel& mo
 
 bool LoopsClosed(const SystemModel& model, const SystemState& state, double tolerance, const BodyDataAtState* data,
                  SystemScratch* scratch) {
-  return !model.has_constraints() || LoopViolation(model, state, nullptr, data, scratch) <=
-                                         tolerance * std::max(BoundingDiagonal(model.node_x0), 1e-300);
+  return !model.has_constraints() ||
+         LoopViolation(model, state, nullptr, data, scratch) <= tolerance * ModelSize(model);
 }
 
 }  // namespace femb

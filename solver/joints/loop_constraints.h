@@ -42,7 +42,7 @@ double LoopViolation(const SystemModel& model, const SystemState& state, int* wo
 /// mechanism's reactions are not unique and this one carries none.
 std::vector<Eigen::Matrix<double, 6, 1>> CutJointReactions(const SystemModel& model, const SystemState& state);
 /// Newton's test on the loops: no constraints, or LoopViolation <= tolerance times the model's
-/// size (BoundingDiagonal of the nodes), the same relative tolerance as the forces'.
+/// size (ModelSize), the same relative tolerance as the forces'.
 bool LoopsClosed(const SystemModel& model, const SystemState& state, double tolerance,
                  const BodyDataAtState* data = nullptr, SystemScratch* scratch = nullptr);
 

@@ -82,7 +82,7 @@ void RequireLoopsClosedAtStart(const SceneSpec& spec, const SystemModel& model, 
   ApplyPrescribed(model, dofs, 0.0, state, nullptr, nullptr);
   int worst = -1;
   const double gap = LoopViolation(model, state, &worst);
-  if (gap <= 1e-9 * std::max(BoundingDiagonal(model.node_x0), 1e-300)) return;
+  if (gap <= 1e-9 * ModelSize(model)) return;
   char buffer[200];
   std::snprintf(buffer, sizeof buffer, ", which opens the loop closed by %s by %.3g at the start",
                 worst >= 0 && size_t(worst) < model.cut_joints.size() ? model.cut_joints[size_t(worst)].name.c_str()
@@ -395,7 +395,7 @@ void AddJoints(const SceneSpec& spec, const Placement& placement, Scene& scene) 
   JointTreeBuilder tree(model);
   AddRigidOffsets(order, placement, scene, tree);
   // The bounding box diagonal of the nodes: the scale of position tolerances.
-  const double scene_length = BoundingDiagonal(model.node_x0);
+  const double scene_length = ModelSize(model);
   for (const SceneJointSpec* jp : order) {
     const SceneJointSpec& j = *jp;
     const int k = scene.node_index.at(j.node);
