@@ -1,6 +1,7 @@
 #include "solver/analysis/dynamic_analysis.h"
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <functional>

@@ -15,6 +15,7 @@
 // drives and on output times.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <atomic>
 #include <functional>
@@ -208,6 +209,25 @@ struct DynamicResume {
 /// open them (G W != 0) are replaced by the nearest that do not, in the kinetic-energy norm.
 DynamicState InitialDynamicState(const SystemModel& model, const SystemState& config, const Eigen::VectorXd& W,
                                  double t0 = 0.0);
+
+/// Generalized-alpha's parameters for a spectral radius rho_inf at infinite frequency (Chung and
+/// Hulbert 1993, second order with the high frequencies damped most): alpha_m = (2 rho - 1) /
+/// (rho + 1), alpha_f = rho / (rho + 1), gamma = 1/2 + alpha_f - alpha_m, beta = (gamma + 1/2)^2
+/// / 4; rho_inf clamped to [0, 1].
+struct AlphaParameters {
+  double alpha_m, alpha_f, gamma, beta;
+  explicit AlphaParameters(double rho_inf) {
+    const double rho = std::clamp(rho_inf, 0.0, 1.0);
+    alpha_m = (2 * rho - 1) / (rho + 1);
+    alpha_f = rho / (rho + 1);
+    gamma = 0.5 + alpha_f - alpha_m;
+    beta = 0.25 * (gamma + 0.5) * (gamma + 0.5);
+  }
+  /// The constant of the positions' local error, q(t_n+1) - q_n+1 = c h^3 q''' + O(h^4):
+  /// 1/6 - beta - (alpha_m - alpha_f) / 2 (the step controller's estimate and the velocity
+  /// offset moved at a change of step).
+  double third_order() const { return 1.0 / 6 - beta - 0.5 * (alpha_m - alpha_f); }
+};
 
 /// A body's highest natural frequency [rad/s] of its reduced K and M (free-free, in its
 /// interface coordinates); 0 for a rigid body.

@@ -16,10 +16,7 @@ StepController::StepController(const SystemModel& model, const DofMap& dofs, con
   if (options.integrator == Integrator::kMidpoint) {
     c_q_ = 1.0 / 12, c_v_ = 1.0 / 24;
   } else {
-    const double rho = std::clamp(options.rho_inf, 0.0, 1.0);
-    const double alpha_m = (2 * rho - 1) / (rho + 1), alpha_f = rho / (rho + 1);
-    const double gamma = 0.5 + alpha_f - alpha_m, beta = 0.25 * (gamma + 0.5) * (gamma + 0.5);
-    c_q_ = std::abs(1.0 / 6 - beta - 0.5 * (alpha_m - alpha_f)), c_v_ = 1.0 / 12;
+    c_q_ = std::abs(AlphaParameters(options.rho_inf).third_order()), c_v_ = 1.0 / 12;
   }
   if (options.integrator == Integrator::kMidpoint && !(options.max_step > 0))
     max_step_ = std::min(max_step_, MidpointResolvedStep(model));

@@ -311,9 +311,8 @@ void KeepIncrement(const DynamicState& state, double h, const Eigen::VectorXd& d
 StepOutcome GeneralizedAlphaStep(const SystemModel& model, const DofMap& dofs, const DynamicOptions& options,
                                  const DynamicState& state, double h, double t_new, IterationMatrix& matrix,
                                  BodyThreads& threads, BodyWorkspace& work, DynamicState& next) {
-  const double rho = std::clamp(options.rho_inf, 0.0, 1.0);
-  const double alpha_m = (2 * rho - 1) / (rho + 1), alpha_f = rho / (rho + 1);
-  const double gamma = 0.5 + alpha_f - alpha_m, beta = 0.25 * (gamma + 0.5) * (gamma + 0.5);
+  const AlphaParameters alpha(options.rho_inf);
+  const double alpha_m = alpha.alpha_m, alpha_f = alpha.alpha_f, gamma = alpha.gamma, beta = alpha.beta;
   next = state;  // storage reused: `next` is the caller's, of the same sizes after the first step
   // Predictor: constant acceleration, Wdot_n+1 = Wdot_n, and a_n+1 from (1 - alpha_m) a_n+1 +
   // alpha_m a_n = (1 - alpha_f) Wdot_n+1 + alpha_f Wdot_n. Arnold & Bruls predict Wdot_n+1 = 0,
@@ -336,7 +335,7 @@ StepOutcome GeneralizedAlphaStep(const SystemModel& model, const DofMap& dofs, c
   Eigen::VectorXd& W_n = work.W_n;
   W_n = state.W;
   work.velocity_change.resize(dofs.n_dofs());  // sized on the first step: it is needed at a change of step
-  if (options.adaptive) MoveVelocityOffset(dofs, state, h, 1.0 / 6 - beta - 0.5 * (alpha_m - alpha_f), work, W_n);
+  if (options.adaptive) MoveVelocityOffset(dofs, state, h, alpha.third_order(), work, W_n);
   next.a = (state.Wdot - alpha_m * a_n) / (1 - alpha_m);
   next.W = W_n + h * (1 - gamma) * a_n + h * gamma * next.a;
   work.dq = h * (W_n + h * (0.5 - beta) * a_n + h * beta * next.a);
