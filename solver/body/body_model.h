@@ -246,8 +246,8 @@ class SuperelementBody {
   double k_max_ = 0.0;  ///< max|D K D|, D = diag(force_weights_): force per length
   /// max|D K D| over the interface nodes' coordinates' columns: the stiffness through which the
   /// absolute positions' round-off reaches the forces (RoundOffForce). The modal coordinates are
-  /// unknowns of their own, untouched by that round-off; with them, a body's stiffest mode set
-  /// the floor (a spinning bar: 2e4 times the residual's true noise).
+  /// unknowns of their own, untouched by that round-off; with them, a body's stiffest mode would
+  /// set the floor (a spinning bar: 2e4 times the residual's true noise).
   double k_nodes_max_ = 0.0;
   double m_max_ = 0.0;             ///< max|D M D|: force per acceleration
   Eigen::VectorXd force_weights_;  ///< see ForceNorm

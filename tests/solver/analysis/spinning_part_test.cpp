@@ -301,9 +301,9 @@ TEST(SpinningPart, ImportedStiffeningRefusesAMissingOrWrongMaterial) {
 // axial mode, 2.6 kHz, not resolved: h omega_axial = 5): the angular momentum is kept to the
 // Newton tolerance with either inertia (measured: 2.1e-11 exact over 20 periods, 6.4e-10 over
 // 1 000 periods at tolerance 1e-12). The bound guards the round-off floor of Newton's test
-// (RoundOffForce): taken from the stiffest modal coordinate, it accepted residuals 2e4 times its
-// true noise, 3.6e-10 of the forces where 1e-12 was asked, and the momentum drifted 8e-10 in 20
-// periods. The energy is not an exact invariant of the scheme for a flexible body (its elastic
+// (RoundOffForce): taken from the stiffest modal coordinate, it would accept residuals 2e4 times
+// its true noise, 3.6e-10 of the forces where 1e-12 is asked, and let the momentum drift 8e-10 in
+// 20 periods. The energy is not an exact invariant of the scheme for a flexible body (its elastic
 // force is no discrete gradient); its error stays bounded (2.5e-6 after 20 periods, 2.8e-6 after
 // 1 000 with the exact inertia) and with the exact inertia it is 40x below the corotational
 // one's (measured over 100 periods: 2.8e-6 against 1.1e-4).
