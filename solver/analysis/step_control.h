@@ -37,18 +37,15 @@
 // taken in equal steps of at most the planned step. The plan is made at the first step and after
 // a rejection (from the step to retry); otherwise it changes only when the controller's proposal
 // after an accepted step leaves [0.9, 1.25] of the step in use, at least 7 steps after the last
-// change or breakpoint, and only when that moves the step. So the step changes seldom, instead of
-// at almost every step as the landing pattern 0.4/0.3/0.3 ms on 1 ms output times did. Every
-// change of step sets generalized-alpha's stiff directions (the static modes of a flexible body,
-// the loops' constrained directions) off by its velocities' offset, which the integrator moves at
-// the change (generalized_alpha.cpp) from an estimate of the motion's third derivative. That
-// move excites the stiff directions a little in turn, and the jerk estimate sees it: moved at
-// every change of a step changing all the time, the steps collapsed (rotating_beam, 10 bodies,
-// 57 649 steps instead of 2 716 at a tolerance of 1e-4); with a band of [0.9, 1.25] but no
-// settling, cantilever_transient took 67 000 steps instead of 3 361 at 1e-5; [0.7, 1.25] kept
-// the steps but let the error double at loose tolerances (benchmarks/step_control.py). Against
-// steps changed at every step this takes 0.85-1.5 times the steps (most cases 1.1-1.4), with
-// errors from half to twice as large, case by case.
+// change or breakpoint, and only when that moves the step. Why the step changes seldom: every
+// change sets generalized-alpha's stiff directions (the static modes of a flexible body, the
+// loops' constrained directions) off by its velocities' offset, which the integrator moves at the
+// change (generalized_alpha.cpp) from an estimate of the motion's third derivative; that move
+// excites the stiff directions a little in turn, and the jerk estimate sees it. Changed at every
+// step, the steps collapse (rotating_beam, 10 bodies: 57 649 steps against 2 716 at a tolerance
+// of 1e-4); without the settling too (cantilever_transient at 1e-5: 67 000 against 3 361); a
+// band of [0.7, 1.25] lets the error double at loose tolerances. benchmarks/step_control.py
+// measures the steps and errors of every dynamic example (docs/performance.md).
 //
 // The midpoint scheme damps no mode, so its reactions and stresses carry every excited mode that
 // its steps do not resolve, whatever the motion's error: its steps stay at or below 0.7 / omega
