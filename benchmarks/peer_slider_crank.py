@@ -12,6 +12,10 @@ example's 20 linear bodies at h = 5 us), as a fraction of its peak (deflection.p
 error: the largest error of that model at that step or at any smaller step run, so that a
 cancellation of time and space error at one step does not count.
 
+Each model runs under two integrators: generalized-alpha (second order) and the three-stage Radau
+IIA scheme (fifth order, analysis.integrator: radau; its bodies' matrices computed at every
+stage, body_matrices_every 1), each at its own steps.
+
 The peer's least solve times (Exudyn 1.11, ANCF cables, index-3 generalized-alpha, its fastest
 build) are the figures measured side by side on this machine against an independent reference (a
 64-element geometrically exact rod; docs/performance.md): they are constants here, not rerun. This
@@ -42,6 +46,9 @@ import stiffening  # noqa: E402
 PEER_LEAST = {2.0: 0.027, 1.0: 0.037, 0.5: 0.037, 0.2: 0.109, 0.1: None}
 LEVELS = (2.0, 1.0, 0.5, 0.2, 0.1)
 STEPS = {2: ("2e-4", "1.4e-4", "1e-4", "7.5e-5", "5e-5", "2.5e-5", "1e-5"), 4: ("2e-4", "1e-4", "5e-5", "1e-5")}
+# The Radau IIA integrator (order 5): its steps, tolerance 1e-3, the bodies' matrices at every stage.
+RADAU_STEPS = {2: ("2e-3", "1.5e-3", "1e-3", "7.5e-4", "5e-4", "2.5e-4"), 4: ("1.5e-3", "1e-3", "5e-4", "2.5e-4")}
+SHORT = {"generalized_alpha": "g-alpha", "radau": "radau"}
 
 
 def rigid_scene(n):
@@ -105,15 +112,15 @@ def prepare(a, solve, reduce):
     return ref
 
 
-def measure(a, solve, ref, n, h, tol, every):
+def measure(a, solve, ref, n, h, tol, every, integrator="generalized_alpha"):
     """One row: (steps, iterations per step, best solve time, best wall time, error in %)."""
-    out = os.path.join(a.out, f"rigid_{n}_{h}_{tol}_{every}")
+    out = os.path.join(a.out, f"rigid_{n}_{integrator}_{h}_{tol}_{every}")
     best_solve = best_wall = float("inf")
     for _ in range(a.repeats):
         start = time.time()
         text = run([solve, os.path.join(a.out, f"rigid_{n}.yaml"), "-o", out, "--threads", "1", "--set",
                     f"analysis.step={h}", "--set", f"analysis.tolerance={tol}", "--set",
-                    f"analysis.body_matrices_every={every}"])
+                    f"analysis.body_matrices_every={every}", "--set", f"analysis.integrator={integrator}"])
         best_wall = min(best_wall, time.time() - start)
         m = re.search(r"solving ([0-9.]+) s.*: (\d+) steps, ([0-9.]+) Newton", text)
         best_solve = min(best_solve, float(m.group(1)))
@@ -133,32 +140,34 @@ def main():
     solve, reduce = os.path.join(a.bin, "femb-solve"), os.path.join(a.bin, "femb-reduce")
     os.makedirs(a.out, exist_ok=True)
     ref = prepare(a, solve, reduce)
-    print("model       step      tolerance  every  steps  its/step  solving [s]  wall [s]  error  counted")
-    measured = []  # (n, h, solve time, counted error) at tolerance 1e-3, every 8
-    for n in (2, 4):
-        rows = [(h, "1e-3", "8") + measure(a, solve, ref, n, h, "1e-3", "8") for h in STEPS[n]]
-        for i, (h, tol, every, steps, its, t_solve, wall, err) in enumerate(rows):
-            counted = max(r[-1] for r in rows[i:])  # this step and every smaller one
-            print(f"{n} bodies  {float(h) * 1e6:6.1f} us  {tol:>9s}  {every:>5s}  {steps:>5d}  {its:8.2f}"
-                  f"  {t_solve:11.3f}  {wall:8.3f}  {err:.3f}%  {counted:.3f}%", flush=True)
-            measured.append((n, h, t_solve, counted))
+    print("model     integrator     step  tolerance  every  steps  its/step  solving [s]  wall [s]  error  counted")
+    measured = []  # (integrator, n, h, solve time, counted error)
+    for integrator, steps, every in (("generalized_alpha", STEPS, "8"), ("radau", RADAU_STEPS, "1")):
+        for n in (2, 4):
+            rows = [(h, "1e-3", every) + measure(a, solve, ref, n, h, "1e-3", every, integrator) for h in steps[n]]
+            for i, (h, tol, ev, count, its, t_solve, wall, err) in enumerate(rows):
+                counted = max(r[-1] for r in rows[i:])  # this step and every smaller one
+                print(f"{n} bodies  {SHORT[integrator]:>9s}  {float(h) * 1e6:6.1f} us  {tol:>9s}  {ev:>5s}  "
+                      f"{count:>5d}  {its:8.2f}  {t_solve:11.3f}  {wall:8.3f}  {err:.3f}%  {counted:.3f}%", flush=True)
+                measured.append((integrator, n, h, t_solve, counted))
     for h in ("1e-4", "1.4e-4"):
         steps, its, t_solve, wall, err = measure(a, solve, ref, 2, h, "1e-8", "1")
-        print(f"2 bodies  {float(h) * 1e6:6.1f} us  {'1e-8':>9s}  {'1':>5s}  {steps:>5d}  {its:8.2f}  {t_solve:11.3f}"
-              f"  {wall:8.3f}  {err:.3f}%  (the defaults)", flush=True)
+        print(f"2 bodies  {'g-alpha':>9s}  {float(h) * 1e6:6.1f} us  {'1e-8':>9s}  {'1':>5s}  {steps:>5d}  {its:8.2f}"
+              f"  {t_solve:11.3f}  {wall:8.3f}  {err:.3f}%  (the defaults)", flush=True)
     print("\nleast solve time reaching a counted error (femb's reference; the peer's figures against the "
           "independent one):")
-    print("level   femb [s]  model, step     peer [s]  peer / femb  target (femb <= peer / 2; 0.1% < 0.1 s)")
+    print("level   femb [s]  model, integrator, step     peer [s]  peer / femb  target (femb <= peer / 2; "
+          "0.1% < 0.1 s)")
     for level in LEVELS:
-        hits = [(t, n, h) for n, h, t, counted in measured if counted <= level]
+        hits = [(t, n, h, i) for i, n, h, t, counted in measured if counted <= level]
         peer = PEER_LEAST[level]
         if not hits:
             print(f"{level:4.1f}%   not reached")
             continue
-        t, n, h = min(hits)
+        t, n, h, integrator = min(hits)
         target = 0.1 if peer is None else peer / 2
         ratio = f"{peer / t:11.2f}" if peer else "   not reached"
-        print(f"{level:4.1f}%   {t:8.3f}  {n} bodies, {float(h) * 1e6:4.0f} us  "
+        print(f"{level:4.1f}%   {t:8.3f}  {n} bodies, {SHORT[integrator]:>7s}, {float(h) * 1e6:4.0f} us  "
               f"{(f'{peer:8.3f}' if peer else '       -')}  {ratio}  {'met' if t <= target else 'not met'} "
               f"({target:.4f} s)")
     if a.png:
@@ -170,10 +179,11 @@ def plot(measured, png):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     fig, ax = plt.subplots(figsize=(7, 4.5))
-    for n, style in ((2, "o-"), (4, "s-")):
-        pts = [(t, c, h) for m, h, t, c in measured if m == n]
+    for integrator, n, style in (("generalized_alpha", 2, "o-"), ("generalized_alpha", 4, "s-"), ("radau", 2, "o--"),
+                                 ("radau", 4, "s--")):
+        pts = [(t, c, h) for i, m, h, t, c in measured if m == n and i == integrator]
         ax.plot([p[0] for p in pts], [p[1] for p in pts], style,
-                label=f"femb, {n} bodies (counted error against femb's reference)")
+                label=f"femb {SHORT[integrator]}, {n} bodies (counted error against femb's reference)")
         for t, c, h in pts:
             ax.annotate(f"{float(h) * 1e6:.0f} us", (t, c), textcoords="offset points", xytext=(4, 4), fontsize=7)
     levels = [lv for lv in LEVELS if PEER_LEAST[lv]]

@@ -172,11 +172,13 @@ struct Words<AnalysisType> {
 enum class Integrator {
   kGeneralizedAlpha,  ///< Lie-group generalized-alpha, numerical damping set by rho_inf
   kMidpoint,          ///< momentum-conserving midpoint (Simo-Wong for rigid bodies), no damping
+  kRadau,             ///< three-stage Radau IIA, order 5, L-stable
 };
 template <>
 struct Words<Integrator> {
   static constexpr KindWord<Integrator> list[] = {{Integrator::kGeneralizedAlpha, "generalized_alpha"},
-                                                  {Integrator::kMidpoint, "midpoint"}};
+                                                  {Integrator::kMidpoint, "midpoint"},
+                                                  {Integrator::kRadau, "radau"}};
 };
 
 /// `analysis.jacobian_reuse`: when Newton factors its iteration matrix anew (IterationMatrix,

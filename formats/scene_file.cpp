@@ -411,6 +411,8 @@ void ParseAnalysis(const YamlValue& analysis, SceneAnalysisSpec& a) {
   }
   if (auto v = m.Optional("integrator")) {
     a.integrator = v->OneOfKinds<Integrator>();
+    if (a.integrator == Integrator::kRadau && a.adaptive_step)
+      v->Fail("radau takes fixed steps (step: auto is generalized_alpha's and midpoint's); give analysis.step a value");
   }
   if (auto v = m.Optional("tolerance")) a.tolerance = v->PositiveNumber();
   if (auto v = m.Optional("max_iterations")) a.max_iterations = int(v->NonNegativeInteger());

@@ -123,9 +123,12 @@ struct DynamicState {
   /// Midpoint scheme only: every node's velocity (xdot, omega), carried by the scheme's own
   /// node kinematics rather than taken as J(q) W (see solver/integrators/midpoint.cpp). Empty: J(q) W.
   std::vector<Eigen::Matrix<double, 6, 1>> node_w;
-  /// Generalized-alpha with error-controlled steps: the increments Delta q of the last steps
-  /// (oldest first), their steps and how many are kept (none after a breakpoint), for the
-  /// velocities' offset at a change of step (solver/integrators/generalized_alpha.cpp).
+  /// What the integrator carries from its last steps beside the state (saved in checkpoints),
+  /// each vector with its step, and how many are kept. Generalized-alpha with error-controlled
+  /// steps: the increments Delta q of the last steps (oldest first; none after a breakpoint), for
+  /// the velocities' offset at a change of step (solver/integrators/generalized_alpha.cpp). Radau
+  /// IIA: the last step's three stage accelerations, for its predictor (solver/integrators/
+  /// radau.cpp).
   static constexpr int kIncrements = 3;
   std::array<Eigen::VectorXd, kIncrements> increments;
   std::array<double, kIncrements> increment_steps{};

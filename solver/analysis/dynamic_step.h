@@ -12,6 +12,8 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <Eigen/SparseLU>
+#include <array>
 #include <functional>
 #include <memory>
 #include <string>
@@ -177,6 +179,23 @@ struct MidpointWorkspace {
   TripletAssembler S_build;
 };
 
+// The Radau IIA step's storage (solver/integrators/radau.cpp), kept from one step to the next:
+// the stages' states, accelerations, velocities and local coordinates, their residuals, and the
+// factored iteration matrix over the stages' solved unknowns.
+struct RadauWorkspace {
+  std::array<DynamicState, 3> stage;
+  std::array<Eigen::VectorXd, 3> A, V, theta;
+  std::array<Assembly, 3> assembly;
+  Eigen::VectorXd rhs, correction, f_drive;
+  std::vector<int> position;  // per unknown: its place among the solved ones (-1: prescribed)
+  Triplets triplets;
+  Eigen::SparseMatrix<double> J;
+  Eigen::SparseLU<Eigen::SparseMatrix<double>> lu;
+  Eigen::Index pattern_nonzeros = 0;
+  bool pattern_known = false, factored = false;
+  double factored_h = -1.0;
+};
+
 // The bodies' storage of a dynamic analysis, kept from one Newton iteration and one step to the
 // next so that evaluating a body reuses its matrices instead of allocating them.
 struct BodyWorkspace {
@@ -211,6 +230,7 @@ struct BodyWorkspace {
   // RotationNodes(model, dofs), set with the weights.
   std::vector<RotationNode> rotation_triples;
   MidpointWorkspace midpoint;  // the midpoint scheme's own (its passes are the ones above)
+  RadauWorkspace radau;        // the Radau IIA step's own (its passes are the ones above)
   // ResidualWeights(model, dofs), computed on the first call (they depend on the model only).
   const Eigen::VectorXd& Weights(const SystemModel& model, const DofMap& dofs) {
     if (weights.size() != dofs.n_dofs()) {
@@ -399,5 +419,12 @@ const SystemMatrix& MidpointIterationMatrix(const SystemModel& model, const DofM
 StepOutcome MidpointStep(const SystemModel& model, const DofMap& dofs, const DynamicOptions& options,
                          const DynamicState& state, double h, double t_new, IterationMatrix& matrix,
                          BodyThreads& threads, BodyWorkspace& work, DynamicState& next);
+
+// One step of the three-stage Radau IIA scheme (solver/integrators/radau.cpp) of size h from
+// `state` into `next`; t_new as for the generalized-alpha step. For models without Lagrange
+// multipliers (SolveDynamic refuses the others).
+StepOutcome RadauStep(const SystemModel& model, const DofMap& dofs, const DynamicOptions& options,
+                      const DynamicState& state, double h, double t_new, IterationMatrix& matrix, BodyThreads& threads,
+                      BodyWorkspace& work, DynamicState& next);
 
 }  // namespace femb::dynamic_internal

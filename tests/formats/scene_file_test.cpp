@@ -97,6 +97,13 @@ TEST(SceneFile, JacobianReuseTakesItsNamesAndTheOldBooleans) {
   EXPECT_NE(bad.find("expected step, steps, none, true or false, got 'sometimes'"), std::string::npos) << bad;
 }
 
+TEST(SceneFile, RadauTakesFixedStepsOnly) {
+  EXPECT_EQ(ParseScene(kGood, "scene.yaml", {"analysis.integrator=radau"}).analysis.integrator, Integrator::kRadau);
+  const std::string bad = Error(kGood, {"analysis.integrator=radau", "analysis.step=auto"});
+  EXPECT_NE(bad.find("integrator"), std::string::npos) << bad;
+  EXPECT_NE(bad.find("radau takes fixed steps"), std::string::npos) << bad;
+}
+
 TEST(SceneFile, TimeFunctionsFollowTheirClosedForms) {
   const SceneSpec s = ParseScene(kGood, "scene.yaml");
   const TimeFunctionSpec& ramp = s.functions.at("drive");

@@ -428,7 +428,7 @@ expect "missing superelement names file" 2 "nothere.h5: cannot open file" 's/{na
 expect "load on clamped node" 2 "load on node 'n0', which is clamped" 's/node: n10, force/node: n0, force/'
 expect "bad option value" 2 "bodies[0].options.tangent: expected full or K1, got 'K2'" 's/{name: b0, superelement: segment.h5,/{name: b0, superelement: segment.h5, options: {tangent: K2},/'
 expect "unknown analysis" 2 "unknown analysis type 'eigen'" 's/type: static/type: eigen/'
-expect "unknown integrator" 2 "analysis.integrator: expected generalized_alpha or midpoint, got 'rk4'" 's/type: static/type: static\n  integrator: rk4/'
+expect "unknown integrator" 2 "analysis.integrator: expected generalized_alpha, midpoint or radau, got 'rk4'" 's/type: static/type: static\n  integrator: rk4/'
 expect "node placed twice" 2 "node 'n1' is placed at" 's/position: \[0.1, 0, 0\]}, nodes: {A: n1/position: [0.15, 0, 0]}, nodes: {A: n1/'
 # Wrong version superelement file.
 cp "$work/segment.h5" "$work/v2.h5"

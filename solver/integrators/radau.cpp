@@ -1,0 +1,272 @@
+// The three-stage Radau IIA integrator (Hairer & Wanner 1996, IV.5; order 5, stiffly accurate,
+// L-stable) on the Lie group of the nodes in the form of Munthe-Kaas (1999): the stages are
+// configurations q_n o exp(Theta_i), the local coordinates Theta_i integrated by the same
+// tableau with the inverse left Jacobian of the rotation triples, Theta_i' = J_l^-1(Theta_i) W.
+// Per stage i (c_i its time fraction, a_ij the tableau):
+//
+//     V_i     = W_n + h sum_j a_ij A_j                        (stage velocities)
+//     Theta_i = h sum_j a_ij J_l^-1(Theta_j) V_j             (rotation triples)
+//             = h c_i W_n + h^2 sum_j (a^2)_ij A_j            (every other unknown: additive)
+//     r(q_n o exp(Theta_i), V_i, A_i, t_n + c_i h) = 0        (the equations of motion)
+//
+// solved for the stage accelerations A_j by simplified Newton: the iteration matrix is
+// I (x) M + h a (x) C + h^2 a^2 (x) K with the K, C and M of the last stage's first iterate (the
+// step's end), factored once a step. The last stage is the step's end (c_3 = 1): the state, its
+// velocity and acceleration. The stage residuals are the dynamic residual of generalized-alpha
+// (AssembleDynamicResidual), so every body kind, force and joint of the tree comes with it; the
+// loops' and interface constraints' multipliers do not (an index-3 stage system, not built).
+#include <Eigen/SparseLU>
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+#include "solver/analysis/dynamic_step.h"
+#include "solver/rotation.h"
+
+namespace femb::dynamic_internal {
+
+namespace {
+
+// The Radau IIA tableau of order 5: c, a and a^2 (the positions' weights of the accelerations).
+struct RadauTableau {
+  std::array<double, 3> c{};
+  double a[3][3]{}, a2[3][3]{};
+  RadauTableau() {
+    const double s6 = std::sqrt(6.0);
+    c = {(4 - s6) / 10, (4 + s6) / 10, 1.0};
+    const double values[3][3] = {{(88 - 7 * s6) / 360, (296 - 169 * s6) / 1800, (-2 + 3 * s6) / 225},
+                                 {(296 + 169 * s6) / 1800, (88 + 7 * s6) / 360, (-2 - 3 * s6) / 225},
+                                 {(16 - s6) / 36, (16 + s6) / 36, 1.0 / 9}};
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) a[i][j] = values[i][j];
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) {
+        a2[i][j] = 0.0;
+        for (int k = 0; k < 3; ++k) a2[i][j] += a[i][k] * a[k][j];
+      }
+  }
+};
+
+const RadauTableau& Tableau() {
+  static const RadauTableau tableau;
+  return tableau;
+}
+
+// The stages' local coordinates Theta_i and velocities V_i from the accelerations A_j (above).
+// The rotation triples' Theta_i are a fixed point of Theta = h a J_l^-1(Theta) V: iterated from
+// the additive value, each pass contracting by about |h omega| (converged to round-off in a few).
+void StageKinematics(const DofMap& dofs, const DynamicState& state, double h, RadauWorkspace& r,
+                     const std::vector<RotationNode>& rotations) {
+  const RadauTableau& t = Tableau();
+  for (int i = 0; i < 3; ++i) {
+    r.V[size_t(i)] = state.W;
+    r.theta[size_t(i)] = (h * t.c[size_t(i)]) * state.W;
+    for (int j = 0; j < 3; ++j) {
+      r.V[size_t(i)] += (h * t.a[i][j]) * r.A[size_t(j)];
+      r.theta[size_t(i)] += (h * h * t.a2[i][j]) * r.A[size_t(j)];
+    }
+    dofs.ClearMultipliers(r.V[size_t(i)]);
+    dofs.ClearMultipliers(r.theta[size_t(i)]);
+  }
+  constexpr int kPasses = 4;
+  for (const RotationNode& n : rotations) {
+    std::array<Eigen::Vector3d, 3> theta, v;
+    for (int i = 0; i < 3; ++i) {
+      theta[size_t(i)] = r.theta[size_t(i)].segment<3>(n.rotation);
+      v[size_t(i)] = r.V[size_t(i)].segment<3>(n.rotation);
+    }
+    for (int pass = 0; pass < kPasses; ++pass) {
+      std::array<Eigen::Vector3d, 3> rate;
+      for (int j = 0; j < 3; ++j) rate[size_t(j)] = LeftJacobianInverse<double>(theta[size_t(j)]) * v[size_t(j)];
+      for (int i = 0; i < 3; ++i) {
+        theta[size_t(i)].setZero();
+        for (int j = 0; j < 3; ++j) theta[size_t(i)] += (h * t.a[i][j]) * rate[size_t(j)];
+      }
+    }
+    for (int i = 0; i < 3; ++i) r.theta[size_t(i)].segment<3>(n.rotation) = theta[size_t(i)];
+  }
+}
+
+// The predictor: the last step's collocation polynomial of the accelerations (the quadratic
+// through its stage accelerations) extrapolated to this step's stages; the accelerations constant
+// over the step at the start (no last step kept).
+void Predict(const DynamicState& state, double h, RadauWorkspace& r) {
+  const RadauTableau& t = Tableau();
+  if (state.increments_kept < 3) {
+    for (int i = 0; i < 3; ++i) r.A[size_t(i)] = state.Wdot;
+    return;
+  }
+  const double h_last = state.increment_steps[0];
+  for (int i = 0; i < 3; ++i) {
+    const double s = 1.0 + t.c[size_t(i)] * h / h_last;  // in the last step's time fraction
+    r.A[size_t(i)].setZero(state.Wdot.size());
+    for (int j = 0; j < 3; ++j) {
+      double l = 1.0;  // Lagrange's basis polynomial of node c_j at s
+      for (int k = 0; k < 3; ++k)
+        if (k != j) l *= (s - t.c[size_t(k)]) / (t.c[size_t(j)] - t.c[size_t(k)]);
+      r.A[size_t(i)] += l * state.increments[size_t(j)];
+    }
+  }
+}
+
+// Stage i's state: q_n o exp(Theta_i) with the prescribed coordinates at their values at t_i
+// (one kinematic update for both), V_i and A_i with the prescribed rates and accelerations.
+void PlaceStage(const SystemModel& model, const DofMap& dofs, const DynamicState& state, double t_i, int i,
+                RadauWorkspace& r) {
+  DynamicState& s = r.stage[size_t(i)];
+  Eigen::VectorXd& theta = r.theta[size_t(i)];
+  s.W = r.V[size_t(i)];
+  s.Wdot = r.A[size_t(i)];
+  for (const SystemModel::Prescribed& p : model.prescribed) {
+    const int j = dofs.prescribed_index(p);
+    theta[j] = p.value(t_i) - state.config.z[size_t(p.node)][p.coordinate];
+    s.W[j] = p.rate ? p.rate(t_i) : 0.0;
+    s.Wdot[j] = p.acceleration ? p.acceleration(t_i) : 0.0;
+  }
+  s.config = state.config;
+  ApplyIncrement(model, dofs, theta, s.config);
+  s.t = t_i;
+}
+
+// The iteration matrix over the stages' solved unknowns (stage i's unknown k at i n_solved + k),
+// block (i, j) = delta_ij M_i + h a_ij C_i + h^2 (a^2)_ij K_i with stage i's K, C and M
+// (r.assembly[i]), factored. False when singular.
+bool FactorStageMatrix(const DofMap& dofs, double h, RadauWorkspace& r) {
+  const RadauTableau& t = Tableau();
+  const std::vector<int>& solved = dofs.solved();
+  const int n = int(solved.size());
+  r.position.assign(size_t(dofs.n_dofs()), -1);
+  for (int k = 0; k < n; ++k) r.position[size_t(solved[size_t(k)])] = k;
+  r.triplets.clear();
+  const auto add = [&](int i, const SystemMatrix& X, int which) {
+    for (int col = 0; col < X.outerSize(); ++col) {
+      const int c = r.position[size_t(col)];
+      if (c < 0) continue;
+      for (SystemMatrix::InnerIterator it(X, col); it; ++it) {
+        const int row = r.position[size_t(it.row())];
+        if (row < 0) continue;
+        for (int j = 0; j < 3; ++j) {
+          const double f = which == 0 ? (i == j ? 1.0 : 0.0) : which == 1 ? h * t.a[i][j] : h * h * t.a2[i][j];
+          if (f != 0.0) r.triplets.emplace_back(i * n + row, j * n + c, f * it.value());
+        }
+      }
+    }
+  };
+  for (int i = 0; i < 3; ++i) {
+    const Assembly& a = r.assembly[size_t(i)];
+    add(i, a.M, 0);
+    add(i, a.C, 1);
+    add(i, a.K, 2);
+  }
+  r.J.resize(3 * n, 3 * n);
+  r.J.setFromTriplets(r.triplets.begin(), r.triplets.end());
+  r.J.makeCompressed();
+  if (!r.pattern_known || r.J.nonZeros() != r.pattern_nonzeros) {
+    r.lu.analyzePattern(r.J);
+    r.pattern_nonzeros = r.J.nonZeros();
+    r.pattern_known = true;
+  }
+  r.lu.factorize(r.J);
+  r.factored = r.lu.info() == Eigen::Success;
+  return r.factored;
+}
+
+}  // namespace
+
+// One Radau IIA step of size h from `state` into `next` (above). t_new: the time reached.
+StepOutcome RadauStep(const SystemModel& model, const DofMap& dofs, const DynamicOptions& options,
+                      const DynamicState& state, double h, double t_new, IterationMatrix& matrix, BodyThreads& threads,
+                      BodyWorkspace& work, DynamicState& next) {
+  const RadauTableau& t = Tableau();
+  RadauWorkspace& r = work.radau;
+  const Eigen::VectorXd& weights = work.Weights(model, dofs);
+  Predict(state, h, r);
+  // The residual's round-off floor (RoundOffForce) from the positions' round-off through the
+  // stiffness alone: the stage accelerations are unknowns of their own, not differences of the
+  // positions as generalized-alpha's are.
+  work.inertia_factor = 0.0;
+  const double tolerance = std::max(options.tolerance, kRoundOffTolerance);
+  const std::vector<int>& solved = dofs.solved();
+  const int n = int(solved.size());
+  const JacobianReuse reuse = JacobianReuseOf(options);
+  if (reuse != JacobianReuse::kSteps || r.factored_h != h) r.factored = false;
+  StepOutcome out;
+  double first = -1.0, last = -1.0;
+  bool refactor = !r.factored;
+  for (; out.iterations < options.max_iterations; ++out.iterations) {
+    refactor = refactor || reuse == JacobianReuse::kNone;
+    // The first matrices of a step may take the bodies' kept ones (body_matrices_every, counted
+    // in steps: three stage passes each).
+    const int every = reuse != JacobianReuse::kNone && !r.factored && options.body_matrices_every > 1
+                          ? 3 * options.body_matrices_every
+                          : 1;
+    StageKinematics(dofs, state, h, r, work.rotation_triples);
+    bool small = true;
+    double r_max = 0.0;
+    for (int i = 0; i < 3; ++i) {
+      const double t_i = i == 2 ? t_new : state.t + t.c[size_t(i)] * h;
+      PlaceStage(model, dofs, state, t_i, i, r);
+      Assembly& a = r.assembly[size_t(i)];
+      AssembleDynamicResidual(model, dofs, r.stage[size_t(i)], t_i, work, &threads, a);
+      if (!a.ok || !a.residual.allFinite()) return out;
+      const double r_norm = FreeNorm(dofs, a.residual, weights);
+      r_max = std::max(r_max, r_norm);
+      small = small && ResidualSmall(dofs, a, weights, r_norm, tolerance);
+      // Stage i's K, C and M at its iterate, from the pass just assembled (the next stage's
+      // pass replaces it).
+      if (refactor)
+        AddDynamicMatrices(model, dofs, r.stage[size_t(i)], t_i, work, options.full_inertia_tangent, a, &threads,
+                           nullptr, every, options.body_matrices_kept);
+    }
+    if (small && out.iterations > 0) {
+      out.converged = true;
+      break;
+    }
+    if (first < 0) first = r_max;
+    if (r_max > first) return out;  // diverging: the caller cuts the step (DivergenceTest)
+    if (refactor) {
+      if (!FactorStageMatrix(dofs, h, r)) {
+        out.singular_matrix = std::make_unique<SystemMatrix>(r.assembly[2].K);
+        return out;
+      }
+      r.factored_h = h;
+      ++matrix.factorizations;
+    }
+    // The next iteration factors anew when this one's correction does not contract the residual
+    // tenfold (as generalized-alpha's kStep).
+    refactor = last >= 0 && r_max > IterationMatrix::kReuseContraction * last;
+    last = r_max;
+    r.rhs.resize(3 * n);
+    for (int i = 0; i < 3; ++i)
+      for (int k = 0; k < n; ++k) r.rhs[i * n + k] = r.assembly[size_t(i)].residual[solved[size_t(k)]];
+    r.correction = r.lu.solve(r.rhs);
+    if (!r.correction.allFinite()) return out;
+    for (int i = 0; i < 3; ++i)
+      for (int k = 0; k < n; ++k) r.A[size_t(i)][solved[size_t(k)]] += r.correction[i * n + k];
+  }
+  if (!out.converged) return out;
+  // The step's end is the last stage. The works of the loads and drives by the stages'
+  // quadrature (order 5): h sum_i b_i f_i . V_i, b the tableau's last row.
+  next = r.stage[2];
+  next.t = t_new;
+  next.a = next.Wdot;
+  next.external_work = state.external_work;
+  next.drive_work = state.drive_work;
+  for (int i = 0; i < 3; ++i) {
+    const Assembly& a = r.assembly[size_t(i)];
+    next.external_work += h * t.a[2][i] * a.f_ext.dot(r.stage[size_t(i)].W);
+    DriveForces(dofs, a.residual, r.f_drive);
+    next.drive_work += h * t.a[2][i] * r.f_drive.dot(r.stage[size_t(i)].W);
+  }
+  for (int i = 0; i < 3; ++i) {
+    next.increments[size_t(i)] = r.A[size_t(i)];
+    next.increment_steps[size_t(i)] = h;
+  }
+  next.increments_kept = 3;
+  next.f_ext = r.assembly[2].f_ext;
+  next.f_drive = r.f_drive;
+  out.passes_kept = true;
+  return out;
+}
+
+}  // namespace femb::dynamic_internal
