@@ -12,6 +12,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <Eigen/LU>
 #include <Eigen/SparseLU>
 #include <array>
 #include <functional>
@@ -187,12 +188,18 @@ struct RadauWorkspace {
   std::array<Eigen::VectorXd, 3> A, V, theta;
   std::array<Assembly, 3> assembly;
   Eigen::VectorXd rhs, correction, f_drive;
-  std::vector<int> position;  // per unknown: its place among the solved ones (-1: prescribed)
+  std::vector<FrameSolution> frames;  // a stage's bodies' frames, kept across its placement
+  std::vector<int> position;          // per unknown: its place among the solved ones (-1: prescribed)
+  // The iteration matrix: dense up to kDenseStages unknowns (a dense LU of that size costs less
+  // than the sparse one's analysis), sparse above.
+  static constexpr int kDenseStages = 240;
+  bool dense = true;
+  Eigen::MatrixXd J_dense;
+  Eigen::PartialPivLU<Eigen::MatrixXd> dense_lu;
   Triplets triplets;
   Eigen::SparseMatrix<double> J;
   Eigen::SparseLU<Eigen::SparseMatrix<double>> lu;
-  Eigen::Index pattern_nonzeros = 0;
-  bool pattern_known = false, factored = false;
+  bool factored = false;
   double factored_h = -1.0;
 };
 

@@ -111,7 +111,7 @@ void Predict(const DynamicState& state, double h, RadauWorkspace& r) {
 
 // Stage i's state: q_n o exp(Theta_i) with the prescribed coordinates at their values at t_i
 // (one kinematic update for both), V_i and A_i with the prescribed rates and accelerations.
-void PlaceStage(const SystemModel& model, const DofMap& dofs, const DynamicState& state, double t_i, int i,
+void PlaceStage(const SystemModel& model, const DofMap& dofs, const DynamicState& state, double t_i, int i, bool first,
                 RadauWorkspace& r) {
   DynamicState& s = r.stage[size_t(i)];
   Eigen::VectorXd& theta = r.theta[size_t(i)];
@@ -123,20 +123,30 @@ void PlaceStage(const SystemModel& model, const DofMap& dofs, const DynamicState
     s.W[j] = p.rate ? p.rate(t_i) : 0.0;
     s.Wdot[j] = p.acceleration ? p.acceleration(t_i) : 0.0;
   }
+  // The bodies' frames solved from the stage's last iterate in this step, from the step's start
+  // at its first iterate (not from the last step's stage: a run resumed from a checkpoint has
+  // none, and takes the same steps to the bit).
+  const bool warm = !first && s.config.frames.size() == state.config.frames.size();
+  if (warm) r.frames = s.config.frames;
   s.config = state.config;
+  if (warm) s.config.frames = r.frames;
   ApplyIncrement(model, dofs, theta, s.config);
   s.t = t_i;
 }
 
 // The iteration matrix over the stages' solved unknowns (stage i's unknown k at i n_solved + k),
 // block (i, j) = delta_ij M_i + h a_ij C_i + h^2 (a^2)_ij K_i with stage i's K, C and M
-// (r.assembly[i]), factored. False when singular.
+// (r.assembly[i]), factored: dense up to kDenseStages unknowns, sparse above (its pattern
+// analysed at every factorization: the bodies' matrices leave out their zero entries, so the
+// pattern may change from step to step). False when singular.
 bool FactorStageMatrix(const DofMap& dofs, double h, RadauWorkspace& r) {
   const RadauTableau& t = Tableau();
   const std::vector<int>& solved = dofs.solved();
   const int n = int(solved.size());
   r.position.assign(size_t(dofs.n_dofs()), -1);
   for (int k = 0; k < n; ++k) r.position[size_t(solved[size_t(k)])] = k;
+  r.dense = 3 * n <= RadauWorkspace::kDenseStages;
+  if (r.dense) r.J_dense.setZero(3 * n, 3 * n);
   r.triplets.clear();
   const auto add = [&](int i, const SystemMatrix& X, int which) {
     for (int col = 0; col < X.outerSize(); ++col) {
@@ -147,7 +157,12 @@ bool FactorStageMatrix(const DofMap& dofs, double h, RadauWorkspace& r) {
         if (row < 0) continue;
         for (int j = 0; j < 3; ++j) {
           const double f = which == 0 ? (i == j ? 1.0 : 0.0) : which == 1 ? h * t.a[i][j] : h * h * t.a2[i][j];
-          if (f != 0.0) r.triplets.emplace_back(i * n + row, j * n + c, f * it.value());
+          if (f == 0.0) continue;
+          if (r.dense) {
+            r.J_dense(i * n + row, j * n + c) += f * it.value();
+          } else {
+            r.triplets.emplace_back(i * n + row, j * n + c, f * it.value());
+          }
         }
       }
     }
@@ -158,14 +173,15 @@ bool FactorStageMatrix(const DofMap& dofs, double h, RadauWorkspace& r) {
     add(i, a.C, 1);
     add(i, a.K, 2);
   }
+  if (r.dense) {
+    r.dense_lu.compute(r.J_dense);
+    r.factored = r.dense_lu.rcond() > 1e-15;
+    return r.factored;
+  }
   r.J.resize(3 * n, 3 * n);
   r.J.setFromTriplets(r.triplets.begin(), r.triplets.end());
   r.J.makeCompressed();
-  if (!r.pattern_known || r.J.nonZeros() != r.pattern_nonzeros) {
-    r.lu.analyzePattern(r.J);
-    r.pattern_nonzeros = r.J.nonZeros();
-    r.pattern_known = true;
-  }
+  r.lu.analyzePattern(r.J);
   r.lu.factorize(r.J);
   r.factored = r.lu.info() == Eigen::Success;
   return r.factored;
@@ -205,7 +221,7 @@ StepOutcome RadauStep(const SystemModel& model, const DofMap& dofs, const Dynami
     double r_max = 0.0;
     for (int i = 0; i < 3; ++i) {
       const double t_i = i == 2 ? t_new : state.t + t.c[size_t(i)] * h;
-      PlaceStage(model, dofs, state, t_i, i, r);
+      PlaceStage(model, dofs, state, t_i, i, out.iterations == 0, r);
       Assembly& a = r.assembly[size_t(i)];
       AssembleDynamicResidual(model, dofs, r.stage[size_t(i)], t_i, work, &threads, a);
       if (!a.ok || !a.residual.allFinite()) return out;
@@ -239,7 +255,11 @@ StepOutcome RadauStep(const SystemModel& model, const DofMap& dofs, const Dynami
     r.rhs.resize(3 * n);
     for (int i = 0; i < 3; ++i)
       for (int k = 0; k < n; ++k) r.rhs[i * n + k] = r.assembly[size_t(i)].residual[solved[size_t(k)]];
-    r.correction = r.lu.solve(r.rhs);
+    if (r.dense) {
+      r.correction = r.dense_lu.solve(r.rhs);
+    } else {
+      r.correction = r.lu.solve(r.rhs);
+    }
     if (!r.correction.allFinite()) return out;
     for (int i = 0; i < 3; ++i)
       for (int k = 0; k < n; ++k) r.A[size_t(i)][solved[size_t(k)]] += r.correction[i * n + k];

@@ -52,6 +52,13 @@ PY
   && "$bin/femb-solve" -q "$work/settled.yaml" --restart "$work/settled_half" \
   && cmp -s "$work/settled/probes.csv" "$work/settled_half/probes.csv" && ok || fail "restart of a run started with initial_state"
 
+# The Radau IIA integrator stopped at half time and restarted equals its run in one go (the
+# predictor's stage accelerations travel in the checkpoint).
+"$bin/femb-solve" -q "$work/drop.yaml" -o "$work/radau" --set analysis.integrator=radau \
+  && "$bin/femb-solve" -q "$work/drop.yaml" -o "$work/radau_half" --set analysis.integrator=radau --set analysis.end_time=0.01 \
+  && "$bin/femb-solve" -q "$work/drop.yaml" --restart "$work/radau_half" --set analysis.integrator=radau \
+  && cmp -s "$work/radau/probes.csv" "$work/radau_half/probes.csv" && ok || fail "restart of a Radau IIA run"
+
 # Modes about the saved static state equal modes_about_static (the same static solve).
 printf '%s\n' "name: bar_modes" "$model" "loads:" "  - {type: gravity, g: [0, -9.81, 0]}" \
   "analysis: {type: modes, count: 4, end_time: 1, steps: 4, about: static}" > "$work/modes.yaml"
