@@ -330,12 +330,7 @@ class DynamicRun {
         n_bodies_(int(model.bodies.size())) {}
 
   DynamicResult Run() {
-    if (options_.integrator == Integrator::kRadau && (options_.adaptive || model_.has_constraints())) {
-      result_.message = options_.adaptive ? "the Radau IIA integrator takes fixed steps"
-                                          : "the Radau IIA integrator takes no Lagrange multipliers (closed loops, "
-                                            "interface constraints)";
-      return result_;
-    }
+    if (result_.message = IntegratorRefusal(model_, options_); !result_.message.empty()) return result_;
     if (resume_) state_ = resume_->state;
     h_ = options_.adaptive ? control_.FirstStep() : options_.step;
     t_base_ = state_.t;
@@ -485,15 +480,7 @@ class DynamicRun {
   }
 
   StepOutcome TryStep(double t_new) {
-    switch (options_.integrator) {
-      case Integrator::kMidpoint:
-        return MidpointStep(model_, dofs_, options_, state_, h_, t_new, matrix_, threads_, work_, next_);
-      case Integrator::kRadau:
-        return RadauStep(model_, dofs_, options_, state_, h_, t_new, matrix_, threads_, work_, next_);
-      case Integrator::kGeneralizedAlpha:
-        break;
-    }
-    return GeneralizedAlphaStep(model_, dofs_, options_, state_, h_, t_new, matrix_, threads_, work_, next_);
+    return IntegratorStep(model_, dofs_, options_, state_, h_, t_new, matrix_, threads_, work_, next_);
   }
 
   // Whether the step stands: Newton converged and, with error-controlled steps, the error

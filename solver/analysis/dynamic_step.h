@@ -434,4 +434,22 @@ StepOutcome RadauStep(const SystemModel& model, const DofMap& dofs, const Dynami
                       const DynamicState& state, double h, double t_new, IterationMatrix& matrix, BodyThreads& threads,
                       BodyWorkspace& work, DynamicState& next);
 
+// Why options.integrator cannot run this model with these options (one line), or empty.
+std::string IntegratorRefusal(const SystemModel& model, const DynamicOptions& options);
+
+// One step of options.integrator (the steps above).
+inline StepOutcome IntegratorStep(const SystemModel& model, const DofMap& dofs, const DynamicOptions& options,
+                                  const DynamicState& state, double h, double t_new, IterationMatrix& matrix,
+                                  BodyThreads& threads, BodyWorkspace& work, DynamicState& next) {
+  switch (options.integrator) {
+    case Integrator::kMidpoint:
+      return MidpointStep(model, dofs, options, state, h, t_new, matrix, threads, work, next);
+    case Integrator::kRadau:
+      return RadauStep(model, dofs, options, state, h, t_new, matrix, threads, work, next);
+    case Integrator::kGeneralizedAlpha:
+      break;
+  }
+  return GeneralizedAlphaStep(model, dofs, options, state, h, t_new, matrix, threads, work, next);
+}
+
 }  // namespace femb::dynamic_internal

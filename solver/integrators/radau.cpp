@@ -19,6 +19,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <string>
 
 #include "solver/analysis/dynamic_step.h"
 #include "solver/rotation.h"
@@ -287,6 +288,14 @@ StepOutcome RadauStep(const SystemModel& model, const DofMap& dofs, const Dynami
   next.f_drive = r.f_drive;
   out.passes_kept = true;
   return out;
+}
+
+std::string IntegratorRefusal(const SystemModel& model, const DynamicOptions& options) {
+  if (options.integrator != Integrator::kRadau) return "";
+  if (options.adaptive) return "the Radau IIA integrator takes fixed steps";
+  if (model.has_constraints())
+    return "the Radau IIA integrator takes no Lagrange multipliers (closed loops, interface constraints)";
+  return "";
 }
 
 }  // namespace femb::dynamic_internal
