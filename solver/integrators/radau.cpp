@@ -9,12 +9,14 @@
 //             = h c_i W_n + h^2 sum_j (a^2)_ij A_j            (every other unknown: additive)
 //     r(q_n o exp(Theta_i), V_i, A_i, t_n + c_i h) = 0        (the equations of motion)
 //
-// solved for the stage accelerations A_j by simplified Newton: the iteration matrix is
-// I (x) M + h a (x) C + h^2 a^2 (x) K with the K, C and M of the last stage's first iterate (the
-// step's end), factored once a step. The last stage is the step's end (c_3 = 1): the state, its
+// solved for the stage accelerations A_j by Newton, the iteration matrix's block (i, j)
+// delta_ij M_i + h a_ij C_i + h^2 (a^2)_ij K_i with stage i's own K, C and M, factored once a step
+// (again when an iteration contracts less than tenfold). The last stage is the step's end (c_3 = 1): the state, its
 // velocity and acceleration. The stage residuals are the dynamic residual of generalized-alpha
-// (AssembleDynamicResidual), so every body kind, force and joint of the tree comes with it; the
-// loops' and interface constraints' multipliers do not (an index-3 stage system, not built).
+// (AssembleDynamicResidual), so every body kind, force and joint comes with it. Closed loops and
+// interface constraints: each stage has its own multipliers Lambda_i, unknowns beside A_i, and
+// its constraint equations g(q_n o exp(Theta_i)) = 0 (the index-3 stage system of Hairer and
+// Wanner, VII.4), their rows scaled by 1 / h^2 in the iteration matrix. The multipliers' entries of A_i hold Lambda_i.
 #include <Eigen/SparseLU>
 #include <algorithm>
 #include <array>
@@ -94,7 +96,10 @@ void StageKinematics(const DofMap& dofs, const DynamicState& state, double h, Ra
 void Predict(const DynamicState& state, double h, RadauWorkspace& r) {
   const RadauTableau& t = Tableau();
   if (state.increments_kept < 3) {
-    for (int i = 0; i < 3; ++i) r.A[size_t(i)] = state.Wdot;
+    for (int i = 0; i < 3; ++i) {
+      r.A[size_t(i)] = state.Wdot;
+      if (state.config.lambda.size() > 0) r.A[size_t(i)].tail(state.config.lambda.size()) = state.config.lambda;
+    }
     return;
   }
   const double h_last = state.increment_steps[0];
@@ -118,6 +123,7 @@ void PlaceStage(const SystemModel& model, const DofMap& dofs, const DynamicState
   Eigen::VectorXd& theta = r.theta[size_t(i)];
   s.W = r.V[size_t(i)];
   s.Wdot = r.A[size_t(i)];
+  dofs.ClearMultipliers(s.Wdot);
   for (const SystemModel::Prescribed& p : model.prescribed) {
     const int j = dofs.prescribed_index(p);
     theta[j] = p.value(t_i) - state.config.z[size_t(p.node)][p.coordinate];
@@ -132,6 +138,7 @@ void PlaceStage(const SystemModel& model, const DofMap& dofs, const DynamicState
   s.config = state.config;
   if (warm) s.config.frames = r.frames;
   ApplyIncrement(model, dofs, theta, s.config);
+  if (dofs.n_multipliers() > 0) s.config.lambda = r.A[size_t(i)].tail(dofs.n_multipliers());
   s.t = t_i;
 }
 
@@ -149,15 +156,21 @@ bool FactorStageMatrix(const DofMap& dofs, double h, RadauWorkspace& r) {
   r.dense = 3 * n <= RadauWorkspace::kDenseStages;
   if (r.dense) r.J_dense.setZero(3 * n, 3 * n);
   r.triplets.clear();
+  // A multiplier's column is stage j's own unknown Lambda_j (in stage j's equations alone, its
+  // K entry as it is); a multiplier's row (a constraint equation) is scaled by 1 / h^2.
   const auto add = [&](int i, const SystemMatrix& X, int which) {
     for (int col = 0; col < X.outerSize(); ++col) {
       const int c = r.position[size_t(col)];
       if (c < 0) continue;
+      const bool multiplier_column = dofs.multiplier(col);
       for (SystemMatrix::InnerIterator it(X, col); it; ++it) {
         const int row = r.position[size_t(it.row())];
         if (row < 0) continue;
+        const double row_scale = dofs.multiplier(int(it.row())) ? 1.0 / (h * h) : 1.0;
         for (int j = 0; j < 3; ++j) {
-          const double f = which == 0 ? (i == j ? 1.0 : 0.0) : which == 1 ? h * t.a[i][j] : h * h * t.a2[i][j];
+          double f = which == 0 ? (i == j ? 1.0 : 0.0) : which == 1 ? h * t.a[i][j] : h * h * t.a2[i][j];
+          if (multiplier_column) f = i == j ? 1.0 : 0.0;
+          f *= row_scale;
           if (f == 0.0) continue;
           if (r.dense) {
             r.J_dense(i * n + row, j * n + c) += f * it.value();
@@ -208,7 +221,8 @@ StepOutcome RadauStep(const SystemModel& model, const DofMap& dofs, const Dynami
   const JacobianReuse reuse = JacobianReuseOf(options);
   if (reuse != JacobianReuse::kSteps || r.factored_h != h) r.factored = false;
   StepOutcome out;
-  double first = -1.0, last = -1.0;
+  DivergenceTest divergence;
+  double last = -1.0;
   bool refactor = !r.factored;
   for (; out.iterations < options.max_iterations; ++out.iterations) {
     refactor = refactor || reuse == JacobianReuse::kNone;
@@ -220,6 +234,7 @@ StepOutcome RadauStep(const SystemModel& model, const DofMap& dofs, const Dynami
     StageKinematics(dofs, state, h, r, work.rotation_triples);
     bool small = true;
     double r_max = 0.0;
+    bool closed = true;
     for (int i = 0; i < 3; ++i) {
       const double t_i = i == 2 ? t_new : state.t + t.c[size_t(i)] * h;
       PlaceStage(model, dofs, state, t_i, i, out.iterations == 0, r);
@@ -229,18 +244,23 @@ StepOutcome RadauStep(const SystemModel& model, const DofMap& dofs, const Dynami
       const double r_norm = FreeNorm(dofs, a.residual, weights);
       r_max = std::max(r_max, r_norm);
       small = small && ResidualSmall(dofs, a, weights, r_norm, tolerance);
+      // The loops at this stage, with its bodies' data (the pass just assembled).
+      if (model.has_constraints())
+        closed =
+            closed && LoopsClosed(model, r.stage[size_t(i)].config, tolerance, &work.pass_data, &work.parts.scratch);
       // Stage i's K, C and M at its iterate, from the pass just assembled (the next stage's
       // pass replaces it).
       if (refactor)
         AddDynamicMatrices(model, dofs, r.stage[size_t(i)], t_i, work, options.full_inertia_tangent, a, &threads,
                            nullptr, every, options.body_matrices_kept);
     }
-    if (small && out.iterations > 0) {
+    if (small && closed && out.iterations > 0) {
       out.converged = true;
       break;
     }
-    if (first < 0) first = r_max;
-    if (r_max > first) return out;  // diverging: the caller cuts the step (DivergenceTest)
+    // Diverging: the caller cuts the step. The reference is the first iterate whose loops are
+    // closed (DivergenceTest).
+    if (divergence.Diverged(r_max, closed)) return out;
     if (refactor) {
       if (!FactorStageMatrix(dofs, h, r)) {
         out.singular_matrix = std::make_unique<SystemMatrix>(r.assembly[2].K);
@@ -255,7 +275,9 @@ StepOutcome RadauStep(const SystemModel& model, const DofMap& dofs, const Dynami
     last = r_max;
     r.rhs.resize(3 * n);
     for (int i = 0; i < 3; ++i)
-      for (int k = 0; k < n; ++k) r.rhs[i * n + k] = r.assembly[size_t(i)].residual[solved[size_t(k)]];
+      for (int k = 0; k < n; ++k)
+        r.rhs[i * n + k] = r.assembly[size_t(i)].residual[solved[size_t(k)]] *
+                           (dofs.multiplier(solved[size_t(k)]) ? 1.0 / (h * h) : 1.0);
     if (r.dense) {
       r.correction = r.dense_lu.solve(r.rhs);
     } else {
@@ -290,11 +312,9 @@ StepOutcome RadauStep(const SystemModel& model, const DofMap& dofs, const Dynami
   return out;
 }
 
-std::string IntegratorRefusal(const SystemModel& model, const DynamicOptions& options) {
+std::string IntegratorRefusal(const SystemModel&, const DynamicOptions& options) {
   if (options.integrator != Integrator::kRadau) return "";
   if (options.adaptive) return "the Radau IIA integrator takes fixed steps";
-  if (model.has_constraints())
-    return "the Radau IIA integrator takes no Lagrange multipliers (closed loops, interface constraints)";
   return "";
 }
 

@@ -558,12 +558,6 @@ Scene BuildScene(const SceneSpec& spec) {
     throw InputError(spec.file + ": joints: " + e.what());
   }
   RequireLoopsClosedAtStart(spec, scene.model, *dofs);
-  if (spec.analysis.type == AnalysisType::kDynamic && spec.analysis.integrator == Integrator::kRadau &&
-      scene.model.has_constraints()) {
-    throw InputError(spec.file + ": analysis.integrator: radau takes no Lagrange multipliers, which this model has (" +
-                     (scene.model.cut_joints.empty() ? "a body's interface constraint" : "a closed loop of joints") +
-                     "); use generalized_alpha or midpoint");
-  }
   AddLoads(spec, scene);
   InitialVelocity(spec, *dofs, scene);
   ResolveProbes(spec, scene);

@@ -1,8 +1,8 @@
 // The three-stage Radau IIA integrator (solver/integrators/radau.cpp) against rigid-body
 // invariants: a torque-free body with three unequal principal moments (a free node: the stages'
 // rotations through the inverse left Jacobian) keeps its energy and angular momentum to the
-// scheme's error, which falls at fifth order with the step; fixed steps only, and no Lagrange
-// multipliers (one message each).
+// scheme's error, which falls at fifth order with the step; fixed steps only (one message).
+// Closed loops: tests/solver/analysis/dynamic_consistency_test.cpp.
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
