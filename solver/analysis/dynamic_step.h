@@ -187,6 +187,7 @@ struct RadauWorkspace {
   std::array<DynamicState, 3> stage;
   std::array<Eigen::VectorXd, 3> A, V, theta;
   std::array<Assembly, 3> assembly;
+  std::array<TripletAssembler, 3> K_build, C_build, M_build;  // each stage's (AddDynamicMatrices)
   Eigen::VectorXd rhs, correction, f_drive;
   std::vector<FrameSolution> frames;  // a stage's bodies' frames, kept across its placement
   std::vector<int> position;          // per unknown: its place among the solved ones (-1: prescribed)

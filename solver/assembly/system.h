@@ -7,6 +7,7 @@
 
 #include <Eigen/Core>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "solver/assembly/free_solver.h"
@@ -90,6 +91,14 @@ class TripletAssembler {
  public:
   const SystemMatrix& Build(int n, const Triplets& triplets);
   long rebuilds() const { return rebuilds_; }
+  /// Exchanges the two assemblers' patterns and matrices (no allocation).
+  void swap(TripletAssembler& other) {
+    matrix_.swap(other.matrix_);
+    rows_.swap(other.rows_);
+    cols_.swap(other.cols_);
+    slots_.swap(other.slots_);
+    std::swap(rebuilds_, other.rebuilds_);
+  }
 
  private:
   SystemMatrix matrix_;

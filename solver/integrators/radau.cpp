@@ -22,6 +22,7 @@
 #include <array>
 #include <cmath>
 #include <string>
+#include <utility>
 
 #include "solver/analysis/dynamic_step.h"
 #include "solver/rotation.h"
@@ -189,7 +190,8 @@ bool FactorStageMatrix(const DofMap& dofs, double h, RadauWorkspace& r) {
   }
   if (r.dense) {
     r.dense_lu.compute(r.J_dense);
-    r.factored = r.dense_lu.rcond() > 1e-15;
+    const auto pivots = r.dense_lu.matrixLU().diagonal().cwiseAbs();
+    r.factored = pivots.minCoeff() > 1e-15 * pivots.maxCoeff();
     return r.factored;
   }
   r.J.resize(3 * n, 3 * n);
@@ -250,9 +252,18 @@ StepOutcome RadauStep(const SystemModel& model, const DofMap& dofs, const Dynami
             closed && LoopsClosed(model, r.stage[size_t(i)].config, tolerance, &work.pass_data, &work.parts.scratch);
       // Stage i's K, C and M at its iterate, from the pass just assembled (the next stage's
       // pass replaces it).
-      if (refactor)
+      // Each stage's matrices built by its own assemblers, whose patterns then stay from step to
+      // step (a loop's blocks differ between the stages' configurations).
+      if (refactor) {
+        work.K_build.swap(r.K_build[size_t(i)]);
+        work.C_build.swap(r.C_build[size_t(i)]);
+        work.M_build.swap(r.M_build[size_t(i)]);
         AddDynamicMatrices(model, dofs, r.stage[size_t(i)], t_i, work, options.full_inertia_tangent, a, &threads,
                            nullptr, every, options.body_matrices_kept);
+        work.K_build.swap(r.K_build[size_t(i)]);
+        work.C_build.swap(r.C_build[size_t(i)]);
+        work.M_build.swap(r.M_build[size_t(i)]);
+      }
     }
     if (small && closed && out.iterations > 0) {
       out.converged = true;
@@ -290,7 +301,12 @@ StepOutcome RadauStep(const SystemModel& model, const DofMap& dofs, const Dynami
   if (!out.converged) return out;
   // The step's end is the last stage. The works of the loads and drives by the stages'
   // quadrature (order 5): h sum_i b_i f_i . V_i, b the tableau's last row.
-  next = r.stage[2];
+  // (Field by field: `next` keeps its storage, what the stages do not carry among it.)
+  const DynamicState& end = r.stage[2];
+  next.config = end.config;
+  next.W = end.W;
+  next.Wdot = end.Wdot;
+  next.node_w.clear();
   next.t = t_new;
   next.a = next.Wdot;
   next.external_work = state.external_work;
