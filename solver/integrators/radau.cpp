@@ -203,6 +203,53 @@ bool FactorStageMatrix(const DofMap& dofs, double h, RadauWorkspace& r) {
   return r.factored;
 }
 
+// Stage i's K, C and M at its iterate, from the pass just assembled (the next stage's pass
+// replaces it), into r.assembly[i]; built by the stage's own triplet assemblers, whose patterns
+// then stay from step to step (a loop's blocks differ between the stages' configurations).
+void StageMatrices(const SystemModel& model, const DofMap& dofs, const DynamicOptions& options, double t_i, int i,
+                   int every, BodyThreads& threads, BodyWorkspace& work) {
+  RadauWorkspace& r = work.radau;
+  work.K_build.swap(r.K_build[size_t(i)]);
+  work.C_build.swap(r.C_build[size_t(i)]);
+  work.M_build.swap(r.M_build[size_t(i)]);
+  AddDynamicMatrices(model, dofs, r.stage[size_t(i)], t_i, work, options.full_inertia_tangent, r.assembly[size_t(i)],
+                     &threads, nullptr, every, options.body_matrices_kept);
+  work.K_build.swap(r.K_build[size_t(i)]);
+  work.C_build.swap(r.C_build[size_t(i)]);
+  work.M_build.swap(r.M_build[size_t(i)]);
+}
+
+// The converged step's end into `next`: the last stage's state, with the works of the loads and
+// drives by the stages' quadrature (order 5), h sum_i b_i f_i . V_i (b the tableau's last row),
+// and the stage accelerations for the next step's predictor. Field by field: `next` keeps its
+// storage.
+void FinishStep(const DofMap& dofs, const DynamicState& state, double h, double t_new, RadauWorkspace& r,
+                DynamicState& next) {
+  const RadauTableau& t = Tableau();
+  const DynamicState& end = r.stage[2];
+  next.config = end.config;
+  next.W = end.W;
+  next.Wdot = end.Wdot;
+  next.node_w.clear();
+  next.t = t_new;
+  next.a = next.Wdot;
+  next.external_work = state.external_work;
+  next.drive_work = state.drive_work;
+  for (int i = 0; i < 3; ++i) {
+    const Assembly& a = r.assembly[size_t(i)];
+    next.external_work += h * t.a[2][i] * a.f_ext.dot(r.stage[size_t(i)].W);
+    DriveForces(dofs, a.residual, r.f_drive);
+    next.drive_work += h * t.a[2][i] * r.f_drive.dot(r.stage[size_t(i)].W);
+  }
+  for (int i = 0; i < 3; ++i) {
+    next.increments[size_t(i)] = r.A[size_t(i)];
+    next.increment_steps[size_t(i)] = h;
+  }
+  next.increments_kept = 3;
+  next.f_ext = r.assembly[2].f_ext;
+  next.f_drive = r.f_drive;
+}
+
 }  // namespace
 
 // One Radau IIA step of size h from `state` into `next` (above). t_new: the time reached.
@@ -250,20 +297,7 @@ StepOutcome RadauStep(const SystemModel& model, const DofMap& dofs, const Dynami
       if (model.has_constraints())
         closed =
             closed && LoopsClosed(model, r.stage[size_t(i)].config, tolerance, &work.pass_data, &work.parts.scratch);
-      // Stage i's K, C and M at its iterate, from the pass just assembled (the next stage's
-      // pass replaces it).
-      // Each stage's matrices built by its own assemblers, whose patterns then stay from step to
-      // step (a loop's blocks differ between the stages' configurations).
-      if (refactor) {
-        work.K_build.swap(r.K_build[size_t(i)]);
-        work.C_build.swap(r.C_build[size_t(i)]);
-        work.M_build.swap(r.M_build[size_t(i)]);
-        AddDynamicMatrices(model, dofs, r.stage[size_t(i)], t_i, work, options.full_inertia_tangent, a, &threads,
-                           nullptr, every, options.body_matrices_kept);
-        work.K_build.swap(r.K_build[size_t(i)]);
-        work.C_build.swap(r.C_build[size_t(i)]);
-        work.M_build.swap(r.M_build[size_t(i)]);
-      }
+      if (refactor) StageMatrices(model, dofs, options, t_i, i, every, threads, work);
     }
     if (small && closed && out.iterations > 0) {
       out.converged = true;
@@ -299,31 +333,7 @@ StepOutcome RadauStep(const SystemModel& model, const DofMap& dofs, const Dynami
       for (int k = 0; k < n; ++k) r.A[size_t(i)][solved[size_t(k)]] += r.correction[i * n + k];
   }
   if (!out.converged) return out;
-  // The step's end is the last stage. The works of the loads and drives by the stages'
-  // quadrature (order 5): h sum_i b_i f_i . V_i, b the tableau's last row.
-  // (Field by field: `next` keeps its storage, what the stages do not carry among it.)
-  const DynamicState& end = r.stage[2];
-  next.config = end.config;
-  next.W = end.W;
-  next.Wdot = end.Wdot;
-  next.node_w.clear();
-  next.t = t_new;
-  next.a = next.Wdot;
-  next.external_work = state.external_work;
-  next.drive_work = state.drive_work;
-  for (int i = 0; i < 3; ++i) {
-    const Assembly& a = r.assembly[size_t(i)];
-    next.external_work += h * t.a[2][i] * a.f_ext.dot(r.stage[size_t(i)].W);
-    DriveForces(dofs, a.residual, r.f_drive);
-    next.drive_work += h * t.a[2][i] * r.f_drive.dot(r.stage[size_t(i)].W);
-  }
-  for (int i = 0; i < 3; ++i) {
-    next.increments[size_t(i)] = r.A[size_t(i)];
-    next.increment_steps[size_t(i)] = h;
-  }
-  next.increments_kept = 3;
-  next.f_ext = r.assembly[2].f_ext;
-  next.f_drive = r.f_drive;
+  FinishStep(dofs, state, h, t_new, r, next);
   out.passes_kept = true;
   return out;
 }
