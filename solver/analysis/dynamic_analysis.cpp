@@ -330,7 +330,7 @@ class DynamicRun {
         n_bodies_(int(model.bodies.size())) {}
 
   DynamicResult Run() {
-    if (result_.message = IntegratorRefusal(model_, options_); !result_.message.empty()) return result_;
+    if (result_.message = IntegratorRefusal(options_); !result_.message.empty()) return result_;
     if (resume_) state_ = resume_->state;
     h_ = options_.adaptive ? control_.FirstStep() : options_.step;
     t_base_ = state_.t;

@@ -1,4 +1,4 @@
-// Dynamic analysis, two integrators on the nodes' coordinates (x_k, R_k) with spatial
+// Dynamic analysis, three integrators on the nodes' coordinates (x_k, R_k) with spatial
 // velocities:
 // - Lie-group generalized-alpha (Arnold & Bruls 2007, Bruls & Cardona 2010), rotations updated
 //   by R <- exp(h dq~) R; Newton with the iteration matrix S = K_t + K_in + gamma' C_t + beta' M_g,
@@ -8,7 +8,9 @@
 //   the momentum balance over the step at the mid configuration, node rotations advanced by the
 //   mean convected angular velocity. Conserves linear and angular momentum exactly for free
 //   systems (flexible ones too) and, for rigid bodies, the kinetic energy; no numerical damping.
-// Both cut the step when Newton diverges. Steps are fixed, or error-controlled (`adaptive`):
+// - Three-stage Radau IIA (solver/integrators/radau.cpp; Hairer & Wanner IV.5): fifth order,
+//   L-stable, on generalized-alpha's residual and matrices; fixed steps only.
+// All cut the step when Newton diverges. Steps are fixed, or error-controlled (`adaptive`):
 // the local error of the positions (and what the velocities' error moves them over a step) is
 // estimated from the accelerations of the steps taken (step_control.h) and kept below
 // step_tolerance of the model's motion; steps land on the kinks and jumps of the loads and

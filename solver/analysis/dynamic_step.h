@@ -429,14 +429,14 @@ StepOutcome MidpointStep(const SystemModel& model, const DofMap& dofs, const Dyn
                          BodyThreads& threads, BodyWorkspace& work, DynamicState& next);
 
 // One step of the three-stage Radau IIA scheme (solver/integrators/radau.cpp) of size h from
-// `state` into `next`; t_new as for the generalized-alpha step. For models without Lagrange
-// multipliers (SolveDynamic refuses the others).
+// `state` into `next`; t_new as for the generalized-alpha step. Fixed steps only (SolveDynamic
+// refuses error-controlled ones, IntegratorRefusal).
 StepOutcome RadauStep(const SystemModel& model, const DofMap& dofs, const DynamicOptions& options,
                       const DynamicState& state, double h, double t_new, IterationMatrix& matrix, BodyThreads& threads,
                       BodyWorkspace& work, DynamicState& next);
 
-// Why options.integrator cannot run this model with these options (one line), or empty.
-std::string IntegratorRefusal(const SystemModel& model, const DynamicOptions& options);
+// Why options.integrator cannot run with these options (one line), or empty.
+std::string IntegratorRefusal(const DynamicOptions& options);
 
 // One step of options.integrator (the steps above).
 inline StepOutcome IntegratorStep(const SystemModel& model, const DofMap& dofs, const DynamicOptions& options,

@@ -210,13 +210,18 @@ void ApplyPrescribed(const SystemModel& model, const DofMap& dofs, double t, Sys
   SystemScratch own;
   Eigen::VectorXd& delta = (scratch ? *scratch : own).delta;
   delta.setZero(dofs.n_dofs());
+  PrescribedIncrements(model, dofs, t, state, delta, W, Wdot);
+  ApplyIncrement(model, dofs, delta, state);
+}
+
+void PrescribedIncrements(const SystemModel& model, const DofMap& dofs, double t, const SystemState& state,
+                          Eigen::VectorXd& delta, Eigen::VectorXd* W, Eigen::VectorXd* Wdot) {
   for (const auto& p : model.prescribed) {
     const int j = dofs.prescribed_index(p);
     delta[j] = p.value(t) - state.z[p.node][p.coordinate];
     if (W) (*W)[j] = p.rate ? p.rate(t) : 0.0;
     if (Wdot) (*Wdot)[j] = p.acceleration ? p.acceleration(t) : 0.0;
   }
-  ApplyIncrement(model, dofs, delta, state);
 }
 
 double BoundingDiagonal(const std::vector<Eigen::Vector3d>& points) {

@@ -231,6 +231,11 @@ SystemState InitialState(const SystemModel& model);
 /// basis), and, when W / Wdot are given, their rates and accelerations.
 void ApplyPrescribed(const SystemModel& model, const DofMap& dofs, double t, SystemState& state, Eigen::VectorXd* W,
                      Eigen::VectorXd* Wdot, SystemScratch* scratch = nullptr);
+/// ApplyPrescribed's increments: on each prescribed coordinate of `delta`, the step from `state`
+/// to its value at t (the other entries untouched), and with W / Wdot its rate and acceleration
+/// at t; for a caller that applies them with increments of its own in one ApplyIncrement.
+void PrescribedIncrements(const SystemModel& model, const DofMap& dofs, double t, const SystemState& state,
+                          Eigen::VectorXd& delta, Eigen::VectorXd* W, Eigen::VectorXd* Wdot);
 
 /// The diagonal of the bounding box of points (node positions): the model's size; 0 for fewer
 /// than two points.

@@ -10,13 +10,14 @@
 //     r(q_n o exp(Theta_i), V_i, A_i, t_n + c_i h) = 0        (the equations of motion)
 //
 // solved for the stage accelerations A_j by Newton, the iteration matrix's block (i, j)
-// delta_ij M_i + h a_ij C_i + h^2 (a^2)_ij K_i with stage i's own K, C and M, factored once a step
-// (again when an iteration contracts less than tenfold). The last stage is the step's end (c_3 = 1): the state, its
-// velocity and acceleration. The stage residuals are the dynamic residual of generalized-alpha
-// (AssembleDynamicResidual), so every body kind, force and joint comes with it. Closed loops and
-// interface constraints: each stage has its own multipliers Lambda_i, unknowns beside A_i, and
-// its constraint equations g(q_n o exp(Theta_i)) = 0 (the index-3 stage system of Hairer and
-// Wanner, VII.4), their rows scaled by 1 / h^2 in the iteration matrix. The multipliers' entries of A_i hold Lambda_i.
+// delta_ij M_i + h a_ij C_i + h^2 (a^2)_ij K_i with stage i's own K, C and M, factored once a
+// step (again when an iteration contracts less than tenfold). The last stage is the step's end
+// (c_3 = 1): the state, its velocity and acceleration. The stage residuals are the dynamic
+// residual of generalized-alpha (AssembleDynamicResidual), so every body kind, force and joint
+// comes with it. Closed loops and interface constraints: each stage has its own multipliers
+// Lambda_i (held in the multipliers' entries of A_i), and its constraint equations
+// g(q_n o exp(Theta_i)) = 0 (the index-3 stage system of Hairer and Wanner, VII.4), their rows
+// scaled by 1 / h^2 in the iteration matrix.
 #include <Eigen/SparseLU>
 #include <algorithm>
 #include <array>
@@ -125,12 +126,7 @@ void PlaceStage(const SystemModel& model, const DofMap& dofs, const DynamicState
   s.W = r.V[size_t(i)];
   s.Wdot = r.A[size_t(i)];
   dofs.ClearMultipliers(s.Wdot);
-  for (const SystemModel::Prescribed& p : model.prescribed) {
-    const int j = dofs.prescribed_index(p);
-    theta[j] = p.value(t_i) - state.config.z[size_t(p.node)][p.coordinate];
-    s.W[j] = p.rate ? p.rate(t_i) : 0.0;
-    s.Wdot[j] = p.acceleration ? p.acceleration(t_i) : 0.0;
-  }
+  PrescribedIncrements(model, dofs, t_i, state.config, theta, &s.W, &s.Wdot);
   // The bodies' frames solved from the stage's last iterate in this step, from the step's start
   // at its first iterate (not from the last step's stage: a run resumed from a checkpoint has
   // none, and takes the same steps to the bit).
@@ -142,6 +138,10 @@ void PlaceStage(const SystemModel& model, const DofMap& dofs, const DynamicState
   if (dofs.n_multipliers() > 0) s.config.lambda = r.A[size_t(i)].tail(dofs.n_multipliers());
   s.t = t_i;
 }
+
+// The scale of unknown j's equation in the iteration matrix and its right-hand side: 1 / h^2 on a
+// multiplier's (a constraint equation, index 3), 1 on the others.
+double RowScale(const DofMap& dofs, int j, double h) { return dofs.multiplier(j) ? 1.0 / (h * h) : 1.0; }
 
 // The iteration matrix over the stages' solved unknowns (stage i's unknown k at i n_solved + k),
 // block (i, j) = delta_ij M_i + h a_ij C_i + h^2 (a^2)_ij K_i with stage i's K, C and M
@@ -158,7 +158,7 @@ bool FactorStageMatrix(const DofMap& dofs, double h, RadauWorkspace& r) {
   if (r.dense) r.J_dense.setZero(3 * n, 3 * n);
   r.triplets.clear();
   // A multiplier's column is stage j's own unknown Lambda_j (in stage j's equations alone, its
-  // K entry as it is); a multiplier's row (a constraint equation) is scaled by 1 / h^2.
+  // K entry as it is); a multiplier's row (a constraint equation) is scaled (RowScale).
   const auto add = [&](int i, const SystemMatrix& X, int which) {
     for (int col = 0; col < X.outerSize(); ++col) {
       const int c = r.position[size_t(col)];
@@ -167,7 +167,7 @@ bool FactorStageMatrix(const DofMap& dofs, double h, RadauWorkspace& r) {
       for (SystemMatrix::InnerIterator it(X, col); it; ++it) {
         const int row = r.position[size_t(it.row())];
         if (row < 0) continue;
-        const double row_scale = dofs.multiplier(int(it.row())) ? 1.0 / (h * h) : 1.0;
+        const double row_scale = RowScale(dofs, int(it.row()), h);
         for (int j = 0; j < 3; ++j) {
           double f = which == 0 ? (i == j ? 1.0 : 0.0) : which == 1 ? h * t.a[i][j] : h * h * t.a2[i][j];
           if (multiplier_column) f = i == j ? 1.0 : 0.0;
@@ -321,8 +321,7 @@ StepOutcome RadauStep(const SystemModel& model, const DofMap& dofs, const Dynami
     r.rhs.resize(3 * n);
     for (int i = 0; i < 3; ++i)
       for (int k = 0; k < n; ++k)
-        r.rhs[i * n + k] = r.assembly[size_t(i)].residual[solved[size_t(k)]] *
-                           (dofs.multiplier(solved[size_t(k)]) ? 1.0 / (h * h) : 1.0);
+        r.rhs[i * n + k] = r.assembly[size_t(i)].residual[solved[size_t(k)]] * RowScale(dofs, solved[size_t(k)], h);
     if (r.dense) {
       r.correction = r.dense_lu.solve(r.rhs);
     } else {
@@ -338,7 +337,7 @@ StepOutcome RadauStep(const SystemModel& model, const DofMap& dofs, const Dynami
   return out;
 }
 
-std::string IntegratorRefusal(const SystemModel&, const DynamicOptions& options) {
+std::string IntegratorRefusal(const DynamicOptions& options) {
   if (options.integrator != Integrator::kRadau) return "";
   if (options.adaptive) return "the Radau IIA integrator takes fixed steps";
   return "";
