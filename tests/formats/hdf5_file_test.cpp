@@ -136,6 +136,26 @@ TEST(Hdf5File, EveryKindReadsBackToTheBit) {
 
 // Single precision: chunked, shuffled and deflated (filters every HDF5 reader has), the values
 // rounded to multiples of `step` when one is given, and so a smooth field compresses.
+// Lists of strings are converted through a buffer sized to the list (hdf5_file.cpp): lists
+// below, near and above the default 1 MiB of descriptors, with strings far longer than a
+// descriptor, read back whole.
+TEST(Hdf5File, StringListsOfEverySizeReadBack) {
+  const std::string path = TempPath("strings.h5");
+  std::vector<std::vector<std::string>> lists;
+  for (const size_t n : {size_t(1), size_t(3000), size_t(40000), size_t(70000)}) {
+    std::vector<std::string> list(n);
+    for (size_t i = 0; i < n; ++i) list[i] = std::string(i % 700, char('a' + i % 26)) + std::to_string(i);
+    lists.push_back(list);
+  }
+  {
+    h5::Writer w(path);
+    for (size_t k = 0; k < lists.size(); ++k) w.Strings("/list" + std::to_string(k), lists[k]);
+    w.Close();
+  }
+  h5::Reader r(path);
+  for (size_t k = 0; k < lists.size(); ++k) EXPECT_EQ(r.Strings("/list" + std::to_string(k)), lists[k]) << k;
+}
+
 TEST(Hdf5File, FloatMatrixIsRoundedAndCompressed) {
   const std::string path = TempPath("float.h5");
   const int rows = 4000;
