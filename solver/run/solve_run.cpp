@@ -491,7 +491,11 @@ void SolveRun::PrintDynamicCounts(const DynamicResult& r, const DynamicOptions& 
   Say("%ld factorizations of the iteration matrix; its sparsity pattern analysed %s; pivots "
       "chosen in %ld, reused in %ld",
       r.factorizations, analysed.c_str(), r.pivoted, r.factorizations - r.pivoted);
-  if (r.body_matrices_turned > 0) {
+  if (r.body_matrices_turned > 0 && options.integrator == Integrator::kRadau && options.body_matrices_every == 1) {
+    Say("bodies' mass and gyroscopic matrices computed %ld times (at each matrix build's first stage), turned with "
+        "their floating frames to the other stages %ld times",
+        r.body_matrices_computed, r.body_matrices_turned);
+  } else if (r.body_matrices_turned > 0) {
     const bool all = options.body_matrices_kept == BodyMatricesKept::kAll;
     Say("bodies' %smatrices computed %ld times, turned with their floating frames %ld times "
         "(analysis.body_matrices_every %d, body_matrices_kept %s)",
