@@ -409,11 +409,7 @@ void ParseAnalysis(const YamlValue& analysis, SceneAnalysisSpec& a) {
     a.rho_inf = v->Number();
     if (a.rho_inf < 0 || a.rho_inf > 1) v->Fail("rho_inf must be in [0, 1]");
   }
-  if (auto v = m.Optional("integrator")) {
-    a.integrator = v->OneOfKinds<Integrator>();
-    if (a.integrator == Integrator::kRadau && a.adaptive_step)
-      v->Fail("radau takes fixed steps (step: auto is generalized_alpha's and midpoint's); give analysis.step a value");
-  }
+  if (auto v = m.Optional("integrator")) a.integrator = v->OneOfKinds<Integrator>();
   if (auto v = m.Optional("tolerance")) a.tolerance = v->PositiveNumber();
   if (auto v = m.Optional("max_iterations")) a.max_iterations = int(v->NonNegativeInteger());
   if (auto v = m.Optional("output_every")) a.output_every = std::max(1, int(v->NonNegativeInteger()));

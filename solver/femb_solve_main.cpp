@@ -21,8 +21,8 @@ Simulates a scene of superelements and rigid bodies in absolute interface coordi
 formats/SCENE_FORMAT.md), with joints along a tree and closed loops cut into constraint equations:
   analysis.type: static   load stepping in pseudo-time, Newton with the full tangent, step cutting
   analysis.type: dynamic  analysis.integrator: generalized_alpha (numerical damping rho_inf),
-                          midpoint (momentum-conserving, no damping) or radau (fifth order, fixed
-                          steps); analysis.step: a fixed step
+                          midpoint (momentum-conserving, no damping) or radau (fifth order,
+                          L-stable); analysis.step: a fixed step
                           (cut where Newton fails, with a warning) or auto (error-controlled by
                           analysis.step_tolerance; the steps are listed in results.h5 /steps)
   analysis.type: modes    linearized eigenfrequencies about the initial or the static state

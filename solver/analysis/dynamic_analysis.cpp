@@ -330,7 +330,6 @@ class DynamicRun {
         n_bodies_(int(model.bodies.size())) {}
 
   DynamicResult Run() {
-    if (result_.message = IntegratorRefusal(options_); !result_.message.empty()) return result_;
     if (resume_) state_ = resume_->state;
     h_ = options_.adaptive ? control_.FirstStep() : options_.step;
     t_base_ = state_.t;
@@ -502,11 +501,11 @@ class DynamicRun {
       return false;
     }
     if (options_.adaptive) {
-      *error = control_.Error(state_, next_, h_);
+      *error = step.error_q ? control_.Error(*step.error_q, *step.error_v) : control_.Error(state_, next_, h_);
       if (*error > 1.0) {
         ++result_.rejected_by_error;
         after_rejection_ = true;
-        const double h_new = h_ * StepController::Factor(*error);
+        const double h_new = h_ * control_.RetryFactor(*error);
         if (h_new < control_.min_step()) {
           char buffer[300];
           std::snprintf(buffer, sizeof buffer,
@@ -580,6 +579,8 @@ class DynamicRun {
       if (options_.integrator == Integrator::kGeneralizedAlpha) {
         state_.a += work_.a_n;
         state_.increments_kept = 0;  // the motion's third derivative jumps here
+      } else if (options_.integrator == Integrator::kRadau) {
+        state_.increments_kept = 0;  // as the accelerations' polynomial, which Radau's predictor extends
       } else {
         state_.h_last = 0.0;
       }

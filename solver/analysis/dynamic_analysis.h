@@ -9,7 +9,8 @@
 //   mean convected angular velocity. Conserves linear and angular momentum exactly for free
 //   systems (flexible ones too) and, for rigid bodies, the kinetic energy; no numerical damping.
 // - Three-stage Radau IIA (solver/integrators/radau.cpp; Hairer & Wanner IV.5): fifth order,
-//   L-stable, on generalized-alpha's residual and matrices; fixed steps only.
+//   L-stable, on generalized-alpha's residual and matrices; its error-controlled steps take its
+//   own local error estimate (an embedded formula, filtered in the stiff directions).
 // All cut the step when Newton diverges. Steps are fixed, or error-controlled (`adaptive`):
 // the local error of the positions (and what the velocities' error moves them over a step) is
 // estimated from the accelerations of the steps taken (step_control.h) and kept below

@@ -202,6 +202,14 @@ struct RadauWorkspace {
   Eigen::SparseLU<Eigen::SparseMatrix<double>> lu;
   bool factored = false;
   double factored_h = -1.0;
+  // Error-controlled steps: the step's local error estimate of the positions and of the
+  // velocities times the step (RadauLocalError), and the filter's matrix, dense or sparse as above.
+  Eigen::VectorXd error_q, error_v, d, filter_rhs, filtered, product;
+  Eigen::MatrixXd S_dense;
+  Eigen::PartialPivLU<Eigen::MatrixXd> S_dense_lu;
+  Triplets S_triplets;
+  Eigen::SparseMatrix<double> S;
+  Eigen::SparseLU<Eigen::SparseMatrix<double>> S_lu;
 };
 
 // The bodies' storage of a dynamic analysis, kept from one Newton iteration and one step to the
@@ -398,6 +406,11 @@ struct StepOutcome {
   /// empty sparse matrix allocates on construction and a step allocates nothing).
   std::unique_ptr<SystemMatrix> singular_matrix;
   bool passes_kept = false;  ///< the workspace's passes hold the bodies' data at the converged state
+  /// The integrator's own estimate of the step's local error (Radau IIA under error control), over
+  /// the coordinates: of the positions, and of the velocities times the step (null: the step
+  /// controller estimates it from the accelerations, StepController::Error).
+  const Eigen::VectorXd* error_q = nullptr;
+  const Eigen::VectorXd* error_v = nullptr;
 };
 
 // The velocities of body b's coordinates: the midpoint scheme's node velocities where the state
@@ -429,14 +442,11 @@ StepOutcome MidpointStep(const SystemModel& model, const DofMap& dofs, const Dyn
                          BodyThreads& threads, BodyWorkspace& work, DynamicState& next);
 
 // One step of the three-stage Radau IIA scheme (solver/integrators/radau.cpp) of size h from
-// `state` into `next`; t_new as for the generalized-alpha step. Fixed steps only (SolveDynamic
-// refuses error-controlled ones, IntegratorRefusal).
+// `state` into `next`; t_new as for the generalized-alpha step. Under error control the outcome
+// carries the step's local error estimate (StepOutcome::error_q, error_v).
 StepOutcome RadauStep(const SystemModel& model, const DofMap& dofs, const DynamicOptions& options,
                       const DynamicState& state, double h, double t_new, IterationMatrix& matrix, BodyThreads& threads,
                       BodyWorkspace& work, DynamicState& next);
-
-// Why options.integrator cannot run with these options (one line), or empty.
-std::string IntegratorRefusal(const DynamicOptions& options);
 
 // One step of options.integrator (the steps above).
 inline StepOutcome IntegratorStep(const SystemModel& model, const DofMap& dofs, const DynamicOptions& options,

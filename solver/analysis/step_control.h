@@ -47,6 +47,13 @@
 // band of [0.7, 1.25] lets the error double at loose tolerances. benchmarks/step_control.py
 // measures the steps and errors of every dynamic example (docs/performance.md).
 //
+// Radau IIA estimates its own local error (solver/integrators/radau.cpp, RadauLocalError), of
+// order h^5: the controller takes it as it is, with the exponents of h^5 (1/5 where the others
+// take 1/3), and the plan follows every proposal that changes the step (a one-step scheme: a
+// change disturbs nothing it carries; and at a steady ratio E the PI growth 0.9 E^(-0.3/5) stays
+// inside [0.9, 1.25] down to E = 4e-3, which held a free rigid body's steps at 1/160 of the error
+// allowed).
+//
 // The midpoint scheme damps no mode, so its reactions and stresses carry every excited mode that
 // its steps do not resolve, whatever the motion's error: its steps stay at or below 0.7 / omega
 // of the bodies' highest reduced-model frequency unless max_step is given (MidpointResolvedStep).
@@ -87,10 +94,16 @@ class StepController {
 
   /// The error ratio E of the step of h from s0 to s1 (<= 1: accept); keeps the jerk for Accept.
   double Error(const DynamicState& s0, const DynamicState& s1, double h);
+  /// The error ratio E of a step whose integrator estimated its own local error (Radau IIA):
+  /// e_q of the positions, e_v of the velocities times the step, over the coordinates.
+  double Error(const Eigen::VectorXd& e_q, const Eigen::VectorXd& e_v);
   /// The next step after an accepted one with error ratio E; updates the motion scale.
   double Accept(const DynamicState& s1, double h, double E, bool after_rejection);
-  /// The factor for a step retried after a rejection with error ratio E (or with no history).
-  static double Factor(double E);
+  /// The factor for a step retried after a rejection with error ratio E (or with no history),
+  /// for an estimate that goes with h^order.
+  static double Factor(double E, double order = 3);
+  /// Factor with this run's estimate's power of the step.
+  double RetryFactor(double E) const { return Factor(E, order_); }
   /// What Accept keeps for the next steps, into or from a DynamicResume.
   void Save(DynamicResume& r) const {
     r.travel = D_, r.last_error = E_prev_, r.last_jerk = jerk_prev_, r.has_last_jerk = has_jerk_prev_;
@@ -114,6 +127,7 @@ class StepController {
   int settled_ = 0;                ///< accepted steps since the last change of plan or breakpoint
   static constexpr int kSettle = 7;
   double min_step_ = 0, max_step_ = 0, D_ = 0, c_q_ = 0, c_v_ = 0, boundary_ = 0, E_prev_ = 0;
+  double order_ = 3;  ///< the estimate's power of the step: h^3, or h^5 for Radau IIA's
   bool lands_ = false, output_ = true, at_breakpoint_ = false;
 };
 

@@ -144,6 +144,21 @@ void PlaceStage(const SystemModel& model, const DofMap& dofs, const DynamicState
 // multiplier's (a constraint equation, index 3), 1 on the others.
 double RowScale(const DofMap& dofs, int j, double h) { return dofs.multiplier(j) ? 1.0 / (h * h) : 1.0; }
 
+// Calls add(row, col, value, row_scale, multiplier_column) for each entry of X between solved
+// unknowns (row and col their places among the solved ones, `position`), with its row's RowScale.
+template <class Add>
+void SolvedEntries(const DofMap& dofs, const std::vector<int>& position, const SystemMatrix& X, double h, Add&& add) {
+  for (int col = 0; col < X.outerSize(); ++col) {
+    const int c = position[size_t(col)];
+    if (c < 0) continue;
+    const bool multiplier_column = dofs.multiplier(col);
+    for (SystemMatrix::InnerIterator it(X, col); it; ++it) {
+      const int row = position[size_t(it.row())];
+      if (row >= 0) add(row, c, it.value(), RowScale(dofs, int(it.row()), h), multiplier_column);
+    }
+  }
+}
+
 // The iteration matrix over the stages' solved unknowns (stage i's unknown k at i n_solved + k),
 // block (i, j) = delta_ij M_i + h a_ij C_i + h^2 (a^2)_ij K_i with stage i's K, C and M
 // (r.assembly[i]), factored: dense up to kDenseStages unknowns, sparse above (its pattern
@@ -161,27 +176,19 @@ bool FactorStageMatrix(const DofMap& dofs, double h, RadauWorkspace& r) {
   // A multiplier's column is stage j's own unknown Lambda_j (in stage j's equations alone, its
   // K entry as it is); a multiplier's row (a constraint equation) is scaled (RowScale).
   const auto add = [&](int i, const SystemMatrix& X, int which) {
-    for (int col = 0; col < X.outerSize(); ++col) {
-      const int c = r.position[size_t(col)];
-      if (c < 0) continue;
-      const bool multiplier_column = dofs.multiplier(col);
-      for (SystemMatrix::InnerIterator it(X, col); it; ++it) {
-        const int row = r.position[size_t(it.row())];
-        if (row < 0) continue;
-        const double row_scale = RowScale(dofs, int(it.row()), h);
-        for (int j = 0; j < 3; ++j) {
-          double f = which == 0 ? (i == j ? 1.0 : 0.0) : which == 1 ? h * t.a[i][j] : h * h * t.a2[i][j];
-          if (multiplier_column) f = i == j ? 1.0 : 0.0;
-          f *= row_scale;
-          if (f == 0.0) continue;
-          if (r.dense) {
-            r.J_dense(i * n + row, j * n + c) += f * it.value();
-          } else {
-            r.triplets.emplace_back(i * n + row, j * n + c, f * it.value());
-          }
+    SolvedEntries(dofs, r.position, X, h, [&](int row, int c, double value, double row_scale, bool multiplier_column) {
+      for (int j = 0; j < 3; ++j) {
+        double f = which == 0 ? (i == j ? 1.0 : 0.0) : which == 1 ? h * t.a[i][j] : h * h * t.a2[i][j];
+        if (multiplier_column) f = i == j ? 1.0 : 0.0;
+        f *= row_scale;
+        if (f == 0.0) continue;
+        if (r.dense) {
+          r.J_dense(i * n + row, j * n + c) += f * value;
+        } else {
+          r.triplets.emplace_back(i * n + row, j * n + c, f * value);
         }
       }
-    }
+    });
   };
   for (int i = 0; i < 3; ++i) {
     const Assembly& a = r.assembly[size_t(i)];
@@ -243,6 +250,84 @@ KeptMatrices KeptMatricesOf(const DynamicOptions& options, JacobianReuse reuse, 
   if (!factored && options.body_matrices_every > 1)
     return {3 * options.body_matrices_every, options.body_matrices_kept};
   return {3, BodyMatricesKept::kInertia, true};
+}
+
+// Error control: the step's local error by an embedded formula of third order (Hairer & Wanner
+// IV.8, in the second-order form): the velocities v^ = v_n + h (g a_n + sum_j b^_j A_j), with
+// g = 0.2749 (the inverse of the tableau's real eigenvalue, 3.6378) and the b^ that make it exact
+// for accelerations of degree 2. Radau's own weights b (on the stages alone) are exact to degree 4,
+// so the two differ by e_v = g h (a_n - P(0)), P the quadratic through the stage accelerations
+// (the collocation polynomial) at the step's start: O(h^3) for a smooth motion, e_v O(h^4).
+// The estimate is filtered by (I - g h J)^-1 in the first-order form (q, v), as Radau5 does: the
+// stiff directions, whose stage accelerations follow a transient that the scheme damps (L-stable),
+// would otherwise set the step. With no error in the positions' formula that is
+//   (M + g h C + g^2 h^2 K) y = M e_v,   x = g h y   (x, y: the positions' and velocities' errors),
+// M, C, K the last stage's (constraint rows as in the iteration matrix, their right-hand side 0,
+// so that the error lies along the constraints). Into r.error_q = x and r.error_v = h y (what the
+// velocities' error moves the positions over a step): both O(h^5). Unfiltered (y = e_v) where the
+// filter's matrix is singular.
+void RadauLocalError(const DofMap& dofs, const DynamicState& state, double h, RadauWorkspace& r) {
+  const RadauTableau& t = Tableau();
+  constexpr double g = 0.27488882959;  // 1 / 3.6378342
+  const std::vector<int>& solved = dofs.solved();
+  const int n = int(solved.size());
+  r.d = state.Wdot;
+  for (int j = 0; j < 3; ++j) {
+    double l = 1.0;  // Lagrange's basis polynomial of node c_j at 0
+    for (int k = 0; k < 3; ++k)
+      if (k != j) l *= (0.0 - t.c[size_t(k)]) / (t.c[size_t(j)] - t.c[size_t(k)]);
+    r.d -= l * r.A[size_t(j)];
+  }
+  for (int j = 0; j < dofs.n_dofs(); ++j)
+    if (r.position[size_t(j)] < 0 || dofs.multiplier(j)) r.d[j] = 0.0;
+  const Assembly& a = r.assembly[2];
+  r.product.noalias() = a.M * r.d;
+  r.filter_rhs.setZero(n);
+  for (int k = 0; k < n; ++k)
+    if (!dofs.multiplier(solved[size_t(k)])) r.filter_rhs[k] = g * h * r.product[solved[size_t(k)]];
+  const bool dense = n <= RadauWorkspace::kDenseStages / 3;
+  if (dense) r.S_dense.setZero(n, n);
+  r.S_triplets.clear();
+  const auto add = [&](const SystemMatrix& X, double coefficient) {
+    SolvedEntries(dofs, r.position, X, h, [&](int row, int c, double value, double row_scale, bool multiplier_column) {
+      const double f = (multiplier_column ? 1.0 : coefficient) * row_scale;
+      if (dense) {
+        r.S_dense(row, c) += f * value;
+      } else {
+        r.S_triplets.emplace_back(row, c, f * value);
+      }
+    });
+  };
+  add(a.M, 1.0);
+  add(a.C, g * h);
+  add(a.K, g * g * h * h);
+  bool filtered = false;
+  if (dense) {
+    r.S_dense_lu.compute(r.S_dense);
+    const auto pivots = r.S_dense_lu.matrixLU().diagonal().cwiseAbs();
+    filtered = pivots.minCoeff() > 1e-15 * pivots.maxCoeff();
+    if (filtered) r.filtered = r.S_dense_lu.solve(r.filter_rhs);
+  } else {
+    r.S.resize(n, n);
+    r.S.setFromTriplets(r.S_triplets.begin(), r.S_triplets.end());
+    r.S.makeCompressed();
+    r.S_lu.analyzePattern(r.S);
+    r.S_lu.factorize(r.S);
+    filtered = r.S_lu.info() == Eigen::Success;
+    if (filtered) r.filtered = r.S_lu.solve(r.filter_rhs);
+  }
+  if (!filtered || !r.filtered.allFinite()) {
+    r.filtered.resize(n);
+    for (int k = 0; k < n; ++k) r.filtered[k] = g * h * r.d[solved[size_t(k)]];
+  }
+  r.error_q.setZero(dofs.n_dofs());
+  r.error_v.setZero(dofs.n_dofs());
+  for (int k = 0; k < n; ++k) {
+    const int j = solved[size_t(k)];
+    if (dofs.multiplier(j)) continue;
+    r.error_q[j] = g * h * r.filtered[k];
+    r.error_v[j] = h * r.filtered[k];
+  }
 }
 
 // The converged step's end into `next`: the last stage's state, with the works of the loads and
@@ -354,15 +439,14 @@ StepOutcome RadauStep(const SystemModel& model, const DofMap& dofs, const Dynami
       for (int k = 0; k < n; ++k) r.A[size_t(i)][solved[size_t(k)]] += r.correction[i * n + k];
   }
   if (!out.converged) return out;
+  if (options.adaptive) {
+    RadauLocalError(dofs, state, h, r);
+    out.error_q = &r.error_q;
+    out.error_v = &r.error_v;
+  }
   FinishStep(dofs, state, h, t_new, r, next);
   out.passes_kept = true;
   return out;
-}
-
-std::string IntegratorRefusal(const DynamicOptions& options) {
-  if (options.integrator != Integrator::kRadau) return "";
-  if (options.adaptive) return "the Radau IIA integrator takes fixed steps";
-  return "";
 }
 
 }  // namespace femb::dynamic_internal

@@ -35,12 +35,15 @@ struct FlightErrors {
   double energy_error = 0, momentum_error = 0;
   double momentum_error_first_half = 0, momentum_error_second_half = 0;
   double min_intermediate = 1;  // min of Omega_2 / |Omega| (body frame, intermediate axis)
+  long steps = 0;
 };
 
-// Free flight from spin omega0 (spatial) about the centre of mass, n_steps of size h.
+// Free flight from spin omega0 (spatial) about the centre of mass, n_steps of size h (with a
+// step_tolerance, error-controlled steps from h over the same time).
 FlightErrors FreeFlight(const Superelement& se, const Eigen::Vector3d& omega0, double h, int n_steps, double rho = 1.0,
                         const Eigen::Vector3d& intermediate_axis = Eigen::Vector3d::Zero(),
-                        Integrator integrator = Integrator::kGeneralizedAlpha, double tolerance = 1e-9) {
+                        Integrator integrator = Integrator::kGeneralizedAlpha, double tolerance = 1e-9,
+                        double step_tolerance = 0.0) {
   SystemModel model;
   AddNode(model, se.interfaces[0].name, se.interfaces[0].position);
   model.bodies.emplace_back(se, SuperelementOptions{});
@@ -56,6 +59,8 @@ FlightErrors FreeFlight(const Superelement& se, const Eigen::Vector3d& omega0, d
   options.rho_inf = rho;
   options.integrator = integrator;
   options.tolerance = tolerance;
+  options.adaptive = step_tolerance > 0;
+  options.step_tolerance = step_tolerance;
   FlightErrors run;
   const DynamicResult result = SolveDynamic(model, s, options, [&](const DynamicStepReport& r, const DynamicState& st) {
     run.energy_error = std::max(run.energy_error, std::abs(r.kinetic_energy - r0.kinetic_energy) / r0.kinetic_energy);
@@ -69,6 +74,7 @@ FlightErrors FreeFlight(const Superelement& se, const Eigen::Vector3d& omega0, d
     }
   });
   EXPECT_TRUE(result.ok) << result.message;
+  run.steps = result.steps;
   return run;
 }
 
@@ -100,8 +106,7 @@ TEST(RigidBodyDynamics, TorqueFreeMotionConservesEnergyAndMomentumAtSecondOrder)
 
 // The three-stage Radau IIA integrator (solver/integrators/radau.cpp): not an energy-momentum
 // scheme, but of fifth order, so the invariants hold to its error, which halving the step divides
-// by about 32 (a free node: the stages' rotations through the inverse left Jacobian). Fixed steps
-// only: step: auto is refused in one line.
+// by about 32 (a free node: the stages' rotations through the inverse left Jacobian).
 TEST(RigidBodyDynamics, RadauKeepsTheInvariantsToFifthOrder) {
   const Superelement se = Jack();
   const Eigen::Vector3d omega0(1.0, 2.0, 3.0);
@@ -119,18 +124,28 @@ TEST(RigidBodyDynamics, RadauKeepsTheInvariantsToFifthOrder) {
   // Fifth order: measured 31.7x for both; at least 2^4.3 = 20.
   EXPECT_GT(coarse.momentum_error / fine.momentum_error, 20.0);
   EXPECT_GT(coarse.energy_error / fine.energy_error, 20.0);
+}
 
-  SystemModel model;
-  AddNode(model, "C", se.interfaces[0].position);
-  model.bodies.emplace_back(se, SuperelementOptions{});
-  model.body_nodes.push_back({0});
-  DynamicState s = InitialDynamicState(model, InitialState(model), Eigen::VectorXd::Zero(6));
-  DynamicOptions options;
-  options.integrator = Integrator::kRadau;
-  options.adaptive = true;
-  const DynamicResult refused = SolveDynamic(model, s, options);
-  EXPECT_FALSE(refused.ok);
-  EXPECT_NE(refused.message.find("takes fixed steps"), std::string::npos) << refused.message;
+// Radau IIA under error control (its own estimate, RadauLocalError): the same ten revolutions
+// from a first step of a hundredth of a revolution. The invariants' errors fall with
+// step_tolerance, and the steps grow about as the fifth root of it.
+TEST(RigidBodyDynamics, RadauErrorControlledStepsKeepTheInvariantsToTheTolerance) {
+  const Superelement se = Jack();
+  const Eigen::Vector3d omega0(1.0, 2.0, 3.0);
+  const double period = 2 * M_PI / omega0.norm();
+  const Eigen::Vector3d none = Eigen::Vector3d::Zero();
+  FlightErrors runs[3];
+  const double tolerances[3] = {1e-3, 1e-5, 1e-7};
+  for (int k = 0; k < 3; ++k) {
+    runs[k] = FreeFlight(se, omega0, period / 100, 1000, 1.0, none, Integrator::kRadau, 1e-12, tolerances[k]);
+    std::printf("[ info ] Radau IIA, step_tolerance %g: %ld steps over ten revolutions, energy %.3e momentum %.3e\n",
+                tolerances[k], runs[k].steps, runs[k].energy_error, runs[k].momentum_error);
+  }
+  for (int k = 1; k < 3; ++k) {
+    EXPECT_LT(runs[k].energy_error, runs[k - 1].energy_error / 10);
+    EXPECT_LT(runs[k].momentum_error, runs[k - 1].momentum_error / 10);
+    EXPECT_GT(runs[k].steps, runs[k - 1].steps);
+  }
 }
 
 // The momentum-conserving midpoint scheme is Simo & Wong's energy-momentum scheme for a rigid
