@@ -12,8 +12,11 @@ reference is missing is run here first (minutes each).
 Wall time: femb-solve on one thread (--threads 1: ratios between the rows are the point), the
 median of REPEATS runs; the reduction is not counted.
 
+With --integrator radau every run (the fixed one at the example's step too) takes the Radau IIA
+integrator (analysis.integrator=radau), with its own error estimate under step: auto.
+
 usage: step_control.py BIN_DIR [--examples-out DIR] [--tolerances 1e-3,3e-4,1e-4] [--repeats 1]
-                       [--cases slider_crank_2d,...]
+                       [--cases slider_crank_2d,...] [--integrator radau]
 """
 import argparse
 import os
@@ -82,6 +85,7 @@ def main():
     ap.add_argument("--repeats", type=int, default=1)
     ap.add_argument("--cases", default="")
     ap.add_argument("--work", default="/tmp/femb_step_control")
+    ap.add_argument("--integrator", default="", help="analysis.integrator for every run (default: the scene's)")
     a = ap.parse_args()
     wanted = set(a.cases.split(",")) if a.cases else None
     tolerances = [t for t in a.tolerances.split(",") if t]
@@ -97,9 +101,12 @@ def main():
         scene_path = scene.replace("EX/", os.path.join(EX, case) + "/").replace("OUT/", out + "/")
         for tol in [None] + tolerances:
             name = "fixed" if tol is None else f"auto_{tol}"
-            run_dir = os.path.join(a.work, case, label.replace(" ", "_").replace(",", "").replace("/", ""), name)
+            run_dir = os.path.join(a.work, a.integrator or "scene", case,
+                                   label.replace(" ", "_").replace(",", "").replace("/", ""), name)
             os.makedirs(run_dir, exist_ok=True)
             run_sets = sets + ([] if tol is None else ["analysis.step=auto", f"analysis.step_tolerance={tol}"])
+            if a.integrator:
+                run_sets = run_sets + [f"analysis.integrator={a.integrator}"]
             measured, failure = solve(a.bin_dir, scene_path, run_dir, run_sets, a.repeats)
             setting = "fixed (example)" if tol is None else f"auto, tol {tol}"
             if failure:
