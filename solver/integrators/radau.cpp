@@ -12,8 +12,8 @@
 // solved for the stage accelerations A_j by Newton, the iteration matrix's block (i, j)
 // delta_ij M_i + h a_ij C_i + h^2 (a^2)_ij K_i with stage i's own K, C and M (the bodies' mass
 // and gyroscopic matrices computed at the first stage and turned to the others: KeptMatricesOf),
-// factored once a step (again when an iteration contracts less than tenfold). The last stage is the step's end
-// (c_3 = 1): the state, its velocity and acceleration. The stage residuals are the dynamic
+// factored once a step (again when an iteration contracts less than tenfold). The last stage is
+// the step's end (c_3 = 1): the state, its velocity and acceleration. The stage residuals are the dynamic
 // residual of generalized-alpha (AssembleDynamicResidual), so every body kind, force and joint
 // comes with it. Closed loops and interface constraints: each stage has its own multipliers
 // Lambda_i (held in the multipliers' entries of A_i), and its constraint equations
@@ -254,7 +254,7 @@ KeptMatrices KeptMatricesOf(const DynamicOptions& options, JacobianReuse reuse, 
 
 // Error control: the step's local error by an embedded formula of third order (Hairer & Wanner
 // IV.8, in the second-order form): the velocities v^ = v_n + h (g a_n + sum_j b^_j A_j), with
-// g = 0.2749 (the inverse of the tableau's real eigenvalue, 3.6378) and the b^ that make it exact
+// g = 0.2749 (the real eigenvalue of the tableau's a, 1 / 3.6378) and the b^ that make it exact
 // for accelerations of degree 2. Radau's own weights b (on the stages alone) are exact to degree 4,
 // so the two differ by e_v = g h (a_n - P(0)), P the quadratic through the stage accelerations
 // (the collocation polynomial) at the step's start: O(h^3) for a smooth motion, e_v O(h^4).
@@ -268,7 +268,7 @@ KeptMatrices KeptMatricesOf(const DynamicOptions& options, JacobianReuse reuse, 
 // filter's matrix is singular.
 void RadauLocalError(const DofMap& dofs, const DynamicState& state, double h, RadauWorkspace& r) {
   const RadauTableau& t = Tableau();
-  constexpr double g = 0.27488882959;  // 1 / 3.6378342
+  constexpr double g = 0.27488882959;  // the real eigenvalue of a, 1 / 3.6378342
   const std::vector<int>& solved = dofs.solved();
   const int n = int(solved.size());
   r.d = state.Wdot;
