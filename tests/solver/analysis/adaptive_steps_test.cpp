@@ -124,8 +124,8 @@ TEST(AdaptiveSteps, MidpointErrorFallsWithTheTolerance) {
   ErrorFallsWithTheTolerance(Integrator::kMidpoint, {1e-3, 1e-4, 1e-5});
 }
 
-// Radau IIA's estimate (its third-order embedded formula, radau.cpp) is the more cautious: 0.1% at
-// 1e-2 in 346 steps, 0.013% at 1e-3 in 502, 0.0053% at 1e-4 in 753, where the reference's own
+// Radau IIA's estimate (its third-order embedded formula, radau.cpp) is the more cautious: 0.12%
+// at 1e-2 in 307 steps, 0.012% at 1e-3 in 493, 0.0053% at 1e-4 in 766, where the reference's own
 // error is reached (its fixed steps take the pulse's jumps inside a step: first order, about 4e-5
 // at 5 us).
 TEST(AdaptiveSteps, RadauErrorFallsWithTheTolerance) {
