@@ -180,6 +180,54 @@ struct MidpointWorkspace {
   TripletAssembler S_build;
 };
 
+// A square linear system of the Radau IIA step (its iteration matrix, its error filter): entries
+// added, factored, solved; held dense or sparse (Start), its storage kept from step to step.
+struct RadauLinearSystem {
+  bool dense = true;
+  Eigen::MatrixXd D;
+  Eigen::PartialPivLU<Eigen::MatrixXd> D_lu;
+  Triplets triplets;
+  Eigen::SparseMatrix<double> S;
+  Eigen::SparseLU<Eigen::SparseMatrix<double>> S_lu;
+  int n = 0;
+  void Start(int size, bool as_dense) {
+    n = size;
+    dense = as_dense;
+    if (dense) D.setZero(n, n);
+    triplets.clear();
+  }
+  void Add(int row, int col, double value) {
+    if (dense) {
+      D(row, col) += value;
+    } else {
+      triplets.emplace_back(row, col, value);
+    }
+  }
+  /// False when singular: dense, a pivot below 1e-15 of the largest (Eigen's rcond allocates);
+  /// sparse, SparseLU's failure (its pattern analysed at every factorization: the bodies'
+  /// matrices leave out their zero entries, so the pattern may change from step to step).
+  bool Factor() {
+    if (dense) {
+      D_lu.compute(D);
+      const auto pivots = D_lu.matrixLU().diagonal().cwiseAbs();
+      return pivots.minCoeff() > 1e-15 * pivots.maxCoeff();
+    }
+    S.resize(n, n);
+    S.setFromTriplets(triplets.begin(), triplets.end());
+    S.makeCompressed();
+    S_lu.analyzePattern(S);
+    S_lu.factorize(S);
+    return S_lu.info() == Eigen::Success;
+  }
+  void Solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) const {
+    if (dense) {
+      x = D_lu.solve(b);
+    } else {
+      x = S_lu.solve(b);
+    }
+  }
+};
+
 // The Radau IIA step's storage (solver/integrators/radau.cpp), kept from one step to the next:
 // the stages' states, accelerations, velocities and local coordinates, their residuals, and the
 // factored iteration matrix over the stages' solved unknowns.
@@ -194,22 +242,13 @@ struct RadauWorkspace {
   // The iteration matrix: dense up to kDenseStages unknowns (a dense LU of that size costs less
   // than the sparse one's analysis), sparse above.
   static constexpr int kDenseStages = 240;
-  bool dense = true;
-  Eigen::MatrixXd J_dense;
-  Eigen::PartialPivLU<Eigen::MatrixXd> dense_lu;
-  Triplets triplets;
-  Eigen::SparseMatrix<double> J;
-  Eigen::SparseLU<Eigen::SparseMatrix<double>> lu;
+  RadauLinearSystem J;
   bool factored = false;
   double factored_h = -1.0;
   // Error-controlled steps: the step's local error estimate of the positions and of the
-  // velocities times the step (RadauLocalError), and the filter's matrix, dense or sparse as above.
+  // velocities times the step (RadauLocalError), and the filter's matrix.
   Eigen::VectorXd error_q, error_v, d, filter_rhs, filtered, product;
-  Eigen::MatrixXd S_dense;
-  Eigen::PartialPivLU<Eigen::MatrixXd> S_dense_lu;
-  Triplets S_triplets;
-  Eigen::SparseMatrix<double> S;
-  Eigen::SparseLU<Eigen::SparseMatrix<double>> S_lu;
+  RadauLinearSystem filter;
 };
 
 // The bodies' storage of a dynamic analysis, kept from one Newton iteration and one step to the

@@ -16,7 +16,7 @@ StepController::StepController(const SystemModel& model, const DofMap& dofs, con
   if (options.integrator == Integrator::kMidpoint) {
     c_q_ = 1.0 / 12, c_v_ = 1.0 / 24;
   } else if (options.integrator == Integrator::kRadau) {
-    order_ = 5;
+    order_ = 5, banded_ = false;
   } else {
     c_q_ = std::abs(AlphaParameters(options.rho_inf).third_order()), c_v_ = 1.0 / 12;
   }
@@ -46,7 +46,7 @@ double StepController::Fit(double t, double h) {
   // The plan: equal steps of at most planned_ to the boundary, made anew at the first step and
   // after a rejection (from the step to retry), and from the proposal when that leaves [0.9, 1.25]
   // of the step in use, at least kSettle steps after the last change or breakpoint, and only
-  // where it changes the step. Radau IIA (order_ 5) carries nothing across a step that a change
+  // where it changes the step. Radau IIA (not banded_) carries nothing across a step that a change
   // disturbs, and takes every proposal that changes the step: the PI controller's growth at a
   // steady error ratio E, 0.9 E^(-0.3/5), stays inside that band down to E = 4e-3.
   const double rest = boundary_ - t;
@@ -55,7 +55,7 @@ double StepController::Fit(double t, double h) {
   if (!proposal_ || !(kept_ > 0)) {
     planned_ = h;
     settled_ = 0;
-  } else if ((order_ == 5 || ((h < 0.9 * kept_ || h > 1.25 * kept_) && settled_ >= kSettle)) &&
+  } else if ((!banded_ || ((h < 0.9 * kept_ || h > 1.25 * kept_) && settled_ >= kSettle)) &&
              equal_steps(h) != equal_steps(planned_)) {
     planned_ = h;
     settled_ = 0;

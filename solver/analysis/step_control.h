@@ -127,7 +127,8 @@ class StepController {
   int settled_ = 0;                ///< accepted steps since the last change of plan or breakpoint
   static constexpr int kSettle = 7;
   double min_step_ = 0, max_step_ = 0, D_ = 0, c_q_ = 0, c_v_ = 0, boundary_ = 0, E_prev_ = 0;
-  double order_ = 3;  ///< the estimate's power of the step: h^3, or h^5 for Radau IIA's
+  double order_ = 3;    ///< the estimate's power of the step: h^3, or h^5 for Radau IIA's
+  bool banded_ = true;  ///< the plan changes only outside [0.9, 1.25] after kSettle steps (Fit)
   bool lands_ = false, output_ = true, at_breakpoint_ = false;
 };
 

@@ -51,6 +51,13 @@ struct RadauTableau {
         for (int k = 0; k < 3; ++k) a2[i][j] += a[i][k] * a[k][j];
       }
   }
+  /// Lagrange's basis polynomial of node c_j at s (in the step's time fraction).
+  double Lagrange(int j, double s) const {
+    double l = 1.0;
+    for (int k = 0; k < 3; ++k)
+      if (k != j) l *= (s - c[size_t(k)]) / (c[size_t(j)] - c[size_t(k)]);
+    return l;
+  }
 };
 
 const RadauTableau& Tableau() {
@@ -109,12 +116,7 @@ void Predict(const DynamicState& state, double h, RadauWorkspace& r) {
   for (int i = 0; i < 3; ++i) {
     const double s = 1.0 + t.c[size_t(i)] * h / h_last;  // in the last step's time fraction
     r.A[size_t(i)].setZero(state.Wdot.size());
-    for (int j = 0; j < 3; ++j) {
-      double l = 1.0;  // Lagrange's basis polynomial of node c_j at s
-      for (int k = 0; k < 3; ++k)
-        if (k != j) l *= (s - t.c[size_t(k)]) / (t.c[size_t(j)] - t.c[size_t(k)]);
-      r.A[size_t(i)] += l * state.increments[size_t(j)];
-    }
+    for (int j = 0; j < 3; ++j) r.A[size_t(i)] += t.Lagrange(j, s) * state.increments[size_t(j)];
   }
 }
 
@@ -161,18 +163,14 @@ void SolvedEntries(const DofMap& dofs, const std::vector<int>& position, const S
 
 // The iteration matrix over the stages' solved unknowns (stage i's unknown k at i n_solved + k),
 // block (i, j) = delta_ij M_i + h a_ij C_i + h^2 (a^2)_ij K_i with stage i's K, C and M
-// (r.assembly[i]), factored: dense up to kDenseStages unknowns, sparse above (its pattern
-// analysed at every factorization: the bodies' matrices leave out their zero entries, so the
-// pattern may change from step to step). False when singular.
+// (r.assembly[i]), factored: dense up to kDenseStages unknowns, sparse above. False when singular.
 bool FactorStageMatrix(const DofMap& dofs, double h, RadauWorkspace& r) {
   const RadauTableau& t = Tableau();
   const std::vector<int>& solved = dofs.solved();
   const int n = int(solved.size());
   r.position.assign(size_t(dofs.n_dofs()), -1);
   for (int k = 0; k < n; ++k) r.position[size_t(solved[size_t(k)])] = k;
-  r.dense = 3 * n <= RadauWorkspace::kDenseStages;
-  if (r.dense) r.J_dense.setZero(3 * n, 3 * n);
-  r.triplets.clear();
+  r.J.Start(3 * n, 3 * n <= RadauWorkspace::kDenseStages);
   // A multiplier's column is stage j's own unknown Lambda_j (in stage j's equations alone, its
   // K entry as it is); a multiplier's row (a constraint equation) is scaled (RowScale).
   const auto add = [&](int i, const SystemMatrix& X, int which) {
@@ -181,12 +179,7 @@ bool FactorStageMatrix(const DofMap& dofs, double h, RadauWorkspace& r) {
         double f = which == 0 ? (i == j ? 1.0 : 0.0) : which == 1 ? h * t.a[i][j] : h * h * t.a2[i][j];
         if (multiplier_column) f = i == j ? 1.0 : 0.0;
         f *= row_scale;
-        if (f == 0.0) continue;
-        if (r.dense) {
-          r.J_dense(i * n + row, j * n + c) += f * value;
-        } else {
-          r.triplets.emplace_back(i * n + row, j * n + c, f * value);
-        }
+        if (f != 0.0) r.J.Add(i * n + row, j * n + c, f * value);
       }
     });
   };
@@ -196,18 +189,7 @@ bool FactorStageMatrix(const DofMap& dofs, double h, RadauWorkspace& r) {
     add(i, a.C, 1);
     add(i, a.K, 2);
   }
-  if (r.dense) {
-    r.dense_lu.compute(r.J_dense);
-    const auto pivots = r.dense_lu.matrixLU().diagonal().cwiseAbs();
-    r.factored = pivots.minCoeff() > 1e-15 * pivots.maxCoeff();
-    return r.factored;
-  }
-  r.J.resize(3 * n, 3 * n);
-  r.J.setFromTriplets(r.triplets.begin(), r.triplets.end());
-  r.J.makeCompressed();
-  r.lu.analyzePattern(r.J);
-  r.lu.factorize(r.J);
-  r.factored = r.lu.info() == Eigen::Success;
+  r.factored = r.J.Factor();
   return r.factored;
 }
 
@@ -272,12 +254,7 @@ void RadauLocalError(const DofMap& dofs, const DynamicState& state, double h, Ra
   const std::vector<int>& solved = dofs.solved();
   const int n = int(solved.size());
   r.d = state.Wdot;
-  for (int j = 0; j < 3; ++j) {
-    double l = 1.0;  // Lagrange's basis polynomial of node c_j at 0
-    for (int k = 0; k < 3; ++k)
-      if (k != j) l *= (0.0 - t.c[size_t(k)]) / (t.c[size_t(j)] - t.c[size_t(k)]);
-    r.d -= l * r.A[size_t(j)];
-  }
+  for (int j = 0; j < 3; ++j) r.d -= t.Lagrange(j, 0.0) * r.A[size_t(j)];
   for (int j = 0; j < dofs.n_dofs(); ++j)
     if (r.position[size_t(j)] < 0 || dofs.multiplier(j)) r.d[j] = 0.0;
   const Assembly& a = r.assembly[2];
@@ -285,37 +262,17 @@ void RadauLocalError(const DofMap& dofs, const DynamicState& state, double h, Ra
   r.filter_rhs.setZero(n);
   for (int k = 0; k < n; ++k)
     if (!dofs.multiplier(solved[size_t(k)])) r.filter_rhs[k] = g * h * r.product[solved[size_t(k)]];
-  const bool dense = n <= RadauWorkspace::kDenseStages / 3;
-  if (dense) r.S_dense.setZero(n, n);
-  r.S_triplets.clear();
+  r.filter.Start(n, n <= RadauWorkspace::kDenseStages / 3);
   const auto add = [&](const SystemMatrix& X, double coefficient) {
     SolvedEntries(dofs, r.position, X, h, [&](int row, int c, double value, double row_scale, bool multiplier_column) {
-      const double f = (multiplier_column ? 1.0 : coefficient) * row_scale;
-      if (dense) {
-        r.S_dense(row, c) += f * value;
-      } else {
-        r.S_triplets.emplace_back(row, c, f * value);
-      }
+      r.filter.Add(row, c, (multiplier_column ? 1.0 : coefficient) * row_scale * value);
     });
   };
   add(a.M, 1.0);
   add(a.C, g * h);
   add(a.K, g * g * h * h);
-  bool filtered = false;
-  if (dense) {
-    r.S_dense_lu.compute(r.S_dense);
-    const auto pivots = r.S_dense_lu.matrixLU().diagonal().cwiseAbs();
-    filtered = pivots.minCoeff() > 1e-15 * pivots.maxCoeff();
-    if (filtered) r.filtered = r.S_dense_lu.solve(r.filter_rhs);
-  } else {
-    r.S.resize(n, n);
-    r.S.setFromTriplets(r.S_triplets.begin(), r.S_triplets.end());
-    r.S.makeCompressed();
-    r.S_lu.analyzePattern(r.S);
-    r.S_lu.factorize(r.S);
-    filtered = r.S_lu.info() == Eigen::Success;
-    if (filtered) r.filtered = r.S_lu.solve(r.filter_rhs);
-  }
+  const bool filtered = r.filter.Factor();
+  if (filtered) r.filter.Solve(r.filter_rhs, r.filtered);
   if (!filtered || !r.filtered.allFinite()) {
     r.filtered.resize(n);
     for (int k = 0; k < n; ++k) r.filtered[k] = g * h * r.d[solved[size_t(k)]];
@@ -443,11 +400,7 @@ StepOutcome RadauStep(const SystemModel& model, const DofMap& dofs, const Dynami
     for (int i = 0; i < 3; ++i)
       for (int k = 0; k < n; ++k)
         r.rhs[i * n + k] = r.assembly[size_t(i)].residual[solved[size_t(k)]] * RowScale(dofs, solved[size_t(k)], h);
-    if (r.dense) {
-      r.correction = r.dense_lu.solve(r.rhs);
-    } else {
-      r.correction = r.lu.solve(r.rhs);
-    }
+    r.J.Solve(r.rhs, r.correction);
     if (!r.correction.allFinite()) return out;
     for (int i = 0; i < 3; ++i)
       for (int k = 0; k < n; ++k) r.A[size_t(i)][solved[size_t(k)]] += r.correction[i * n + k];
