@@ -43,7 +43,7 @@ options:
                         uninterrupted run's to the bit
   --set key=value       override a scene key, e.g. --set analysis.step=5e-4
                         --set analysis.end_time=0.5 (repeatable)
-  --threads N           threads for the bodies' forces and matrices in dynamic analysis
+  --threads N           threads for the bodies' forces and matrices in static and dynamic analysis
                         (default: the processors available; the results are the same bits
                         for any N)
   -q, --quiet           no progress lines

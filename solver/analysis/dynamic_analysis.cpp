@@ -17,62 +17,6 @@ namespace femb {
 
 namespace dynamic_internal {
 
-void StartAssembly(const SystemModel& model, const DofMap& dofs, AssemblyParts& parts, Assembly& out) {
-  out.ok = true;
-  out.message.clear();
-  out.residual.setZero(dofs.n_dofs());
-  out.f_ext.setZero(dofs.n_dofs());
-  out.scale = 0.0;
-  out.dof_scale.setZero(dofs.n_dofs());
-  out.roundoff = 0.0;
-  parts.K.clear();
-  parts.C.clear();
-  parts.M.clear();
-  parts.node_forces.f.assign(size_t(model.n_nodes()), Eigen::Matrix<double, 6, 1>::Zero());
-}
-
-void FinishAssembly(const SystemModel& model, const DofMap& dofs, const SystemState& config, double t,
-                    const Eigen::VectorXd& W, bool matrices, AssemblyParts& parts, Assembly& out) {
-  Eigen::VectorXd &loads = parts.loads, &springs = parts.springs, &weights = parts.weights;
-  const int n = dofs.n_dofs();
-  loads.setZero(n);
-  AddNodeLoads(model, config, t, loads, matrices ? &parts.K : nullptr, &parts.node_forces);
-  AddUserForces(model, config, W, t, &loads, matrices ? &parts.K : nullptr, matrices ? &parts.C : nullptr,
-                &parts.node_forces);
-  out.residual += loads;
-  out.f_ext += loads;
-  springs.setZero(n);
-  AddSpringDampers(model, config, W, &springs, matrices ? &parts.K : nullptr, matrices ? &parts.C : nullptr, nullptr,
-                   &parts.node_forces, &parts.scratch);
-  out.residual += springs;
-  if (matrices) AddJointGeometricStiffness(model, dofs, config, parts.node_forces, parts.K, &parts.scratch);
-  ResidualWeights(model, dofs, weights);
-  const double applied = std::max((weights.asDiagonal() * springs).norm(), (weights.asDiagonal() * loads).norm());
-  out.scale = std::max({out.scale, applied, 1e-300});
-  FinishDofScale(applied, out.scale, out.dof_scale);
-  out.node_forces.f = parts.node_forces.f;
-}
-
-bool AddBodyTerms(const SystemModel& model, const std::vector<BodyTerms>& terms, AssemblyParts& parts, Assembly& out) {
-  for (size_t b = 0; b < terms.size(); ++b) {
-    const BodyTerms& r = terms[b];
-    if (!r.frame_ok) {
-      out.ok = false;
-      out.message = "floating frame of body " + std::to_string(b) + " did not converge";
-      return false;
-    }
-    out.scale = std::max(out.scale, r.scale);
-    AddBodyScale(r.map, r.scale, out.dof_scale);
-    out.roundoff += r.roundoff;
-    AddBodyNodeForces(model, int(b), r.r_b, parts.node_forces);
-    const bool matrices = r.K.size() > 0;
-    ScatterBody(r.map, &r.r_b, matrices ? &r.K : nullptr, &out.residual, matrices ? &parts.K : nullptr);
-    ScatterBody(r.map, &r.f_grav, matrices ? &r.C : nullptr, &out.f_ext, matrices ? &parts.C : nullptr);
-    if (matrices) ScatterBody(r.map, nullptr, &r.M, nullptr, &parts.M);
-  }
-  return true;
-}
-
 Eigen::VectorXd DriveForces(const DofMap& dofs, const Eigen::VectorXd& residual) {
   Eigen::VectorXd f;
   DriveForces(dofs, residual, f);
@@ -144,9 +88,13 @@ void ConsistentAccelerations(const SystemModel& model, const DofMap& dofs, Dynam
 
 }  // namespace
 
+bool AccelerationsConsistent(const SystemModel& model, const DynamicState& state) {
+  return model.dofs().n_multipliers() == 0 && state.node_w.empty();
+}
+
 DynamicState WithConsistentAccelerations(const SystemModel& model, const DynamicState& state) {
   DynamicState s = state;
-  if (model.dofs().n_multipliers() > 0 || !state.node_w.empty()) ConsistentAccelerations(model, model.dofs(), s);
+  if (!AccelerationsConsistent(model, state)) ConsistentAccelerations(model, model.dofs(), s);
   return s;
 }
 
@@ -567,6 +515,7 @@ class DynamicRun {
   // at a change of step.
   void Accept(const StepOutcome& step) {
     next_.h_last = h_;
+    restarted_ = false;
     if (result_.steps == 0 || h_ < result_.smallest_step)
       result_.smallest_step = h_, result_.smallest_step_time = next_.t;
     result_.largest_step = std::max(result_.largest_step, h_);
@@ -576,6 +525,7 @@ class DynamicRun {
       ApplyPrescribed(model_, dofs_, state_.t, state_.config, &state_.W, &state_.Wdot, &work_.parts.scratch);
       if (options_.integrator == Integrator::kGeneralizedAlpha) work_.a_n = state_.a - state_.Wdot;
       ConsistentAccelerations(model_, dofs_, state_);
+      restarted_ = true;
       if (options_.integrator == Integrator::kGeneralizedAlpha) {
         state_.a += work_.a_n;
         state_.increments_kept = 0;  // the motion's third derivative jumps here
@@ -598,6 +548,8 @@ class DynamicRun {
     r.rejected = result_.rejected_by_error + result_.newton_cuts;
     r.output = output;
     r.capture = &capture_;
+    if (options_.integrator == Integrator::kGeneralizedAlpha && step.passes_kept && !restarted_)
+      r.node_forces = &work_.assembly.node_forces;
     return r;
   }
 
@@ -667,6 +619,7 @@ class DynamicRun {
   double h_ = 0.0;
   int cuts_ = 0;
   bool after_rejection_ = false;
+  bool restarted_ = false;  ///< the last accepted step ended at a breakpoint's restart
   IterationMatrix matrix_;
   BodyThreads threads_;
   BodyWorkspace work_;

@@ -151,6 +151,11 @@ struct DynamicStepReport {
   double kinetic_energy = 0.0, elastic_energy = 0.0, external_work = 0.0;
   Eigen::Vector3d linear_momentum = Eigen::Vector3d::Zero();
   Eigen::Vector3d angular_momentum = Eigen::Vector3d::Zero();
+  /// The converged pass's forces on the nodes (residual sense) when that pass is at the reported
+  /// state (generalized-alpha: its residual holds at the step's end; not after a breakpoint's
+  /// restart, which changes the accelerations), else null: what DynamicReactions would assemble
+  /// again. Valid during on_step.
+  const NodeForces* node_forces = nullptr;
 };
 
 struct DynamicResult {
@@ -253,6 +258,9 @@ DynamicStepReport Measure(const SystemModel& model, DynamicState& state);
 /// accelerations already satisfy the equations of motion at t_n+1 and the state is returned
 /// as it is.
 DynamicState WithConsistentAccelerations(const SystemModel& model, const DynamicState& state);
+/// Whether the state's accelerations and multipliers are the consistent ones as they are (no
+/// closed loops, not the midpoint scheme's): WithConsistentAccelerations returns it unchanged.
+bool AccelerationsConsistent(const SystemModel& model, const DynamicState& state);
 
 /// Support and joint reactions (JointReactions, solver/joints/joint_tree.h) at a state: the inertia forces with its
 /// accelerations (give it WithConsistentAccelerations' state).

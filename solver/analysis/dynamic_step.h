@@ -21,26 +21,11 @@
 #include <vector>
 
 #include "solver/analysis/dynamic_analysis.h"
+#include "solver/assembly/body_pass.h"
 #include "solver/assembly/system.h"
 #include "solver/parallel.h"
 
 namespace femb::dynamic_internal {
-
-struct Assembly {
-  bool ok = true;
-  std::string message;
-  Eigen::VectorXd residual;  // f_ext + f_grav - f_int - f_in
-  Eigen::VectorXd f_ext;     // nodal loads and gravity, for the work
-  SystemMatrix K, C, M;
-  double scale = 0.0;
-  // Per unknown: the largest force scale of the bodies acting on it, floored by the loads' and
-  // springs' (the model's `scale` where no body acts: loop multipliers). Newton's test weighs
-  // each unknown's residual by it (ScaledFreeNorm), so that one stiff body's forces set the
-  // tolerance of its own unknowns only.
-  Eigen::VectorXd dof_scale;
-  double roundoff = 0.0;   // residual noise from the round-off of absolute positions
-  NodeForces node_forces;  // per node, residual sense (for the reactions)
-};
 
 // Newton's convergence test on an assembly's residual (weighted norm r_norm, FreeNorm): at the
 // round-off of the positions, or below `tolerance` relative to the forces on each unknown
@@ -49,52 +34,6 @@ inline bool ResidualSmall(const DofMap& dofs, const Assembly& a, const Eigen::Ve
                           double tolerance) {
   return r_norm <= a.roundoff || ScaledFreeNorm(dofs, a.residual, weights, a.dof_scale) <= tolerance;
 }
-
-// The triplets of an assembly in progress and the node forces for the joints' stiffness; the
-// loads' and springs' vectors and the weights of FinishAssembly, and the system-level functions'
-// scratch (storage kept: an assembly allocates nothing once they have their sizes).
-struct AssemblyParts {
-  Triplets K, C, M;
-  NodeForces node_forces;
-  Eigen::VectorXd loads, springs, weights;
-  SystemScratch scratch;
-};
-
-// Starts an assembly in `out` (residual and f_ext zero, parts emptied): storage reused.
-void StartAssembly(const SystemModel& model, const DofMap& dofs, AssemblyParts& parts, Assembly& out);
-
-// Nodal loads at t, spring-dampers at velocities W (both on `config`), and with `matrices` their
-// and the joints' geometric stiffness into parts.K and parts.C (the caller builds the matrices).
-void FinishAssembly(const SystemModel& model, const DofMap& dofs, const SystemState& config, double t,
-                    const Eigen::VectorXd& W, bool matrices, AssemblyParts& parts, Assembly& out);
-
-// f(b) for every body, on the pool when there is one (f is called, never copied).
-template <class F>
-void ForEachBody(BodyThreads* threads, int n, const F& f) {
-  if (threads) {
-    threads->ForEach(n, f);
-  } else {
-    for (int b = 0; b < n; ++b) f(b);
-  }
-}
-
-// What the residual pass keeps of one body for the iteration matrix (AddDynamicMatrices).
-struct BodyPass {
-  BodyData data;
-  Eigen::VectorXd w, wdot;
-  InertiaLoadFactors load;
-};
-
-// One body's share of an assembly pass, computed on its own (in parallel with the others) and
-// added into the system in body order (AddBodyTerms).
-struct BodyTerms {
-  bool frame_ok = true;
-  Eigen::VectorXd r_b, f_grav;  // f_grav - f_int - f_in, and f_grav
-  Eigen::MatrixXd K, C, M;      // empty in a residual-only pass
-  double scale = 0.0, roundoff = 0.0;
-  std::vector<MapEntry> map;
-  Eigen::VectorXd f_int, f_in, f_acc, f_quadratic;  // the pass's scratch (storage kept)
-};
 
 // One body's share of a step's measures (energies, momenta).
 struct BodyMeasure {
@@ -329,10 +268,6 @@ void AddDynamicMatrices(const SystemModel& model, const DofMap& dofs, const Dyna
 // Residual and (with `matrices`) K, C, M at s, with a workspace of its own.
 Assembly AssembleDynamic(const SystemModel& model, const DofMap& dofs, DynamicState& s, double t, bool matrices,
                          bool full_inertia_tangent = false);
-
-// Adds the bodies' terms in body order: the same sums whatever thread computed them. False (the
-// message in `out`) when a body's floating frame did not converge.
-bool AddBodyTerms(const SystemModel& model, const std::vector<BodyTerms>& terms, AssemblyParts& parts, Assembly& out);
 
 // The generalized forces the prescribed motions exert: minus the residual on the prescribed
 // coordinates (zero elsewhere).

@@ -5,6 +5,8 @@
 #include <cstdio>
 
 #include "solver/analysis/singularity.h"
+#include "solver/assembly/body_pass.h"
+#include "solver/parallel.h"
 
 namespace femb {
 namespace {
@@ -97,6 +99,15 @@ struct StaticNewton {
   int iterations = 0;
   double r_norm = 0.0, energy = 0.0;
   Eigen::VectorXd travelled, loads_after;  ///< the step's motion and the loads at its end
+  NodeForces node_forces;                  ///< the converged pass's (for the reactions)
+};
+
+// The passes' storage and threads of a static run.
+struct StaticPasses {
+  StaticWorkspace work;
+  BodyThreads threads;
+  explicit StaticPasses(int n) : threads(n) {}
+  BodyThreads* pool() { return threads.threads() > 1 ? &threads : nullptr; }
 };
 
 // Newton on the static residual at load factor `target` from `trial` (moved in place). At the run's
@@ -107,14 +118,15 @@ struct StaticNewton {
 // and no force scale to compare it with.
 StaticNewton NewtonSteps(const SystemModel& model, const DofMap& dofs, const StaticOptions& options, double target,
                          double size, double tolerance, const Eigen::VectorXd& weights, bool first_step,
-                         SystemState& trial, StabilityWatch& stability, StaticResult& result, std::string* fatal) {
+                         SystemState& trial, StabilityWatch& stability, StaticPasses& passes, StaticResult& result,
+                         std::string* fatal) {
   StaticNewton out;
   double last_step = 1e300;
   out.travelled = Eigen::VectorXd::Zero(dofs.n_dofs());
   bool minimum_norm = false;  // the first step of the run was MinimumNormStep's
   for (; out.iterations < options.max_iterations; ++out.iterations) {
     const int it = out.iterations;
-    const SystemForces f = AssembleStatic(model, dofs, trial, target, true);
+    const SystemForces f = AssembleStatic(model, dofs, trial, target, true, &passes.work, passes.pool());
     if (!f.ok) break;
     out.r_norm = FreeNorm(dofs, f.residual, weights);
     out.energy = f.elastic_energy;
@@ -124,6 +136,7 @@ StaticNewton NewtonSteps(const SystemModel& model, const DofMap& dofs, const Sta
         (out.r_norm <= f.roundoff || ScaledFreeNorm(dofs, f.residual, weights, f.dof_scale) <= tolerance ||
          last_step <= 1e-13 * size)) {
       out.converged = true;
+      out.node_forces = f.node_forces;
       break;
     }
     FreeSolver solver;
@@ -171,13 +184,14 @@ StaticResult SolveStatic(const SystemModel& model, SystemState& state, const Sta
   const Eigen::VectorXd weights = ResidualWeights(model, dofs);
   if (const std::string w = RoundOffToleranceWarning(options.tolerance); !w.empty()) result.warnings.push_back(w);
   StabilityWatch stability;
+  StaticPasses passes(options.threads);
   while (lambda < end * (1 - 1e-12)) {
     const double target = std::min(end, lambda + step);
     SystemState trial = state;
     ApplyPrescribed(model, dofs, target, trial, nullptr, nullptr);
     std::string fatal;
     const StaticNewton newton = NewtonSteps(model, dofs, options, target, size, tolerance, weights,
-                                            result.steps.empty(), trial, stability, result, &fatal);
+                                            result.steps.empty(), trial, stability, passes, result, &fatal);
     if (!fatal.empty()) {
       result.message = fatal;
       return result;
@@ -200,7 +214,7 @@ StaticResult SolveStatic(const SystemModel& model, SystemState& state, const Sta
     loads_before = newton.loads_after;
     state = trial;
     lambda = target;
-    StaticStepReport report{lambda, newton.iterations, newton.r_norm, newton.energy, work};
+    StaticStepReport report{lambda, newton.iterations, newton.r_norm, newton.energy, work, &newton.node_forces};
     result.steps.push_back(report);
     if (on_step) on_step(report, state);
     if (options.stop && options.stop->load() != 0) {

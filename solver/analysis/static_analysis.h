@@ -20,6 +20,7 @@ struct StaticOptions {
   int max_iterations = 25;  ///< Newton iterations per step
   int max_cuts = 6;         ///< halvings of a step before giving up
   double tolerance = 1e-8;  ///< ||residual|| <= tol * (largest force term of the step); at least kRoundOffTolerance
+  int threads = 1;          ///< bodies evaluated in parallel on this many threads (the same results for any number)
 };
 
 struct StaticStepReport {
@@ -28,6 +29,9 @@ struct StaticStepReport {
   double residual = 0.0;
   double elastic_energy = 0.0;
   double external_work = 0.0;  ///< work of the nodal loads so far (trapezoidal rule per step)
+  /// The converged pass's forces on the nodes (residual sense), at the step's state: what
+  /// JointReactions needs, without assembling again. Valid during the callback.
+  const NodeForces* node_forces = nullptr;
 };
 
 struct StaticResult {

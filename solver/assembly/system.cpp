@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "solver/assembly/body_pass.h"
 #include "solver/rotation.h"
 
 namespace femb {
@@ -111,71 +112,86 @@ void AddBodyNodeForces(const SystemModel& model, int b, const Eigen::VectorXd& r
   }
 }
 
+namespace {
+
+// The bodies' static terms added in body order: the internal forces (and tangents) into the
+// residual, their weight into `gravity` (the loads', for the force scale). False (the message in
+// `out`) when a body's floating frame did not converge.
+bool AddStaticBodyTerms(const SystemModel& model, bool with_tangent, bool gravity_on, StaticWorkspace& work,
+                        SystemForces& out) {
+  for (size_t b = 0; b < work.terms.size(); ++b) {
+    const BodyTerms& r = work.terms[b];
+    if (!r.frame_ok) {
+      out.ok = false;
+      out.message = "floating frame of body " + std::to_string(b) + " did not converge";
+      return false;
+    }
+    out.elastic_energy += r.elastic_energy;
+    out.force_scale = std::max(out.force_scale, r.scale);
+    out.roundoff += r.roundoff;
+    AddBodyScale(r.map, r.scale, out.dof_scale);
+    ScatterBody(r.map, &r.r_b, with_tangent ? &r.K : nullptr, &out.residual, with_tangent ? &work.parts.K : nullptr);
+    AddBodyNodeForces(model, int(b), r.r_b, work.parts.node_forces);
+    if (gravity_on) {
+      ScatterBody(r.map, &r.f_grav, nullptr, &work.gravity, nullptr);
+      AddBodyNodeForces(model, int(b), r.f_grav, work.parts.node_forces);
+    }
+  }
+  return true;
+}
+
+}  // namespace
+
 SystemForces AssembleStatic(const SystemModel& model, const DofMap& dofs, SystemState& state, double lambda,
-                            bool with_tangent) {
+                            bool with_tangent, StaticWorkspace* workspace, BodyThreads* threads) {
+  StaticWorkspace own;
+  StaticWorkspace& work = workspace ? *workspace : own;
   SystemForces out;
   const int n = dofs.n_dofs();
   out.residual = Eigen::VectorXd::Zero(n);
   out.dof_scale = Eigen::VectorXd::Zero(n);
-  Triplets tangent;
-  NodeForces node_forces = ZeroNodeForces(model);
-  Eigen::VectorXd gravity = Eigen::VectorXd::Zero(n);
-  for (size_t b = 0; b < model.bodies.size(); ++b) {
-    const SuperelementBody& body = model.bodies[b];
-    BodyData data;
-    BodyConfigurationOf(model, state, int(b), data.c);
-    const FrameSolution frame = PlaceBody(body, state.frames[b], data);
-    if (!frame.ok) {
-      out.ok = false;
-      out.message = "floating frame of body " + std::to_string(b) + " did not converge";
-      return out;
-    }
-    state.frames[b] = frame;
-    Eigen::VectorXd f;
-    Eigen::MatrixXd K;
-    // Gravity in a static analysis, ramped to full at pseudo-time static_gravity_end.
-    const bool gravity_on = model.static_gravity_end > 0 && model.gravity.squaredNorm() > 0;
-    const double ramp = gravity_on ? std::min(lambda / model.static_gravity_end, 1.0) : 0.0;
-    // The stress of the body's own weight stiffens it (load factors -R_j^T g at rest).
-    const Eigen::VectorXd rest = Eigen::VectorXd::Zero(body.n_coordinates());
-    InertiaLoadFactors load;
-    StiffenedElasticForce(body, data, rest, rest, ramp * model.gravity, load, f, with_tangent ? &K : nullptr);
-    out.elastic_energy += ElasticEnergy(body, data);
-    const double scale = std::max(body.ForceNorm(f), body.force_floor());
-    out.force_scale = std::max(out.force_scale, scale);
-    out.roundoff += RoundOffForce(body, data.c);
-    // The weight's configuration derivative in the tangent (S = -dr/dq: minus GravityTangent; the
-    // dynamic iteration matrix takes it with the inertia's, generalized_alpha.cpp).
-    if (with_tangent && gravity_on && ramp > 0) K -= GravityTangent(body, data, ramp * model.gravity);
-    const std::vector<MapEntry> map = BodyMap(model, dofs, state, int(b));
-    AddBodyScale(map, scale, out.dof_scale);
-    const Eigen::VectorXd minus_f = -f;
-    ScatterBody(map, &minus_f, with_tangent ? &K : nullptr, &out.residual, with_tangent ? &tangent : nullptr);
-    AddBodyNodeForces(model, int(b), minus_f, node_forces);
-    if (gravity_on) {
-      Eigen::VectorXd f_grav;
-      GravityForce(body, data, ramp * model.gravity, f_grav);
-      ScatterBody(map, &f_grav, nullptr, &gravity, nullptr);
-      AddBodyNodeForces(model, int(b), f_grav, node_forces);
-    }
-  }
-  Eigen::VectorXd loads = Eigen::VectorXd::Zero(n);
-  AddNodeLoads(model, state, lambda, loads, with_tangent ? &tangent : nullptr, &node_forces);
-  AddUserForces(model, state, Eigen::VectorXd(), lambda, &loads, with_tangent ? &tangent : nullptr, nullptr,
-                &node_forces);
-  loads += gravity;
+  AssemblyParts& parts = work.parts;
+  Triplets* tangent = with_tangent ? &parts.K : nullptr;
+  parts.K.clear();
+  parts.node_forces.f.assign(size_t(model.n_nodes()), Eigen::Matrix<double, 6, 1>::Zero());
+  work.gravity.setZero(n);
+  // Gravity in a static analysis, ramped to full at pseudo-time static_gravity_end; the stress of
+  // the body's own weight stiffens it (load factors -R_j^T g at rest).
+  const bool gravity_on = model.static_gravity_end > 0 && model.gravity.squaredNorm() > 0;
+  const double ramp = gravity_on ? std::min(lambda / model.static_gravity_end, 1.0) : 0.0;
+  BodyPassKind kind;
+  kind.at_rest = true;
+  kind.elastic_tangent = with_tangent;
+  kind.gravity = ramp * model.gravity;
+  const int n_bodies = int(model.bodies.size());
+  work.passes.resize(size_t(n_bodies));
+  work.terms.resize(size_t(n_bodies));
+  ForEachBody(threads, n_bodies, [&](int b) {
+    BodyPass& pass = work.passes[size_t(b)];
+    pass.w.setZero(model.bodies[b].n_coordinates());
+    pass.wdot.setZero(model.bodies[b].n_coordinates());
+    EvaluateBodyTerms(model, dofs, state, b, kind, pass, work.terms[size_t(b)]);
+  });
+  if (!AddStaticBodyTerms(model, with_tangent, gravity_on, work, out)) return out;
+  NodeForces& node_forces = parts.node_forces;
+  Eigen::VectorXd& loads = parts.loads;
+  loads.setZero(n);
+  AddNodeLoads(model, state, lambda, loads, tangent, &node_forces);
+  AddUserForces(model, state, Eigen::VectorXd(), lambda, &loads, tangent, nullptr, &node_forces);
+  loads += work.gravity;
   out.loads = loads;
-  AddSpringDampers(model, state, Eigen::VectorXd(), &loads, with_tangent ? &tangent : nullptr, nullptr,
-                   &out.elastic_energy, &node_forces);
+  AddSpringDampers(model, state, Eigen::VectorXd(), &loads, tangent, nullptr, &out.elastic_energy, &node_forces,
+                   &parts.scratch);
   out.residual += loads;
-  const double applied = (ResidualWeights(model, dofs).asDiagonal() * loads).norm();
+  ResidualWeights(model, dofs, parts.weights);
+  const double applied = (parts.weights.asDiagonal() * loads).norm();
   out.force_scale = std::max(out.force_scale, applied);
   FinishDofScale(applied, std::max(out.force_scale, 1e-300), out.dof_scale);
-  AddLoopConstraints(model, dofs, state, &out.residual, with_tangent ? &tangent : nullptr, &node_forces);
+  AddLoopConstraints(model, dofs, state, &out.residual, tangent, &node_forces);
   out.node_forces = node_forces;
   if (with_tangent) {
-    AddJointGeometricStiffness(model, dofs, state, node_forces, tangent);
-    out.tangent = ToMatrix(n, tangent);
+    AddJointGeometricStiffness(model, dofs, state, node_forces, parts.K);
+    out.tangent = work.tangent.Build(n, parts.K);
   }
   return out;
 }

@@ -31,10 +31,15 @@ struct SystemForces {
   Eigen::VectorXd loads;      ///< the nodal loads alone, over the coordinates (for their work)
 };
 
+class BodyThreads;
+struct StaticWorkspace;
+
 /// Solves every body's floating frame (updating state.frames) and assembles the static
-/// residual and tangent at load factor `lambda`.
+/// residual and tangent at load factor `lambda`: the bodies at rest in the pass shared with the
+/// dynamic integrators (EvaluateBodyTerms, body_pass.h), on `threads` when given, in `work`'s
+/// storage when given (kept between Newton iterations, nothing allocated for the bodies).
 SystemForces AssembleStatic(const SystemModel& model, const DofMap& dofs, SystemState& state, double lambda,
-                            bool with_tangent);
+                            bool with_tangent, StaticWorkspace* work = nullptr, BodyThreads* threads = nullptr);
 
 /// External nodal loads at time t (or load factor) and their stiffness d(-f_ext)/dq added to
 /// `tangent` when not null (follower loads).

@@ -25,42 +25,15 @@ void AssembleDynamicResidual(const SystemModel& model, const DofMap& dofs, Dynam
   for (int b = 0; b < n_bodies; ++b) work.pass_data[size_t(b)] = &passes[size_t(b)].data;
   NodeAccelerations(model, dofs, s.config, s.W, s.Wdot, work.node_acc, &work.parts.scratch);
   const std::vector<Eigen::Matrix<double, 6, 1>>& node_acc = work.node_acc;
+  BodyPassKind kind;
+  kind.warm_frame = true;
+  kind.inertia_factor = work.inertia_factor;
+  kind.gravity = model.gravity;
   ForEachBody(threads, n_bodies, [&](int b) {
-    const SuperelementBody& body = model.bodies[b];
-    BodyTerms& r = results[size_t(b)];
     BodyPass& pass = passes[size_t(b)];
-    r.frame_ok = true;
-    BodyConfiguration& c = pass.data.c;  // evaluated in place: the pass's storage is reused
-    BodyConfigurationOf(model, s.config, b, c);
-    // The frame from the last one, iterating with the last pass's S^-1 (the same body a Newton
-    // correction or a step earlier).
-    const FrameSolution frame = PlaceBody(body, s.config.frames[b], pass.data, true);
-    if (!frame.ok) {
-      r.frame_ok = false;
-      return;
-    }
-    s.config.frames[b] = frame;
     GatherBody(model, dofs, s.config, b, s.W, pass.w);
     GatherBodyAcceleration(model, dofs, b, node_acc, s.Wdot, pass.wdot);
-    // Inertia stiffening: K + K_sigma(a), a from this iterate's frame motion; its
-    // velocity and acceleration derivatives go into C and M of the iteration matrix.
-    Eigen::VectorXd &f_int = r.f_int, &f_in = r.f_in, &f_acc = r.f_acc;
-    StiffenedElasticForce(body, pass.data, pass.w, pass.wdot, model.gravity, pass.load, f_int);
-    InertiaForce(body, pass.data, pass.w, pass.wdot, &f_in, nullptr, nullptr, &f_acc);
-    AddModalDamping(body, pass.w, f_in, nullptr);
-    if (model.gravity.squaredNorm() > 0) {
-      GravityForce(body, pass.data, model.gravity, r.f_grav);
-    } else {
-      r.f_grav.setZero(body.n_coordinates());
-    }
-    // Scale of the forces in balance, each term on its own (for a torque-free body M_g wdot and
-    // the gyroscopic terms cancel: their sum is no scale).
-    r.f_quadratic = f_in - f_acc;
-    r.scale = std::max({body.ForceNorm(f_int), body.ForceNorm(f_in), body.ForceNorm(r.f_grav), body.force_floor(),
-                        body.ForceNorm(f_acc), body.ForceNorm(r.f_quadratic)});
-    r.roundoff = RoundOffForce(body, c, work.inertia_factor);
-    BodyMap(model, dofs, s.config, b, r.map);
-    r.r_b = r.f_grav - f_int - f_in;
+    EvaluateBodyTerms(model, dofs, s.config, b, kind, pass, results[size_t(b)]);
   });
   if (!AddBodyTerms(model, results, parts, out)) return;
   FinishAssembly(model, dofs, s.config, t, s.W, false, parts, out);

@@ -351,11 +351,13 @@ int SolveRun::RunModes() {
   return 0;
 }
 
-// The joints' reactions at a static state, when the scene asks for them (an assembly per
-// output step).
-std::vector<Eigen::Matrix<double, 6, 1>> SolveRun::StaticReactions(double lambda, const SystemState& st) const {
+// The joints' reactions at a static state, when the scene asks for them: from the converged
+// pass's node forces when given, else from an assembly at the state.
+std::vector<Eigen::Matrix<double, 6, 1>> SolveRun::StaticReactions(double lambda, const SystemState& st,
+                                                                   const NodeForces* converged) const {
   std::vector<Eigen::Matrix<double, 6, 1>> out;
   if (!spec_.reactions) return out;
+  if (converged) return JointReactions(scene_.model, scene_.model.dofs(), st, *converged);
   SystemState copy = st;
   const SystemForces f = AssembleStatic(scene_.model, scene_.model.dofs(), copy, lambda, false);
   return JointReactions(scene_.model, scene_.model.dofs(), copy, f.node_forces);
@@ -370,12 +372,13 @@ void SolveRun::RunStatic() {
   Flush(AtRest(state, 0.0), true);
   StaticOptions static_options = StaticOptionsOf(spec_.analysis);
   static_options.stop = options_.stop;
+  static_options.threads = options_.threads;
   const StaticResult r =
       SolveStatic(scene_.model, state, static_options, [&](const StaticStepReport& s, const SystemState& st) {
         ++step_count_;
         total_iterations_ += s.iterations;
         if (step_count_ % spec_.analysis.output_every == 0) {
-          const auto reactions = StaticReactions(s.lambda, st);
+          const auto reactions = StaticReactions(s.lambda, st, s.node_forces);
           recorder().Record(s.lambda, st, Eigen::VectorXd(), 0.0, s.elastic_energy, s.external_work,
                             Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), spec_.reactions ? &reactions : nullptr);
           if (recorder().FlushDue()) Flush(AtRest(st, s.lambda), true);
@@ -460,11 +463,17 @@ void SolveRun::RunDynamic() {
         recorder().RecordStep(s.t, s.h);
         if (spec_.analysis.output_step > 0 ? s.output : step_count_ % spec_.analysis.output_every == 0) {
           // Reactions from the output state's consistent accelerations and multipliers, not
-          // from the integrator's own (WithConsistentAccelerations).
+          // from the integrator's own (WithConsistentAccelerations); where those are the
+          // integrator's own, from its converged pass's node forces.
+          const bool converged_pass = s.node_forces && AccelerationsConsistent(scene_.model, st);
           const DynamicState& out =
-              spec_.reactions ? (output_state = WithConsistentAccelerations(scene_.model, st)) : st;
-          const auto reactions =
-              spec_.reactions ? DynamicReactions(scene_.model, out) : std::vector<Eigen::Matrix<double, 6, 1>>();
+              spec_.reactions && !converged_pass ? (output_state = WithConsistentAccelerations(scene_.model, st)) : st;
+          std::vector<Eigen::Matrix<double, 6, 1>> reactions;
+          if (spec_.reactions && converged_pass) {
+            reactions = JointReactions(scene_.model, scene_.model.dofs(), st.config, *s.node_forces);
+          } else if (spec_.reactions) {
+            reactions = DynamicReactions(scene_.model, out);
+          }
           recorder().Record(s.t, out.config, out.W, s.kinetic_energy, s.elastic_energy, s.external_work,
                             s.linear_momentum, s.angular_momentum, spec_.reactions ? &reactions : nullptr, &out.Wdot);
           recorder().RecordStepSize(s.h);

@@ -106,7 +106,8 @@ class SolveRun {
   void Flush(const DynamicState& state, bool force, const DynamicStepReport* report = nullptr);
   void Progress(double t, bool force);
   int RunModes();
-  std::vector<Eigen::Matrix<double, 6, 1>> StaticReactions(double lambda, const SystemState& st) const;
+  std::vector<Eigen::Matrix<double, 6, 1>> StaticReactions(double lambda, const SystemState& st,
+                                                           const NodeForces* converged = nullptr) const;
   void RunStatic();
   DynamicOptions DynamicOptionsOf();
   DynamicState InitialDynamicState();

@@ -61,7 +61,7 @@ TEST(NewtonScale, EachUnknownIsJudgedByTheBodiesActingOnIt) {
   const SystemModel model = Model(true);
   const DofMap& dofs = model.dofs();
   DynamicState s = InitialDynamicState(model, InitialState(model), Eigen::VectorXd::Zero(dofs.n_dofs()));
-  const dynamic_internal::Assembly a = dynamic_internal::AssembleDynamic(model, dofs, s, 0.0, false);
+  const Assembly a = dynamic_internal::AssembleDynamic(model, dofs, s, 0.0, false);
   ASSERT_TRUE(a.ok) << a.message;
   ASSERT_EQ(a.dof_scale.size(), dofs.n_dofs());
   const int mid = 3;  // rod_mid: a free node between the two rod bodies
