@@ -214,8 +214,9 @@ StaticResult SolveStatic(const SystemModel& model, SystemState& state, const Sta
     loads_before = newton.loads_after;
     state = trial;
     lambda = target;
-    StaticStepReport report{lambda, newton.iterations, newton.r_norm, newton.energy, work, &newton.node_forces};
-    result.steps.push_back(report);
+    StaticStepReport report{lambda, newton.iterations, newton.r_norm, newton.energy, work};
+    result.steps.push_back(report);  // without the pass's node forces: they live for this step
+    report.node_forces = &newton.node_forces;
     if (on_step) on_step(report, state);
     if (options.stop && options.stop->load() != 0) {
       result.stopped = options.stop->load();
