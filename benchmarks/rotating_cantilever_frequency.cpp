@@ -63,6 +63,7 @@ double MeasuredOmega(const Superelement& se, double Omega, bool in_plane, double
   p.rate = [Omega](double) { return Omega; };
   p.acceleration = [](double) { return 0.0; };
   model.prescribed.push_back(p);
+  model.Number();
   const DofMap& dofs = model.dofs();
   Eigen::VectorXd v0 = Eigen::VectorXd::Zero(dofs.n_dofs());
   v0[dofs.node_first(0)] = Omega;

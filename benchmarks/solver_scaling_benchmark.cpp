@@ -60,6 +60,7 @@ int main(int argc, char** argv) {
         model.body_nodes.push_back({i, i + 1});
       }
       model.gravity = Eigen::Vector3d(0, -9.81, 0);
+      model.Number();
       const femb::DofMap& dofs = model.dofs();
       const int steps = fixed_steps > 0    ? fixed_steps
                         : n_bodies >= 1000 ? 5

@@ -74,6 +74,7 @@ SystemModel ClampedOneBodyModel(const Superelement& se, double L, const Eigen::V
   load.node = 1;
   load.force = tip_force;
   model.loads.push_back(load);
+  model.Number();
   return model;
 }
 
@@ -121,6 +122,7 @@ SystemModel SliderCrankModel(const Superelement& crank, const Superelement& rod,
   model.joints.push_back(MakeNodeJoint(JointType::kRevolute, b, s, z, model.node_x0[s], model.node_R0[s],
                                        model.node_x0[b], model.node_R0[b]));
   model.gravity = Eigen::Vector3d(0, -9.81, 0);
+  model.Number();
   return model;
 }
 

@@ -2,6 +2,7 @@
 
 #include <Eigen/Dense>
 #include <cmath>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -43,8 +44,15 @@ bool DofMap::Matches(const SystemModel& model) const {
   return same && i == shape_.size();
 }
 
+void SystemModel::Number() { dofs_ = std::make_shared<const DofMap>(*this); }
+
 const DofMap& SystemModel::dofs() const {
-  if (!dofs_ || !dofs_->Matches(*this)) dofs_ = std::make_shared<const DofMap>(*this);
+  if (!dofs_) throw std::logic_error("SystemModel::dofs(): the model was not numbered (SystemModel::Number)");
+  if (!dofs_->Matches(*this)) {
+    throw std::logic_error(
+        "SystemModel::dofs(): the model's structure changed since it was numbered "
+        "(SystemModel::Number)");
+  }
   return *dofs_;
 }
 

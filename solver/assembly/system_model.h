@@ -76,10 +76,13 @@ struct SystemModel {
   double static_gravity_end = 0.0;
 
   int n_nodes() const { return int(node_names.size()); }
-  /// The model's numbering of its unknowns (DofMap), made on the first call and kept with the
-  /// model (a copy of the model shares it); made anew when the model's structure changed since
-  /// (nodes, their supports, joints, prescribed coordinates, bodies, cut joints). The analyses
-  /// take it from here instead of each building its own. Not from several threads at once.
+  /// Numbers the model's unknowns (DofMap) once its structure is complete: nodes, their supports,
+  /// joints, prescribed coordinates, bodies, cut joints (BuildScene does it last). Again after a
+  /// change of that structure. An InputError when a joint names a node that does not exist.
+  void Number();
+  /// The numbering Number() made (a copy of the model shares it). The analyses take it from
+  /// here instead of each building its own. A std::logic_error when the model was not numbered
+  /// or its structure changed since.
   const DofMap& dofs() const;
   /// True with Lagrange multipliers: cut joints, or bodies with an interface constraint.
   bool has_constraints() const {
@@ -90,7 +93,7 @@ struct SystemModel {
   }
 
  private:
-  mutable std::shared_ptr<const DofMap> dofs_;  ///< dofs(), immutable once made
+  std::shared_ptr<const DofMap> dofs_;  ///< dofs(), immutable once made
 };
 
 /// System matrices are sparse (assembled from triplets) and factorized sparse (FreeSolver);
@@ -148,7 +151,7 @@ struct SystemState {
 };
 
 /// Numbering of the unknowns (coordinates). It holds no reference to the model, so it stays
-/// valid when the model it came from is moved or destroyed (SystemModel::dofs()).
+/// valid when the model it came from is moved or destroyed (SystemModel::Number, dofs()).
 class DofMap {
  public:
   explicit DofMap(const SystemModel& model);

@@ -250,6 +250,7 @@ void RequireDrivesFree(const SystemModel& model, const DofMap& dofs, const Eigen
 std::vector<std::string> DropRedundantEquations(SystemModel& model) {
   std::vector<std::string> notes(model.cut_joints.size());
   if (model.cut_joints.empty()) return notes;
+  model.Number();  // with every equation of the cut joints
   const DofMap& dofs = model.dofs();
   const SystemState state = InitialState(model);
   Eigen::MatrixXd G_s, G_p;
@@ -271,6 +272,7 @@ std::vector<std::string> DropRedundantEquations(SystemModel& model) {
     notes[c] = dropped;
     cut.equations = kept;
   }
+  model.Number();  // with the kept ones
   return notes;
 }
 

@@ -56,6 +56,7 @@ bool LoopsClosed(const SystemModel& model, const SystemState& state, double tole
 /// multibody code. An equation that the coordinates solved for cannot move but the prescribed ones
 /// do (a loop that locks its drive: no coordinate left to follow it) throws InputError naming the
 /// cut joint, the equation and the driven nodes: dropped, it would let the loop open.
+/// Numbers the model (SystemModel::Number) before and again after.
 std::vector<std::string> DropRedundantEquations(SystemModel& model);
 
 /// Closed loops at `state`: the cut joint whose kept equation is nearest to depending on the

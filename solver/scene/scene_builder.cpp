@@ -6,7 +6,6 @@
 #include <cstdio>
 #include <filesystem>
 #include <limits>
-#include <memory>
 
 #include "formats/input_error.h"
 #include "formats/part_file.h"
@@ -550,16 +549,16 @@ Scene BuildScene(const SceneSpec& spec) {
   }
   AddJoints(spec, placement, scene);
   NoteCutJoints(scene);
-  // The joint graph (cycles, two parents) before anything walks it.
-  std::unique_ptr<DofMap> dofs;
+  // The joint graph (cycles, two parents) before anything walks it: numbering checks it.
   try {
-    dofs = std::make_unique<DofMap>(scene.model);
+    scene.model.Number();
   } catch (const InputError& e) {
     throw InputError(spec.file + ": joints: " + e.what());
   }
-  RequireLoopsClosedAtStart(spec, scene.model, *dofs);
+  const DofMap& dofs = scene.model.dofs();
+  RequireLoopsClosedAtStart(spec, scene.model, dofs);
   AddLoads(spec, scene);
-  InitialVelocity(spec, *dofs, scene);
+  InitialVelocity(spec, dofs, scene);
   ResolveProbes(spec, scene);
   ResolveStressExclusion(spec, scene);
   return scene;

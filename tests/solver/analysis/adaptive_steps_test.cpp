@@ -37,6 +37,7 @@ SystemModel PushedTube(const Superelement& se) {
   pulse.force = Eigen::Vector3d(0, 10.0, 0);
   pulse.scale = [](double t) { return t >= kPulseOn && t < kPulseOff ? 1.0 : 0.0; };
   model.loads.push_back(pulse);
+  model.Number();
   return model;
 }
 
@@ -185,6 +186,7 @@ TEST(AdaptiveSteps, AFreeBodyOnOneNodeTakesErrorControlledSteps) {
     const double omega = 5.0, end = 1.0;
     Eigen::VectorXd W = Eigen::VectorXd::Zero(6);
     W[5] = omega;
+    model.Number();
     DynamicState s = InitialDynamicState(model, InitialState(model), W);
     DynamicOptions options;
     options.integrator = integrator;

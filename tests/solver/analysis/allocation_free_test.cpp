@@ -60,6 +60,7 @@ void PrintStack() {
   tip.force = Eigen::Vector3d(0, 0, 5.0);
   tip.scale = [](double) { return 1.0; };
   model.loads.push_back(tip);
+  model.Number();
   return model;
 }
 
@@ -75,6 +76,7 @@ void PrintStack() {
   cut.name = "pin";
   for (int i = 0; i < ConstraintCount(JointType::kRevolute); ++i) cut.equations.push_back(i);
   model.cut_joints.push_back(cut);
+  model.Number();
   return model;
 }
 
@@ -94,6 +96,7 @@ void PrintStack() {
   model.joints.push_back(MakeNodeJoint(JointType::kRevolute, 2, 1, Eigen::Vector3d::UnitZ(), model.node_x0[1],
                                        model.node_R0[1], model.node_x0[2], model.node_R0[2]));
   model.gravity = Eigen::Vector3d(0, -9.81, 0);
+  model.Number();
   return model;
 }
 

@@ -37,6 +37,7 @@ SystemModel TubeChain(int n_bodies, const SuperelementOptions& options, double P
   load.node = n_bodies;
   load.force = Eigen::Vector3d(0, -P, 0);
   model.loads.push_back(load);
+  model.Number();
   return model;
 }
 

@@ -289,6 +289,7 @@ reduction: {internal_modes: 20, floating_frame: center_of_mass}
     AddNode(model, "B", b);
     model.bodies.emplace_back(se, SuperelementOptions{});
     model.body_nodes.push_back({0, 1});
+    model.Number();
     const DofMap& dofs = model.dofs();
     Eigen::VectorXd W = Eigen::VectorXd::Zero(dofs.n_dofs());
     const Eigen::Vector3d omega(0, 0, 200);

@@ -29,6 +29,7 @@ SystemModel ClampedTube(const Superelement& se, const SuperelementOptions& optio
   Clamp(model, 0);
   model.bodies.emplace_back(se, options);
   model.body_nodes.push_back({0, 1});
+  model.Number();
   return model;
 }
 
@@ -87,6 +88,7 @@ TEST(FlexibleDynamics, FreeSpinningFlexibleBodyConservesEnergyAndMomentum) {
   model.body_nodes.push_back({0, 1});
   // Spin about z through the centre (0.5, 0, 0) at 20 rad/s, plus a slight tumble about x.
   const Eigen::Vector3d omega(2.0, 0.0, 20.0), c(0.5, 0, 0);
+  model.Number();
   Eigen::VectorXd W = Eigen::VectorXd::Zero(DofMap(model).n_dofs());
   W.segment<3>(0) = omega.cross(Eigen::Vector3d(0, 0, 0) - c);
   W.segment<3>(3) = omega;
@@ -229,6 +231,7 @@ TEST(FlexibleDynamics, BodiesOnSeveralThreadsGiveTheSameBits) {
   }
   model.gravity = Eigen::Vector3d(0, -9.81, 0);
   auto run = [&](Integrator integrator, int threads) {
+    model.Number();
     const DofMap dofs(model);
     Eigen::VectorXd W = Eigen::VectorXd::Zero(dofs.n_dofs());
     W[0] = 2.0;  // the hinge turns at 2 rad/s
@@ -267,6 +270,7 @@ TEST(FlexibleDynamics, ModalDampingDecaysTheRingingAtTheGivenRatio) {
   options.modal_damping = zeta;
   SystemModel model = ClampedTube(se, options);
   Clamp(model, 1);
+  model.Number();
   const DofMap dofs(model);
   Eigen::VectorXd W = Eigen::VectorXd::Zero(dofs.n_dofs());
   W[dofs.mode_dof(0)] = 1.0;  // first internal mode set ringing

@@ -39,6 +39,7 @@ SystemModel Chain(int n_bodies, double axial_force) {
   load.node = n_bodies;
   load.force = Eigen::Vector3d(-axial_force, 0, 0);  // compression
   model.loads.push_back(load);
+  model.Number();
   return model;
 }
 

@@ -51,6 +51,7 @@ FlightErrors FreeFlight(const Superelement& se, const Eigen::Vector3d& omega0, d
   const Eigen::Vector3d c = se.mass_properties.center_of_mass;
   Eigen::VectorXd W(6);
   W << omega0.cross(se.interfaces[0].position - c), omega0;
+  model.Number();
   DynamicState s = InitialDynamicState(model, InitialState(model), W);
   const DynamicStepReport r0 = Measure(model, s);
   DynamicOptions options;
@@ -235,6 +236,7 @@ TEST(RigidBodyDynamics, HeavySymmetricTopPrecessesAtTheAnalyticRate) {
     model.gravity = Eigen::Vector3d(0, 0, -g);
     Eigen::VectorXd W(3);
     W << omega;
+    model.Number();
     DynamicState s = InitialDynamicState(model, InitialState(model), W);
     DynamicOptions options;
     const double precession_period = 2 * M_PI / Omega_p;

@@ -31,6 +31,7 @@ SystemModel Cantilever(const Superelement& se) {
   load.node = 1;
   load.force = Eigen::Vector3d(0, -100, 0);
   model.loads.push_back(load);
+  model.Number();
   return model;
 }
 
@@ -38,6 +39,7 @@ TEST(Singularity, ClampedCantileverIsRegular) {
   const Superelement se = Rod();
   SystemModel model = Cantilever(se);
   Clamp(model, 0);
+  model.Number();
   const DofMap dofs(model);
   SystemState state = InitialState(model);
   const SystemForces f = AssembleStatic(model, dofs, state, 1.0, true);
@@ -52,6 +54,7 @@ TEST(Singularity, RevoluteSupportLeavesTheRotationAboutItsAxis) {
   const Superelement se = Rod();
   SystemModel model = Cantilever(se);
   RevoluteToGround(model, 0, Eigen::Vector3d::UnitZ());
+  model.Number();
   const DofMap dofs(model);
   SystemState state = InitialState(model);
   const SystemForces f = AssembleStatic(model, dofs, state, 1.0, true);
@@ -73,6 +76,7 @@ TEST(Singularity, RevoluteSupportLeavesTheRotationAboutItsAxis) {
 TEST(Singularity, BadlyScaledRegularMatrixIsRegular) {
   SystemModel model;
   AddNode(model, "a", Eigen::Vector3d::Zero());
+  model.Number();
   const DofMap dofs(model);
   Triplets t;
   const double scales[6] = {1e12, 1e12, 1e12, 1e-6, 1e-6, 1e-6};

@@ -52,6 +52,7 @@ SpinUpResult SpinUp(double ws, int n_bodies, double end_time) {
   p.rate = [theta](double t) { return theta.Rate(t); };
   p.acceleration = [theta](double t) { return theta.Acceleration(t); };
   model.prescribed.push_back(p);
+  model.Number();
   DynamicState s = InitialDynamicState(model, InitialState(model), Eigen::VectorXd::Zero(DofMap(model).n_dofs()));
   DynamicOptions options;
   options.step = 0.01;

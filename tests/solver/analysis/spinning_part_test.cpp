@@ -148,6 +148,7 @@ SystemModel SpinningBar(const Superelement& se, bool exact, bool tumble, Eigen::
   body_options.exact_inertia = exact;
   model.bodies.emplace_back(se, body_options);
   model.body_nodes.push_back({0, 1});
+  model.Number();
   const DofMap& dofs = model.dofs();
   *W = Eigen::VectorXd::Zero(dofs.n_dofs());
   const Eigen::Vector3d omega(tumble ? 5.0 : 0.0, 0, kOmega);

@@ -14,6 +14,7 @@ SystemModel TwoNodes() {
   SystemModel model;
   AddNode(model, "a", Eigen::Vector3d::Zero());
   AddNode(model, "b", Eigen::Vector3d(1, 0, 0));
+  model.Number();
   return model;
 }
 

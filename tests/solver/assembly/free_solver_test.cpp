@@ -22,6 +22,7 @@ SystemModel Nodes(int nodes) {
   drive.node = 0;
   drive.value = drive.rate = drive.acceleration = [](double) { return 0.0; };
   model.prescribed.push_back(drive);
+  model.Number();
   return model;
 }
 

@@ -35,6 +35,7 @@ TEST(SystemModel, PrescribedSupportsFollowTheirFunctions) {
                               [](double t) { return 2 * std::cos(2 * t); },
                               [](double t) { return -4 * std::sin(2 * t); }});
   model.prescribed.push_back({1, 0, [](double t) { return 0.5 * t * t; }, [](double t) { return t; }, nullptr});
+  model.Number();
   const DofMap& dofs = model.dofs();
   ASSERT_EQ(dofs.n_dofs(), 2);
   EXPECT_TRUE(dofs.solved().empty());
@@ -68,6 +69,7 @@ TEST(SystemModel, FixedToGroundOnlyThroughRigidJoints) {
       MakeNodeJoint(JointType::kRevolute, 2, 1, Eigen::Vector3d::UnitZ(), model.node_x0[1], I, model.node_x0[2], I));
   model.joints.push_back(
       MakeNodeJoint(JointType::kRigid, 3, 2, Eigen::Vector3d::UnitZ(), model.node_x0[2], I, model.node_x0[3], I));
+  model.Number();
   EXPECT_TRUE(FixedToGround(model, 0));
   EXPECT_TRUE(FixedToGround(model, 1));
   EXPECT_FALSE(FixedToGround(model, 2));
@@ -101,6 +103,7 @@ TEST(SystemModel, InitialStateAndABodysConfiguration) {
   }
   const Eigen::Vector3d z = Eigen::Vector3d::UnitZ();
   RevoluteToGround(model, 0, z);
+  model.Number();
   const SystemState s = InitialState(model);
   const DofMap& dofs = model.dofs();
   ASSERT_EQ(s.x.size(), 3u);

@@ -12,7 +12,9 @@
 
 #include <Eigen/Dense>
 #include <cmath>
+#include <memory>
 #include <random>
+#include <stdexcept>
 
 #include "solver/analysis/dynamic_analysis.h"
 #include "solver/analysis/dynamic_step.h"
@@ -48,6 +50,7 @@ SystemModel OneFreeRod(const Superelement& rod) {
   AddNode(model, "a", Eigen::Vector3d::Zero());
   AddNode(model, "b", Eigen::Vector3d(kL, 0, 0));
   AddRod(model, rod, 0, 1);
+  model.Number();
   return model;
 }
 
@@ -78,6 +81,7 @@ TEST(System, DofMapNumbersNodesModesAndMultipliers) {
   model.cut_joints.push_back(cut);
   model.prescribed.push_back(
       {0, 0, [](double t) { return t; }, [](double) { return 1.0; }, [](double) { return 0.0; }});
+  model.Number();
   const DofMap dofs(model);
   const int counts[6] = {1, 6, 3, 3, 0, 6};
   int first = 0;
@@ -124,12 +128,14 @@ TEST(System, ModelOwnsItsDofMap) {
   EXPECT_EQ(&model.dofs(), first);  // kept, not made again
   const SystemModel copy = model;
   EXPECT_EQ(&copy.dofs(), first);                        // a copy of the model shares it
-  RevoluteToGround(model, 0, Eigen::Vector3d::UnitZ());  // the structure changes: a new map
+  RevoluteToGround(model, 0, Eigen::Vector3d::UnitZ());  // the structure changes
+  EXPECT_THROW(model.dofs(), std::logic_error);          // not numbered for it yet
+  model.Number();
   EXPECT_EQ(model.dofs().n_dofs(), 9);
   EXPECT_EQ(model.dofs().node_count(0), 1);
   RevoluteToGround(model, 0, Eigen::Vector3d::UnitY());  // same shape, another axis
   ASSERT_EQ(model.joints.size(), 1u);                    // replaced, not added
-  EXPECT_EQ(model.dofs().n_dofs(), 9);
+  EXPECT_EQ(model.dofs().n_dofs(), 9);                   // the numbering still holds
   const SystemState state = InitialState(model);
   ASSERT_EQ(state.J[0].size(), 1u);
   EXPECT_EQ(state.J[0][0].second.tail<3>(), Eigen::Vector3d::UnitY());
@@ -142,6 +148,9 @@ TEST(System, ModelOwnsItsDofMap) {
   EXPECT_EQ(kept->node_count(0), 1);  // valid without the model
   EXPECT_TRUE(kept->free(1));
   EXPECT_EQ(kept->node_count(1), 6);
+  SystemModel unnumbered;
+  AddNode(unnumbered, "a", Eigen::Vector3d::Zero());
+  EXPECT_THROW(unnumbered.dofs(), std::logic_error);
 }
 
 TEST(System, IncrementsKeepEachSupportsMotionExact) {
@@ -156,6 +165,7 @@ TEST(System, IncrementsKeepEachSupportsMotionExact) {
   AddRod(model, rod, 1, 2);
   RevoluteToGround(model, 0, axis);
   PrismaticToGround(model, 1, axis);
+  model.Number();
   const DofMap dofs(model);
   SystemState state = InitialState(model);
   const double phi[3] = {0.7, -1.9, 2.6};
@@ -249,6 +259,7 @@ TEST(System, StaticTangentOnEveryKindOfSupportMatchesFiniteDifferences) {
     model.loads.push_back(load);
     model.gravity = Eigen::Vector3d(0, -9.81, 0);
     model.static_gravity_end = 1.0;
+    model.Number();
     const DofMap dofs(model);
     SystemState state = InitialState(model);
     std::mt19937 rng(17);
@@ -289,6 +300,7 @@ TEST(System, DynamicIterationMatrixUnderGravityMatchesFiniteDifferences) {
     model.joints.push_back(MakeNodeJoint(JointType::kRevolute, 2, 1, Eigen::Vector3d(0.36, 0.48, 0.8), model.node_x0[1],
                                          model.node_R0[1], model.node_x0[2], model.node_R0[2]));
     model.gravity = Eigen::Vector3d(0, -9.81, 0);
+    model.Number();
     const DofMap dofs(model);
     const int n = dofs.n_dofs();
     DynamicState s = InitialDynamicState(model, InitialState(model), Eigen::VectorXd::Zero(n));
@@ -351,6 +363,7 @@ TEST(System, HangingRodSolvesStaticallyAndSwingsAtThePendulumFrequency) {
   RevoluteToGround(model, 0, Eigen::Vector3d::UnitZ());
   model.gravity = Eigen::Vector3d(0, -g, 0);
   model.static_gravity_end = 1.0;
+  model.Number();
   SystemState state = InitialState(model);
   StaticOptions options;
   options.steps = 2;

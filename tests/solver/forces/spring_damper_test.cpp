@@ -62,6 +62,7 @@ TEST(SpringDamper, BodyOnASpringOscillatesAndDecaysAsTheClosedForm) {
   model.springs.push_back(s);
   Eigen::VectorXd W = Eigen::VectorXd::Zero(6);
   W[0] = 0.1;  // initial velocity along the spring
+  model.Number();
   DynamicState state = InitialDynamicState(model, InitialState(model), W);
   const double f_n = std::sqrt(k / m) / (2 * M_PI), f_d = f_n * std::sqrt(1 - zeta * zeta);
   DynamicOptions options;

@@ -151,6 +151,7 @@ TEST(MidpointIterationMatrix, FreeSpinningTubeMatchesDifferences) {
     model.bodies.emplace_back(tube, options, Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero());
     model.body_nodes.push_back({0, 1});
     const std::string what = std::string("free tube spinning at 50 rad/s, ") + (exact ? "exact" : "corotational");
+    model.Number();
     const double coarse = ErrorAfterSteps(model, 1e-3, what, Eigen::Vector3d(0, 5, 50));
     ErrorAfterSteps(model, 1e-4, what, Eigen::Vector3d(0, 5, 50));
     const double fine = ErrorAfterSteps(model, 1e-5, what, Eigen::Vector3d(0, 5, 50));
@@ -183,6 +184,7 @@ TEST(MidpointIterationMatrix, HingedChainMatchesDifferences) {
       tip = b;
     }
     const std::string what = links == 1 ? "one hinged tube" : "two hinged tubes";
+    model.Number();
     const double coarse = ErrorAfterSteps(model, 1e-4, what, Eigen::Vector3d(0, 0, 100));
     const double fine = ErrorAfterSteps(model, 1e-5, what, Eigen::Vector3d(0, 0, 100));
     EXPECT_LT(fine, coarse / 3) << what;  // measured 5.8x (one tube), 6.1x (two)

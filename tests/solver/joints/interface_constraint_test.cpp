@@ -52,6 +52,7 @@ SystemModel Chain(const Superelement& se, const SuperelementOptions& options = {
   model.joints.push_back(MakeNodeJoint(JointType::kRevolute, 2, 1, Eigen::Vector3d(0, 0, 1), model.node_x0[1],
                                        model.node_R0[1], model.node_x0[2], model.node_R0[2]));
   model.gravity = Eigen::Vector3d(0, -9.81, 0);
+  model.Number();
   return model;
 }
 

@@ -50,6 +50,7 @@ SystemModel Chain() {
   joint(JointType::kCylindrical, 4, 3, Eigen::Vector3d(1, 0, 0.4));
   joint(JointType::kRigid, 5, 4, Eigen::Vector3d::UnitZ());
   joint(JointType::kRevolute, 7, 6, Eigen::Vector3d(0.5, -1, 0.3));
+  model.Number();
   return model;
 }
 

@@ -70,6 +70,7 @@ SystemModel Loop(const Superelement& se, double L, JointType type) {
   load.force = Eigen::Vector3d(10, -20, 15);
   load.moment = Eigen::Vector3d(1, 2, -1);
   model.loads.push_back(load);
+  model.Number();
   return model;
 }
 

@@ -41,6 +41,7 @@ SystemModel TwoFreeNodes(JointType type) {
   cut.name = "cut";
   for (int i = 0; i < ConstraintCount(type); ++i) cut.equations.push_back(i);
   model.cut_joints.push_back(cut);
+  model.Number();
   return model;
 }
 
@@ -142,6 +143,7 @@ TEST(LoopConstraints, ViolationIsTheLargestEquationWithRotationsScaled) {
   // No loops: nothing to close.
   SystemModel open = model;
   open.cut_joints.clear();
+  open.Number();
   EXPECT_EQ(LoopViolation(open, InitialState(open)), 0.0);
   EXPECT_TRUE(LoopsClosed(open, InitialState(open), 0.0));
 }
@@ -177,6 +179,7 @@ SystemModel FourBar(double theta, double a = 0.3, double b = 0.9, double c = 0.7
   model.cut_joints.push_back(cut);
   model.prescribed.push_back(
       {4, 0, [](double) { return 0.0; }, [](double) { return 0.0; }, [](double) { return 0.0; }});
+  model.Number();
   return model;
 }
 
@@ -197,6 +200,7 @@ TEST(LoopConstraints, PlanarFourBarKeepsTwoEquationsAndIsNamedAtItsDeadPoint) {
   const double r = a + b, cos_phi = (r * r + d * d - c * c) / (2 * r * d);
   SystemModel dead = FourBar(std::acos(cos_phi), a, b, c, d);
   dead.cut_joints[0].equations = model.cut_joints[0].equations;  // those kept at the generic place
+  dead.Number();
   const std::string message = LoopSingularity(dead, InitialState(dead));
   EXPECT_EQ(message.rfind("revolute joint between nodes 'C1' and 'C2': the loop it closes is at or near a singular", 0),
             0u)

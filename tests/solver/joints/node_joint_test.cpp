@@ -65,6 +65,7 @@ SystemModel Chain(const Superelement& se, double L) {
   fixed.node = 4;
   fixed.force = Eigen::Vector3d(-5, 30, 7);
   model.loads.push_back(fixed);
+  model.Number();
   return model;
 }
 
@@ -179,6 +180,7 @@ void DoublePendulum(JointType second, const Eigen::Vector3d& spin, Integrator in
   model.gravity = Eigen::Vector3d(0, -9.81, 0);
   double max_z = 0;
   auto run = [&](double h, double* drift, double* min_y) {
+    model.Number();
     const DofMap dofs(model);
     Eigen::VectorXd W0 = Eigen::VectorXd::Zero(dofs.n_dofs());
     if (spin.squaredNorm() > 0) {
@@ -251,6 +253,7 @@ TEST(NodeJoint, SupportsAreJointsToTheGroundAndMoveAsOnAClampedNode) {
         JointToGround(model, type, 0, a, a2);
       }
       model.gravity = Eigen::Vector3d(0, -9.81, 0);
+      model.Number();
       return model;
     };
     const SystemModel grounded = make(false), clamped = make(true);
@@ -303,6 +306,7 @@ TEST(NodeJoint, SupportsAreJointsToTheGroundAndMoveAsOnAClampedNode) {
   model.joints.push_back(MakeNodeJoint(JointType::kRigid, 1, 0, a, Eigen::Vector3d::Zero(), Eigen::Matrix3d::Identity(),
                                        Eigen::Vector3d::UnitX(), Eigen::Matrix3d::Identity()));
   EXPECT_EQ(model.joints[0].type, JointType::kRigid);
+  model.Number();
   EXPECT_EQ(model.dofs().n_dofs(), 0);
   EXPECT_TRUE(FixedToGround(model, 0));
   EXPECT_TRUE(FixedToGround(model, 1));
