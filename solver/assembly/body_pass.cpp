@@ -42,6 +42,15 @@ void FinishAssembly(const SystemModel& model, const DofMap& dofs, const SystemSt
 
 namespace {
 
+// The body's weight (GravityForce), or zeros without gravity.
+void Weight(const SuperelementBody& body, const BodyPassKind& kind, BodyPass& pass, BodyTerms& r) {
+  if (kind.gravity.squaredNorm() > 0) {
+    GravityForce(body, pass.data, kind.gravity, r.f_grav);
+  } else {
+    r.f_grav.setZero(body.n_coordinates());
+  }
+}
+
 // At rest: the internal force and, for statics' tangent, its stiffness less the weight's
 // configuration derivative (S = -dr/dq: minus GravityTangent); the elastic energy; the weight.
 void BodyTermsAtRest(const SuperelementBody& body, const BodyPassKind& kind, BodyPass& pass, BodyTerms& r) {
@@ -53,11 +62,7 @@ void BodyTermsAtRest(const SuperelementBody& body, const BodyPassKind& kind, Bod
   r.roundoff = RoundOffForce(body, pass.data.c, kind.inertia_factor);
   if (kind.elastic_tangent && weight) r.K -= GravityTangent(body, pass.data, kind.gravity);
   r.r_b = -r.f_int;
-  if (weight) {
-    GravityForce(body, pass.data, kind.gravity, r.f_grav);
-  } else {
-    r.f_grav.setZero(body.n_coordinates());
-  }
+  Weight(body, kind, pass, r);
 }
 
 // In motion: the stiffened internal force, the inertia force with modal damping, the weight.
@@ -68,11 +73,7 @@ void BodyTermsInMotion(const SuperelementBody& body, const BodyPassKind& kind, B
   StiffenedElasticForce(body, pass.data, pass.w, pass.wdot, kind.gravity, pass.load, f_int);
   InertiaForce(body, pass.data, pass.w, pass.wdot, &f_in, nullptr, nullptr, &f_acc);
   AddModalDamping(body, pass.w, f_in, nullptr);
-  if (kind.gravity.squaredNorm() > 0) {
-    GravityForce(body, pass.data, kind.gravity, r.f_grav);
-  } else {
-    r.f_grav.setZero(body.n_coordinates());
-  }
+  Weight(body, kind, pass, r);
   // Scale of the forces in balance, each term on its own (for a torque-free body M_g wdot and
   // the gyroscopic terms cancel: their sum is no scale).
   r.f_quadratic = f_in - f_acc;
