@@ -78,7 +78,8 @@ struct SystemModel {
   int n_nodes() const { return int(node_names.size()); }
   /// Numbers the model's unknowns (DofMap) once its structure is complete: nodes, their supports,
   /// joints, prescribed coordinates, bodies, cut joints (BuildScene does it last). Again after a
-  /// change of that structure. An InputError when a joint names a node that does not exist.
+  /// change of that structure. An InputError when the joints do not form a tree (a joint naming
+  /// a node that does not exist, a node with two parent joints, a cycle).
   void Number();
   /// The numbering Number() made (a copy of the model shares it). The analyses take it from
   /// here instead of each building its own. A std::logic_error when the model was not numbered
