@@ -289,8 +289,10 @@ void SolveRun::Flush(const DynamicState& state, bool force, const DynamicStepRep
   std::snprintf(running, sizeof running, "running: %s %.6g of %.6g (written during the run)",
                 is_static() ? "load factor" : "t =", state.t, spec_.analysis.end_time);
   if (report) Take(*report);
+  const double start = Seconds(wall_);
   recorder().Flush(running);
   SaveCheckpoint(state);
+  run_write_seconds_ += Seconds(wall_) - start;
 }
 // A progress line at most once a second (or now with `force`), with the largest violation of
 // the closed loops' equations so far (a length).
@@ -553,12 +555,13 @@ int SolveRun::Finish() {
         recorder().flush_seconds());
   }
   // The phases: reading (scene, superelement files, model), the analysis with its per-step
-  // recording, writing results.h5 and the animation.
+  // recording, writing results.h5, the checkpoint and the animation (at the end and during the
+  // run: the files written during the run count as writing, not as solving).
   const double end = Seconds(wall_);
   Say("done in %.2f s (reading %.3f s, solving %.3f s, writing %.3f s): %ld steps, %.2f "
       "Newton iterations per step; %s",
-      end, read_seconds_, solve_end - read_seconds_, end - solve_end, step_count_,
-      step_count_ ? double(total_iterations_) / step_count_ : 0.0,
+      end, read_seconds_, solve_end - read_seconds_ - run_write_seconds_, end - solve_end + run_write_seconds_,
+      step_count_, step_count_ ? double(total_iterations_) / step_count_ : 0.0,
       options_.in_memory ? "results in memory"
                          : ("results in " + recorder().h5_path() + ", " + recorder().csv_path()).c_str());
   return 0;

@@ -125,6 +125,7 @@ class SolveRun {
   std::optional<ResultsRecorder> recorder_;
   std::string signature_;  ///< Signature(): made on first use
   double read_seconds_ = 0.0;
+  double run_write_seconds_ = 0.0;  // results and checkpoints written during the run (Flush)
   long step_count_ = 0, total_iterations_ = 0;
   long rejected_ = 0;  ///< steps rejected so far (step: auto)
   double last_print_ = -1.0;
