@@ -318,15 +318,58 @@ void FinishStep(const DofMap& dofs, const DynamicState& state, double h, double 
   next.f_drive = r.f_drive;
 }
 
+// The stages' residuals at the current accelerations r.A (their kinematics, placement and pass),
+// with each stage's matrices (StageMatrices) when `matrices`; their largest weighted norm, the
+// largest relative to the forces (ScaledFreeNorm), and whether all are small and the loops closed.
+struct StageResiduals {
+  bool ok = true, small = true, closed = true;
+  double r_max = 0.0, scaled_max = 0.0;
+};
+
+StageResiduals EvaluateStages(const SystemModel& model, const DofMap& dofs, const DynamicOptions& options,
+                              const DynamicState& state, double h, double t_new, bool first, double tolerance,
+                              const KeptMatrices* matrices, BodyThreads& threads, BodyWorkspace& work) {
+  const RadauTableau& t = Tableau();
+  RadauWorkspace& r = work.radau;
+  const Eigen::VectorXd& weights = work.Weights(model, dofs);
+  StageKinematics(dofs, state, h, r, work.rotation_triples);
+  StageResiduals out;
+  for (int i = 0; i < 3; ++i) {
+    const double t_i = i == 2 ? t_new : state.t + t.c[size_t(i)] * h;
+    PlaceStage(model, dofs, state, t_i, i, first, r);
+    Assembly& a = r.assembly[size_t(i)];
+    AssembleDynamicResidual(model, dofs, r.stage[size_t(i)], t_i, work, &threads, a);
+    if (!a.ok || !a.residual.allFinite()) {
+      out.ok = false;
+      return out;
+    }
+    const double r_norm = FreeNorm(dofs, a.residual, weights);
+    out.r_max = std::max(out.r_max, r_norm);
+    out.scaled_max = std::max(out.scaled_max, ScaledFreeNorm(dofs, a.residual, weights, a.dof_scale));
+    out.small = out.small && ResidualSmall(dofs, a, weights, r_norm, tolerance);
+    // The loops at this stage, with its bodies' data (the pass just assembled).
+    if (model.has_constraints())
+      out.closed =
+          out.closed && LoopsClosed(model, r.stage[size_t(i)].config, tolerance, &work.pass_data, &work.parts.scratch);
+    if (matrices) StageMatrices(model, dofs, options, t_i, i, *matrices, threads, work);
+  }
+  return out;
+}
+
+// Newton's first correction leaves the residual above this many times the tolerance: the predictor
+// was far from the solution, and so were the forces its matrices carry (a rod's stiff axial force,
+// whose geometric stiffness sets its transverse directions). The next corrections then contract
+// little with them (the slider-crank's rod at 2 ms steps: 38 -> 25 N, where fresh ones give
+// 38 -> 1.5 N), so the matrices are computed anew at the first iterate.
+constexpr double kFarFromSolution = 10.0;
+
 }  // namespace
 
 // One Radau IIA step of size h from `state` into `next` (above). t_new: the time reached.
 StepOutcome RadauStep(const SystemModel& model, const DofMap& dofs, const DynamicOptions& options,
                       const DynamicState& state, double h, double t_new, IterationMatrix& matrix, BodyThreads& threads,
                       BodyWorkspace& work, DynamicState& next) {
-  const RadauTableau& t = Tableau();
   RadauWorkspace& r = work.radau;
-  const Eigen::VectorXd& weights = work.Weights(model, dofs);
   Predict(state, h, r);
   // The residual's round-off floor (RoundOffForce) from the positions' round-off through the
   // stiffness alone: the stage accelerations are unknowns of their own, not differences of the
@@ -347,34 +390,20 @@ StepOutcome RadauStep(const SystemModel& model, const DofMap& dofs, const Dynami
   // at 2 ms steps, 1e4-6e4 N). Before the step is cut it starts once more from the predictor so.
   bool fresh_matrices = false, kept_matrix = false;
   for (; out.iterations < options.max_iterations; ++out.iterations) {
+    // The matrices with the residuals where they are due before them (the first iterate, full
+    // Newton); otherwise decided from the residuals (below), so that a converged iterate builds none.
     refactor = refactor || reuse == JacobianReuse::kNone || fresh_matrices;
-    const KeptMatrices kept = KeptMatricesOf(options, reuse, r.factored);
-    StageKinematics(dofs, state, h, r, work.rotation_triples);
-    bool small = true;
-    double r_max = 0.0;
-    bool closed = true;
-    for (int i = 0; i < 3; ++i) {
-      const double t_i = i == 2 ? t_new : state.t + t.c[size_t(i)] * h;
-      PlaceStage(model, dofs, state, t_i, i, out.iterations == 0, r);
-      Assembly& a = r.assembly[size_t(i)];
-      AssembleDynamicResidual(model, dofs, r.stage[size_t(i)], t_i, work, &threads, a);
-      if (!a.ok || !a.residual.allFinite()) return out;
-      const double r_norm = FreeNorm(dofs, a.residual, weights);
-      r_max = std::max(r_max, r_norm);
-      small = small && ResidualSmall(dofs, a, weights, r_norm, tolerance);
-      // The loops at this stage, with its bodies' data (the pass just assembled).
-      if (model.has_constraints())
-        closed =
-            closed && LoopsClosed(model, r.stage[size_t(i)].config, tolerance, &work.pass_data, &work.parts.scratch);
-      if (refactor) StageMatrices(model, dofs, options, t_i, i, kept, threads, work);
-    }
-    if (small && closed && out.iterations > 0) {
+    KeptMatrices kept = KeptMatricesOf(options, reuse, r.factored);
+    StageResiduals s = EvaluateStages(model, dofs, options, state, h, t_new, out.iterations == 0, tolerance,
+                                      refactor ? &kept : nullptr, threads, work);
+    if (!s.ok) return out;
+    if (s.small && s.closed && out.iterations > 0) {
       out.converged = true;
       break;
     }
     // Diverging: the caller cuts the step (above: once first from the predictor with fresh
     // matrices). The reference is the first iterate whose loops are closed (DivergenceTest).
-    if (divergence.Diverged(r_max, closed)) {
+    if (divergence.Diverged(s.r_max, s.closed)) {
       if (fresh_matrices || !kept_matrix) return out;
       fresh_matrices = true;
       Predict(state, h, r);
@@ -382,6 +411,17 @@ StepOutcome RadauStep(const SystemModel& model, const DofMap& dofs, const Dynami
       last = -1.0;
       refactor = true;
       continue;
+    }
+    // Fresh matrices at this iterate when the kept ones' last correction did not contract the
+    // residual tenfold (as generalized-alpha's kStep), or when the first left it far from the
+    // solution (kFarFromSolution): the stages' passes again, each followed by its matrices.
+    if (!refactor && last >= 0 &&
+        (s.r_max > IterationMatrix::kReuseContraction * last ||
+         (out.iterations == 1 && s.scaled_max > kFarFromSolution * tolerance))) {
+      kept = KeptMatricesOf(options, reuse, r.factored);
+      s = EvaluateStages(model, dofs, options, state, h, t_new, false, tolerance, &kept, threads, work);
+      if (!s.ok) return out;
+      refactor = true;
     }
     kept_matrix = !refactor;
     if (refactor) {
@@ -392,10 +432,8 @@ StepOutcome RadauStep(const SystemModel& model, const DofMap& dofs, const Dynami
       r.factored_h = h;
       ++matrix.factorizations;
     }
-    // The next iteration factors anew when this one's correction does not contract the residual
-    // tenfold (as generalized-alpha's kStep).
-    refactor = last >= 0 && r_max > IterationMatrix::kReuseContraction * last;
-    last = r_max;
+    refactor = false;
+    last = s.r_max;
     r.rhs.resize(3 * n);
     for (int i = 0; i < 3; ++i)
       for (int k = 0; k < n; ++k)
