@@ -205,9 +205,9 @@ struct KeptMatrices {
 // replaces it), into r.assembly[i]; built by the stage's own triplet assemblers, whose patterns
 // then stay from step to step (a loop's blocks differ between the stages' configurations).
 void StageMatrices(const SystemModel& model, const DofMap& dofs, const DynamicOptions& options, double t_i, int i,
-                   const KeptMatrices& kept, BodyThreads& threads, BodyWorkspace& work) {
+                   bool first, const KeptMatrices& kept, BodyThreads& threads, BodyWorkspace& work) {
   RadauWorkspace& r = work.radau;
-  if (kept.restart && i == 0)
+  if (kept.restart && first)
     for (BodyWorkspace::BodyMatrices& m : work.matrices) m.age = -1;
   work.K_build.swap(r.K_build[size_t(i)]);
   work.C_build.swap(r.C_build[size_t(i)]);
@@ -221,8 +221,9 @@ void StageMatrices(const SystemModel& model, const DofMap& dofs, const DynamicOp
 
 // The bodies' matrices of this matrix build. With body_matrices_every k > 1 a step's first build
 // may take the kept ones of up to k steps ago (which ones: body_matrices_kept). Otherwise, and in
-// a step's later builds, each body's mass and gyroscopic matrices are computed at the first stage
-// and turned with the floating frame to the other two: the inertia force is objective, so they
+// a step's later builds, each body's mass and gyroscopic matrices are computed at the build's
+// first stage (the first; the last in RefreshStageMatrices) and turned with the floating frame to
+// the other two: the inertia force is objective, so they
 // differ between the stages only by the change of the deformation and of the velocities in the
 // frame within the step (the slider-crank's Newton iterations at 0.75-2 ms steps are the same as
 // with each stage's own, at 0.87x the time). The tangents, which carry the stage's internal
@@ -351,17 +352,40 @@ StageResiduals EvaluateStages(const SystemModel& model, const DofMap& dofs, cons
     if (model.has_constraints())
       out.closed =
           out.closed && LoopsClosed(model, r.stage[size_t(i)].config, tolerance, &work.pass_data, &work.parts.scratch);
-    if (matrices) StageMatrices(model, dofs, options, t_i, i, *matrices, threads, work);
+    if (matrices) StageMatrices(model, dofs, options, t_i, i, i == 0, *matrices, threads, work);
   }
   return out;
+}
+
+// The stages' matrices anew at the current iterate, decided after its residuals: the last stage's
+// first, from its pass (the one just assembled), then the other two stages' passes again, each
+// followed by its matrices (the bodies' mass and gyroscopic matrices the last stage's, turned).
+// False when a pass fails.
+bool RefreshStageMatrices(const SystemModel& model, const DofMap& dofs, const DynamicOptions& options,
+                          const DynamicState& state, double h, double t_new, const KeptMatrices& kept,
+                          BodyThreads& threads, BodyWorkspace& work) {
+  const RadauTableau& t = Tableau();
+  RadauWorkspace& r = work.radau;
+  StageMatrices(model, dofs, options, t_new, 2, true, kept, threads, work);
+  for (int i = 0; i < 2; ++i) {
+    const double t_i = state.t + t.c[size_t(i)] * h;
+    Assembly& a = r.assembly[size_t(i)];
+    AssembleDynamicResidual(model, dofs, r.stage[size_t(i)], t_i, work, &threads, a);
+    if (!a.ok || !a.residual.allFinite()) return false;
+    StageMatrices(model, dofs, options, t_i, i, false, kept, threads, work);
+  }
+  return true;
 }
 
 // Newton's first correction leaves the residual above this many times the tolerance: the predictor
 // was far from the solution, and so were the forces its matrices carry (a rod's stiff axial force,
 // whose geometric stiffness sets its transverse directions). The next corrections then contract
 // little with them (the slider-crank's rod at 2 ms steps: 38 -> 25 N, where fresh ones give
-// 38 -> 1.5 N), so the matrices are computed anew at the first iterate.
-constexpr double kFarFromSolution = 10.0;
+// 38 -> 1.5 N), so the matrices are computed anew at the first iterate. Measured, with the kept
+// matrices: of the steps whose first correction left the residual above 30x the tolerance, 59 of
+// 61 contracted less than tenfold (the example's rod at 2 ms), 10 of 17 (tube bodies at 2 ms);
+// of those between 10x and 30x, 1 of 1 and 1 of 26: below 30x the kept ones mostly serve.
+constexpr double kFarFromSolution = 30.0;
 
 }  // namespace
 
@@ -414,13 +438,13 @@ StepOutcome RadauStep(const SystemModel& model, const DofMap& dofs, const Dynami
     }
     // Fresh matrices at this iterate when the kept ones' last correction did not contract the
     // residual tenfold (as generalized-alpha's kStep), or when the first left it far from the
-    // solution (kFarFromSolution): the stages' passes again, each followed by its matrices.
+    // solution (kFarFromSolution).
     if (!refactor && last >= 0 &&
         (s.r_max > IterationMatrix::kReuseContraction * last ||
          (out.iterations == 1 && s.scaled_max > kFarFromSolution * tolerance))) {
-      kept = KeptMatricesOf(options, reuse, r.factored);
-      s = EvaluateStages(model, dofs, options, state, h, t_new, false, tolerance, &kept, threads, work);
-      if (!s.ok) return out;
+      if (!RefreshStageMatrices(model, dofs, options, state, h, t_new, KeptMatricesOf(options, reuse, r.factored),
+                                threads, work))
+        return out;
       refactor = true;
     }
     kept_matrix = !refactor;

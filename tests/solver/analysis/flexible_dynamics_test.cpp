@@ -327,7 +327,7 @@ TEST(FlexibleDynamics, RadauCutsALongStepOnlyWhenNewtonWithFreshMatricesFails) {
 // solution (the slider-crank at 2 ms): the predictor's matrices carry its wrong forces, so when
 // the first correction leaves the residual far above the tolerance the matrices are computed anew
 // at the first iterate (radau.cpp, kFarFromSolution). Then the kept matrices cost few iterations
-// more than full Newton with fresh ones at every iteration: measured 2.17 against 2.11 a step.
+// more than full Newton with fresh ones at every iteration: measured 2.27 against 2.11 a step.
 // Kept from the predictor until an iteration contracted less than tenfold, they took 2.55 here,
 // and 5.27 against full Newton's 3.05 on the example's rod at 2 ms.
 TEST(FlexibleDynamics, RadauKeptMatricesConvergeAlmostAsFullNewtonOnLongSteps) {
