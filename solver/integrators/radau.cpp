@@ -223,11 +223,11 @@ void StageMatrices(const SystemModel& model, const DofMap& dofs, const DynamicOp
 // may take the kept ones of up to k steps ago (which ones: body_matrices_kept). Otherwise, and in
 // a step's later builds, each body's mass and gyroscopic matrices are computed at the build's
 // first stage (the first; the last in RefreshStageMatrices) and turned with the floating frame to
-// the other two: the inertia force is objective, so they
-// differ between the stages only by the change of the deformation and of the velocities in the
-// frame within the step (the slider-crank's Newton iterations at 0.75-2 ms steps are the same as
-// with each stage's own, at 0.87x the time). The tangents, which carry the stage's internal
-// forces and accelerations, are computed at every stage. jacobian_reuse: none computes them all.
+// the other two: the inertia force is objective, so they differ between the stages only by the
+// change of the deformation and of the velocities in the frame within the step (the
+// slider-crank's Newton iterations at 0.75-2 ms steps are the same as with each stage's own, at
+// 0.87x the time). The tangents, which carry the stage's internal forces and accelerations, are
+// computed at every stage. jacobian_reuse: none computes them all.
 KeptMatrices KeptMatricesOf(const DynamicOptions& options, JacobianReuse reuse, bool factored) {
   if (reuse == JacobianReuse::kNone) return {};
   if (!factored && options.body_matrices_every > 1)
@@ -320,11 +320,11 @@ void FinishStep(const DofMap& dofs, const DynamicState& state, double h, double 
 }
 
 // The stages' residuals at the current accelerations r.A (their kinematics, placement and pass),
-// with each stage's matrices (StageMatrices) when `matrices`; their largest weighted norm, the
-// largest relative to the forces (ScaledFreeNorm), and whether all are small and the loops closed.
+// with each stage's matrices (StageMatrices) when `matrices`; their largest weighted norm, and
+// whether all are small and the loops closed.
 struct StageResiduals {
   bool ok = true, small = true, closed = true;
-  double r_max = 0.0, scaled_max = 0.0;
+  double r_max = 0.0;
 };
 
 StageResiduals EvaluateStages(const SystemModel& model, const DofMap& dofs, const DynamicOptions& options,
@@ -346,7 +346,6 @@ StageResiduals EvaluateStages(const SystemModel& model, const DofMap& dofs, cons
     }
     const double r_norm = FreeNorm(dofs, a.residual, weights);
     out.r_max = std::max(out.r_max, r_norm);
-    out.scaled_max = std::max(out.scaled_max, ScaledFreeNorm(dofs, a.residual, weights, a.dof_scale));
     out.small = out.small && ResidualSmall(dofs, a, weights, r_norm, tolerance);
     // The loops at this stage, with its bodies' data (the pass just assembled).
     if (model.has_constraints())
@@ -375,6 +374,16 @@ bool RefreshStageMatrices(const SystemModel& model, const DofMap& dofs, const Dy
     StageMatrices(model, dofs, options, t_i, i, false, kept, threads, work);
   }
   return true;
+}
+
+// The stages' largest residual relative to the forces on each unknown (ScaledFreeNorm, Newton's
+// measure), from their last passes.
+double LargestScaledResidual(const SystemModel& model, const DofMap& dofs, BodyWorkspace& work) {
+  const Eigen::VectorXd& weights = work.Weights(model, dofs);
+  double largest = 0.0;
+  for (const Assembly& a : work.radau.assembly)
+    largest = std::max(largest, ScaledFreeNorm(dofs, a.residual, weights, a.dof_scale));
+  return largest;
 }
 
 // Newton's first correction leaves the residual above this many times the tolerance: the predictor
@@ -417,7 +426,7 @@ StepOutcome RadauStep(const SystemModel& model, const DofMap& dofs, const Dynami
     // The matrices with the residuals where they are due before them (the first iterate, full
     // Newton); otherwise decided from the residuals (below), so that a converged iterate builds none.
     refactor = refactor || reuse == JacobianReuse::kNone || fresh_matrices;
-    KeptMatrices kept = KeptMatricesOf(options, reuse, r.factored);
+    const KeptMatrices kept = KeptMatricesOf(options, reuse, r.factored);
     StageResiduals s = EvaluateStages(model, dofs, options, state, h, t_new, out.iterations == 0, tolerance,
                                       refactor ? &kept : nullptr, threads, work);
     if (!s.ok) return out;
@@ -441,7 +450,7 @@ StepOutcome RadauStep(const SystemModel& model, const DofMap& dofs, const Dynami
     // solution (kFarFromSolution).
     if (!refactor && last >= 0 &&
         (s.r_max > IterationMatrix::kReuseContraction * last ||
-         (out.iterations == 1 && s.scaled_max > kFarFromSolution * tolerance))) {
+         (out.iterations == 1 && LargestScaledResidual(model, dofs, work) > kFarFromSolution * tolerance))) {
       if (!RefreshStageMatrices(model, dofs, options, state, h, t_new, KeptMatricesOf(options, reuse, r.factored),
                                 threads, work))
         return out;
