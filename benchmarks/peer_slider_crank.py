@@ -3,9 +3,10 @@
 peer, and femb's least solve time at each error level against the peer's.
 
 The model as a multibody user would build it for that comparison: a rigid crank (0.15 m, 0.371 kg,
-driven at 150 rad/s) and a rigid slider (0.0334 kg), the flexible rod (0.3 m, d = 6 mm, steel) in 2
-or 4 superelements (examples/slider_crank_2d's rod segment of 0.15 m or 0.075 m, 4 internal modes,
-geometric stiffening, exact inertia), Newton tolerance 1e-3 and analysis.body_matrices_every 8 (the
+driven at 150 rad/s) and a rigid slider (0.0334 kg), the flexible rod (0.3 m, d = 6 mm, steel) in 1,
+2 or 4 superelements: the whole rod in one body with its first bending pair (2 internal modes), or
+examples/slider_crank_2d's rod segment of 0.15 m or 0.075 m (4 internal modes); each with geometric
+stiffening and exact inertia. The one-body rod's midpoint is a point probe, the others' a node; Newton tolerance 1e-3 and analysis.body_matrices_every 8 (the
 error does not change with either; the defaults are run too, at 2 steps). Error: RMS of the
 rod-midpoint deflection over three revolutions against femb's own converged reference (the
 example's 20 linear bodies at h = 5 us), as a fraction of its peak (deflection.py). "Counted"
@@ -45,15 +46,21 @@ import stiffening  # noqa: E402
 # at 0.1%).
 PEER_LEAST = {2.0: 0.027, 1.0: 0.037, 0.5: 0.037, 0.2: 0.109, 0.1: None}
 LEVELS = (2.0, 1.0, 0.5, 0.2, 0.1)
-STEPS = {2: ("2e-4", "1.4e-4", "1e-4", "7.5e-5", "5e-5", "2.5e-5", "1e-5"), 4: ("2e-4", "1e-4", "5e-5", "1e-5")}
+STEPS = {1: ("2e-4", "1.4e-4", "1e-4", "7.5e-5", "5e-5", "2.5e-5", "1e-5"),
+         2: ("2e-4", "1.4e-4", "1e-4", "7.5e-5", "5e-5", "2.5e-5", "1e-5"), 4: ("2e-4", "1e-4", "5e-5", "1e-5")}
 # The Radau IIA integrator (order 5): its steps, tolerance 1e-3, the bodies' matrices at every stage.
-RADAU_STEPS = {2: ("2e-3", "1.5e-3", "1e-3", "7.5e-4", "5e-4", "2.5e-4"), 4: ("1.5e-3", "1e-3", "5e-4", "2.5e-4")}
+RADAU_STEPS = {1: ("2.5e-3", "2e-3", "1.5e-3", "1.25e-3", "1e-3", "7.5e-4", "5e-4", "2.5e-4"),
+               2: ("2e-3", "1.5e-3", "1e-3", "7.5e-4", "5e-4", "2.5e-4"), 4: ("1.5e-3", "1e-3", "5e-4", "2.5e-4")}
+MODELS = (1, 2, 4)
 SHORT = {"generalized_alpha": "g-alpha", "radau": "radau"}
 
 
 def rigid_scene(n):
-    """The scene with a rigid crank and slider and the rod in n segments of rod_<n>.h5."""
-    names = rod.node_names(n)
+    """The scene with a rigid crank and slider and the rod in n segments of rod_<n>.h5 (n = 1: the
+    midpoint a point probe of the body)."""
+    names = ["rod_a", "rod_b"] if n == 1 else rod.node_names(n)
+    mid = ("{name: rod_mid, body: rod0, point: [0.3, 0, 0], quantities: [position]}" if n == 1 else
+           "{name: rod_mid, node: rod_mid, quantities: [position]}")
     length = 0.3 / n
     segments = "\n".join(
         f"  - {{name: rod{i}, superelement: rod_{n}.h5, placement: {{position: [{0.15 + i * length!r}, 0, 0]}}, "
@@ -79,10 +86,14 @@ outputs:
   probes:
     - {{name: crank, node: O, quantities: [joint]}}
     - {{name: rod_a, node: rod_a, quantities: [position]}}
-    - {{name: rod_mid, node: rod_mid, quantities: [position]}}
+    - {mid}
     - {{name: rod_b, node: rod_b, quantities: [position]}}
     - {{name: slider, node: slider, quantities: [position, joint]}}
 """
+
+
+def bodies(n):
+    return "1 body  " if n == 1 else f"{n} bodies"
 
 
 def run(cmd):
@@ -97,10 +108,11 @@ def prepare(a, solve, reduce):
     the scenes and femb's reference."""
     for part in ("crank", "slider", "rod_2"):
         run([reduce, "-q", os.path.join(EX, part + ".yaml"), "-o", os.path.join(a.out, part + ".h5")])
-    rod.write_segment(a.out, 4, 4)
-    stiffening.apply(os.path.join(a.out, "rod_4.yaml"), True)
-    run([reduce, "-q", os.path.join(a.out, "rod_4.yaml"), "-o", os.path.join(a.out, "rod_4.h5")])
-    for n in (2, 4):
+    for n, modes in ((1, 2), (4, 4)):
+        rod.write_segment(a.out, n, modes)
+        stiffening.apply(os.path.join(a.out, f"rod_{n}.yaml"), True)
+        run([reduce, "-q", os.path.join(a.out, f"rod_{n}.yaml"), "-o", os.path.join(a.out, f"rod_{n}.h5")])
+    for n in MODELS:
         with open(os.path.join(a.out, f"rigid_{n}.yaml"), "w") as f:
             f.write(rigid_scene(n))
     ref = os.path.join(a.out, "reference_20_bodies")
@@ -143,11 +155,11 @@ def main():
     print("model     integrator     step  tolerance  every  steps  its/step  solving [s]  wall [s]  error  counted")
     measured = []  # (integrator, n, h, solve time, counted error)
     for integrator, steps, every in (("generalized_alpha", STEPS, "8"), ("radau", RADAU_STEPS, "1")):
-        for n in (2, 4):
+        for n in MODELS:
             rows = [(h, "1e-3", every) + measure(a, solve, ref, n, h, "1e-3", every, integrator) for h in steps[n]]
             for i, (h, tol, ev, count, its, t_solve, wall, err) in enumerate(rows):
                 counted = max(r[-1] for r in rows[i:])  # this step and every smaller one
-                print(f"{n} bodies  {SHORT[integrator]:>9s}  {float(h) * 1e6:6.1f} us  {tol:>9s}  {ev:>5s}  "
+                print(f"{bodies(n)}  {SHORT[integrator]:>9s}  {float(h) * 1e6:6.1f} us  {tol:>9s}  {ev:>5s}  "
                       f"{count:>5d}  {its:8.2f}  {t_solve:11.3f}  {wall:8.3f}  {err:.3f}%  {counted:.3f}%", flush=True)
                 measured.append((integrator, n, h, t_solve, counted))
     for h in ("1e-4", "1.4e-4"):
@@ -167,7 +179,7 @@ def main():
         t, n, h, integrator = min(hits)
         target = 0.1 if peer is None else peer / 2
         ratio = f"{peer / t:11.2f}" if peer else "   not reached"
-        print(f"{level:4.1f}%   {t:8.3f}  {n} bodies, {SHORT[integrator]:>7s}, {float(h) * 1e6:4.0f} us  "
+        print(f"{level:4.1f}%   {t:8.3f}  {bodies(n)}, {SHORT[integrator]:>7s}, {float(h) * 1e6:4.0f} us  "
               f"{(f'{peer:8.3f}' if peer else '       -')}  {ratio}  {'met' if t <= target else 'not met'} "
               f"({target:.4f} s)")
     if a.png:
@@ -179,11 +191,12 @@ def plot(measured, png):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     fig, ax = plt.subplots(figsize=(7, 4.5))
-    for integrator, n, style in (("generalized_alpha", 2, "o-"), ("generalized_alpha", 4, "s-"), ("radau", 2, "o--"),
+    for integrator, n, style in (("generalized_alpha", 1, "^-"), ("generalized_alpha", 2, "o-"),
+                                 ("generalized_alpha", 4, "s-"), ("radau", 1, "^--"), ("radau", 2, "o--"),
                                  ("radau", 4, "s--")):
         pts = [(t, c, h) for i, m, h, t, c in measured if m == n and i == integrator]
         ax.plot([p[0] for p in pts], [p[1] for p in pts], style,
-                label=f"femb {SHORT[integrator]}, {n} bodies (counted error against femb's reference)")
+                label=f"femb {SHORT[integrator]}, {bodies(n)} (counted error against femb's reference)")
         for t, c, h in pts:
             ax.annotate(f"{float(h) * 1e6:.0f} us", (t, c), textcoords="offset points", xytext=(4, 4), fontsize=7)
     levels = [lv for lv in LEVELS if PEER_LEAST[lv]]
