@@ -421,6 +421,14 @@ StepOutcome MidpointStep(const SystemModel& model, const DofMap& dofs, const Dyn
 StepOutcome RadauStep(const SystemModel& model, const DofMap& dofs, const DynamicOptions& options,
                       const DynamicState& state, double h, double t_new, IterationMatrix& matrix, BodyThreads& threads,
                       BodyWorkspace& work, DynamicState& next);
+// The Radau IIA step's Newton system at the stage accelerations A (a step of h from `state`): the
+// three stages' residuals over the solved unknowns, stage after stage, each row scaled as the
+// iteration matrix's (1 / h^2 on a constraint equation), and with `matrix` the iteration matrix
+// there, -d(residual)/dA, from each stage's own K, C and M (every body's computed; `options`:
+// full_inertia_tangent). For the tests of the matrix against differences of the residuals.
+Eigen::VectorXd RadauStageResiduals(const SystemModel& model, const DofMap& dofs, const DynamicOptions& options,
+                                    const DynamicState& state, double h, const std::array<Eigen::VectorXd, 3>& A,
+                                    BodyWorkspace& work, Eigen::MatrixXd* matrix = nullptr);
 
 // One step of options.integrator (the steps above).
 inline StepOutcome IntegratorStep(const SystemModel& model, const DofMap& dofs, const DynamicOptions& options,

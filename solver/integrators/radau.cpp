@@ -398,6 +398,30 @@ constexpr double kFarFromSolution = 30.0;
 
 }  // namespace
 
+Eigen::VectorXd RadauStageResiduals(const SystemModel& model, const DofMap& dofs, const DynamicOptions& options,
+                                    const DynamicState& state, double h, const std::array<Eigen::VectorXd, 3>& A,
+                                    BodyWorkspace& work, Eigen::MatrixXd* matrix) {
+  RadauWorkspace& r = work.radau;
+  BodyThreads threads;
+  work.inertia_factor = 0.0;
+  r.A = A;
+  const KeptMatrices all;  // each stage's own matrices, every body's computed
+  const StageResiduals s = EvaluateStages(model, dofs, options, state, h, state.t + h, true, kRoundOffTolerance,
+                                          matrix ? &all : nullptr, threads, work);
+  const std::vector<int>& solved = dofs.solved();
+  const int n = int(solved.size());
+  Eigen::VectorXd residual = Eigen::VectorXd::Constant(3 * n, s.ok ? 0.0 : NAN);
+  if (!s.ok) return residual;
+  for (int i = 0; i < 3; ++i)
+    for (int k = 0; k < n; ++k)
+      residual[i * n + k] = r.assembly[size_t(i)].residual[solved[size_t(k)]] * RowScale(dofs, solved[size_t(k)], h);
+  if (matrix) {
+    FactorStageMatrix(dofs, h, r);  // (the sparse form's matrix is assembled by its factorization)
+    *matrix = r.J.dense ? r.J.D : Eigen::MatrixXd(r.J.S);
+  }
+  return residual;
+}
+
 // One Radau IIA step of size h from `state` into `next` (above). t_new: the time reached.
 StepOutcome RadauStep(const SystemModel& model, const DofMap& dofs, const DynamicOptions& options,
                       const DynamicState& state, double h, double t_new, IterationMatrix& matrix, BodyThreads& threads,
