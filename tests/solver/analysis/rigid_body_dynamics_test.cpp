@@ -125,6 +125,18 @@ TEST(RigidBodyDynamics, RadauKeepsTheInvariantsToFifthOrder) {
   // Fifth order: measured 31.7x for both; at least 2^4.3 = 20.
   EXPECT_GT(coarse.momentum_error / fine.momentum_error, 20.0);
   EXPECT_GT(coarse.energy_error / fine.energy_error, 20.0);
+  // The slope of the error against the step from 20 to 80 steps per revolution (the finest at
+  // 1e-8 and 2.5e-8, far above Newton's tolerance): measured 4.98 and 5.00 for the energy, 4.99
+  // and 5.00 for the momentum.
+  const FlightErrors finest = FreeFlight(se, omega0, period / 80, 800, 1.0, none, Integrator::kRadau, 1e-12);
+  const double slopes[4] = {
+      std::log2(coarse.energy_error / fine.energy_error), std::log2(fine.energy_error / finest.energy_error),
+      std::log2(coarse.momentum_error / fine.momentum_error), std::log2(fine.momentum_error / finest.momentum_error)};
+  std::printf(
+      "[ info ] Radau IIA: 80 steps/rev: energy %.3e momentum %.3e; slopes: energy %.2f, %.2f; momentum %.2f, "
+      "%.2f\n",
+      finest.energy_error, finest.momentum_error, slopes[0], slopes[1], slopes[2], slopes[3]);
+  for (double slope : slopes) EXPECT_NEAR(slope, 5.0, 0.1);
 }
 
 // Radau IIA under error control (its own estimate, RadauLocalError): the same ten revolutions
