@@ -190,25 +190,25 @@ def plot(measured, png):
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    fig, ax = plt.subplots(figsize=(7, 4.5))
+    fig, ax = plt.subplots(figsize=(10, 4.8))
     for integrator, n, style in (("generalized_alpha", 1, "^-"), ("generalized_alpha", 2, "o-"),
                                  ("generalized_alpha", 4, "s-"), ("radau", 1, "^--"), ("radau", 2, "o--"),
                                  ("radau", 4, "s--")):
         pts = [(t, c, h) for i, m, h, t, c in measured if m == n and i == integrator]
         ax.plot([p[0] for p in pts], [p[1] for p in pts], style,
-                label=f"femb {SHORT[integrator]}, {bodies(n)} (counted error against femb's reference)")
+                label=f"femb {SHORT[integrator]}, {bodies(n).strip()}")
         for t, c, h in pts:
             ax.annotate(f"{float(h) * 1e6:.0f} us", (t, c), textcoords="offset points", xytext=(4, 4), fontsize=7)
     levels = [lv for lv in LEVELS if PEER_LEAST[lv]]
     ax.plot([PEER_LEAST[lv] for lv in levels], levels, "x", color="tab:red", markersize=9,
-            label="peer's least time at each level (side by side, independent reference)")
+            label="peer's least time at each level\n(side by side, independent reference)")
     ax.set_xscale("log")
     ax.set_yscale("log")
     ax.set_xlabel("solve time [s], one thread")
-    ax.set_ylabel("counted RMS error of the rod midpoint deflection [% of peak]")
+    ax.set_ylabel("counted RMS error of the rod midpoint\ndeflection [% of peak], femb's reference")
     ax.set_title("planar slider-crank, 3 revolutions: error against solve time")
     ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=8)
+    ax.legend(fontsize=8, loc="center left", bbox_to_anchor=(1.02, 0.5))
     fig.tight_layout()
     fig.savefig(png, dpi=120)
     print(f"peer_slider_crank: plot {png}")
