@@ -93,6 +93,19 @@ Superelement TubeSegment(double L, int elements, bool stiffened) {
       std::string(stiffened ? "true" : "false") + "}\n");
 }
 
+DynamicState AdvanceSteps(const SystemModel& model, DynamicState s, Integrator integrator, double h, int steps,
+                          double tolerance) {
+  DynamicOptions options;
+  options.integrator = integrator;
+  options.step = h;
+  options.end_time = s.t + steps * h;
+  options.tolerance = tolerance;
+  options.threads = 1;
+  const DynamicResult r = SolveDynamic(model, s, options, nullptr);
+  EXPECT_TRUE(r.ok) << r.message;
+  return s;
+}
+
 SystemModel SliderCrankModel(const Superelement& crank, const Superelement& rod, double Lc, double Lr,
                              const SuperelementOptions& options) {
   SystemModel model;

@@ -7,6 +7,7 @@
 #include "formats/input_error.h"
 #include "formats/part_file.h"
 #include "formats/superelement.h"
+#include "solver/analysis/dynamic_analysis.h"
 #include "solver/assembly/system.h"
 
 namespace femb::test {
@@ -57,6 +58,11 @@ Superelement BendingShapesRod(double L);
 /// the rod bodies'.
 SystemModel SliderCrankModel(const Superelement& crank, const Superelement& rod, double Lc, double Lr,
                              const SuperelementOptions& options = SuperelementOptions{});
+
+/// The state after `steps` fixed steps of h from `s` under `integrator` (Newton tolerance
+/// `tolerance`, one thread); fails the calling test when the run stops.
+DynamicState AdvanceSteps(const SystemModel& model, DynamicState s, Integrator integrator, double h, int steps,
+                          double tolerance);
 
 /// -d(residual)/d(unknowns) of AssembleStatic at `state` (load factor `lambda`) by central
 /// differences with steps h along each unknown (ApplyIncrement): the reference for static

@@ -40,19 +40,6 @@ using dynamic_internal::MidpointResidual;
 
 constexpr double kBound = 1e-3;
 
-// A state after 20 midpoint steps of h from `s`.
-DynamicState Advance(const SystemModel& model, DynamicState s, double h) {
-  DynamicOptions options;
-  options.integrator = Integrator::kMidpoint;
-  options.step = h;
-  options.end_time = s.t + 20 * h;
-  options.tolerance = 1e-12;
-  options.threads = 1;
-  const DynamicResult r = SolveDynamic(model, s, options, nullptr);
-  EXPECT_TRUE(r.ok) << r.message;
-  return s;
-}
-
 // Per unknown: its scale (a free node's translation: the model's size; rotations and joint
 // coordinates: 1; modal coordinates: 1e-3 of the size times sqrt of the body's mass, as the
 // mass-normalized modes move the body by ~1/sqrt(mass) per unit).
@@ -132,7 +119,8 @@ double ErrorAfterSteps(const SystemModel& model, double h, const std::string& wh
       W0.segment<3>(dofs.node_first(k) + 3) = spin;
     }
   }
-  const DynamicState s0 = Advance(model, InitialDynamicState(model, InitialState(model), W0), h);
+  const DynamicState s0 = test::AdvanceSteps(model, InitialDynamicState(model, InitialState(model), W0),
+                                             Integrator::kMidpoint, h, 20, 1e-12);
   const double error = MatrixError(model, dofs, s0, h, OffSolution(model, dofs, s0, h, Scales(model, dofs)));
   std::printf("[ info ] %s, h = %.3g: the iteration matrix off the differences by %.2e of the largest column\n",
               what.c_str(), h, error);

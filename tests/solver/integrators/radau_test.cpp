@@ -50,19 +50,6 @@ using dynamic_internal::RadauStageResiduals;
 
 constexpr double kBound = 1e-4;
 
-// A state after 20 Radau steps of h from `s`.
-DynamicState Advance(const SystemModel& model, DynamicState s, double h) {
-  DynamicOptions options;
-  options.integrator = Integrator::kRadau;
-  options.step = h;
-  options.end_time = s.t + 20 * h;
-  options.tolerance = 1e-10;
-  options.threads = 1;
-  const DynamicResult r = SolveDynamic(model, s, options, nullptr);
-  EXPECT_TRUE(r.ok) << r.message;
-  return s;
-}
-
 // The iteration matrix at stage accelerations off the solution of a step of h from s0 (each the
 // state's accelerations and multipliers moved by a random 1% of their scale: the entry itself, at
 // least 1e-3 of the largest of its kind) against central differences (steps 1e-2 of each entry's
@@ -122,7 +109,7 @@ void CheckAfterSteps(const SystemModel& model, const DynamicState& start, const 
     double error[2];
     for (int i = 0; i < 2; ++i) {
       const double h = i == 0 ? 1e-3 : 1e-4;
-      error[i] = MatrixError(model, dofs, Advance(model, start, h), h, full);
+      error[i] = MatrixError(model, dofs, test::AdvanceSteps(model, start, Integrator::kRadau, h, 20, 1e-10), h, full);
       std::printf("[ info ] %s, h = %.3g, %s: the iteration matrix off the differences by %.2e of the largest column\n",
                   what.c_str(), h, full ? "full inertia tangent" : "default", error[i]);
       EXPECT_LT(error[i], kBound) << what << ", h = " << h;
