@@ -439,6 +439,15 @@ expect "stiffening not in the file" 2 "options.geometric_stiffening is true but"
 sed 's/{name: b3, superelement: segment.h5/{name: b3, options: {geometric_stiffening: true}, superelement: segment_gs.h5/' "$work/scene.yaml" > "$work/gs.yaml"
 "$bin/femb-solve" "$work/gs.yaml" -o "$work/gs_out" > "$work/gs_log.txt" 2>&1 && grep -q "note: body 'b0': .*has no geometric stiffening" "$work/gs_log.txt" \
   && ! grep -q "note: body 'b3'" "$work/gs_log.txt" && ok || fail "stiffening file used, note for the others: $(cat "$work/gs_log.txt")"
+# A file with modal derivatives but without the stiffening: the note says the body is nonlinear
+# inside through their cubic force, not that it is linear.
+"$bin/femb-reduce" -q "$work/segment.yaml" -o "$work/segment_md.h5" --set reduction.geometric_stiffening=false \
+  --set reduction.modal_derivatives=true || fail "reduce with modal derivatives"
+sed 's/{name: b3, superelement: segment.h5/{name: b3, superelement: segment_md.h5/' "$work/scene.yaml" > "$work/md.yaml"
+"$bin/femb-solve" "$work/md.yaml" -o "$work/md_out" > "$work/md_log.txt" 2>&1 \
+  && grep -q "note: body 'b3': .*has no geometric stiffening; the body is nonlinear inside through its modal derivatives' cubic force alone" "$work/md_log.txt" \
+  && grep -q "note: body 'b0': .*has no geometric stiffening; the body is linear inside" "$work/md_log.txt" \
+  && ok || fail "modal derivatives without stiffening: $(cat "$work/md_log.txt")"
 # The exact inertia asked for from a file without the invariants: one line, exit 2; a corrupted
 # invariant: the load gate names the dataset and the check.
 # A file of an older femb-reduce (without the invariants: they are deleted here) keeps loading,
