@@ -426,10 +426,16 @@ bool NonlinearForce(const PartSpec& part, const FeModel& model, const CraigBampt
   Stopwatch tensors;
   const NonlinearModel& f = nonlinear.Get();
   const Eigen::MatrixXd mesh_shapes = nonlinear.to_model_dofs() * cb.shapes;
-  const auto completion = InterfaceRotationCompletion(model.nodes, mesh_shapes, model.interface_positions,
-                                                      se.floating_frame.origin, part.type == PartType::kBeam ? 6 : 3);
+  // The interface faces' second-order rotation: solid meshes only (InterfaceRotationCompletion).
+  const std::vector<std::pair<int, Eigen::VectorXd>> completion =
+      part.type == PartType::kBeam ? std::vector<std::pair<int, Eigen::VectorXd>>{}
+                                   : InterfaceRotationCompletion(model.nodes, mesh_shapes, model.interface_positions,
+                                                                 se.floating_frame.origin, 3);
   PolynomialRequest poly_request;
   poly_request.cubic = derivatives;
+  // Only the static modes' stress works on it (PolynomialRequest); with derivatives every row, so
+  // that the cubic energy stays a square (C (L q + Q z / 2))^2 / 2 (without it a leaf buckled).
+  if (!derivatives) poly_request.completion_rows = 6 * int(model.interface_names.size());
   if (stiffening) {
     Eigen::MatrixXd u = cb.inertia_displacements;
     const Eigen::Matrix<double, 3, 12> at_origin = InertiaFieldAt(se.floating_frame.origin);

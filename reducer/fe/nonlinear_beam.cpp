@@ -97,7 +97,7 @@ ReducedPolynomial ReduceVonKarman(const VonKarmanBeams& beams, const Eigen::Matr
                                   const PolynomialRequest& request) {
   const int n = int(shapes.cols()), P = n * (n + 1) / 2;
   const int n_stress = request.stress_fields ? int(request.stress_fields->cols()) : 0;
-  PolynomialAccumulator accumulator(n, request.cubic, n_stress);
+  PolynomialAccumulator accumulator(n, request.cubic, n_stress, request.completion_rows);
   Eigen::MatrixXd L(6, n), Q(6, P), stress_local(12, n_stress), L_stress(6, n_stress);
   Eigen::MatrixXd local(12, n), fields(12, long(pair_fields.size()));
   for (const VonKarmanBeams::Element& e : beams.elements_) {
@@ -123,7 +123,8 @@ ReducedPolynomial ReduceVonKarman(const VonKarmanBeams& beams, const Eigen::Matr
     C_axial(0, 0) = std::sqrt(e.D[0]);
     Eigen::MatrixXd L_mean = Eigen::MatrixXd::Zero(6, n), Q_mean = Eigen::MatrixXd::Zero(6, P);
     // The stress fields' geometric stiffness without the rotation completion (PolynomialAccumulator).
-    const bool separate = n_stress > 0 && !pair_fields.empty();
+    const bool separate =
+        !pair_fields.empty() && (n_stress > 0 || (request.completion_rows >= 0 && request.completion_rows < n));
     Eigen::MatrixXd Q_plain, Q_plain_mean = separate ? Eigen::MatrixXd::Zero(6, P) : Eigen::MatrixXd();
     Eigen::MatrixXd L_stress_mean = Eigen::MatrixXd::Zero(6, n_stress);
     double length = 0.0;

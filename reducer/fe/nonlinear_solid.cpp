@@ -187,7 +187,7 @@ ReducedPolynomial ReduceSvk(const SvkSolidMesh& solid, const Eigen::MatrixXd& me
                             const PolynomialRequest& request) {
   const int n = int(mesh_shapes.cols()), P = n * (n + 1) / 2, ne = solid.n_per_cell_;
   const int n_stress = request.stress_fields ? int(request.stress_fields->cols()) : 0;
-  PolynomialAccumulator accumulator(n, request.cubic, n_stress);
+  PolynomialAccumulator accumulator(n, request.cubic, n_stress, request.completion_rows);
   Eigen::MatrixXd stress_element(3 * ne, n_stress), L_stress(6, n_stress);
   const Eigen::Matrix<double, 6, 6> C = solid.D_.llt().matrixU();  // D = C^T C
   std::vector<Eigen::Matrix3d> G(static_cast<size_t>(n));
@@ -219,7 +219,8 @@ ReducedPolynomial ReduceSvk(const SvkSolidMesh& solid, const Eigen::MatrixXd& me
               0.5 * (G[size_t(j)].transpose() * G[size_t(k)] + G[size_t(k)].transpose() * G[size_t(j)]);
           Q.col(p) << S(0, 0), S(1, 1), S(2, 2), 2 * S(1, 2), 2 * S(0, 2), 2 * S(0, 1);
         }
-      const bool separate = n_stress > 0 && n_fields > 0;
+      const bool separate =
+          n_fields > 0 && (n_stress > 0 || (request.completion_rows >= 0 && request.completion_rows < n));
       if (separate) Q_plain = Q;
       for (int f = 0; f < n_fields; ++f) {
         for (int a = 0; a < ne; ++a) U.row(a) = field_element.block(3 * a, f, 3, 1).transpose();
@@ -235,7 +236,8 @@ ReducedPolynomial ReduceSvk(const SvkSolidMesh& solid, const Eigen::MatrixXd& me
   return accumulator.Finish();
 }
 
-PolynomialAccumulator::PolynomialAccumulator(int n, bool cubic, int n_fields) : cubic_(cubic) {
+PolynomialAccumulator::PolynomialAccumulator(int n, bool cubic, int n_fields, int completion_rows)
+    : cubic_(cubic), completion_rows_(completion_rows >= 0 && completion_rows < n ? completion_rows : n) {
   const int P = n * (n + 1) / 2;
   r_.K = Eigen::MatrixXd::Zero(n, n);
   r_.A = Eigen::MatrixXd::Zero(n, P);
@@ -251,10 +253,11 @@ void PolynomialAccumulator::Add(double dV, const Eigen::Matrix<double, 6, 6>& C,
                                 const Eigen::MatrixXd* Q_fields) {
   const Eigen::MatrixXd CL = C * L, CQ = C * Q;
   r_.K.noalias() += dV * CL.transpose() * CL;
-  r_.A.noalias() += (0.5 * dV) * CL.transpose() * CQ;
-  if (L_fields && r_.S.rows() > 0) {
-    r_.S.noalias() += dV * (C * *L_fields).transpose() * (Q_fields ? Eigen::MatrixXd(C * *Q_fields) : CQ);
-  }
+  const int n = int(L.cols()), kept = Q_fields ? completion_rows_ : n;
+  const Eigen::MatrixXd CQ_plain = Q_fields ? Eigen::MatrixXd(C * *Q_fields) : Eigen::MatrixXd();
+  r_.A.topRows(kept).noalias() += (0.5 * dV) * CL.leftCols(kept).transpose() * CQ;
+  if (kept < n) r_.A.bottomRows(n - kept).noalias() += (0.5 * dV) * CL.rightCols(n - kept).transpose() * CQ_plain;
+  if (L_fields && r_.S.rows() > 0) r_.S.noalias() += dV * (C * *L_fields).transpose() * (Q_fields ? CQ_plain : CQ);
   if (!cubic_) return;
   // B gathers (C Q)^T (C Q) dV / 8, stacked into blocks of rows (one BLAS product each).
   stack_.middleRows(6 * stacked_, 6) = std::sqrt(dV / 8) * CQ;
