@@ -3,7 +3,8 @@
 // independent converged 1-D rotating-beam model and Southwell's closed form, with and without
 // geometric stiffening, for an interface frame (at the hub) and a centre-of-mass frame. "1 body":
 // a file with the stiffening (and so the exact inertia); "no stiff.": without either (the
-// thesis' corotational inertia). Prints the table; no pass/fail (the linearized check is
+// thesis' corotational inertia). Then stiffened bases whose shapes stretch the part (more modes,
+// modal derivatives; a solid bar too). Prints the tables; no pass/fail (the linearized check is
 // tests/solver/analysis/exact_inertia_test.cpp).
 // Usage: build/bin/rotating_cantilever_frequency
 #include <Eigen/Dense>
@@ -25,22 +26,38 @@ constexpr double kL = 1.0, kE = 70e9, kRho = 2700, kRo = 0.01, kRi = 0.009;
 const double kI = M_PI / 4 * (std::pow(kRo, 4) - std::pow(kRi, 4));
 const double kA = M_PI * (kRo * kRo - kRi * kRi);
 
-Superelement Tube(bool stiffening, const std::string& frame) {
-  const std::string yaml =
-      "name: tube\ntype: beam\nmaterial: {E: 70.0e9, nu: 0.3, rho: 2700}\n"
-      "section: {shape: tube, outer_radius: 0.01, wall: 0.001}\n"
-      "beam:\n  theory: euler_bernoulli\n  points: {A: [0, 0, 0], B: [1, 0, 0]}\n"
-      "  segments: [{from: A, to: B, elements: 40}]\ninterfaces: [{name: A}, {name: B}]\n"
-      "reduction: {internal_modes: 4, geometric_stiffening: " +
-      std::string(stiffening ? "true" : "false") + ", floating_frame: '" + frame + "'}\n";
-  ReduceResult r = ReducePart(ParsePart(yaml, "tube.yaml", {}), nullptr);
+Superelement Reduced(const std::string& yaml) {
+  ReduceResult r = ReducePart(ParsePart(yaml, "part.yaml", {}), nullptr);
   if (!r.ok) std::printf("reduction failed: %s\n", r.message.c_str());
   return r.superelement;
 }
 
+// `basis`: the reduction's keys before the stiffening and the frame.
+Superelement Tube(bool stiffening, const std::string& frame, const std::string& basis = "internal_modes: 4") {
+  return Reduced(
+      "name: tube\ntype: beam\nmaterial: {E: 70.0e9, nu: 0.3, rho: 2700}\n"
+      "section: {shape: tube, outer_radius: 0.01, wall: 0.001}\n"
+      "beam:\n  theory: euler_bernoulli\n  points: {A: [0, 0, 0], B: [1, 0, 0]}\n"
+      "  segments: [{from: A, to: B, elements: 40}]\ninterfaces: [{name: A}, {name: B}]\n"
+      "reduction: {" +
+      basis + ", geometric_stiffening: " + std::string(stiffening ? "true" : "false") + ", floating_frame: '" + frame +
+      "'}\n");
+}
+
+// A steel bar 1 m x 20 mm x 20 mm (TET10, 10 mm; RBE2 end faces), stiffened: EI = E a^4 / 12.
+constexpr double kBarSide = 0.02, kBarE = 2.1e11, kBarRho = 7850;
+Superelement Bar(int modes, const std::string& frame) {
+  return Reduced(
+      "name: bar\ntype: solid\nunits: SI\nmaterial: {E: 2.1e11, nu: 0.3, rho: 7850}\n"
+      "geometry: {shape: box, size: [1.0, 0.02, 0.02]}\nmesh: {size: 0.01, order: 2}\n"
+      "interfaces:\n  - {name: A, group: xmin}\n  - {name: B, group: xmax}\n"
+      "reduction: {internal_modes: " +
+      std::to_string(modes) + ", floating_frame: '" + frame + "'}\n");
+}
+
 // The converged 1-D rotating-beam model (tests/rotating_beam_reference.h).
-double ReferenceOmega2(double Omega, bool in_plane) {
-  return reference::RotatingBeamOmega2(kE * kI, kRho * kA, kL, Omega, in_plane);
+double ReferenceOmega2(double Omega, bool in_plane, double EI = kE * kI, double rhoA = kRho * kA) {
+  return reference::RotatingBeamOmega2(EI, rhoA, kL, Omega, in_plane);
 }
 
 // The first bending frequency of ONE body rotating steadily about z at Omega (hub clamped to a
@@ -132,5 +149,35 @@ int main() {
     }
   }
   std::printf("(+-35.00%%: no spectral peak within +-35%% of the reference)\n");
+  // Stiffened bases whose shapes stretch the part (their stress, balanced by body forces, takes
+  // its geometric stiffness without the interface rotation completion): the tube with 14 internal
+  // modes (the 14th its first axial mode) and with the derivatives of every pair of 4 modes; the
+  // bar with 4 and 20 internal modes.
+  const double bar_EI = kBarE * std::pow(kBarSide, 4) / 12, bar_rhoA = kBarRho * kBarSide * kBarSide;
+  std::printf("\n%-34s %-16s %-9s %7s %10s %9s %10s\n", "part, basis (stiffened)", "frame", "motion", "Omega/w0",
+              "reference", "1 body", "error");
+  for (const char* frame : {"interface:A", "center_of_mass"}) {
+    const struct {
+      const char* name;
+      Superelement se;
+      double EI, rhoA;
+    } parts[] = {{"tube, 14 modes", Tube(true, frame, "internal_modes: 14"), kE * kI, kRho * kA},
+                 {"tube, 4 modes + derivatives", Tube(true, frame, "internal_modes: 4, modal_derivatives: true"),
+                  kE * kI, kRho * kA},
+                 {"bar TET10, 4 modes", Bar(4, frame), bar_EI, bar_rhoA},
+                 {"bar TET10, 20 modes", Bar(20, frame), bar_EI, bar_rhoA}};
+    for (const auto& part : parts) {
+      const double w0 = std::sqrt(ReferenceOmega2(0.0, false, part.EI, part.rhoA));
+      for (bool in_plane : {false, true}) {
+        for (double ratio : {1.0, 2.0}) {
+          const double reference = std::sqrt(ReferenceOmega2(ratio * w0, in_plane, part.EI, part.rhoA));
+          const double measured = MeasuredOmega(part.se, ratio * w0, in_plane, reference);
+          std::printf("%-34s %-16s %-9s %7.1f %10.3f %9.3f %+9.2f%%\n", part.name, frame,
+                      in_plane ? "in-plane" : "flapwise", ratio, reference, measured, 100 * (measured / reference - 1));
+          std::fflush(stdout);
+        }
+      }
+    }
+  }
   return 0;
 }
