@@ -426,13 +426,9 @@ bool NonlinearForce(const PartSpec& part, const FeModel& model, const CraigBampt
   Stopwatch tensors;
   const NonlinearModel& f = nonlinear.Get();
   const Eigen::MatrixXd mesh_shapes = nonlinear.to_model_dofs() * cb.shapes;
-  // The interface faces' second-order rotation: solid meshes only (InterfaceRotationCompletion).
-  const std::vector<std::pair<int, Eigen::VectorXd>> completion =
-      part.type == PartType::kBeam ? std::vector<std::pair<int, Eigen::VectorXd>>{}
-                                   : InterfaceRotationCompletion(model.nodes, mesh_shapes, model.interface_positions,
-                                                                 se.floating_frame.origin, 3);
   PolynomialRequest poly_request;
   poly_request.cubic = derivatives;
+  // A solid's interface faces turn to second order (InterfaceRotationCompletion; beams have none).
   // Only the static modes' stress works on it (PolynomialRequest); with derivatives every row, so
   // that the cubic energy stays a square (C (L q + Q z / 2))^2 / 2 (without it a leaf buckled).
   if (!derivatives) poly_request.completion_rows = 6 * int(model.interface_names.size());
@@ -445,8 +441,11 @@ bool NonlinearForce(const PartSpec& part, const FeModel& model, const CraigBampt
   }
   ReducedPolynomial poly =
       part.type != PartType::kBeam
-          ? ReduceSvk(static_cast<const SvkSolidMesh&>(f), mesh_shapes, completion, poly_request)
-          : ReduceVonKarman(static_cast<const VonKarmanBeams&>(f), mesh_shapes, completion, poly_request);
+          ? ReduceSvk(static_cast<const SvkSolidMesh&>(f), mesh_shapes,
+                      InterfaceRotationCompletion(model.nodes, mesh_shapes, model.interface_positions,
+                                                  se.floating_frame.origin),
+                      poly_request)
+          : ReduceVonKarman(static_cast<const VonKarmanBeams&>(f), mesh_shapes, poly_request);
   const double mismatch = (poly.K - cb.K).norm() / cb.K.norm();
   if (part.type == PartType::kImported && mismatch > kImportedStiffnessMismatch) {
     // femb's elements with the part's material on the imported mesh must be the imported

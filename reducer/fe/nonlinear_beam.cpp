@@ -93,13 +93,12 @@ SparseMatrix VonKarmanBeams::Tangent(const Eigen::VectorXd& u) const {
 }
 
 ReducedPolynomial ReduceVonKarman(const VonKarmanBeams& beams, const Eigen::MatrixXd& shapes,
-                                  const std::vector<std::pair<int, Eigen::VectorXd>>& pair_fields,
                                   const PolynomialRequest& request) {
   const int n = int(shapes.cols()), P = n * (n + 1) / 2;
   const int n_stress = request.stress_fields ? int(request.stress_fields->cols()) : 0;
-  PolynomialAccumulator accumulator(n, request.cubic, n_stress, request.completion_rows);
+  PolynomialAccumulator accumulator(n, request.cubic, n_stress);
   Eigen::MatrixXd L(6, n), Q(6, P), stress_local(12, n_stress), L_stress(6, n_stress);
-  Eigen::MatrixXd local(12, n), fields(12, long(pair_fields.size()));
+  Eigen::MatrixXd local(12, n);
   for (const VonKarmanBeams::Element& e : beams.elements_) {
     local.topRows(6) = shapes.middleRows(6 * e.n1, 6);
     local.bottomRows(6) = shapes.middleRows(6 * e.n2, 6);
@@ -109,11 +108,6 @@ ReducedPolynomial ReduceVonKarman(const VonKarmanBeams& beams, const Eigen::Matr
       stress_local.bottomRows(6) = request.stress_fields->middleRows(6 * e.n2, 6);
       stress_local = e.T * stress_local;
     }
-    for (size_t f = 0; f < pair_fields.size(); ++f) {
-      Eigen::Matrix<double, 12, 1> w;
-      w << pair_fields[f].second.segment<6>(6 * e.n1), pair_fields[f].second.segment<6>(6 * e.n2);
-      fields.col(long(f)) = e.T * w;
-    }
     // Per point: torsion, bending and shear (D without the axial term); per element: the mean
     // axial strain (weight = element length).
     Eigen::Matrix<double, 6, 1> c = e.D.cwiseSqrt();
@@ -122,10 +116,6 @@ ReducedPolynomial ReduceVonKarman(const VonKarmanBeams& beams, const Eigen::Matr
     Eigen::Matrix<double, 6, 6> C_axial = Eigen::Matrix<double, 6, 6>::Zero();
     C_axial(0, 0) = std::sqrt(e.D[0]);
     Eigen::MatrixXd L_mean = Eigen::MatrixXd::Zero(6, n), Q_mean = Eigen::MatrixXd::Zero(6, P);
-    // The stress fields' geometric stiffness without the rotation completion (PolynomialAccumulator).
-    const bool separate =
-        !pair_fields.empty() && (n_stress > 0 || (request.completion_rows >= 0 && request.completion_rows < n));
-    Eigen::MatrixXd Q_plain, Q_plain_mean = separate ? Eigen::MatrixXd::Zero(6, P) : Eigen::MatrixXd();
     Eigen::MatrixXd L_stress_mean = Eigen::MatrixXd::Zero(6, n_stress);
     double length = 0.0;
     for (const TimoshenkoBeam::QuadraturePoint& p : e.points) {
@@ -136,10 +126,7 @@ ReducedPolynomial ReduceVonKarman(const VonKarmanBeams& beams, const Eigen::Matr
       int k = 0;
       for (int i = 0; i < n; ++i)
         for (int j = i; j < n; ++j, ++k) Q(0, k) = G.col(i).dot(G.col(j));
-      if (separate) Q_plain = Q;
-      for (size_t f = 0; f < pair_fields.size(); ++f) Q.col(pair_fields[f].first) += 2 * (p.B * fields.col(long(f)));
-      accumulator.Add(p.weight, C_points, L, Q, n_stress > 0 ? &L_stress : nullptr, separate ? &Q_plain : nullptr);
-      if (separate) Q_plain_mean.row(0) += p.weight * Q_plain.row(0);
+      accumulator.Add(p.weight, C_points, L, Q, n_stress > 0 ? &L_stress : nullptr);
       length += p.weight;
       L_mean.row(0) += p.weight * L.row(0);
       Q_mean.row(0) += p.weight * Q.row(0);
@@ -147,9 +134,7 @@ ReducedPolynomial ReduceVonKarman(const VonKarmanBeams& beams, const Eigen::Matr
     }
     // The geometric stiffness of beams is the axial force's (von Karman): N = EA (mean strain).
     const Eigen::MatrixXd L_stress_axial = L_stress_mean / length;
-    const Eigen::MatrixXd Q_plain_axial = separate ? Eigen::MatrixXd(Q_plain_mean / length) : Eigen::MatrixXd();
-    accumulator.Add(length, C_axial, L_mean / length, Q_mean / length, n_stress > 0 ? &L_stress_axial : nullptr,
-                    separate ? &Q_plain_axial : nullptr);
+    accumulator.Add(length, C_axial, L_mean / length, Q_mean / length, n_stress > 0 ? &L_stress_axial : nullptr);
   }
   return accumulator.Finish();
 }

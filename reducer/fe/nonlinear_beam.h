@@ -33,7 +33,6 @@ class VonKarmanBeams : public NonlinearModel {
   SparseMatrix Tangent(const Eigen::VectorXd& u) const override;
   const std::vector<Eigen::Vector3d>& nodes() const { return nodes_; }
   friend ReducedPolynomial ReduceVonKarman(const VonKarmanBeams& beams, const Eigen::MatrixXd& shapes,
-                                           const std::vector<std::pair<int, Eigen::VectorXd>>& pair_fields,
                                            const PolynomialRequest& request);
 
  private:
@@ -51,10 +50,10 @@ class VonKarmanBeams : public NonlinearModel {
   std::vector<Element> elements_;
 };
 
-/// The reduced polynomial (ReducedPolynomial) of the basis `shapes` (n_dofs x n) on this model,
-/// with optional second-order pair fields (Q_p += 2 E_lin(W_p)).
+/// The reduced polynomial (ReducedPolynomial) of the basis `shapes` (n_dofs x n) on this model.
+/// No interface rotation completion (InterfaceRotationCompletion): on beam nodes it vanishes at
+/// every interface, whose nodes carry their exact positions.
 ReducedPolynomial ReduceVonKarman(const VonKarmanBeams& beams, const Eigen::MatrixXd& shapes,
-                                  const std::vector<std::pair<int, Eigen::VectorXd>>& pair_fields = {},
                                   const PolynomialRequest& request = {});
 
 }  // namespace femb

@@ -159,7 +159,7 @@ SparseMatrix SvkSolidMesh::Tangent(const Eigen::VectorXd& u) const {
 
 std::vector<std::pair<int, Eigen::VectorXd>> InterfaceRotationCompletion(
     const Eigen::MatrixXd& mesh_nodes, const Eigen::MatrixXd& mesh_shapes,
-    const std::vector<Eigen::Vector3d>& interface_points, const Eigen::Vector3d& origin, int dofs_per_node) {
+    const std::vector<Eigen::Vector3d>& interface_points, const Eigen::Vector3d& origin) {
   const int n = int(mesh_shapes.cols());
   const long n_nodes = mesh_nodes.rows();
   auto pair_index = [n](int j, int k) { return j * n - j * (j - 1) / 2 + (k - j); };  // j <= k
@@ -170,10 +170,10 @@ std::vector<std::pair<int, Eigen::VectorXd>> InterfaceRotationCompletion(
       for (int b = a; b < 3; ++b) {
         const Eigen::Matrix3d Ea = Skew<double>(Eigen::Vector3d::Unit(a)), Eb = Skew<double>(Eigen::Vector3d::Unit(b));
         const Eigen::Matrix3d C = 0.25 * (Ea * Eb + Eb * Ea);  // sym(e_a~ e_b~) / 2
-        Eigen::VectorXd W = Eigen::VectorXd::Zero(dofs_per_node * n_nodes);
+        Eigen::VectorXd W = Eigen::VectorXd::Zero(3 * n_nodes);
         for (long i = 0; i < n_nodes; ++i) {
-          const double phi = mesh_shapes(dofs_per_node * i, first);  // x component of interface k's u_x mode
-          W.segment<3>(dofs_per_node * i) = phi * C * (mesh_nodes.row(i).transpose() - origin);
+          const double phi = mesh_shapes(3 * i, first);  // x component of interface k's u_x mode
+          W.segment<3>(3 * i) = phi * C * (mesh_nodes.row(i).transpose() - origin);
         }
         W -= mesh_shapes.middleCols(first, 3) * (C * (interface_points[k] - origin));
         fields.emplace_back(pair_index(first + 3 + a, first + 3 + b), std::move(W));

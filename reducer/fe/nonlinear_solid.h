@@ -147,17 +147,16 @@ ReducedPolynomial ReduceSvk(const SvkSolidMesh& solid, const Eigen::MatrixXd& me
 /// rotation; and for a rigid rotation of the whole part (all theta_k equal, u_k = (R - 1) X_k)
 /// the second-order field is exactly theta~^2 (x - o) / 2, strain-free. Pair indices p refer to
 /// the n reduced coordinates (reduced_polynomial.h).
-/// `dofs_per_node`: 3 (solid mesh) or 6 (beam nodes: translations first; the rotation rows of
-/// W_p hold only the -Psi_k term). On beam nodes W_p vanishes at every interface (their nodes
-/// carry their exact positions): all it would add is interior work with the stress of the shapes
-/// that vanish there (axial modes, modal derivatives), which the exact inertia does not balance,
-/// so femb-reduce leaves it out for beams. Measured on the rotating beam example in one body (tip
-/// deflection, RMS off the 20-body reference): with it 37.5% (14 internal modes, the first axial
-/// one among them) and 37.5% / 30.6% / 19.3% (modal derivatives of every pair; centre of mass /
-/// mean axes / hub frame); without it 1.8% for each.
+/// Solid meshes only (3 DOFs per node): on beam nodes W_p would vanish at every interface (their
+/// nodes carry their exact positions) and add only interior work with the stress of the shapes
+/// that vanish there (axial modes, modal derivatives), which the exact inertia does not balance.
+/// Measured on the rotating beam example in one body (tip deflection, RMS off the 20-body
+/// reference): with it 37.5% (14 internal modes, the first axial one among them) and 37.5% / 30.6%
+/// / 19.3% (modal derivatives of every pair; centre of mass / mean axes / hub frame); without it
+/// 1.8% for each.
 std::vector<std::pair<int, Eigen::VectorXd>> InterfaceRotationCompletion(
     const Eigen::MatrixXd& mesh_nodes, const Eigen::MatrixXd& mesh_shapes,
-    const std::vector<Eigen::Vector3d>& interface_points, const Eigen::Vector3d& origin, int dofs_per_node = 3);
+    const std::vector<Eigen::Vector3d>& interface_points, const Eigen::Vector3d& origin);
 
 /// Static equilibrium of a full nonlinear model by Newton with load stepping:
 ///   T^T f(T u) = lambda f_ext  on the free model DOFs, u = prescribed values on the others
