@@ -52,8 +52,9 @@ struct CraigBamptonResult {
   std::vector<std::pair<int, int>> derivative_pairs;  ///< of the derivatives kept, in order
   /// With `inertia_fields`: the static response to each field's inertia load with the
   /// interfaces held, u_k = -K_ii^-1 (M A_k)_i (zero on the interface DOFs, W u = 0 at RBE3
-  /// interfaces), minus its part in the span of the internal modes and modal derivatives
-  /// (M_ii-orthogonal projection: that part is the basis's own, dynamic, response), n_full x k.
+  /// interfaces), minus the part the internal modes and modal derivatives V carry statically
+  /// (K_ii-orthogonal projection, V (V^T K_ii V)^-1 V^T f: that part is the basis's own
+  /// response), n_full x k.
   Eigen::MatrixXd inertia_displacements;
 };
 
