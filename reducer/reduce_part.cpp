@@ -428,10 +428,10 @@ bool NonlinearForce(const PartSpec& part, const FeModel& model, const CraigBampt
   const Eigen::MatrixXd mesh_shapes = nonlinear.to_model_dofs() * cb.shapes;
   PolynomialRequest poly_request;
   poly_request.cubic = derivatives;
-  // A solid's interface faces turn to second order (InterfaceRotationCompletion; beams have none).
-  // Only the static modes' stress works on it (PolynomialRequest); with derivatives every row, so
-  // that the cubic energy stays a square (C (L q + Q z / 2))^2 / 2 (without it a leaf buckled).
-  if (!derivatives) poly_request.completion_rows = 6 * int(model.interface_names.size());
+  // A solid's interface faces turn to second order (InterfaceRotationCompletion; beams have none),
+  // made K-orthogonal to the internal modes and derivatives (CompletionProjection): only the
+  // static modes' stress works on it, and the cubic energy stays a square (C (L q + Q z / 2))^2 / 2.
+  poly_request.static_coordinates = 6 * int(model.interface_names.size());
   if (stiffening) {
     Eigen::MatrixXd u = cb.inertia_displacements;
     const Eigen::Matrix<double, 3, 12> at_origin = InertiaFieldAt(se.floating_frame.origin);

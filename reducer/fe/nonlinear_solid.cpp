@@ -182,36 +182,78 @@ std::vector<std::pair<int, Eigen::VectorXd>> InterfaceRotationCompletion(
   return fields;
 }
 
+namespace {
+
+// Gathers one element's columns of node-major mesh fields (3 per node) into `element` (3 ne x k).
+void Gather(const Eigen::MatrixXd& fields, const Eigen::MatrixXi& cells, long c, Eigen::MatrixXd& element) {
+  const int ne = int(cells.cols());
+  for (int a = 0; a < ne; ++a) element.middleRows(3 * a, 3) = fields.middleRows(3 * long(cells(c, a)), 3);
+}
+
+// The linear Voigt strains (6 x k) at a point of the element fields (3 ne x k), and the gradients.
+void PointStrains(const Eigen::MatrixXd& element, const Eigen::MatrixXd& g, Eigen::MatrixXd& U,
+                  std::vector<Eigen::Matrix3d>* G, Eigen::MatrixXd& L) {
+  const int ne = int(g.rows());
+  for (long j = 0; j < element.cols(); ++j) {
+    for (int a = 0; a < ne; ++a) U.row(a) = element.block(3 * a, j, 3, 1).transpose();
+    const Eigen::Matrix3d Gj = U.transpose() * g;
+    if (G) (*G)[size_t(j)] = Gj;
+    L.col(j) = LinearStrain(Gj);
+  }
+}
+
+}  // namespace
+
+// The completion's work with the basis vectors from `first` on, made zero: the fields W_f minus
+// their K-orthogonal projection onto those vectors V, a = (V^T K V)^-1 V^T K W (both from the
+// point strains, one pass over the mesh without the quadratic terms). Returns a (n - first x
+// n_fields) with W'_f = W_f - V a_f.
+Eigen::MatrixXd CompletionProjection(const SvkSolidMesh& solid, const Eigen::MatrixXd& mesh_shapes,
+                                     const Eigen::MatrixXd& fields, int first) {
+  const int n = int(mesh_shapes.cols()), nv = n - first, ne = solid.n_per_cell_, nf = int(fields.cols());
+  const Eigen::MatrixXd V = mesh_shapes.rightCols(nv);
+  Eigen::MatrixXd element(3 * ne, nv), field_element(3 * ne, nf), U(ne, 3), L(6, nv), Lf(6, nf);
+  Eigen::MatrixXd K_vv = Eigen::MatrixXd::Zero(nv, nv), G = Eigen::MatrixXd::Zero(nv, nf);
+  for (long c = 0; c < solid.cells_.rows(); ++c) {
+    Gather(V, solid.cells_, c, element);
+    Gather(fields, solid.cells_, c, field_element);
+    for (int q = 0; q < solid.points_per_cell_; ++q) {
+      const size_t point = size_t(c) * solid.points_per_cell_ + q;
+      PointStrains(element, solid.dNdX_[point], U, nullptr, L);
+      PointStrains(field_element, solid.dNdX_[point], U, nullptr, Lf);
+      const Eigen::MatrixXd DL = solid.D_ * L;
+      K_vv.noalias() += solid.dV_[point] * L.transpose() * DL;
+      G.noalias() += solid.dV_[point] * DL.transpose() * Lf;
+    }
+  }
+  return Eigen::MatrixXd(0.5 * (K_vv + K_vv.transpose())).ldlt().solve(G);
+}
+
 ReducedPolynomial ReduceSvk(const SvkSolidMesh& solid, const Eigen::MatrixXd& mesh_shapes,
                             const std::vector<std::pair<int, Eigen::VectorXd>>& pair_fields,
                             const PolynomialRequest& request) {
   const int n = int(mesh_shapes.cols()), P = n * (n + 1) / 2, ne = solid.n_per_cell_;
   const int n_stress = request.stress_fields ? int(request.stress_fields->cols()) : 0;
-  PolynomialAccumulator accumulator(n, request.cubic, n_stress, request.completion_rows);
-  Eigen::MatrixXd stress_element(3 * ne, n_stress), L_stress(6, n_stress);
+  const int n_fields = int(pair_fields.size());
+  Eigen::MatrixXd fields(mesh_shapes.rows(), n_fields);
+  for (int f = 0; f < n_fields; ++f) fields.col(f) = pair_fields[size_t(f)].second;
+  const int first = request.static_coordinates;
+  const bool project = n_fields > 0 && first >= 0 && first < n;
+  const Eigen::MatrixXd a = project ? CompletionProjection(solid, mesh_shapes, fields, first) : Eigen::MatrixXd();
+  PolynomialAccumulator accumulator(n, request.cubic, n_stress);
+  Eigen::MatrixXd stress_element(3 * ne, n_stress), L_stress(6, n_stress), L_fields(6, n_fields);
   const Eigen::Matrix<double, 6, 6> C = solid.D_.llt().matrixU();  // D = C^T C
   std::vector<Eigen::Matrix3d> G(static_cast<size_t>(n));
   Eigen::MatrixXd L(6, n), Q(6, P), Q_plain, U(ne, 3);
-  Eigen::MatrixXd element(3 * ne, n);
-  const int n_fields = int(pair_fields.size());
-  Eigen::MatrixXd field_element(3 * ne, n_fields);
+  Eigen::MatrixXd element(3 * ne, n), field_element(3 * ne, n_fields);
   for (long c = 0; c < solid.cells_.rows(); ++c) {
-    for (int a = 0; a < ne; ++a) element.middleRows(3 * a, 3) = mesh_shapes.middleRows(3 * long(solid.cells_(c, a)), 3);
-    for (int f = 0; f < n_fields; ++f)
-      for (int a = 0; a < ne; ++a)
-        field_element.block(3 * a, f, 3, 1) = pair_fields[size_t(f)].second.segment<3>(3 * long(solid.cells_(c, a)));
-    for (int a = 0; a < ne && n_stress > 0; ++a)
-      stress_element.middleRows(3 * a, 3) = request.stress_fields->middleRows(3 * long(solid.cells_(c, a)), 3);
+    Gather(mesh_shapes, solid.cells_, c, element);
+    Gather(fields, solid.cells_, c, field_element);
+    if (n_stress > 0) Gather(*request.stress_fields, solid.cells_, c, stress_element);
     for (int q = 0; q < solid.points_per_cell_; ++q) {
       const size_t point = size_t(c) * solid.points_per_cell_ + q;
       const Eigen::MatrixXd& g = solid.dNdX_[point];
-      const double dV = solid.dV_[point];
-      for (int j = 0; j < n; ++j) {
-        for (int a = 0; a < ne; ++a) U.row(a) = element.block(3 * a, j, 3, 1).transpose();
-        G[size_t(j)] = U.transpose() * g;
-        const Eigen::Matrix3d& Gj = G[size_t(j)];
-        L.col(j) = LinearStrain(Gj);
-      }
+      PointStrains(element, g, U, &G, L);
       int p = 0;
       for (int j = 0; j < n; ++j)
         for (int k = j; k < n; ++k, ++p) {
@@ -219,25 +261,21 @@ ReducedPolynomial ReduceSvk(const SvkSolidMesh& solid, const Eigen::MatrixXd& me
               0.5 * (G[size_t(j)].transpose() * G[size_t(k)] + G[size_t(k)].transpose() * G[size_t(j)]);
           Q.col(p) << S(0, 0), S(1, 1), S(2, 2), 2 * S(1, 2), 2 * S(0, 2), 2 * S(0, 1);
         }
-      const bool separate =
-          n_fields > 0 && (n_stress > 0 || (request.completion_rows >= 0 && request.completion_rows < n));
+      const bool separate = n_fields > 0 && n_stress > 0;
       if (separate) Q_plain = Q;
-      for (int f = 0; f < n_fields; ++f) {
-        for (int a = 0; a < ne; ++a) U.row(a) = field_element.block(3 * a, f, 3, 1).transpose();
-        Q.col(pair_fields[size_t(f)].first) += 2 * LinearStrain(U.transpose() * g);
+      if (n_fields > 0) {
+        PointStrains(field_element, g, U, nullptr, L_fields);
+        if (project) L_fields.noalias() -= L.rightCols(n - first) * a;
+        for (int f = 0; f < n_fields; ++f) Q.col(pair_fields[size_t(f)].first) += 2 * L_fields.col(f);
       }
-      for (int f = 0; f < n_stress; ++f) {
-        for (int a = 0; a < ne; ++a) U.row(a) = stress_element.block(3 * a, f, 3, 1).transpose();
-        L_stress.col(f) = LinearStrain(U.transpose() * g);
-      }
-      accumulator.Add(dV, C, L, Q, n_stress > 0 ? &L_stress : nullptr, separate ? &Q_plain : nullptr);
+      if (n_stress > 0) PointStrains(stress_element, g, U, nullptr, L_stress);
+      accumulator.Add(solid.dV_[point], C, L, Q, n_stress > 0 ? &L_stress : nullptr, separate ? &Q_plain : nullptr);
     }
   }
   return accumulator.Finish();
 }
 
-PolynomialAccumulator::PolynomialAccumulator(int n, bool cubic, int n_fields, int completion_rows)
-    : cubic_(cubic), completion_rows_(completion_rows >= 0 && completion_rows < n ? completion_rows : n) {
+PolynomialAccumulator::PolynomialAccumulator(int n, bool cubic, int n_fields) : cubic_(cubic) {
   const int P = n * (n + 1) / 2;
   r_.K = Eigen::MatrixXd::Zero(n, n);
   r_.A = Eigen::MatrixXd::Zero(n, P);
@@ -253,11 +291,10 @@ void PolynomialAccumulator::Add(double dV, const Eigen::Matrix<double, 6, 6>& C,
                                 const Eigen::MatrixXd* Q_fields) {
   const Eigen::MatrixXd CL = C * L, CQ = C * Q;
   r_.K.noalias() += dV * CL.transpose() * CL;
-  const int n = int(L.cols()), kept = Q_fields ? completion_rows_ : n;
-  const Eigen::MatrixXd CQ_plain = Q_fields ? Eigen::MatrixXd(C * *Q_fields) : Eigen::MatrixXd();
-  r_.A.topRows(kept).noalias() += (0.5 * dV) * CL.leftCols(kept).transpose() * CQ;
-  if (kept < n) r_.A.bottomRows(n - kept).noalias() += (0.5 * dV) * CL.rightCols(n - kept).transpose() * CQ_plain;
-  if (L_fields && r_.S.rows() > 0) r_.S.noalias() += dV * (C * *L_fields).transpose() * (Q_fields ? CQ_plain : CQ);
+  r_.A.noalias() += (0.5 * dV) * CL.transpose() * CQ;
+  if (L_fields && r_.S.rows() > 0) {
+    r_.S.noalias() += dV * (C * *L_fields).transpose() * (Q_fields ? Eigen::MatrixXd(C * *Q_fields) : CQ);
+  }
   if (!cubic_) return;
   // B gathers (C Q)^T (C Q) dV / 8, stacked into blocks of rows (one BLAS product each).
   stack_.middleRows(6 * stacked_, 6) = std::sqrt(dV / 8) * CQ;

@@ -45,11 +45,11 @@ struct ReducedPolynomial {
 struct PolynomialRequest {
   bool cubic = true;
   const Eigen::MatrixXd* stress_fields = nullptr;  ///< n_dofs x n_fields on the model's DOF vector
-  /// The basis vectors whose stress does work on the interface rotation completion (`pair_fields`):
-  /// the first `completion_rows`, the interfaces' static modes; -1: all. The others (internal
-  /// modes, modal derivatives: zero on the interfaces) take the quadratic strains without it in
-  /// their geometric stiffness, as the stress fields do (PolynomialAccumulator).
-  int completion_rows = -1;
+  /// The first `static_coordinates` basis vectors are the interfaces' static modes; the
+  /// completion fields (`pair_fields`) are made K-orthogonal to the others (internal modes, modal
+  /// derivatives: CompletionProjection), so that their stress does no work on them. -1: kept as
+  /// given.
+  int static_coordinates = -1;
 };
 
 /// One element: `X` n x 3 node coordinates, `u` its 3 n displacements (node-major).
@@ -74,17 +74,10 @@ class NonlinearModel {
 /// (default Q): the quadratic strains their geometric stiffness uses (without the interface
 /// rotation completion: SuperelementBody's exact inertia does not see that second-order field,
 /// and the inertia load's stress does work on it that nothing balances; on a rotating cantilever
-/// the completion added rho A Omega^2 L^2 / 12 to the tip slope's geometric stiffness). The same
-/// holds for the basis vectors that vanish on the interfaces (internal modes, modal derivatives):
-/// their stress is balanced by body forces (K phi = omega^2 M phi inside), which the exact inertia
-/// applies to the basis' field and not to the completion's, so their rows of A after the first
-/// `completion_rows` take Q_fields too. The interfaces' static modes, whose stress the interface
-/// forces balance, keep the completion: its work there is the faces' second-order rotation, and
-/// their stress does no work on its interior (K psi vanishes inside). It is the completion whose
-/// interior is the static extension of its faces' motion, on the rows of A.
+/// the completion added rho A Omega^2 L^2 / 12 to the tip slope's geometric stiffness).
 class PolynomialAccumulator {
  public:
-  PolynomialAccumulator(int n, bool cubic = true, int n_fields = 0, int completion_rows = -1);
+  PolynomialAccumulator(int n, bool cubic = true, int n_fields = 0);
   void Add(double dV, const Eigen::Matrix<double, 6, 6>& C, const Eigen::MatrixXd& L, const Eigen::MatrixXd& Q,
            const Eigen::MatrixXd* L_fields = nullptr, const Eigen::MatrixXd* Q_fields = nullptr);
   ReducedPolynomial Finish();
@@ -93,7 +86,6 @@ class PolynomialAccumulator {
   void Flush();
   static constexpr int kPointsPerBlock = 64;
   bool cubic_;
-  int completion_rows_;
   ReducedPolynomial r_;
   Eigen::MatrixXd stack_;
   int stacked_ = 0;
@@ -108,6 +100,8 @@ class SvkSolidMesh : public NonlinearModel {
   double Energy(const Eigen::VectorXd& u) const override;
   Eigen::VectorXd Force(const Eigen::VectorXd& u) const override;
   SparseMatrix Tangent(const Eigen::VectorXd& u) const override;
+  friend Eigen::MatrixXd CompletionProjection(const SvkSolidMesh& solid, const Eigen::MatrixXd& mesh_shapes,
+                                              const Eigen::MatrixXd& fields, int first);
   friend ReducedPolynomial ReduceSvk(const SvkSolidMesh& solid, const Eigen::MatrixXd& mesh_shapes,
                                      const std::vector<std::pair<int, Eigen::VectorXd>>& pair_fields,
                                      const PolynomialRequest& request);
@@ -132,6 +126,20 @@ class SvkSolidMesh : public NonlinearModel {
 ReducedPolynomial ReduceSvk(const SvkSolidMesh& solid, const Eigen::MatrixXd& mesh_shapes,
                             const std::vector<std::pair<int, Eigen::VectorXd>>& pair_fields = {},
                             const PolynomialRequest& request = {});
+
+/// The completion fields' work with the basis vectors V from `first` on (internal modes, modal
+/// derivatives), made zero: a = (V^T K V)^-1 V^T K W (n - first x n_fields, from the point strains
+/// of the linear model), and ReduceSvk uses W' = W - V a. Those vectors vanish on the interfaces
+/// and their stress is balanced by body forces (K phi = omega^2 M phi inside), which the exact
+/// inertia applies to the basis' field and not to the completion's, so their work on the
+/// completion's interior would be balanced by nothing: a rotating cantilever in one body whose
+/// basis stretches it (an axial mode, modal derivatives) lost or doubled its centrifugal
+/// stiffening (a TET10 bar with the derivatives of its modes' pairs: +12% / -16%). W' changes
+/// only the parametrization: the basis spans the same fields, and the static modes' rows (K psi
+/// vanishes inside) are unchanged. Under a rigid rotation of the whole part a second-order
+/// V a (theta theta) is left, which the internal coordinates take up (V a is theirs).
+Eigen::MatrixXd CompletionProjection(const SvkSolidMesh& solid, const Eigen::MatrixXd& mesh_shapes,
+                                     const Eigen::MatrixXd& fields, int first);
 
 /// The second-order completion of the interface rotations of a solid part (RBE2 faces): with
 /// linear static modes a local rotation theta of interface k moves its face by theta x r only,

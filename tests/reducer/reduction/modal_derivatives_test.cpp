@@ -158,11 +158,27 @@ TEST(ModalDerivatives, ReducedPolynomialForceIsTheProjectedFullForce) {
   EXPECT_EQ(back.polynomial->B, se.polynomial->B);
 }
 
+// The polynomial energy at q with the coordinates from `first` on (internal modes, derivatives)
+// at their equilibrium (Newton on the polynomial's force and tangent).
+double RelaxedEnergy(const Eigen::MatrixXd& K, const PolynomialStiffness& p, Eigen::VectorXd q, int first) {
+  const long m = q.size() - first;
+  for (int it = 0; it < 20; ++it) {
+    const Eigen::VectorXd f = PolynomialForce(K, p, q).tail(m);
+    const Eigen::VectorXd dq = PolynomialTangent(K, p, q).bottomRightCorner(m, m).ldlt().solve(f);
+    q.tail(m) -= dq;
+    if (dq.norm() <= 1e-14 * std::max(q.norm(), 1e-300)) break;
+  }
+  return PolynomialEnergy(K, p, q);
+}
+
 TEST(ModalDerivatives, FiniteRigidRotationCostsNoStrainEnergyWithTheRotationCompletion) {
   // Local coordinates of the whole leaf turned rigidly by theta about y (interfaces at X_k from
-  // the frame origin): u_k = (R - 1) X_k, theta_k = theta e_y, modes 0. The linear static modes
-  // move the faces by theta x r only, which Green-Lagrange reads as a stretch theta^2 / 2; the
-  // second-order completion of the face rotation (nonlinear_solid.h) removes it to higher order.
+  // the frame origin): u_k = (R - 1) X_k, theta_k = theta e_y, the internal coordinates at their
+  // equilibrium. The linear static modes move the faces by theta x r only, which Green-Lagrange
+  // reads as a stretch theta^2 / 2; the second-order completion of the face rotation
+  // (nonlinear_solid.h) removes it to higher order. (Made K-orthogonal to the internal modes and
+  // derivatives, the completion leaves a second-order field V a theta^2 of theirs: at modes 0 the
+  // energy is 0.62 of the linear faces', and the internal coordinates take it up.)
   const PartSpec part = ParsePart(Leaf(", modal_derivatives: {pairs: [[8, 8]]}"), "leaf.yaml");
   const ReduceResult r = ReducePart(part, nullptr);
   ASSERT_TRUE(r.ok) << r.message;
@@ -173,8 +189,10 @@ TEST(ModalDerivatives, FiniteRigidRotationCostsNoStrainEnergyWithTheRotationComp
   const ReducedPolynomial plain = ReduceSvk(solid, V);  // without the completion
   std::vector<Eigen::Vector3d> points;
   for (const InterfaceNode& node : se.interfaces) points.push_back(node.position);
-  const ReducedPolynomial completed =
-      ReduceSvk(solid, V, InterfaceRotationCompletion(se.visualization->nodes, V, points, se.floating_frame.origin));
+  PolynomialRequest request;
+  request.static_coordinates = 12;
+  const ReducedPolynomial completed = ReduceSvk(
+      solid, V, InterfaceRotationCompletion(se.visualization->nodes, V, points, se.floating_frame.origin), request);
   EXPECT_LT((completed.B - se.polynomial->B).norm(), 1e-12 * completed.B.norm());  // what the reducer stored
   const PolynomialStiffness without{plain.A, plain.B, Eigen::MatrixXd()};
   const int n = se.n_reduced_dofs();
@@ -191,11 +209,13 @@ TEST(ModalDerivatives, FiniteRigidRotationCostsNoStrainEnergyWithTheRotationComp
     Eigen::VectorXd bend = Eigen::VectorXd::Zero(n);
     bend[10] = theta;
     const double scale = 0.5 * bend.dot(se.K * bend);
-    const double with_completion = PolynomialEnergy(se.K, *se.polynomial, q) / scale;
-    const double linear_faces = PolynomialEnergy(se.K, without, q) / scale;
+    const double with_completion = RelaxedEnergy(se.K, *se.polynomial, q, 12) / scale;
+    const double linear_faces = RelaxedEnergy(se.K, without, q, 12) / scale;
     std::printf(
-        "[ info ] rigid rotation %.2f rad: strain energy / bending energy %.2e with the completion, %.2e without\n",
-        theta, with_completion, linear_faces);
+        "[ info ] rigid rotation %.2f rad: strain energy / bending energy %.2e with the completion, %.2e without "
+        "(modes 0: %.2e, %.2e)\n",
+        theta, with_completion, linear_faces, PolynomialEnergy(se.K, *se.polynomial, q) / scale,
+        PolynomialEnergy(se.K, without, q) / scale);
     EXPECT_LT(std::abs(with_completion), 0.05 * linear_faces);
   }
 }
