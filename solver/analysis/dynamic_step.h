@@ -82,6 +82,7 @@ struct MidpointKinematics {
   StepColumnMap V;                                     // d W_n+1 / d delta: 2/h off the rotation nodes
   std::vector<Eigen::Matrix<double, 6, 1>> node_w1;    // every node's velocity at n+1 (EndNodeVelocity)
   std::vector<Eigen::Matrix<double, 6, 1>> node_step;  // every node's (x_n+1 - x_n, log(R_n+1 R_n^T))
+  std::vector<char> screw_mid;  // per node: its mid position moved for the energy closure (set per model)
 };
 
 /// out += B^T (K B T' + M B V' / h) for a body's K and M (local) and map B on the rotation nodes'
@@ -99,7 +100,16 @@ struct MidpointBody {
   Eigen::MatrixXd S_b;  // the body's combined iteration matrix (MidpointMatrix)
   BodyData side;        // the exact inertia: MomentumConfigurationTangent's perturbed data
   InertiaLoadFactors load;
+  // The energy closure (midpoint_energy.cpp): the energy at q_n, the inertia and elastic forces
+  // it closes, its direction per unit mismatch (closure_on: there is one this iteration), the mismatch and its
+  // gradient, and scratch.
+  double E0 = 0.0, mismatch = 0.0, closure_noise = 0.0;
+  bool closure_on = false, dc_fresh = false;
+  Eigen::VectorXd F, closure, u_local, v, Wv, Q0, base;
+  Eigen::MatrixXd dc, Kq, KB, K_end;
 };
+
+struct BodyWorkspace;
 
 // The midpoint scheme's storage, kept from one iteration and one step to the next.
 struct MidpointWorkspace {
@@ -108,6 +118,9 @@ struct MidpointWorkspace {
   MidpointKinematics k;
   // Set once for the model: per body, whether it has a free node; the model's size squared.
   std::vector<char> free_node;
+  std::vector<char> closes;                        // per body: whether its energy is closed (ClosesEnergy)
+  std::shared_ptr<BodyWorkspace> closure_scratch;  // EnergyClosureGradient's differences
+  DynamicState closure_state;
   double L2 = 0.0;
   std::vector<double> gravity_work;  // per body
   // Per unknown: 2 i for the rotation triple of rotation node i, 2 i + 1 for its translation
@@ -234,6 +247,32 @@ struct BodyWorkspace {
     return weights;
   }
 };
+
+// The energy closure of a flexible body under the midpoint scheme (midpoint_energy.cpp): which
+// bodies take it (two nodes or more, all free and unprescribed, no inertia stiffening, no interface
+// constraint, the exact kinematics and quadratic velocity terms); its elastic force, the two
+// ends' local forces averaged through the map at q_m; the closure added to that force f_int (m.F
+// holds the inertia force without damping on entry); and the closure's derivative over the
+// body's coordinates for Newton's matrix (into m.dc), by one-sided differences of the body's
+// terms about the end state s1 of the residual pass just made (a scratch workspace of its own).
+bool ClosesEnergy(const SystemModel& model, const DofMap& dofs, int b);
+// A free node's mid position moved where its step (Delta_x, Delta_pi) is a rigid motion's (into
+// `half`, the increment from q_n to q_m), with the maps of the end increments onto it.
+void ScrewMidShift(const Eigen::Vector3d& dpi, const Eigen::Vector3d& dx, const Eigen::Matrix3d& Jinv,
+                   Eigen::Ref<Eigen::Vector3d> half, Eigen::Matrix3d& T_translation, Eigen::Matrix3d& T_coupling);
+void AveragedElasticForce(const SuperelementBody& body, BodyData& d1, MidpointBody& m, Eigen::VectorXd& f_int);
+void AveragedElasticTangent(const SuperelementBody& body, BodyData& d1, MidpointBody& m, Eigen::MatrixXd& K_mid,
+                            Eigen::MatrixXd& K_end);
+void CloseEnergy(const SuperelementBody& body, double h, BodyData& d1, const Eigen::VectorXd& w1, MidpointBody& m,
+                 Eigen::VectorXd& f_int);
+void EnergyClosureGradient(const SystemModel& model, const DofMap& dofs, const DynamicState& s0, double h,
+                           const DynamicState& s1, int b, BodyWorkspace& work);
+// The midpoint step's kinematics at the end state s1 (sets s1's end velocities), into k; one
+// body's terms of its balance (BodyTerms) into work (midpoint.cpp).
+void Midpoint(const SystemModel& model, const DofMap& dofs, const std::vector<RotationNode>& nodes,
+              const DynamicState& s0, double h, DynamicState& s1, MidpointKinematics& k);
+void MidpointBodyTerms(const SystemModel& model, const DofMap& dofs, const DynamicState& s0, double h, DynamicState& s1,
+                       int b, BodyWorkspace& work);
 
 // The generalized-alpha residual at state s and time t: frames solved (s.config.frames
 // updated), each body's kinematics evaluated once and kept in the workspace's passes for the

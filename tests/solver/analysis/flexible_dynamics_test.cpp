@@ -141,17 +141,18 @@ TEST(FlexibleDynamics, FreeSpinningFlexibleBodyConservesEnergyAndMomentum) {
   // Linear momentum (initially zero) stays at round-off: mass 0.161 kg, speeds up to 10 m/s.
   EXPECT_LT(coarse.dL, 1e-9 * se.mass_properties.mass * 10.0);
 
-  // The momentum-conserving midpoint scheme: angular and linear momentum are invariants of the
-  // discrete map also for the flexible body (to the Newton tolerance 1e-9); energy is not an
-  // exact invariant here (midpoint elastic force) but its error is second order and ~300x below
-  // generalized-alpha's (5.8e-6 against 1.7e-3 at 200 steps per turn when written).
+  // The momentum-conserving midpoint scheme: angular and linear momentum and, through the free
+  // body's energy closure (solver/integrators/midpoint_energy.cpp), the energy are invariants of
+  // the discrete map also for the flexible body, to the Newton tolerance 1e-9 (measured: energy
+  // 7.0e-10 and 5.3e-10 at 200 and 400 steps per turn; without the closure a second-order error,
+  // 5.8e-6 at 200).
   const Errors mid_coarse = run(200, Integrator::kMidpoint), mid_fine = run(400, Integrator::kMidpoint);
   EXPECT_GT(mid_coarse.max_elastic, 0.0);
   EXPECT_LT(mid_coarse.dH, 1e-8);
   EXPECT_LT(mid_fine.dH, 1e-8);
   EXPECT_LT(mid_coarse.dL, 1e-9 * se.mass_properties.mass * 10.0);
-  EXPECT_LT(mid_coarse.dE, coarse.dE);
-  EXPECT_GT(mid_coarse.dE / mid_fine.dE, 3.5);
+  EXPECT_LT(mid_coarse.dE, 1e-8);
+  EXPECT_LT(mid_fine.dE, 1e-8);
 }
 
 TEST(FlexibleDynamics, JacobianReuseGivesTheSameMotionWithFewerFactorizations) {
