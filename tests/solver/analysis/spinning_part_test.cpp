@@ -301,13 +301,15 @@ TEST(SpinningPart, ImportedStiffeningRefusesAMissingOrWrongMaterial) {
 // axis, so that the spin is no relative equilibrium), 20 periods at 100 steps per period (the
 // axial mode, 2.6 kHz, not resolved: h omega_axial = 5): the angular momentum and the energy are
 // kept to the Newton tolerance with either inertia, the energy through the body's energy closure
-// (solver/integrators/midpoint_energy.cpp; measured: energy 3.9e-12 exact, 7.2e-12 corotational,
-// angular momentum 9.1e-12 and 8.2e-12 over 20 periods at tolerance 1e-12; without the closure the
-// energy's error was bounded, 2.5e-6 exact and 1.0e-4 corotational). The momentum bound guards the
-// round-off floor of Newton's test (RoundOffForce): taken from the stiffest modal coordinate, it
-// would accept residuals 2e4 times its true noise, 3.6e-10 of the forces where 1e-12 is asked, and
-// let the momentum drift 8e-10 in 20 periods. Newton takes about 6.5 iterations per step with
-// either inertia (the matrix leaves out O(omega h) terms: linear convergence, midpoint_test.cpp).
+// (solver/integrators/midpoint_energy.cpp; measured over 20 periods at tolerance 1e-12: energy
+// 3.8e-12 exact, 5.5e-12 corotational, angular momentum 5.1e-11 and 2.5e-11; over 1 000 periods
+// 7.9e-11 and 1.7e-10 exact, 2.8e-11 and 4.0e-10 corotational; without the closure the energy's
+// error was bounded, 2.5e-6 exact and 1.0e-4 corotational over 20 periods). The momentum bound
+// guards the round-off floor of Newton's test (RoundOffForce): taken from the stiffest modal
+// coordinate, it would accept residuals 2e4 times its true noise, 3.6e-10 of the forces where
+// 1e-12 is asked, and let the momentum drift 8e-10 in 20 periods. Newton takes about 6.5
+// iterations per step with either inertia (the matrix leaves out O(omega h) terms: linear
+// convergence, midpoint_test.cpp).
 TEST(SpinningPart, MidpointConservesMomentumWithTheExactInertia) {
   const Files files;
   const Superelement se = files.Reduce("native.yaml", {"reduction.geometric_stiffening=false"});
