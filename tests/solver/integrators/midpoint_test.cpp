@@ -130,18 +130,24 @@ double ErrorAfterSteps(const SystemModel& model, double h, const std::string& wh
   return error;
 }
 
+// A free tube of 0.3 m on nodes a (origin) and b, numbered.
+SystemModel FreeTube(const Superelement& tube, bool exact) {
+  SystemModel model;
+  AddNode(model, "a", Eigen::Vector3d::Zero());
+  AddNode(model, "b", Eigen::Vector3d(0.3, 0, 0));
+  SuperelementOptions options;
+  options.exact_inertia = exact;
+  model.bodies.emplace_back(tube, options, Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero());
+  model.body_nodes.push_back({0, 1});
+  model.Number();
+  return model;
+}
+
 TEST(MidpointIterationMatrix, FreeSpinningTubeMatchesDifferences) {
   const Superelement tube = test::TubeSegment(0.3, 6, true);
   for (bool exact : {true, false}) {
-    SystemModel model;
-    AddNode(model, "a", Eigen::Vector3d::Zero());
-    AddNode(model, "b", Eigen::Vector3d(0.3, 0, 0));
-    SuperelementOptions options;
-    options.exact_inertia = exact;
-    model.bodies.emplace_back(tube, options, Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero());
-    model.body_nodes.push_back({0, 1});
+    const SystemModel model = FreeTube(tube, exact);
     const std::string what = std::string("free tube spinning at 50 rad/s, ") + (exact ? "exact" : "corotational");
-    model.Number();
     const double coarse = ErrorAfterSteps(model, 1e-3, what, Eigen::Vector3d(0, 5, 50));
     ErrorAfterSteps(model, 1e-4, what, Eigen::Vector3d(0, 5, 50));
     const double fine = ErrorAfterSteps(model, 1e-5, what, Eigen::Vector3d(0, 5, 50));
@@ -207,14 +213,7 @@ TEST(MidpointIterationMatrix, SliderCrankMatchesDifferences) {
 TEST(MidpointIterationMatrix, FreeTubeWithTheEnergyClosureMatchesDifferences) {
   const Superelement tube = test::TubeSegment(0.3, 6, false);
   for (bool exact : {true, false}) {
-    SystemModel model;
-    AddNode(model, "a", Eigen::Vector3d::Zero());
-    AddNode(model, "b", Eigen::Vector3d(0.3, 0, 0));
-    SuperelementOptions options;
-    options.exact_inertia = exact;
-    model.bodies.emplace_back(tube, options, Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero());
-    model.body_nodes.push_back({0, 1});
-    model.Number();
+    const SystemModel model = FreeTube(tube, exact);
     const std::string what =
         std::string("free tube with the energy closure at 50 rad/s, ") + (exact ? "exact" : "corotational");
     for (double h : {1e-3, 1e-4, 1e-5}) ErrorAfterSteps(model, h, what, Eigen::Vector3d(0, 5, 50));
@@ -231,14 +230,7 @@ TEST(MidpointIterationMatrix, FreeTubeWithTheEnergyClosureMatchesDifferences) {
 TEST(MidpointEnergyClosure, ARigidStepOfADeformedBodyDoesNoWork) {
   const Superelement tube = test::TubeSegment(0.3, 6, false);
   for (bool exact : {true, false}) {
-    SystemModel model;
-    AddNode(model, "a", Eigen::Vector3d::Zero());
-    AddNode(model, "b", Eigen::Vector3d(0.3, 0, 0));
-    SuperelementOptions options;
-    options.exact_inertia = exact;
-    model.bodies.emplace_back(tube, options, Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero());
-    model.body_nodes.push_back({0, 1});
-    model.Number();
+    const SystemModel model = FreeTube(tube, exact);
     const DofMap dofs(model);
     SystemState c = InitialState(model);
     Eigen::VectorXd d = Eigen::VectorXd::Zero(dofs.n_dofs());
