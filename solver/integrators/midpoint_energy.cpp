@@ -73,11 +73,12 @@ void AveragedElasticTangent(const SuperelementBody& body, BodyData& d1, Midpoint
   // the mid configuration; its first term Rbar_m B_m^T K B_m Rbar_m^T becomes the end strain's own,
   // d (B_m^T Q(q_n+1) / 2) = B_m^T K(q_n+1) B_n+1 / 2 (frames turned on each side), into K_end.
   const int blocks = 2 * body.n_nodes();
-  LocalTangent(body, d1, nullptr, m.Kq);
-  m.KB.noalias() = body.K() * m.dm.kin.B;
+  LocalTangent(body, m.dm, nullptr, m.Kq);
+  m.KB.noalias() = m.Kq * m.dm.kin.B;
   K_end.noalias() = m.dm.kin.B.transpose() * m.KB;
   body_blocks::TurnNodeBlocks(K_end, blocks, m.dm.frame.R);
   K_mid -= K_end;
+  LocalTangent(body, d1, nullptr, m.Kq);
   m.KB.noalias() = m.Kq * d1.kin.B;
   K_end.noalias() = 0.5 * m.dm.kin.B.transpose() * m.KB;
   body_blocks::TurnRowBlocks(K_end, blocks, [&](int) { return m.dm.frame.R; });
