@@ -100,11 +100,10 @@ struct MidpointBody {
   Eigen::MatrixXd S_b;  // the body's combined iteration matrix (MidpointMatrix)
   BodyData side;        // the exact inertia: MomentumConfigurationTangent's perturbed data
   InertiaLoadFactors load;
-  // The energy closure (midpoint_energy.cpp): the energy at q_n, the mismatch, its round-off,
-  // whether there is a closure this iteration and whether its derivative dc is this step's; the
-  // inertia and elastic forces it closes, its direction per unit mismatch, the local force at q_n;
-  // the end strain's tangent K_end, and scratch.
-  double E0 = 0.0, mismatch = 0.0, closure_noise = 0.0;
+  // The energy closure (midpoint_energy.cpp): the energy at q_n, the mismatch, whether there is a closure this
+  // iteration and whether its derivative dc is this step's; the inertia and elastic forces it closes, its direction per
+  // unit mismatch, the local force at q_n; the end strain's tangent K_end, and scratch.
+  double E0 = 0.0, mismatch = 0.0;
   bool closure_on = false, dc_fresh = false;
   Eigen::VectorXd F, closure, u_local, v, Wv, Q0, base;
   Eigen::MatrixXd dc, Kq, KB, K_end;

@@ -357,7 +357,6 @@ void MidpointBodyTerms(const SystemModel& model, const DofMap& dofs, const Dynam
   r.scale = std::max(
       {body.ForceNorm(f_int), body.ForceNorm(f_in), body.ForceNorm(f_grav), body.force_floor(), body.ForceNorm(f_acc)});
   r.roundoff = RoundOffForce(body, d1.c, work.inertia_factor);
-  if (closes) r.roundoff += m.closure_noise;
   BodyMap(model, dofs, k.mid, int(b), r.map);
   r.r_b = f_grav - f_int - f_in;
 }

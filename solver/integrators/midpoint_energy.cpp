@@ -11,7 +11,6 @@
 // (EnergyClosureGradient).
 #include <Eigen/Dense>
 #include <cmath>
-#include <limits>
 
 #include "solver/analysis/dynamic_step.h"
 #include "solver/body/body_blocks.h"
@@ -94,7 +93,6 @@ void CloseEnergy(const SuperelementBody& body, double h, BodyData& d1, const Eig
   const double work = h * m.F.dot(m.wm);
   const double mismatch = (E1 - m.E0) - work;
   m.mismatch = mismatch;
-  m.closure_noise = 0.0;
   // v = B_m Rbar_m^T u, weighted by the body's local mass diagonal.
   const Eigen::Matrix3d& R = m.dm.frame.R;
   Eigen::VectorXd& u = m.u_local;
@@ -109,9 +107,6 @@ void CloseEnergy(const SuperelementBody& body, double h, BodyData& d1, const Eig
   m.closure /= norm;
   for (int a = 0; a < blocks; ++a) m.closure.segment<3>(3 * a) = R * m.closure.segment<3>(3 * a);
   f_int += m.closure * mismatch;
-  // The mismatch is a difference of energies: its round-off, times the closure per unit.
-  m.closure_noise = 8.0 * std::numeric_limits<double>::epsilon() * (std::abs(E1) + std::abs(m.E0) + std::abs(work)) *
-                    body.ForceNorm(m.closure);
 }
 
 void EnergyClosureGradient(const SystemModel& model, const DofMap& dofs, const DynamicState& s0, double h,
