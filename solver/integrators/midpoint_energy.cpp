@@ -127,7 +127,7 @@ void EnergyClosureGradient(const SystemModel& model, const DofMap& dofs, const D
   smw.bodies.resize(n_bodies);
   sw.passes.resize(n_bodies);
   sw.terms.resize(n_bodies);
-  const MidpointBody& m = mw.bodies[size_t(b)];
+  MidpointBody& m = mw.bodies[size_t(b)];
   MidpointBody& sm = smw.bodies[size_t(b)];
   sm.w0 = m.w0;
   sm.p0 = m.p0;
@@ -141,9 +141,8 @@ void EnergyClosureGradient(const SystemModel& model, const DofMap& dofs, const D
   s = s1;
   Eigen::VectorXd& d = sw.delta;
   d.setZero(dofs.n_dofs());
-  MidpointBody& target = mw.bodies[size_t(b)];
-  target.dc.resize(n, n);
-  target.base = target.closure * target.mismatch;
+  m.dc.resize(n, n);
+  m.base = m.closure * m.mismatch;
   for (int j = 0; j < n; ++j) {
     const int a = j / 6;
     const int col = j < 6 * body.n_nodes() ? dofs.node_first(model.body_nodes[b][size_t(a)]) + j % 6
@@ -156,9 +155,9 @@ void EnergyClosureGradient(const SystemModel& model, const DofMap& dofs, const D
     d[col] = 0.0;
     Midpoint(model, dofs, sw.rotation_triples, s0, h, s, smw.k);
     MidpointBodyTerms(model, dofs, s0, h, s, b, sw);
-    target.dc.col(j) = -target.base;
-    if (sm.closure_on) target.dc.col(j).noalias() += sm.closure * sm.mismatch;
-    target.dc.col(j) /= eps;
+    m.dc.col(j) = -m.base;
+    if (sm.closure_on) m.dc.col(j).noalias() += sm.closure * sm.mismatch;
+    m.dc.col(j) /= eps;
   }
 }
 }  // namespace femb::dynamic_internal
