@@ -302,7 +302,7 @@ TEST(SpinningPart, ImportedStiffeningRefusesAMissingOrWrongMaterial) {
 // axial mode, 2.6 kHz, not resolved: h omega_axial = 5): the angular momentum and the energy are
 // kept to the Newton tolerance with either inertia, the energy through the body's energy closure
 // (solver/integrators/midpoint_energy.cpp; measured over 20 periods at tolerance 1e-12: energy
-// 2.0e-12 exact, 2.1e-12 corotational, angular momentum 2.3e-11 and 5.1e-12; over 1 000 periods
+// 1.9e-12 exact, 1.2e-12 corotational, angular momentum 1.9e-11 and 1.0e-11; over 1 000 periods
 // 3.4e-11 and 1.1e-10 exact, 2.2e-11 and 1.4e-10 corotational; without the closure the energy's
 // error was bounded, 2.5e-6 exact and 1.0e-4 corotational over 20 periods). The momentum bound
 // guards the round-off floor of Newton's test (RoundOffForce): taken from the stiffest modal
