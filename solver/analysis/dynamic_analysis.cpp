@@ -288,7 +288,6 @@ class DynamicRun {
     const DynamicStepReport start = resume_ ? DynamicStepReport() : Measure(model_, state_);
     E0_ = resume_ ? resume_->E0 : start.kinetic_energy + start.elastic_energy;
     energy_scale_ = resume_ ? resume_->energy_scale : std::abs(E0_);
-    last_drive_work_ = state_.drive_work;
     for (const SuperelementBody& body : model_.bodies) model_mass_ += std::max(body.mass(), 0.0);
     if (const std::string w = RoundOffToleranceWarning(options_.tolerance); !w.empty()) {
       result_.warnings.push_back(w);
@@ -565,14 +564,14 @@ class DynamicRun {
   std::string WatchEnergy(const DynamicStepReport& r) {
     const double energy = r.kinetic_energy + r.elastic_energy;
     // The drives' work has the round-off of their forces (the prescribed rows of the residual, at
-    // Newton's floor where the motion is slow): its share of each step's work summed.
+    // Newton's floor where the motion is slow): their relative round-off times the work so far
+    // (the scale keeps the largest, so a noisy start counts on).
     const double f_drive = state_.f_drive.size() ? state_.f_drive.norm() : 0.0;
-    const double drive_step = std::abs(state_.drive_work - last_drive_work_);
-    if (f_drive > 0) drive_noise_ += drive_step * std::min(1.0, work_.assembly.roundoff / f_drive);
-    last_drive_work_ = state_.drive_work;
+    const double drive_noise =
+        f_drive > 0 ? std::abs(state_.drive_work) * std::min(1.0, work_.assembly.roundoff / f_drive) : 0.0;
     energy_scale_ =
         std::max({energy_scale_, std::abs(energy), std::abs(state_.external_work), std::abs(state_.drive_work),
-                  EnergyNoise(model_mass_, state_.config, h_) / kEnergyWarn, drive_noise_ / kEnergyWarn});
+                  EnergyNoise(model_mass_, state_.config, h_) / kEnergyWarn, drive_noise / kEnergyWarn});
     const double growth = energy - state_.external_work - state_.drive_work - E0_;
     if (!(result_.steps >= 10 && energy_scale_ > 0 && growth > kEnergyWarn * energy_scale_)) return "";
     char buffer[400];
@@ -641,8 +640,7 @@ class DynamicRun {
   long n_nominal_ = 0;
   double t_output0_ = 0.0, last_output_ = 0.0;
   double E0_ = 0.0, energy_scale_ = 0.0;
-  double last_drive_work_ = 0.0, drive_noise_ = 0.0;  ///< WatchEnergy's round-off of the drives' work
-  double first_cut_time_ = -1.0;                      ///< fixed steps: where Newton first needed a shorter step
+  double first_cut_time_ = -1.0;  ///< fixed steps: where Newton first needed a shorter step
   double model_mass_ = 0.0;
   bool warned_ = false;
   const int n_bodies_;
