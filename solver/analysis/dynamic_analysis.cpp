@@ -365,6 +365,12 @@ class DynamicRun {
         m.K_frame = r.kept_K[size_t(b)], m.age = r.kept_age[size_t(b)];
       }
     }
+    MidpointWorkspace& mw = work_.midpoint;
+    mw.last_step_iterations = r.last_step_iterations;
+    if (!r.closure_dc.empty()) mw.bodies.resize(size_t(n_bodies_));
+    for (size_t b = 0; b < r.closure_dc.size() && b < mw.bodies.size(); ++b) {
+      mw.bodies[b].dc = r.closure_dc[b], mw.bodies[b].dc_fresh = r.closure_dc_fresh[b] != 0;
+    }
     return true;
   }
 
@@ -395,6 +401,11 @@ class DynamicRun {
       r.kept_M.push_back(m.M_frame), r.kept_C.push_back(m.C_frame), r.kept_K.push_back(m.K_frame);
       r.kept_age.push_back(m.age);
     }
+    r.closure_dc.clear(), r.closure_dc_fresh.clear();
+    for (const MidpointBody& m : work_.midpoint.bodies) {
+      r.closure_dc.push_back(m.dc_fresh ? m.dc : Eigen::MatrixXd()), r.closure_dc_fresh.push_back(char(m.dc_fresh));
+    }
+    r.last_step_iterations = work_.midpoint.last_step_iterations;
   }
 
   void CountFactorizations() {

@@ -101,7 +101,7 @@ struct MidpointBody {
   BodyData side;        // the exact inertia: MomentumConfigurationTangent's perturbed data
   InertiaLoadFactors load;
   // The energy closure (midpoint_energy.cpp): the energy at q_n, the mismatch, whether there is a closure this
-  // iteration and whether its derivative dc is this step's; the inertia and elastic forces it closes, its direction per
+  // iteration and whether its derivative dc is current; the inertia and elastic forces it closes, its direction per
   // unit mismatch, the local force at q_n; the end strain's tangent K_end, and scratch.
   double E0 = 0.0, mismatch = 0.0;
   bool closure_on = false, dc_fresh = false;
@@ -123,6 +123,9 @@ struct MidpointWorkspace {
   DynamicState closure_state;
   double L2 = 0.0;
   std::vector<double> gravity_work;  // per body
+  // The last step's Newton iterations (-1: it did not converge): below 4, the energy closures'
+  // derivatives are kept from it into the next step (StartMidpointStep; in a checkpoint).
+  int last_step_iterations = -1;
   // Per unknown: 2 i for the rotation triple of rotation node i, 2 i + 1 for its translation
   // triple, -1 elsewhere (StepColumnMap's blocks).
   std::vector<int> triple_of;

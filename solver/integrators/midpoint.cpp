@@ -475,8 +475,9 @@ const SystemMatrix& MidpointMatrix(const SystemModel& model, const DofMap& dofs,
     const std::vector<MapEntry>& map = work.terms[size_t(b)].map;  // the residual pass's, at q_m
     Eigen::MatrixXd& S_b = mw.bodies[size_t(b)].S_b;
     S_b = k.T.diagonal * r.K + (1.0 / h) * r.C + (k.V.diagonal / h) * r.M;
-    // An energy closure's derivative: computed at a step's first matrix and again after a
-    // correction that contracted the residual less than tenfold (MidpointStep), kept between.
+    // An energy closure's derivative: computed at a step's first matrix (or kept from the last
+    // step where that converged in fewer than 4 iterations) and again after a correction that
+    // contracted the residual less than tenfold (MidpointStep), kept between.
     MidpointBody& m = mw.bodies[size_t(b)];
     if (mw.closes[size_t(b)]) S_b += m.K_end;
     if (m.closure_on) {
@@ -578,7 +579,7 @@ void StartMidpointStep(const SystemModel& model, const DofMap& dofs, const Dynam
       m.p0.noalias() = MapsOf(body, m.d0).Mg * m.w0;
     }
     m.com0 = CenterOfMass(body, m.d0.q, state.config.frames[b]);
-    m.dc_fresh = false;
+    m.dc_fresh = m.dc_fresh && mw.last_step_iterations >= 0 && mw.last_step_iterations < 4;
     if (mw.closes[size_t(b)]) {
       m.E0 = KineticEnergy(body, m.d0, m.w0) + ElasticEnergy(body, m.d0);
       m.Q0 = LocalForce(body, m.d0);
@@ -607,6 +608,7 @@ StepOutcome MidpointStep(const SystemModel& model, const DofMap& dofs, const Dyn
                          BodyThreads& threads, BodyWorkspace& work, DynamicState& next) {
   next = state;  // storage reused: `next` is the caller's, of the same sizes after the first step
   StartMidpointStep(model, dofs, state, work, &threads);
+  work.midpoint.last_step_iterations = -1;
   const Eigen::VectorXd& weights = work.Weights(model, dofs);
   const std::vector<RotationNode>& triples = work.rotation_triples;
   MidpointWorkspace& mw = work.midpoint;
@@ -650,6 +652,7 @@ StepOutcome MidpointStep(const SystemModel& model, const DofMap& dofs, const Dyn
     if (small && out.iterations > 0 &&
         LoopsClosed(model, next.config, tolerance, &work.pass_data, &work.parts.scratch)) {
       out.converged = true;
+      mw.last_step_iterations = out.iterations;
       next.t = t_new;
       // a: the mean acceleration over the step (t_n+1/2); Wdot: extrapolated to t_n+1 from
       // the last two means (the predictor's acceleration; also what the output reports).

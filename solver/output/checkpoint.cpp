@@ -126,6 +126,11 @@ void WriteResume(h5::Writer& w, const DynamicResume& r) {
     w.Matrix(g + "/C", r.kept_C[b]);
     w.Matrix(g + "/K", r.kept_K[b]);
   }
+  w.IntVector("/resume/closure_fresh", std::vector<int>(r.closure_dc_fresh.begin(), r.closure_dc_fresh.end()));
+  w.IntVector("/resume/closure_last_iterations", std::vector<int>{r.last_step_iterations});
+  for (size_t b = 0; b < r.closure_dc.size(); ++b) {
+    if (r.closure_dc_fresh[b]) w.Matrix("/resume/closure_dc_" + std::to_string(b), r.closure_dc[b]);
+  }
 }
 
 }  // namespace
@@ -357,6 +362,20 @@ bool ReadResume(const std::string& directory, const Scene& scene, const std::str
     resume.kept_M.push_back(r.Matrix(g + "/M"));
     resume.kept_C.push_back(r.Matrix(g + "/C"));
     resume.kept_K.push_back(r.Matrix(g + "/K"));
+  }
+  // The midpoint scheme's energy closures (absent from an older checkpoint: computed anew).
+  resume.closure_dc.clear(), resume.closure_dc_fresh.clear(), resume.last_step_iterations = -1;
+  if (r.Exists("/resume/closure_fresh")) {
+    const Eigen::VectorXi fresh = r.IntVector("/resume/closure_fresh");
+    if (fresh.size() != 0 && fresh.size() != n_bodies)
+      throw InputError(r.path() + ": /resume/closure_fresh does not have the model's size");
+    for (long b = 0; b < fresh.size(); ++b) {
+      const std::string name = "/resume/closure_dc_" + std::to_string(b);
+      resume.closure_dc_fresh.push_back(char(fresh[b] != 0 && r.Exists(name)));
+      resume.closure_dc.push_back(resume.closure_dc_fresh.back() ? r.Matrix(name) : Eigen::MatrixXd());
+    }
+    const Eigen::VectorXi last = r.IntVector("/resume/closure_last_iterations");
+    if (last.size() == 1) resume.last_step_iterations = last[0];
   }
   return true;
 }
