@@ -645,7 +645,7 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
                      "bases are not distributed yet): use solver: cholmod, on one process, with method: " +
                      std::string(Name(part.reduction.method)));
   }
-  const FeModel model = BuildFeModel(part, report);
+  FeModel model = BuildFeModel(part, report);  // CraigBamptonReduce holds its K and M as blocks for a while
   const Budget budget = CheckBeforeFactorization(part, model);
   NonlinearModelOf nonlinear(part, model);
   const DerivativeRequest request = ModalDerivativeRequest(part, model, nonlinear);

@@ -24,9 +24,12 @@ constexpr int kLanczosBlock = 8;
 constexpr double kLanczosTolerance = 1e-8;
 
 // Splits A into the blocks named by the partition (-1: boundary position, else interior index).
+// `rest`: A's entries in a boundary row or column (full indices), column by column with rows
+// ascending, for Unpartition.
 struct Blocks {
   SparseMatrix ii, ib;
   Eigen::MatrixXd bb;
+  std::vector<Eigen::Triplet<double>> rest;
 };
 
 Blocks Partition(const SparseMatrix& A, const std::vector<int>& interior_index, const std::vector<int>& boundary_index,
@@ -44,6 +47,7 @@ Blocks Partition(const SparseMatrix& A, const std::vector<int>& interior_index, 
     if (ci >= 0) out.ii.startVec(ci);
     for (SparseMatrix::InnerIterator it(A, col); it; ++it) {
       const int ri = interior_index[it.row()], rb = boundary_index[it.row()];
+      if (ri < 0 || ci < 0) out.rest.emplace_back(int(it.row()), col, it.value());
       if (ri >= 0 && ci >= 0) {
         out.ii.insertBack(ri, ci) = it.value();
       } else if (ri >= 0 && cb >= 0) {
@@ -64,6 +68,32 @@ Blocks Partition(const SparseMatrix& A, const std::vector<int>& interior_index, 
   }
   out.ib.finalize();
   return out;
+}
+
+// The matrix that Partition split, from its interior block and the entries it kept of the rest:
+// the same entries with the same values, column by column with rows ascending, as A was.
+SparseMatrix Unpartition(const Blocks& blocks, const std::vector<int>& interior,
+                         const std::vector<int>& interior_index) {
+  const int n = int(interior_index.size());
+  const std::vector<Eigen::Triplet<double>>& rest = blocks.rest;
+  SparseMatrix A(n, n);
+  A.reserve(blocks.ii.nonZeros() + long(rest.size()));
+  size_t next = 0;
+  for (int col = 0; col < n; ++col) {
+    A.startVec(col);
+    const auto rest_row = [&]() { return next < rest.size() && rest[next].col() == col ? rest[next].row() : n; };
+    if (interior_index[col] >= 0) {
+      for (SparseMatrix::InnerIterator it(blocks.ii, interior_index[col]); it; ++it) {
+        const int row = interior[it.row()];
+        for (; rest_row() < row; ++next) A.insertBack(rest[next].row(), col) = rest[next].value();
+        A.insertBack(row, col) = it.value();
+      }
+    }
+    for (; rest_row() < n; ++next) A.insertBack(rest[next].row(), col) = rest[next].value();
+  }
+  A.finalize();
+  A.makeCompressed();
+  return A;
 }
 
 }  // namespace
@@ -407,11 +437,10 @@ Eigen::MatrixXd FullFields(const FeModel& model, const InterfacePartition& p, co
 // projection (Phi^T K = Lambda Phi^T M); the derivatives are not eigenvectors, and with the M_ii
 // projection the stress they carry was counted twice or lost: a rotating cantilever with the
 // derivatives of its modes' pairs was 21% stiff (beams) to 400% (a TET10 bar) in its bending
-// frequency. The full fields (n x 12).
+// frequency. The loads f = -M A_k given; the full fields (n x 12).
 Eigen::MatrixXd InertiaDisplacements(const FeModel& model, const InterfacePartition& p, const SparseMatrix& K_ii,
                                      const Eigen::MatrixXd& Phi_i, const Eigen::MatrixXd& Theta,
-                                     const Eigen::MatrixXd& inertia_fields, const ConstrainedSolver& solver) {
-  const Eigen::MatrixXd f = -(model.M * inertia_fields);
+                                     const Eigen::MatrixXd& f, const ConstrainedSolver& solver) {
   Eigen::MatrixXd u = HeldResponse(p, f, solver);
   const long m = Phi_i.cols(), d = Theta.cols();
   if (m + d > 0) {
@@ -451,11 +480,38 @@ std::string FactorizationDetail(const FactorizationInfo& f, int n_i) {
          Format(" (numeric %.3g s; ordering %.3g s, ", f.numeric_seconds, f.analyze_seconds) + f.ordering + ")";
 }
 
-}  // namespace
+// The model's K and M held only as their blocks (Partition) while the interior's factor lives:
+// released on construction (when given a model to release them from) and rebuilt from the blocks,
+// the same entries, by Restore or at the end. The peak memory is then lower by K and M.
+class HeldAsBlocks {
+ public:
+  HeldAsBlocks(FeModel* model, const Blocks& K, const Blocks& M, const InterfacePartition& p)
+      : model_(model), K_(K), M_(M), p_(p) {
+    if (!model_) return;
+    // Empty matrices of the same size (n_dofs() is K's).
+    const long n = model_->K.rows();
+    SparseMatrix(n, n).swap(model_->K);
+    SparseMatrix(n, n).swap(model_->M);
+  }
+  ~HeldAsBlocks() { Restore(); }
+  HeldAsBlocks(const HeldAsBlocks&) = delete;
+  HeldAsBlocks& operator=(const HeldAsBlocks&) = delete;
+  void Restore() {
+    if (!model_) return;
+    model_->K = Unpartition(K_, p_.interior, p_.interior_index);
+    model_->M = Unpartition(M_, p_.interior, p_.interior_index);
+    model_ = nullptr;
+  }
 
-CraigBamptonResult CraigBamptonReduce(const FeModel& model, int internal_modes, const ProgressFn& progress,
-                                      long dense_limit, double memory_limit_bytes, const DerivativeRequest* derivatives,
-                                      const Eigen::MatrixXd* inertia_fields, ReductionSolver solver_kind) {
+ private:
+  FeModel* model_;
+  const Blocks &K_, &M_;
+  const InterfacePartition& p_;
+};
+
+CraigBamptonResult Reduce(const FeModel& model, FeModel* release, int internal_modes, const ProgressFn& progress,
+                          long dense_limit, double memory_limit_bytes, const DerivativeRequest* derivatives,
+                          const Eigen::MatrixXd* inertia_fields, ReductionSolver solver_kind) {
   CraigBamptonResult r;
   Stopwatch clock;
   InterfacePartition p;
@@ -465,14 +521,17 @@ CraigBamptonResult CraigBamptonReduce(const FeModel& model, int internal_modes, 
                 std::to_string(p.n_i - p.n_c) + " interior DOFs of the model";
     return r;
   }
-  const Blocks K = Partition(model.K, p.interior_index, p.boundary_index, p.n_i, p.n_b);
-  const Blocks M = Partition(model.M, p.interior_index, p.boundary_index, p.n_i, p.n_b);
+  Blocks K = Partition(model.K, p.interior_index, p.boundary_index, p.n_i, p.n_b);
+  Blocks M = Partition(model.M, p.interior_index, p.boundary_index, p.n_i, p.n_b);
+  const Eigen::MatrixXd inertia_loads =
+      inertia_fields && inertia_fields->cols() > 0 ? Eigen::MatrixXd(-(model.M * *inertia_fields)) : Eigen::MatrixXd();
+  HeldAsBlocks held(release, K, M, p);
 
   // One factorization (METIS ordering, supernodal) of K_ii, or of the augmented F (Augmented).
   clock.Restart();
   SparseMatrix F_augmented;
   if (p.n_b == 0) F_augmented = Augmented(K.ii, p.Wt);
-  const std::unique_ptr<InteriorSolver> factor = MakeInteriorSolver(solver_kind);
+  std::unique_ptr<InteriorSolver> factor = MakeInteriorSolver(solver_kind);
   r.factorization = factor->Factorize(p.n_b == 0 ? F_augmented : K.ii, memory_limit_bytes);
   const double t_factor = clock.Seconds();
   if (r.factorization.too_big) {
@@ -549,18 +608,38 @@ CraigBamptonResult CraigBamptonReduce(const FeModel& model, int internal_modes, 
     }
     clock.Restart();
   }
-  if (inertia_fields && inertia_fields->cols() > 0) {
-    r.inertia_displacements = InertiaDisplacements(model, p, K.ii, Phi_i, Theta, *inertia_fields, solver);
+  if (inertia_loads.cols() > 0) {
+    r.inertia_displacements = InertiaDisplacements(model, p, K.ii, Phi_i, Theta, inertia_loads, solver);
     if (progress) {
       progress("inertia loads", clock.Seconds(),
                Format("%.0f static solves with the interfaces held", double(inertia_fields->cols())));
     }
     clock.Restart();
   }
+  // The factor is no longer needed: freed before K and M are rebuilt, then the blocks.
+  factor.reset();
+  held.Restore();
+  K = Blocks(), M = Blocks();
   Project(model, p, shapes, Theta, r);
   if (progress) progress("projection", clock.Seconds(), Format("%.0f reduced DOFs", int(r.shapes.cols())));
   r.ok = true;
   return r;
+}
+
+}  // namespace
+
+CraigBamptonResult CraigBamptonReduce(const FeModel& model, int internal_modes, const ProgressFn& progress,
+                                      long dense_limit, double memory_limit_bytes, const DerivativeRequest* derivatives,
+                                      const Eigen::MatrixXd* inertia_fields, ReductionSolver solver_kind) {
+  return Reduce(model, nullptr, internal_modes, progress, dense_limit, memory_limit_bytes, derivatives, inertia_fields,
+                solver_kind);
+}
+
+CraigBamptonResult CraigBamptonReduce(FeModel& model, int internal_modes, const ProgressFn& progress, long dense_limit,
+                                      double memory_limit_bytes, const DerivativeRequest* derivatives,
+                                      const Eigen::MatrixXd* inertia_fields, ReductionSolver solver_kind) {
+  return Reduce(model, &model, internal_modes, progress, dense_limit, memory_limit_bytes, derivatives, inertia_fields,
+                solver_kind);
 }
 
 }  // namespace femb

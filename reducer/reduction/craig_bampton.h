@@ -67,6 +67,15 @@ CraigBamptonResult CraigBamptonReduce(const FeModel& model, int internal_modes, 
                                       const DerivativeRequest* derivatives = nullptr,
                                       const Eigen::MatrixXd* inertia_fields = nullptr,
                                       ReductionSolver solver = ReductionSolver::kCholmod);
+/// The same, holding the model's K and M only as the blocks of the interior and interface DOFs
+/// while the interior's factor lives (released from `model` and rebuilt from the blocks, the same
+/// entries, before the projection, also when the reduction fails): the peak memory is lower by
+/// the size of K and M.
+CraigBamptonResult CraigBamptonReduce(FeModel& model, int internal_modes, const ProgressFn& progress,
+                                      long dense_limit = 200, double memory_limit_bytes = 0,
+                                      const DerivativeRequest* derivatives = nullptr,
+                                      const Eigen::MatrixXd* inertia_fields = nullptr,
+                                      ReductionSolver solver = ReductionSolver::kCholmod);
 
 /// The six rigid-body motions (translations, rotations about the part origin) as fields on the
 /// model DOFs, n_dofs x 6.

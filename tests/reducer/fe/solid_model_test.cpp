@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -325,6 +326,43 @@ TEST(SolidModel, SelectionSphereAndBadSelectionsAreNamed) {
   message = test::ThrownMessage(
       [] { test::Reduce(Bar("[{name: a, select: {plane: {point: [0, 0, 0], normal: [0, 0, 0]}}}]", 2)); });
   EXPECT_NE(message.find("normal: must be a nonzero vector"), std::string::npos) << message;
+}
+
+// The reduction that holds the model's K and M only as their blocks while the factor lives (the
+// mutable model's overload) gives the same numbers to the bit as the one that leaves the model
+// alone, and gives K and M back with the same entries: with an RBE2 and an RBE3 interface (the
+// boundary DOFs and the constraint rows), the inertia load cases (their loads taken before K and M
+// are released) and a factor refused under a memory limit (K and M given back on that way out
+// too).
+TEST(SolidModel, ReductionHoldingTheMatricesAsBlocksGivesTheSameNumbers) {
+  const PartSpec part =
+      ParsePart(Bar("[{name: root, group: xmin, coupling: rbe2}, {name: tip, group: xmax, coupling: rbe3}]", 6, 0.05),
+                "test.yaml");
+  const FeModel kept = BuildSolidModel(part);
+  const Eigen::MatrixXd fields = InertiaFields(kept);
+  const CraigBamptonResult a = CraigBamptonReduce(kept, 6, nullptr, 200, 0, nullptr, &fields);
+  ASSERT_TRUE(a.ok) << a.message;
+  FeModel model = kept;
+  const CraigBamptonResult b = CraigBamptonReduce(model, 6, nullptr, 200, 0, nullptr, &fields);
+  ASSERT_TRUE(b.ok) << b.message;
+  const auto same = [](const SparseMatrix& x, const SparseMatrix& y) {
+    return x.rows() == y.rows() && x.nonZeros() == y.nonZeros() && x.isCompressed() && y.isCompressed() &&
+           std::equal(x.outerIndexPtr(), x.outerIndexPtr() + x.outerSize() + 1, y.outerIndexPtr()) &&
+           std::equal(x.innerIndexPtr(), x.innerIndexPtr() + x.nonZeros(), y.innerIndexPtr()) &&
+           std::equal(x.valuePtr(), x.valuePtr() + x.nonZeros(), y.valuePtr());
+  };
+  EXPECT_TRUE(same(model.K, kept.K));
+  EXPECT_TRUE(same(model.M, kept.M));
+  EXPECT_EQ((a.K - b.K).cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_EQ((a.M - b.M).cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_EQ((a.shapes - b.shapes).cwiseAbs().maxCoeff(), 0.0);
+  ASSERT_EQ(b.inertia_displacements.cols(), 12);
+  EXPECT_EQ((a.inertia_displacements - b.inertia_displacements).cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_GT(b.inertia_displacements.cwiseAbs().maxCoeff(), 0.0);
+  const CraigBamptonResult refused = CraigBamptonReduce(model, 6, nullptr, 200, 1.0);
+  EXPECT_TRUE(refused.factorization.too_big);
+  EXPECT_TRUE(same(model.K, kept.K));
+  EXPECT_TRUE(same(model.M, kept.M));
 }
 
 }  // namespace
