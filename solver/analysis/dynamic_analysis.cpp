@@ -366,7 +366,6 @@ class DynamicRun {
       }
     }
     MidpointWorkspace& mw = work_.midpoint;
-    mw.last_step_iterations = r.last_step_iterations;
     if (!r.closure_dc.empty()) mw.bodies.resize(size_t(n_bodies_));
     for (size_t b = 0; b < r.closure_dc.size() && b < mw.bodies.size(); ++b) {
       mw.bodies[b].dc = r.closure_dc[b], mw.bodies[b].dc_fresh = r.closure_dc_fresh[b] != 0;
@@ -405,7 +404,6 @@ class DynamicRun {
     for (const MidpointBody& m : work_.midpoint.bodies) {
       r.closure_dc.push_back(m.dc_fresh ? m.dc : Eigen::MatrixXd()), r.closure_dc_fresh.push_back(char(m.dc_fresh));
     }
-    r.last_step_iterations = work_.midpoint.last_step_iterations;
   }
 
   void CountFactorizations() {

@@ -211,11 +211,10 @@ struct DynamicResume {
   std::vector<Eigen::MatrixXd> kept_M, kept_C, kept_K;
   std::vector<int> kept_age;
   long matrices_computed = 0, matrices_turned = 0;
-  /// The midpoint scheme's energy closures: per body the derivative and whether it is current,
-  /// and the last step's Newton iterations, which decide whether the next step keeps it.
+  /// The midpoint scheme's energy closures: per body the derivative and whether it is current
+  /// (kept from a step that converged in fewer than 4 iterations).
   std::vector<Eigen::MatrixXd> closure_dc;
   std::vector<char> closure_dc_fresh;
-  int last_step_iterations = -1;
 };
 
 /// Initial state: configuration and velocities given; accelerations from M_g wdot = f_ext -

@@ -123,9 +123,6 @@ struct MidpointWorkspace {
   DynamicState closure_state;
   double L2 = 0.0;
   std::vector<double> gravity_work;  // per body
-  // The last step's Newton iterations (-1: it did not converge): below 4, the energy closures'
-  // derivatives are kept from it into the next step (StartMidpointStep; in a checkpoint).
-  int last_step_iterations = -1;
   // Per unknown: 2 i for the rotation triple of rotation node i, 2 i + 1 for its translation
   // triple, -1 elsewhere (StepColumnMap's blocks).
   std::vector<int> triple_of;
@@ -133,6 +130,19 @@ struct MidpointWorkspace {
   NodeForces loads;
   Triplets S, loop_mid, loop_end;  // the iteration matrix's triplets
   TripletAssembler S_build;
+};
+
+// Clears the energy closures' derivatives when it goes out of scope, unless `keep` is set: every
+// way out of a step but a fast convergence (failures and exceptions too) leaves them to be
+// computed anew.
+struct ClosureKeeping {
+  MidpointWorkspace& mw;
+  bool keep = false;
+  ~ClosureKeeping() {
+    if (!keep) {
+      for (MidpointBody& m : mw.bodies) m.dc_fresh = false;
+    }
+  }
 };
 
 // A square linear system of the Radau IIA step (its iteration matrix, its error filter): entries

@@ -579,7 +579,6 @@ void StartMidpointStep(const SystemModel& model, const DofMap& dofs, const Dynam
       m.p0.noalias() = MapsOf(body, m.d0).Mg * m.w0;
     }
     m.com0 = CenterOfMass(body, m.d0.q, state.config.frames[b]);
-    m.dc_fresh = m.dc_fresh && mw.last_step_iterations >= 0 && mw.last_step_iterations < 4;
     if (mw.closes[size_t(b)]) {
       m.E0 = KineticEnergy(body, m.d0, m.w0) + ElasticEnergy(body, m.d0);
       m.Q0 = LocalForce(body, m.d0);
@@ -592,6 +591,7 @@ void StartMidpointStep(const SystemModel& model, const DofMap& dofs, const Dynam
 const Assembly& MidpointResidual(const SystemModel& model, const DofMap& dofs, const DynamicState& s0, double h,
                                  DynamicState& s1, BodyWorkspace& work) {
   StartMidpointStep(model, dofs, s0, work, nullptr);
+  for (MidpointBody& m : work.midpoint.bodies) m.dc_fresh = false;  // no step to keep it from
   Midpoint(model, dofs, work.rotation_triples, s0, h, s1, work.midpoint.k);
   AssembleMidpoint(model, dofs, s0, h, s1, work, nullptr, work.assembly);
   return work.assembly;
@@ -608,7 +608,6 @@ StepOutcome MidpointStep(const SystemModel& model, const DofMap& dofs, const Dyn
                          BodyThreads& threads, BodyWorkspace& work, DynamicState& next) {
   next = state;  // storage reused: `next` is the caller's, of the same sizes after the first step
   StartMidpointStep(model, dofs, state, work, &threads);
-  work.midpoint.last_step_iterations = -1;
   const Eigen::VectorXd& weights = work.Weights(model, dofs);
   const std::vector<RotationNode>& triples = work.rotation_triples;
   MidpointWorkspace& mw = work.midpoint;
@@ -625,6 +624,8 @@ StepOutcome MidpointStep(const SystemModel& model, const DofMap& dofs, const Dyn
   int floor_iterations = 0;
   const int n_lambda = dofs.n_multipliers();
   Assembly& a = work.assembly;
+  // The energy closures' derivatives go into the next step if this one converges in < 4 iterations.
+  ClosureKeeping keeping{mw};
   matrix.BeginStep();
   for (; out.iterations < options.max_iterations; ++out.iterations) {
     Midpoint(model, dofs, triples, state, h, next, k);
@@ -652,7 +653,7 @@ StepOutcome MidpointStep(const SystemModel& model, const DofMap& dofs, const Dyn
     if (small && out.iterations > 0 &&
         LoopsClosed(model, next.config, tolerance, &work.pass_data, &work.parts.scratch)) {
       out.converged = true;
-      mw.last_step_iterations = out.iterations;
+      keeping.keep = out.iterations < 4;
       next.t = t_new;
       // a: the mean acceleration over the step (t_n+1/2); Wdot: extrapolated to t_n+1 from
       // the last two means (the predictor's acceleration; also what the output reports).

@@ -127,7 +127,6 @@ void WriteResume(h5::Writer& w, const DynamicResume& r) {
     w.Matrix(g + "/K", r.kept_K[b]);
   }
   w.IntVector("/resume/closure_fresh", std::vector<int>(r.closure_dc_fresh.begin(), r.closure_dc_fresh.end()));
-  w.IntVector("/resume/closure_last_iterations", std::vector<int>{r.last_step_iterations});
   for (size_t b = 0; b < r.closure_dc.size(); ++b) {
     if (r.closure_dc_fresh[b]) w.Matrix("/resume/closure_dc_" + std::to_string(b), r.closure_dc[b]);
   }
@@ -364,7 +363,7 @@ bool ReadResume(const std::string& directory, const Scene& scene, const std::str
     resume.kept_K.push_back(r.Matrix(g + "/K"));
   }
   // The midpoint scheme's energy closures (absent from an older checkpoint: computed anew).
-  resume.closure_dc.clear(), resume.closure_dc_fresh.clear(), resume.last_step_iterations = -1;
+  resume.closure_dc.clear(), resume.closure_dc_fresh.clear();
   if (r.Exists("/resume/closure_fresh")) {
     const Eigen::VectorXi fresh = r.IntVector("/resume/closure_fresh");
     if (fresh.size() != 0 && fresh.size() != n_bodies)
@@ -374,8 +373,14 @@ bool ReadResume(const std::string& directory, const Scene& scene, const std::str
       resume.closure_dc_fresh.push_back(char(fresh[b] != 0 && r.Exists(name)));
       resume.closure_dc.push_back(resume.closure_dc_fresh.back() ? r.Matrix(name) : Eigen::MatrixXd());
     }
-    const Eigen::VectorXi last = r.IntVector("/resume/closure_last_iterations");
-    if (last.size() == 1) resume.last_step_iterations = last[0];
+    // Written with the last step's iteration count, the flags are from before the next step's
+    // start decided on them: 4 or more (or -1, not converged) drops the derivatives.
+    if (r.Exists("/resume/closure_last_iterations")) {
+      const Eigen::VectorXi last = r.IntVector("/resume/closure_last_iterations");
+      if (last.size() != 1 || last[0] < 0 || last[0] >= 4) {
+        for (char& fresh_b : resume.closure_dc_fresh) fresh_b = 0;
+      }
+    }
   }
   return true;
 }
