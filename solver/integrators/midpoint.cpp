@@ -645,8 +645,8 @@ StepOutcome MidpointStep(const SystemModel& model, const DofMap& dofs, const Dyn
     // residual is mostly the noise of the elastic forces, but the rest of Newton's error moves
     // the momenta each step, much the same way each step where Newton converges linearly:
     // stopping as soon as the floor was reached let the free spinning bar's angular momentum
-    // drift 1.9e-11 in 2 000 steps, where going on gives about 1e-12 (1e-10 in 100 000 steps, the
-    // round-off of the absolute positions: docs/theory/integrators.md).
+    // drift 1.9e-11 in 2 000 steps, where going on gives about 1e-12 (1e-10 in 100 000 steps:
+    // docs/theory/integrators.md).
     floor_iterations += r_norm <= a.roundoff;
     const bool small = ScaledFreeNorm(dofs, a.residual, weights, a.dof_scale) <= tolerance ||
                        (r_norm <= a.roundoff && (r_norm > 0.25 * last_norm || floor_iterations > 2));

@@ -303,9 +303,9 @@ TEST(SpinningPart, ImportedStiffeningRefusesAMissingOrWrongMaterial) {
 // kept to round-off with either inertia, the energy through the body's energy closure
 // (solver/integrators/midpoint_energy.cpp; without it the energy's error was bounded, 2.5e-6
 // exact and 1.0e-4 corotational over 20 periods). Measured at tolerance 1e-12 over 20 periods:
-// energy 2.3e-13 exact, 1.2e-13 corotational, angular momentum 9.5e-13 and 6.2e-13; over 1 000
-// periods energy 1.6e-12 and 1.1e-12, angular momentum 3.5e-11 and 9.7e-11, a drift of its
-// direction nearly linear in time (1.1e-10 exact at 100.37 steps per period; docs/theory/
+// energy 2.3e-13 exact, 1.4e-13 corotational, angular momentum 1.3e-12 and 1.1e-12; over 1 000
+// periods energy 3.0e-12 and 1.9e-12, angular momentum 1.0e-10 and 7.6e-11, a drift of its
+// direction that scatters by 2x with round-off-level changes of the step (docs/theory/
 // integrators.md). The momentum bound guards Newton's test at the round-off of the positions
 // (RoundOffForce; the tolerance asks for less than that floor here): stopping as soon as the floor
 // was reached let the momentum drift 1.9e-11 in 20 periods, and a floor taken from the stiffest
