@@ -310,10 +310,17 @@ InterfaceNodes ResolveInterfaceNodes(const PartSpec& part, const Eigen::MatrixXd
   return out;
 }
 
-Eigen::MatrixXd Rbe3Weights(const Eigen::MatrixXd& nodes, const std::vector<int>& set, const Eigen::Vector3d& point,
-                            const std::string& where, const std::string& name) {
+namespace {
+
+// A node set's centroid c and the matrix A = sum (|r_i|^2 1 - r_i r_i^T), r_i = x_i - c (the
+// set's polar moment about c); throws unless the set has at least 3 nodes not on one line: a
+// coupling on fewer leaves the rotation about their line (or point) free, with no stiffness (a
+// rigid coupling: the interface's rotation and the part's turn about it; K_ii singular) or
+// undetermined (a distributing one).
+Eigen::Matrix3d CheckedPolarMoment(const Eigen::MatrixXd& nodes, const std::vector<int>& set, const char* coupling,
+                                   const std::string& where, const std::string& name, Eigen::Vector3d& c) {
   const int ns = int(set.size());
-  Eigen::Vector3d c = Eigen::Vector3d::Zero();
+  c.setZero();
   for (int node : set) c += nodes.row(node).transpose();
   c /= std::max(ns, 1);
   Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
@@ -322,8 +329,21 @@ Eigen::MatrixXd Rbe3Weights(const Eigen::MatrixXd& nodes, const std::vector<int>
     A += r.squaredNorm() * Eigen::Matrix3d::Identity() - r * r.transpose();
   }
   if (ns < 3 || std::abs(A.determinant()) < 1e-12 * std::pow(A.trace(), 3)) {
-    throw InputError(where + ": interface '" + name + "': an RBE3 coupling needs at least 3 nodes not on one line");
+    throw InputError(where + ": interface '" + name + "': an " + coupling + " coupling needs at least 3 nodes not on " +
+                     "one line (it ties " +
+                     (ns == 1 ? std::string("1 node: the rotations about it would be free)")
+                              : std::to_string(ns) + " nodes on one line: the rotation about it would be free)"));
   }
+  return A;
+}
+
+}  // namespace
+
+Eigen::MatrixXd Rbe3Weights(const Eigen::MatrixXd& nodes, const std::vector<int>& set, const Eigen::Vector3d& point,
+                            const std::string& where, const std::string& name) {
+  const int ns = int(set.size());
+  Eigen::Vector3d c;
+  const Eigen::Matrix3d A = CheckedPolarMoment(nodes, set, "RBE3", where, name, c);
   const Eigen::Matrix3d Ainv = A.inverse();
   const Eigen::Vector3d d = point - c;
   Eigen::MatrixXd W = Eigen::MatrixXd::Zero(6, 3 * ns);
@@ -409,6 +429,10 @@ std::vector<Rbe3> Rbe3Couplings(const PartSpec& part, const SolidMesh& mesh, con
                                 const FeModel& model) {
   std::vector<Rbe3> rbe3(part.interfaces.size());
   for (size_t k = 0; k < part.interfaces.size(); ++k) {
+    if (part.interfaces[k].coupling == Coupling::kRbe2) {
+      Eigen::Vector3d c;
+      CheckedPolarMoment(mesh.nodes, sets[k], "RBE2", part.interfaces[k].where, part.interfaces[k].name, c);
+    }
     if (part.interfaces[k].coupling != Coupling::kRbe3) continue;
     const std::vector<int>& set = sets[k];
     Rbe3& r3 = rbe3[k];

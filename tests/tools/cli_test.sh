@@ -162,6 +162,17 @@ solid_error "missing physical group" "interface 'A': node set 'hole' not found i
   "$(solid_part group.yaml 'geometry: {file: two.geo}' '[{name: A, group: hole}]')"
 solid_error "region held by no interface" "is connected to no interface" \
   "$(solid_part island.yaml 'geometry: {file: two.geo}' '[{name: A, group: end}]')"
+# A rigid coupling on the nodes of one edge (or one corner): the part could turn about them, which
+# K_ii does not resist (a factorization may or may not notice: a pivot at round-off).
+cat > "$work/solid/one.geo" <<'GEO'
+SetFactory("OpenCASCADE");
+Box(1) = {0, 0, 0, 0.1, 0.02, 0.02};
+Physical Volume("all") = {1};
+GEO
+solid_error "rigid coupling on one line" "interface 'A': an RBE2 coupling needs at least 3 nodes not on one line (it ties 5 nodes on one line: the rotation about it would be free)" \
+  "$(solid_part edge.yaml 'geometry: {file: one.geo}' '[{name: A, select: {box: {min: [-0.001, -0.001, -0.001], max: [0.001, 0.021, 0.001]}}}]')"
+solid_error "rigid coupling on one node" "interface 'B': an RBE2 coupling needs at least 3 nodes not on one line (it ties 1 node: the rotations about it would be free)" \
+  "$(solid_part corner.yaml 'geometry: {file: one.geo}' '[{name: A, select: {plane: {point: [0, 0, 0], normal: [1, 0, 0]}}}, {name: B, select: {sphere: {center: [0.1, 0.02, 0.02], radius: 1.0e-6}}}]')"
 solid_error "mixed units" "it looks like mm-t-s or mm-kg-ms (mixed units?)" \
   "$(solid_part mm.yaml 'geometry: {shape: box, size: [1000, 50, 50]}' '[{name: A, group: xmin}]')"
 printf '*NODE\n1, 0, 0, 0\n2, 1, 0, 0\n3, 0, 1, 0\n4, 0, 0, 1\n*ELEMENT, TYPE=C3D4\n1, 1, 2, 3, 4\n*NSET, NSET=A\n1, 2, 3\n' > "$work/solid/tet.inp"

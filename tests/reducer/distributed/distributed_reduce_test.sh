@@ -2,11 +2,12 @@
 # femb-reduce on MPI ranks (reduction.solver: petsc: MUMPS' distributed Cholesky and SLEPc's
 # Krylov-Schur) against the CHOLMOD path on the same part: the solid crank (TET10, 16 293 DOFs,
 # 12 fixed-interface modes) with an RBE3 and an RBE2 bore, with two RBE2 bores, with two RBE3
-# bores, and with the modal derivatives of 4 modes; np 1 and np 2 files equal to CHOLMOD's (frequencies 1e-9,
-# reduced K and M 1e-8 relative, compare_superelements.py) and femb-inspect's checks passing. Then
-# the faults: one rank's geometry unreadable, a rank killed during the run, the factor over the
-# per-rank memory limit, a distributed reduction of a basis that is not distributed: one line (or
-# mpirun's own report of the killed rank), a non-zero exit in bounded time, no file.
+# bores, and with the modal derivatives of 4 modes; np 1 and np 2 files equal to CHOLMOD's
+# (frequencies 1e-9, reduced K and M 1e-8 relative, compare_superelements.py) and femb-inspect's
+# checks passing. Then the faults: one rank's geometry unreadable, a rank killed during the run,
+# the factor over the per-rank memory limit, a distributed reduction of a basis that is not
+# distributed, a part with a free motion: one line (or mpirun's own report of the killed rank), a
+# non-zero exit in bounded time, no file.
 # Usage: distributed_reduce_test.sh BIN_DIR SOURCE_DIR
 set -u
 bin=$1
@@ -74,6 +75,41 @@ expect_failure "factor over the per-rank limit" 4 "MUMPS' factorization of K_ii 
   $mpi -np 2 "$bin/femb-reduce" "$work/mixed.yaml" -q -o "$work/failed.h5" --set reduction.memory_limit_gb=0.02
 expect_failure "petsc with a free-interface basis" 2 "reduction.solver: petsc reduces by craig_bampton only" \
   $mpi -np 2 "$bin/femb-reduce" "$work/mixed.yaml" -q -o "$work/failed.h5" --set reduction.method=free_interface
+
+# A part with a free motion: a second block that no interface holds (K_ii singular), named on
+# every rank as on one process.
+cat > "$work/loose.geo" <<EOT
+SetFactory("OpenCASCADE");
+Box(1) = {0, 0, 0, 0.1, 0.02, 0.02};
+Box(2) = {0.2, 0, 0, 0.05, 0.02, 0.02};
+e = 1e-4;
+end() = Surface In BoundingBox{-e, -e, -e, e, 0.02 + e, 0.02 + e};
+Physical Surface("end") = end();
+Physical Volume("blocks") = {1, 2};
+EOT
+cat > "$work/loose.yaml" <<EOT
+name: loose
+type: solid
+units: SI
+material: {E: 2.1e11, nu: 0.3, rho: 7850}
+geometry: {file: $work/loose.geo}
+mesh: {size: 0.01, order: 2}
+interfaces:
+  - {name: end, group: end, coupling: rbe2}
+reduction: {internal_modes: 4, full_modes: 0}
+EOT
+expect_failure "a free motion, one process" 2 "is connected to no interface" \
+  "$bin/femb-reduce" "$work/loose.yaml" -q -o "$work/failed.h5"
+expect_failure "a free motion, 2 ranks" 2 "is connected to no interface" \
+  $mpi -np 2 "$bin/femb-reduce" "$work/loose.yaml" -q -o "$work/failed.h5"
+# The first block held by a rigid coupling on one of its edges only: free to turn about it (MUMPS
+# factors such a K_ii without a word, a pivot at round-off), refused before the factorization.
+sed -e '/^Box(2)/d' -e 's/{1, 2}/{1}/' "$work/loose.geo" > "$work/edge.geo"
+sed -e "s#$work/loose.geo#$work/edge.geo#" \
+  -e 's#{name: end, group: end, coupling: rbe2}#{name: end, coupling: rbe2, select: {box: {min: [-0.001, -0.001, -0.001], max: [0.001, 0.021, 0.001]}}}#' \
+  "$work/loose.yaml" > "$work/edge.yaml"
+expect_failure "a rigid coupling on one edge, 2 ranks" 2 "an RBE2 coupling needs at least 3 nodes not on one line" \
+  $mpi -np 2 "$bin/femb-reduce" "$work/edge.yaml" -q -o "$work/failed.h5"
 
 # A rank killed once the reduction runs: mpirun ends the others, non-zero, no file.
 rm -f "$work/failed.h5"
