@@ -96,6 +96,7 @@ struct MidpointBody {
   BodyData d0, dm;                                 // at q_n (once per step) and at q_m
   Eigen::Vector3d com0 = Eigen::Vector3d::Zero();  // the centre of mass at q_n
   Eigen::VectorXd w0, p0, p1, p_mean, wm, w_first, w_second, dw, wdot, s_first, s_second, u, Du;
+  Eigen::VectorXd rigid;  // a rigid velocity of the body's nodes (KeepMomenta)
   Eigen::MatrixXd d_w, d_p;
   Eigen::MatrixXd S_b;  // the body's combined iteration matrix (MidpointMatrix)
   BodyData side;        // the exact inertia: MomentumConfigurationTangent's perturbed data
@@ -130,6 +131,11 @@ struct MidpointWorkspace {
   NodeForces loads;
   Triplets S, loop_mid, loop_end;  // the iteration matrix's triplets
   TripletAssembler S_build;
+  // The free systems (FindFreeSystems, set once for the model): per node its system or -1, per
+  // system its reference node; per system the locked inertia and the leftover's impulse of a step.
+  std::vector<int> system_of, system_origin;
+  std::vector<Eigen::Matrix<double, 6, 6>> locked;
+  std::vector<Eigen::Matrix<double, 6, 1>> leftover;
 };
 
 // Clears the energy closures' derivatives when it goes out of scope, unless `keep` is set: every
@@ -280,6 +286,15 @@ void CloseEnergy(const SuperelementBody& body, double h, BodyData& d1, const Eig
                  Eigen::VectorXd& f_int);
 void EnergyClosureGradient(const SystemModel& model, const DofMap& dofs, const DynamicState& s0, double h,
                            const DynamicState& s1, int b, BodyWorkspace& work);
+// The momenta of each free system kept through Newton's leftover (midpoint_momentum.cpp): which
+// nodes move together under a rigid motion of a system held by nothing (FindFreeSystems, into
+// mw); and, at a converged step whose residual is r, the rigid velocity increment of each such
+// system that gives its momenta the impulse h G_m^T r the leftover withheld and what the bodies'
+// terms hold against their identities at round-off (KeepMomenta: into next's velocities, the
+// node velocities and the passes' body velocities).
+void FindFreeSystems(const SystemModel& model, const DofMap& dofs, MidpointWorkspace& mw);
+void KeepMomenta(const SystemModel& model, const DofMap& dofs, double h, const Eigen::VectorXd& r, BodyWorkspace& work,
+                 DynamicState& next);
 // The midpoint step's kinematics at the end state s1 (sets s1's end velocities), into k; one
 // body's terms of its balance (BodyTerms) into work (midpoint.cpp).
 void Midpoint(const SystemModel& model, const DofMap& dofs, const std::vector<RotationNode>& nodes,

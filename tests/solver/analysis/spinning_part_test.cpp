@@ -302,16 +302,16 @@ TEST(SpinningPart, ImportedStiffeningRefusesAMissingOrWrongMaterial) {
 // axial mode, 2.6 kHz, not resolved: h omega_axial = 5): the angular momentum and the energy are
 // kept to round-off with either inertia, the energy through the body's energy closure
 // (solver/integrators/midpoint_energy.cpp; without it the energy's error was bounded, 2.5e-6
-// exact and 1.0e-4 corotational over 20 periods). Measured at tolerance 1e-12 over 20 periods:
-// energy 2.3e-13 exact, 1.4e-13 corotational, angular momentum 1.3e-12 and 1.1e-12; over 1 000
-// periods energy 3.0e-12 and 1.9e-12, angular momentum 1.0e-10 and 7.6e-11, a drift of its
-// direction that scatters by 2x with round-off-level changes of the step (docs/theory/
-// integrators.md). The momentum bound guards Newton's test at the round-off of the positions
-// (RoundOffForce; the tolerance asks for less than that floor here): stopping as soon as the floor
-// was reached let the momentum drift 1.9e-11 in 20 periods, and a floor taken from the stiffest
-// modal coordinate, 2e4 times the true noise, 8e-10. Newton takes about 7.5 iterations per step
-// with either inertia (the matrix leaves out O(omega h) terms: linear convergence,
-// midpoint_test.cpp), one of them for the round-off.
+// exact and 1.0e-4 corotational over 20 periods), the momenta through what each step gives back
+// of Newton's leftover and of the bodies' forces' round-off (solver/integrators/
+// midpoint_momentum.cpp; without it 1.3e-12 and 1.1e-12 over 20 periods, 1.0e-10 and 7.6e-11 over
+// 1 000). Measured at tolerance 1e-12 over 20 periods: energy 3.4e-14 exact, 2.4e-14
+// corotational, angular momentum 2.2e-14 and 8.0e-15; over 1 000 periods energy 1.7e-12 and
+// 8.8e-13, angular momentum 7.3e-14 and 2.0e-13, no step cut (docs/theory/integrators.md). The
+// tolerance asks for less than the round-off of the positions here (RoundOffForce): the run also
+// guards Newton's test at that floor, where a step stalled at 2.9x the floor was once cut. Newton
+// takes about 7.5 iterations per step with either inertia (the matrix leaves out O(omega h)
+// terms: linear convergence, midpoint_test.cpp), one of them for the round-off.
 TEST(SpinningPart, MidpointConservesMomentumWithTheExactInertia) {
   const Files files;
   const Superelement se = files.Reduce("native.yaml", {"reduction.geometric_stiffening=false"});
