@@ -317,24 +317,27 @@ namespace {
 // coupling on fewer leaves the rotation about their line (or point) free, with no stiffness (a
 // rigid coupling: the interface's rotation and the part's turn about it; K_ii singular) or
 // undetermined (a distributing one).
-Eigen::Matrix3d CheckedPolarMoment(const Eigen::MatrixXd& nodes, const std::vector<int>& set, const char* coupling,
-                                   const std::string& where, const std::string& name, Eigen::Vector3d& c) {
-  const int ns = int(set.size());
-  c.setZero();
-  for (int node : set) c += nodes.row(node).transpose();
-  c /= std::max(ns, 1);
+struct PolarMoment {
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
   Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
+};
+PolarMoment CheckedPolarMoment(const Eigen::MatrixXd& nodes, const std::vector<int>& set, const char* coupling,
+                               const std::string& where, const std::string& name) {
+  const int ns = int(set.size());
+  PolarMoment p;
+  for (int node : set) p.centroid += nodes.row(node).transpose();
+  p.centroid /= std::max(ns, 1);
   for (int node : set) {
-    const Eigen::Vector3d r = nodes.row(node).transpose() - c;
-    A += r.squaredNorm() * Eigen::Matrix3d::Identity() - r * r.transpose();
+    const Eigen::Vector3d r = nodes.row(node).transpose() - p.centroid;
+    p.A += r.squaredNorm() * Eigen::Matrix3d::Identity() - r * r.transpose();
   }
-  if (ns < 3 || std::abs(A.determinant()) < 1e-12 * std::pow(A.trace(), 3)) {
+  if (ns < 3 || std::abs(p.A.determinant()) < 1e-12 * std::pow(p.A.trace(), 3)) {
     throw InputError(where + ": interface '" + name + "': an " + coupling + " coupling needs at least 3 nodes not on " +
                      "one line (it ties " +
                      (ns == 1 ? std::string("1 node: the rotations about it would be free)")
                               : std::to_string(ns) + " nodes on one line: the rotation about it would be free)"));
   }
-  return A;
+  return p;
 }
 
 }  // namespace
@@ -342,9 +345,9 @@ Eigen::Matrix3d CheckedPolarMoment(const Eigen::MatrixXd& nodes, const std::vect
 Eigen::MatrixXd Rbe3Weights(const Eigen::MatrixXd& nodes, const std::vector<int>& set, const Eigen::Vector3d& point,
                             const std::string& where, const std::string& name) {
   const int ns = int(set.size());
-  Eigen::Vector3d c;
-  const Eigen::Matrix3d A = CheckedPolarMoment(nodes, set, "RBE3", where, name, c);
-  const Eigen::Matrix3d Ainv = A.inverse();
+  const PolarMoment p = CheckedPolarMoment(nodes, set, "RBE3", where, name);
+  const Eigen::Matrix3d Ainv = p.A.inverse();
+  const Eigen::Vector3d& c = p.centroid;
   const Eigen::Vector3d d = point - c;
   Eigen::MatrixXd W = Eigen::MatrixXd::Zero(6, 3 * ns);
   for (int a = 0; a < ns; ++a) {
@@ -425,14 +428,22 @@ struct Rbe3 {
   Eigen::MatrixXd W;      // 6 x dofs
 };
 
+// Every RBE2 and RBE3 node set can carry the interface's rotation (CheckedPolarMoment), checked in
+// interface order before either coupling is built (Rbe3Weights checks its set again: imported
+// parts call it too).
+void CheckCouplingSets(const PartSpec& part, const SolidMesh& mesh, const std::vector<std::vector<int>>& sets) {
+  for (size_t k = 0; k < part.interfaces.size(); ++k) {
+    const InterfaceSpec& i = part.interfaces[k];
+    if (i.coupling == Coupling::kRbe2 || i.coupling == Coupling::kRbe3) {
+      CheckedPolarMoment(mesh.nodes, sets[k], i.coupling == Coupling::kRbe2 ? "RBE2" : "RBE3", i.where, i.name);
+    }
+  }
+}
+
 std::vector<Rbe3> Rbe3Couplings(const PartSpec& part, const SolidMesh& mesh, const std::vector<std::vector<int>>& sets,
                                 const FeModel& model) {
   std::vector<Rbe3> rbe3(part.interfaces.size());
   for (size_t k = 0; k < part.interfaces.size(); ++k) {
-    if (part.interfaces[k].coupling == Coupling::kRbe2) {
-      Eigen::Vector3d c;
-      CheckedPolarMoment(mesh.nodes, sets[k], "RBE2", part.interfaces[k].where, part.interfaces[k].name, c);
-    }
     if (part.interfaces[k].coupling != Coupling::kRbe3) continue;
     const std::vector<int>& set = sets[k];
     Rbe3& r3 = rbe3[k];
@@ -565,6 +576,7 @@ FeModel BuildSolidModel(const PartSpec& part, const ProgressFn& progress) {
     model.interface_positions.push_back(interface_nodes.positions[k]);
   }
   model.interface_node_sets = interface_nodes.sets;
+  CheckCouplingSets(part, *mesh, interface_nodes.sets);
   const std::vector<Rbe3> rbe3 = Rbe3Couplings(part, *mesh, interface_nodes.sets, model);
   std::vector<int> kept, rbe2_base;
   const SparseMatrix T = RigidCouplingMap(part, *mesh, interface_nodes.owner, model, kept, rbe2_base);
