@@ -231,7 +231,7 @@ MomentumDrift MidpointMomentumDrift(const TwoTubes& t, double tolerance) {
 // by a spring-damper keep the momenta of the pair at round-off at the loose tolerance 1e-6 as at
 // 1e-12 (measured 1.5e-14 / 1.5e-14; without it the angular momentum drifted 8.0e-6 / 5.9e-10 in
 // the 3 periods, the linear 6.3e-8 / 6.1e-13 kg m/s); a chain on a spherical joint ends with the
-// same angular momentum at 1e-6 as at 1e-12, to 1e-11 (measured 3.3e-14; without, 2.0e-5).
+// same angular momentum at 1e-6 as at 1e-12, to 1e-11 (measured 2.0e-14; without, 2.0e-5).
 TEST(FlexibleDynamics, MidpointKeepsTheMomentaWhateverNewtonsTolerance) {
   const Superelement se = Tube(4);
   const TwoTubes pair = TwoTumblingTubes(se, false), chain = TwoTumblingTubes(se, true);

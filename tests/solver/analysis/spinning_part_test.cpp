@@ -305,13 +305,13 @@ TEST(SpinningPart, ImportedStiffeningRefusesAMissingOrWrongMaterial) {
 // exact and 1.0e-4 corotational over 20 periods), the momenta through what each step gives back
 // of Newton's leftover and of the bodies' forces' round-off (solver/integrators/
 // midpoint_momentum.cpp; without it 1.3e-12 and 1.1e-12 over 20 periods, 1.0e-10 and 7.6e-11 over
-// 1 000). Measured at tolerance 1e-12 over 20 periods: energy 3.4e-14 exact, 2.4e-14
-// corotational, angular momentum 2.2e-14 and 8.0e-15; over 1 000 periods energy 1.7e-12 and
-// 8.8e-13, angular momentum 7.3e-14 and 2.0e-13, no step cut (docs/theory/integrators.md). The
+// 1 000). Measured at tolerance 1e-12 over 20 periods: energy 5.6e-14 exact, 5.6e-14
+// corotational, angular momentum 1.5e-14 and 1.7e-14; over 1 000 periods energy 2.2e-12 and
+// 2.3e-12, angular momentum 1.2e-13 and 6.3e-14, no step cut (docs/theory/integrators.md). The
 // tolerance asks for less than the round-off of the positions here (RoundOffForce): the run also
 // guards Newton's test at that floor, where a step stalled at 2.9x the floor was once cut. Newton
-// takes about 7.5 iterations per step with either inertia (the matrix leaves out O(omega h)
-// terms: linear convergence, midpoint_test.cpp), one of them for the round-off.
+// takes 6.9 and 6.4 iterations per step (the matrix leaves out O(omega h) terms: linear
+// convergence, midpoint_test.cpp).
 TEST(SpinningPart, MidpointConservesMomentumWithTheExactInertia) {
   const Files files;
   const Superelement se = files.Reduce("native.yaml", {"reduction.geometric_stiffening=false"});
