@@ -14,6 +14,7 @@
 #include "reducer/fe/nonlinear_solid.h"
 #include "reducer/fe/solid_model.h"
 #include "reducer/linalg/interior_solver.h"
+#include "reducer/linalg/shared_columns.h"
 #include "reducer/linalg/sparse_cholesky.h"
 #include "reducer/reduction/craig_bampton.h"
 #include "reducer/reduction/floating_frame.h"
@@ -82,17 +83,41 @@ SolidType SolidCellType(CellType cell) {
   throw InputError(std::string("no solid element type '") + Name(cell) + "'");
 }
 
-// The FE model of the part: meshed solids, imported matrices or beams.
-FeModel BuildFeModel(const PartSpec& part, const ProgressFn& report) {
-  if (part.type == PartType::kSolid) return BuildSolidModel(part, report);
-  if (part.type == PartType::kImported) return BuildImportedModel(part, report);
-  Stopwatch clock;
-  FeModel model = BuildBeamModel(part);
-  char detail[200];
-  std::snprintf(detail, sizeof detail, "%ld nodes, %ld %s elements, %ld DOFs", model.n_nodes(), model.n_elements(),
-                model.element_type.c_str(), model.n_dofs());
-  report("mesh+assembly", clock.Seconds(), detail);
+// The FE model of the part: meshed solids, imported matrices or beams. `shared`: on the MPI ranks
+// of a distributed reduction, K and M shared by columns (a solid assembles only its share; the
+// others keep their share of the whole), checked to be one model on every rank.
+FeModel BuildFeModel(const PartSpec& part, const ProgressFn& report, bool shared) {
+  FeModel model;
+  if (part.type == PartType::kSolid) {
+    model = BuildSolidModel(part, report, shared);
+  } else if (part.type == PartType::kImported) {
+    model = BuildImportedModel(part, report);
+  } else {
+    Stopwatch clock;
+    model = BuildBeamModel(part);
+    char detail[200];
+    std::snprintf(detail, sizeof detail, "%ld nodes, %ld %s elements, %ld DOFs", model.n_nodes(), model.n_elements(),
+                  model.element_type.c_str(), model.n_dofs());
+    report("mesh+assembly", clock.Seconds(), detail);
+  }
+  if (!shared) return model;
+  if (model.columns.whole()) {
+    model.columns = ShareOfColumns(model.n_dofs());
+    model.K = KeepColumns(model.K, model.columns);
+    model.M = KeepColumns(model.M, model.columns);
+  }
+  std::vector<double> replicated = {double(model.n_dofs()), double(model.n_nodes()), double(model.n_elements()),
+                                    model.nodes.sum(), double(model.cells.sum())};
+  for (const Eigen::Vector3d& x : model.interface_positions)
+    replicated.insert(replicated.end(), x.data(), x.data() + 3);
+  CheckSameOnRanks(replicated, "models");
   return model;
+}
+
+// The elements this rank takes of the stages that loop over them (stiffening, modal derivatives'
+// forces, stresses): all on one process; on MPI ranks sharing K and M, a share of the cells.
+ColumnShare ElementShare(const FeModel& model) {
+  return model.columns.whole() ? ColumnShare() : ShareOfColumns(model.n_elements());
 }
 
 // What the factorization may use, from the checks that need only the mesh and the mass.
@@ -138,7 +163,8 @@ Budget CheckBeforeFactorization(const PartSpec& part, const FeModel& model) {
 
 // The Green-Lagrange (solids, imported meshes) or von Karman (beams) model of the part, built on
 // first use for the modal derivatives and the geometric stiffening, and the map from the FE
-// model's DOFs to its own (its DOFs = to_model_dofs() x the model's).
+// model's DOFs to its own (its DOFs = to_model_dofs() x the model's). On MPI ranks sharing the
+// model a solid's elements are shared too (ElementShare).
 class NonlinearModelOf {
  public:
   NonlinearModelOf(const PartSpec& part, const FeModel& model)
@@ -146,8 +172,8 @@ class NonlinearModelOf {
   const NonlinearModel& Get() {
     if (nonlinear_) return *nonlinear_;
     if (part_.type == PartType::kSolid || part_.type == PartType::kImported) {
-      nonlinear_ =
-          std::make_unique<SvkSolidMesh>(SolidCellType(model_.cell_type), model_.nodes, model_.cells, part_.material);
+      nonlinear_ = std::make_unique<SvkSolidMesh>(SolidCellType(model_.cell_type), model_.nodes, model_.cells,
+                                                  part_.material, ElementShare(model_));
     } else {
       nonlinear_ = std::make_unique<VonKarmanBeams>(part_);
       to_model_dofs_.resize(model_.n_dofs(), model_.n_dofs());
@@ -244,17 +270,6 @@ std::string TooBigMessage(const Budget& budget, const std::string& message) {
          "MPI ranks (mpirun -np N femb-reduce, reduction.solver: petsc), or run on a machine with more memory";
 }
 
-// The largest K_jj / M_jj over the DOFs with mass: an eigenvalue scale of the model, for the
-// shift of its free-free eigen solves.
-double LargestDiagonalRatio(const FeModel& model) {
-  double max_ratio = 0.0;
-  for (int j = 0; j < model.K.outerSize(); ++j) {
-    const double m_jj = model.M.coeff(j, j);
-    if (m_jj > 0) max_ratio = std::max(max_ratio, model.K.coeff(j, j) / m_jj);
-  }
-  return max_ratio;
-}
-
 // The free-interface basis: the part's lowest free-free modes with the static constraint modes
 // (which carry the interface stiffness exactly). Into V with its description; false with
 // result.message when the eigen solve fails.
@@ -265,7 +280,7 @@ bool FreeInterfaceShapes(const PartSpec& part, const FeModel& model, const Craig
   Eigen::VectorXd free_lambda;
   if (k > 0) {
     const FullModesResult full =
-        FullFreeFreeFrequencies(model, k, 1e-8 * LargestDiagonalRatio(model), &free_modes, &free_lambda);
+        FullFreeFreeFrequencies(model, k, 1e-8 * LargestDiagonalRatio(model.K, model.M), &free_modes, &free_lambda);
     if (!full.ok) {
       result.message = "free-free eigen solve failed: " + full.message;
       return false;
@@ -531,7 +546,7 @@ void Stresses(const PartSpec& part, const FeModel& model, const Eigen::MatrixXd&
   const Visualization& v = *se.visualization;
   auto stresses_of = [&](const Eigen::MatrixXd& fields, bool quadratic) {
     return part.type != PartType::kBeam ? SolidModalStress(SolidCellType(model.cell_type), model.nodes, model.cells,
-                                                           part.material, fields, quadratic)
+                                                           part.material, fields, quadratic, ElementShare(model))
                                         : BeamModalStress(part, fields, quadratic);
   };
   se.stress = stresses_of(v.shapes, se.n_modal_derivatives > 0);
@@ -555,78 +570,6 @@ void Stresses(const PartSpec& part, const FeModel& model, const Eigen::MatrixXd&
   report("stresses", stress_clock.Seconds(), detail);
 }
 
-// The reduced model's free-free frequencies (dense, small) against the full model's: the first
-// and the largest relative error, reported.
-void CompareFreeFree(const Superelement& se, const FullModesResult& full, const ProgressFn& report) {
-  Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> reduced(se.K, se.M, Eigen::EigenvaluesOnly);
-  if (reduced.info() != Eigen::Success) return;
-  double worst = 0.0, first = 0.0;
-  int worst_mode = 0, compared = 0;
-  for (int k = 6; k < full.frequencies_hz.size() && k < reduced.eigenvalues().size(); ++k) {
-    const double f_full = full.frequencies_hz[k], f_reduced = FrequencyHz(reduced.eigenvalues()[k]);
-    if (!(f_full > 0)) continue;
-    const double error = f_reduced / f_full - 1;
-    if (compared++ == 0) first = error;
-    if (std::abs(error) > std::abs(worst)) {
-      worst = error;
-      worst_mode = k - 5;
-    }
-  }
-  if (compared == 0) return;
-  char detail[640];
-  std::snprintf(detail, sizeof detail,
-                "%d flexible free-free frequencies of the reduced model against the full model's: first %+.3g%%, "
-                "largest %+.3g%% (mode %d); more modes in the basis lower it (femb-inspect lists them)",
-                compared, 100 * first, 100 * worst, worst_mode);
-  report("free-free check", 0.0, detail);
-}
-
-// The full model's free-free modes against the reduced model's: how far the basis carries the
-// free body's own vibration (a free bar's first axial mode 0.43% stiff with 20 fixed-interface
-// modes), by default for models up to kFullModesMaxDofs DOFs. false with result.message when
-// the eigen solve the part asked for fails (one it did not ask for is skipped with a line).
-bool FreeFreeCheck(const PartSpec& part, const FeModel& model, const CraigBamptonResult& cb, const ProgressFn& progress,
-                   const ProgressFn& report, Superelement& se, ReduceResult& result) {
-  int full_modes = part.reduction.full_modes;
-  if (!part.reduction.full_modes_given) {
-    full_modes = model.n_dofs() <= ReductionSpec::kFullModesMaxDofs ? std::min(12, se.n_reduced_dofs() - 6) : 0;
-    if (full_modes <= 0 && model.n_dofs() > ReductionSpec::kFullModesMaxDofs && progress) {
-      progress("free-free check", 0.0,
-               "skipped above " + std::to_string(ReductionSpec::kFullModesMaxDofs) +
-                   " DOFs (reduction.full_modes: K or --full-modes K computes K)");
-    }
-  }
-  if (full_modes <= 0) return true;
-  Stopwatch clock;
-  double s = 0.0;
-  if (cb.lambda.size() > 0) {
-    s = 1e-2 * cb.lambda[0];
-  } else {
-    s = 1e-8 * LargestDiagonalRatio(model);
-  }
-  const FullModesResult full = FullFreeFreeFrequencies(model, full_modes, s);
-  if (!full.ok && part.reduction.full_modes_given) {
-    result.message = "full-model free-free eigen solve failed: " + full.message;
-    return false;
-  }
-  if (!full.ok) {
-    report("free-free check", clock.Seconds(),
-           "skipped: the full model's free-free eigen solve failed (" + full.message + ")");
-    return true;
-  }
-  se.full_free_free_frequencies_hz = full.frequencies_hz;
-  std::string rigid;
-  for (const std::string& name : se.full_rigid_couplings) rigid += (rigid.empty() ? "" : ", ") + name;
-  char detail[640];
-  std::snprintf(detail, sizeof detail, "%d free-free frequencies of the full model%s, %ld linear solves",
-                int(full.frequencies_hz.size()),
-                rigid.empty() ? "" : (" with the RBE2 couplings of " + rigid + " (their node sets rigid)").c_str(),
-                full.linear_solves);
-  report("full modes", clock.Seconds(), detail);
-  CompareFreeFree(se, full, report);
-  return true;
-}
-
 }  // namespace
 
 ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
@@ -645,7 +588,8 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
                      "bases are not distributed yet): use solver: cholmod, on one process, with method: " +
                      std::string(Name(part.reduction.method)));
   }
-  FeModel model = BuildFeModel(part, report);  // CraigBamptonReduce holds its K and M as blocks for a while
+  // (CraigBamptonReduce holds its K and M as blocks for a while)
+  FeModel model = BuildFeModel(part, report, solver == ReductionSolver::kPetsc && DistributedRanks() > 1);
   const Budget budget = CheckBeforeFactorization(part, model);
   NonlinearModelOf nonlinear(part, model);
   const DerivativeRequest request = ModalDerivativeRequest(part, model, nonlinear);
@@ -686,7 +630,7 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
       "floating frame " + se.floating_frame.type +
           (budget.keep_mesh ? ", mesh and mode shapes kept" : ", mesh and mode shapes not kept (reduction.keep_mesh)"));
   if (UsesStresses(part, model, budget.keep_mesh)) Stresses(part, model, stress_fields, report, se);
-  if (!FreeFreeCheck(part, model, cb, progress, report, se, result)) return result;
+  if (!FreeFreeCheck(part, model, cb.lambda, progress, report, se, &result.message)) return result;
   result.ok = true;
   return result;
 }

@@ -6,15 +6,57 @@
 
 #include <algorithm>
 #include <cstdlib>
+#include <limits>
 #include <stdexcept>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include "reducer/distributed/petsc_interior.h"
 #include "reducer/linalg/interior_solver.h"
+#include "reducer/linalg/shared_columns.h"
 #include "reducer/linalg/sparse_cholesky.h"
 
 namespace femb {
+namespace {
+
+// The collectives of the ranks sharing the model's columns (shared_columns.h), each after the
+// ranks agreed to start. Large buffers go in pieces below MPI's int counts.
+void SumOverAll(double* data, long count) {
+  EnsureStartAgreed();
+  constexpr long kPiece = 1L << 28;
+  for (long at = 0; at < count; at += kPiece) {
+    MPI_Allreduce(MPI_IN_PLACE, data + at, int(std::min(kPiece, count - at)), MPI_DOUBLE, MPI_SUM, PETSC_COMM_WORLD);
+  }
+}
+
+std::vector<std::string> GatherAll(const std::string& mine) {
+  EnsureStartAgreed();
+  int size = 1;
+  MPI_Comm_size(PETSC_COMM_WORLD, &size);
+  if (mine.size() > size_t(std::numeric_limits<int>::max())) {
+    throw std::runtime_error("a rank's share to gather exceeds 2 GB");
+  }
+  const int bytes = int(mine.size());
+  std::vector<int> counts(static_cast<size_t>(size)), displacements(static_cast<size_t>(size), 0);
+  MPI_Allgather(&bytes, 1, MPI_INT, counts.data(), 1, MPI_INT, PETSC_COMM_WORLD);
+  long total = 0;
+  for (int r = 0; r < size; ++r) {
+    if (total > std::numeric_limits<int>::max()) throw std::runtime_error("the ranks' shares to gather exceed 2 GB");
+    displacements[size_t(r)] = int(total);
+    total += counts[size_t(r)];
+  }
+  if (total > std::numeric_limits<int>::max()) throw std::runtime_error("the ranks' shares to gather exceed 2 GB");
+  std::string all(size_t(total), '\0');
+  MPI_Allgatherv(mine.data(), bytes, MPI_BYTE, all.data(), counts.data(), displacements.data(), MPI_BYTE,
+                 PETSC_COMM_WORLD);
+  std::vector<std::string> out;
+  for (int r = 0; r < size; ++r) out.push_back(all.substr(size_t(displacements[size_t(r)]), size_t(counts[size_t(r)])));
+  return out;
+}
+
+}  // namespace
+
 MpiRanks::MpiRanks() {
   // PETSc's signal handlers would print pages for a SIGINT; its error handler returns the code,
   // which the solver turns into one line (petsc_interior.cpp).
@@ -45,9 +87,11 @@ MpiRanks::MpiRanks() {
     return RankAgreement{all[0], all[1] < size ? all[1] : -1};
   };
   RegisterDistributedSolver([] { return MakePetscInterior(); }, size_, agree, rank_, on_node);
+  if (size_ > 1) RegisterRankCollectives(SumOverAll, GatherAll);
 }
 
 MpiRanks::~MpiRanks() {
+  RegisterRankCollectives(nullptr, nullptr);
   RegisterDistributedSolver(nullptr, 1);
   SlepcFinalize();
 }

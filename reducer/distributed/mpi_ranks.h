@@ -1,7 +1,8 @@
 // femb-reduce on MPI ranks (mpirun -np N femb-reduce PART.yaml): MPI, PETSc and SLEPc started
-// and ended for the process. Every rank runs the same
-// reduction on the same replicated model; the interior's factor and eigen solve are distributed
-// (petsc_interior.h); rank 0 alone prints and writes the file.
+// and ended for the process, the ranks' collectives registered (shared_columns.h). Every rank runs
+// the same reduction on the same mesh, holding its share of the columns of K and M; the interior's
+// factor and eigen solve are distributed (petsc_interior.h); rank 0 alone prints and writes the
+// file.
 #pragma once
 
 #include <utility>

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "reducer/linalg/shared_columns.h"
 #include "reducer/progress.h"
 
 namespace femb {
@@ -23,17 +24,17 @@ void Check(PetscErrorCode code, const char* call) {
 }
 #define FEMB_PETSC(call) Check((call), #call)
 
-// The rows each rank owns of an n-row matrix or vector (PETSc's default split), with every
-// rank's count and first row for gathering.
+// The rows each rank owns of an n-row matrix or vector (the columns it holds of the matrix
+// factored, else PETSc's default split), with every rank's count and first row for gathering.
 struct RowSplit {
   PetscInt n = 0, first = 0, count = 0;
   std::vector<int> counts, firsts;
 };
 
-RowSplit SplitRows(PetscInt n) {
+RowSplit SplitRows(PetscInt n, const ColumnShare& held) {
   RowSplit s;
   s.n = n;
-  PetscInt local = PETSC_DECIDE, global = n;
+  PetscInt local = held.whole() ? PETSC_DECIDE : PetscInt(held.count), global = n;
   FEMB_PETSC(PetscSplitOwnership(PETSC_COMM_WORLD, &local, &global));
   s.count = local;
   int size = 1;
@@ -49,8 +50,8 @@ RowSplit SplitRows(PetscInt n) {
   return s;
 }
 
-// This rank's rows of the replicated symmetric A (both triangles stored, so row j is column j)
-// as a distributed AIJ matrix.
+// This rank's rows of the symmetric A (both triangles stored, so row j is column j; A replicated
+// or shared by columns as `rows` are) as a distributed AIJ matrix.
 Mat DistributedMatrix(const SparseMatrix& A, const RowSplit& rows) {
   std::vector<PetscInt> start(size_t(rows.count) + 1, 0), columns;
   std::vector<PetscScalar> values;
@@ -65,30 +66,6 @@ Mat DistributedMatrix(const SparseMatrix& A, const RowSplit& rows) {
   FEMB_PETSC(MatCreateMPIAIJWithArrays(PETSC_COMM_WORLD, rows.count, rows.count, rows.n, rows.n, start.data(),
                                        columns.data(), values.data(), &M));
   return M;
-}
-
-// Every rank must have built the same model (each builds it itself): the size, the entries'
-// count and two sums agree on all ranks, or the run stops with one line.
-void CheckSameMatrix(const SparseMatrix& A) {
-  double mine[4] = {double(A.rows()), double(A.nonZeros()), 0.0, 0.0};
-  for (int c = 0; c < A.outerSize(); ++c) {
-    for (SparseMatrix::InnerIterator it(A, c); it; ++it) {
-      mine[2] += it.value();
-      mine[3] += std::abs(it.value()) * double(1 + (it.row() + 3 * c) % 7);
-    }
-  }
-  double low[4], high[4];
-  MPI_Allreduce(mine, low, 4, MPI_DOUBLE, MPI_MIN, PETSC_COMM_WORLD);
-  MPI_Allreduce(mine, high, 4, MPI_DOUBLE, MPI_MAX, PETSC_COMM_WORLD);
-  for (int i = 0; i < 4; ++i) {
-    if (low[i] != high[i]) {
-      throw RankFailure(
-          3,
-          "the MPI ranks built different interior matrices (each rank meshes and assembles the part itself; "
-          "a mesher or reader that is not deterministic across processes?)",
-          DistributedRank() == 0);
-    }
-  }
 }
 
 // A replicated n x k block from each rank's rows (column-major, `lda` apart).
@@ -161,14 +138,13 @@ class PetscInterior : public InteriorSolver {
     MatDestroy(&A_);
   }
 
-  FactorizationInfo Factorize(const SparseMatrix& A, double memory_limit_bytes) override {
+  FactorizationInfo Factorize(const SparseMatrix& A, const ColumnShare& held, double memory_limit_bytes) override {
     FactorizationInfo info;
     Stopwatch clock;
-    // The first collective step: a rank that failed before says so here (AgreeOnStart).
-    const RankAgreement start = AgreeOnStart(0);
-    if (start.code != 0) throw RankFailure(start.code, "another rank failed", false);
-    CheckSameMatrix(A);
-    rows_ = SplitRows(PetscInt(A.rows()));
+    // (the first collective step when nothing came before: a rank that failed before says so here)
+    EnsureStartAgreed();
+    rows_ = SplitRows(PetscInt(A.rows()), held);
+    held_ = held;
     A_ = DistributedMatrix(A, rows_);
     factored_ = &A;
     FEMB_PETSC(MatSetOption(A_, MAT_SPD, PETSC_TRUE));
@@ -255,6 +231,7 @@ class PetscInterior : public InteriorSolver {
 
  private:
   RowSplit rows_;
+  ColumnShare held_;  ///< the columns this rank holds of the matrices given
   Mat A_ = nullptr, F_ = nullptr;
   const SparseMatrix* factored_ = nullptr;  ///< the matrix A_ holds (K_ii itself unless augmented)
   long solves_ = 0;
@@ -299,8 +276,8 @@ std::optional<EigenResult> PetscInterior::Eigenpairs(const SparseMatrix& K, cons
   FEMB_PETSC(EPSSetTolerances(eps, tol, 1000));
   Vec start = nullptr, x = nullptr;
   FEMB_PETSC(MatCreateVecs(Kd, &start, &x));
-  const Eigen::VectorXd ones = Eigen::VectorXd::Ones(K.rows());
-  ScatterVector(rows_, solve(Eigen::MatrixXd(M * ones)).col(0), start);
+  const Eigen::MatrixXd ones = Eigen::MatrixXd::Ones(K.rows(), 1);
+  ScatterVector(rows_, solve(SharedTimes(M, ones, held_)).col(0), start);
   FEMB_PETSC(EPSSetInitialSpace(eps, 1, &start));
   FEMB_PETSC(EPSSolve(eps));
   PetscInt converged = 0, iterations = 0;
@@ -316,7 +293,7 @@ std::optional<EigenResult> PetscInterior::Eigenpairs(const SparseMatrix& K, cons
       PetscScalar lambda = 0;
       FEMB_PETSC(EPSGetEigenpair(eps, i, &lambda, nullptr, x, nullptr));
       Eigen::VectorXd v = GatherVector(rows_, x);
-      v /= std::sqrt(v.dot(M * v));
+      v /= std::sqrt(v.dot(SharedTimes(M, v, held_).col(0)));
       r.lambda[i] = lambda;
       r.vectors.col(i) = v;
     }

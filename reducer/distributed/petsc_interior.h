@@ -3,9 +3,10 @@
 // each rank holding its share of the factor), the solves are MUMPS' multi-right-hand-side solves,
 // and the fixed-interface modes come from SLEPc's Krylov-Schur with shift-and-invert at 0 on that
 // same factor (the interfaces' constraints applied in the shift-invert operator, as on one
-// process). K_ii and M_ii are distributed by rows in PETSc's default split; right-hand sides and
-// solutions are replicated on every rank (the reduction's dense blocks are small beside the
-// factor).
+// process). K_ii and M_ii are distributed by rows: each rank gives the columns it holds of them
+// (shared_columns.h; the symmetric matrices' rows), or PETSc's default split of a replicated one;
+// right-hand sides and solutions are replicated on every rank (the reduction's dense blocks are
+// small beside the factor).
 #pragma once
 
 #include <memory>

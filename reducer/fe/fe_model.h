@@ -20,6 +20,16 @@ struct FullDof {
   int value;
 };
 
+/// A contiguous range of a matrix's columns: those one MPI rank holds of a matrix shared by
+/// columns (reducer/linalg/shared_columns.h). count < 0: every column (one process).
+struct ColumnShare {
+  long first = 0;
+  long count = -1;
+  bool whole() const { return count < 0; }
+  long end(long n) const { return whole() ? n : first + count; }
+  bool Holds(long column) const { return whole() || (column >= first && column < first + count); }
+};
+
 struct FeModel {
   int dofs_per_node = 6;  ///< 6 for beams (u, theta); 3 for solids
   Eigen::MatrixXd nodes;  ///< n_nodes x 3, part axes
@@ -27,6 +37,9 @@ struct FeModel {
   CellType cell_type = CellType::kLine2;
   std::string element_type;  ///< e.g. "timoshenko_beam"
   SparseMatrix K, M;         ///< n_dofs x n_dofs, full (both triangles stored)
+  /// The columns of K and M this process holds: all of them, or on the MPI ranks of a distributed
+  /// reduction its share (the other columns are empty; shared_columns.h).
+  ColumnShare columns;
 
   /// Boundary coordinates: 6 per interface, ordered (u_x, u_y, u_z, th_x, th_y, th_z) in part
   /// axes. For beams these are DOFs of interface nodes directly.

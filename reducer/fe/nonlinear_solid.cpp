@@ -8,6 +8,7 @@
 
 #include "formats/skew.h"
 #include "reducer/linalg/dense_products.h"
+#include "reducer/linalg/shared_columns.h"
 
 namespace femb {
 namespace {
@@ -86,19 +87,22 @@ NonlinearElementState SvkSolidElement(SolidType type, const Eigen::MatrixXd& X, 
 }
 
 SvkSolidMesh::SvkSolidMesh(SolidType type, const Eigen::MatrixXd& nodes, const Eigen::MatrixXi& cells,
-                           const MaterialSpec& material)
+                           const MaterialSpec& material, const ColumnShare& held)
     : n_per_cell_(SolidNodeCount(type)),
       n_nodes_(nodes.rows()),
       cells_(cells),
+      held_(held),
+      first_cell_(held.whole() ? 0 : held.first),
+      end_cell_(held.end(cells.rows())),
       D_(IsotropicElasticity(material.E, material.nu)) {
   std::vector<Eigen::Vector3d> points;
   std::vector<double> weights;
   SolidQuadrature(type, &points, &weights);
   points_per_cell_ = int(points.size());
-  dNdX_.reserve(size_t(cells.rows()) * points.size());
+  dNdX_.reserve(size_t(end_cell_ - first_cell_) * points.size());
   dV_.reserve(dNdX_.capacity());
   Eigen::MatrixXd X(n_per_cell_, 3);
-  for (long c = 0; c < cells.rows(); ++c) {
+  for (long c = first_cell_; c < end_cell_; ++c) {
     for (int a = 0; a < n_per_cell_; ++a) X.row(a) = nodes.row(cells(c, a));
     ElementPoints(type, X, c + 1, &dNdX_, &dV_);
   }
@@ -107,10 +111,10 @@ SvkSolidMesh::SvkSolidMesh(SolidType type, const Eigen::MatrixXd& nodes, const E
 template <class Visit>
 void SvkSolidMesh::ForEachPoint(const Eigen::VectorXd& u, Visit visit) const {
   Eigen::VectorXd u_e(3 * n_per_cell_);
-  for (long c = 0; c < cells_.rows(); ++c) {
+  for (long c = first_cell_; c < end_cell_; ++c) {
     for (int a = 0; a < n_per_cell_; ++a) u_e.segment<3>(3 * a) = u.segment<3>(3 * long(cells_(c, a)));
     const Eigen::MatrixXd U = AsRows(u_e);
-    visit(c, U, size_t(c) * points_per_cell_);
+    visit(c, U, size_t(c - first_cell_) * points_per_cell_);
   }
 }
 
@@ -123,7 +127,9 @@ double SvkSolidMesh::Energy(const Eigen::VectorXd& u) const {
     for (int q = 0; q < points_per_cell_; ++q) AddPoint(dNdX_[first + q], dV_[first + q], D_, U, &e, false);
     energy += e.energy;
   });
-  return energy;
+  Eigen::Matrix<double, 1, 1> summed(energy);
+  SumOverRanks(summed, held_);
+  return summed(0, 0);
 }
 
 Eigen::VectorXd SvkSolidMesh::Force(const Eigen::VectorXd& u) const {
@@ -134,10 +140,12 @@ Eigen::VectorXd SvkSolidMesh::Force(const Eigen::VectorXd& u) const {
     for (int q = 0; q < points_per_cell_; ++q) AddPoint(dNdX_[first + q], dV_[first + q], D_, U, &e, false);
     for (int a = 0; a < n_per_cell_; ++a) f.segment<3>(3 * long(cells_(c, a))) += e.force.segment<3>(3 * a);
   });
+  SumOverRanks(f, held_);
   return f;
 }
 
 SparseMatrix SvkSolidMesh::Tangent(const Eigen::VectorXd& u) const {
+  if (first_cell_ != 0 || end_cell_ != cells_.rows()) throw std::logic_error("the tangent of a share of the elements");
   std::vector<Eigen::Triplet<double>> triplets;
   triplets.reserve(size_t(cells_.rows()) * 9 * n_per_cell_ * n_per_cell_);
   NonlinearElementState e;
@@ -214,11 +222,11 @@ Eigen::MatrixXd CompletionProjection(const SvkSolidMesh& solid, const Eigen::Mat
   const Eigen::MatrixXd V = mesh_shapes.rightCols(nv);
   Eigen::MatrixXd element(3 * ne, nv), field_element(3 * ne, nf), U(ne, 3), L(6, nv), Lf(6, nf);
   Eigen::MatrixXd K_vv = Eigen::MatrixXd::Zero(nv, nv), G = Eigen::MatrixXd::Zero(nv, nf);
-  for (long c = 0; c < solid.cells_.rows(); ++c) {
+  for (long c = solid.first_cell_; c < solid.end_cell_; ++c) {
     Gather(V, solid.cells_, c, element);
     Gather(fields, solid.cells_, c, field_element);
     for (int q = 0; q < solid.points_per_cell_; ++q) {
-      const size_t point = size_t(c) * solid.points_per_cell_ + q;
+      const size_t point = size_t(c - solid.first_cell_) * solid.points_per_cell_ + q;
       PointStrains(element, solid.dNdX_[point], U, nullptr, L);
       PointStrains(field_element, solid.dNdX_[point], U, nullptr, Lf);
       const Eigen::MatrixXd DL = solid.D_ * L;
@@ -226,6 +234,8 @@ Eigen::MatrixXd CompletionProjection(const SvkSolidMesh& solid, const Eigen::Mat
       G.noalias() += solid.dV_[point] * DL.transpose() * Lf;
     }
   }
+  SumOverRanks(K_vv, solid.held_);
+  SumOverRanks(G, solid.held_);
   return Eigen::MatrixXd(0.5 * (K_vv + K_vv.transpose())).ldlt().solve(G);
 }
 
@@ -246,12 +256,12 @@ ReducedPolynomial ReduceSvk(const SvkSolidMesh& solid, const Eigen::MatrixXd& me
   std::vector<Eigen::Matrix3d> G(static_cast<size_t>(n));
   Eigen::MatrixXd L(6, n), Q(6, P), Q_plain, U(ne, 3);
   Eigen::MatrixXd element(3 * ne, n), field_element(3 * ne, n_fields);
-  for (long c = 0; c < solid.cells_.rows(); ++c) {
+  for (long c = solid.first_cell_; c < solid.end_cell_; ++c) {
     Gather(mesh_shapes, solid.cells_, c, element);
     Gather(fields, solid.cells_, c, field_element);
     if (n_stress > 0) Gather(*request.stress_fields, solid.cells_, c, stress_element);
     for (int q = 0; q < solid.points_per_cell_; ++q) {
-      const size_t point = size_t(c) * solid.points_per_cell_ + q;
+      const size_t point = size_t(c - solid.first_cell_) * solid.points_per_cell_ + q;
       const Eigen::MatrixXd& g = solid.dNdX_[point];
       PointStrains(element, g, U, &G, L);
       int p = 0;
@@ -272,7 +282,10 @@ ReducedPolynomial ReduceSvk(const SvkSolidMesh& solid, const Eigen::MatrixXd& me
       accumulator.Add(solid.dV_[point], C, L, Q, n_stress > 0 ? &L_stress : nullptr, separate ? &Q_plain : nullptr);
     }
   }
-  return accumulator.Finish();
+  ReducedPolynomial r = accumulator.Finish();
+  for (Eigen::MatrixXd* X : {&r.K, &r.A, &r.B, &r.S})
+    SumOverRanks(*X, solid.held_);  // (the ranks' shares of the elements)
+  return r;
 }
 
 PolynomialAccumulator::PolynomialAccumulator(int n, bool cubic, int n_fields) : cubic_(cubic) {

@@ -92,10 +92,14 @@ class PolynomialAccumulator {
 };
 
 /// A whole mesh (3 DOFs per mesh node, node-major), quadrature data computed once.
+/// The Green-Lagrange model of a solid mesh (3 DOFs per node). On the MPI ranks of a distributed
+/// reduction each rank takes a share of the elements (`held`: a range of the cells; all by
+/// default) and the results are summed over the ranks (shared_columns.h), whole on every rank:
+/// every rank must then make the same calls. The tangent is for one process only.
 class SvkSolidMesh : public NonlinearModel {
  public:
-  SvkSolidMesh(SolidType type, const Eigen::MatrixXd& nodes, const Eigen::MatrixXi& cells,
-               const MaterialSpec& material);
+  SvkSolidMesh(SolidType type, const Eigen::MatrixXd& nodes, const Eigen::MatrixXi& cells, const MaterialSpec& material,
+               const ColumnShare& held = ColumnShare());
   long n_dofs() const override { return 3 * n_nodes_; }
   double Energy(const Eigen::VectorXd& u) const override;
   Eigen::VectorXd Force(const Eigen::VectorXd& u) const override;
@@ -113,9 +117,11 @@ class SvkSolidMesh : public NonlinearModel {
   int n_per_cell_;
   long n_nodes_;
   Eigen::MatrixXi cells_;
+  ColumnShare held_;            ///< the elements held (of the cells' rows)
+  long first_cell_, end_cell_;  ///< [first_cell_, end_cell_)
   Eigen::Matrix<double, 6, 6> D_;
   int points_per_cell_;
-  std::vector<Eigen::MatrixXd> dNdX_;  ///< cell-major, points_per_cell_ per cell
+  std::vector<Eigen::MatrixXd> dNdX_;  ///< cell-major, points_per_cell_ per held cell
   std::vector<double> dV_;
 };
 

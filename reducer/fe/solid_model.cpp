@@ -10,6 +10,8 @@
 #include "formats/skew.h"
 #include "reducer/fe/connectivity.h"
 #include "reducer/fe/solid_element.h"
+#include "reducer/linalg/interior_solver.h"
+#include "reducer/linalg/shared_columns.h"
 #include "reducer/mesh/gmsh_mesher.h"
 #include "reducer/mesh/meshio_import.h"
 #include "reducer/mesh/node_selection.h"
@@ -27,7 +29,8 @@ bool Locate(const SolidMesh& mesh, int e, const Eigen::Vector3d& x, Eigen::Vecto
 // DOF order, so sorting by number sorts the rows), and per neighbour the offset of its rows in
 // the column. Every column of model node P has the same rows: all DOFs of each neighbour Q for K;
 // for M only the like component when P and Q are both free 3-DOF nodes (consistent mass couples
-// like components), all DOFs of Q otherwise.
+// like components), all DOFs of Q otherwise. Only the columns held (a rank's share) have rows: a
+// node none of whose DOFs is held has no neighbours here.
 struct SolidPattern {
   std::vector<long> start;               ///< per model node, its first entry in `adjacent` (n + 1)
   std::vector<int> adjacent;             ///< neighbours, ascending
@@ -39,7 +42,13 @@ struct SolidPattern {
   }
 };
 
-SolidPattern Pattern(const SolidMesh& mesh, const SolidDofMap& map) {
+// Whether this process holds a column of model node P.
+bool HoldsNode(const SolidDofMap& map, const ColumnShare& held, int P) {
+  const long first = map.first_dof[P];
+  return held.whole() || (first < held.first + held.count && first + map.dofs[P] > held.first);
+}
+
+SolidPattern Pattern(const SolidMesh& mesh, const SolidDofMap& map, const ColumnShare& held) {
   const int per = SolidNodeCount(mesh.type);
   const long n_cells = mesh.cells.rows();
   const int n_model_nodes = int(map.first_dof.size());
@@ -47,7 +56,9 @@ SolidPattern Pattern(const SolidMesh& mesh, const SolidDofMap& map) {
   std::vector<std::vector<int>> cells_of(n_model_nodes);
   for (long e = 0; e < n_cells; ++e)
     for (int a = 0; a < per; ++a) {
-      std::vector<int>& c = cells_of[map.model_node[mesh.cells(e, a)]];
+      const int P = map.model_node[mesh.cells(e, a)];
+      if (!HoldsNode(map, held, P)) continue;
+      std::vector<int>& c = cells_of[P];
       if (c.empty() || c.back() != int(e)) c.push_back(int(e));
     }
   std::vector<long>& start = g.start;
@@ -83,9 +94,9 @@ SolidPattern Pattern(const SolidMesh& mesh, const SolidDofMap& map) {
   return g;
 }
 
-// An n x n matrix with the pattern's entries for K (or M with `mass`), zero-filled: built column
-// by column, no triplet list.
-void ShapeMatrix(const SolidDofMap& map, const SolidPattern& g, bool mass, SparseMatrix* A) {
+// An n x n matrix with the pattern's entries for K (or M with `mass`) in the held columns,
+// zero-filled: built column by column, no triplet list.
+void ShapeMatrix(const SolidDofMap& map, const SolidPattern& g, bool mass, const ColumnShare& held, SparseMatrix* A) {
   const long n = map.n_dofs;
   const int n_model_nodes = int(map.first_dof.size());
   const std::vector<long>& start = g.start;
@@ -95,7 +106,9 @@ void ShapeMatrix(const SolidDofMap& map, const SolidPattern& g, bool mass, Spars
   const auto mass_rows = [&](int P, int Q) { return SolidPattern::MassRows(map, P, Q); };
   *A = SparseMatrix(n, n);
   long total = 0;
-  for (int P = 0; P < n_model_nodes; ++P) total += map.dofs[P] * (mass ? length_m[P] : length_k[P]);
+  for (int P = 0; P < n_model_nodes; ++P)
+    for (int d = 0; d < map.dofs[P]; ++d)
+      if (held.Holds(map.first_dof[P] + d)) total += mass ? length_m[P] : length_k[P];
   A->resizeNonZeros(total);
   int* outer = A->outerIndexPtr();
   int* inner = A->innerIndexPtr();
@@ -103,6 +116,7 @@ void ShapeMatrix(const SolidDofMap& map, const SolidPattern& g, bool mass, Spars
   for (int P = 0; P < n_model_nodes; ++P)
     for (int d = 0; d < map.dofs[P]; ++d) {
       outer[map.first_dof[P] + d] = int(p);
+      if (!held.Holds(map.first_dof[P] + d)) continue;
       for (long k = start[P]; k < start[P + 1]; ++k) {
         const int Q = adjacent[k];
         if (mass && mass_rows(P, Q) == 1) {
@@ -119,12 +133,12 @@ void ShapeMatrix(const SolidDofMap& map, const SolidPattern& g, bool mass, Spars
 }  // namespace
 
 void AssembleSolid(const SolidMesh& mesh, const MaterialSpec& material, const SolidDofMap& map, SparseMatrix* K,
-                   SparseMatrix* M) {
+                   SparseMatrix* M, const ColumnShare& held) {
   const int per = SolidNodeCount(mesh.type);
   const long n_cells = mesh.cells.rows();
-  const SolidPattern g = Pattern(mesh, map);
-  ShapeMatrix(map, g, false, K);
-  ShapeMatrix(map, g, true, M);
+  const SolidPattern g = Pattern(mesh, map, held);
+  ShapeMatrix(map, g, false, held, K);
+  ShapeMatrix(map, g, true, held, M);
   const std::vector<long>& start = g.start;
   const std::vector<int>& adjacent = g.adjacent;
   const std::vector<long>& prefix_k = g.prefix_k;
@@ -140,6 +154,11 @@ void AssembleSolid(const SolidMesh& mesh, const MaterialSpec& material, const So
   std::vector<int> a_of;          // uncoupled element: element node of the i-th model node
   Eigen::MatrixXd Te, Ke, Me;
   for (long e = 0; e < n_cells; ++e) {
+    if (!held.whole()) {
+      bool touches = false;
+      for (int a = 0; a < per && !touches; ++a) touches = HoldsNode(map, held, map.model_node[mesh.cells(e, a)]);
+      if (!touches) continue;
+    }
     for (int a = 0; a < per; ++a) X.row(a) = mesh.nodes.row(mesh.cells(e, a));
     const SolidElementMatrices em = ComputeSolidElement(mesh.type, X, material, e);
     nodes.clear();
@@ -177,6 +196,7 @@ void AssembleSolid(const SolidMesh& mesh, const MaterialSpec& material, const So
     // Scatter: column DOF (P, d), row DOF (Q, c).
     for (size_t i = 0; i < nodes.size(); ++i) {
       const int P = nodes[i];
+      if (!HoldsNode(map, held, P)) continue;
       const int* first = adjacent.data() + start[P];
       const int* last = adjacent.data() + start[P + 1];
       for (size_t j = 0; j < nodes.size(); ++j) {
@@ -184,6 +204,7 @@ void AssembleSolid(const SolidMesh& mesh, const MaterialSpec& material, const So
         const long k = start[P] + (std::lower_bound(first, last, Q) - first);
         const bool diagonal_mass = mass_rows(P, Q) == 1;
         for (int d = 0; d < map.dofs[P]; ++d) {
+          if (!held.Holds(map.first_dof[P] + d)) continue;
           // Local column of (P, d) and rows of Q in the element matrices; for an uncoupled
           // element the local numbering is the element's node order, not the sorted one.
           int col_local, row_local;
@@ -556,7 +577,7 @@ void InterfaceCouplings(const PartSpec& part, const std::vector<Rbe3>& rbe3, con
 
 }  // namespace
 
-FeModel BuildSolidModel(const PartSpec& part, const ProgressFn& progress) {
+FeModel BuildSolidModel(const PartSpec& part, const ProgressFn& progress, bool shared) {
   Stopwatch clock;
   auto mesh = std::make_shared<SolidMesh>(MeshSolidPart(part));
   const int n_nodes = int(mesh->nodes.rows());
@@ -590,11 +611,16 @@ FeModel BuildSolidModel(const PartSpec& part, const ProgressFn& progress) {
   // Element matrices straight onto the model DOFs (RBE2 folded in per element).
   clock.Restart();
   const SolidDofMap map = AssemblyMap(part, *mesh, interface_nodes.owner, model, kept, rbe2_base, n_model);
-  AssembleSolid(*mesh, part.material, map, &model.K, &model.M);
+  if (shared) model.columns = ShareOfColumns(n_model);
+  AssembleSolid(*mesh, part.material, map, &model.K, &model.M, model.columns);
   if (progress) {
-    progress(
-        "assembly", clock.Seconds(),
-        std::to_string(mesh->cells.rows()) + " elements, " + std::to_string(model.K.nonZeros()) + " stiffness entries");
+    const std::string entries = std::to_string(model.K.nonZeros()) + " stiffness entries";
+    progress("assembly", clock.Seconds(),
+             std::to_string(mesh->cells.rows()) + " elements, " +
+                 (model.columns.whole()
+                      ? entries
+                      : entries + " in the " + std::to_string(model.columns.count) + " of " + std::to_string(n_model) +
+                            " columns rank " + std::to_string(DistributedRank()) + " holds"));
   }
   InterfaceCouplings(part, rbe3, kept, rbe2_base, n_model, model);
   model.mesh_map = T;

@@ -28,8 +28,10 @@ SolidMesh MeshSolidPart(const PartSpec& part);
 
 /// Throws InputError for a missing or empty node set, node sets that overlap, or an inverted
 /// element (named).
-/// Reports the stages mesh, assembly and couplings through `progress` (may be null).
-FeModel BuildSolidModel(const PartSpec& part, const ProgressFn& progress = nullptr);
+/// Reports the stages mesh, assembly and couplings through `progress` (may be null). `shared`: K
+/// and M only in this MPI rank's share of the columns (FeModel::columns, ShareOfColumns), from the
+/// elements that touch them.
+FeModel BuildSolidModel(const PartSpec& part, const ProgressFn& progress = nullptr, bool shared = false);
 
 /// How mesh node s enters the model: its displacement is T_s q_P, P = model_node[s], whose
 /// model DOFs are first_dof[P] .. first_dof[P] + dofs[P] - 1: 3 for a free node (T_s = 1), 6 for
@@ -46,8 +48,9 @@ struct SolidDofMap {
 /// (T_e^T K_e T_e), assembled into a sparsity pattern computed once from the model-node graph:
 /// K with full node blocks, M with the diagonals only between free nodes (consistent mass
 /// couples like components). No triplet lists and no sparse products: memory is the matrices.
+/// Only the columns `held` get entries (the others are empty), from the elements that touch them.
 void AssembleSolid(const SolidMesh& mesh, const MaterialSpec& material, const SolidDofMap& map, SparseMatrix* K,
-                   SparseMatrix* M);
+                   SparseMatrix* M, const ColumnShare& held = ColumnShare());
 
 /// The area-weighted centroid of the boundary faces whose corners all lie in `set` (the default
 /// interface point: on a bore's axis, where the nodes' mean is not); none when the set has no face.

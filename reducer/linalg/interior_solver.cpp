@@ -1,6 +1,7 @@
 #include "reducer/linalg/interior_solver.h"
 
 #include <cstdlib>
+#include <stdexcept>
 
 #include "formats/input_error.h"
 
@@ -10,7 +11,8 @@ namespace {
 // CHOLMOD's supernodal factor (one process; BLAS threads inside).
 class CholmodInterior : public InteriorSolver {
  public:
-  FactorizationInfo Factorize(const SparseMatrix& A, double memory_limit_bytes) override {
+  FactorizationInfo Factorize(const SparseMatrix& A, const ColumnShare& held, double memory_limit_bytes) override {
+    if (!held.whole()) throw std::logic_error("CHOLMOD factors a whole matrix, not a rank's share of its columns");
     return factor_.Compute(A, memory_limit_bytes);
   }
   Eigen::MatrixXd Solve(const Eigen::MatrixXd& B) override { return factor_.Solve(B); }
@@ -74,6 +76,12 @@ RankAgreement AgreeOnStart(int code) {
 }
 
 bool StartAgreed() { return TheRegistry().agreed; }
+
+void EnsureStartAgreed() {
+  if (StartAgreed()) return;
+  const RankAgreement start = AgreeOnStart(0);
+  if (start.code != 0) throw RankFailure(start.code, "another rank failed", false);
+}
 
 int DistributedRank() { return TheRegistry().rank; }
 

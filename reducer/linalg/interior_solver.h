@@ -3,7 +3,8 @@
 // eigen solver. CHOLMOD (sparse_cholesky.h) on one process is the default; a distributed solver
 // (MUMPS and SLEPc over MPI, reducer/distributed/) is registered by femb-reduce when it runs on
 // MPI ranks. Every rank of a distributed run holds the same replicated right-hand sides and
-// receives the same replicated solutions, so the code that calls these stays serial.
+// receives the same replicated solutions, so the code that calls these stays serial (its products
+// with the matrices, which the ranks share by columns, are summed: shared_columns.h).
 #pragma once
 
 #include <Eigen/Core>
@@ -23,15 +24,17 @@ namespace femb {
 class InteriorSolver {
  public:
   virtual ~InteriorSolver() = default;
-  /// Factorizes the symmetric positive definite A (both triangles stored). With
-  /// `memory_limit_bytes` > 0, refuses (info.too_big) before the numeric factorization when the
-  /// factor (a distributed solver: its largest rank's share) would not fit.
-  virtual FactorizationInfo Factorize(const SparseMatrix& A, double memory_limit_bytes) = 0;
+  /// Factorizes the symmetric positive definite A (both triangles stored) of which this process
+  /// holds the columns `held` (all on one process; a rank's share when A is shared by columns,
+  /// shared_columns.h: only a distributed solver takes a share). With `memory_limit_bytes` > 0,
+  /// refuses (info.too_big) before the numeric factorization when the factor (a distributed
+  /// solver: its largest rank's share) would not fit.
+  virtual FactorizationInfo Factorize(const SparseMatrix& A, const ColumnShare& held, double memory_limit_bytes) = 0;
   /// X = A^-1 B for a block of right-hand sides. Precondition: Factorize succeeded.
   virtual Eigen::MatrixXd Solve(const Eigen::MatrixXd& B) = 0;
   /// Right-hand sides solved so far.
   virtual long solves() const = 0;
-  /// The lowest `nev` eigenpairs of K x = lambda M x on the space the constrained shift-invert
+  /// The lowest `nev` eigenpairs of K x = lambda M x (K and M held as A was) on the space the constrained shift-invert
   /// `solve` maps into (it applies the factor), residual tolerance `tol` relative to the
   /// eigenvalue; empty when this solver has no eigen solver of its own (femb's block Lanczos then
   /// runs on `solve`). `plain`: `solve` is the factor's own solve (no constraints), which the
@@ -85,6 +88,10 @@ int LaunchedRank();
 RankAgreement AgreeOnStart(int code);
 /// True once AgreeOnStart ran (a failure after it is every rank's, or one rank's that ends all).
 bool StartAgreed();
+/// AgreeOnStart(0) unless it ran: the first collective of a distributed run (its solver's first
+/// step, or the first sum over the ranks). Throws RankFailure with the code of a rank that failed
+/// before it.
+void EnsureStartAgreed();
 /// This process's MPI rank (0 on one process).
 int DistributedRank();
 

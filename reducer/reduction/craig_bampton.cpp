@@ -12,6 +12,7 @@
 #include "reducer/linalg/dense_products.h"
 #include "reducer/linalg/generalized_eigen.h"
 #include "reducer/linalg/interior_solver.h"
+#include "reducer/linalg/shared_columns.h"
 
 namespace femb {
 namespace {
@@ -211,7 +212,7 @@ void InertiaInvariants(const FeModel& model, const Eigen::MatrixXd& shapes, std:
   xi->clear();
   std::array<Eigen::MatrixXd, 3> M_turned;
   for (int a = 0; a < 3; ++a) {
-    M_turned[size_t(a)] = model.M * turned[size_t(a)];
+    M_turned[size_t(a)] = SharedTimes(model.M, turned[size_t(a)], model.columns);
     gamma->push_back(TransposeTimes(shapes, M_turned[size_t(a)]));
   }
   const int pairs[6][2] = {{0, 0}, {1, 1}, {2, 2}, {0, 1}, {0, 2}, {1, 2}};
@@ -239,11 +240,14 @@ namespace {
 // The reduced coordinates' kinds: 6 per interface in order, then the modes. A DOF interface's six
 // coordinates are boundary DOFs b; a distributing (RBE3) interface's are constraint rows q = W u
 // on the interior DOFs, W^T (n_i x n_c) sparse: nonzero only on the coupled node sets.
+// `interior_share`: the interior columns this rank holds of K_ii and M_ii (the interior DOFs among
+// the model's columns it holds; all on one process).
 struct InterfacePartition {
   std::vector<int> boundary, boundary_coordinate, constraint_coordinate, interior;
   std::vector<int> interior_index, boundary_index;  ///< per full DOF, -1 elsewhere
   SparseMatrix Wt;
   int n_b = 0, n_i = 0, n_c = 0;
+  ColumnShare interior_share;
 };
 
 // The partition of the model's DOFs by its interfaces; false with *message when an RBE3
@@ -270,6 +274,11 @@ bool PartitionInterfaces(const FeModel& model, InterfacePartition& p, std::strin
   p.boundary_index.assign(size_t(n), -1);
   for (int k = 0; k < p.n_i; ++k) p.interior_index[p.interior[k]] = k;
   for (int k = 0; k < p.n_b; ++k) p.boundary_index[p.boundary[k]] = k;
+  if (!model.columns.whole()) {  // (interior DOFs ascending: the held ones are a range of them)
+    const auto first = std::lower_bound(p.interior.begin(), p.interior.end(), model.columns.first);
+    const auto end = std::lower_bound(p.interior.begin(), p.interior.end(), model.columns.end(n));
+    p.interior_share = {long(first - p.interior.begin()), long(end - first)};
+  }
   p.Wt.resize(p.n_i, p.n_c);
   std::vector<Eigen::Triplet<double>> entries;
   int row = 0;
@@ -296,7 +305,8 @@ bool PartitionInterfaces(const FeModel& model, InterfacePartition& p, std::strin
 // constraint force that the multipliers absorb. So the static modes, the fixed-interface modes and
 // the modal derivatives are those of K_ii exactly, at any scale of the part (no shift, no
 // iteration); a only sets the conditioning: the mean diagonal of K_ii over the DOFs W_1 weights.
-SparseMatrix Augmented(const SparseMatrix& K_ii, const SparseMatrix& Wt) {
+// K_ii shared by columns: the diagonal summed over the ranks, the augmentation in the held columns.
+SparseMatrix Augmented(const SparseMatrix& K_ii, const SparseMatrix& Wt, const ColumnShare& held) {
   const int n_i = int(K_ii.rows());
   Eigen::MatrixXd W1 = Eigen::MatrixXd(Wt.leftCols(6));  // n_i x 6 (dense columns, sparse support)
   for (int c = 0; c < 6; ++c) W1.col(c) /= std::max(W1.col(c).norm(), 1e-300);
@@ -310,9 +320,13 @@ SparseMatrix Augmented(const SparseMatrix& K_ii, const SparseMatrix& Wt) {
     diagonal += K_ii.coeff(j, j);
     ++touched;
   }
+  Eigen::Matrix<double, 1, 1> summed(diagonal);
+  SumOverRanks(summed, held);
+  diagonal = summed(0, 0);
   const double a = touched > 0 ? diagonal / touched : 1.0;
   for (int i : support)
     for (int j : support) {
+      if (!held.Holds(j)) continue;
       const double v = a * W1.row(i).dot(W1.row(j));
       if (v != 0.0) entries.emplace_back(i, j, v);
     }
@@ -353,7 +367,10 @@ class ConstrainedSolver {
 // W x = 0), into Psi_b; a distributing interface's, into Psi_c (UnitConstraintModes).
 void StaticModes(const FeModel& model, const InterfacePartition& p, const SparseMatrix& K_ib,
                  const ConstrainedSolver& solver, Eigen::MatrixXd& Psi_b, Eigen::MatrixXd& Psi_c) {
-  Psi_b = p.n_b > 0 ? Eigen::MatrixXd(-solver.Solve(Eigen::MatrixXd(K_ib))) : Eigen::MatrixXd(p.n_i, 0);
+  // (K_ib summed over the ranks: each holds the boundary columns it holds, exactly)
+  Eigen::MatrixXd K_ib_dense = p.n_b > 0 ? Eigen::MatrixXd(K_ib) : Eigen::MatrixXd(p.n_i, 0);
+  SumOverRanks(K_ib_dense, p.interior_share);
+  Psi_b = p.n_b > 0 ? Eigen::MatrixXd(-solver.Solve(K_ib_dense)) : Eigen::MatrixXd(p.n_i, 0);
   // Rigid motions exactly: mathematically the static modes reproduce them (Psi_b R_b = R_i for
   // the rigid fields R); in floating point only to cond(K_ii) times the round-off of K R = 0,
   // which a thin part (a 0.5 mm leaf: 3e-8) makes visible in Phi_CB Phi_rig0 = 1. A rank-6
@@ -393,6 +410,9 @@ Eigen::MatrixXd ModalDerivatives(const InterfacePartition& p, const SparseMatrix
                                  const Eigen::MatrixXd& shapes, const DerivativeRequest& derivatives,
                                  const ConstrainedSolver& solver, CraigBamptonResult& r) {
   const int m = int(Phi_i.cols());
+  const auto M_ii_times = [&](const Eigen::VectorXd& v) {
+    return Eigen::VectorXd(SharedTimes(M_ii, v, p.interior_share));
+  };
   const Eigen::MatrixXd dK = derivatives.stiffness_derivative(shapes, derivatives.pairs);
   Eigen::MatrixXd z(p.n_i, dK.cols());
   for (int k = 0; k < p.n_i; ++k) z.row(k) = -dK.row(p.interior[k]);
@@ -401,12 +421,12 @@ Eigen::MatrixXd ModalDerivatives(const InterfacePartition& p, const SparseMatrix
   int kept = 0;
   for (long c = 0; c < raw.cols(); ++c) {
     Eigen::VectorXd v = raw.col(c);
-    const double before = std::sqrt(std::max(v.dot(M_ii * v), 0.0));
+    const double before = std::sqrt(std::max(v.dot(M_ii_times(v)), 0.0));
     for (int pass = 0; pass < 2; ++pass) {
-      if (m > 0) v -= Phi_i * (Phi_i.transpose() * (M_ii * v));
-      if (kept > 0) v -= Theta.leftCols(kept) * (Theta.leftCols(kept).transpose() * (M_ii * v));
+      if (m > 0) v -= Phi_i * (Phi_i.transpose() * M_ii_times(v));
+      if (kept > 0) v -= Theta.leftCols(kept) * (Theta.leftCols(kept).transpose() * M_ii_times(v));
     }
-    const double after = std::sqrt(std::max(v.dot(M_ii * v), 0.0));
+    const double after = std::sqrt(std::max(v.dot(M_ii_times(v)), 0.0));
     if (!(before > 0) || after <= derivatives.tolerance * before) continue;
     Theta.col(kept++) = v / after;
     r.derivative_pairs.push_back(derivatives.pairs[size_t(c)]);
@@ -447,8 +467,7 @@ Eigen::MatrixXd InertiaDisplacements(const FeModel& model, const InterfacePartit
     Eigen::MatrixXd V(p.n_i, m + d), f_i(p.n_i, f.cols());
     V << Phi_i, Theta;
     for (int k = 0; k < p.n_i; ++k) f_i.row(k) = f.row(p.interior[k]);
-    const Eigen::MatrixXd KV = K_ii * V;
-    const Eigen::MatrixXd K_r = TransposeTimes(V, KV);
+    const Eigen::MatrixXd K_r = SharedCongruence(V, K_ii, V, p.interior_share);
     u -= V * Eigen::MatrixXd(0.5 * (K_r + K_r.transpose())).ldlt().solve(TransposeTimes(V, f_i));
   }
   return FullFields(model, p, u);
@@ -465,10 +484,8 @@ void Project(const FeModel& model, const InterfacePartition& p, const Eigen::Mat
   r.shapes.leftCols(n_cb) = shapes;
   for (int k = 0; k < p.n_i; ++k)
     if (d > 0) r.shapes.row(p.interior[k]).tail(d) = Theta.row(k);
-  const Eigen::MatrixXd K_shapes = model.K * r.shapes;  // evaluated first: Eigen would nest it lazily
-  r.K = TransposeTimes(r.shapes, K_shapes);
-  const Eigen::MatrixXd M_shapes = model.M * r.shapes;
-  r.M = TransposeTimes(r.shapes, M_shapes);
+  r.K = SharedCongruence(r.shapes, model.K, r.shapes, model.columns);
+  r.M = SharedCongruence(r.shapes, model.M, r.shapes, model.columns);
   r.K = 0.5 * (r.K + r.K.transpose()).eval();
   r.M = 0.5 * (r.M + r.M.transpose()).eval();
 }
@@ -523,16 +540,17 @@ CraigBamptonResult Reduce(const FeModel& model, FeModel* release, int internal_m
   }
   Blocks K = Partition(model.K, p.interior_index, p.boundary_index, p.n_i, p.n_b);
   Blocks M = Partition(model.M, p.interior_index, p.boundary_index, p.n_i, p.n_b);
-  const Eigen::MatrixXd inertia_loads =
-      inertia_fields && inertia_fields->cols() > 0 ? Eigen::MatrixXd(-(model.M * *inertia_fields)) : Eigen::MatrixXd();
+  const Eigen::MatrixXd inertia_loads = inertia_fields && inertia_fields->cols() > 0
+                                            ? Eigen::MatrixXd(-SharedTimes(model.M, *inertia_fields, model.columns))
+                                            : Eigen::MatrixXd();
   HeldAsBlocks held(release, K, M, p);
 
   // One factorization (METIS ordering, supernodal) of K_ii, or of the augmented F (Augmented).
   clock.Restart();
   SparseMatrix F_augmented;
-  if (p.n_b == 0) F_augmented = Augmented(K.ii, p.Wt);
+  if (p.n_b == 0) F_augmented = Augmented(K.ii, p.Wt, p.interior_share);
   std::unique_ptr<InteriorSolver> factor = MakeInteriorSolver(solver_kind);
-  r.factorization = factor->Factorize(p.n_b == 0 ? F_augmented : K.ii, memory_limit_bytes);
+  r.factorization = factor->Factorize(p.n_b == 0 ? F_augmented : K.ii, p.interior_share, memory_limit_bytes);
   const double t_factor = clock.Seconds();
   if (r.factorization.too_big) {
     r.message = r.factorization.message;
@@ -569,10 +587,12 @@ CraigBamptonResult Reduce(const FeModel& model, FeModel* release, int internal_m
   const bool dense = p.n_i <= dense_limit || 2 * nev + 1 > p.n_i - p.n_c;
   std::optional<EigenResult> own =
       dense ? std::nullopt : factor->Eigenpairs(K.ii, M.ii, nev, kLanczosTolerance, constrained_solve, p.n_c == 0);
-  EigenResult eig = dense ? LowestConstrainedEigenpairs(K.ii, M.ii, C, nev, 0.0, solve, dense_limit)
-                    : own ? std::move(*own)
-                          : BlockLanczosEigenpairs(K.ii, M.ii, C, nev, 0.0, constrained_solve, kLanczosBlock,
-                                                   kLanczosTolerance, &passes);
+  EigenResult eig =
+      dense ? LowestConstrainedEigenpairs(GatherColumns(K.ii, p.interior_share), GatherColumns(M.ii, p.interior_share),
+                                          C, nev, 0.0, solve, dense_limit)
+      : own ? std::move(*own)
+            : BlockLanczosEigenpairs(K.ii, M.ii, C, nev, 0.0, constrained_solve, kLanczosBlock, kLanczosTolerance,
+                                     &passes);
   if (!eig.ok) {
     r.message = "fixed-interface eigen solve failed: " + eig.message;
     return r;

@@ -5,6 +5,7 @@
 #include <optional>
 
 #include "formats/input_error.h"
+#include "reducer/linalg/shared_columns.h"
 #include "reducer/reduction/craig_bampton.h"
 
 namespace femb {
@@ -37,7 +38,8 @@ void CheckFloatingFrame(const ReductionSpec& reduction, const FeModel& model) {
   // The centre of mass from the rigid fields R (translations, rotations about the part origin):
   // R^T M R = [m 1, -S~; S~, J], the first moment S = m c from its (translation, rotation) block.
   const Eigen::MatrixXd R = RigidFields(model);
-  const Eigen::MatrixXd M_rig = R.transpose() * (model.M * R);
+  const Eigen::MatrixXd MR = SharedTimes(model.M, R, model.columns);  // (M shared by columns on MPI ranks)
+  const Eigen::MatrixXd M_rig = R.transpose() * MR;
   const double m = M_rig(0, 0);
   if (!(m > 0)) return;  // (a massless model is refused elsewhere, with its own message)
   const Eigen::Vector3d c = Eigen::Vector3d(-M_rig(2, 4), -M_rig(0, 5), -M_rig(1, 3)) / m;

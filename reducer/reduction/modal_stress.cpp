@@ -6,6 +6,7 @@
 
 #include "reducer/fe/beam_model.h"
 #include "reducer/fe/timoshenko_beam.h"
+#include "reducer/linalg/shared_columns.h"
 
 namespace femb {
 namespace {
@@ -97,7 +98,8 @@ std::vector<Fibre> SectionFibres(const BeamSectionSpec& s, const SectionProperti
 }  // namespace
 
 ModalStress SolidModalStress(SolidType type, const Eigen::MatrixXd& nodes, const Eigen::MatrixXi& cells,
-                             const MaterialSpec& material, const Eigen::MatrixXd& mesh_shapes, bool gradients) {
+                             const MaterialSpec& material, const Eigen::MatrixXd& mesh_shapes, bool gradients,
+                             const ColumnShare& held) {
   const long n_nodes = nodes.rows(), m = mesh_shapes.cols();
   const int n = SolidNodeCount(type);
   // Per point the rows projected: the 6 stresses D B u, then (with gradients) the 9 entries of
@@ -107,7 +109,7 @@ ModalStress SolidModalStress(SolidType type, const Eigen::MatrixXd& nodes, const
   Eigen::MatrixXd sum = Eigen::MatrixXd::Zero(rows * n_nodes, m);
   Eigen::VectorXd weight = Eigen::VectorXd::Zero(n_nodes);
   Eigen::MatrixXd X(n, 3), U(3 * n, m), op(rows, 3 * n);
-  for (long e = 0; e < cells.rows(); ++e) {
+  for (long e = held.whole() ? 0 : held.first; e < held.end(cells.rows()); ++e) {
     for (int a = 0; a < n; ++a) {
       X.row(a) = nodes.row(cells(e, a));
       U.middleRows(3 * a, 3) = mesh_shapes.middleRows(3 * long(cells(e, a)), 3);
@@ -138,6 +140,8 @@ ModalStress SolidModalStress(SolidType type, const Eigen::MatrixXd& nodes, const
     }
     for (int a = 0; a < n; ++a) weight[cells(e, a)] += volume;
   }
+  SumOverRanks(sum, held);
+  SumOverRanks(weight, held);
   ModalStress out;
   out.method = "solid_nodal_l2";
   out.points = nodes;

@@ -31,6 +31,7 @@
 
 #include "formats/part_file.h"
 #include "formats/superelement.h"
+#include "reducer/fe/fe_model.h"
 #include "reducer/fe/solid_element.h"
 
 namespace femb {
@@ -40,8 +41,11 @@ namespace femb {
 /// `gradients` (parts with modal derivatives): also each basis vector's displacement gradient at
 /// the nodes, projected the same way, for the quadratic part of the Green-Lagrange strain
 /// (ModalStress::gradients).
+/// On the MPI ranks of a distributed reduction each rank takes the elements `held` (a range of the
+/// cells) and the nodes' sums are added over the ranks: the whole result on every rank.
 ModalStress SolidModalStress(SolidType type, const Eigen::MatrixXd& nodes, const Eigen::MatrixXi& cells,
-                             const MaterialSpec& material, const Eigen::MatrixXd& mesh_shapes, bool gradients = false);
+                             const MaterialSpec& material, const Eigen::MatrixXd& mesh_shapes, bool gradients = false,
+                             const ColumnShare& held = ColumnShare());
 
 /// Modal stresses of a beam part: `shapes` (6 n_nodes x n) on the nodes of BeamElements(part).
 /// `quadratic` (parts with modal derivatives): also the element quadratic forms of the von Karman

@@ -2,7 +2,8 @@
 # femb-reduce on MPI ranks (reduction.solver: petsc: MUMPS' distributed Cholesky and SLEPc's
 # Krylov-Schur) against the CHOLMOD path on the same part: the solid crank (TET10, 16 293 DOFs,
 # 12 fixed-interface modes) with an RBE3 and an RBE2 bore, with two RBE2 bores, with two RBE3
-# bores, and with the modal derivatives of 4 modes; np 1 and np 2 files equal to CHOLMOD's
+# bores, and with the modal derivatives of 4 modes; np 1 and np 2 files equal to CHOLMOD's (on 2
+# ranks K and M shared by columns, the full model's free-free check gathering them)
 # (frequencies 1e-9, reduced K and M 1e-8 relative, compare_superelements.py) and femb-inspect's
 # checks passing. Then the faults: one rank's geometry unreadable, a rank killed during the run,
 # the factor over the per-rank memory limit, a distributed reduction of a basis that is not
@@ -48,6 +49,16 @@ for part in mixed pins seats derivatives; do
   "$bin/femb-inspect" "$work/${part}_np2.h5" --check > "$work/$part.check" && ok ||
     fail "$part: femb-inspect --check: $(cat "$work/$part.check")"
 done
+# The ranks share K and M by columns (each assembles the elements touching its own); the full
+# model's free-free check gathers them: its flexible frequencies equal the one-process run's.
+$mpi -np 2 "$bin/femb-reduce" "$work/mixed.yaml" -o "$work/mixed_full_np2.h5" --set reduction.full_modes=6 \
+  > "$work/mixed_full.log" 2>&1 && ok || fail "full modes on 2 ranks: $(cat "$work/mixed_full.log")"
+grep -q "assembly .* in the 8147 of 16293 columns rank 0 holds" "$work/mixed_full.log" && ok ||
+  fail "np 2: rank 0 does not say it holds half the columns: $(grep assembly "$work/mixed_full.log")"
+"$bin/femb-reduce" "$work/mixed.yaml" -q -o "$work/mixed_full.h5" --set reduction.full_modes=6 && ok ||
+  fail "full modes on one process"
+$compare "$work/mixed_full.h5" "$work/mixed_full_np2.h5" | grep -q "full model's flexible free-free frequencies" &&
+  $compare "$work/mixed_full.h5" "$work/mixed_full_np2.h5" > /dev/null && ok || fail "full modes on 2 ranks differ"
 # Without mpirun, reduction.solver: petsc runs on one rank.
 "$bin/femb-reduce" "$work/mixed.yaml" -q -o "$work/mixed_one.h5" --set reduction.solver=petsc && ok ||
   fail "petsc without mpirun"

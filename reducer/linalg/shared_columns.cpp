@@ -1,0 +1,153 @@
+#include "reducer/linalg/shared_columns.h"
+
+#include <cstring>
+#include <stdexcept>
+
+#include "reducer/linalg/dense_products.h"
+#include "reducer/linalg/interior_solver.h"
+
+namespace femb {
+namespace {
+
+struct Collectives {
+  std::function<void(double*, long)> sum;
+  std::function<std::vector<std::string>(const std::string&)> gather;
+};
+
+Collectives& TheCollectives() {
+  static Collectives collectives;
+  return collectives;
+}
+
+// The bytes of a vector, and back.
+template <typename T>
+void Append(std::string& out, const T* data, size_t count) {
+  out.append(reinterpret_cast<const char*>(data), count * sizeof(T));
+}
+
+template <typename T>
+const char* Take(const char* from, T* data, size_t count) {
+  std::memcpy(data, from, count * sizeof(T));
+  return from + count * sizeof(T);
+}
+
+}  // namespace
+
+ColumnShare ShareOfColumns(long n) {
+  const int ranks = DistributedRanks(), rank = DistributedRank();
+  if (ranks <= 1) return {};
+  const long base = n / ranks, extra = n % ranks;
+  ColumnShare share;
+  share.count = base + (rank < extra ? 1 : 0);
+  share.first = rank * base + std::min<long>(rank, extra);
+  return share;
+}
+
+void RegisterRankCollectives(std::function<void(double*, long)> sum,
+                             std::function<std::vector<std::string>(const std::string&)> gather) {
+  TheCollectives().sum = std::move(sum);
+  TheCollectives().gather = std::move(gather);
+}
+
+void SumOverRanks(Eigen::Ref<Eigen::MatrixXd> X, const ColumnShare& share) {
+  const Collectives& c = TheCollectives();
+  if (share.whole()) return;
+  if (!c.sum) throw std::logic_error("a share of a matrix to sum without the ranks' collectives");
+  if (X.outerStride() == X.rows()) {
+    c.sum(X.data(), long(X.size()));
+  } else {
+    Eigen::MatrixXd copy = X;
+    c.sum(copy.data(), long(copy.size()));
+    X = copy;
+  }
+}
+
+void CheckSameOnRanks(const std::vector<double>& values, const std::string& what) {
+  const Collectives& c = TheCollectives();
+  if (!c.gather) return;
+  const std::string mine(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(double));
+  for (const std::string& theirs : c.gather(mine)) {
+    if (theirs != mine) {
+      throw RankFailure(3,
+                        "the MPI ranks built different " + what +
+                            " (each rank builds the model itself; a mesher or reader that is not deterministic "
+                            "across processes?)",
+                        DistributedRank() == 0);
+    }
+  }
+}
+
+Eigen::MatrixXd SharedTimes(const SparseMatrix& A, const Eigen::MatrixXd& X, const ColumnShare& share) {
+  Eigen::MatrixXd AX = A * X;
+  SumOverRanks(AX, share);
+  return AX;
+}
+
+Eigen::MatrixXd SharedCongruence(const Eigen::MatrixXd& Y, const SparseMatrix& A, const Eigen::MatrixXd& X,
+                                 const ColumnShare& share) {
+  const Eigen::MatrixXd AX = A * X;  // evaluated first: Eigen would nest it lazily
+  Eigen::MatrixXd YAX = TransposeTimes(Y, AX);
+  SumOverRanks(YAX, share);
+  return YAX;
+}
+
+SparseMatrix KeepColumns(const SparseMatrix& A, const ColumnShare& share) {
+  if (share.whole()) return A;
+  const long n = A.cols(), first = share.first, last = share.end(n);
+  SparseMatrix out(A.rows(), n);
+  long entries = 0;
+  for (long c = first; c < last; ++c) entries += A.outerIndexPtr()[c + 1] - A.outerIndexPtr()[c];
+  out.reserve(entries);
+  for (long c = 0; c < n; ++c) {
+    out.startVec(Eigen::Index(c));
+    if (c < first || c >= last) continue;
+    for (SparseMatrix::InnerIterator it(A, Eigen::Index(c)); it; ++it) out.insertBack(it.row(), it.col()) = it.value();
+  }
+  out.finalize();
+  return out;
+}
+
+SparseMatrix GatherColumns(const SparseMatrix& A, const ColumnShare& share) {
+  const Collectives& c = TheCollectives();
+  if (share.whole() || !c.gather) return A;
+  const long n = A.cols(), first = share.first, last = share.end(n);
+  // This rank's columns: first, count, then per column its entries' count, rows and values.
+  std::string mine;
+  const long header[2] = {first, last - first};
+  Append(mine, header, 2);
+  std::vector<int> counts, rows;
+  std::vector<double> values;
+  for (long col = first; col < last; ++col) {
+    counts.push_back(int(A.outerIndexPtr()[col + 1] - A.outerIndexPtr()[col]));
+    for (SparseMatrix::InnerIterator it(A, Eigen::Index(col)); it; ++it) {
+      rows.push_back(int(it.row()));
+      values.push_back(it.value());
+    }
+  }
+  const long entries = long(rows.size());
+  Append(mine, &entries, 1);
+  Append(mine, counts.data(), counts.size());
+  Append(mine, rows.data(), rows.size());
+  Append(mine, values.data(), values.size());
+  const std::vector<std::string> all = c.gather(mine);
+  SparseMatrix out(A.rows(), n);
+  std::vector<Eigen::Triplet<double>> triplets;
+  for (const std::string& bytes : all) {
+    long h[2], k = 0;
+    const char* at = Take(bytes.data(), h, 2);
+    at = Take(at, &k, 1);
+    std::vector<int> col_counts(static_cast<size_t>(h[1])), col_rows(static_cast<size_t>(k));
+    std::vector<double> col_values(static_cast<size_t>(k));
+    at = Take(at, col_counts.data(), col_counts.size());
+    at = Take(at, col_rows.data(), col_rows.size());
+    Take(at, col_values.data(), col_values.size());
+    size_t e = 0;
+    for (long j = 0; j < h[1]; ++j)
+      for (int i = 0; i < col_counts[size_t(j)]; ++i, ++e)
+        triplets.emplace_back(col_rows[e], int(h[0] + j), col_values[e]);
+  }
+  out.setFromTriplets(triplets.begin(), triplets.end());
+  return out;
+}
+
+}  // namespace femb

@@ -1,0 +1,54 @@
+// The model's K and M shared by columns between the MPI ranks of a distributed reduction: each
+// rank holds a contiguous range of the columns (its share; the other columns are empty) and
+// assembles only the elements that touch it, so their memory divides by the number of ranks.
+// Since K and M are symmetric, a rank's columns are also its rows: a product with a replicated
+// block is this rank's part of the whole, and the ranks' parts summed (SumOverRanks) make it.
+// On one process every function here does nothing more than the plain product: the rank
+// collectives are registered by a program that runs on MPI (femb-reduce, mpi_ranks.h).
+#pragma once
+
+#include <Eigen/Core>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "reducer/fe/fe_model.h"
+
+namespace femb {
+
+/// The share of the columns this rank takes of an n-column matrix: n / ranks each, the first
+/// n % ranks one more (PETSc's default split), in rank order. The whole on one process.
+ColumnShare ShareOfColumns(long n);
+
+/// The collectives of the ranks sharing a reduction: `sum` adds the buffers of all ranks in place,
+/// `gather` gives every rank's bytes in rank order. Each first lets the ranks agree to start
+/// (EnsureStartAgreed: it is the ranks' first collective). Unset on one process.
+void RegisterRankCollectives(std::function<void(double*, long)> sum,
+                             std::function<std::vector<std::string>(const std::string&)> gather);
+
+/// X computed from this rank's `share` (of a matrix's columns, of the elements): every rank's X
+/// added into X, in place, the same on every rank. Nothing when the share is the whole (one
+/// process, or a rank that works alone).
+void SumOverRanks(Eigen::Ref<Eigen::MatrixXd> X, const ColumnShare& share);
+
+/// Throws RankFailure (exit 3) unless `values` are the same on every rank: the ranks build the
+/// model each for itself, and what they replicate (sizes, the mesh, the couplings) must agree.
+void CheckSameOnRanks(const std::vector<double>& values, const std::string& what);
+
+/// A X for A of which this rank holds the columns `share`: every rank's part summed, the whole
+/// product on every rank.
+Eigen::MatrixXd SharedTimes(const SparseMatrix& A, const Eigen::MatrixXd& X, const ColumnShare& share);
+
+/// Y^T A X for A held as in SharedTimes (the reduction's projections): each rank's part, summed.
+Eigen::MatrixXd SharedCongruence(const Eigen::MatrixXd& Y, const SparseMatrix& A, const Eigen::MatrixXd& X,
+                                 const ColumnShare& share);
+
+/// A with only the columns of `share` (the others emptied): the share of a matrix built whole.
+SparseMatrix KeepColumns(const SparseMatrix& A, const ColumnShare& share);
+
+/// The whole of A from every rank's columns (`share` this rank's), for the steps that need the
+/// full matrix and are only run on small ones: the dense eigen solve of a small interior, the
+/// full model's free-free check. A itself on one process.
+SparseMatrix GatherColumns(const SparseMatrix& A, const ColumnShare& share);
+
+}  // namespace femb
