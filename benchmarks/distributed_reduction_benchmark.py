@@ -8,7 +8,9 @@ each; at the first size also on 4 ranks, for the file only), and prints what thi
 largest rank and of all ranks, the factor's size and flops (MUMPS' own figures), and how far the
 MPI files are from CHOLMOD's (compare_superelements.py: frequencies, reduced K and M).
 
-At the first size (below 5e5 DOFs) it also compares the files of 4 ranks and of a variant with two RBE3 bores, and
+At the first size (below 5e5 DOFs) it also compares the files of 4 ranks and of a variant with two RBE3 bores,
+times the stages that loop over the elements (geometric stiffening with its inertia load cases, modal stresses on the
+kept mesh: the part's defaults) on one process and on 2 ranks, each rank taking a share of the elements, and
 shows the per-rank memory limit: a limit under which the one-process
 path refuses the part (exit 4) while 2 ranks, each within it, reduce it to the file the one-process
 path writes without a limit. Last, a projection of the factor's size and flops to 1e7 and 3e7 DOFs
@@ -37,7 +39,8 @@ def run(cmd, env=None):
     return subprocess.run(cmd, env=env, capture_output=True, text=True)
 
 
-def part_file(work, msh, extra="", coupling="rbe2", name="part"):
+def part_file(work, msh, extra="", coupling="rbe2", name="part",
+              options="keep_mesh: false, full_modes: 0, geometric_stiffening: false"):
     path = os.path.join(work, f"{name}.yaml")
     with open(path, "w") as f:
         f.write(f"""name: crank_mpi
@@ -48,7 +51,7 @@ geometry: {{file: {msh}}}
 interfaces:
   - {{name: big_bore, group: big_bore, coupling: {coupling}}}
   - {{name: small_bore, group: small_bore, coupling: {coupling}}}
-reduction: {{internal_modes: {MODES}, keep_mesh: false, full_modes: 0, geometric_stiffening: false{extra}}}
+reduction: {{internal_modes: {MODES}, {options}{extra}}}
 """)
     return path
 
@@ -101,6 +104,23 @@ def limit_case(bin_dir, work, part, serial, two):
           f"2 ranks exit {mpi['code']}, against the unlimited one-process file: {cmp.stdout.strip().split(': ', 1)[-1]}")
 
 
+def element_stages(bin_dir, work, msh):
+    """The stages that loop over the elements, with the part's defaults (stiffening, stresses)."""
+    full = part_file(work, msh, name="defaults", options="keep_mesh: true, full_modes: 0")
+    one = reduce(bin_dir, full, os.path.join(work, "defaults_0.h5"), 0)
+    two = reduce(bin_dir, full, os.path.join(work, "defaults_2.h5"), 2)
+    for label, r in (("one process", one), ("2 ranks", two)):
+        if r["code"] != 0:
+            sys.exit(f"defaults on {label} failed: {r['stderr'][-400:]}")
+    c = run(["/usr/bin/python3", COMPARE, os.path.join(work, "defaults_0.h5"), os.path.join(work, "defaults_2.h5")])
+    times = ", ".join(f"{stage} {one['stages'].get(stage, 0.0):.2f} s -> {two['stages'].get(stage, 0.0):.2f} s"
+                      for stage in ("inertia loads", "stiffening", "stresses"))
+    print(f"  with the part's defaults (stiffening, stresses), one process -> 2 ranks: {times}; total "
+          f"{sum(one['stages'].values()):.2f} s -> {sum(two['stages'].values()):.2f} s, peak largest rank "
+          f"{one['largest_gb']:.3f} -> {two['largest_gb']:.3f} GB; 2 ranks against one process: "
+          f"{c.stdout.strip().split(': ', 1)[-1]}{'' if c.returncode == 0 else '  EXCEEDS'}")
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("bin_dir")
@@ -145,12 +165,13 @@ def main():
                   f"{'' if c.returncode == 0 else '  EXCEEDS 1e-9 / 1e-8'}")
         two = figures["MUMPS+SLEPc, np 2"]
         fits.append((n, two["factor_gb"], two["gflop"], two["gflop"] / runs["MUMPS+SLEPc, np 2"]["stages"]["factorize K_ii"]))
-        if index == 0 and n < 5e5:  # 4 ranks hold 4 replicated models: the extra runs at the small size only
+        if index == 0 and n < 5e5:  # (4 ranks on 2 cores: the extra runs at the small size only)
             four = reduce(a.bin_dir, part, os.path.join(work, "np4.h5"), 4)
             c = run(["/usr/bin/python3", COMPARE, os.path.join(work, "cholmod.h5"), os.path.join(work, "np4.h5")])
             print(f"  MUMPS+SLEPc, np 4 (oversubscribed: its times mean nothing here) exit {four['code']}, against "
                   f"CHOLMOD: {c.stdout.strip().split(': ', 1)[-1]}{'' if c.returncode == 0 else '  EXCEEDS 1e-9 / 1e-8'}")
             limit_case(a.bin_dir, work, part, figures["CHOLMOD, 1 process"], two)
+            element_stages(a.bin_dir, work, msh)
             # Both bores distributing (RBE3): the constrained shift-invert, the augmented factor.
             seats = part_file(work, msh, coupling="rbe3", name="seats")
             for ranks in (0, 2, 4):

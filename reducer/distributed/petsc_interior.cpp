@@ -148,51 +148,76 @@ class PetscInterior : public InteriorSolver {
     A_ = DistributedMatrix(A, rows_);
     factored_ = &A;
     FEMB_PETSC(MatSetOption(A_, MAT_SPD, PETSC_TRUE));
+    // MUMPS' workspace is its analysis' estimate plus ICNTL(14) percent; on several ranks its
+    // dynamic scheduling can need more (INFOG(1) -8, -9, -17, -20: an all-RBE3 crank on 4 ranks
+    // failed so in one run of ten at the default 20%), and the factorization then starts again
+    // from the analysis with three times as much (PETSc does not repeat a failed factorization).
+    info.analyze_seconds = clock.Seconds();  // (the distributed matrix, then the analyses)
+    PetscInt status = 0, percent = 20;
+    for (int attempt = 0;; ++attempt, percent *= 3) {
+      MatFactorInfo factor_info;
+      if (!Analyze(percent, memory_limit_bytes, &factor_info, &info)) return info;
+      clock.Restart();
+      FEMB_PETSC(MatCholeskyFactorNumeric(F_, A_, &factor_info));
+      info.numeric_seconds = clock.Seconds();
+      FEMB_PETSC(MatMumpsGetInfog(F_, 1, &status));
+      if (!(status == -8 || status == -9 || status == -17 || status == -20) || attempt == 2) break;
+    }
+    MatFactorError error = MAT_FACTOR_NOERROR;
+    FEMB_PETSC(MatFactorGetError(F_, &error));
+    if (error != MAT_FACTOR_NOERROR || status < 0) {
+      info.message = status == -10 ? std::string("MUMPS found a zero or negative pivot (INFOG(1) = -10)")
+                     : status == -13
+                         ? std::string("MUMPS could not allocate its workspace (INFOG(1) = -13): out of memory")
+                         : Format("MUMPS stopped with INFOG(1) = %.0f", double(status)) +
+                               Format(" (its workspace %.0f%% over the analysis' estimate)", double(percent));
+      info.resource_failure = status != -10;
+      return info;
+    }
+    PetscReal flops = 0;
+    FEMB_PETSC(MatMumpsGetRinfog(F_, 3, &flops));
+    info.flops = flops;
+    PetscInt entries = 0;
+    FEMB_PETSC(MatMumpsGetInfog(F_, 29, &entries));  // the factor's entries
+    info.factor_entries = Count(entries);
+    info.factor_bytes = 8.0 * info.factor_entries;
+    info.ok = true;
+    return info;
+  }
+
+  // MUMPS' analysis of A_ (sequential, METIS' nested dissection) into a new F_ whose workspace
+  // is the estimate plus `percent`; the estimates into `info`. False (info->too_big) when the
+  // largest rank's estimate exceeds the limit (the smallest of the ranks' limits).
+  bool Analyze(PetscInt percent, double memory_limit_bytes, MatFactorInfo* factor_info, FactorizationInfo* info) {
+    Stopwatch clock;
+    MatDestroy(&F_);
     FEMB_PETSC(MatGetFactor(A_, MATSOLVERMUMPS, MAT_FACTOR_CHOLESKY, &F_));
     FEMB_PETSC(MatMumpsSetIcntl(F_, 28, 1));  // sequential analysis ...
     FEMB_PETSC(MatMumpsSetIcntl(F_, 7, 5));   // ... with METIS' nested dissection
-    MatFactorInfo factor_info;
-    FEMB_PETSC(MatFactorInfoInitialize(&factor_info));
-    FEMB_PETSC(MatCholeskyFactorSymbolic(F_, A_, nullptr, &factor_info));
-    info.analyze_seconds = clock.Seconds();
+    FEMB_PETSC(MatMumpsSetIcntl(F_, 14, percent));
+    FEMB_PETSC(MatFactorInfoInitialize(factor_info));
+    FEMB_PETSC(MatCholeskyFactorSymbolic(F_, A_, nullptr, factor_info));
+    info->analyze_seconds += clock.Seconds();
     PetscInt largest_mb = 0, total_mb = 0, entries = 0;
     FEMB_PETSC(MatMumpsGetInfog(F_, 16, &largest_mb));  // estimated memory, largest rank (MB)
     FEMB_PETSC(MatMumpsGetInfog(F_, 17, &total_mb));    // ... all ranks
     FEMB_PETSC(MatMumpsGetInfog(F_, 20, &entries));     // estimated entries of the factor
     int size = 1;
     MPI_Comm_size(PETSC_COMM_WORLD, &size);
-    info.ordering = Format("metis; MUMPS on %.0f ranks, estimated %.3g GB on the largest, %.3g GB in all", size,
-                           double(largest_mb) / 1e3, double(total_mb) / 1e3);
-    info.factor_entries = Count(entries);
-    info.factor_bytes = 8.0 * info.factor_entries;
-    // (each rank's limit may differ, MemAvailable read at another moment: the smallest holds)
+    info->ordering = Format("metis; MUMPS on %.0f ranks, estimated %.3g GB on the largest, %.3g GB in all", size,
+                            double(largest_mb) / 1e3, double(total_mb) / 1e3) +
+                     (percent > 20 ? Format(", workspace +%.0f%%", double(percent)) : "");
+    info->factor_entries = Count(entries);
+    info->factor_bytes = 8.0 * info->factor_entries;
     MPI_Allreduce(MPI_IN_PLACE, &memory_limit_bytes, 1, MPI_DOUBLE, MPI_MIN, PETSC_COMM_WORLD);
     if (memory_limit_bytes > 0 && 1e6 * double(largest_mb) > memory_limit_bytes) {
-      info.too_big = true;
-      info.message = Format("MUMPS' factorization of K_ii needs %.3g GB on its largest rank (%.3g GB in all)",
-                            double(largest_mb) / 1e3, double(total_mb) / 1e3) +
-                     Format(", more than the %.3g GB a rank may use", memory_limit_bytes / 1e9);
-      return info;
+      info->too_big = true;
+      info->message = Format("MUMPS' factorization of K_ii needs %.3g GB on its largest rank (%.3g GB in all)",
+                             double(largest_mb) / 1e3, double(total_mb) / 1e3) +
+                      Format(", more than the %.3g GB a rank may use", memory_limit_bytes / 1e9);
+      return false;
     }
-    clock.Restart();
-    FEMB_PETSC(MatCholeskyFactorNumeric(F_, A_, &factor_info));
-    info.numeric_seconds = clock.Seconds();
-    MatFactorError error = MAT_FACTOR_NOERROR;
-    FEMB_PETSC(MatFactorGetError(F_, &error));
-    PetscInt status = 0;
-    FEMB_PETSC(MatMumpsGetInfog(F_, 1, &status));
-    if (error != MAT_FACTOR_NOERROR || status < 0) {
-      info.message = Format("MUMPS stopped with INFOG(1) = %.0f (not positive definite)", double(status));
-      return info;
-    }
-    PetscReal flops = 0;
-    FEMB_PETSC(MatMumpsGetRinfog(F_, 3, &flops));
-    info.flops = flops;
-    FEMB_PETSC(MatMumpsGetInfog(F_, 29, &entries));  // the factor's entries
-    info.factor_entries = Count(entries);
-    info.factor_bytes = 8.0 * info.factor_entries;
-    info.ok = true;
-    return info;
+    return true;
   }
 
   Eigen::MatrixXd Solve(const Eigen::MatrixXd& B) override {

@@ -14,14 +14,15 @@ namespace femb {
 /// Outcome of a factorization: a status the caller must look at.
 struct FactorizationInfo {
   bool ok = false;
-  std::string message;         ///< why it failed (not positive definite at column k, ...)
-  double factor_entries = 0;   ///< nonzeros stored in L
-  double factor_bytes = 0;     ///< memory of L
-  double flops = 0;            ///< floating-point operations of the numeric factorization
-  double analyze_seconds = 0;  ///< ordering and symbolic factorization
-  double numeric_seconds = 0;  ///< numeric factorization (the flops above)
-  std::string ordering;        ///< ordering CHOLMOD used ("metis", "amd", ...)
-  bool too_big = false;        ///< refused before the numeric factorization: L would exceed the memory limit
+  std::string message;            ///< why it failed (not positive definite at column k, ...)
+  double factor_entries = 0;      ///< nonzeros stored in L
+  double factor_bytes = 0;        ///< memory of L
+  double flops = 0;               ///< floating-point operations of the numeric factorization
+  double analyze_seconds = 0;     ///< ordering and symbolic factorization
+  double numeric_seconds = 0;     ///< numeric factorization (the flops above)
+  std::string ordering;           ///< ordering CHOLMOD used ("metis", "amd", ...)
+  bool too_big = false;           ///< refused before the numeric factorization: L would exceed the memory limit
+  bool resource_failure = false;  ///< failed for lack of workspace or memory, not for the matrix
 };
 
 /// MemAvailable of /proc/meminfo in bytes (0 when unknown).

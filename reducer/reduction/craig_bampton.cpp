@@ -557,8 +557,10 @@ CraigBamptonResult Reduce(const FeModel& model, FeModel* release, int internal_m
     return r;
   }
   if (!r.factorization.ok) {
-    r.message = "K_ii (stiffness with all interfaces clamped) is singular: " + r.factorization.message +
-                "; some part of the model is not held by any interface";
+    r.message = r.factorization.resource_failure
+                    ? "the factorization of K_ii failed: " + r.factorization.message
+                    : "K_ii (stiffness with all interfaces clamped) is singular: " + r.factorization.message +
+                          "; some part of the model is not held by any interface";
     return r;
   }
   if (progress) progress("factorize K_ii", t_factor, FactorizationDetail(r.factorization, p.n_i));
