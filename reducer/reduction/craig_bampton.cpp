@@ -497,6 +497,14 @@ std::string FactorizationDetail(const FactorizationInfo& f, int n_i) {
          Format(" (numeric %.3g s; ordering %.3g s, ", f.numeric_seconds, f.analyze_seconds) + f.ordering + ")";
 }
 
+// Why the factorization of K_ii failed: the matrix (singular: a part no interface holds), or the
+// solver's workspace or memory.
+std::string FactorizationFailure(const FactorizationInfo& f) {
+  if (f.resource_failure) return "the factorization of K_ii failed: " + f.message;
+  return "K_ii (stiffness with all interfaces clamped) is singular: " + f.message +
+         "; some part of the model is not held by any interface";
+}
+
 // The model's K and M held only as their blocks (Partition) while the interior's factor lives:
 // released on construction (when given a model to release them from) and rebuilt from the blocks,
 // the same entries, by Restore or at the end. The peak memory is then lower by K and M.
@@ -557,10 +565,7 @@ CraigBamptonResult Reduce(const FeModel& model, FeModel* release, int internal_m
     return r;
   }
   if (!r.factorization.ok) {
-    r.message = r.factorization.resource_failure
-                    ? "the factorization of K_ii failed: " + r.factorization.message
-                    : "K_ii (stiffness with all interfaces clamped) is singular: " + r.factorization.message +
-                          "; some part of the model is not held by any interface";
+    r.message = FactorizationFailure(r.factorization);
     return r;
   }
   if (progress) progress("factorize K_ii", t_factor, FactorizationDetail(r.factorization, p.n_i));
