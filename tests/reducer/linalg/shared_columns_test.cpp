@@ -1,0 +1,133 @@
+// K and M shared by columns between MPI ranks (shared_columns.h), on one process: the ranks'
+// registry and collectives are stood in for, one rank at a time. Each rank's share of a solid's
+// assembly is exactly those columns of the whole; the ranks' parts of a projection and of the
+// Green-Lagrange polynomial add up to the whole's (to round-off); the columns gathered from every
+// rank are the whole matrix.
+#include "reducer/linalg/shared_columns.h"
+
+#include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
+
+#include "formats/part_file.h"
+#include "reducer/fe/nonlinear_solid.h"
+#include "reducer/fe/solid_model.h"
+#include "reducer/linalg/interior_solver.h"
+
+namespace femb {
+namespace {
+
+// This process plays rank `rank` of `ranks`; the sum leaves each rank's part as it is (the test
+// adds the parts), the gather returns what `gathered` holds.
+class PlayedRanks {
+ public:
+  PlayedRanks(int ranks, int rank, const std::vector<std::string>* gathered = nullptr) {
+    RegisterDistributedSolver(nullptr, ranks, nullptr, rank);
+    RegisterRankCollectives(
+        [](double*, long) {},
+        [gathered](const std::string& mine) { return gathered ? *gathered : std::vector<std::string>{mine}; });
+  }
+  ~PlayedRanks() {
+    RegisterRankCollectives(nullptr, nullptr);
+    RegisterDistributedSolver(nullptr, 1);
+  }
+};
+
+PartSpec Bar() {
+  return ParsePart(
+      "name: bar\ntype: solid\nmaterial: {E: 2.1e11, nu: 0.3, rho: 7850}\n"
+      "geometry: {shape: box, size: [0.4, 0.04, 0.03]}\nmesh: {size: 0.02, order: 2}\n"
+      "interfaces: [{name: root, group: xmin}, {name: tip, group: xmax, coupling: rbe3}]\n"
+      "reduction: {internal_modes: 4}\n",
+      "bar.yaml");
+}
+
+TEST(SharedColumns, SharesSplitTheColumnsInRankOrderAsPetscDoes) {
+  long next = 0;
+  for (int rank = 0; rank < 3; ++rank) {
+    PlayedRanks played(3, rank);
+    const ColumnShare share = ShareOfColumns(10);
+    EXPECT_EQ(share.first, next);
+    EXPECT_EQ(share.count, rank == 0 ? 4 : 3);  // 10 = 4 + 3 + 3
+    next += share.count;
+  }
+  EXPECT_EQ(next, 10);
+  EXPECT_TRUE(ShareOfColumns(10).whole());  // one process
+}
+
+TEST(SharedColumns, EachRankAssemblesExactlyItsColumnsOfTheWholeModel) {
+  const PartSpec part = Bar();
+  const FeModel whole = BuildSolidModel(part);
+  ASSERT_TRUE(whole.columns.whole());
+  long entries = 0;
+  for (int rank = 0; rank < 2; ++rank) {
+    PlayedRanks played(2, rank);
+    const FeModel shared = BuildSolidModel(part, nullptr, true);
+    ASSERT_FALSE(shared.columns.whole());
+    EXPECT_EQ(shared.columns.first, rank == 0 ? 0 : ShareOfColumns(whole.n_dofs()).first);
+    // The same entries, summed from the same elements in the same order: exactly equal.
+    EXPECT_EQ(SparseMatrix(shared.K - KeepColumns(whole.K, shared.columns)).norm(), 0.0);
+    EXPECT_EQ(SparseMatrix(shared.M - KeepColumns(whole.M, shared.columns)).norm(), 0.0);
+    entries += shared.K.nonZeros();
+  }
+  EXPECT_EQ(entries, whole.K.nonZeros());
+}
+
+TEST(SharedColumns, RanksPartsOfAProjectionAddUpAndGatheredColumnsMakeTheWhole) {
+  const FeModel whole = BuildSolidModel(Bar());
+  const long n = whole.n_dofs();
+  const Eigen::MatrixXd X = Eigen::MatrixXd::Random(n, 5);
+  const Eigen::MatrixXd KX = whole.K * X, XKX = X.transpose() * KX;
+  Eigen::MatrixXd sum_KX = Eigen::MatrixXd::Zero(n, 5), sum_XKX = Eigen::MatrixXd::Zero(5, 5);
+  std::vector<std::string> pieces;
+  for (int rank = 0; rank < 2; ++rank) {
+    PlayedRanks played(2, rank);
+    const ColumnShare share = ShareOfColumns(n);
+    const SparseMatrix K_r = KeepColumns(whole.K, share);
+    sum_KX += SharedTimes(K_r, X, share);
+    sum_XKX += SharedCongruence(X, K_r, X, share);
+    std::vector<std::string> mine;
+    RegisterRankCollectives([](double*, long) {},
+                            [&mine](const std::string& bytes) {
+                              mine = {bytes};
+                              return mine;
+                            });
+    GatherColumns(K_r, share);
+    pieces.push_back(mine[0]);
+  }
+  EXPECT_LT((sum_KX - KX).norm(), 1e-13 * KX.norm());
+  EXPECT_LT((sum_XKX - XKX).norm(), 1e-13 * XKX.norm());
+  PlayedRanks played(2, 0, &pieces);
+  const SparseMatrix gathered = GatherColumns(KeepColumns(whole.K, ShareOfColumns(n)), ShareOfColumns(n));
+  EXPECT_EQ(SparseMatrix(gathered - whole.K).norm(), 0.0);
+  EXPECT_EQ(gathered.nonZeros(), whole.K.nonZeros());
+}
+
+TEST(SharedColumns, RanksSharesOfTheElementsAddUpToTheWholePolynomial) {
+  const FeModel model = BuildSolidModel(Bar());
+  const SolidType type = *SolidTypeOf(model.cell_type);
+  const Eigen::MatrixXd shapes = Eigen::MatrixXd::Random(model.mesh_map.rows(), 4) * 1e-3;
+  PolynomialRequest request;
+  const ReducedPolynomial whole =
+      ReduceSvk(SvkSolidMesh(type, model.nodes, model.cells, Bar().material), shapes, {}, request);
+  Eigen::MatrixXd K = Eigen::MatrixXd::Zero(4, 4), A = Eigen::MatrixXd::Zero(whole.A.rows(), whole.A.cols()),
+                  B = Eigen::MatrixXd::Zero(whole.B.rows(), whole.B.cols());
+  Eigen::VectorXd force = Eigen::VectorXd::Zero(model.mesh_map.rows());
+  const SvkSolidMesh all(type, model.nodes, model.cells, Bar().material);
+  for (int rank = 0; rank < 2; ++rank) {
+    PlayedRanks played(2, rank);
+    const SvkSolidMesh part(type, model.nodes, model.cells, Bar().material, ShareOfColumns(model.n_elements()));
+    const ReducedPolynomial p = ReduceSvk(part, shapes, {}, request);
+    K += p.K, A += p.A, B += p.B;
+    force += part.Force(shapes.col(0));
+  }
+  EXPECT_LT((K - whole.K).norm(), 1e-13 * whole.K.norm());
+  EXPECT_LT((A - whole.A).norm(), 1e-13 * whole.A.norm());
+  EXPECT_LT((B - whole.B).norm(), 1e-13 * whole.B.norm());
+  const Eigen::VectorXd f = all.Force(shapes.col(0));
+  EXPECT_LT((force - f).norm(), 1e-13 * f.norm());
+}
+
+}  // namespace
+}  // namespace femb
