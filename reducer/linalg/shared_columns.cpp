@@ -85,8 +85,14 @@ Eigen::MatrixXd SharedTimes(const SparseMatrix& A, const Eigen::MatrixXd& X, con
 
 Eigen::MatrixXd SharedCongruence(const Eigen::MatrixXd& Y, const SparseMatrix& A, const Eigen::MatrixXd& X,
                                  const ColumnShare& share) {
-  const Eigen::MatrixXd AX = A * X;  // evaluated first: Eigen would nest it lazily
-  Eigen::MatrixXd YAX = TransposeTimes(Y, AX);
+  if (share.whole()) {
+    const Eigen::MatrixXd AX = A * X;  // evaluated first: Eigen would nest it lazily
+    return TransposeTimes(Y, AX);
+  }
+  // This rank's part Y^T A_h X_h over its columns h: (A_h^T Y)^T X_h, whose product has only the
+  // held rows (A X would have n).
+  const Eigen::MatrixXd AtY = A.middleCols(share.first, share.count).transpose() * Y;
+  Eigen::MatrixXd YAX = TransposeTimes(AtY, X.middleRows(share.first, share.count));
   SumOverRanks(YAX, share);
   return YAX;
 }
