@@ -3,7 +3,8 @@
 # Krylov-Schur) against the CHOLMOD path on the same part: the solid crank (TET10, 16 293 DOFs,
 # 12 fixed-interface modes) with an RBE3 and an RBE2 bore, with two RBE2 bores, with two RBE3
 # bores, and with the modal derivatives of 4 modes; np 1 and np 2 files equal to CHOLMOD's (on 2
-# ranks K and M shared by columns, the full model's free-free check gathering them)
+# ranks K and M shared by columns, the full model's free-free check gathering them), and a beam
+# part on 2 and 3 ranks
 # (frequencies 1e-9, reduced K and M 1e-8 relative, compare_superelements.py) and femb-inspect's
 # checks passing. Then the faults: one rank's geometry unreadable, a rank killed during the run,
 # the factor over the per-rank memory limit, a distributed reduction of a basis that is not
@@ -59,6 +60,14 @@ grep -q "assembly .* in the 8147 of 16293 columns rank 0 holds" "$work/mixed_ful
   fail "full modes on one process"
 $compare "$work/mixed_full.h5" "$work/mixed_full_np2.h5" | grep -q "full model's flexible free-free frequencies" &&
   $compare "$work/mixed_full.h5" "$work/mixed_full_np2.h5" > /dev/null && ok || fail "full modes on 2 ranks differ"
+# A beam part (assembled whole, each rank keeping its share of the columns; the interior small
+# enough for the dense eigen solve, which gathers them) on 2 and 3 ranks.
+"$bin/femb-reduce" "$src/examples/beam_rod/part.yaml" -q -o "$work/beam_cholmod.h5" && ok || fail "beam: serial"
+for np in 2 3; do
+  $mpi -np $np "$bin/femb-reduce" "$src/examples/beam_rod/part.yaml" -q -o "$work/beam_np$np.h5" && ok ||
+    fail "beam: np $np"
+  $compare "$work/beam_cholmod.h5" "$work/beam_np$np.h5" > /dev/null && ok || fail "beam: np $np differs"
+done
 # Without mpirun, reduction.solver: petsc runs on one rank.
 "$bin/femb-reduce" "$work/mixed.yaml" -q -o "$work/mixed_one.h5" --set reduction.solver=petsc && ok ||
   fail "petsc without mpirun"
