@@ -42,8 +42,7 @@ std::vector<std::string> GatherAll(const std::string& mine) {
   MPI_Allgather(&bytes, 1, MPI_INT, counts.data(), 1, MPI_INT, PETSC_COMM_WORLD);
   long total = 0;
   for (int r = 0; r < size; ++r) {
-    if (total > std::numeric_limits<int>::max()) throw std::runtime_error("the ranks' shares to gather exceed 2 GB");
-    displacements[size_t(r)] = int(total);
+    displacements[size_t(r)] = int(total);  // (meaningful once the total is checked below)
     total += counts[size_t(r)];
   }
   if (total > std::numeric_limits<int>::max()) throw std::runtime_error("the ranks' shares to gather exceed 2 GB");

@@ -92,17 +92,15 @@ SvkSolidMesh::SvkSolidMesh(SolidType type, const Eigen::MatrixXd& nodes, const E
       n_nodes_(nodes.rows()),
       cells_(cells),
       held_(held),
-      first_cell_(held.whole() ? 0 : held.first),
-      end_cell_(held.end(cells.rows())),
       D_(IsotropicElasticity(material.E, material.nu)) {
   std::vector<Eigen::Vector3d> points;
   std::vector<double> weights;
   SolidQuadrature(type, &points, &weights);
   points_per_cell_ = int(points.size());
-  dNdX_.reserve(size_t(end_cell_ - first_cell_) * points.size());
+  dNdX_.reserve(size_t(end_cell() - first_cell()) * points.size());
   dV_.reserve(dNdX_.capacity());
   Eigen::MatrixXd X(n_per_cell_, 3);
-  for (long c = first_cell_; c < end_cell_; ++c) {
+  for (long c = first_cell(); c < end_cell(); ++c) {
     for (int a = 0; a < n_per_cell_; ++a) X.row(a) = nodes.row(cells(c, a));
     ElementPoints(type, X, c + 1, &dNdX_, &dV_);
   }
@@ -111,10 +109,10 @@ SvkSolidMesh::SvkSolidMesh(SolidType type, const Eigen::MatrixXd& nodes, const E
 template <class Visit>
 void SvkSolidMesh::ForEachPoint(const Eigen::VectorXd& u, Visit visit) const {
   Eigen::VectorXd u_e(3 * n_per_cell_);
-  for (long c = first_cell_; c < end_cell_; ++c) {
+  for (long c = first_cell(); c < end_cell(); ++c) {
     for (int a = 0; a < n_per_cell_; ++a) u_e.segment<3>(3 * a) = u.segment<3>(3 * long(cells_(c, a)));
     const Eigen::MatrixXd U = AsRows(u_e);
-    visit(c, U, size_t(c - first_cell_) * points_per_cell_);
+    visit(c, U, size_t(c - first_cell()) * points_per_cell_);
   }
 }
 
@@ -145,7 +143,7 @@ Eigen::VectorXd SvkSolidMesh::Force(const Eigen::VectorXd& u) const {
 }
 
 SparseMatrix SvkSolidMesh::Tangent(const Eigen::VectorXd& u) const {
-  if (first_cell_ != 0 || end_cell_ != cells_.rows()) throw std::logic_error("the tangent of a share of the elements");
+  if (!held_.whole()) throw std::logic_error("the tangent of a share of the elements");
   std::vector<Eigen::Triplet<double>> triplets;
   triplets.reserve(size_t(cells_.rows()) * 9 * n_per_cell_ * n_per_cell_);
   NonlinearElementState e;
@@ -222,11 +220,11 @@ Eigen::MatrixXd CompletionProjection(const SvkSolidMesh& solid, const Eigen::Mat
   const Eigen::MatrixXd V = mesh_shapes.rightCols(nv);
   Eigen::MatrixXd element(3 * ne, nv), field_element(3 * ne, nf), U(ne, 3), L(6, nv), Lf(6, nf);
   Eigen::MatrixXd K_vv = Eigen::MatrixXd::Zero(nv, nv), G = Eigen::MatrixXd::Zero(nv, nf);
-  for (long c = solid.first_cell_; c < solid.end_cell_; ++c) {
+  for (long c = solid.first_cell(); c < solid.end_cell(); ++c) {
     Gather(V, solid.cells_, c, element);
     Gather(fields, solid.cells_, c, field_element);
     for (int q = 0; q < solid.points_per_cell_; ++q) {
-      const size_t point = size_t(c - solid.first_cell_) * solid.points_per_cell_ + q;
+      const size_t point = size_t(c - solid.first_cell()) * solid.points_per_cell_ + q;
       PointStrains(element, solid.dNdX_[point], U, nullptr, L);
       PointStrains(field_element, solid.dNdX_[point], U, nullptr, Lf);
       const Eigen::MatrixXd DL = solid.D_ * L;
@@ -256,12 +254,12 @@ ReducedPolynomial ReduceSvk(const SvkSolidMesh& solid, const Eigen::MatrixXd& me
   std::vector<Eigen::Matrix3d> G(static_cast<size_t>(n));
   Eigen::MatrixXd L(6, n), Q(6, P), Q_plain, U(ne, 3);
   Eigen::MatrixXd element(3 * ne, n), field_element(3 * ne, n_fields);
-  for (long c = solid.first_cell_; c < solid.end_cell_; ++c) {
+  for (long c = solid.first_cell(); c < solid.end_cell(); ++c) {
     Gather(mesh_shapes, solid.cells_, c, element);
     Gather(fields, solid.cells_, c, field_element);
     if (n_stress > 0) Gather(*request.stress_fields, solid.cells_, c, stress_element);
     for (int q = 0; q < solid.points_per_cell_; ++q) {
-      const size_t point = size_t(c - solid.first_cell_) * solid.points_per_cell_ + q;
+      const size_t point = size_t(c - solid.first_cell()) * solid.points_per_cell_ + q;
       const Eigen::MatrixXd& g = solid.dNdX_[point];
       PointStrains(element, g, U, &G, L);
       int p = 0;

@@ -117,8 +117,9 @@ class SvkSolidMesh : public NonlinearModel {
   int n_per_cell_;
   long n_nodes_;
   Eigen::MatrixXi cells_;
-  ColumnShare held_;            ///< the elements held (of the cells' rows)
-  long first_cell_, end_cell_;  ///< [first_cell_, end_cell_)
+  ColumnShare held_;  ///< the elements held (of the cells' rows)
+  long first_cell() const { return held_.first; }
+  long end_cell() const { return held_.end(cells_.rows()); }
   Eigen::Matrix<double, 6, 6> D_;
   int points_per_cell_;
   std::vector<Eigen::MatrixXd> dNdX_;  ///< cell-major, points_per_cell_ per held cell
