@@ -64,8 +64,8 @@ options:
 
 on MPI: mpirun -np N femb-reduce PART.yaml [-o OUT.h5] reduces with reduction.solver: petsc (MUMPS'
   distributed Cholesky and SLEPc's Krylov-Schur over the N ranks; --set reduction.solver=petsc
-  for one rank); every rank meshes the part and assembles its share of K and M, rank 0 prints and
-  writes the file
+  for one rank); rank 0 meshes the part (or reads its mesh) and METIS cuts it in N parts, each
+  rank assembles its part's columns of K and M, rank 0 prints and writes the file
 
 exit codes: 0 success, 2 bad input (one line names the file, line and key), 3 numerical failure,
   4 refused: the Cholesky factor would not fit in memory (the line says how much it needs).

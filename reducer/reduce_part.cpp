@@ -13,6 +13,7 @@
 #include "reducer/fe/nonlinear_beam.h"
 #include "reducer/fe/nonlinear_solid.h"
 #include "reducer/fe/solid_model.h"
+#include "reducer/fe/solid_ranks.h"
 #include "reducer/linalg/interior_solver.h"
 #include "reducer/linalg/shared_columns.h"
 #include "reducer/linalg/sparse_cholesky.h"
@@ -89,7 +90,7 @@ SolidType SolidCellType(CellType cell) {
 FeModel BuildFeModel(const PartSpec& part, const ProgressFn& report, bool shared) {
   FeModel model;
   if (part.type == PartType::kSolid) {
-    model = BuildSolidModel(part, report, shared);
+    model = shared ? BuildSolidModelOnRanks(part, report) : BuildSolidModel(part, report);
   } else if (part.type == PartType::kImported) {
     model = BuildImportedModel(part, report);
   } else {
@@ -101,6 +102,7 @@ FeModel BuildFeModel(const PartSpec& part, const ProgressFn& report, bool shared
     report("mesh+assembly", clock.Seconds(), detail);
   }
   if (!shared) return model;
+  if (part.type != PartType::kSolid) CheckSamePartOnRanks(part);  // (a solid's: once it has the mesh)
   if (model.columns.whole()) {
     model.columns = ShareOfColumns(model.n_dofs());
     model.K = KeepColumns(model.K, model.columns);

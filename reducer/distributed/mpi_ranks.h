@@ -1,8 +1,8 @@
 // femb-reduce on MPI ranks (mpirun -np N femb-reduce PART.yaml): MPI, PETSc and SLEPc started
 // and ended for the process, the ranks' collectives registered (shared_columns.h). Every rank runs
-// the same reduction on the same mesh, holding its share of the columns of K and M; the interior's
-// factor and eigen solve are distributed (petsc_interior.h); rank 0 alone prints and writes the
-// file.
+// the same reduction on the mesh rank 0 made and partitioned (solid_ranks.h), holding its part's
+// columns of K and M; the interior's factor and eigen solve are distributed (petsc_interior.h);
+// rank 0 alone prints and writes the file.
 #pragma once
 
 #include <utility>

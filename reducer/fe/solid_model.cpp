@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <map>
 #include <memory>
+#include <numeric>
 #include <optional>
 
 #include "formats/input_error.h"
@@ -132,7 +133,7 @@ void ShapeMatrix(const SolidDofMap& map, const SolidPattern& g, bool mass, const
 
 }  // namespace
 
-void AssembleSolid(const SolidMesh& mesh, const MaterialSpec& material, const SolidDofMap& map, SparseMatrix* K,
+long AssembleSolid(const SolidMesh& mesh, const MaterialSpec& material, const SolidDofMap& map, SparseMatrix* K,
                    SparseMatrix* M, const ColumnShare& held) {
   const int per = SolidNodeCount(mesh.type);
   const long n_cells = mesh.cells.rows();
@@ -153,12 +154,14 @@ void AssembleSolid(const SolidMesh& mesh, const MaterialSpec& material, const So
   std::vector<int> local_offset;  // their first column in the element's model DOFs
   std::vector<int> a_of;          // uncoupled element: element node of the i-th model node
   Eigen::MatrixXd Te, Ke, Me;
+  long assembled = 0;
   for (long e = 0; e < n_cells; ++e) {
     if (!held.whole()) {
       bool touches = false;
       for (int a = 0; a < per && !touches; ++a) touches = HoldsNode(map, held, map.model_node[mesh.cells(e, a)]);
       if (!touches) continue;
     }
+    ++assembled;
     for (int a = 0; a < per; ++a) X.row(a) = mesh.nodes.row(mesh.cells(e, a));
     const SolidElementMatrices em = ComputeSolidElement(mesh.type, X, material, e);
     nodes.clear();
@@ -227,6 +230,7 @@ void AssembleSolid(const SolidMesh& mesh, const MaterialSpec& material, const So
       }
     }
   }
+  return assembled;
 }
 
 // The area-weighted centroid of the boundary faces whose corners all lie in `set` (flat facets
@@ -476,11 +480,13 @@ std::vector<Rbe3> Rbe3Couplings(const PartSpec& part, const SolidMesh& mesh, con
   return rbe3;
 }
 
-// Model coordinates: every mesh DOF not in an RBE2 set (kept: its model DOF, -1 in a set), then 6
-// per RBE2 interface (rbe2_base: its first, -1 if not RBE2). The map T (mesh DOFs -> model DOFs):
-// a node in an RBE2 set moves with the interface's rigid motion.
+// Model coordinates: every mesh DOF not in an RBE2 set, node by node in the mesh nodes' `order`
+// (kept: its model DOF, -1 in a set), then 6 per RBE2 interface (rbe2_base: its first, -1 if not
+// RBE2). The map T (mesh DOFs -> model DOFs): a node in an RBE2 set moves with the interface's
+// rigid motion.
 SparseMatrix RigidCouplingMap(const PartSpec& part, const SolidMesh& mesh, const std::vector<int>& owner,
-                              const FeModel& model, std::vector<int>& kept, std::vector<int>& rbe2_base) {
+                              const std::vector<int>& order, const FeModel& model, std::vector<int>& kept,
+                              std::vector<int>& rbe2_base) {
   const int n_nodes = int(mesh.nodes.rows());
   std::vector<int> coupled;
   for (int s = 0; s < n_nodes; ++s) {
@@ -489,7 +495,7 @@ SparseMatrix RigidCouplingMap(const PartSpec& part, const SolidMesh& mesh, const
   CheckRegionsHeldByInterfaces(mesh.cells, mesh.nodes, coupled, part.solid.where);
   kept.assign(size_t(3 * n_nodes), -1);
   int n_kept = 0;
-  for (int s = 0; s < n_nodes; ++s) {
+  for (const int s : order) {
     const bool rbe2 = owner[s] >= 0 && part.interfaces[owner[s]].coupling == Coupling::kRbe2;
     for (int d = 0; d < 3; ++d) {
       if (!rbe2) kept[3 * s + d] = n_kept++;
@@ -524,18 +530,19 @@ SparseMatrix RigidCouplingMap(const PartSpec& part, const SolidMesh& mesh, const
   return T;
 }
 
-// The assembly's map of mesh nodes to model nodes: a free node (3 DOFs) each, then one node (6
-// DOFs) per RBE2 interface, on which its set's nodes hang by their arms.
+// The assembly's map of mesh nodes to model nodes: a free node (3 DOFs) each, in the `order` of
+// RigidCouplingMap, then one node (6 DOFs) per RBE2 interface, on which its set's nodes hang by
+// their arms.
 SolidDofMap AssemblyMap(const PartSpec& part, const SolidMesh& mesh, const std::vector<int>& owner,
-                        const FeModel& model, const std::vector<int>& kept, const std::vector<int>& rbe2_base,
-                        int n_model) {
+                        const std::vector<int>& order, const FeModel& model, const std::vector<int>& kept,
+                        const std::vector<int>& rbe2_base, int n_model) {
   const int n_nodes = int(mesh.nodes.rows());
   SolidDofMap map;
   map.n_dofs = n_model;
   map.model_node.assign(n_nodes, -1);
   map.arm.assign(n_nodes, Eigen::Matrix3d::Zero());
   std::vector<int> interface_node(part.interfaces.size(), -1);
-  for (int s = 0; s < n_nodes; ++s) {
+  for (const int s : order) {
     if (kept[3 * s] < 0) continue;
     map.model_node[s] = int(map.first_dof.size());
     map.first_dof.push_back(kept[3 * s]);
@@ -575,20 +582,50 @@ void InterfaceCouplings(const PartSpec& part, const std::vector<Rbe3>& rbe3, con
   }
 }
 
+// The mesh nodes in the order of the model's DOFs: as meshed, or part by part of a partition
+// (in mesh order within a part).
+std::vector<int> NodeOrder(int n_nodes, const NodePartition* partition) {
+  std::vector<int> order(static_cast<size_t>(n_nodes));
+  std::iota(order.begin(), order.end(), 0);
+  if (partition) {
+    std::stable_sort(order.begin(), order.end(),
+                     [&](int a, int b) { return partition->part[size_t(a)] < partition->part[size_t(b)]; });
+  }
+  return order;
+}
+
+// This rank's columns of a model numbered part by part: its part's DOFs (the RBE2 interfaces',
+// numbered last, with the last part's). PETSc's even split instead where a part would hold none.
+ColumnShare ShareOfPart(const NodePartition& partition, const std::vector<int>& kept, long n_model) {
+  std::vector<long> first(size_t(partition.parts) + 1, 0);
+  for (size_t s = 0; s < partition.part.size(); ++s)
+    if (kept[3 * s] >= 0) first[size_t(partition.part[s]) + 1] += 3;
+  for (int p = 0; p < partition.parts; ++p) first[size_t(p) + 1] += first[size_t(p)];
+  first.back() = n_model;
+  for (int p = 0; p < partition.parts; ++p)
+    if (first[size_t(p) + 1] == first[size_t(p)]) return ShareOfColumns(n_model);
+  const int rank = DistributedRank();
+  return {first[size_t(rank)], first[size_t(rank) + 1] - first[size_t(rank)]};
+}
+
 }  // namespace
 
 FeModel BuildSolidModel(const PartSpec& part, const ProgressFn& progress, bool shared) {
   Stopwatch clock;
   auto mesh = std::make_shared<SolidMesh>(MeshSolidPart(part));
-  const int n_nodes = int(mesh->nodes.rows());
-  if (progress) {
-    progress("mesh", clock.Seconds(),
-             std::to_string(n_nodes) + " nodes, " + std::to_string(mesh->cells.rows()) + " " +
-                 SolidTypeName(mesh->type) + " elements" + (part.solid.file.empty() ? "" : " from " + part.solid.file));
-  }
+  if (progress) progress("mesh", clock.Seconds(), MeshSummary(part, *mesh));
+  return BuildSolidModelOn(part, mesh, shared, nullptr, progress);
+}
 
+std::string MeshSummary(const PartSpec& part, const SolidMesh& mesh) {
+  return std::to_string(mesh.nodes.rows()) + " nodes, " + std::to_string(mesh.cells.rows()) + " " +
+         SolidTypeName(mesh.type) + " elements" + (part.solid.file.empty() ? "" : " from " + part.solid.file);
+}
+
+FeModel BuildSolidModelOn(const PartSpec& part, const std::shared_ptr<const SolidMesh>& mesh, bool shared,
+                          const NodePartition* partition, const ProgressFn& progress) {
   // Interface node sets: a named set of the mesh, or nodes picked by geometry.
-  clock.Restart();
+  Stopwatch clock;
   FeModel model;
   const InterfaceNodes interface_nodes =
       ResolveInterfaceNodes(part, mesh->nodes, mesh->node_sets, mesh.get(), "the mesh");
@@ -600,7 +637,8 @@ FeModel BuildSolidModel(const PartSpec& part, const ProgressFn& progress, bool s
   CheckCouplingSets(part, *mesh, interface_nodes.sets);
   const std::vector<Rbe3> rbe3 = Rbe3Couplings(part, *mesh, interface_nodes.sets, model);
   std::vector<int> kept, rbe2_base;
-  const SparseMatrix T = RigidCouplingMap(part, *mesh, interface_nodes.owner, model, kept, rbe2_base);
+  const std::vector<int> order = NodeOrder(int(mesh->nodes.rows()), partition);
+  const SparseMatrix T = RigidCouplingMap(part, *mesh, interface_nodes.owner, order, model, kept, rbe2_base);
   const int n_model = int(T.cols());
   if (progress) {
     progress("couplings", clock.Seconds(),
@@ -610,17 +648,17 @@ FeModel BuildSolidModel(const PartSpec& part, const ProgressFn& progress, bool s
 
   // Element matrices straight onto the model DOFs (RBE2 folded in per element).
   clock.Restart();
-  const SolidDofMap map = AssemblyMap(part, *mesh, interface_nodes.owner, model, kept, rbe2_base, n_model);
-  if (shared) model.columns = ShareOfColumns(n_model);
-  AssembleSolid(*mesh, part.material, map, &model.K, &model.M, model.columns);
+  const SolidDofMap map = AssemblyMap(part, *mesh, interface_nodes.owner, order, model, kept, rbe2_base, n_model);
+  if (shared) model.columns = partition ? ShareOfPart(*partition, kept, n_model) : ShareOfColumns(n_model);
+  const long assembled = AssembleSolid(*mesh, part.material, map, &model.K, &model.M, model.columns);
   if (progress) {
     const std::string entries = std::to_string(model.K.nonZeros()) + " stiffness entries";
+    const std::string cells = std::to_string(mesh->cells.rows());
     progress("assembly", clock.Seconds(),
-             std::to_string(mesh->cells.rows()) + " elements, " +
-                 (model.columns.whole()
-                      ? entries
-                      : entries + " in the " + std::to_string(model.columns.count) + " of " + std::to_string(n_model) +
-                            " columns rank " + std::to_string(DistributedRank()) + " holds"));
+             model.columns.whole() ? cells + " elements, " + entries
+                                   : std::to_string(assembled) + " of " + cells + " elements, " + entries + " in the " +
+                                         std::to_string(model.columns.count) + " of " + std::to_string(n_model) +
+                                         " columns rank " + std::to_string(DistributedRank()) + " holds");
   }
   InterfaceCouplings(part, rbe3, kept, rbe2_base, n_model, model);
   model.mesh_map = T;

@@ -33,6 +33,22 @@ SolidMesh MeshSolidPart(const PartSpec& part);
 /// elements that touch them.
 FeModel BuildSolidModel(const PartSpec& part, const ProgressFn& progress = nullptr, bool shared = false);
 
+/// The MPI ranks' partition of a solid mesh (solid_ranks.h): the part of every mesh node, 0 to
+/// parts - 1, one part per rank.
+struct NodePartition {
+  std::vector<int> part;
+  int parts = 1;
+};
+
+/// BuildSolidModel on a mesh made already, without its "mesh" stage. With a `partition` (and
+/// `shared`) the model's DOFs are numbered part by part, the RBE2 interfaces' last, and this rank
+/// holds its part's columns: it assembles the elements of its part and those touching it only.
+FeModel BuildSolidModelOn(const PartSpec& part, const std::shared_ptr<const SolidMesh>& mesh, bool shared,
+                          const NodePartition* partition, const ProgressFn& progress);
+
+/// The "mesh" stage's progress text: nodes, elements and the mesh file.
+std::string MeshSummary(const PartSpec& part, const SolidMesh& mesh);
+
 /// How mesh node s enters the model: its displacement is T_s q_P, P = model_node[s], whose
 /// model DOFs are first_dof[P] .. first_dof[P] + dofs[P] - 1: 3 for a free node (T_s = 1), 6 for
 /// an RBE2 interface node (T_s = [1, arm[s]], arm = -(x_s - x_k)~). Model nodes are numbered in
@@ -49,7 +65,8 @@ struct SolidDofMap {
 /// K with full node blocks, M with the diagonals only between free nodes (consistent mass
 /// couples like components). No triplet lists and no sparse products: memory is the matrices.
 /// Only the columns `held` get entries (the others are empty), from the elements that touch them.
-void AssembleSolid(const SolidMesh& mesh, const MaterialSpec& material, const SolidDofMap& map, SparseMatrix* K,
+/// Returns the number of elements assembled.
+long AssembleSolid(const SolidMesh& mesh, const MaterialSpec& material, const SolidDofMap& map, SparseMatrix* K,
                    SparseMatrix* M, const ColumnShare& held = ColumnShare());
 
 /// The area-weighted centroid of the boundary faces whose corners all lie in `set` (the default

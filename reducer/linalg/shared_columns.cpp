@@ -1,8 +1,8 @@
 #include "reducer/linalg/shared_columns.h"
 
-#include <cstring>
 #include <stdexcept>
 
+#include "reducer/linalg/byte_buffer.h"
 #include "reducer/linalg/dense_products.h"
 #include "reducer/linalg/interior_solver.h"
 
@@ -17,18 +17,6 @@ struct Collectives {
 Collectives& TheCollectives() {
   static Collectives collectives;
   return collectives;
-}
-
-// The bytes of a vector, and back.
-template <typename T>
-void Append(std::string& out, const T* data, size_t count) {
-  out.append(reinterpret_cast<const char*>(data), count * sizeof(T));
-}
-
-template <typename T>
-const char* Take(const char* from, T* data, size_t count) {
-  std::memcpy(data, from, count * sizeof(T));
-  return from + count * sizeof(T);
 }
 
 }  // namespace
@@ -62,19 +50,29 @@ void SumOverRanks(Eigen::Ref<Eigen::MatrixXd> X, const ColumnShare& share) {
   }
 }
 
-void CheckSameOnRanks(const std::vector<double>& values, const std::string& what) {
+bool SameOnRanks(const std::string& mine) {
   const Collectives& c = TheCollectives();
-  if (!c.gather) return;
-  const std::string mine(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(double));
-  for (const std::string& theirs : c.gather(mine)) {
-    if (theirs != mine) {
-      throw RankFailure(3,
-                        "the MPI ranks built different " + what +
-                            " (each rank builds the model itself; a mesher or reader that is not deterministic "
-                            "across processes?)",
-                        DistributedRank() == 0);
-    }
+  if (!c.gather) return true;
+  for (const std::string& theirs : c.gather(mine))
+    if (theirs != mine) return false;
+  return true;
+}
+
+void CheckSameOnRanks(const std::vector<double>& values, const std::string& what) {
+  if (!SameOnRanks(std::string(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(double)))) {
+    throw RankFailure(3,
+                      "the MPI ranks built different " + what +
+                          " (each rank builds the model itself; a mesher or reader that is not deterministic "
+                          "across processes?)",
+                      DistributedRank() == 0);
   }
+}
+
+std::string FromFirstRank(const std::string& bytes) {
+  const Collectives& c = TheCollectives();
+  if (!c.gather) return bytes;
+  // (the gather with the others' bytes left empty: what every rank receives is rank 0's)
+  return c.gather(DistributedRank() == 0 ? bytes : std::string()).front();
 }
 
 Eigen::MatrixXd SharedTimes(const SparseMatrix& A, const Eigen::MatrixXd& X, const ColumnShare& share) {
@@ -120,7 +118,7 @@ SparseMatrix GatherColumns(const SparseMatrix& A, const ColumnShare& share) {
   // This rank's columns: first, count, then per column its entries' count, rows and values.
   std::string mine;
   const long header[2] = {first, last - first};
-  Append(mine, header, 2);
+  AppendBytes(mine, header, 2);
   std::vector<int> counts, rows;
   std::vector<double> values;
   for (long col = first; col < last; ++col) {
@@ -131,22 +129,22 @@ SparseMatrix GatherColumns(const SparseMatrix& A, const ColumnShare& share) {
     }
   }
   const long entries = long(rows.size());
-  Append(mine, &entries, 1);
-  Append(mine, counts.data(), counts.size());
-  Append(mine, rows.data(), rows.size());
-  Append(mine, values.data(), values.size());
+  AppendBytes(mine, &entries, 1);
+  AppendBytes(mine, counts.data(), counts.size());
+  AppendBytes(mine, rows.data(), rows.size());
+  AppendBytes(mine, values.data(), values.size());
   const std::vector<std::string> all = c.gather(mine);
   SparseMatrix out(A.rows(), n);
   std::vector<Eigen::Triplet<double>> triplets;
   for (const std::string& bytes : all) {
     long h[2], k = 0;
-    const char* at = Take(bytes.data(), h, 2);
-    at = Take(at, &k, 1);
+    const char* at = TakeBytes(bytes.data(), h, 2);
+    at = TakeBytes(at, &k, 1);
     std::vector<int> col_counts(static_cast<size_t>(h[1])), col_rows(static_cast<size_t>(k));
     std::vector<double> col_values(static_cast<size_t>(k));
-    at = Take(at, col_counts.data(), col_counts.size());
-    at = Take(at, col_rows.data(), col_rows.size());
-    Take(at, col_values.data(), col_values.size());
+    at = TakeBytes(at, col_counts.data(), col_counts.size());
+    at = TakeBytes(at, col_rows.data(), col_rows.size());
+    TakeBytes(at, col_values.data(), col_values.size());
     size_t e = 0;
     for (long j = 0; j < h[1]; ++j)
       for (int i = 0; i < col_counts[size_t(j)]; ++i, ++e)

@@ -31,9 +31,16 @@ void RegisterRankCollectives(std::function<void(double*, long)> sum,
 /// process, or a rank that works alone).
 void SumOverRanks(Eigen::Ref<Eigen::MatrixXd> X, const ColumnShare& share);
 
+/// Whether `mine` is the same on every rank (true on one process).
+bool SameOnRanks(const std::string& mine);
+
 /// Throws RankFailure (exit 3) unless `values` are the same on every rank: the ranks build the
 /// model each for itself, and what they replicate (sizes, the mesh, the couplings) must agree.
 void CheckSameOnRanks(const std::vector<double>& values, const std::string& what);
+
+/// Rank 0's `bytes` on every rank (what the others pass is not sent): the mesh made once. `bytes`
+/// on one process. A failure of rank 0 before it is met here by the others (EnsureStartAgreed).
+std::string FromFirstRank(const std::string& bytes);
 
 /// A X for A of which this rank holds the columns `share`: every rank's part summed, the whole
 /// product on every rank.

@@ -6,7 +6,9 @@
 # ranks K and M shared by columns, the full model's free-free check gathering them), and a beam
 # part on 2 and 3 ranks
 # (frequencies 1e-9, reduced K and M 1e-8 relative, compare_superelements.py) and femb-inspect's
-# checks passing. Then the faults: one rank's geometry unreadable, a rank killed during the run,
+# checks passing; rank 0 meshing the part, METIS cutting it, each rank assembling about half the
+# elements. Then the faults: one rank's geometry unreadable, rank 0's mesh without volume
+# elements, ranks given different parts, a rank killed during the run,
 # the factor over the per-rank memory limit, a distributed reduction of a basis that is not
 # distributed, a part with a free motion: one line (or mpirun's own report of the killed rank), a
 # non-zero exit in bounded time, no file.
@@ -50,12 +52,20 @@ for part in mixed pins seats derivatives; do
   "$bin/femb-inspect" "$work/${part}_np2.h5" --check > "$work/$part.check" && ok ||
     fail "$part: femb-inspect --check: $(cat "$work/$part.check")"
 done
-# The ranks share K and M by columns (each assembles the elements touching its own); the full
-# model's free-free check gathers them: its flexible frequencies equal the one-process run's.
+# The ranks share K and M by columns: rank 0 meshes the part and METIS cuts it in 2, each rank
+# holds its part's columns and assembles the elements touching them (about half: the 2 882
+# elements' cut is a few hundred); the full model's free-free check gathers them: its flexible
+# frequencies equal the one-process run's.
 $mpi -np 2 "$bin/femb-reduce" "$work/mixed.yaml" -o "$work/mixed_full_np2.h5" --set reduction.full_modes=6 \
   > "$work/mixed_full.log" 2>&1 && ok || fail "full modes on 2 ranks: $(cat "$work/mixed_full.log")"
-grep -q "assembly .* in the 8147 of 16293 columns rank 0 holds" "$work/mixed_full.log" && ok ||
-  fail "np 2: rank 0 does not say it holds half the columns: $(grep assembly "$work/mixed_full.log")"
+grep -q "mesh .*rank 0 made it and METIS cut it in 2 parts" "$work/mixed_full.log" && ok ||
+  fail "np 2: the mesh line does not say how it was cut: $(grep mesh "$work/mixed_full.log")"
+assembly=$(grep -o "assembly .* [0-9]* of [0-9]* elements, [0-9]* stiffness entries in the [0-9]* of [0-9]* columns rank 0 holds" "$work/mixed_full.log" |
+  sed -E 's/.* ([0-9]+) of ([0-9]+) elements, [0-9]+ stiffness entries in the ([0-9]+) of ([0-9]+) columns.*/\1 \2 \3 \4/')
+read -r cells all_cells columns all_columns <<< "${assembly:-0 1 0 1}"
+[ $((100 * cells / all_cells)) -le 60 ] && [ $((100 * columns / all_columns)) -ge 40 ] &&
+  [ $((100 * columns / all_columns)) -le 60 ] && ok ||
+  fail "np 2: rank 0 holds $columns of $all_columns columns from $cells of $all_cells elements (expected 40-60% of the columns from at most 60% of the elements)"
 "$bin/femb-reduce" "$work/mixed.yaml" -q -o "$work/mixed_full.h5" --set reduction.full_modes=6 && ok ||
   fail "full modes on one process"
 $compare "$work/mixed_full.h5" "$work/mixed_full_np2.h5" | grep -q "full model's flexible free-free frequencies" &&
@@ -91,6 +101,19 @@ expect_failure "one rank's geometry missing" 2 "nothing.geo' not found" \
   -np 1 "$bin/femb-reduce" "$work/unreadable.yaml" -q -o "$work/failed.h5"
 expect_failure "every rank's geometry missing" 2 "nothing.geo' not found" \
   $mpi -np 2 "$bin/femb-reduce" "$work/unreadable.yaml" -q -o "$work/failed.h5"
+# Rank 0 alone meshes: its failure reaches the rank waiting for the mesh.
+cat > "$work/flat.geo" <<EOT
+SetFactory("OpenCASCADE");
+Rectangle(1) = {0, 0, 0, 0.1, 0.02};
+Physical Surface("end") = {1};
+EOT
+sed "s#$src/meshes/crank.geo#$work/flat.geo#" "$work/mixed.yaml" > "$work/flat.yaml"
+expect_failure "rank 0's mesh without volume elements" 2 "the mesh has no volume elements" \
+  $mpi -np 2 "$bin/femb-reduce" "$work/flat.yaml" -q -o "$work/failed.h5"
+sed "s#E: 2.1e11#E: 2.0e11#" "$work/mixed.yaml" > "$work/other.yaml"
+expect_failure "ranks given different parts" 2 "the MPI ranks were given different parts" \
+  $mpi -np 1 "$bin/femb-reduce" "$work/mixed.yaml" -q -o "$work/failed.h5" : \
+  -np 1 "$bin/femb-reduce" "$work/other.yaml" -q -o "$work/failed.h5"
 expect_failure "factor over the per-rank limit" 4 "MUMPS' factorization of K_ii needs" \
   $mpi -np 2 "$bin/femb-reduce" "$work/mixed.yaml" -q -o "$work/failed.h5" --set reduction.memory_limit_gb=0.02
 expect_failure "petsc with a free-interface basis" 2 "reduction.solver: petsc reduces by craig_bampton only" \

@@ -2,17 +2,22 @@
 // registry and collectives are stood in for, one rank at a time. Each rank's share of a solid's
 // assembly is exactly those columns of the whole; the ranks' parts of a projection and of the
 // Green-Lagrange polynomial add up to the whole's (to round-off); the columns gathered from every
-// rank are the whole matrix.
+// rank are the whole matrix. Meshed once and cut by METIS, each rank holds its part's columns
+// (about half) from at most 60% of the elements, and the ranks' K and M are the whole renumbered.
 #include "reducer/linalg/shared_columns.h"
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "formats/part_file.h"
 #include "reducer/fe/nonlinear_solid.h"
 #include "reducer/fe/solid_model.h"
+#include "reducer/fe/solid_ranks.h"
 #include "reducer/linalg/interior_solver.h"
 
 namespace femb {
@@ -127,6 +132,75 @@ TEST(SharedColumns, RanksSharesOfTheElementsAddUpToTheWholePolynomial) {
   EXPECT_LT((B - whole.B).norm(), 1e-13 * whole.B.norm());
   const Eigen::VectorXd f = all.Force(shapes.col(0));
   EXPECT_LT((force - f).norm(), 1e-13 * f.norm());
+}
+
+// The model DOF that whole-model DOF i became in a renumbered model: the mesh DOF each free model
+// DOF moves (its column of the mesh map holds one entry) is the same; the RBE2 interfaces' six
+// each, numbered last in both, and an RBE2 set's DOFs hang on them.
+std::vector<long> Renumbering(const SparseMatrix& T_whole, const SparseMatrix& T_new) {
+  std::vector<long> model_of_mesh(size_t(T_whole.rows()), -1), renumbered(size_t(T_whole.cols()));
+  for (long j = 0; j < T_new.cols(); ++j) {
+    renumbered[size_t(j)] = j;  // (the RBE2 interfaces')
+    if (T_new.col(j).nonZeros() == 1) model_of_mesh[size_t(SparseMatrix::InnerIterator(T_new, j).row())] = j;
+  }
+  for (long i = 0; i < T_whole.cols(); ++i)
+    if (T_whole.col(i).nonZeros() == 1)
+      renumbered[size_t(i)] = model_of_mesh[size_t(SparseMatrix::InnerIterator(T_whole, i).row())];
+  return renumbered;
+}
+
+TEST(SharedColumns, RankZerosMeshAndMetisPartitionMakeEachRankAssembleAboutItsShare) {
+  const PartSpec part = Bar();
+  const FeModel whole = BuildSolidModel(part);
+  const SolidMesh meshed = MeshSolidPart(part);
+  std::vector<long> cells;
+  const NodePartition cut = PartitionMesh(meshed, 2, &cells);
+  // METIS' parts hold about half the elements each (its default imbalance is 3%).
+  ASSERT_EQ(cells.size(), 2u);
+  EXPECT_NEAR(double(cells[0]) / double(meshed.cells.rows()), 0.5, 0.03);
+  // What rank 0 sends is what the others rebuild.
+  NodePartition received;
+  const auto mesh = std::make_shared<SolidMesh>(MeshFromBytes(MeshBytes(meshed, cut), &received));
+  EXPECT_EQ(received.part, cut.part);
+  EXPECT_EQ(received.parts, 2);
+  EXPECT_EQ(mesh->nodes, meshed.nodes);
+  EXPECT_EQ(mesh->cells, meshed.cells);
+  EXPECT_EQ(mesh->node_sets, meshed.node_sets);
+  // Each rank holds the columns of its part (numbered part by part), assembled from its part's
+  // elements and those touching it: together the whole K and M renumbered, to round-off.
+  SparseMatrix K(whole.n_dofs(), whole.n_dofs()), M = K;
+  std::vector<long> renumbered;
+  long next = 0;
+  for (int rank = 0; rank < 2; ++rank) {
+    PlayedRanks played(2, rank);
+    std::string assembly;
+    const FeModel shared = BuildSolidModelOn(part, mesh, true, &received,
+                                             [&](const std::string& stage, double, const std::string& detail) {
+                                               if (stage == "assembly") assembly = detail;
+                                             });
+    EXPECT_EQ(shared.columns.first, next);
+    EXPECT_NEAR(double(shared.columns.count) / double(whole.n_dofs()), 0.5, 0.05);
+    next += shared.columns.count;
+    const long assembled = std::stol(assembly);  // "N of M elements, ..."
+    EXPECT_LT(double(assembled), 0.6 * double(mesh->cells.rows())) << assembly;
+    K += shared.K, M += shared.M;
+    renumbered = Renumbering(whole.mesh_map, shared.mesh_map);
+  }
+  EXPECT_EQ(next, whole.n_dofs());
+  std::vector<long> seen = renumbered;
+  std::sort(seen.begin(), seen.end());
+  for (long i = 0; i < whole.n_dofs(); ++i) ASSERT_EQ(seen[size_t(i)], i) << "not a renumbering";
+  for (const auto& [A, A_whole] : {std::pair{&K, &whole.K}, std::pair{&M, &whole.M}}) {
+    double largest = 0.0, worst = 0.0;
+    long entries = 0;
+    for (long i = 0; i < A_whole->outerSize(); ++i)
+      for (SparseMatrix::InnerIterator it(*A_whole, i); it; ++it, ++entries) {
+        largest = std::max(largest, std::abs(it.value()));
+        worst = std::max(worst, std::abs(A->coeff(renumbered[size_t(it.row())], renumbered[size_t(i)]) - it.value()));
+      }
+    EXPECT_EQ(A->nonZeros(), entries);
+    EXPECT_LT(worst, 1e-14 * largest);
+  }
 }
 
 }  // namespace

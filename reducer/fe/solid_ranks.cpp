@@ -1,0 +1,133 @@
+#include "reducer/fe/solid_ranks.h"
+
+#include <metis.h>
+
+#include <algorithm>
+#include <memory>
+#include <stdexcept>
+
+#include "reducer/linalg/byte_buffer.h"
+#include "reducer/linalg/interior_solver.h"
+#include "reducer/linalg/shared_columns.h"
+
+namespace femb {
+namespace {
+
+// The nodes two elements share when they share a face (METIS' ncommon), by SolidType: a
+// triangle's 3 (TET4) or 6 (TET10), a quadrilateral's 4 (HEX8) or 8 (HEX20).
+constexpr idx_t kFaceNodes[] = {3, 6, 4, 8};
+
+}  // namespace
+
+NodePartition PartitionMesh(const SolidMesh& mesh, int parts, std::vector<long>* cells_per_part) {
+  NodePartition partition;
+  partition.parts = parts;
+  idx_t n_cells = idx_t(mesh.cells.rows()), n_nodes = idx_t(mesh.nodes.rows());
+  partition.part.assign(size_t(n_nodes), 0);
+  std::vector<idx_t> cell_part(size_t(n_cells), 0);
+  if (parts > 1) {
+    const idx_t per = idx_t(mesh.cells.cols());
+    std::vector<idx_t> start(size_t(n_cells) + 1), nodes(size_t(n_cells) * size_t(per));
+    for (idx_t e = 0; e < n_cells; ++e) {
+      start[size_t(e)] = e * per;
+      for (idx_t a = 0; a < per; ++a) nodes[size_t(e * per + a)] = mesh.cells(e, a);
+    }
+    start.back() = n_cells * per;
+    idx_t options[METIS_NOPTIONS];
+    METIS_SetDefaultOptions(options);
+    options[METIS_OPTION_NUMBERING] = 0;
+    idx_t common = kFaceNodes[int(mesh.type)], n_parts = parts, cut = 0;
+    std::vector<idx_t> node_part(static_cast<size_t>(n_nodes));
+    const int status = METIS_PartMeshDual(&n_cells, &n_nodes, start.data(), nodes.data(), nullptr, nullptr, &common,
+                                          &n_parts, nullptr, options, &cut, cell_part.data(), node_part.data());
+    if (status != METIS_OK) {
+      throw std::runtime_error("METIS could not partition the mesh into " + std::to_string(parts) + " parts (status " +
+                               std::to_string(status) + ")");
+    }
+    partition.part.assign(node_part.begin(), node_part.end());
+  }
+  if (cells_per_part) {
+    cells_per_part->assign(size_t(parts), 0);
+    for (const idx_t p : cell_part) ++(*cells_per_part)[size_t(p)];
+  }
+  return partition;
+}
+
+std::string MeshBytes(const SolidMesh& mesh, const NodePartition& partition) {
+  std::string out;
+  const long header[5] = {long(mesh.nodes.rows()), long(mesh.cells.rows()), long(mesh.cells.cols()), long(mesh.type),
+                          long(partition.parts)};
+  AppendBytes(out, header, 5);
+  AppendBytes(out, mesh.nodes.data(), size_t(mesh.nodes.size()));
+  AppendBytes(out, mesh.cells.data(), size_t(mesh.cells.size()));
+  AppendBytes(out, partition.part.data(), partition.part.size());
+  const long sets = long(mesh.node_sets.size());
+  AppendBytes(out, &sets, 1);
+  for (const auto& [name, set] : mesh.node_sets) {
+    const long sizes[2] = {long(name.size()), long(set.size())};
+    AppendBytes(out, sizes, 2);
+    AppendBytes(out, name.data(), name.size());
+    AppendBytes(out, set.data(), set.size());
+  }
+  return out;
+}
+
+SolidMesh MeshFromBytes(const std::string& bytes, NodePartition* partition) {
+  SolidMesh mesh;
+  long header[5];
+  const char* at = TakeBytes(bytes.data(), header, 5);
+  mesh.nodes.resize(header[0], 3);
+  mesh.cells.resize(header[1], header[2]);
+  mesh.type = SolidType(header[3]);
+  partition->parts = int(header[4]);
+  partition->part.resize(size_t(header[0]));
+  at = TakeBytes(at, mesh.nodes.data(), size_t(mesh.nodes.size()));
+  at = TakeBytes(at, mesh.cells.data(), size_t(mesh.cells.size()));
+  at = TakeBytes(at, partition->part.data(), partition->part.size());
+  long sets = 0;
+  at = TakeBytes(at, &sets, 1);
+  for (long k = 0; k < sets; ++k) {
+    long sizes[2];
+    at = TakeBytes(at, sizes, 2);
+    std::string name(size_t(sizes[0]), '\0');
+    std::vector<int> set(static_cast<size_t>(sizes[1]));
+    at = TakeBytes(at, name.data(), name.size());
+    at = TakeBytes(at, set.data(), set.size());
+    mesh.node_sets.emplace(std::move(name), std::move(set));
+  }
+  return mesh;
+}
+
+void CheckSamePartOnRanks(const PartSpec& part) {
+  if (!SameOnRanks(part.text_hash)) {
+    throw RankFailure(2,
+                      "the MPI ranks were given different parts (part file or --set values): every rank reduces "
+                      "the same part",
+                      DistributedRank() == 0);
+  }
+}
+
+FeModel BuildSolidModelOnRanks(const PartSpec& part, const ProgressFn& progress) {
+  Stopwatch clock;
+  const int ranks = DistributedRanks();
+  auto mesh = std::make_shared<SolidMesh>();
+  NodePartition partition;
+  std::string bytes, parts = std::to_string(ranks) + " parts";
+  if (DistributedRank() == 0) {
+    *mesh = MeshSolidPart(part);
+    std::vector<long> cells;
+    partition = PartitionMesh(*mesh, ranks, &cells);
+    parts += " of " + std::to_string(*std::min_element(cells.begin(), cells.end())) + " to " +
+             std::to_string(*std::max_element(cells.begin(), cells.end())) + " elements";
+    bytes = MeshBytes(*mesh, partition);
+  }
+  bytes = FromFirstRank(bytes);
+  if (DistributedRank() != 0) *mesh = MeshFromBytes(bytes, &partition);
+  bytes = std::string();
+  CheckSamePartOnRanks(part);
+  if (progress)
+    progress("mesh", clock.Seconds(), MeshSummary(part, *mesh) + "; rank 0 made it and METIS cut it in " + parts);
+  return BuildSolidModelOn(part, mesh, true, &partition, progress);
+}
+
+}  // namespace femb
