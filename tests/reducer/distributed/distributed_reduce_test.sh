@@ -3,12 +3,13 @@
 # Krylov-Schur) against the CHOLMOD path on the same part: the solid crank (TET10, 16 293 DOFs,
 # 12 fixed-interface modes) with an RBE3 and an RBE2 bore, with two RBE2 bores, with two RBE3
 # bores, and with the modal derivatives of 4 modes; np 1 and np 2 files equal to CHOLMOD's (on 2
-# ranks K and M shared by columns, the full model's free-free check gathering them), and a beam
-# part on 2 and 3 ranks
+# ranks K and M shared by columns, the full model's free-free check gathering them), a beam
+# part on 2 and 3 ranks and the crank's matrices imported on 2
 # (frequencies 1e-9, reduced K and M 1e-8 relative, compare_superelements.py) and femb-inspect's
 # checks passing; rank 0 meshing the part, METIS cutting it, each rank assembling about half the
 # elements. Then the faults: one rank's geometry unreadable, rank 0's mesh without volume
-# elements, ranks given different parts, a rank killed during the run,
+# elements, ranks given different parts, a hinge inside the part (K_ii singular where the
+# connectivity check cannot see it), a rank killed during the run,
 # the factor over the per-rank memory limit, a distributed reduction of a basis that is not
 # distributed, a part with a free motion: one line (or mpirun's own report of the killed rank), a
 # non-zero exit in bounded time, no file.
@@ -78,6 +79,25 @@ for np in 2 3; do
     fail "beam: np $np"
   $compare "$work/beam_cholmod.h5" "$work/beam_np$np.h5" > /dev/null && ok || fail "beam: np $np differs"
 done
+# Imported matrices (the crank's, exported by femb-reduce in CalculiX's files, with the geometric
+# stiffening of femb's elements on the imported mesh): read whole on every rank, each keeping an
+# even share of the columns.
+"$bin/femb-reduce" "$work/mixed.yaml" -q --export-matrices "$work/exported" && ok || fail "export the crank's matrices"
+cat > "$work/imported.yaml" <<EOT
+name: imported
+type: imported
+units: SI
+geometry: {file: $work/exported/mixed.inp}
+matrices: {format: calculix, stiffness: $work/exported/mixed.sti, mass: $work/exported/mixed.mas, dofs: $work/exported/mixed.dof}
+interfaces:
+  - {name: big_bore, group: big_bore, coupling: rbe3}
+  - {name: small_bore, group: small_bore, coupling: rbe2}
+material: {E: 2.1e11, nu: 0.3, rho: 7850}
+reduction: {internal_modes: 12, full_modes: 0}
+EOT
+"$bin/femb-reduce" "$work/imported.yaml" -q -o "$work/imported_cholmod.h5" && ok || fail "imported: serial"
+$mpi -np 2 "$bin/femb-reduce" "$work/imported.yaml" -q -o "$work/imported_np2.h5" && ok || fail "imported: np 2"
+$compare "$work/imported_cholmod.h5" "$work/imported_np2.h5" > /dev/null && ok || fail "imported: np 2 differs"
 # Without mpirun, reduction.solver: petsc runs on one rank.
 "$bin/femb-reduce" "$work/mixed.yaml" -q -o "$work/mixed_one.h5" --set reduction.solver=petsc && ok ||
   fail "petsc without mpirun"
@@ -153,6 +173,27 @@ sed -e "s#$work/loose.geo#$work/edge.geo#" \
   "$work/loose.yaml" > "$work/edge.yaml"
 expect_failure "a rigid coupling on one edge, 2 ranks" 2 "an RBE2 coupling needs at least 3 nodes not on one line" \
   $mpi -np 2 "$bin/femb-reduce" "$work/edge.yaml" -q -o "$work/failed.h5"
+
+# A hidden mechanism: two blocks joined along one edge only, a hinge (the connectivity check sees one
+# region; K_ii is singular, the turn about the edge free). CHOLMOD stops at its pivot; MUMPS
+# factors it without a word (Cholesky, SYM=1, has no null-pivot detection: ICNTL(24) found none
+# here even at a threshold of 1e-3), and the reduced model's check finds the seventh zero
+# eigenvalue: exit 3 either way, no file.
+cat > "$work/hinge.geo" <<EOT
+SetFactory("OpenCASCADE");
+Box(1) = {0, 0, 0, 0.1, 0.02, 0.02};
+Box(2) = {0.1, 0.02, 0, 0.1, 0.02, 0.02};
+BooleanFragments{ Volume{1}; Delete; }{ Volume{2}; Delete; }
+e = 1e-4;
+end() = Surface In BoundingBox{-e, -e, -e, e, 0.02 + e, 0.02 + e};
+Physical Surface("end") = end();
+Physical Volume("blocks") = {1, 2};
+EOT
+sed "s#$work/loose.geo#$work/hinge.geo#" "$work/loose.yaml" > "$work/hinge.yaml"
+expect_failure "a hinge, one process" 3 "K_ii (stiffness with all interfaces clamped) is singular" \
+  "$bin/femb-reduce" "$work/hinge.yaml" -q -o "$work/failed.h5"
+expect_failure "a hinge, 2 ranks" 3 "7 eigenvalues with |lambda| <= 1e-8 max|lambda| (need 6)" \
+  $mpi -np 2 "$bin/femb-reduce" "$work/hinge.yaml" -q -o "$work/failed.h5"
 
 # A rank killed once the reduction runs: mpirun ends the others, non-zero, no file.
 rm -f "$work/failed.h5"
