@@ -6,7 +6,8 @@ mesh with CHOLMOD (reduction.solver: cholmod, 2 BLAS threads), and with MUMPS an
 (reduction.solver: petsc) on 1 rank (2 BLAS threads) and on 2 ranks (mpirun -np 2, a BLAS thread
 each; at the first size also on 4 ranks, for the file only), and prints what this run measured: the time of every stage, the peak memory of the
 largest rank and of all ranks, the factor's size and flops (MUMPS' own figures), and how far the
-MPI files are from CHOLMOD's (compare_superelements.py: frequencies, reduced K and M).
+MPI files are from CHOLMOD's (compare_superelements.py: frequencies, reduced K and M), and the
+share of the columns and of the elements rank 0 of 2 assembles.
 
 At the first size (below 5e5 DOFs) it also compares the files of 4 ranks and of a variant with two RBE3 bores,
 times the stages that loop over the elements (geometric stiffening with its inertia load cases, modal stresses on the
@@ -158,6 +159,12 @@ def main():
         print(f"  {'peak all GB':<16}" + "".join(f"{r['all_gb']:22.3f}" for r in runs.values()))
         print(f"  {'factor GB':<16}" + "".join(f"{f['factor_gb']:22.3f}" for f in figures.values()))
         print(f"  {'factor GFLOP':<16}" + "".join(f"{f['gflop']:22.1f}" for f in figures.values()))
+        share = re.match(r"(\d+) of (\d+) elements, .* in the (\d+) of (\d+) columns",
+                         runs["MUMPS+SLEPc, np 2"]["detail"].get("assembly", ""))
+        if share:
+            cells, all_cells, columns, all_columns = (int(g) for g in share.groups())
+            print(f"  np 2: rank 0 holds {columns} of {all_columns} columns ({100 * columns / all_columns:.1f}%), "
+                  f"assembled from {cells} of {all_cells} elements ({100 * cells / all_cells:.1f}%; METIS' cut)")
         for label in ("MUMPS+SLEPc, np 1", "MUMPS+SLEPc, np 2"):
             out = "np1.h5" if label.endswith("1") else "np2.h5"
             c = run(["/usr/bin/python3", COMPARE, os.path.join(work, "cholmod.h5"), os.path.join(work, out)])
