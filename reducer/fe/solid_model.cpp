@@ -610,11 +610,11 @@ ColumnShare ShareOfPart(const NodePartition& partition, const std::vector<int>& 
 
 }  // namespace
 
-FeModel BuildSolidModel(const PartSpec& part, const ProgressFn& progress, bool shared) {
+FeModel BuildSolidModel(const PartSpec& part, const ProgressFn& progress) {
   Stopwatch clock;
   auto mesh = std::make_shared<SolidMesh>(MeshSolidPart(part));
   if (progress) progress("mesh", clock.Seconds(), MeshSummary(part, *mesh));
-  return BuildSolidModelOn(part, mesh, shared, nullptr, progress);
+  return BuildSolidModelOn(part, mesh, false, nullptr, progress);
 }
 
 std::string MeshSummary(const PartSpec& part, const SolidMesh& mesh) {

@@ -28,10 +28,9 @@ SolidMesh MeshSolidPart(const PartSpec& part);
 
 /// Throws InputError for a missing or empty node set, node sets that overlap, or an inverted
 /// element (named).
-/// Reports the stages mesh, assembly and couplings through `progress` (may be null). `shared`: K
-/// and M only in this MPI rank's share of the columns (FeModel::columns, ShareOfColumns), from the
-/// elements that touch them.
-FeModel BuildSolidModel(const PartSpec& part, const ProgressFn& progress = nullptr, bool shared = false);
+/// Reports the stages mesh, assembly and couplings through `progress` (may be null). The whole K
+/// and M (on MPI ranks: BuildSolidModelOnRanks, solid_ranks.h).
+FeModel BuildSolidModel(const PartSpec& part, const ProgressFn& progress = nullptr);
 
 /// The MPI ranks' partition of a solid mesh (solid_ranks.h): the part of every mesh node, 0 to
 /// parts - 1, one part per rank.
@@ -40,9 +39,11 @@ struct NodePartition {
   int parts = 1;
 };
 
-/// BuildSolidModel on a mesh made already, without its "mesh" stage. With a `partition` (and
-/// `shared`) the model's DOFs are numbered part by part, the RBE2 interfaces' last, and this rank
-/// holds its part's columns: it assembles the elements of its part and those touching it only.
+/// BuildSolidModel on a mesh made already, without its "mesh" stage. `shared`: K and M only in
+/// this MPI rank's share of the columns (FeModel::columns), from the elements that touch them:
+/// with a `partition` the model's DOFs are numbered part by part, the RBE2 interfaces' last, and
+/// this rank holds its part's columns (it assembles the elements of its part and those touching
+/// it only); without, the DOFs as meshed and an even share (ShareOfColumns).
 FeModel BuildSolidModelOn(const PartSpec& part, const std::shared_ptr<const SolidMesh>& mesh, bool shared,
                           const NodePartition* partition, const ProgressFn& progress);
 

@@ -65,10 +65,11 @@ TEST(SharedColumns, EachRankAssemblesExactlyItsColumnsOfTheWholeModel) {
   const PartSpec part = Bar();
   const FeModel whole = BuildSolidModel(part);
   ASSERT_TRUE(whole.columns.whole());
+  const auto mesh = std::make_shared<const SolidMesh>(MeshSolidPart(part));
   long entries = 0;
   for (int rank = 0; rank < 2; ++rank) {
     PlayedRanks played(2, rank);
-    const FeModel shared = BuildSolidModel(part, nullptr, true);
+    const FeModel shared = BuildSolidModelOn(part, mesh, true, nullptr, nullptr);
     ASSERT_FALSE(shared.columns.whole());
     EXPECT_EQ(shared.columns.first, rank == 0 ? 0 : ShareOfColumns(whole.n_dofs()).first);
     // The same entries, summed from the same elements in the same order: exactly equal.
