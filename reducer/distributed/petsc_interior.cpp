@@ -24,29 +24,20 @@ void Check(PetscErrorCode code, const char* call) {
 }
 #define FEMB_PETSC(call) Check((call), #call)
 
-// The rows each rank owns of an n-row matrix or vector (the columns it holds of the matrix
-// factored, else PETSc's default split), with every rank's count and first row for gathering.
+// The rows this rank owns of an n-row matrix or vector (the columns it holds of the matrix
+// factored, else PETSc's default split): `count` of them from `first`.
 struct RowSplit {
   PetscInt n = 0, first = 0, count = 0;
-  std::vector<int> counts, firsts;
 };
 
 RowSplit SplitRows(PetscInt n, const ColumnShare& held) {
   RowSplit s;
   s.n = n;
-  PetscInt local = held.whole() ? PETSC_DECIDE : PetscInt(held.count), global = n;
+  PetscInt local = held.whole() ? PETSC_DECIDE : PetscInt(held.count), global = n, end = 0;
   FEMB_PETSC(PetscSplitOwnership(PETSC_COMM_WORLD, &local, &global));
   s.count = local;
-  int size = 1;
-  MPI_Comm_size(PETSC_COMM_WORLD, &size);
-  s.counts.resize(size_t(size));
-  s.firsts.resize(size_t(size));
-  const int mine = int(local);
-  MPI_Allgather(&mine, 1, MPI_INT, s.counts.data(), 1, MPI_INT, PETSC_COMM_WORLD);
-  int rank = 0;
-  MPI_Comm_rank(PETSC_COMM_WORLD, &rank);
-  for (int r = 1; r < size; ++r) s.firsts[size_t(r)] = s.firsts[size_t(r - 1)] + s.counts[size_t(r - 1)];
-  s.first = s.firsts[size_t(rank)];
+  MPI_Scan(&local, &end, 1, MPIU_INT, MPI_SUM, PETSC_COMM_WORLD);
+  s.first = end - local;
   return s;
 }
 
@@ -68,48 +59,27 @@ Mat DistributedMatrix(const SparseMatrix& A, const RowSplit& rows) {
   return M;
 }
 
-// A replicated n x k block from each rank's rows (column-major, `lda` apart).
-Eigen::MatrixXd Gather(const RowSplit& rows, const PetscScalar* local, PetscInt lda, int k) {
-  std::vector<double> mine(size_t(rows.count) * size_t(k));
-  for (int c = 0; c < k; ++c)
-    for (PetscInt i = 0; i < rows.count; ++i) mine[size_t(c) * size_t(rows.count) + size_t(i)] = local[c * lda + i];
-  std::vector<int> counts(rows.counts.size()), displacements(rows.counts.size());
-  for (size_t r = 0; r < counts.size(); ++r) {
-    counts[r] = rows.counts[r] * k;
-    displacements[r] = rows.firsts[r] * k;
-  }
-  std::vector<double> all(size_t(rows.n) * size_t(k));
-  MPI_Allgatherv(mine.data(), int(mine.size()), MPI_DOUBLE, all.data(), counts.data(), displacements.data(), MPI_DOUBLE,
-                 PETSC_COMM_WORLD);
-  Eigen::MatrixXd X(rows.n, k);
-  for (size_t r = 0; r < counts.size(); ++r)
-    for (int c = 0; c < k; ++c)
-      for (int i = 0; i < rows.counts[r]; ++i)
-        X(rows.firsts[r] + i, c) = all[size_t(displacements[r]) + size_t(c) * size_t(rows.counts[r]) + size_t(i)];
-  return X;
-}
-
-Eigen::VectorXd GatherVector(const RowSplit& rows, Vec v) {
+// This rank's rows of a vector as a column.
+Eigen::VectorXd LocalRows(const RowSplit& rows, Vec v) {
   const PetscScalar* local = nullptr;
   FEMB_PETSC(VecGetArrayRead(v, &local));
-  Eigen::VectorXd x = Gather(rows, local, rows.count, 1).col(0);
+  Eigen::VectorXd x = Eigen::Map<const Eigen::VectorXd>(local, rows.count);
   FEMB_PETSC(VecRestoreArrayRead(v, &local));
   return x;
 }
 
-void ScatterVector(const RowSplit& rows, const Eigen::VectorXd& x, Vec v) {
+void SetLocalRows(const RowSplit& rows, const Eigen::VectorXd& x, Vec v) {
   PetscScalar* local = nullptr;
   FEMB_PETSC(VecGetArrayWrite(v, &local));
-  for (PetscInt i = 0; i < rows.count; ++i) local[i] = x[rows.first + i];
+  Eigen::Map<Eigen::VectorXd>(local, rows.count) = x;
   FEMB_PETSC(VecRestoreArrayWrite(v, &local));
 }
 
 // MUMPS' INFOG entries that count in millions when negative.
 double Count(PetscInt infog) { return infog < 0 ? -1e6 * double(infog) : double(infog); }
 
-// The shift-invert operator SLEPc applies (a PCSHELL in its KSP): the constrained solve on the
-// replicated vector.
-// Without constraints it is the factor's own solve on the distributed vectors.
+// The shift-invert operator SLEPc applies (a PCSHELL in its KSP): the constrained solve on this
+// rank's rows of the vector. Without constraints it is the factor's own solve.
 struct ShellContext {
   const RowSplit* rows = nullptr;
   const BlockShiftInvertFn* solve = nullptr;
@@ -123,8 +93,7 @@ PetscErrorCode ApplyShiftInvert(PC pc, Vec x, Vec y) {
   ++context->applications;
   if (context->factor) return MatSolve(context->factor, x, y);
   try {
-    const Eigen::VectorXd z = (*context->solve)(GatherVector(*context->rows, x)).col(0);
-    ScatterVector(*context->rows, z, y);
+    SetLocalRows(*context->rows, (*context->solve)(LocalRows(*context->rows, x)).col(0), y);
   } catch (const std::exception&) {
     return PETSC_ERR_LIB;
   }
@@ -223,7 +192,8 @@ class PetscInterior : public InteriorSolver {
   Eigen::MatrixXd Solve(const Eigen::MatrixXd& B) override {
     const int k = int(B.cols());
     solves_ += k;
-    if (k == 0) return Eigen::MatrixXd(B.rows(), 0);
+    if (k == 0) return Eigen::MatrixXd(rows_.count, 0);
+    if (B.rows() != rows_.count) throw std::logic_error("a solve given other rows than this rank's");
     Mat Bm = nullptr, Xm = nullptr;
     FEMB_PETSC(MatCreateDense(PETSC_COMM_WORLD, rows_.count, PETSC_DECIDE, rows_.n, k, nullptr, &Bm));
     PetscScalar* b = nullptr;
@@ -231,7 +201,7 @@ class PetscInterior : public InteriorSolver {
     FEMB_PETSC(MatDenseGetLDA(Bm, &lda));
     FEMB_PETSC(MatDenseGetArrayWrite(Bm, &b));
     for (int c = 0; c < k; ++c)
-      for (PetscInt i = 0; i < rows_.count; ++i) b[c * lda + i] = B(rows_.first + i, c);
+      for (PetscInt i = 0; i < rows_.count; ++i) b[c * lda + i] = B(i, c);
     FEMB_PETSC(MatDenseRestoreArrayWrite(Bm, &b));
     FEMB_PETSC(MatAssemblyBegin(Bm, MAT_FINAL_ASSEMBLY));
     FEMB_PETSC(MatAssemblyEnd(Bm, MAT_FINAL_ASSEMBLY));
@@ -240,7 +210,9 @@ class PetscInterior : public InteriorSolver {
     const PetscScalar* x = nullptr;
     FEMB_PETSC(MatDenseGetLDA(Xm, &lda));
     FEMB_PETSC(MatDenseGetArrayRead(Xm, &x));
-    Eigen::MatrixXd X = Gather(rows_, x, lda, k);
+    Eigen::MatrixXd X(rows_.count, k);
+    for (int c = 0; c < k; ++c)
+      for (PetscInt i = 0; i < rows_.count; ++i) X(i, c) = x[c * lda + i];
     FEMB_PETSC(MatDenseRestoreArrayRead(Xm, &x));
     MatDestroy(&Xm);
     MatDestroy(&Bm);
@@ -301,8 +273,8 @@ std::optional<EigenResult> PetscInterior::Eigenpairs(const SparseMatrix& K, cons
   FEMB_PETSC(EPSSetTolerances(eps, tol, 1000));
   Vec start = nullptr, x = nullptr;
   FEMB_PETSC(MatCreateVecs(Kd, &start, &x));
-  const Eigen::MatrixXd ones = Eigen::MatrixXd::Ones(K.rows(), 1);
-  ScatterVector(rows_, solve(SharedTimes(M, ones, held_)).col(0), start);
+  const Eigen::MatrixXd ones = Eigen::MatrixXd::Ones(rows_.count, 1);
+  SetLocalRows(rows_, solve(SharedTimesRows(M, ones, held_)).col(0), start);
   FEMB_PETSC(EPSSetInitialSpace(eps, 1, &start));
   FEMB_PETSC(EPSSolve(eps));
   PetscInt converged = 0, iterations = 0;
@@ -313,15 +285,18 @@ std::optional<EigenResult> PetscInterior::Eigenpairs(const SparseMatrix& K, cons
                        nev, double(iterations));
   } else {
     r.lambda.resize(nev);
-    r.vectors.resize(K.rows(), nev);
+    r.vectors.resize(rows_.count, nev);
+    Vec Mx = nullptr;
+    FEMB_PETSC(VecDuplicate(x, &Mx));
     for (int i = 0; i < nev; ++i) {
-      PetscScalar lambda = 0;
+      PetscScalar lambda = 0, norm2 = 0;
       FEMB_PETSC(EPSGetEigenpair(eps, i, &lambda, nullptr, x, nullptr));
-      Eigen::VectorXd v = GatherVector(rows_, x);
-      v /= std::sqrt(v.dot(SharedTimes(M, v, held_).col(0)));
+      FEMB_PETSC(MatMult(Md, x, Mx));
+      FEMB_PETSC(VecDot(Mx, x, &norm2));
       r.lambda[i] = lambda;
-      r.vectors.col(i) = v;
+      r.vectors.col(i) = LocalRows(rows_, x) / std::sqrt(norm2);
     }
+    VecDestroy(&Mx);
     r.ok = true;
   }
   r.linear_solves = context.applications + 1;

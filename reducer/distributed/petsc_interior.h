@@ -5,8 +5,7 @@
 // same factor (the interfaces' constraints applied in the shift-invert operator, as on one
 // process). K_ii and M_ii are distributed by rows: each rank gives the columns it holds of them
 // (shared_columns.h; the symmetric matrices' rows), or PETSc's default split of a replicated one;
-// right-hand sides and solutions are replicated on every rank (the reduction's dense blocks are
-// small beside the factor).
+// right-hand sides, solutions and eigenvectors are this rank's rows of them, as PETSc holds them.
 #pragma once
 
 #include <memory>

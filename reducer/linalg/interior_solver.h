@@ -2,9 +2,10 @@
 // augmented matrix when every interface is distributing) with its solves, and optionally its own
 // eigen solver. CHOLMOD (sparse_cholesky.h) on one process is the default; a distributed solver
 // (MUMPS and SLEPc over MPI, reducer/distributed/) is registered by femb-reduce when it runs on
-// MPI ranks. Every rank of a distributed run holds the same replicated right-hand sides and
-// receives the same replicated solutions, so the code that calls these stays serial (its products
-// with the matrices, which the ranks share by columns, are summed: shared_columns.h).
+// MPI ranks. Each rank of a distributed run gives and receives its rows of the right-hand sides
+// and solutions (the rows of the columns it holds of the matrix factored: the reduction's dense
+// blocks divide by the number of ranks while the factor lives); their products with the matrices,
+// which the ranks share by columns, and with each other are summed (shared_columns.h).
 #pragma once
 
 #include <Eigen/Core>
@@ -30,12 +31,14 @@ class InteriorSolver {
   /// refuses (info.too_big) before the numeric factorization when the factor (a distributed
   /// solver: its largest rank's share) would not fit.
   virtual FactorizationInfo Factorize(const SparseMatrix& A, const ColumnShare& held, double memory_limit_bytes) = 0;
-  /// X = A^-1 B for a block of right-hand sides. Precondition: Factorize succeeded.
+  /// X = A^-1 B for a block of right-hand sides, B and X this rank's rows (HeldRows of the share
+  /// given to Factorize; all of them on one process). Precondition: Factorize succeeded.
   virtual Eigen::MatrixXd Solve(const Eigen::MatrixXd& B) = 0;
   /// Right-hand sides solved so far.
   virtual long solves() const = 0;
   /// The lowest `nev` eigenpairs of K x = lambda M x (K and M held as A was) on the space the constrained shift-invert
-  /// `solve` maps into (it applies the factor), residual tolerance `tol` relative to the
+  /// `solve` maps into (it applies the factor, on this rank's rows as Solve; the eigenvectors are
+  /// this rank's rows too), residual tolerance `tol` relative to the
   /// eigenvalue; empty when this solver has no eigen solver of its own (femb's block Lanczos then
   /// runs on `solve`). `plain`: `solve` is the factor's own solve (no constraints), which the
   /// solver may then apply in its own way.

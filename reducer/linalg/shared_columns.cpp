@@ -1,5 +1,6 @@
 #include "reducer/linalg/shared_columns.h"
 
+#include <algorithm>
 #include <stdexcept>
 
 #include "reducer/linalg/byte_buffer.h"
@@ -93,6 +94,97 @@ Eigen::MatrixXd SharedCongruence(const Eigen::MatrixXd& Y, const SparseMatrix& A
   Eigen::MatrixXd YAX = TransposeTimes(AtY, X.middleRows(share.first, share.count));
   SumOverRanks(YAX, share);
   return YAX;
+}
+
+Eigen::MatrixXd HeldRows(const Eigen::MatrixXd& X, const ColumnShare& share) {
+  if (share.whole()) return X;
+  return X.middleRows(share.first, share.count);
+}
+
+Eigen::MatrixXd HeldRows(const SparseMatrix& A, const ColumnShare& share) {
+  if (share.whole()) return Eigen::MatrixXd(A);
+  Eigen::MatrixXd out = Eigen::MatrixXd::Zero(share.count, A.cols());
+  for (int col = 0; col < A.outerSize(); ++col)
+    for (SparseMatrix::InnerIterator it(A, col); it; ++it)
+      if (share.Holds(it.row())) out(it.row() - share.first, col) = it.value();
+  return out;
+}
+
+namespace {
+
+// Columns per step of the gathers and products that go a few columns at a time: about 256 MB of
+// n-row columns, so that the whole n x k block is never held at once.
+long ColumnsPerStep(long n) { return std::max<long>(1, (long(1) << 25) / std::max<long>(n, 1)); }
+
+}  // namespace
+
+Eigen::MatrixXd GatherRows(const Eigen::MatrixXd& mine, const ColumnShare& share) {
+  const Collectives& c = TheCollectives();
+  if (share.whole() || !c.gather) return mine;
+  Eigen::Matrix<double, 1, 1> rows(double(mine.rows()));
+  SumOverRanks(rows, share);
+  const long n = long(rows(0, 0)), k = mine.cols(), step = ColumnsPerStep(n);
+  Eigen::MatrixXd out(n, k);
+  for (long c0 = 0; c0 < k; c0 += step) {
+    const long w = std::min(step, k - c0);
+    std::string bytes;
+    AppendBytes(bytes, mine.data() + c0 * mine.rows(), size_t(w * mine.rows()));
+    long first = 0;  // (the ranks' rows follow each other in rank order)
+    for (const std::string& theirs : c.gather(bytes)) {
+      const long count = long(theirs.size() / sizeof(double)) / w;
+      const char* at = theirs.data();
+      for (long j = 0; j < w && count > 0; ++j) at = TakeBytes(at, &out(first, c0 + j), size_t(count));
+      first += count;
+    }
+  }
+  return out;
+}
+
+Eigen::MatrixXd SharedTimesRows(const SparseMatrix& A, const Eigen::MatrixXd& X, const ColumnShare& share) {
+  if (share.whole()) return A * X;
+  const long k = X.cols(), step = ColumnsPerStep(A.rows());
+  Eigen::MatrixXd out(share.count, k);
+  for (long c0 = 0; c0 < k; c0 += step) {
+    const long w = std::min(step, k - c0);
+    // (A's other columns are empty: its held columns times this rank's rows of X is its part)
+    Eigen::MatrixXd part = A.middleCols(share.first, share.count) * X.middleCols(c0, w);
+    SumOverRanks(part, share);
+    out.middleCols(c0, w) = part.middleRows(share.first, share.count);
+  }
+  return out;
+}
+
+SparseMatrix SumSparseOverRanks(const SparseMatrix& A, const ColumnShare& share) {
+  const Collectives& c = TheCollectives();
+  if (share.whole() || !c.gather) return A;
+  std::vector<int> rows, cols;
+  std::vector<double> values;
+  for (int col = 0; col < A.outerSize(); ++col)
+    for (SparseMatrix::InnerIterator it(A, col); it; ++it) {
+      rows.push_back(int(it.row()));
+      cols.push_back(col);
+      values.push_back(it.value());
+    }
+  std::string mine;
+  const long entries = long(rows.size());
+  AppendBytes(mine, &entries, 1);
+  AppendBytes(mine, rows.data(), rows.size());
+  AppendBytes(mine, cols.data(), cols.size());
+  AppendBytes(mine, values.data(), values.size());
+  std::vector<Eigen::Triplet<double>> triplets;
+  for (const std::string& bytes : c.gather(mine)) {
+    long k = 0;
+    const char* at = TakeBytes(bytes.data(), &k, 1);
+    std::vector<int> r(static_cast<size_t>(k)), q(static_cast<size_t>(k));
+    std::vector<double> v(static_cast<size_t>(k));
+    at = TakeBytes(at, r.data(), r.size());
+    at = TakeBytes(at, q.data(), q.size());
+    TakeBytes(at, v.data(), v.size());
+    for (size_t e = 0; e < r.size(); ++e) triplets.emplace_back(r[e], q[e], v[e]);
+  }
+  SparseMatrix out(A.rows(), A.cols());
+  out.setFromTriplets(triplets.begin(), triplets.end());
+  return out;
 }
 
 SparseMatrix KeepColumns(const SparseMatrix& A, const ColumnShare& share) {

@@ -2,7 +2,9 @@
 // rank holds a contiguous range of the columns (its share; the other columns are empty) and
 // assembles only the elements that touch it, so their memory divides by the number of ranks.
 // Since K and M are symmetric, a rank's columns are also its rows: a product with a replicated
-// block is this rank's part of the whole, and the ranks' parts summed (SumOverRanks) make it.
+// block is this rank's part of the whole, and the ranks' parts summed (SumOverRanks) make it. The
+// reduction's dense blocks are held as each rank's rows while the factor lives (HeldRows,
+// SharedTimesRows) and gathered whole after it (GatherRows).
 // On one process every function here does nothing more than the plain product: the rank
 // collectives are registered by a program that runs on MPI (femb-reduce, mpi_ranks.h).
 #pragma once
@@ -49,6 +51,27 @@ Eigen::MatrixXd SharedTimes(const SparseMatrix& A, const Eigen::MatrixXd& X, con
 /// Y^T A X for A held as in SharedTimes (the reduction's projections): each rank's part, summed.
 Eigen::MatrixXd SharedCongruence(const Eigen::MatrixXd& Y, const SparseMatrix& A, const Eigen::MatrixXd& X,
                                  const ColumnShare& share);
+
+/// This rank's rows of X: those of the columns `share` holds (the dense blocks of a reduction
+/// held as each rank's rows, as the distributed solver gives and takes them). X when the share is
+/// the whole.
+Eigen::MatrixXd HeldRows(const Eigen::MatrixXd& X, const ColumnShare& share);
+/// The same for a sparse A: this rank's rows of it, dense.
+Eigen::MatrixXd HeldRows(const SparseMatrix& A, const ColumnShare& share);
+
+/// The whole matrix of which every rank holds its rows (`mine`, its `share`; the ranks' shares
+/// follow each other in rank order), on every rank: gathered a few columns at a time. `mine`
+/// itself when the share is the whole.
+Eigen::MatrixXd GatherRows(const Eigen::MatrixXd& mine, const ColumnShare& share);
+
+/// This rank's rows of A X for A shared by columns and X held as its rows (`share` both): each
+/// rank's part A_h X_h of the whole, summed a few columns at a time (the whole product is never
+/// held at once). The plain A X when the share is the whole.
+Eigen::MatrixXd SharedTimesRows(const SparseMatrix& A, const Eigen::MatrixXd& X, const ColumnShare& share);
+
+/// Every rank's entries of A added up (sparse; each rank's A the same size): the whole of a
+/// block that the ranks hold pieces of. A itself on one process.
+SparseMatrix SumSparseOverRanks(const SparseMatrix& A, const ColumnShare& share);
 
 /// A with only the columns of `share` (the others emptied): the share of a matrix built whole.
 SparseMatrix KeepColumns(const SparseMatrix& A, const ColumnShare& share);

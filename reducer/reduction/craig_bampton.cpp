@@ -7,12 +7,15 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <optional>
+#include <stdexcept>
 #include <unordered_map>
 
 #include "reducer/linalg/dense_products.h"
 #include "reducer/linalg/generalized_eigen.h"
 #include "reducer/linalg/interior_solver.h"
 #include "reducer/linalg/shared_columns.h"
+#include "reducer/reduction/interior_blocks.h"
 
 namespace femb {
 namespace {
@@ -23,83 +26,6 @@ constexpr int kLanczosBlock = 8;
 // values are then exact to ~tol^2 and the reduced matrices are the Galerkin projection on the
 // computed vectors whatever their accuracy.
 constexpr double kLanczosTolerance = 1e-8;
-
-// Splits A into the blocks named by the partition (-1: boundary position, else interior index).
-// `rest`: A's entries in a boundary row or column (full indices), column by column with rows
-// ascending, for Unpartition.
-struct Blocks {
-  SparseMatrix ii, ib;
-  Eigen::MatrixXd bb;
-  std::vector<Eigen::Triplet<double>> rest;
-};
-
-Blocks Partition(const SparseMatrix& A, const std::vector<int>& interior_index, const std::vector<int>& boundary_index,
-                 int n_i, int n_b) {
-  // Interior and boundary indices keep the order of A, so each block fills column by column
-  // with rows ascending: built in place, no triplet list (A may hold 1e8 entries).
-  Blocks out;
-  out.bb = Eigen::MatrixXd::Zero(n_b, n_b);
-  out.ii.resize(n_i, n_i);
-  out.ib.resize(n_i, n_b);
-  out.ii.reserve(A.nonZeros());
-  std::vector<std::vector<std::pair<int, double>>> ib_cols(n_b);
-  for (int col = 0; col < A.outerSize(); ++col) {
-    const int ci = interior_index[col], cb = boundary_index[col];
-    if (ci >= 0) out.ii.startVec(ci);
-    for (SparseMatrix::InnerIterator it(A, col); it; ++it) {
-      const int ri = interior_index[it.row()], rb = boundary_index[it.row()];
-      if (ri < 0 || ci < 0) out.rest.emplace_back(int(it.row()), col, it.value());
-      if (ri >= 0 && ci >= 0) {
-        out.ii.insertBack(ri, ci) = it.value();
-      } else if (ri >= 0 && cb >= 0) {
-        ib_cols[cb].emplace_back(ri, it.value());
-      } else if (rb >= 0 && cb >= 0) {
-        out.bb(rb, cb) += it.value();
-      }
-    }
-  }
-  out.ii.finalize();
-  out.ii.makeCompressed();
-  std::size_t n_ib = 0;
-  for (const auto& c : ib_cols) n_ib += c.size();
-  out.ib.reserve(long(n_ib));
-  for (int c = 0; c < n_b; ++c) {
-    out.ib.startVec(c);
-    for (const auto& [r, v] : ib_cols[c]) out.ib.insertBack(r, c) = v;
-  }
-  out.ib.finalize();
-  return out;
-}
-
-// The matrix that Partition split, from its interior block and the entries it kept of the rest:
-// the same entries with the same values, column by column with rows ascending, as A was.
-SparseMatrix Unpartition(const Blocks& blocks, const std::vector<int>& interior,
-                         const std::vector<int>& interior_index) {
-  const int n = int(interior_index.size());
-  const std::vector<Eigen::Triplet<double>>& rest = blocks.rest;
-  SparseMatrix A(n, n);
-  A.reserve(blocks.ii.nonZeros() + long(rest.size()));
-  size_t next = 0;
-  for (int col = 0; col < n; ++col) {
-    A.startVec(col);
-    const auto rest_row = [&]() { return next < rest.size() && rest[next].col() == col ? rest[next].row() : n; };
-    if (interior_index[col] >= 0) {
-      for (SparseMatrix::InnerIterator it(blocks.ii, interior_index[col]); it; ++it) {
-        const int row = interior[it.row()];
-        for (; rest_row() < row; ++next) A.insertBack(rest[next].row(), col) = rest[next].value();
-        A.insertBack(row, col) = it.value();
-      }
-    }
-    for (; rest_row() < n; ++next) A.insertBack(rest[next].row(), col) = rest[next].value();
-  }
-  A.finalize();
-  A.makeCompressed();
-  return A;
-}
-
-}  // namespace
-
-namespace {
 
 // Solids: the model DOF fields that the mesh map T sends closest to the given mesh fields
 // (3 rows per mesh node): least squares, (T^T T) x = T^T f.
@@ -248,6 +174,8 @@ struct InterfacePartition {
   SparseMatrix Wt;
   int n_b = 0, n_i = 0, n_c = 0;
   ColumnShare interior_share;
+  /// The interior rows this rank holds of the dense blocks while the factor lives.
+  long held_rows() const { return interior_share.whole() ? n_i : interior_share.count; }
 };
 
 // The partition of the model's DOFs by its interfaces; false with *message when an RBE3
@@ -338,16 +266,19 @@ SparseMatrix Augmented(const SparseMatrix& K_ii, const SparseMatrix& Wt, const C
 // Solves on the constrained space W x = 0 (Lagrange multipliers eliminated through the 6r x 6r
 // Schur complement S = W F^-1 W^T, F the factored matrix):
 //   F x + W^T mu = z, W x = 0   =>   x = F^-1 z - Y S^-1 W F^-1 z,  Y = F^-1 W^T.
+// On this rank's rows (`share` of the interior; all on one process) as the factor's solves: the
+// products W x are each rank's part, summed.
 class ConstrainedSolver {
  public:
-  ConstrainedSolver(InteriorSolver& factor, const SparseMatrix& Wt)
+  ConstrainedSolver(InteriorSolver& factor, const SparseMatrix& Wt, const ColumnShare& share)
       : factor_(factor),
-        Wt_(Wt),
-        Y_(Wt.cols() > 0 ? factor.Solve(Eigen::MatrixXd(Wt)) : Eigen::MatrixXd(Wt.rows(), 0)),
-        S_(Eigen::MatrixXd(Wt.transpose() * Y_)) {}
+        share_(share),
+        Wt_(share.whole() ? Wt : SparseMatrix(Wt.middleRows(share.first, share.count))),
+        Y_(Wt.cols() > 0 ? factor.Solve(Eigen::MatrixXd(Wt_)) : Eigen::MatrixXd(Wt_.rows(), 0)),
+        S_(Constraints(Y_)) {}
   Eigen::MatrixXd Solve(const Eigen::MatrixXd& z) const {
     Eigen::MatrixXd x = factor_.Solve(z);
-    if (Wt_.cols() > 0) x -= Y_ * S_.solve(Eigen::MatrixXd(Wt_.transpose() * x));
+    if (Wt_.cols() > 0) x -= Y_ * S_.solve(Constraints(x));
     return x;
   }
   // The distributing interfaces' static modes: their six coordinates set to unit values
@@ -357,8 +288,16 @@ class ConstrainedSolver {
   }
 
  private:
+  // W x for x held as this rank's rows.
+  Eigen::MatrixXd Constraints(const Eigen::MatrixXd& x) const {
+    Eigen::MatrixXd Wx = Wt_.transpose() * x;
+    SumOverRanks(Wx, share_);
+    return Wx;
+  }
+
   InteriorSolver& factor_;
-  const SparseMatrix& Wt_;
+  const ColumnShare share_;
+  const SparseMatrix Wt_;  ///< this rank's rows of W^T
   const Eigen::MatrixXd Y_;
   const Eigen::LDLT<Eigen::MatrixXd> S_;
 };
@@ -367,24 +306,26 @@ class ConstrainedSolver {
 // W x = 0), into Psi_b; a distributing interface's, into Psi_c (UnitConstraintModes).
 void StaticModes(const FeModel& model, const InterfacePartition& p, const SparseMatrix& K_ib,
                  const ConstrainedSolver& solver, Eigen::MatrixXd& Psi_b, Eigen::MatrixXd& Psi_c) {
-  // (K_ib summed over the ranks: each holds the boundary columns it holds, exactly)
-  Eigen::MatrixXd K_ib_dense = p.n_b > 0 ? Eigen::MatrixXd(K_ib) : Eigen::MatrixXd(p.n_i, 0);
-  SumOverRanks(K_ib_dense, p.interior_share);
-  Psi_b = p.n_b > 0 ? Eigen::MatrixXd(-solver.Solve(K_ib_dense)) : Eigen::MatrixXd(p.n_i, 0);
+  // (this rank's rows of K_ib: the ranks hold its columns, the boundary DOFs', in pieces)
+  const ColumnShare& held = p.interior_share;
+  const long rows = p.held_rows(), first = held.whole() ? 0 : held.first;
+  const Eigen::MatrixXd K_ib_rows =
+      p.n_b > 0 ? HeldRows(SumSparseOverRanks(K_ib, held), held) : Eigen::MatrixXd(rows, 0);
+  Psi_b = p.n_b > 0 ? Eigen::MatrixXd(-solver.Solve(K_ib_rows)) : Eigen::MatrixXd(rows, 0);
   // Rigid motions exactly: mathematically the static modes reproduce them (Psi_b R_b = R_i for
   // the rigid fields R); in floating point only to cond(K_ii) times the round-off of K R = 0,
   // which a thin part (a 0.5 mm leaf: 3e-8) makes visible in Phi_CB Phi_rig0 = 1. A rank-6
   // correction Psi_b += (R_i - Psi_b R_b) (R_b^T R_b)^-1 R_b^T restores it to round-off; it
-  // changes the static modes by that residual only. (DOF interfaces only.)
+  // changes the static modes by that residual only. (DOF interfaces only; row by row.)
   if (p.n_b > 0 && p.n_c == 0) {
     const Eigen::MatrixXd R = RigidFields(model);
-    Eigen::MatrixXd R_b(p.n_b, 6), R_i(p.n_i, 6);
+    Eigen::MatrixXd R_b(p.n_b, 6), R_i(rows, 6);
     for (int k = 0; k < p.n_b; ++k) R_b.row(k) = R.row(p.boundary[k]);
-    for (int k = 0; k < p.n_i; ++k) R_i.row(k) = R.row(p.interior[k]);
+    for (long k = 0; k < rows; ++k) R_i.row(k) = R.row(p.interior[size_t(first + k)]);
     const Eigen::MatrixXd G = R_b.transpose() * R_b;
     Psi_b += (R_i - Psi_b * R_b) * G.ldlt().solve(R_b.transpose());
   }
-  Psi_c.resize(p.n_i, p.n_c);
+  Psi_c.resize(rows, p.n_c);
   if (p.n_c > 0) Psi_c = solver.UnitConstraintModes();
 }
 
@@ -403,44 +344,75 @@ Eigen::MatrixXd CraigBamptonShapes(const FeModel& model, const InterfacePartitio
   return shapes;
 }
 
+// Pairs whose (dK/dq_j) phi_i are evaluated at a time: the n x pairs block of them is never held
+// whole (20 modes' pairs are 210 columns).
+constexpr size_t kDerivativePairsPerStep = 16;
+
+// x^T y for x and y held as each rank's rows of the interior.
+double RowsDot(const InterfacePartition& p, const Eigen::VectorXd& x, const Eigen::VectorXd& y) {
+  Eigen::Matrix<double, 1, 1> d(x.dot(y));
+  SumOverRanks(d, p.interior_share);
+  return d(0, 0);
+}
+
+// X^T y for X and y held as each rank's rows of the interior (Eigen's product: a vector).
+Eigen::VectorXd RowsCoefficients(const InterfacePartition& p, const Eigen::Ref<const Eigen::MatrixXd>& X,
+                                 const Eigen::VectorXd& y) {
+  Eigen::VectorXd c = X.transpose() * y;
+  SumOverRanks(c, p.interior_share);
+  return c;
+}
+
+// X^T Y for X and Y held as each rank's rows of the interior (dense_products' product).
+Eigen::MatrixXd RowsTransposeTimes(const InterfacePartition& p, const Eigen::MatrixXd& X, const Eigen::MatrixXd& Y) {
+  Eigen::MatrixXd XtY = TransposeTimes(X, Y);
+  SumOverRanks(XtY, p.interior_share);
+  return XtY;
+}
+
+// This rank's interior rows of full-DOF fields f (n x k).
+Eigen::MatrixXd HeldInteriorRows(const InterfacePartition& p, const Eigen::MatrixXd& f) {
+  const long rows = p.held_rows(), first = p.interior_share.whole() ? 0 : p.interior_share.first;
+  Eigen::MatrixXd out(rows, f.cols());
+  for (long k = 0; k < rows; ++k) out.row(k) = f.row(p.interior[size_t(first + k)]);
+  return out;
+}
+
 // Modal derivatives: interior solves with the interfaces held, deflated against the modes and
 // the derivatives kept (M_ii inner product, twice), normalized; a derivative that deflation
-// leaves below the request's tolerance of its norm is dropped. The kept pairs into r.
+// leaves below the request's tolerance of its norm is dropped. The kept pairs into r. Phi_i and
+// the derivatives: this rank's rows; `shapes`: the whole Craig-Bampton shapes.
 Eigen::MatrixXd ModalDerivatives(const InterfacePartition& p, const SparseMatrix& M_ii, const Eigen::MatrixXd& Phi_i,
                                  const Eigen::MatrixXd& shapes, const DerivativeRequest& derivatives,
                                  const ConstrainedSolver& solver, CraigBamptonResult& r) {
   const int m = int(Phi_i.cols());
   const auto M_ii_times = [&](const Eigen::VectorXd& v) {
-    return Eigen::VectorXd(SharedTimes(M_ii, v, p.interior_share));
+    return Eigen::VectorXd(SharedTimesRows(M_ii, v, p.interior_share));
   };
-  const Eigen::MatrixXd dK = derivatives.stiffness_derivative(shapes, derivatives.pairs);
-  Eigen::MatrixXd z(p.n_i, dK.cols());
-  for (int k = 0; k < p.n_i; ++k) z.row(k) = -dK.row(p.interior[k]);
+  const std::vector<std::pair<int, int>>& pairs = derivatives.pairs;
+  Eigen::MatrixXd z(p.held_rows(), long(pairs.size()));
+  for (size_t at = 0; at < pairs.size(); at += kDerivativePairsPerStep) {
+    const size_t end = std::min(pairs.size(), at + kDerivativePairsPerStep);
+    const std::vector<std::pair<int, int>> step(pairs.begin() + long(at), pairs.begin() + long(end));
+    z.middleCols(long(at), long(step.size())) = -HeldInteriorRows(p, derivatives.stiffness_derivative(shapes, step));
+  }
   const Eigen::MatrixXd raw = solver.Solve(z);
-  Eigen::MatrixXd Theta(p.n_i, raw.cols());
+  Eigen::MatrixXd Theta(p.held_rows(), raw.cols());
   int kept = 0;
   for (long c = 0; c < raw.cols(); ++c) {
     Eigen::VectorXd v = raw.col(c);
-    const double before = std::sqrt(std::max(v.dot(M_ii_times(v)), 0.0));
+    const double before = std::sqrt(std::max(RowsDot(p, v, M_ii_times(v)), 0.0));
     for (int pass = 0; pass < 2; ++pass) {
-      if (m > 0) v -= Phi_i * (Phi_i.transpose() * M_ii_times(v));
-      if (kept > 0) v -= Theta.leftCols(kept) * (Theta.leftCols(kept).transpose() * M_ii_times(v));
+      if (m > 0) v -= Phi_i * RowsCoefficients(p, Phi_i, M_ii_times(v));
+      if (kept > 0) v -= Theta.leftCols(kept) * RowsCoefficients(p, Theta.leftCols(kept), M_ii_times(v));
     }
-    const double after = std::sqrt(std::max(v.dot(M_ii_times(v)), 0.0));
+    const double after = std::sqrt(std::max(RowsDot(p, v, M_ii_times(v)), 0.0));
     if (!(before > 0) || after <= derivatives.tolerance * before) continue;
     Theta.col(kept++) = v / after;
-    r.derivative_pairs.push_back(derivatives.pairs[size_t(c)]);
+    r.derivative_pairs.push_back(pairs[size_t(c)]);
   }
-  Theta.conservativeResize(p.n_i, kept);
+  Theta.conservativeResize(p.held_rows(), kept);
   return Theta;
-}
-
-// The interior of the static responses to loads f (full DOFs, n x k) with the interfaces held:
-// K_ii u = f_i on W u = 0.
-Eigen::MatrixXd HeldResponse(const InterfacePartition& p, const Eigen::MatrixXd& f, const ConstrainedSolver& solver) {
-  Eigen::MatrixXd z(p.n_i, f.cols());
-  for (int k = 0; k < p.n_i; ++k) z.row(k) = f.row(p.interior[k]);
-  return solver.Solve(z);
 }
 
 // Interior fields (n_i x k) on the full DOFs, zero on the boundary DOFs.
@@ -457,20 +429,20 @@ Eigen::MatrixXd FullFields(const FeModel& model, const InterfacePartition& p, co
 // projection (Phi^T K = Lambda Phi^T M); the derivatives are not eigenvectors, and with the M_ii
 // projection the stress they carry was counted twice or lost: a rotating cantilever with the
 // derivatives of its modes' pairs was 21% stiff (beams) to 400% (a TET10 bar) in its bending
-// frequency. The loads f = -M A_k given; the full fields (n x 12).
-Eigen::MatrixXd InertiaDisplacements(const FeModel& model, const InterfacePartition& p, const SparseMatrix& K_ii,
+// frequency. Given this rank's rows of the loads' interior f_i = (-M A_k)_i (and of Phi_i and
+// Theta); its rows of the interior fields (n_i x 12).
+Eigen::MatrixXd InertiaDisplacements(const InterfacePartition& p, const SparseMatrix& K_ii,
                                      const Eigen::MatrixXd& Phi_i, const Eigen::MatrixXd& Theta,
-                                     const Eigen::MatrixXd& f, const ConstrainedSolver& solver) {
-  Eigen::MatrixXd u = HeldResponse(p, f, solver);
+                                     const Eigen::MatrixXd& f_i, const ConstrainedSolver& solver) {
+  Eigen::MatrixXd u = solver.Solve(f_i);  // K_ii u = f_i on W u = 0
   const long m = Phi_i.cols(), d = Theta.cols();
   if (m + d > 0) {
-    Eigen::MatrixXd V(p.n_i, m + d), f_i(p.n_i, f.cols());
+    Eigen::MatrixXd V(p.held_rows(), m + d);
     V << Phi_i, Theta;
-    for (int k = 0; k < p.n_i; ++k) f_i.row(k) = f.row(p.interior[k]);
-    const Eigen::MatrixXd K_r = SharedCongruence(V, K_ii, V, p.interior_share);
-    u -= V * Eigen::MatrixXd(0.5 * (K_r + K_r.transpose())).ldlt().solve(TransposeTimes(V, f_i));
+    const Eigen::MatrixXd K_r = RowsTransposeTimes(p, V, SharedTimesRows(K_ii, V, p.interior_share));
+    u -= V * Eigen::MatrixXd(0.5 * (K_r + K_r.transpose())).ldlt().solve(RowsTransposeTimes(p, V, f_i));
   }
-  return FullFields(model, p, u);
+  return u;
 }
 
 // Projection K_r = Phi^T K Phi, M_r = Phi^T M Phi with Phi the full fields of the reduced
@@ -505,34 +477,49 @@ std::string FactorizationFailure(const FactorizationInfo& f) {
          "; some part of the model is not held by any interface";
 }
 
-// The model's K and M held only as their blocks (Partition) while the interior's factor lives:
-// released on construction (when given a model to release them from) and rebuilt from the blocks,
-// the same entries, by Restore or at the end. The peak memory is then lower by K and M.
-class HeldAsBlocks {
- public:
-  HeldAsBlocks(FeModel* model, const Blocks& K, const Blocks& M, const InterfacePartition& p)
-      : model_(model), K_(K), M_(M), p_(p) {
-    if (!model_) return;
-    // Empty matrices of the same size (n_dofs() is K's).
-    const long n = model_->K.rows();
-    SparseMatrix(n, n).swap(model_->K);
-    SparseMatrix(n, n).swap(model_->M);
-  }
-  ~HeldAsBlocks() { Restore(); }
-  HeldAsBlocks(const HeldAsBlocks&) = delete;
-  HeldAsBlocks& operator=(const HeldAsBlocks&) = delete;
-  void Restore() {
-    if (!model_) return;
-    model_->K = Unpartition(K_, p_.interior, p_.interior_index);
-    model_->M = Unpartition(M_, p_.interior, p_.interior_index);
-    model_ = nullptr;
-  }
+// This rank's rows of the interior of the inertia loads f = -M A_k (A: the inertia fields, n x k).
+Eigen::MatrixXd InertiaLoads(const FeModel& model, const InterfacePartition& p, const Eigen::MatrixXd& fields) {
+  const ColumnShare& rows = model.columns;
+  const Eigen::MatrixXd MA = SharedTimesRows(model.M, HeldRows(fields, rows), rows);  // this rank's model rows
+  const long first = rows.whole() ? 0 : rows.first, i0 = p.interior_share.whole() ? 0 : p.interior_share.first;
+  Eigen::MatrixXd f(p.held_rows(), fields.cols());
+  for (long k = 0; k < f.rows(); ++k) f.row(k) = -MA.row(p.interior[size_t(i0 + k)] - first);
+  return f;
+}
 
- private:
-  FeModel* model_;
-  const Blocks &K_, &M_;
-  const InterfacePartition& p_;
-};
+// The lowest `nev` fixed-interface modes: shift-invert around 0 on the factor, on W x = 0, by a
+// dense solver for a small interior, the solver's own (SLEPc on MPI ranks) or femb's block
+// Lanczos; the vectors are this rank's rows. How they were solved into *how.
+EigenResult FixedInterfaceModes(const InterfacePartition& p, const Blocks& K, const Blocks& M, InteriorSolver& factor,
+                                const ConstrainedSolver& solver, int nev, long dense_limit, std::string* how) {
+  const ColumnShare& held = p.interior_share;
+  // (whole vectors in and out: this rank's rows solved, the ranks' gathered)
+  const auto whole_solve = [&](const Eigen::MatrixXd& z) { return GatherRows(solver.Solve(HeldRows(z, held)), held); };
+  if (p.n_i <= dense_limit || 2 * nev + 1 > p.n_i - p.n_c) {
+    const ShiftInvertFn solve = [&](const double* b, double* x) {
+      Eigen::Map<const Eigen::VectorXd> bv(b, p.n_i);
+      Eigen::Map<Eigen::VectorXd> xv(x, p.n_i);
+      xv = whole_solve(Eigen::MatrixXd(bv));
+    };
+    EigenResult eig = LowestConstrainedEigenpairs(GatherColumns(K.ii, held), GatherColumns(M.ii, held),
+                                                  Eigen::MatrixXd(p.Wt.transpose()), nev, 0.0, solve, dense_limit);
+    eig.vectors = HeldRows(eig.vectors, held);
+    *how = eig.dense ? ", dense solver (small interior)" : ", block shift-invert Lanczos, 0 passes over the factor";
+    return eig;
+  }
+  const auto rows_solve = [&](const Eigen::MatrixXd& z) { return solver.Solve(z); };
+  if (std::optional<EigenResult> own = factor.Eigenpairs(K.ii, M.ii, nev, kLanczosTolerance, rows_solve, p.n_c == 0)) {
+    *how = ", " + factor.EigenDetail();
+    return std::move(*own);
+  }
+  // (femb's Lanczos multiplies by the whole K_ii and M_ii: one process)
+  if (!held.whole()) throw std::logic_error("the block Lanczos on a share of K_ii and M_ii");
+  long passes = 0;
+  EigenResult eig = BlockLanczosEigenpairs(K.ii, M.ii, Eigen::MatrixXd(p.Wt.transpose()), nev, 0.0, rows_solve,
+                                           kLanczosBlock, kLanczosTolerance, &passes);
+  *how = Format(", block shift-invert Lanczos, %.0f passes over the factor", double(passes));
+  return eig;
+}
 
 CraigBamptonResult Reduce(const FeModel& model, FeModel* release, int internal_modes, const ProgressFn& progress,
                           long dense_limit, double memory_limit_bytes, const DerivativeRequest* derivatives,
@@ -548,12 +535,13 @@ CraigBamptonResult Reduce(const FeModel& model, FeModel* release, int internal_m
   }
   Blocks K = Partition(model.K, p.interior_index, p.boundary_index, p.n_i, p.n_b);
   Blocks M = Partition(model.M, p.interior_index, p.boundary_index, p.n_i, p.n_b);
-  const Eigen::MatrixXd inertia_loads = inertia_fields && inertia_fields->cols() > 0
-                                            ? Eigen::MatrixXd(-SharedTimes(model.M, *inertia_fields, model.columns))
-                                            : Eigen::MatrixXd();
-  HeldAsBlocks held(release, K, M, p);
+  const bool inertia = inertia_fields && inertia_fields->cols() > 0;
+  Eigen::MatrixXd inertia_loads = inertia ? InertiaLoads(model, p, *inertia_fields) : Eigen::MatrixXd();
+  HeldAsBlocks held(release, K, M, p.interior, p.interior_index);
 
   // One factorization (METIS ordering, supernodal) of K_ii, or of the augmented F (Augmented).
+  // While it lives, the dense blocks (static modes, modes, derivatives, inertia displacements) are
+  // each rank's rows of them (on MPI ranks: the factor's own share, not the whole on every rank).
   clock.Restart();
   SparseMatrix F_augmented;
   if (p.n_b == 0) F_augmented = Augmented(K.ii, p.Wt, p.interior_share);
@@ -571,7 +559,7 @@ CraigBamptonResult Reduce(const FeModel& model, FeModel* release, int internal_m
   if (progress) progress("factorize K_ii", t_factor, FactorizationDetail(r.factorization, p.n_i));
 
   clock.Restart();
-  const ConstrainedSolver solver(*factor, p.Wt);
+  const ConstrainedSolver solver(*factor, p.Wt, p.interior_share);
   Eigen::MatrixXd Psi_b, Psi_c;
   StaticModes(model, p, K.ib, solver, Psi_b, Psi_c);
   if (progress) {
@@ -579,27 +567,12 @@ CraigBamptonResult Reduce(const FeModel& model, FeModel* release, int internal_m
              Format("%.0f constraint modes, %.0f linear solves", p.n_b + p.n_c, double(factor->solves())));
   }
 
-  // Fixed-interface modes, shift-invert around 0 on the same factor, on W x = 0; one mode more
-  // than kept (when there is one): its frequency tells whether the cut splits equal modes.
+  // Fixed-interface modes; one mode more than kept (when there is one): its frequency tells
+  // whether the cut splits equal modes.
   clock.Restart();
-  const ShiftInvertFn solve = [&](const double* b, double* x) {
-    Eigen::Map<const Eigen::VectorXd> bv(b, p.n_i);
-    Eigen::Map<Eigen::VectorXd> xv(x, p.n_i);
-    xv = solver.Solve(Eigen::MatrixXd(bv));
-  };
-  const auto constrained_solve = [&](const Eigen::MatrixXd& z) { return solver.Solve(z); };
-  const Eigen::MatrixXd C = Eigen::MatrixXd(p.Wt.transpose());
-  long passes = 0;
   const int nev = internal_modes > 0 && internal_modes + 1 <= p.n_i - p.n_c ? internal_modes + 1 : internal_modes;
-  const bool dense = p.n_i <= dense_limit || 2 * nev + 1 > p.n_i - p.n_c;
-  std::optional<EigenResult> own =
-      dense ? std::nullopt : factor->Eigenpairs(K.ii, M.ii, nev, kLanczosTolerance, constrained_solve, p.n_c == 0);
-  EigenResult eig =
-      dense ? LowestConstrainedEigenpairs(GatherColumns(K.ii, p.interior_share), GatherColumns(M.ii, p.interior_share),
-                                          C, nev, 0.0, solve, dense_limit)
-      : own ? std::move(*own)
-            : BlockLanczosEigenpairs(K.ii, M.ii, C, nev, 0.0, constrained_solve, kLanczosBlock, kLanczosTolerance,
-                                     &passes);
+  std::string how;
+  EigenResult eig = FixedInterfaceModes(p, K, M, *factor, solver, nev, dense_limit, &how);
   if (!eig.ok) {
     r.message = "fixed-interface eigen solve failed: " + eig.message;
     return r;
@@ -612,20 +585,21 @@ CraigBamptonResult Reduce(const FeModel& model, FeModel* release, int internal_m
   r.lambda = eig.lambda;
   r.eigen_linear_solves = eig.linear_solves;
   r.dense_eigen = eig.dense;
-  const Eigen::MatrixXd& Phi_i = eig.vectors;
+  Eigen::MatrixXd& Phi_i = eig.vectors;
   if (progress) {
     progress("eigen solve", clock.Seconds(),
              Format("%.0f fixed-interface modes, %.0f linear solves (%.1f per mode)", internal_modes,
                     double(eig.linear_solves), double(eig.linear_solves) / std::max(internal_modes, 1)) +
-                 (eig.dense ? ", dense solver (small interior)"
-                  : own     ? ", " + factor->EigenDetail()
-                            : Format(", block shift-invert Lanczos, %.0f passes over the factor", double(passes))));
+                 how);
   }
 
   clock.Restart();
-  const Eigen::MatrixXd shapes = CraigBamptonShapes(model, p, Psi_b, Psi_c, Phi_i, internal_modes);
-  Eigen::MatrixXd Theta(p.n_i, 0);
+  const ColumnShare& rows = p.interior_share;
+  Eigen::MatrixXd Theta(p.held_rows(), 0), inertia_u;
   if (derivatives && !derivatives->pairs.empty()) {
+    // (the element loops of dK/dq take the whole shapes: gathered for them)
+    const Eigen::MatrixXd shapes = CraigBamptonShapes(model, p, GatherRows(Psi_b, rows), GatherRows(Psi_c, rows),
+                                                      GatherRows(Phi_i, rows), internal_modes);
     Theta = ModalDerivatives(p, M.ii, Phi_i, shapes, *derivatives, solver, r);
     if (progress) {
       progress(
@@ -635,19 +609,24 @@ CraigBamptonResult Reduce(const FeModel& model, FeModel* release, int internal_m
     }
     clock.Restart();
   }
-  if (inertia_loads.cols() > 0) {
-    r.inertia_displacements = InertiaDisplacements(model, p, K.ii, Phi_i, Theta, inertia_loads, solver);
+  if (inertia) {
+    inertia_u = InertiaDisplacements(p, K.ii, Phi_i, Theta, inertia_loads, solver);
+    inertia_loads = Eigen::MatrixXd();
     if (progress) {
       progress("inertia loads", clock.Seconds(),
                Format("%.0f static solves with the interfaces held", double(inertia_fields->cols())));
     }
     clock.Restart();
   }
-  // The factor is no longer needed: freed before K and M are rebuilt, then the blocks.
+  // The factor is no longer needed: freed before K and M are rebuilt, then the blocks; only then
+  // are the dense blocks gathered whole.
   factor.reset();
   held.Restore();
   K = Blocks(), M = Blocks();
-  Project(model, p, shapes, Theta, r);
+  if (inertia) r.inertia_displacements = FullFields(model, p, GatherRows(inertia_u, rows));
+  const Eigen::MatrixXd shapes = CraigBamptonShapes(model, p, GatherRows(Psi_b, rows), GatherRows(Psi_c, rows),
+                                                    GatherRows(Phi_i, rows), internal_modes);
+  Project(model, p, shapes, GatherRows(Theta, rows), r);
   if (progress) progress("projection", clock.Seconds(), Format("%.0f reduced DOFs", int(r.shapes.cols())));
   r.ok = true;
   return r;

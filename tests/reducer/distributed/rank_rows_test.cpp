@@ -1,0 +1,105 @@
+// The dense blocks of a reduction held as each MPI rank's rows (shared_columns.h), on real ranks
+// (mpirun -np 3: MpiRanks registers MPI's collectives): gathered rows are the whole block exactly,
+// whatever the column count (several gather steps, no columns, a rank without rows); this rank's
+// rows of A X from A's share of columns and X's share of rows are those of the whole product
+// (1e-14 of its norm: only the order of the sums differs); the ranks' pieces of a sparse block add
+// up to it exactly. Each rank builds the same matrices from one seed.
+#include <gtest/gtest.h>
+
+#include <random>
+#include <vector>
+
+#include "reducer/distributed/mpi_ranks.h"
+#include "reducer/linalg/interior_solver.h"
+#include "reducer/linalg/shared_columns.h"
+
+namespace femb {
+namespace {
+
+// A symmetric banded n x n matrix with random entries, the same on every rank.
+SparseMatrix Banded(long n, int half_width, unsigned seed) {
+  std::mt19937 random(seed);
+  std::uniform_real_distribution<double> value(-1.0, 1.0);
+  std::vector<Eigen::Triplet<double>> entries;
+  for (long j = 0; j < n; ++j) {
+    entries.emplace_back(int(j), int(j), 4.0 + value(random));
+    for (long i = j + 1; i <= std::min(n - 1, j + half_width); ++i) {
+      const double v = value(random);
+      entries.emplace_back(int(i), int(j), v);
+      entries.emplace_back(int(j), int(i), v);
+    }
+  }
+  SparseMatrix A(n, n);
+  A.setFromTriplets(entries.begin(), entries.end());
+  return A;
+}
+
+Eigen::MatrixXd RandomBlock(long n, long k, unsigned seed) {
+  std::mt19937 random(seed);
+  std::uniform_real_distribution<double> value(-1.0, 1.0);
+  Eigen::MatrixXd X(n, k);
+  for (long c = 0; c < k; ++c)
+    for (long i = 0; i < n; ++i) X(i, c) = value(random);
+  return X;
+}
+
+TEST(RankRows, GatheredRowsAreTheWholeBlockExactly) {
+  ASSERT_GT(DistributedRanks(), 1);
+  // 2^19 rows: 64 columns per gather step, so 70 columns take two; 2 rows: a rank holds none.
+  for (const long n : {long(1) << 19, 1000L, 2L}) {
+    const ColumnShare share = ShareOfColumns(n);
+    ASSERT_FALSE(share.whole());
+    for (const long k : {70L, 1L, 0L}) {
+      if (n == (long(1) << 19) && k != 70) continue;
+      const Eigen::MatrixXd X = RandomBlock(n, k, 7);
+      const Eigen::MatrixXd mine = HeldRows(X, share);
+      EXPECT_EQ(mine.rows(), share.count);
+      const Eigen::MatrixXd gathered = GatherRows(mine, share);
+      ASSERT_EQ(gathered.rows(), n);
+      ASSERT_EQ(gathered.cols(), k);
+      EXPECT_TRUE(gathered == X) << n << " x " << k;
+    }
+  }
+}
+
+TEST(RankRows, RowsOfAProductFromSharedColumnsAreThoseOfTheWhole) {
+  for (const long n : {long(1) << 19, 1000L}) {
+    const SparseMatrix A = Banded(n, 5, 11);
+    const Eigen::MatrixXd X = RandomBlock(n, n > 1000 ? 70 : 9, 13);
+    const ColumnShare share = ShareOfColumns(n);
+    const Eigen::MatrixXd whole = A * X;
+    const Eigen::MatrixXd mine = SharedTimesRows(KeepColumns(A, share), HeldRows(X, share), share);
+    const Eigen::MatrixXd expected = HeldRows(whole, share);
+    ASSERT_EQ(mine.rows(), expected.rows());
+    ASSERT_EQ(mine.cols(), expected.cols());
+    EXPECT_LE((mine - expected).norm(), 1e-14 * whole.norm()) << n;
+  }
+}
+
+TEST(RankRows, RanksPiecesOfASparseBlockAddUpToItExactly) {
+  const long n = 500;
+  const SparseMatrix A = Banded(n, 3, 17);
+  const int ranks = DistributedRanks(), rank = DistributedRank();
+  std::vector<Eigen::Triplet<double>> mine;
+  for (int col = 0; col < A.outerSize(); ++col)
+    for (SparseMatrix::InnerIterator it(A, col); it; ++it)
+      if ((it.row() + col) % ranks == rank) mine.emplace_back(int(it.row()), col, it.value());
+  SparseMatrix piece(n, n);
+  piece.setFromTriplets(mine.begin(), mine.end());
+  const SparseMatrix summed = SumSparseOverRanks(piece, ShareOfColumns(n));
+  EXPECT_EQ(summed.nonZeros(), A.nonZeros());
+  EXPECT_EQ(SparseMatrix(summed - A).norm(), 0.0);
+}
+
+}  // namespace
+}  // namespace femb
+
+int main(int argc, char** argv) {
+  ::testing::InitGoogleTest(&argc, argv);
+  const femb::MpiRanks ranks;
+  if (ranks.rank() != 0) {  // (one report: rank 0's; every rank's exit code counts)
+    ::testing::TestEventListeners& listeners = ::testing::UnitTest::GetInstance()->listeners();
+    delete listeners.Release(listeners.default_result_printer());
+  }
+  return RUN_ALL_TESTS();
+}
