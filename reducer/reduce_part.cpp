@@ -596,7 +596,8 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
   NonlinearModelOf nonlinear(part, model);
   const DerivativeRequest request = ModalDerivativeRequest(part, model, nonlinear);
   const bool stiffening = UsesStiffening(part, model, progress);
-  const Eigen::MatrixXd inertia_fields = stiffening ? InertiaFields(model) : Eigen::MatrixXd();
+  // (on MPI ranks this rank's rows of them: they live as long as the factor)
+  const Eigen::MatrixXd inertia_fields = stiffening ? HeldRows(InertiaFields(model), model.columns) : Eigen::MatrixXd();
   const bool other_basis =
       part.reduction.method == ReductionMethod::kFreeInterface || part.reduction.method == ReductionMethod::kGeneral;
   CraigBamptonResult cb =

@@ -112,9 +112,9 @@ Eigen::MatrixXd HeldRows(const SparseMatrix& A, const ColumnShare& share) {
 
 namespace {
 
-// Columns per step of the gathers and products that go a few columns at a time: about 256 MB of
+// Columns per step of the gathers and products that go a few columns at a time: about 32 MB of
 // n-row columns, so that the whole n x k block is never held at once.
-long ColumnsPerStep(long n) { return std::max<long>(1, (long(1) << 25) / std::max<long>(n, 1)); }
+long ColumnsPerStep(long n) { return std::max<long>(1, (long(1) << 22) / std::max<long>(n, 1)); }
 
 }  // namespace
 

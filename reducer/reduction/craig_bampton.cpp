@@ -477,10 +477,11 @@ std::string FactorizationFailure(const FactorizationInfo& f) {
          "; some part of the model is not held by any interface";
 }
 
-// This rank's rows of the interior of the inertia loads f = -M A_k (A: the inertia fields, n x k).
+// This rank's rows of the interior of the inertia loads f = -M A_k (A: this rank's rows of the
+// inertia fields, n x k in all).
 Eigen::MatrixXd InertiaLoads(const FeModel& model, const InterfacePartition& p, const Eigen::MatrixXd& fields) {
   const ColumnShare& rows = model.columns;
-  const Eigen::MatrixXd MA = SharedTimesRows(model.M, HeldRows(fields, rows), rows);  // this rank's model rows
+  const Eigen::MatrixXd MA = SharedTimesRows(model.M, fields, rows);  // this rank's model rows
   const long first = rows.whole() ? 0 : rows.first, i0 = p.interior_share.whole() ? 0 : p.interior_share.first;
   Eigen::MatrixXd f(p.held_rows(), fields.cols());
   for (long k = 0; k < f.rows(); ++k) f.row(k) = -MA.row(p.interior[size_t(i0 + k)] - first);

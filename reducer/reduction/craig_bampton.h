@@ -60,8 +60,10 @@ struct CraigBamptonResult {
 
 /// `internal_modes` fixed-interface modes are kept. Reports stages through `progress`. With
 /// `memory_limit_bytes` > 0, refuses (factorization.too_big) when the factor of K_ii would not fit.
-/// `derivatives` (optional) appends modal derivatives to the basis. `solver`: the interior's
-/// factor and eigen solver (linalg/interior_solver.h).
+/// `derivatives` (optional) appends modal derivatives to the basis. `inertia_fields` (optional,
+/// n x k on one process; on MPI ranks sharing K and M this rank's rows of them, HeldRows of the
+/// model's columns) asks for the inertia displacements. `solver`: the interior's factor and eigen
+/// solver (linalg/interior_solver.h).
 CraigBamptonResult CraigBamptonReduce(const FeModel& model, int internal_modes, const ProgressFn& progress,
                                       long dense_limit = 200, double memory_limit_bytes = 0,
                                       const DerivativeRequest* derivatives = nullptr,

@@ -45,12 +45,12 @@ Eigen::MatrixXd RandomBlock(long n, long k, unsigned seed) {
 
 TEST(RankRows, GatheredRowsAreTheWholeBlockExactly) {
   ASSERT_GT(DistributedRanks(), 1);
-  // 2^19 rows: 64 columns per gather step, so 70 columns take two; 2 rows: a rank holds none.
-  for (const long n : {long(1) << 19, 1000L, 2L}) {
+  // 2^16 rows: 64 columns per gather step, so 70 columns take two; 2 rows: a rank holds none.
+  for (const long n : {long(1) << 16, 1000L, 2L}) {
     const ColumnShare share = ShareOfColumns(n);
     ASSERT_FALSE(share.whole());
     for (const long k : {70L, 1L, 0L}) {
-      if (n == (long(1) << 19) && k != 70) continue;
+      if (n == (long(1) << 16) && k != 70) continue;
       const Eigen::MatrixXd X = RandomBlock(n, k, 7);
       const Eigen::MatrixXd mine = HeldRows(X, share);
       EXPECT_EQ(mine.rows(), share.count);
@@ -63,7 +63,7 @@ TEST(RankRows, GatheredRowsAreTheWholeBlockExactly) {
 }
 
 TEST(RankRows, RowsOfAProductFromSharedColumnsAreThoseOfTheWhole) {
-  for (const long n : {long(1) << 19, 1000L}) {
+  for (const long n : {long(1) << 16, 1000L}) {
     const SparseMatrix A = Banded(n, 5, 11);
     const Eigen::MatrixXd X = RandomBlock(n, n > 1000 ? 70 : 9, 13);
     const ColumnShare share = ShareOfColumns(n);
