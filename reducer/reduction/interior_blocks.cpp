@@ -7,7 +7,6 @@ Blocks Partition(const SparseMatrix& A, const std::vector<int>& interior_index, 
   // Interior and boundary indices keep the order of A, so each block fills column by column
   // with rows ascending: built in place, no triplet list (A may hold 1e8 entries).
   Blocks out;
-  out.bb = Eigen::MatrixXd::Zero(n_b, n_b);
   out.ii.resize(n_i, n_i);
   out.ib.resize(n_i, n_b);
   out.ii.reserve(A.nonZeros());
@@ -16,14 +15,12 @@ Blocks Partition(const SparseMatrix& A, const std::vector<int>& interior_index, 
     const int ci = interior_index[col], cb = boundary_index[col];
     if (ci >= 0) out.ii.startVec(ci);
     for (SparseMatrix::InnerIterator it(A, col); it; ++it) {
-      const int ri = interior_index[it.row()], rb = boundary_index[it.row()];
+      const int ri = interior_index[it.row()];
       if (ri < 0 || ci < 0) out.rest.emplace_back(int(it.row()), col, it.value());
       if (ri >= 0 && ci >= 0) {
         out.ii.insertBack(ri, ci) = it.value();
       } else if (ri >= 0 && cb >= 0) {
         ib_cols[cb].emplace_back(ri, it.value());
-      } else if (rb >= 0 && cb >= 0) {
-        out.bb(rb, cb) += it.value();
       }
     }
   }

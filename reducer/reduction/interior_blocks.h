@@ -1,6 +1,6 @@
 // The blocks of the model's K or M that a Craig-Bampton reduction works with (interior-interior,
-// interior-boundary, boundary-boundary), split from the full matrix and joined back, and the model
-// held only as its blocks while the interior's factor lives.
+// interior-boundary), split from the full matrix and joined back, and the model held only as its
+// blocks while the interior's factor lives.
 #pragma once
 
 #include <Eigen/Core>
@@ -15,7 +15,6 @@ namespace femb {
 /// row or column (full indices), column by column with rows ascending, for Unpartition.
 struct Blocks {
   SparseMatrix ii, ib;
-  Eigen::MatrixXd bb;
   std::vector<Eigen::Triplet<double>> rest;
 };
 
