@@ -54,6 +54,40 @@ std::vector<std::string> GatherAll(const std::string& mine) {
   return out;
 }
 
+std::vector<std::string> ExchangeAll(const std::vector<std::string>& to) {
+  EnsureStartAgreed();
+  int size = 1;
+  MPI_Comm_size(PETSC_COMM_WORLD, &size);
+  if (to.size() != size_t(size)) throw std::logic_error("an exchange with other than one message per rank");
+  const size_t ranks = static_cast<size_t>(size);
+  std::vector<int> send_counts(ranks), receive_counts(ranks);
+  std::vector<int> send_at(ranks, 0), receive_at(ranks, 0);
+  long send_total = 0, receive_total = 0;
+  for (int r = 0; r < size; ++r) {
+    send_counts[size_t(r)] = int(to[size_t(r)].size());
+    send_at[size_t(r)] = int(send_total);
+    send_total += long(to[size_t(r)].size());
+  }
+  MPI_Alltoall(send_counts.data(), 1, MPI_INT, receive_counts.data(), 1, MPI_INT, PETSC_COMM_WORLD);
+  for (int r = 0; r < size; ++r) {
+    receive_at[size_t(r)] = int(receive_total);
+    receive_total += receive_counts[size_t(r)];
+  }
+  // (the check after the counts' exchange, so that every rank takes part in it)
+  int too_big = send_total > std::numeric_limits<int>::max() || receive_total > std::numeric_limits<int>::max();
+  MPI_Allreduce(MPI_IN_PLACE, &too_big, 1, MPI_INT, MPI_MAX, PETSC_COMM_WORLD);
+  if (too_big) throw std::runtime_error("a rank's rows to exchange exceed 2 GB");
+  std::string sent;
+  for (const std::string& bytes : to) sent += bytes;
+  std::string received(size_t(receive_total), '\0');
+  MPI_Alltoallv(sent.data(), send_counts.data(), send_at.data(), MPI_BYTE, received.data(), receive_counts.data(),
+                receive_at.data(), MPI_BYTE, PETSC_COMM_WORLD);
+  std::vector<std::string> from;
+  for (int r = 0; r < size; ++r)
+    from.push_back(received.substr(size_t(receive_at[size_t(r)]), size_t(receive_counts[size_t(r)])));
+  return from;
+}
+
 }  // namespace
 
 MpiRanks::MpiRanks() {
@@ -86,7 +120,7 @@ MpiRanks::MpiRanks() {
     return RankAgreement{all[0], all[1] < size ? all[1] : -1};
   };
   RegisterDistributedSolver([] { return MakePetscInterior(); }, size_, agree, rank_, on_node);
-  if (size_ > 1) RegisterRankCollectives(SumOverAll, GatherAll);
+  if (size_ > 1) RegisterRankCollectives(SumOverAll, GatherAll, ExchangeAll);
 }
 
 MpiRanks::~MpiRanks() {

@@ -13,6 +13,7 @@ namespace {
 struct Collectives {
   std::function<void(double*, long)> sum;
   std::function<std::vector<std::string>(const std::string&)> gather;
+  std::function<std::vector<std::string>(const std::vector<std::string>&)> exchange;
 };
 
 Collectives& TheCollectives() {
@@ -33,9 +34,11 @@ ColumnShare ShareOfColumns(long n) {
 }
 
 void RegisterRankCollectives(std::function<void(double*, long)> sum,
-                             std::function<std::vector<std::string>(const std::string&)> gather) {
+                             std::function<std::vector<std::string>(const std::string&)> gather,
+                             std::function<std::vector<std::string>(const std::vector<std::string>&)> exchange) {
   TheCollectives().sum = std::move(sum);
   TheCollectives().gather = std::move(gather);
+  TheCollectives().exchange = std::move(exchange);
 }
 
 void SumOverRanks(Eigen::Ref<Eigen::MatrixXd> X, const ColumnShare& share) {
@@ -140,8 +143,77 @@ Eigen::MatrixXd GatherRows(const Eigen::MatrixXd& mine, const ColumnShare& share
   return out;
 }
 
+namespace {
+
+// Every rank's share (first, count), in rank order.
+std::vector<ColumnShare> SharesOfRanks(const ColumnShare& share) {
+  std::string mine;
+  const long header[2] = {share.first, share.count};
+  AppendBytes(mine, header, 2);
+  std::vector<ColumnShare> shares;
+  for (const std::string& bytes : TheCollectives().gather(mine)) {
+    long h[2];
+    TakeBytes(bytes.data(), h, 2);
+    shares.push_back({h[0], h[1]});
+  }
+  return shares;
+}
+
+// SharedTimesRows by the exchange: this rank's part A_h X_h on its own rows and on the rows
+// beyond them that its columns touch (`ghosts`, ascending); those go to the ranks that hold them
+// (each rank's in one message: row indices, then the rows' values), which add them in rank order.
+Eigen::MatrixXd TimesRowsExchanged(const SparseMatrix& A, const Eigen::MatrixXd& X, const ColumnShare& share) {
+  const long first = share.first, count = share.count, k = X.cols();
+  std::vector<int> ghosts;
+  for (long col = first; col < first + count; ++col)
+    for (SparseMatrix::InnerIterator it(A, Eigen::Index(col)); it; ++it)
+      if (!share.Holds(it.row())) ghosts.push_back(int(it.row()));
+  std::sort(ghosts.begin(), ghosts.end());
+  ghosts.erase(std::unique(ghosts.begin(), ghosts.end()), ghosts.end());
+  Eigen::MatrixXd out = Eigen::MatrixXd::Zero(count, k), G = Eigen::MatrixXd::Zero(long(ghosts.size()), k);
+  for (long c = 0; c < k; ++c)
+    for (long col = first; col < first + count; ++col) {
+      const double x = X(col - first, c);
+      for (SparseMatrix::InnerIterator it(A, Eigen::Index(col)); it; ++it) {
+        if (share.Holds(it.row())) {
+          out(it.row() - first, c) += it.value() * x;
+        } else {
+          const long g = std::lower_bound(ghosts.begin(), ghosts.end(), int(it.row())) - ghosts.begin();
+          G(g, c) += it.value() * x;
+        }
+      }
+    }
+  const std::vector<ColumnShare> shares = SharesOfRanks(share);
+  std::vector<std::string> to(shares.size());
+  for (size_t r = 0; r < shares.size(); ++r) {
+    if (shares[r].count <= 0) continue;
+    const auto begin = std::lower_bound(ghosts.begin(), ghosts.end(), int(shares[r].first));
+    const auto end = std::lower_bound(ghosts.begin(), ghosts.end(), int(shares[r].first + shares[r].count));
+    const long rows = long(end - begin), g0 = long(begin - ghosts.begin());
+    if (rows == 0) continue;
+    AppendBytes(to[r], &rows, 1);
+    AppendBytes(to[r], &*begin, size_t(rows));
+    const Eigen::MatrixXd values = G.middleRows(g0, rows);
+    AppendBytes(to[r], values.data(), size_t(values.size()));
+  }
+  for (const std::string& bytes : TheCollectives().exchange(to)) {
+    if (bytes.empty()) continue;
+    long rows = 0;
+    const char* at = TakeBytes(bytes.data(), &rows, 1);
+    std::vector<int> which(static_cast<size_t>(rows));
+    at = TakeBytes(at, which.data(), which.size());
+    Eigen::MatrixXd values(rows, k);
+    TakeBytes(at, values.data(), size_t(values.size()));
+    for (long i = 0; i < rows; ++i) out.row(which[size_t(i)] - first) += values.row(i);
+  }
+  return out;
+}
+
+}  // namespace
+
 Eigen::MatrixXd SharedTimesRows(const SparseMatrix& A, const Eigen::MatrixXd& X, const ColumnShare& share) {
   if (share.whole()) return A * X;
+  if (TheCollectives().exchange) return TimesRowsExchanged(A, X, share);
   const long k = X.cols(), step = ColumnsPerStep(A.rows());
   Eigen::MatrixXd out(share.count, k);
   for (long c0 = 0; c0 < k; c0 += step) {

@@ -23,10 +23,12 @@ namespace femb {
 ColumnShare ShareOfColumns(long n);
 
 /// The collectives of the ranks sharing a reduction: `sum` adds the buffers of all ranks in place,
-/// `gather` gives every rank's bytes in rank order. Each first lets the ranks agree to start
-/// (EnsureStartAgreed: it is the ranks' first collective). Unset on one process.
-void RegisterRankCollectives(std::function<void(double*, long)> sum,
-                             std::function<std::vector<std::string>(const std::string&)> gather);
+/// `gather` gives every rank's bytes in rank order, `exchange` sends the bytes of to[r] to rank r
+/// and returns what each rank sent this one, in rank order. Each first lets the ranks agree to
+/// start (EnsureStartAgreed: it is the ranks' first collective). Unset on one process.
+void RegisterRankCollectives(
+    std::function<void(double*, long)> sum, std::function<std::vector<std::string>(const std::string&)> gather,
+    std::function<std::vector<std::string>(const std::vector<std::string>&)> exchange = nullptr);
 
 /// X computed from this rank's `share` (of a matrix's columns, of the elements): every rank's X
 /// added into X, in place, the same on every rank. Nothing when the share is the whole (one
@@ -65,8 +67,9 @@ Eigen::MatrixXd HeldRows(const SparseMatrix& A, const ColumnShare& share);
 Eigen::MatrixXd GatherRows(const Eigen::MatrixXd& mine, const ColumnShare& share);
 
 /// This rank's rows of A X for A shared by columns and X held as its rows (`share` both): each
-/// rank's part A_h X_h of the whole, summed a few columns at a time (the whole product is never
-/// held at once). The plain A X when the share is the whole.
+/// rank's part A_h X_h of the whole, whose rows beyond its own (the layer of the mesh around its
+/// part) are sent to the ranks that hold them and added there (without `exchange`: summed over all
+/// ranks a few columns at a time). The plain A X when the share is the whole.
 Eigen::MatrixXd SharedTimesRows(const SparseMatrix& A, const Eigen::MatrixXd& X, const ColumnShare& share);
 
 /// Every rank's entries of A added up (sparse; each rank's A the same size): the whole of a

@@ -1,9 +1,10 @@
 // The dense blocks of a reduction held as each MPI rank's rows (shared_columns.h), on real ranks
 // (mpirun -np 3: MpiRanks registers MPI's collectives): gathered rows are the whole block exactly,
 // whatever the column count (several gather steps, no columns, a rank without rows); this rank's
-// rows of A X from A's share of columns and X's share of rows are those of the whole product
-// (1e-14 of its norm: only the order of the sums differs); the ranks' pieces of a sparse block add
-// up to it exactly. Each rank builds the same matrices from one seed.
+// rows of A X from A's share of columns and X's share of rows, the rows its columns touch beyond
+// its own sent to the ranks that hold them, are those of the whole product (1e-14 of its norm:
+// only the order of the sums differs); the ranks' pieces of a sparse block add up to it exactly.
+// Each rank builds the same matrices from one seed.
 #include <gtest/gtest.h>
 
 #include <random>
