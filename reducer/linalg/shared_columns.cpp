@@ -276,46 +276,8 @@ SparseMatrix KeepColumns(const SparseMatrix& A, const ColumnShare& share) {
 }
 
 SparseMatrix GatherColumns(const SparseMatrix& A, const ColumnShare& share) {
-  const Collectives& c = TheCollectives();
-  if (share.whole() || !c.gather) return A;
-  const long n = A.cols(), first = share.first, last = share.end(n);
-  // This rank's columns: first, count, then per column its entries' count, rows and values.
-  std::string mine;
-  const long header[2] = {first, last - first};
-  AppendBytes(mine, header, 2);
-  std::vector<int> counts, rows;
-  std::vector<double> values;
-  for (long col = first; col < last; ++col) {
-    counts.push_back(int(A.outerIndexPtr()[col + 1] - A.outerIndexPtr()[col]));
-    for (SparseMatrix::InnerIterator it(A, Eigen::Index(col)); it; ++it) {
-      rows.push_back(int(it.row()));
-      values.push_back(it.value());
-    }
-  }
-  const long entries = long(rows.size());
-  AppendBytes(mine, &entries, 1);
-  AppendBytes(mine, counts.data(), counts.size());
-  AppendBytes(mine, rows.data(), rows.size());
-  AppendBytes(mine, values.data(), values.size());
-  const std::vector<std::string> all = c.gather(mine);
-  SparseMatrix out(A.rows(), n);
-  std::vector<Eigen::Triplet<double>> triplets;
-  for (const std::string& bytes : all) {
-    long h[2], k = 0;
-    const char* at = TakeBytes(bytes.data(), h, 2);
-    at = TakeBytes(at, &k, 1);
-    std::vector<int> col_counts(static_cast<size_t>(h[1])), col_rows(static_cast<size_t>(k));
-    std::vector<double> col_values(static_cast<size_t>(k));
-    at = TakeBytes(at, col_counts.data(), col_counts.size());
-    at = TakeBytes(at, col_rows.data(), col_rows.size());
-    TakeBytes(at, col_values.data(), col_values.size());
-    size_t e = 0;
-    for (long j = 0; j < h[1]; ++j)
-      for (int i = 0; i < col_counts[size_t(j)]; ++i, ++e)
-        triplets.emplace_back(col_rows[e], int(h[0] + j), col_values[e]);
-  }
-  out.setFromTriplets(triplets.begin(), triplets.end());
-  return out;
+  // (the other ranks' columns are empty here: each entry comes from the one rank that holds it)
+  return SumSparseOverRanks(A, share);
 }
 
 }  // namespace femb

@@ -174,8 +174,10 @@ struct InterfacePartition {
   SparseMatrix Wt;
   int n_b = 0, n_i = 0, n_c = 0;
   ColumnShare interior_share;
-  /// The interior rows this rank holds of the dense blocks while the factor lives.
+  /// The interior rows this rank holds of the dense blocks while the factor lives: held_rows()
+  /// from held_first().
   long held_rows() const { return interior_share.whole() ? n_i : interior_share.count; }
+  long held_first() const { return interior_share.whole() ? 0 : interior_share.first; }
 };
 
 // The partition of the model's DOFs by its interfaces; false with *message when an RBE3
@@ -302,13 +304,20 @@ class ConstrainedSolver {
   const Eigen::LDLT<Eigen::MatrixXd> S_;
 };
 
+// This rank's interior rows of full-DOF fields f (n x k).
+Eigen::MatrixXd HeldInteriorRows(const InterfacePartition& p, const Eigen::MatrixXd& f) {
+  Eigen::MatrixXd out(p.held_rows(), f.cols());
+  for (long k = 0; k < out.rows(); ++k) out.row(k) = f.row(p.interior[size_t(p.held_first() + k)]);
+  return out;
+}
+
 // Static modes: a DOF interface moved by a unit motion with the others held (K_ii x = -K_ib,
 // W x = 0), into Psi_b; a distributing interface's, into Psi_c (UnitConstraintModes).
 void StaticModes(const FeModel& model, const InterfacePartition& p, const SparseMatrix& K_ib,
                  const ConstrainedSolver& solver, Eigen::MatrixXd& Psi_b, Eigen::MatrixXd& Psi_c) {
   // (this rank's rows of K_ib: the ranks hold its columns, the boundary DOFs', in pieces)
   const ColumnShare& held = p.interior_share;
-  const long rows = p.held_rows(), first = held.whole() ? 0 : held.first;
+  const long rows = p.held_rows();
   const Eigen::MatrixXd K_ib_rows =
       p.n_b > 0 ? HeldRows(SumSparseOverRanks(K_ib, held), held) : Eigen::MatrixXd(rows, 0);
   Psi_b = p.n_b > 0 ? Eigen::MatrixXd(-solver.Solve(K_ib_rows)) : Eigen::MatrixXd(rows, 0);
@@ -319,9 +328,9 @@ void StaticModes(const FeModel& model, const InterfacePartition& p, const Sparse
   // changes the static modes by that residual only. (DOF interfaces only; row by row.)
   if (p.n_b > 0 && p.n_c == 0) {
     const Eigen::MatrixXd R = RigidFields(model);
-    Eigen::MatrixXd R_b(p.n_b, 6), R_i(rows, 6);
+    Eigen::MatrixXd R_b(p.n_b, 6);
     for (int k = 0; k < p.n_b; ++k) R_b.row(k) = R.row(p.boundary[k]);
-    for (long k = 0; k < rows; ++k) R_i.row(k) = R.row(p.interior[size_t(first + k)]);
+    const Eigen::MatrixXd R_i = HeldInteriorRows(p, R);
     const Eigen::MatrixXd G = R_b.transpose() * R_b;
     Psi_b += (R_i - Psi_b * R_b) * G.ldlt().solve(R_b.transpose());
   }
@@ -368,14 +377,6 @@ Eigen::MatrixXd RowsTransposeTimes(const InterfacePartition& p, const Eigen::Mat
   Eigen::MatrixXd XtY = TransposeTimes(X, Y);
   SumOverRanks(XtY, p.interior_share);
   return XtY;
-}
-
-// This rank's interior rows of full-DOF fields f (n x k).
-Eigen::MatrixXd HeldInteriorRows(const InterfacePartition& p, const Eigen::MatrixXd& f) {
-  const long rows = p.held_rows(), first = p.interior_share.whole() ? 0 : p.interior_share.first;
-  Eigen::MatrixXd out(rows, f.cols());
-  for (long k = 0; k < rows; ++k) out.row(k) = f.row(p.interior[size_t(first + k)]);
-  return out;
 }
 
 // Modal derivatives: interior solves with the interfaces held, deflated against the modes and
@@ -482,9 +483,9 @@ std::string FactorizationFailure(const FactorizationInfo& f) {
 Eigen::MatrixXd InertiaLoads(const FeModel& model, const InterfacePartition& p, const Eigen::MatrixXd& fields) {
   const ColumnShare& rows = model.columns;
   const Eigen::MatrixXd MA = SharedTimesRows(model.M, fields, rows);  // this rank's model rows
-  const long first = rows.whole() ? 0 : rows.first, i0 = p.interior_share.whole() ? 0 : p.interior_share.first;
+  const long first = rows.whole() ? 0 : rows.first;
   Eigen::MatrixXd f(p.held_rows(), fields.cols());
-  for (long k = 0; k < f.rows(); ++k) f.row(k) = -MA.row(p.interior[size_t(i0 + k)] - first);
+  for (long k = 0; k < f.rows(); ++k) f.row(k) = -MA.row(p.interior[size_t(p.held_first() + k)] - first);
   return f;
 }
 
