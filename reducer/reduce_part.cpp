@@ -185,11 +185,21 @@ class NonlinearModelOf {
   }
   bool built() const { return nonlinear_ != nullptr; }
   const SparseMatrix& to_model_dofs() const { return to_model_dofs_; }
+  /// A solid's Green-Lagrange model on this rank's cells (`mesh`): the model itself on one process.
+  const SvkSolidMesh& OnRankMesh(const RankMesh& mesh) {
+    if (mesh.share.whole()) return static_cast<const SvkSolidMesh&>(Get());
+    if (!rank_solid_) {
+      rank_solid_ = std::make_unique<SvkSolidMesh>(SolidCellType(model_.cell_type), mesh.nodes, mesh.cells,
+                                                   part_.material, mesh.share);
+    }
+    return *rank_solid_;
+  }
 
  private:
   const PartSpec& part_;
   const FeModel& model_;
   std::unique_ptr<NonlinearModel> nonlinear_;
+  std::unique_ptr<SvkSolidMesh> rank_solid_;
   SparseMatrix to_model_dofs_;
 };
 
@@ -434,15 +444,13 @@ void LinearContent(const PartSpec& part, const FeModel& model, const CraigBampto
 // linear part equals K_r. With stiffening also the geometric stiffness of the inertia load cases'
 // stresses (InertiaLoads, solver/body/inertia_stiffening.h), about the frame
 // origin o: a field about o is the one about the part origin minus the translation it has at o;
-// those fields on the mesh go to `stress_fields` for their stresses. false with result.message
-// when the polynomial's linear part is not K_r.
+// those fields on the model DOFs (this rank's rows on MPI ranks) go to `stress_fields` for their
+// stresses. false with result.message when the polynomial's linear part is not K_r.
 bool NonlinearForce(const PartSpec& part, const FeModel& model, const CraigBamptonResult& cb, bool stiffening,
                     NonlinearModelOf& nonlinear, const ProgressFn& report, Superelement& se,
                     Eigen::MatrixXd& stress_fields, ReduceResult& result) {
   const bool derivatives = se.n_modal_derivatives > 0;
   Stopwatch tensors;
-  const NonlinearModel& f = nonlinear.Get();
-  const Eigen::MatrixXd mesh_shapes = nonlinear.to_model_dofs() * cb.shapes;
   PolynomialRequest poly_request;
   poly_request.cubic = derivatives;
   // A solid's interface faces turn to second order (InterfaceRotationCompletion; beams have none),
@@ -450,19 +458,30 @@ bool NonlinearForce(const PartSpec& part, const FeModel& model, const CraigBampt
   // static modes' stress works on it, and the cubic energy stays a square (C (L q + Q z / 2))^2 / 2.
   poly_request.static_coordinates = 6 * int(model.interface_names.size());
   if (stiffening) {
-    Eigen::MatrixXd u = cb.inertia_displacements;
+    stress_fields = cb.inertia_displacements;  // (this rank's rows of them on MPI ranks)
     const Eigen::Matrix<double, 3, 12> at_origin = InertiaFieldAt(se.floating_frame.origin);
-    for (int k = 3; k < kInertiaLoadCaseCount; ++k) u.col(k) -= u.leftCols(3) * at_origin.col(k);
-    stress_fields = nonlinear.to_model_dofs() * u;
-    poly_request.stress_fields = &stress_fields;
+    for (int k = 3; k < kInertiaLoadCaseCount; ++k)
+      stress_fields.col(k) -= stress_fields.leftCols(3) * at_origin.col(k);
   }
-  ReducedPolynomial poly =
-      part.type != PartType::kBeam
-          ? ReduceSvk(static_cast<const SvkSolidMesh&>(f), mesh_shapes,
-                      InterfaceRotationCompletion(model.nodes, mesh_shapes, model.interface_positions,
-                                                  se.floating_frame.origin),
-                      poly_request)
-          : ReduceVonKarman(static_cast<const VonKarmanBeams&>(f), mesh_shapes, poly_request);
+  ReducedPolynomial poly;
+  if (part.type != PartType::kBeam) {
+    // (a solid's element loops on this rank's cells, with the shapes' rows their nodes need)
+    const RankMesh mesh = RankMeshOf(model);
+    const Eigen::MatrixXd mesh_shapes = RankMeshFields(model, mesh, cb.shapes);
+    const Eigen::MatrixXd mesh_fields = stiffening ? RankMeshFields(model, mesh, stress_fields) : Eigen::MatrixXd();
+    if (stiffening) poly_request.stress_fields = &mesh_fields;
+    poly = ReduceSvk(
+        nonlinear.OnRankMesh(mesh), mesh_shapes,
+        InterfaceRotationCompletion(mesh.nodes, mesh_shapes, model.interface_positions, se.floating_frame.origin),
+        poly_request);
+  } else {
+    const NonlinearModel& beams = nonlinear.Get();
+    const SparseMatrix& T = nonlinear.to_model_dofs();  // (the identity, set by Get)
+    const Eigen::MatrixXd fields = stiffening ? MappedGatherRows(T, stress_fields, model.columns) : Eigen::MatrixXd();
+    if (stiffening) poly_request.stress_fields = &fields;
+    poly = ReduceVonKarman(static_cast<const VonKarmanBeams&>(beams), MappedGatherRows(T, cb.shapes, model.columns),
+                           poly_request);
+  }
   const double mismatch = (poly.K - cb.K).norm() / cb.K.norm();
   if (part.type == PartType::kImported && mismatch > kImportedStiffnessMismatch) {
     // femb's elements with the part's material on the imported mesh must be the imported
@@ -510,14 +529,15 @@ bool NonlinearForce(const PartSpec& part, const FeModel& model, const CraigBampt
   return true;
 }
 
-// The mesh and the mode shapes on it, for pictures and stresses.
+// The mesh and the mode shapes on it, for pictures and stresses (the whole shapes on every rank).
 Visualization MeshAndShapes(const FeModel& model, const CraigBamptonResult& cb) {
   Visualization v;
   v.nodes = model.nodes;
   v.cells = model.cells;
   v.cell_type = model.cell_type;
   v.dofs_per_node = model.dofs_per_node;
-  v.shapes = model.mesh_map.size() ? Eigen::MatrixXd(model.mesh_map * cb.shapes) : cb.shapes;
+  v.shapes = model.mesh_map.size() ? MappedGatherRows(model.mesh_map, cb.shapes, model.columns)
+                                   : GatherRows(cb.shapes, model.columns);
   v.interface_nodes = model.interface_node_sets;
   return v;
 }
@@ -553,7 +573,11 @@ void Stresses(const PartSpec& part, const FeModel& model, const Eigen::MatrixXd&
   };
   se.stress = stresses_of(v.shapes, se.n_modal_derivatives > 0);
   if (stress_fields.cols() > 0) {
-    const ModalStress inertia = stresses_of(stress_fields, false);
+    // (on the mesh, whole: held as the shapes are)
+    const ModalStress inertia =
+        stresses_of(model.mesh_map.size() ? MappedGatherRows(model.mesh_map, stress_fields, model.columns)
+                                          : GatherRows(stress_fields, model.columns),
+                    false);
     se.stress->inertia_modes = inertia.modes;
     se.stress->inertia_section_forces = inertia.section_forces;
   }
@@ -615,7 +639,7 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
   Superelement& se = result.superelement;
   if (std::optional<std::string> warning = CutGroupWarning(cb)) result.warnings.push_back(*warning);
   LinearContent(part, model, cb, interface_constraint, se);
-  Eigen::MatrixXd stress_fields;  // the inertia load cases' fields on the mesh, with stiffening
+  Eigen::MatrixXd stress_fields;  // the inertia load cases' fields on the model DOFs, with stiffening
   if (stiffening || (nonlinear.built() && se.n_modal_derivatives > 0)) {
     if (!NonlinearForce(part, model, cb, stiffening, nonlinear, report, se, stress_fields, result)) return result;
     clock.Restart();

@@ -40,6 +40,9 @@ struct FeModel {
   /// The columns of K and M this process holds: all of them, or on the MPI ranks of a distributed
   /// reduction its share (the other columns are empty; shared_columns.h).
   ColumnShare columns;
+  /// A solid on MPI ranks cut by METIS: the cells of this rank's part, ascending, which it takes in
+  /// the loops over the elements after the reduction (RankMeshOf). Empty otherwise.
+  std::vector<int> rank_cells;
 
   /// Boundary coordinates: 6 per interface, ordered (u_x, u_y, u_z, th_x, th_y, th_z) in part
   /// axes. For beams these are DOFs of interface nodes directly.

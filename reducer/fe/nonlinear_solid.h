@@ -95,7 +95,10 @@ class PolynomialAccumulator {
 /// The Green-Lagrange model of a solid mesh (3 DOFs per node). On the MPI ranks of a distributed
 /// reduction each rank takes a share of the elements (`held`: a range of the cells; all by
 /// default) and the results are summed over the ranks (shared_columns.h), whole on every rank:
-/// every rank must then make the same calls. The tangent is for one process only.
+/// every rank must then make the same calls. The tangent is for one process only. On a rank's own
+/// cells (RankMesh, solid_ranks.h: `nodes` and `cells` its compact numbering, `held` all of them)
+/// the reduced polynomial is summed the same way; the force, a vector of the rank's own nodes,
+/// is not.
 class SvkSolidMesh : public NonlinearModel {
  public:
   SvkSolidMesh(SolidType type, const Eigen::MatrixXd& nodes, const Eigen::MatrixXi& cells, const MaterialSpec& material,

@@ -650,6 +650,10 @@ FeModel BuildSolidModelOn(const PartSpec& part, const std::shared_ptr<const Soli
   clock.Restart();
   const SolidDofMap map = AssemblyMap(part, *mesh, interface_nodes.owner, order, model, kept, rbe2_base, n_model);
   if (shared) model.columns = partition ? ShareOfPart(*partition, kept, n_model) : ShareOfColumns(n_model);
+  if (shared && partition) {
+    for (size_t c = 0; c < partition->cell_part.size(); ++c)
+      if (partition->cell_part[c] == DistributedRank()) model.rank_cells.push_back(int(c));
+  }
   const long assembled = AssembleSolid(*mesh, part.material, map, &model.K, &model.M, model.columns);
   if (progress) {
     const std::string entries = std::to_string(model.K.nonZeros()) + " stiffness entries";

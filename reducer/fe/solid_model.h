@@ -33,9 +33,10 @@ SolidMesh MeshSolidPart(const PartSpec& part);
 FeModel BuildSolidModel(const PartSpec& part, const ProgressFn& progress = nullptr);
 
 /// The MPI ranks' partition of a solid mesh (solid_ranks.h): the part of every mesh node, 0 to
-/// parts - 1, one part per rank.
+/// parts - 1, one part per rank, and of every cell (the element loops' share of the rank).
 struct NodePartition {
   std::vector<int> part;
+  std::vector<int> cell_part;
   int parts = 1;
 };
 

@@ -24,6 +24,7 @@ NodePartition PartitionMesh(const SolidMesh& mesh, int parts, std::vector<long>*
   partition.parts = parts;
   idx_t n_cells = idx_t(mesh.cells.rows()), n_nodes = idx_t(mesh.nodes.rows());
   partition.part.assign(size_t(n_nodes), 0);
+  partition.cell_part.assign(size_t(n_cells), 0);
   std::vector<idx_t> cell_part(size_t(n_cells), 0);
   if (parts > 1) {
     const idx_t per = idx_t(mesh.cells.cols());
@@ -45,6 +46,7 @@ NodePartition PartitionMesh(const SolidMesh& mesh, int parts, std::vector<long>*
                                std::to_string(status) + ")");
     }
     partition.part.assign(node_part.begin(), node_part.end());
+    partition.cell_part.assign(cell_part.begin(), cell_part.end());
   }
   if (cells_per_part) {
     cells_per_part->assign(size_t(parts), 0);
@@ -61,6 +63,7 @@ std::string MeshBytes(const SolidMesh& mesh, const NodePartition& partition) {
   AppendBytes(out, mesh.nodes.data(), size_t(mesh.nodes.size()));
   AppendBytes(out, mesh.cells.data(), size_t(mesh.cells.size()));
   AppendBytes(out, partition.part.data(), partition.part.size());
+  AppendBytes(out, partition.cell_part.data(), partition.cell_part.size());
   const long sets = long(mesh.node_sets.size());
   AppendBytes(out, &sets, 1);
   for (const auto& [name, set] : mesh.node_sets) {
@@ -81,9 +84,11 @@ SolidMesh MeshFromBytes(const std::string& bytes, NodePartition* partition) {
   mesh.type = SolidType(header[3]);
   partition->parts = int(header[4]);
   partition->part.resize(size_t(header[0]));
+  partition->cell_part.resize(size_t(header[1]));
   at = TakeBytes(at, mesh.nodes.data(), size_t(mesh.nodes.size()));
   at = TakeBytes(at, mesh.cells.data(), size_t(mesh.cells.size()));
   at = TakeBytes(at, partition->part.data(), partition->part.size());
+  at = TakeBytes(at, partition->cell_part.data(), partition->cell_part.size());
   long sets = 0;
   at = TakeBytes(at, &sets, 1);
   for (long k = 0; k < sets; ++k) {
@@ -128,6 +133,60 @@ FeModel BuildSolidModelOnRanks(const PartSpec& part, const ProgressFn& progress)
   if (progress)
     progress("mesh", clock.Seconds(), MeshSummary(part, *mesh) + "; rank 0 made it and METIS cut it in " + parts);
   return BuildSolidModelOn(part, mesh, true, &partition, progress);
+}
+
+RankMesh RankMeshOf(const FeModel& model) {
+  RankMesh mesh;
+  if (model.columns.whole()) {
+    mesh.nodes = model.nodes;
+    mesh.cells = model.cells;
+    mesh.node.resize(size_t(model.n_nodes()));
+    for (size_t i = 0; i < mesh.node.size(); ++i) mesh.node[i] = int(i);
+    return mesh;
+  }
+  std::vector<int> cells = model.rank_cells;
+  if (cells.empty()) {
+    const ColumnShare even = ShareOfColumns(model.n_elements());
+    for (long c = even.first; c < even.first + even.count; ++c) cells.push_back(int(c));
+  }
+  std::vector<int> local(size_t(model.n_nodes()), -1);
+  for (const int c : cells)
+    for (long a = 0; a < model.cells.cols(); ++a) local[size_t(model.cells(c, a))] = 0;
+  for (size_t i = 0; i < local.size(); ++i)
+    if (local[i] == 0) {
+      local[i] = int(mesh.node.size());
+      mesh.node.push_back(int(i));
+    }
+  mesh.nodes.resize(long(mesh.node.size()), 3);
+  for (size_t i = 0; i < mesh.node.size(); ++i) mesh.nodes.row(long(i)) = model.nodes.row(mesh.node[i]);
+  mesh.cells.resize(long(cells.size()), model.cells.cols());
+  for (size_t e = 0; e < cells.size(); ++e)
+    for (long a = 0; a < model.cells.cols(); ++a) mesh.cells(long(e), a) = local[size_t(model.cells(cells[e], a))];
+  mesh.share = {0, long(cells.size())};
+  // The rows of mesh_map for the nodes' mesh DOFs (the columns of its transpose), on the model
+  // DOFs they touch.
+  const SparseMatrix Tt = model.mesh_map.transpose();
+  std::vector<Eigen::Triplet<double>> entries;
+  for (size_t i = 0; i < mesh.node.size(); ++i)
+    for (int c = 0; c < 3; ++c)
+      for (SparseMatrix::InnerIterator it(Tt, 3 * mesh.node[i] + c); it; ++it) {
+        entries.emplace_back(int(3 * i) + c, int(it.row()), it.value());
+        mesh.model_rows.push_back(int(it.row()));
+      }
+  std::sort(mesh.model_rows.begin(), mesh.model_rows.end());
+  mesh.model_rows.erase(std::unique(mesh.model_rows.begin(), mesh.model_rows.end()), mesh.model_rows.end());
+  for (Eigen::Triplet<double>& t : entries) {
+    const long at = std::lower_bound(mesh.model_rows.begin(), mesh.model_rows.end(), t.col()) - mesh.model_rows.begin();
+    t = Eigen::Triplet<double>(t.row(), int(at), t.value());
+  }
+  mesh.map.resize(3 * long(mesh.node.size()), long(mesh.model_rows.size()));
+  mesh.map.setFromTriplets(entries.begin(), entries.end());
+  return mesh;
+}
+
+Eigen::MatrixXd RankMeshFields(const FeModel& model, const RankMesh& mesh, const Eigen::MatrixXd& X) {
+  if (model.columns.whole()) return model.mesh_map * X;
+  return mesh.map * FetchRows(X, model.columns, mesh.model_rows);
 }
 
 }  // namespace femb

@@ -27,6 +27,29 @@ SolidMesh MeshFromBytes(const std::string& bytes, NodePartition* partition);
 /// file's text after --set): each builds the model from its own part spec.
 void CheckSamePartOnRanks(const PartSpec& part);
 
+/// The cells a rank takes in the loops over the elements after the reduction (stiffening,
+/// stresses), on a compact numbering of the nodes they touch: on one process all of them, the
+/// mesh as it is; on MPI ranks its METIS part's (FeModel::rank_cells), or an even share of them
+/// where the mesh was not cut (an imported mesh).
+struct RankMesh {
+  Eigen::MatrixXd nodes;  ///< the nodes its cells touch, in the mesh's order
+  Eigen::MatrixXi cells;  ///< its cells on that numbering
+  std::vector<int> node;  ///< the mesh node of each of `nodes`
+  /// Whole on one process; on MPI ranks all its cells, {0, cells}: what they make is summed over
+  /// the ranks (SvkSolidMesh's `held`).
+  ColumnShare share;
+  /// On MPI ranks: the model DOFs (ascending) its nodes' mesh DOFs need, and the rows of
+  /// FeModel::mesh_map for those mesh DOFs on them.
+  std::vector<int> model_rows;
+  SparseMatrix map;
+};
+RankMesh RankMeshOf(const FeModel& model);
+
+/// Fields X held as each rank's rows of the model's DOFs (model.columns) on the rank mesh's nodes
+/// (3 per node): mesh_map X there, the model rows it needs fetched from the ranks that hold them
+/// (FetchRows). mesh_map X on one process.
+Eigen::MatrixXd RankMeshFields(const FeModel& model, const RankMesh& mesh, const Eigen::MatrixXd& X);
+
 /// The solid's model on the ranks sharing a reduction: meshed and partitioned by rank 0 (a failure
 /// there is every rank's: the others meet it where they wait for the mesh), reported as the stage
 /// "mesh" by every rank once it has the mesh, then BuildSolidModelOn with the partition.

@@ -85,20 +85,6 @@ Eigen::MatrixXd SharedTimes(const SparseMatrix& A, const Eigen::MatrixXd& X, con
   return AX;
 }
 
-Eigen::MatrixXd SharedCongruence(const Eigen::MatrixXd& Y, const SparseMatrix& A, const Eigen::MatrixXd& X,
-                                 const ColumnShare& share) {
-  if (share.whole()) {
-    const Eigen::MatrixXd AX = A * X;  // evaluated first: Eigen would nest it lazily
-    return TransposeTimes(Y, AX);
-  }
-  // This rank's part Y^T A_h X_h over its columns h: (A_h^T Y)^T X_h, whose product has only the
-  // held rows (A X would have n).
-  const Eigen::MatrixXd AtY = A.middleCols(share.first, share.count).transpose() * Y;
-  Eigen::MatrixXd YAX = TransposeTimes(AtY, X.middleRows(share.first, share.count));
-  SumOverRanks(YAX, share);
-  return YAX;
-}
-
 Eigen::MatrixXd HeldRows(const Eigen::MatrixXd& X, const ColumnShare& share) {
   if (share.whole()) return X;
   return X.middleRows(share.first, share.count);
@@ -159,6 +145,19 @@ std::vector<ColumnShare> SharesOfRanks(const ColumnShare& share) {
   return shares;
 }
 
+// The entries of `sorted` (ascending) in each rank's share: [begin, end) per rank.
+std::vector<std::pair<long, long>> RanksEntries(const std::vector<int>& sorted,
+                                                const std::vector<ColumnShare>& shares) {
+  std::vector<std::pair<long, long>> ranges;
+  for (const ColumnShare& s : shares) {
+    const long begin = std::lower_bound(sorted.begin(), sorted.end(), int(s.first)) - sorted.begin();
+    const long end =
+        std::lower_bound(sorted.begin(), sorted.end(), int(s.first + std::max<long>(s.count, 0))) - sorted.begin();
+    ranges.emplace_back(begin, end);
+  }
+  return ranges;
+}
+
 // SharedTimesRows by the exchange: this rank's part A_h X_h on its own rows and on the rows
 // beyond them that its columns touch (`ghosts`, ascending); those go to the ranks that hold them
 // (each rank's in one message: row indices, then the rows' values), which add them in rank order.
@@ -184,15 +183,13 @@ Eigen::MatrixXd TimesRowsExchanged(const SparseMatrix& A, const Eigen::MatrixXd&
       }
     }
   const std::vector<ColumnShare> shares = SharesOfRanks(share);
+  const std::vector<std::pair<long, long>> held = RanksEntries(ghosts, shares);
   std::vector<std::string> to(shares.size());
   for (size_t r = 0; r < shares.size(); ++r) {
-    if (shares[r].count <= 0) continue;
-    const auto begin = std::lower_bound(ghosts.begin(), ghosts.end(), int(shares[r].first));
-    const auto end = std::lower_bound(ghosts.begin(), ghosts.end(), int(shares[r].first + shares[r].count));
-    const long rows = long(end - begin), g0 = long(begin - ghosts.begin());
+    const long rows = held[r].second - held[r].first, g0 = held[r].first;
     if (rows == 0) continue;
     AppendBytes(to[r], &rows, 1);
-    AppendBytes(to[r], &*begin, size_t(rows));
+    AppendBytes(to[r], ghosts.data() + g0, size_t(rows));
     const Eigen::MatrixXd values = G.middleRows(g0, rows);
     AppendBytes(to[r], values.data(), size_t(values.size()));
   }
@@ -211,6 +208,40 @@ Eigen::MatrixXd TimesRowsExchanged(const SparseMatrix& A, const Eigen::MatrixXd&
 
 }  // namespace
 
+Eigen::MatrixXd FetchRows(const Eigen::MatrixXd& mine, const ColumnShare& share, const std::vector<int>& wanted) {
+  const long k = mine.cols();
+  Eigen::MatrixXd out(long(wanted.size()), k);
+  if (share.whole() || !TheCollectives().exchange) {
+    const Eigen::MatrixXd whole = GatherRows(mine, share);
+    for (size_t i = 0; i < wanted.size(); ++i) out.row(long(i)) = whole.row(wanted[i]);
+    return out;
+  }
+  const std::vector<ColumnShare> shares = SharesOfRanks(share);
+  const std::vector<std::pair<long, long>> asked = RanksEntries(wanted, shares);
+  // The rows asked of each rank, then its answer: the rows' values, column-major.
+  std::vector<std::string> questions(shares.size());
+  for (size_t r = 0; r < shares.size(); ++r)
+    AppendBytes(questions[r], wanted.data() + asked[r].first, size_t(asked[r].second - asked[r].first));
+  const std::vector<std::string> theirs = TheCollectives().exchange(questions);
+  std::vector<std::string> answers(shares.size());
+  for (size_t r = 0; r < shares.size(); ++r) {
+    std::vector<int> rows(theirs[r].size() / sizeof(int));
+    TakeBytes(theirs[r].data(), rows.data(), rows.size());
+    Eigen::MatrixXd values(long(rows.size()), k);
+    for (size_t i = 0; i < rows.size(); ++i) values.row(long(i)) = mine.row(rows[i] - share.first);
+    AppendBytes(answers[r], values.data(), size_t(values.size()));
+  }
+  const std::vector<std::string> received = TheCollectives().exchange(answers);
+  for (size_t r = 0; r < shares.size(); ++r) {
+    const long rows = asked[r].second - asked[r].first;
+    if (rows == 0) continue;  // (Eigen's slice assignment of no rows can read before them)
+    Eigen::MatrixXd values(rows, k);
+    TakeBytes(received[r].data(), values.data(), size_t(values.size()));
+    out.middleRows(asked[r].first, rows) = values;
+  }
+  return out;
+}
+
 Eigen::MatrixXd SharedTimesRows(const SparseMatrix& A, const Eigen::MatrixXd& X, const ColumnShare& share) {
   if (share.whole()) return A * X;
   if (TheCollectives().exchange) return TimesRowsExchanged(A, X, share);
@@ -224,6 +255,37 @@ Eigen::MatrixXd SharedTimesRows(const SparseMatrix& A, const Eigen::MatrixXd& X,
     out.middleCols(c0, w) = part.middleRows(share.first, share.count);
   }
   return out;
+}
+
+Eigen::MatrixXd TransposeTimesRows(const Eigen::MatrixXd& X, const Eigen::MatrixXd& Y, const ColumnShare& share) {
+  Eigen::MatrixXd XtY = TransposeTimes(X, Y);
+  SumOverRanks(XtY, share);
+  return XtY;
+}
+
+Eigen::MatrixXd RowsCongruence(const SparseMatrix& A, const Eigen::MatrixXd& X, const ColumnShare& share) {
+  const Eigen::MatrixXd AX = SharedTimesRows(A, X, share);
+  return TransposeTimesRows(X, AX, share);
+}
+
+Eigen::MatrixXd TimesHeldRows(const SparseMatrix& B, const Eigen::MatrixXd& X, const ColumnShare& share) {
+  if (share.whole()) return B * X;
+  Eigen::MatrixXd BX = B.middleCols(share.first, share.count) * X;
+  SumOverRanks(BX, share);
+  return BX;
+}
+
+Eigen::MatrixXd MappedGatherRows(const SparseMatrix& T, const Eigen::MatrixXd& X, const ColumnShare& share) {
+  if (share.whole()) return T * X;
+  Eigen::Matrix<double, 1, 1> rows(double(X.rows()));
+  SumOverRanks(rows, share);
+  const long k = X.cols(), step = ColumnsPerStep(long(rows(0, 0)));
+  Eigen::MatrixXd TX(T.rows(), k);
+  for (long c0 = 0; c0 < k; c0 += step) {
+    const long w = std::min(step, k - c0);
+    TX.middleCols(c0, w) = T * GatherRows(X.middleCols(c0, w), share);
+  }
+  return TX;
 }
 
 SparseMatrix SumSparseOverRanks(const SparseMatrix& A, const ColumnShare& share) {

@@ -50,10 +50,6 @@ std::string FromFirstRank(const std::string& bytes);
 /// product on every rank.
 Eigen::MatrixXd SharedTimes(const SparseMatrix& A, const Eigen::MatrixXd& X, const ColumnShare& share);
 
-/// Y^T A X for A held as in SharedTimes (the reduction's projections): each rank's part, summed.
-Eigen::MatrixXd SharedCongruence(const Eigen::MatrixXd& Y, const SparseMatrix& A, const Eigen::MatrixXd& X,
-                                 const ColumnShare& share);
-
 /// This rank's rows of X: those of the columns `share` holds (the dense blocks of a reduction
 /// held as each rank's rows, as the distributed solver gives and takes them). X when the share is
 /// the whole.
@@ -66,11 +62,33 @@ Eigen::MatrixXd HeldRows(const SparseMatrix& A, const ColumnShare& share);
 /// itself when the share is the whole.
 Eigen::MatrixXd GatherRows(const Eigen::MatrixXd& mine, const ColumnShare& share);
 
+/// The rows `wanted` (ascending, of the whole) of X held as each rank's rows (`mine`, its
+/// `share`): its own copied, the others' asked of the ranks that hold them (the exchange; without
+/// it, gathered whole). X's rows `wanted` when the share is the whole.
+Eigen::MatrixXd FetchRows(const Eigen::MatrixXd& mine, const ColumnShare& share, const std::vector<int>& wanted);
+
 /// This rank's rows of A X for A shared by columns and X held as its rows (`share` both): each
 /// rank's part A_h X_h of the whole, whose rows beyond its own (the layer of the mesh around its
 /// part) are sent to the ranks that hold them and added there (without `exchange`: summed over all
 /// ranks a few columns at a time). The plain A X when the share is the whole.
 Eigen::MatrixXd SharedTimesRows(const SparseMatrix& A, const Eigen::MatrixXd& X, const ColumnShare& share);
+
+/// X^T Y for X and Y held as this rank's rows (`share`): each rank's rows' part, summed (the
+/// plain X^T Y, dense_products' TransposeTimes, when the share is the whole).
+Eigen::MatrixXd TransposeTimesRows(const Eigen::MatrixXd& X, const Eigen::MatrixXd& Y, const ColumnShare& share);
+
+/// X^T A X for A shared by columns and X held as its rows (`share` both): the reduction's
+/// projections, X^T (A X) from this rank's rows of A X (SharedTimesRows), summed.
+Eigen::MatrixXd RowsCongruence(const SparseMatrix& A, const Eigen::MatrixXd& X, const ColumnShare& share);
+
+/// B X for a few-row B whole on every rank and X held as each rank's rows (`share` of B's
+/// columns): each rank's columns of B times its rows, summed. B X when the share is the whole.
+Eigen::MatrixXd TimesHeldRows(const SparseMatrix& B, const Eigen::MatrixXd& X, const ColumnShare& share);
+
+/// T times the whole of X held as each rank's rows (`share`), on every rank: X gathered a few
+/// columns at a time, each step mapped at once, so that the whole X is never held beside T X
+/// (the mode shapes mapped onto the mesh). T X when the share is the whole.
+Eigen::MatrixXd MappedGatherRows(const SparseMatrix& T, const Eigen::MatrixXd& X, const ColumnShare& share);
 
 /// Every rank's entries of A added up (sparse; each rank's A the same size): the whole of a
 /// block that the ranks hold pieces of. A itself on one process.

@@ -95,8 +95,11 @@ Eigen::MatrixXd InertiaFields(const FeModel& model) {
   return ModelFieldsFromMesh(model, A_mesh);
 }
 
-void InertiaInvariants(const FeModel& model, const Eigen::MatrixXd& shapes, std::vector<Eigen::MatrixXd>* gamma,
-                       std::vector<Eigen::MatrixXd>* xi) {
+namespace {
+
+// S_a Phi for the skew matrices S_a of e_a on every DOF triple (InertiaInvariants), on the whole
+// of the model's DOFs.
+std::array<Eigen::MatrixXd, 3> TurnedFields(const FeModel& model, const Eigen::MatrixXd& shapes) {
   const long n = shapes.rows();
   std::array<Eigen::MatrixXd, 3> turned;
   std::array<Eigen::Matrix3d, 3> S;  // S_a v = e_a x v
@@ -134,16 +137,32 @@ void InertiaInvariants(const FeModel& model, const Eigen::MatrixXd& shapes, std:
       }
     }
   }
+  return turned;
+}
+
+}  // namespace
+
+void InertiaInvariants(const FeModel& model, const Eigen::MatrixXd& shapes, std::vector<Eigen::MatrixXd>* gamma,
+                       std::vector<Eigen::MatrixXd>* xi) {
+  // On MPI ranks a rank's rows are whole DOF triples where they start at one (a solid's METIS
+  // parts: 3 DOFs per node, the RBE2 interfaces' 6 after them): turned on its own rows; otherwise
+  // (an even split of a beam's or an imported model's DOFs) turned whole and its rows kept.
+  const ColumnShare& rows = model.columns;
+  const bool own_triples = rows.whole() || (model.dof_node.empty() && rows.first % 3 == 0 && rows.count % 3 == 0);
+  std::array<Eigen::MatrixXd, 3> turned =
+      own_triples ? TurnedFields(model, shapes) : TurnedFields(model, GatherRows(shapes, rows));
+  if (!own_triples)
+    for (Eigen::MatrixXd& t : turned) t = HeldRows(t, rows);
   gamma->clear();
   xi->clear();
   std::array<Eigen::MatrixXd, 3> M_turned;
   for (int a = 0; a < 3; ++a) {
-    M_turned[size_t(a)] = SharedTimes(model.M, turned[size_t(a)], model.columns);
-    gamma->push_back(TransposeTimes(shapes, M_turned[size_t(a)]));
+    M_turned[size_t(a)] = SharedTimesRows(model.M, turned[size_t(a)], rows);
+    gamma->push_back(TransposeTimesRows(shapes, M_turned[size_t(a)], rows));
   }
   const int pairs[6][2] = {{0, 0}, {1, 1}, {2, 2}, {0, 1}, {0, 2}, {1, 2}};
   for (const auto& ab : pairs) {
-    Eigen::MatrixXd X = TransposeTimes(turned[size_t(ab[0])], M_turned[size_t(ab[1])]);
+    Eigen::MatrixXd X = TransposeTimesRows(turned[size_t(ab[0])], M_turned[size_t(ab[1])], rows);
     if (ab[0] == ab[1]) X = 0.5 * (X + X.transpose()).eval();
     xi->push_back(std::move(X));
   }
@@ -338,20 +357,33 @@ void StaticModes(const FeModel& model, const InterfacePartition& p, const Sparse
   if (p.n_c > 0) Psi_c = solver.UnitConstraintModes();
 }
 
-// The full fields of the Craig-Bampton coordinates (n x (6 interfaces + m)): unit boundary DOFs,
-// the static modes on the interior, the fixed-interface modes.
-Eigen::MatrixXd CraigBamptonShapes(const FeModel& model, const InterfacePartition& p, const Eigen::MatrixXd& Psi_b,
-                                   const Eigen::MatrixXd& Psi_c, const Eigen::MatrixXd& Phi_i, int m) {
-  const int n = int(model.n_dofs()), n_cb = 6 * int(model.interface_names.size()) + m;
-  Eigen::MatrixXd shapes = Eigen::MatrixXd::Zero(n, n_cb);
-  for (int k = 0; k < p.n_b; ++k) shapes(p.boundary[k], p.boundary_coordinate[k]) = 1.0;
-  for (int k = 0; k < p.n_i; ++k) {
-    for (int j = 0; j < p.n_b; ++j) shapes(p.interior[k], p.boundary_coordinate[j]) = Psi_b(k, j);
-    for (int j = 0; j < p.n_c; ++j) shapes(p.interior[k], p.constraint_coordinate[j]) = Psi_c(k, j);
-    if (m > 0) shapes.row(p.interior[k]).tail(m) = Phi_i.row(k);
+// The full fields of the reduced coordinates on the model DOFs [first, first + rows): unit
+// boundary DOFs, the static modes on the interior, the fixed-interface modes (n_cb: 6 per
+// interface and the m modes), then the derivatives. The blocks' rows are the interior's from
+// `interior_first` on.
+Eigen::MatrixXd ShapesOnRows(const InterfacePartition& p, long first, long rows, long interior_first,
+                             const Eigen::MatrixXd& Psi_b, const Eigen::MatrixXd& Psi_c, const Eigen::MatrixXd& Phi_i,
+                             const Eigen::MatrixXd& Theta, int n_cb) {
+  const long m = Phi_i.cols(), d = Theta.cols();
+  Eigen::MatrixXd shapes = Eigen::MatrixXd::Zero(rows, n_cb + d);
+  for (long g = first; g < first + rows; ++g) {
+    const long row = g - first;
+    if (const int b = p.boundary_index[size_t(g)]; b >= 0) {
+      shapes(row, p.boundary_coordinate[size_t(b)]) = 1.0;
+      continue;
+    }
+    const long k = p.interior_index[size_t(g)] - interior_first;
+    for (int j = 0; j < p.n_b; ++j) shapes(row, p.boundary_coordinate[size_t(j)]) = Psi_b(k, j);
+    for (int j = 0; j < p.n_c; ++j) shapes(row, p.constraint_coordinate[size_t(j)]) = Psi_c(k, j);
+    if (m > 0) shapes.row(row).segment(n_cb - m, m) = Phi_i.row(k);
+    if (d > 0) shapes.row(row).tail(d) = Theta.row(k);
   }
   return shapes;
 }
+
+// The model DOFs this rank holds the rows of after the factor: its columns (all on one process).
+long FirstModelRow(const FeModel& model) { return model.columns.whole() ? 0 : model.columns.first; }
+long ModelRows(const FeModel& model) { return model.columns.whole() ? model.n_dofs() : model.columns.count; }
 
 // Pairs whose (dK/dq_j) phi_i are evaluated at a time: the n x pairs block of them is never held
 // whole (20 modes' pairs are 210 columns).
@@ -374,9 +406,7 @@ Eigen::VectorXd RowsCoefficients(const InterfacePartition& p, const Eigen::Ref<c
 
 // X^T Y for X and Y held as each rank's rows of the interior (dense_products' product).
 Eigen::MatrixXd RowsTransposeTimes(const InterfacePartition& p, const Eigen::MatrixXd& X, const Eigen::MatrixXd& Y) {
-  Eigen::MatrixXd XtY = TransposeTimes(X, Y);
-  SumOverRanks(XtY, p.interior_share);
-  return XtY;
+  return TransposeTimesRows(X, Y, p.interior_share);
 }
 
 // Modal derivatives: interior solves with the interfaces held, deflated against the modes and
@@ -416,10 +446,15 @@ Eigen::MatrixXd ModalDerivatives(const InterfacePartition& p, const SparseMatrix
   return Theta;
 }
 
-// Interior fields (n_i x k) on the full DOFs, zero on the boundary DOFs.
-Eigen::MatrixXd FullFields(const FeModel& model, const InterfacePartition& p, const Eigen::MatrixXd& u) {
-  Eigen::MatrixXd out = Eigen::MatrixXd::Zero(model.n_dofs(), u.cols());
-  for (int k = 0; k < p.n_i; ++k) out.row(p.interior[k]) = u.row(k);
+// Interior fields (this rank's rows of the interior) on the model DOFs this rank holds the rows of,
+// zero on the boundary DOFs.
+Eigen::MatrixXd FieldsOnModelRows(const FeModel& model, const InterfacePartition& p, const Eigen::MatrixXd& u) {
+  const long first = FirstModelRow(model);
+  Eigen::MatrixXd out = Eigen::MatrixXd::Zero(ModelRows(model), u.cols());
+  for (long row = 0; row < out.rows(); ++row) {
+    const int k = p.interior_index[size_t(first + row)];
+    if (k >= 0) out.row(row) = u.row(k - p.held_first());
+  }
   return out;
 }
 
@@ -447,18 +482,14 @@ Eigen::MatrixXd InertiaDisplacements(const InterfacePartition& p, const SparseMa
 }
 
 // Projection K_r = Phi^T K Phi, M_r = Phi^T M Phi with Phi the full fields of the reduced
-// coordinates (the Craig-Bampton shapes, then the derivatives): a Galerkin projection whatever
-// the accuracy of the vectors (the static and modal blocks of K_r are K-orthogonal and
-// Phi_i^T K Phi_i = Lambda up to the eigen solve's residual; femb-inspect shows both).
-void Project(const FeModel& model, const InterfacePartition& p, const Eigen::MatrixXd& shapes,
-             const Eigen::MatrixXd& Theta, CraigBamptonResult& r) {
-  const int n = int(model.n_dofs()), n_cb = int(shapes.cols()), d = int(Theta.cols());
-  r.shapes = Eigen::MatrixXd::Zero(n, n_cb + d);
-  r.shapes.leftCols(n_cb) = shapes;
-  for (int k = 0; k < p.n_i; ++k)
-    if (d > 0) r.shapes.row(p.interior[k]).tail(d) = Theta.row(k);
-  r.K = SharedCongruence(r.shapes, model.K, r.shapes, model.columns);
-  r.M = SharedCongruence(r.shapes, model.M, r.shapes, model.columns);
+// coordinates (the Craig-Bampton shapes, then the derivatives; this rank's rows of them on MPI
+// ranks): a Galerkin projection whatever the accuracy of the vectors (the static and modal blocks
+// of K_r are K-orthogonal and Phi_i^T K Phi_i = Lambda up to the eigen solve's residual;
+// femb-inspect shows both).
+void Project(const FeModel& model, Eigen::MatrixXd shapes, CraigBamptonResult& r) {
+  r.shapes = std::move(shapes);
+  r.K = RowsCongruence(model.K, r.shapes, model.columns);
+  r.M = RowsCongruence(model.M, r.shapes, model.columns);
   r.K = 0.5 * (r.K + r.K.transpose()).eval();
   r.M = 0.5 * (r.M + r.M.transpose()).eval();
 }
@@ -600,8 +631,9 @@ CraigBamptonResult Reduce(const FeModel& model, FeModel* release, int internal_m
   Eigen::MatrixXd Theta(p.held_rows(), 0), inertia_u;
   if (derivatives && !derivatives->pairs.empty()) {
     // (the element loops of dK/dq take the whole shapes: gathered for them)
-    const Eigen::MatrixXd shapes = CraigBamptonShapes(model, p, GatherRows(Psi_b, rows), GatherRows(Psi_c, rows),
-                                                      GatherRows(Phi_i, rows), internal_modes);
+    const Eigen::MatrixXd shapes =
+        ShapesOnRows(p, 0, model.n_dofs(), 0, GatherRows(Psi_b, rows), GatherRows(Psi_c, rows), GatherRows(Phi_i, rows),
+                     Eigen::MatrixXd(), 6 * int(model.interface_names.size()) + internal_modes);
     Theta = ModalDerivatives(p, M.ii, Phi_i, shapes, *derivatives, solver, r);
     if (progress) {
       progress(
@@ -620,15 +652,16 @@ CraigBamptonResult Reduce(const FeModel& model, FeModel* release, int internal_m
     }
     clock.Restart();
   }
-  // The factor is no longer needed: freed before K and M are rebuilt, then the blocks; only then
-  // are the dense blocks gathered whole.
+  // The factor is no longer needed: freed before K and M are rebuilt, then the blocks. The shapes
+  // stay each rank's rows: those of the model's columns it holds.
   factor.reset();
   held.Restore();
   K = Blocks(), M = Blocks();
-  if (inertia) r.inertia_displacements = FullFields(model, p, GatherRows(inertia_u, rows));
-  const Eigen::MatrixXd shapes = CraigBamptonShapes(model, p, GatherRows(Psi_b, rows), GatherRows(Psi_c, rows),
-                                                    GatherRows(Phi_i, rows), internal_modes);
-  Project(model, p, shapes, GatherRows(Theta, rows), r);
+  if (inertia) r.inertia_displacements = FieldsOnModelRows(model, p, inertia_u);
+  Project(model,
+          ShapesOnRows(p, FirstModelRow(model), ModelRows(model), p.held_first(), Psi_b, Psi_c, Phi_i, Theta,
+                       6 * int(model.interface_names.size()) + internal_modes),
+          r);
   if (progress) progress("projection", clock.Seconds(), Format("%.0f reduced DOFs", int(r.shapes.cols())));
   r.ok = true;
   return r;

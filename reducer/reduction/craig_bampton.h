@@ -45,7 +45,9 @@ struct CraigBamptonResult {
   /// a group of equal frequencies (a round or square section, a symmetric part); 0 when none is
   /// left to solve for.
   double next_lambda = 0.0;
-  Eigen::MatrixXd shapes;  ///< n_full x n_r: full DOF field of each reduced coordinate
+  /// n_full x n_r: full DOF field of each reduced coordinate; on MPI ranks sharing the model by
+  /// columns this rank's rows of it, those of model.columns (GatherRows makes the whole).
+  Eigen::MatrixXd shapes;
   FactorizationInfo factorization;
   long eigen_linear_solves = 0;
   bool dense_eigen = false;
@@ -54,7 +56,7 @@ struct CraigBamptonResult {
   /// interfaces held, u_k = -K_ii^-1 (M A_k)_i (zero on the interface DOFs, W u = 0 at RBE3
   /// interfaces), minus the part the internal modes and modal derivatives V carry statically
   /// (K_ii-orthogonal projection, V (V^T K_ii V)^-1 V^T f: that part is the basis's own
-  /// response), n_full x k.
+  /// response), n_full x k (on MPI ranks this rank's rows, as `shapes`).
   Eigen::MatrixXd inertia_displacements;
 };
 
@@ -91,7 +93,8 @@ Eigen::Matrix<double, 3, 12> InertiaFieldAt(const Eigen::Vector3d& x);
 /// angular accelerations), n_dofs x 12.
 Eigen::MatrixXd InertiaFields(const FeModel& model);
 
-/// The inertia invariants of a basis (formats/superelement.h: inertia_gamma, inertia_xi):
+/// The inertia invariants of a basis (formats/superelement.h: inertia_gamma, inertia_xi), from
+/// `shapes` held as CraigBamptonResult::shapes (on MPI ranks this rank's rows of them):
 /// Gamma_a = Phi^T M S_a Phi and Xi_ab = (S_a Phi)^T M (S_b Phi), S_a the skew matrix of e_a on
 /// every DOF triple (beams: u and theta of each node; solids: each mesh node's u, and u and theta
 /// of each RBE2 interface node, whose turned field is then the rigid face's nearest: the face

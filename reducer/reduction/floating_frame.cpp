@@ -59,7 +59,7 @@ FloatingFrame ComputeFloatingFrame(const ReductionSpec& reduction, const Superel
     case FloatingFrameType::kCenterOfMass: {
       const std::optional<SparseMatrix> interpolation = CenterOfMassInterpolation(where, model, c);
       frame.origin = c;
-      frame.Phi_CB = (*interpolation) * shapes;
+      frame.Phi_CB = TimesHeldRows(*interpolation, shapes, model.columns);
       break;
     }
     case FloatingFrameType::kMeanAxes: {

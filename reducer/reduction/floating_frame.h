@@ -21,7 +21,8 @@ namespace femb {
 
 /// The frame `reduction` asks for (floating_frame, floating_frame_interface; messages name
 /// where_floating_frame). `se` must have interfaces, K, M and mass_properties set; `shapes` is
-/// n_full x n_r. Throws InputError for center_of_mass outside the material.
+/// n_full x n_r (held as CraigBamptonResult::shapes: on MPI ranks this rank's rows). Throws InputError for
+/// center_of_mass outside the material.
 FloatingFrame ComputeFloatingFrame(const ReductionSpec& reduction, const Superelement& se, const FeModel& model,
                                    const Eigen::MatrixXd& shapes);
 

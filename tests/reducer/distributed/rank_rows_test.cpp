@@ -3,7 +3,9 @@
 // whatever the column count (several gather steps, no columns, a rank without rows); this rank's
 // rows of A X from A's share of columns and X's share of rows, the rows its columns touch beyond
 // its own sent to the ranks that hold them, are those of the whole product (1e-14 of its norm:
-// only the order of the sums differs); the ranks' pieces of a sparse block add up to it exactly.
+// only the order of the sums differs), and so are the projection X^T A X from the rows and a map
+// of the gathered rows; rows fetched from the ranks that hold them are the block's exactly; the
+// ranks' pieces of a sparse block add up to it exactly.
 // Each rank builds the same matrices from one seed.
 #include <gtest/gtest.h>
 
@@ -74,6 +76,34 @@ TEST(RankRows, RowsOfAProductFromSharedColumnsAreThoseOfTheWhole) {
     ASSERT_EQ(mine.rows(), expected.rows());
     ASSERT_EQ(mine.cols(), expected.cols());
     EXPECT_LE((mine - expected).norm(), 1e-14 * whole.norm()) << n;
+    // The projection X^T A X from the ranks' rows, and T X gathered mapped a few columns at a
+    // time (T: a sparse map onto more rows than X has), the same on every rank.
+    const Eigen::MatrixXd XAX = X.transpose() * whole;
+    const Eigen::MatrixXd projected = RowsCongruence(KeepColumns(A, share), HeldRows(X, share), share);
+    EXPECT_LE((projected - XAX).norm(), 1e-14 * XAX.norm()) << n;
+    const SparseMatrix T = SparseMatrix(Banded(n + 7, 2, 19).leftCols(n));
+    const Eigen::MatrixXd TX = T * X;
+    const Eigen::MatrixXd mapped = MappedGatherRows(T, HeldRows(X, share), share);
+    ASSERT_EQ(mapped.rows(), n + 7);
+    EXPECT_LE((mapped - TX).norm(), 1e-14 * TX.norm()) << n;
+  }
+}
+
+TEST(RankRows, FetchedRowsAreTheWholeBlocksRowsExactly) {
+  const long n = 1000;
+  const ColumnShare share = ShareOfColumns(n);
+  const Eigen::MatrixXd X = RandomBlock(n, 7, 23);
+  const Eigen::MatrixXd mine = HeldRows(X, share);
+  // Each rank asks for a different set: every third row from its rank on (rows of every rank),
+  // the first rank's rows only, and none.
+  std::vector<std::vector<int>> asks(3);
+  for (long i = DistributedRank(); i < n; i += 3) asks[0].push_back(int(i));
+  for (long i = 0; i < ShareOfColumns(n).count && DistributedRank() == 2; ++i) asks[1].push_back(int(i));
+  for (const std::vector<int>& wanted : asks) {
+    const Eigen::MatrixXd rows = FetchRows(mine, share, wanted);
+    ASSERT_EQ(rows.rows(), long(wanted.size()));
+    ASSERT_EQ(rows.cols(), X.cols());
+    for (size_t i = 0; i < wanted.size(); ++i) ASSERT_TRUE(rows.row(long(i)) == X.row(wanted[i])) << wanted[i];
   }
 }
 

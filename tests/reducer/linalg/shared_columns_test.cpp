@@ -85,14 +85,19 @@ TEST(SharedColumns, RanksPartsOfAProjectionAddUpAndGatheredColumnsMakeTheWhole) 
   const long n = whole.n_dofs();
   const Eigen::MatrixXd X = Eigen::MatrixXd::Random(n, 5);
   const Eigen::MatrixXd KX = whole.K * X, XKX = X.transpose() * KX;
+  const SparseMatrix B = whole.K.topRows(6);  // (a few rows, whole on every rank)
+  const Eigen::MatrixXd BX = B * X;
   Eigen::MatrixXd sum_KX = Eigen::MatrixXd::Zero(n, 5), sum_XKX = Eigen::MatrixXd::Zero(5, 5);
+  Eigen::MatrixXd sum_BX = Eigen::MatrixXd::Zero(6, 5);
   std::vector<std::string> pieces;
   for (int rank = 0; rank < 2; ++rank) {
     PlayedRanks played(2, rank);
     const ColumnShare share = ShareOfColumns(n);
     const SparseMatrix K_r = KeepColumns(whole.K, share);
     sum_KX += SharedTimes(K_r, X, share);
-    sum_XKX += SharedCongruence(X, K_r, X, share);
+    // (X^T K X from this rank's rows of X and of K X)
+    sum_XKX += TransposeTimesRows(HeldRows(X, share), HeldRows(KX, share), share);
+    sum_BX += TimesHeldRows(B, HeldRows(X, share), share);
     std::vector<std::string> mine;
     RegisterRankCollectives([](double*, long) {},
                             [&mine](const std::string& bytes) {
@@ -104,6 +109,7 @@ TEST(SharedColumns, RanksPartsOfAProjectionAddUpAndGatheredColumnsMakeTheWhole) 
   }
   EXPECT_LT((sum_KX - KX).norm(), 1e-13 * KX.norm());
   EXPECT_LT((sum_XKX - XKX).norm(), 1e-13 * XKX.norm());
+  EXPECT_LT((sum_BX - BX).norm(), 1e-13 * BX.norm());
   PlayedRanks played(2, 0, &pieces);
   const SparseMatrix gathered = GatherColumns(KeepColumns(whole.K, ShareOfColumns(n)), ShareOfColumns(n));
   EXPECT_EQ(SparseMatrix(gathered - whole.K).norm(), 0.0);
@@ -163,6 +169,7 @@ TEST(SharedColumns, RankZerosMeshAndMetisPartitionMakeEachRankAssembleAboutItsSh
   NodePartition received;
   const auto mesh = std::make_shared<SolidMesh>(MeshFromBytes(MeshBytes(meshed, cut), &received));
   EXPECT_EQ(received.part, cut.part);
+  EXPECT_EQ(received.cell_part, cut.cell_part);
   EXPECT_EQ(received.parts, 2);
   EXPECT_EQ(mesh->nodes, meshed.nodes);
   EXPECT_EQ(mesh->cells, meshed.cells);
@@ -180,6 +187,8 @@ TEST(SharedColumns, RankZerosMeshAndMetisPartitionMakeEachRankAssembleAboutItsSh
                                                if (stage == "assembly") assembly = detail;
                                              });
     EXPECT_EQ(shared.columns.first, next);
+    // (each rank's element loops take its METIS part's cells)
+    EXPECT_EQ(long(shared.rank_cells.size()), cells[size_t(rank)]);
     EXPECT_NEAR(double(shared.columns.count) / double(whole.n_dofs()), 0.5, 0.05);
     next += shared.columns.count;
     const long assembled = std::stol(assembly);  // "N of M elements, ..."
