@@ -5,6 +5,8 @@
 #include "formats/input_error.h"
 #include "formats/superelement_checks.h"
 #include "formats/superelement_file.h"
+#include "reducer/linalg/interior_solver.h"
+#include "reducer/linalg/shared_columns.h"
 #include "reducer/linalg/sparse_cholesky.h"
 #include "reducer/reduce_part.h"
 
@@ -37,8 +39,14 @@ ReduceFileOutcome ReduceToFile(const PartSpec& part, const std::string& output, 
     if (warning) warning("warning: " + part.file + ": " + w);
   Stopwatch check_clock;
   const SuperelementChecks checks = CheckSuperelement(result.superelement);
-  if (const Check* c = checks.first_failure()) {
-    return refuse(3, "numerical failure: the reduced model fails check " + c->name + ": " + c->detail +
+  const Check* c = checks.first_failure();
+  std::string failure = c ? "the reduced model fails check " + c->name + ": " + c->detail : "";
+  // (on the MPI ranks sharing the reduction rank 0's verdict: it alone holds the stresses and the
+  // mesh shapes whole)
+  if (ResolvedSolver(part.reduction.solver) == ReductionSolver::kPetsc && DistributedRanks() > 1)
+    failure = FromFirstRank(failure);
+  if (!failure.empty()) {
+    return refuse(3, "numerical failure: " + failure +
                          "; the part may be nearly a mechanism (a region held by a connection many orders of "
                          "magnitude softer than the rest) or ill-conditioned");
   }

@@ -185,8 +185,15 @@ class NonlinearModelOf {
   }
   bool built() const { return nonlinear_ != nullptr; }
   const SparseMatrix& to_model_dofs() const { return to_model_dofs_; }
-  /// A solid's Green-Lagrange model on this rank's cells (`mesh`): the model itself on one process.
-  const SvkSolidMesh& OnRankMesh(const RankMesh& mesh) {
+  /// A solid's cells this rank takes in the loops over the elements after the reduction, built on
+  /// first use (RankMeshOf: all of them on one process).
+  const RankMesh& Mesh() {
+    if (!rank_mesh_) rank_mesh_ = std::make_unique<RankMesh>(RankMeshOf(model_));
+    return *rank_mesh_;
+  }
+  /// A solid's Green-Lagrange model on those cells: the model itself on one process.
+  const SvkSolidMesh& OnRankMesh() {
+    const RankMesh& mesh = Mesh();
     if (mesh.share.whole()) return static_cast<const SvkSolidMesh&>(Get());
     if (!rank_solid_) {
       rank_solid_ = std::make_unique<SvkSolidMesh>(SolidCellType(model_.cell_type), mesh.nodes, mesh.cells,
@@ -199,6 +206,7 @@ class NonlinearModelOf {
   const PartSpec& part_;
   const FeModel& model_;
   std::unique_ptr<NonlinearModel> nonlinear_;
+  std::unique_ptr<RankMesh> rank_mesh_;
   std::unique_ptr<SvkSolidMesh> rank_solid_;
   SparseMatrix to_model_dofs_;
 };
@@ -466,12 +474,12 @@ bool NonlinearForce(const PartSpec& part, const FeModel& model, const CraigBampt
   ReducedPolynomial poly;
   if (part.type != PartType::kBeam) {
     // (a solid's element loops on this rank's cells, with the shapes' rows their nodes need)
-    const RankMesh mesh = RankMeshOf(model);
+    const RankMesh& mesh = nonlinear.Mesh();
     const Eigen::MatrixXd mesh_shapes = RankMeshFields(model, mesh, cb.shapes);
     const Eigen::MatrixXd mesh_fields = stiffening ? RankMeshFields(model, mesh, stress_fields) : Eigen::MatrixXd();
     if (stiffening) poly_request.stress_fields = &mesh_fields;
     poly = ReduceSvk(
-        nonlinear.OnRankMesh(mesh), mesh_shapes,
+        nonlinear.OnRankMesh(), mesh_shapes,
         InterfaceRotationCompletion(mesh.nodes, mesh_shapes, model.interface_positions, se.floating_frame.origin),
         poly_request);
   } else {
@@ -529,14 +537,16 @@ bool NonlinearForce(const PartSpec& part, const FeModel& model, const CraigBampt
   return true;
 }
 
-// The mesh and the mode shapes on it, for pictures and stresses (the whole shapes on every rank).
+// The mesh and the mode shapes on it, for pictures and stresses.
 Visualization MeshAndShapes(const FeModel& model, const CraigBamptonResult& cb) {
   Visualization v;
   v.nodes = model.nodes;
   v.cells = model.cells;
   v.cell_type = model.cell_type;
   v.dofs_per_node = model.dofs_per_node;
-  v.shapes = model.mesh_map.size() ? MappedGatherRows(model.mesh_map, cb.shapes, model.columns)
+  // (a solid's on MPI ranks gathered on rank 0 only, which writes the file: the others' stresses
+  // take their own rows)
+  v.shapes = model.mesh_map.size() ? MappedGatherRows(model.mesh_map, cb.shapes, model.columns, true)
                                    : GatherRows(cb.shapes, model.columns);
   v.interface_nodes = model.interface_node_sets;
   return v;
@@ -561,30 +571,35 @@ bool UsesStresses(const PartSpec& part, const FeModel& model, bool keep_mesh) {
 // The modal stresses of the basis on the mesh (reducer/reduction/modal_stress.h) and of the
 // inertia load cases' fields. With modal derivatives the stress keeps the strain's quadratic part
 // (solids: Green-Lagrange; beams: the von Karman axial term), as the body's polynomial force
-// does; the inertia load cases' stresses are linear.
-void Stresses(const PartSpec& part, const FeModel& model, const Eigen::MatrixXd& stress_fields,
-              const ProgressFn& report, Superelement& se) {
+// does; the inertia load cases' stresses are linear. On MPI ranks a solid's are each rank's cells',
+// gathered on rank 0 (SolidModalStressOnRanks): the others keep none.
+void Stresses(const PartSpec& part, const FeModel& model, const CraigBamptonResult& cb,
+              const Eigen::MatrixXd& stress_fields, NonlinearModelOf& elements, const ProgressFn& report,
+              Superelement& se) {
   Stopwatch stress_clock;
-  const Visualization& v = *se.visualization;
-  auto stresses_of = [&](const Eigen::MatrixXd& fields, bool quadratic) {
-    return part.type != PartType::kBeam ? SolidModalStress(SolidCellType(model.cell_type), model.nodes, model.cells,
-                                                           part.material, fields, quadratic, ElementShare(model))
-                                        : BeamModalStress(part, fields, quadratic);
+  // (`rows`: fields on the model DOFs, each rank's rows of them on MPI ranks; `on_mesh`: the same on
+  // the mesh when at hand)
+  const auto stresses_of = [&](const Eigen::MatrixXd& rows, bool quadratic, const Eigen::MatrixXd* on_mesh) {
+    if (part.type == PartType::kBeam) return BeamModalStress(part, GatherRows(rows, model.columns), quadratic);
+    const SolidType type = SolidCellType(model.cell_type);
+    if (!model.columns.whole()) {
+      const RankMesh& mesh = elements.Mesh();
+      return SolidModalStressOnRanks(type, model.nodes, mesh, part.material, RankMeshFields(model, mesh, rows),
+                                     quadratic);
+    }
+    if (on_mesh) return SolidModalStress(type, model.nodes, model.cells, part.material, *on_mesh, quadratic);
+    return SolidModalStress(type, model.nodes, model.cells, part.material, model.mesh_map * rows, quadratic);
   };
-  se.stress = stresses_of(v.shapes, se.n_modal_derivatives > 0);
+  se.stress = stresses_of(cb.shapes, se.n_modal_derivatives > 0, &se.visualization->shapes);
   if (stress_fields.cols() > 0) {
-    // (on the mesh, whole: held as the shapes are)
-    const ModalStress inertia =
-        stresses_of(model.mesh_map.size() ? MappedGatherRows(model.mesh_map, stress_fields, model.columns)
-                                          : GatherRows(stress_fields, model.columns),
-                    false);
+    const ModalStress inertia = stresses_of(stress_fields, false, nullptr);
     se.stress->inertia_modes = inertia.modes;
     se.stress->inertia_section_forces = inertia.section_forces;
   }
   const ModalStress& st = *se.stress;
   char detail[640];
   std::snprintf(detail, sizeof detail, "%d stress points x %ld coordinates (%s%s%s), %.3g MB in single precision",
-                st.n_points(), long(v.shapes.cols()), st.method.c_str(),
+                st.n_points(), long(cb.shapes.cols()), st.method.c_str(),
                 st.gradients.size()           ? "; displacement gradients for the Green-Lagrange quadratic part"
                 : st.element_quadratic.size() ? "; element forms of the von Karman axial strain"
                                               : "",
@@ -656,7 +671,7 @@ ReduceResult ReducePart(const PartSpec& part, const ProgressFn& progress) {
       "frame+mass", clock.Seconds(),
       "floating frame " + se.floating_frame.type +
           (budget.keep_mesh ? ", mesh and mode shapes kept" : ", mesh and mode shapes not kept (reduction.keep_mesh)"));
-  if (UsesStresses(part, model, budget.keep_mesh)) Stresses(part, model, stress_fields, report, se);
+  if (UsesStresses(part, model, budget.keep_mesh)) Stresses(part, model, cb, stress_fields, nonlinear, report, se);
   if (!FreeFreeCheck(part, model, cb.lambda, progress, report, se, &result.message)) return result;
   result.ok = true;
   return result;

@@ -166,13 +166,20 @@ RankMesh RankMeshOf(const FeModel& model) {
   // The rows of mesh_map for the nodes' mesh DOFs (the columns of its transpose), on the model
   // DOFs they touch.
   const SparseMatrix Tt = model.mesh_map.transpose();
+  const std::vector<ColumnShare> shares = RanksShares(model.columns);
   std::vector<Eigen::Triplet<double>> entries;
-  for (size_t i = 0; i < mesh.node.size(); ++i)
+  mesh.owner.assign(mesh.node.size(), 0);
+  for (size_t i = 0; i < mesh.node.size(); ++i) {
     for (int c = 0; c < 3; ++c)
       for (SparseMatrix::InnerIterator it(Tt, 3 * mesh.node[i] + c); it; ++it) {
         entries.emplace_back(int(3 * i) + c, int(it.row()), it.value());
         mesh.model_rows.push_back(int(it.row()));
       }
+    SparseMatrix::InnerIterator first(Tt, 3 * mesh.node[i]);
+    if (!first) continue;
+    for (size_t r = 0; r < shares.size(); ++r)
+      if (shares[r].Holds(first.row()) && shares[r].count > 0) mesh.owner[i] = int(r);
+  }
   std::sort(mesh.model_rows.begin(), mesh.model_rows.end());
   mesh.model_rows.erase(std::unique(mesh.model_rows.begin(), mesh.model_rows.end()), mesh.model_rows.end());
   for (Eigen::Triplet<double>& t : entries) {

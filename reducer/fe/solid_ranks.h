@@ -42,6 +42,9 @@ struct RankMesh {
   /// FeModel::mesh_map for those mesh DOFs on them.
   std::vector<int> model_rows;
   SparseMatrix map;
+  /// On MPI ranks: the rank each node's sums go to (AddOnOwners): the one holding the model DOF
+  /// its first mesh DOF maps from (rank 0 for a node that maps from none).
+  std::vector<int> owner;
 };
 RankMesh RankMeshOf(const FeModel& model);
 

@@ -1,6 +1,7 @@
 #include "reducer/linalg/shared_columns.h"
 
 #include <algorithm>
+#include <numeric>
 #include <stdexcept>
 
 #include "reducer/linalg/byte_buffer.h"
@@ -129,10 +130,8 @@ Eigen::MatrixXd GatherRows(const Eigen::MatrixXd& mine, const ColumnShare& share
   return out;
 }
 
-namespace {
-
-// Every rank's share (first, count), in rank order.
-std::vector<ColumnShare> SharesOfRanks(const ColumnShare& share) {
+std::vector<ColumnShare> RanksShares(const ColumnShare& share) {
+  if (!TheCollectives().gather) return {share};
   std::string mine;
   const long header[2] = {share.first, share.count};
   AppendBytes(mine, header, 2);
@@ -144,6 +143,8 @@ std::vector<ColumnShare> SharesOfRanks(const ColumnShare& share) {
   }
   return shares;
 }
+
+namespace {
 
 // The entries of `sorted` (ascending) in each rank's share: [begin, end) per rank.
 std::vector<std::pair<long, long>> RanksEntries(const std::vector<int>& sorted,
@@ -182,7 +183,7 @@ Eigen::MatrixXd TimesRowsExchanged(const SparseMatrix& A, const Eigen::MatrixXd&
         }
       }
     }
-  const std::vector<ColumnShare> shares = SharesOfRanks(share);
+  const std::vector<ColumnShare> shares = RanksShares(share);
   const std::vector<std::pair<long, long>> held = RanksEntries(ghosts, shares);
   std::vector<std::string> to(shares.size());
   for (size_t r = 0; r < shares.size(); ++r) {
@@ -216,7 +217,7 @@ Eigen::MatrixXd FetchRows(const Eigen::MatrixXd& mine, const ColumnShare& share,
     for (size_t i = 0; i < wanted.size(); ++i) out.row(long(i)) = whole.row(wanted[i]);
     return out;
   }
-  const std::vector<ColumnShare> shares = SharesOfRanks(share);
+  const std::vector<ColumnShare> shares = RanksShares(share);
   const std::vector<std::pair<long, long>> asked = RanksEntries(wanted, shares);
   // The rows asked of each rank, then its answer: the rows' values, column-major.
   std::vector<std::string> questions(shares.size());
@@ -275,17 +276,125 @@ Eigen::MatrixXd TimesHeldRows(const SparseMatrix& B, const Eigen::MatrixXd& X, c
   return BX;
 }
 
-Eigen::MatrixXd MappedGatherRows(const SparseMatrix& T, const Eigen::MatrixXd& X, const ColumnShare& share) {
+namespace {
+
+// The whole of X held as each rank's rows (`share`) on rank 0 (the ranks' rows in rank order),
+// 0 x k on the others.
+Eigen::MatrixXd GatherRowsOnFirst(const Eigen::MatrixXd& mine) {
+  const long k = mine.cols();
+  std::vector<std::string> to(static_cast<size_t>(DistributedRanks()));
+  AppendBytes(to[0], mine.data(), size_t(mine.size()));
+  const std::vector<std::string> received = TheCollectives().exchange(to);
+  if (DistributedRank() != 0) return Eigen::MatrixXd(0, k);
+  std::vector<long> counts;
+  for (const std::string& bytes : received) counts.push_back(k > 0 ? long(bytes.size() / sizeof(double)) / k : 0);
+  Eigen::MatrixXd out(std::accumulate(counts.begin(), counts.end(), 0L), k);
+  long first = 0;
+  for (size_t r = 0; r < received.size(); ++r) {
+    const char* at = received[r].data();
+    for (long j = 0; j < k && counts[r] > 0; ++j) at = TakeBytes(at, &out(first, j), size_t(counts[r]));
+    first += counts[r];
+  }
+  return out;
+}
+
+}  // namespace
+
+Eigen::MatrixXd MappedGatherRows(const SparseMatrix& T, const Eigen::MatrixXd& X, const ColumnShare& share,
+                                 bool first_only) {
   if (share.whole()) return T * X;
+  first_only = first_only && TheCollectives().exchange;
   Eigen::Matrix<double, 1, 1> rows(double(X.rows()));
   SumOverRanks(rows, share);
   const long k = X.cols(), step = ColumnsPerStep(long(rows(0, 0)));
-  Eigen::MatrixXd TX(T.rows(), k);
+  const bool here = !first_only || DistributedRank() == 0;
+  Eigen::MatrixXd TX(here ? T.rows() : 0, k);
   for (long c0 = 0; c0 < k; c0 += step) {
     const long w = std::min(step, k - c0);
-    TX.middleCols(c0, w) = T * GatherRows(X.middleCols(c0, w), share);
+    const Eigen::MatrixXd columns = X.middleCols(c0, w);
+    const Eigen::MatrixXd whole = first_only ? GatherRowsOnFirst(columns) : GatherRows(columns, share);
+    if (here) TX.middleCols(c0, w) = T * whole;
   }
   return TX;
+}
+
+void AddOnOwners(std::vector<int>& keys, Eigen::MatrixXd& rows, int per_key, const std::vector<int>& owner) {
+  const int me = DistributedRank();
+  const long k = rows.cols();
+  std::vector<std::vector<long>> to_rank(static_cast<size_t>(DistributedRanks()));
+  std::vector<long> kept;
+  for (size_t i = 0; i < keys.size(); ++i) (owner[i] == me ? kept : to_rank[size_t(owner[i])]).push_back(long(i));
+  // To each rank: the count, its keys, then their blocks (column-major).
+  std::vector<std::string> to(to_rank.size());
+  for (size_t r = 0; r < to_rank.size(); ++r) {
+    const long count = long(to_rank[r].size());
+    if (count == 0) continue;
+    std::vector<int> sent_keys;
+    Eigen::MatrixXd blocks(per_key * count, k);
+    for (long j = 0; j < count; ++j) {
+      sent_keys.push_back(keys[size_t(to_rank[r][size_t(j)])]);
+      blocks.middleRows(per_key * j, per_key) = rows.middleRows(per_key * to_rank[r][size_t(j)], per_key);
+    }
+    AppendBytes(to[r], &count, 1);
+    AppendBytes(to[r], sent_keys.data(), sent_keys.size());
+    AppendBytes(to[r], blocks.data(), size_t(blocks.size()));
+  }
+  const std::vector<std::string> received = TheCollectives().exchange(to);
+  std::vector<int> owned;
+  for (const long i : kept) owned.push_back(keys[size_t(i)]);
+  std::vector<std::pair<std::vector<int>, Eigen::MatrixXd>> theirs;
+  for (const std::string& bytes : received) {
+    if (bytes.empty()) continue;
+    long count = 0;
+    const char* at = TakeBytes(bytes.data(), &count, 1);
+    std::vector<int> their_keys(static_cast<size_t>(count));
+    at = TakeBytes(at, their_keys.data(), their_keys.size());
+    Eigen::MatrixXd blocks(per_key * count, k);
+    TakeBytes(at, blocks.data(), size_t(blocks.size()));
+    owned.insert(owned.end(), their_keys.begin(), their_keys.end());
+    theirs.emplace_back(std::move(their_keys), std::move(blocks));
+  }
+  std::sort(owned.begin(), owned.end());
+  owned.erase(std::unique(owned.begin(), owned.end()), owned.end());
+  const auto at_key = [&owned](int key) {
+    return long(std::lower_bound(owned.begin(), owned.end(), key) - owned.begin());
+  };
+  Eigen::MatrixXd sums = Eigen::MatrixXd::Zero(per_key * long(owned.size()), k);
+  for (const long i : kept)
+    sums.middleRows(per_key * at_key(keys[size_t(i)]), per_key) += rows.middleRows(per_key * i, per_key);
+  for (const auto& [their_keys, blocks] : theirs)
+    for (size_t j = 0; j < their_keys.size(); ++j)
+      sums.middleRows(per_key * at_key(their_keys[j]), per_key) += blocks.middleRows(per_key * long(j), per_key);
+  keys = std::move(owned);
+  rows = std::move(sums);
+}
+
+Eigen::MatrixXf GatherBlocksOnFirst(const std::vector<int>& keys, const Eigen::MatrixXd& rows, int per_key, long n) {
+  const bool first = DistributedRank() == 0;
+  const long k = rows.cols(), step = ColumnsPerStep(per_key * n);
+  Eigen::MatrixXf whole = first ? Eigen::MatrixXf::Zero(per_key * n, k) : Eigen::MatrixXf(0, k);
+  std::vector<std::string> to(static_cast<size_t>(DistributedRanks()));
+  for (long c0 = 0; c0 < k; c0 += step) {
+    const long w = std::min(step, k - c0), count = long(keys.size());
+    to[0].clear();
+    AppendBytes(to[0], &count, 1);
+    AppendBytes(to[0], keys.data(), keys.size());
+    const Eigen::MatrixXd columns = rows.middleCols(c0, w);
+    AppendBytes(to[0], columns.data(), size_t(columns.size()));
+    for (const std::string& bytes : TheCollectives().exchange(to)) {
+      long their_count = 0;
+      const char* at = bytes.empty() ? nullptr : TakeBytes(bytes.data(), &their_count, 1);
+      if (their_count == 0) continue;
+      std::vector<int> their_keys(static_cast<size_t>(their_count));
+      at = TakeBytes(at, their_keys.data(), their_keys.size());
+      Eigen::MatrixXd values(per_key * their_count, w);
+      TakeBytes(at, values.data(), size_t(values.size()));
+      for (size_t j = 0; j < their_keys.size(); ++j)
+        whole.block(per_key * long(their_keys[j]), c0, per_key, w) =
+            values.middleRows(per_key * long(j), per_key).cast<float>();
+    }
+  }
+  return whole;
 }
 
 SparseMatrix SumSparseOverRanks(const SparseMatrix& A, const ColumnShare& share) {

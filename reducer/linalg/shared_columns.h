@@ -67,6 +67,20 @@ Eigen::MatrixXd GatherRows(const Eigen::MatrixXd& mine, const ColumnShare& share
 /// it, gathered whole). X's rows `wanted` when the share is the whole.
 Eigen::MatrixXd FetchRows(const Eigen::MatrixXd& mine, const ColumnShare& share, const std::vector<int>& wanted);
 
+/// Every rank's share (first, count), in rank order (on one process: the one share given).
+std::vector<ColumnShare> RanksShares(const ColumnShare& share);
+
+/// Blocks of `per_key` rows, one per key (`keys`, ascending; `rows` per_key x keys.size() rows):
+/// each sent to the rank owner[i] names and added there to the same key's blocks from the other
+/// ranks, after its own, in rank order. Leaves in `keys` and `rows` the keys this rank owns
+/// (ascending; also those only other ranks had) and their sums. Needs the exchange collective.
+void AddOnOwners(std::vector<int>& keys, Eigen::MatrixXd& rows, int per_key, const std::vector<int>& owner);
+
+/// Blocks of `per_key` rows, one per key (`keys`; each key on one rank), gathered on rank 0 into
+/// the whole (per_key n x k, single precision, zero where no rank has the key) a few columns at
+/// a time; 0 x k on the other ranks. Needs the exchange collective.
+Eigen::MatrixXf GatherBlocksOnFirst(const std::vector<int>& keys, const Eigen::MatrixXd& rows, int per_key, long n);
+
 /// This rank's rows of A X for A shared by columns and X held as its rows (`share` both): each
 /// rank's part A_h X_h of the whole, whose rows beyond its own (the layer of the mesh around its
 /// part) are sent to the ranks that hold them and added there (without `exchange`: summed over all
@@ -87,8 +101,10 @@ Eigen::MatrixXd TimesHeldRows(const SparseMatrix& B, const Eigen::MatrixXd& X, c
 
 /// T times the whole of X held as each rank's rows (`share`), on every rank: X gathered a few
 /// columns at a time, each step mapped at once, so that the whole X is never held beside T X
-/// (the mode shapes mapped onto the mesh). T X when the share is the whole.
-Eigen::MatrixXd MappedGatherRows(const SparseMatrix& T, const Eigen::MatrixXd& X, const ColumnShare& share);
+/// (the mode shapes mapped onto the mesh). T X when the share is the whole. `first_only`: on rank
+/// 0 only (the file's), 0 x k on the others (without the exchange collective: on every rank).
+Eigen::MatrixXd MappedGatherRows(const SparseMatrix& T, const Eigen::MatrixXd& X, const ColumnShare& share,
+                                 bool first_only = false);
 
 /// Every rank's entries of A added up (sparse; each rank's A the same size): the whole of a
 /// block that the ranks hold pieces of. A itself on one process.

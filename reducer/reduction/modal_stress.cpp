@@ -6,6 +6,7 @@
 
 #include "reducer/fe/beam_model.h"
 #include "reducer/fe/timoshenko_beam.h"
+#include "reducer/linalg/interior_solver.h"
 #include "reducer/linalg/shared_columns.h"
 
 namespace femb {
@@ -97,19 +98,26 @@ std::vector<Fibre> SectionFibres(const BeamSectionSpec& s, const SectionProperti
 
 }  // namespace
 
-ModalStress SolidModalStress(SolidType type, const Eigen::MatrixXd& nodes, const Eigen::MatrixXi& cells,
-                             const MaterialSpec& material, const Eigen::MatrixXd& mesh_shapes, bool gradients,
-                             const ColumnShare& held) {
+namespace {
+
+// The volume-weighted sums of the elements' projected values at the nodes (`rows` per node,
+// node-major) and the nodes' volumes, over `cells`.
+struct NodalSums {
+  Eigen::MatrixXd sum;
+  Eigen::VectorXd weight;
+};
+
+NodalSums SumOverElements(SolidType type, const Eigen::MatrixXd& nodes, const Eigen::MatrixXi& cells,
+                          const MaterialSpec& material, const Eigen::MatrixXd& mesh_shapes, bool gradients) {
   const long n_nodes = nodes.rows(), m = mesh_shapes.cols();
   const int n = SolidNodeCount(type);
   // Per point the rows projected: the 6 stresses D B u, then (with gradients) the 9 entries of
   // the displacement gradient du_i/dX_j (row 3 i + j).
   const int rows = gradients ? 15 : 6;
   const Eigen::Matrix<double, 6, 6> D = IsotropicElasticity(material.E, material.nu);
-  Eigen::MatrixXd sum = Eigen::MatrixXd::Zero(rows * n_nodes, m);
-  Eigen::VectorXd weight = Eigen::VectorXd::Zero(n_nodes);
+  NodalSums out{Eigen::MatrixXd::Zero(rows * n_nodes, m), Eigen::VectorXd::Zero(n_nodes)};
   Eigen::MatrixXd X(n, 3), U(3 * n, m), op(rows, 3 * n);
-  for (long e = held.whole() ? 0 : held.first; e < held.end(cells.rows()); ++e) {
+  for (long e = 0; e < cells.rows(); ++e) {
     for (int a = 0; a < n; ++a) {
       X.row(a) = nodes.row(cells(e, a));
       U.middleRows(3 * a, 3) = mesh_shapes.middleRows(3 * long(cells(e, a)), 3);
@@ -136,29 +144,66 @@ ModalStress SolidModalStress(SolidType type, const Eigen::MatrixXd& nodes, const
       Eigen::MatrixXd rhs(n, m);
       for (int a = 0; a < n; ++a) rhs.row(a) = S.row(rows * a + c);
       const Eigen::MatrixXd nodal = llt.solve(rhs);
-      for (int a = 0; a < n; ++a) sum.row(rows * long(cells(e, a)) + c) += volume * nodal.row(a);
+      for (int a = 0; a < n; ++a) out.sum.row(rows * long(cells(e, a)) + c) += volume * nodal.row(a);
     }
-    for (int a = 0; a < n; ++a) weight[cells(e, a)] += volume;
+    for (int a = 0; a < n; ++a) out.weight[cells(e, a)] += volume;
   }
-  SumOverRanks(sum, held);
-  SumOverRanks(weight, held);
-  ModalStress out;
+  return out;
+}
+
+// The result's points (every mesh node) and material.
+void SetPoints(const Eigen::MatrixXd& nodes, const MaterialSpec& material, bool gradients, ModalStress& out) {
   out.method = "solid_nodal_l2";
   out.points = nodes;
-  out.node.resize(n_nodes);
-  out.modes.resize(6 * n_nodes, m);
+  out.node.resize(nodes.rows());
+  for (long i = 0; i < nodes.rows(); ++i) out.node[i] = int(i);
   if (gradients) {
-    out.gradients.resize(9 * n_nodes, m);
     out.E = material.E;
     out.nu = material.nu;
   }
+}
+
+}  // namespace
+
+ModalStress SolidModalStress(SolidType type, const Eigen::MatrixXd& nodes, const Eigen::MatrixXi& cells,
+                             const MaterialSpec& material, const Eigen::MatrixXd& mesh_shapes, bool gradients) {
+  const NodalSums s = SumOverElements(type, nodes, cells, material, mesh_shapes, gradients);
+  const long n_nodes = nodes.rows(), m = mesh_shapes.cols();
+  const int rows = gradients ? 15 : 6;
+  ModalStress out;
+  SetPoints(nodes, material, gradients, out);
+  out.modes.resize(6 * n_nodes, m);
+  if (gradients) out.gradients.resize(9 * n_nodes, m);
   for (long i = 0; i < n_nodes; ++i) {
-    out.node[i] = int(i);
     // Nodes of no element (none in a meshed part) keep zero stress.
-    const double w = weight[i] > 0 ? weight[i] : 1.0;
-    out.modes.middleRows(6 * i, 6) = (sum.middleRows(rows * i, 6) / w).cast<float>();
-    if (gradients) out.gradients.middleRows(9 * i, 9) = (sum.middleRows(rows * i + 6, 9) / w).cast<float>();
+    const double w = s.weight[i] > 0 ? s.weight[i] : 1.0;
+    out.modes.middleRows(6 * i, 6) = (s.sum.middleRows(rows * i, 6) / w).cast<float>();
+    if (gradients) out.gradients.middleRows(9 * i, 9) = (s.sum.middleRows(rows * i + 6, 9) / w).cast<float>();
   }
+  return out;
+}
+
+ModalStress SolidModalStressOnRanks(SolidType type, const Eigen::MatrixXd& points, const RankMesh& mesh,
+                                    const MaterialSpec& material, const Eigen::MatrixXd& mesh_fields, bool gradients) {
+  NodalSums s = SumOverElements(type, mesh.nodes, mesh.cells, material, mesh_fields, gradients);
+  const long m = mesh_fields.cols();
+  const int rows = gradients ? 15 : 6;
+  std::vector<int> keys = mesh.node, weight_keys = mesh.node;
+  Eigen::MatrixXd weight = s.weight;
+  AddOnOwners(keys, s.sum, rows, mesh.owner);
+  AddOnOwners(weight_keys, weight, 1, mesh.owner);  // (the same keys: the same owners)
+  Eigen::MatrixXd modes(6 * long(keys.size()), m), slopes(gradients ? 9 * long(keys.size()) : 0, m);
+  for (long i = 0; i < long(keys.size()); ++i) {
+    const double w = weight(i, 0) > 0 ? weight(i, 0) : 1.0;
+    modes.middleRows(6 * i, 6) = s.sum.middleRows(rows * i, 6) / w;
+    if (gradients) slopes.middleRows(9 * i, 9) = s.sum.middleRows(rows * i + 6, 9) / w;
+  }
+  s = NodalSums();
+  ModalStress out;
+  const long n_nodes = points.rows();
+  out.modes = GatherBlocksOnFirst(keys, modes, 6, n_nodes);
+  if (gradients) out.gradients = GatherBlocksOnFirst(keys, slopes, 9, n_nodes);
+  if (DistributedRank() == 0) SetPoints(points, material, gradients, out);
   return out;
 }
 

@@ -33,6 +33,7 @@
 #include "formats/superelement.h"
 #include "reducer/fe/fe_model.h"
 #include "reducer/fe/solid_element.h"
+#include "reducer/fe/solid_ranks.h"
 
 namespace femb {
 
@@ -41,11 +42,16 @@ namespace femb {
 /// `gradients` (parts with modal derivatives): also each basis vector's displacement gradient at
 /// the nodes, projected the same way, for the quadratic part of the Green-Lagrange strain
 /// (ModalStress::gradients).
-/// On the MPI ranks of a distributed reduction each rank takes the elements `held` (a range of the
-/// cells) and the nodes' sums are added over the ranks: the whole result on every rank.
 ModalStress SolidModalStress(SolidType type, const Eigen::MatrixXd& nodes, const Eigen::MatrixXi& cells,
-                             const MaterialSpec& material, const Eigen::MatrixXd& mesh_shapes, bool gradients = false,
-                             const ColumnShare& held = ColumnShare());
+                             const MaterialSpec& material, const Eigen::MatrixXd& mesh_shapes, bool gradients = false);
+
+/// The same on the MPI ranks of a distributed reduction: each rank takes its own cells (`mesh`,
+/// RankMesh; `mesh_fields` on its nodes), a node's sums are added on its owner (RankMesh::owner),
+/// which divides them, and rank 0 gathers them: the whole result on rank 0 (`points` the whole
+/// mesh's nodes), none (no points, 0-row stresses) on the others.
+ModalStress SolidModalStressOnRanks(SolidType type, const Eigen::MatrixXd& points, const RankMesh& mesh,
+                                    const MaterialSpec& material, const Eigen::MatrixXd& mesh_fields,
+                                    bool gradients = false);
 
 /// Modal stresses of a beam part: `shapes` (6 n_nodes x n) on the nodes of BeamElements(part).
 /// `quadratic` (parts with modal derivatives): also the element quadratic forms of the von Karman

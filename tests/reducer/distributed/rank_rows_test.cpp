@@ -4,8 +4,9 @@
 // rows of A X from A's share of columns and X's share of rows, the rows its columns touch beyond
 // its own sent to the ranks that hold them, are those of the whole product (1e-14 of its norm:
 // only the order of the sums differs), and so are the projection X^T A X from the rows and a map
-// of the gathered rows; rows fetched from the ranks that hold them are the block's exactly; the
-// ranks' pieces of a sparse block add up to it exactly.
+// of the gathered rows (on every rank, or on rank 0 only); rows fetched from the ranks that hold
+// them are the block's exactly; blocks keyed by node add up exactly on their owners and gather on
+// rank 0 (zero where no rank had one); the ranks' pieces of a sparse block add up to it exactly.
 // Each rank builds the same matrices from one seed.
 #include <gtest/gtest.h>
 
@@ -105,6 +106,52 @@ TEST(RankRows, FetchedRowsAreTheWholeBlocksRowsExactly) {
     ASSERT_EQ(rows.cols(), X.cols());
     for (size_t i = 0; i < wanted.size(); ++i) ASSERT_TRUE(rows.row(long(i)) == X.row(wanted[i])) << wanted[i];
   }
+}
+
+// Rank r's value of row i of key's block, column j (whole numbers: their sums are exact).
+double BlockValue(int key, long i, long j, int rank) {
+  return 1000.0 * rank + 10.0 * key + 3.0 * double(i) + double(j);
+}
+
+TEST(RankRows, KeyedBlocksAddOnTheirOwnersAndGatherOnTheFirstRank) {
+  const int ranks = DistributedRanks(), rank = DistributedRank(), per_key = 2;
+  const long n = 40, k = 3;
+  // Rank r has the keys with key % (r + 2) == 0 (keys on several ranks, and on none: 1, 5, 7,
+  // ...); key's owner is key % ranks.
+  const auto has = [](int key, int r) { return key % (r + 2) == 0; };
+  std::vector<int> keys, owner;
+  for (int key = 0; key < n; ++key)
+    if (has(key, rank)) keys.push_back(key), owner.push_back(key % ranks);
+  Eigen::MatrixXd rows(per_key * long(keys.size()), k);
+  for (size_t b = 0; b < keys.size(); ++b)
+    for (long i = 0; i < per_key; ++i)
+      for (long j = 0; j < k; ++j) rows(per_key * long(b) + i, j) = BlockValue(keys[b], i, j, rank);
+  AddOnOwners(keys, rows, per_key, owner);
+  std::vector<int> expected_keys;
+  Eigen::MatrixXd expected = Eigen::MatrixXd::Zero(per_key * n, k);
+  for (int key = 0; key < n; ++key)
+    for (int r = 0; r < ranks; ++r) {
+      if (!has(key, r)) continue;
+      if (key % ranks == rank && (expected_keys.empty() || expected_keys.back() != key)) expected_keys.push_back(key);
+      for (long i = 0; i < per_key; ++i)
+        for (long j = 0; j < k; ++j) expected(per_key * key + i, j) += BlockValue(key, i, j, r);
+    }
+  ASSERT_EQ(keys, expected_keys);
+  for (size_t b = 0; b < keys.size(); ++b)
+    EXPECT_TRUE(rows.middleRows(per_key * long(b), per_key) == expected.middleRows(per_key * keys[b], per_key));
+  const Eigen::MatrixXf whole = GatherBlocksOnFirst(keys, rows, per_key, n);
+  if (rank == 0) {
+    EXPECT_TRUE(whole == expected.cast<float>());  // (zero where no rank had the key)
+  } else {
+    EXPECT_EQ(whole.rows(), 0);
+  }
+  // The shapes on the mesh on rank 0 only: the whole T X there, no rows elsewhere.
+  const ColumnShare share = ShareOfColumns(n);
+  const Eigen::MatrixXd X = RandomBlock(n, k, 29);
+  const SparseMatrix T = SparseMatrix(Banded(n + 5, 1, 31).leftCols(n));
+  const Eigen::MatrixXd mapped = MappedGatherRows(T, HeldRows(X, share), share, true);
+  EXPECT_EQ(mapped.rows(), rank == 0 ? n + 5 : 0);
+  if (rank == 0) EXPECT_LE((mapped - T * X).norm(), 1e-14 * (T * X).norm());
 }
 
 TEST(RankRows, RanksPiecesOfASparseBlockAddUpToItExactly) {
