@@ -17,6 +17,7 @@
 #include "reducer/linalg/interior_solver.h"
 #include "reducer/linalg/shared_columns.h"
 #include "reducer/linalg/sparse_cholesky.h"
+#include "reducer/part_nonlinear.h"
 #include "reducer/reduction/craig_bampton.h"
 #include "reducer/reduction/floating_frame.h"
 #include "reducer/reduction/full_modes.h"
@@ -58,32 +59,6 @@ Eigen::MatrixXd ReadShapes(const std::string& path, long rows) {
   return V;
 }
 
-// The pairs of Craig-Bampton coordinates whose modal derivatives are asked for.
-std::vector<std::pair<int, int>> DerivativePairs(const PartSpec& part, int n_interface_dofs, int n_cb) {
-  const ModalDerivativeSpec& spec = part.reduction.modal_derivatives;
-  if (!spec.pairs.empty()) {
-    for (const auto& [i, j] : spec.pairs) {
-      if (i >= n_cb || j >= n_cb) {
-        throw InputError(spec.where + ".pairs: [" + std::to_string(i) + ", " + std::to_string(j) +
-                         "] is not a pair of the " + std::to_string(n_cb) +
-                         " Craig-Bampton coordinates (0-based: interfaces' 6 each, then the internal modes)");
-      }
-    }
-    return spec.pairs;
-  }
-  const int first = spec.of == DerivativePairs::kInternal ? n_interface_dofs : 0;
-  const int last = spec.of == DerivativePairs::kStatic ? n_interface_dofs : n_cb;
-  std::vector<std::pair<int, int>> pairs;
-  for (int i = first; i < last; ++i)
-    for (int j = i; j < last; ++j) pairs.emplace_back(i, j);
-  return pairs;
-}
-
-SolidType SolidCellType(CellType cell) {
-  if (const std::optional<SolidType> t = SolidTypeOf(cell)) return *t;
-  throw InputError(std::string("no solid element type '") + Name(cell) + "'");
-}
-
 // The FE model of the part: meshed solids, imported matrices or beams. `shared`: on the MPI ranks
 // of a distributed reduction, K and M shared by columns (a solid assembles only its share; the
 // others keep their share of the whole), checked to be one model on every rank.
@@ -114,12 +89,6 @@ FeModel BuildFeModel(const PartSpec& part, const ProgressFn& report, bool shared
     replicated.insert(replicated.end(), x.data(), x.data() + 3);
   CheckSameOnRanks(replicated, "models");
   return model;
-}
-
-// The elements this rank takes of the stages that loop over them (stiffening, modal derivatives'
-// forces, stresses): all on one process; on MPI ranks sharing K and M, a share of the cells.
-ColumnShare ElementShare(const FeModel& model) {
-  return model.columns.whole() ? ColumnShare() : ShareOfColumns(model.n_elements());
 }
 
 // What the factorization may use, from the checks that need only the mesh and the mass.
@@ -161,87 +130,6 @@ Budget CheckBeforeFactorization(const PartSpec& part, const FeModel& model) {
       budget.limit_given ? part.reduction.memory_limit_gb * 1e9 : AvailableMemoryBytes() / double(std::max(sharing, 1));
   budget.factor_bytes = limit > 0 ? std::max(limit - budget.dense_bytes, 0.1 * limit) : 0.0;
   return budget;
-}
-
-// The Green-Lagrange (solids, imported meshes) or von Karman (beams) model of the part, built on
-// first use for the modal derivatives and the geometric stiffening, and the map from the FE
-// model's DOFs to its own (its DOFs = to_model_dofs() x the model's). On MPI ranks sharing the
-// model a solid's elements are shared too (ElementShare).
-class NonlinearModelOf {
- public:
-  NonlinearModelOf(const PartSpec& part, const FeModel& model)
-      : part_(part), model_(model), to_model_dofs_(model.mesh_map) {}
-  const NonlinearModel& Get() {
-    if (nonlinear_) return *nonlinear_;
-    if (part_.type == PartType::kSolid || part_.type == PartType::kImported) {
-      nonlinear_ = std::make_unique<SvkSolidMesh>(SolidCellType(model_.cell_type), model_.nodes, model_.cells,
-                                                  part_.material, ElementShare(model_));
-    } else {
-      nonlinear_ = std::make_unique<VonKarmanBeams>(part_);
-      to_model_dofs_.resize(model_.n_dofs(), model_.n_dofs());
-      to_model_dofs_.setIdentity();
-    }
-    return *nonlinear_;
-  }
-  bool built() const { return nonlinear_ != nullptr; }
-  const SparseMatrix& to_model_dofs() const { return to_model_dofs_; }
-  /// A solid's cells this rank takes in the loops over the elements after the reduction, built on
-  /// first use (RankMeshOf: all of them on one process).
-  const RankMesh& Mesh() {
-    if (!rank_mesh_) rank_mesh_ = std::make_unique<RankMesh>(RankMeshOf(model_));
-    return *rank_mesh_;
-  }
-  /// A solid's Green-Lagrange model on those cells: the model itself on one process.
-  const SvkSolidMesh& OnRankMesh() {
-    const RankMesh& mesh = Mesh();
-    if (mesh.share.whole()) return static_cast<const SvkSolidMesh&>(Get());
-    if (!rank_solid_) {
-      rank_solid_ = std::make_unique<SvkSolidMesh>(SolidCellType(model_.cell_type), mesh.nodes, mesh.cells,
-                                                   part_.material, mesh.share);
-    }
-    return *rank_solid_;
-  }
-
- private:
-  const PartSpec& part_;
-  const FeModel& model_;
-  std::unique_ptr<NonlinearModel> nonlinear_;
-  std::unique_ptr<RankMesh> rank_mesh_;
-  std::unique_ptr<SvkSolidMesh> rank_solid_;
-  SparseMatrix to_model_dofs_;
-};
-
-// Modal derivatives: (dK/dq_j) phi_i = 2 f2(phi_i, phi_j), the symmetric bilinear part of the
-// cubic internal force f(u) = K u + f2(u, u) + f3(u, u, u) of the nonlinear model (solids:
-// Green-Lagrange; beams: moderate rotation), by the exact polarization identity
-// 8 f2(a, b) = [f(a + b) - f(a - b)] - [f(b - a) - f(-a - b)] (the linear and cubic terms
-// cancel), evaluated at displacements scaled to 1e-6 of the part size (round-off ~1e-10).
-// No pairs when the part asks for none. The request refers to `nonlinear` and `model`.
-DerivativeRequest ModalDerivativeRequest(const PartSpec& part, const FeModel& model, NonlinearModelOf& nonlinear) {
-  DerivativeRequest request;
-  if (!part.reduction.modal_derivatives.enabled) return request;
-  const int n_b = 6 * int(model.interface_names.size());
-  request.pairs = DerivativePairs(part, n_b, n_b + part.reduction.internal_modes);
-  request.tolerance = part.reduction.modal_derivatives.tolerance;
-  nonlinear.Get();
-  const double size = (model.nodes.colwise().maxCoeff() - model.nodes.colwise().minCoeff()).norm();
-  request.stiffness_derivative = [&model, &nonlinear, size](const Eigen::MatrixXd& shapes,
-                                                            const std::vector<std::pair<int, int>>& pairs) {
-    const SparseMatrix& T = nonlinear.to_model_dofs();
-    const NonlinearModel& f = nonlinear.Get();
-    const Eigen::MatrixXd mesh_shapes = T * shapes;
-    Eigen::MatrixXd out(model.n_dofs(), long(pairs.size()));
-    for (size_t k = 0; k < pairs.size(); ++k) {
-      const Eigen::VectorXd a0 = mesh_shapes.col(pairs[k].first), b0 = mesh_shapes.col(pairs[k].second);
-      const double sa = 1e-6 * size / std::max(a0.cwiseAbs().maxCoeff(), 1e-300);
-      const double sb = 1e-6 * size / std::max(b0.cwiseAbs().maxCoeff(), 1e-300);
-      const Eigen::VectorXd a = sa * a0, b = sb * b0;
-      const Eigen::VectorXd f2 = ((f.Force(a + b) - f.Force(a - b)) - (f.Force(b - a) - f.Force(-a - b))) / 8;
-      out.col(long(k)) = T.transpose() * (2 * f2 / (sa * sb));
-    }
-    return out;
-  };
-  return request;
 }
 
 // Why femb's own solid elements cannot be put on an imported part's mesh (empty: they can):

@@ -131,6 +131,12 @@ double SvkSolidMesh::Energy(const Eigen::VectorXd& u) const {
 }
 
 Eigen::VectorXd SvkSolidMesh::Force(const Eigen::VectorXd& u) const {
+  Eigen::VectorXd f = OwnForce(u);
+  SumOverRanks(f, held_);
+  return f;
+}
+
+Eigen::VectorXd SvkSolidMesh::OwnForce(const Eigen::VectorXd& u) const {
   Eigen::VectorXd f = Eigen::VectorXd::Zero(n_dofs());
   NonlinearElementState e;
   ForEachPoint(u, [&](long c, const Eigen::MatrixXd& U, size_t first) {
@@ -138,7 +144,6 @@ Eigen::VectorXd SvkSolidMesh::Force(const Eigen::VectorXd& u) const {
     for (int q = 0; q < points_per_cell_; ++q) AddPoint(dNdX_[first + q], dV_[first + q], D_, U, &e, false);
     for (int a = 0; a < n_per_cell_; ++a) f.segment<3>(3 * long(cells_(c, a))) += e.force.segment<3>(3 * a);
   });
-  SumOverRanks(f, held_);
   return f;
 }
 

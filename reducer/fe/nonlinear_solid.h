@@ -106,6 +106,9 @@ class SvkSolidMesh : public NonlinearModel {
   long n_dofs() const override { return 3 * n_nodes_; }
   double Energy(const Eigen::VectorXd& u) const override;
   Eigen::VectorXd Force(const Eigen::VectorXd& u) const override;
+  /// The force of the cells held only, not summed over the ranks (on a rank's own cells: a vector
+  /// of its nodes). Force on one process.
+  Eigen::VectorXd OwnForce(const Eigen::VectorXd& u) const;
   SparseMatrix Tangent(const Eigen::VectorXd& u) const override;
   friend Eigen::MatrixXd CompletionProjection(const SvkSolidMesh& solid, const Eigen::MatrixXd& mesh_shapes,
                                               const Eigen::MatrixXd& fields, int first);

@@ -182,6 +182,11 @@ RankMesh RankMeshOf(const FeModel& model) {
   }
   std::sort(mesh.model_rows.begin(), mesh.model_rows.end());
   mesh.model_rows.erase(std::unique(mesh.model_rows.begin(), mesh.model_rows.end()), mesh.model_rows.end());
+  for (const int row : mesh.model_rows) {
+    size_t r = 0;
+    while (r + 1 < shares.size() && !(shares[r].Holds(row) && shares[r].count > 0)) ++r;
+    mesh.row_owner.push_back(int(r));
+  }
   for (Eigen::Triplet<double>& t : entries) {
     const long at = std::lower_bound(mesh.model_rows.begin(), mesh.model_rows.end(), t.col()) - mesh.model_rows.begin();
     t = Eigen::Triplet<double>(t.row(), int(at), t.value());

@@ -41,6 +41,7 @@ struct RankMesh {
   /// On MPI ranks: the model DOFs (ascending) its nodes' mesh DOFs need, and the rows of
   /// FeModel::mesh_map for those mesh DOFs on them.
   std::vector<int> model_rows;
+  std::vector<int> row_owner;  ///< the rank that holds each of model_rows
   SparseMatrix map;
   /// On MPI ranks: the rank each node's sums go to (AddOnOwners): the one holding the model DOF
   /// its first mesh DOF maps from (rank 0 for a node that maps from none).

@@ -55,6 +55,19 @@ void SumOverRanks(Eigen::Ref<Eigen::MatrixXd> X, const ColumnShare& share) {
   }
 }
 
+void MaxOverRanks(Eigen::Ref<Eigen::VectorXd> x) {
+  const Collectives& c = TheCollectives();
+  if (!c.gather) return;
+  std::string mine;
+  const Eigen::VectorXd copy = x;
+  AppendBytes(mine, copy.data(), size_t(copy.size()));
+  for (const std::string& bytes : c.gather(mine)) {
+    Eigen::VectorXd theirs(x.size());
+    TakeBytes(bytes.data(), theirs.data(), size_t(theirs.size()));
+    x = x.cwiseMax(theirs);
+  }
+}
+
 bool SameOnRanks(const std::string& mine) {
   const Collectives& c = TheCollectives();
   if (!c.gather) return true;

@@ -35,6 +35,9 @@ void RegisterRankCollectives(
 /// process, or a rank that works alone).
 void SumOverRanks(Eigen::Ref<Eigen::MatrixXd> X, const ColumnShare& share);
 
+/// The largest of every rank's x, entry by entry, in place (x on one process).
+void MaxOverRanks(Eigen::Ref<Eigen::VectorXd> x);
+
 /// Whether `mine` is the same on every rank (true on one process).
 bool SameOnRanks(const std::string& mine);
 

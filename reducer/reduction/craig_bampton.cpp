@@ -323,10 +323,11 @@ class ConstrainedSolver {
   const Eigen::LDLT<Eigen::MatrixXd> S_;
 };
 
-// This rank's interior rows of full-DOF fields f (n x k).
-Eigen::MatrixXd HeldInteriorRows(const InterfacePartition& p, const Eigen::MatrixXd& f) {
+// This rank's interior rows of full-DOF fields f (n x k), or of f's rows from model DOF
+// `first_row` on (this rank's rows of the model's DOFs).
+Eigen::MatrixXd HeldInteriorRows(const InterfacePartition& p, const Eigen::MatrixXd& f, long first_row = 0) {
   Eigen::MatrixXd out(p.held_rows(), f.cols());
-  for (long k = 0; k < out.rows(); ++k) out.row(k) = f.row(p.interior[size_t(p.held_first() + k)]);
+  for (long k = 0; k < out.rows(); ++k) out.row(k) = f.row(p.interior[size_t(p.held_first() + k)] - first_row);
   return out;
 }
 
@@ -412,9 +413,10 @@ Eigen::MatrixXd RowsTransposeTimes(const InterfacePartition& p, const Eigen::Mat
 // Modal derivatives: interior solves with the interfaces held, deflated against the modes and
 // the derivatives kept (M_ii inner product, twice), normalized; a derivative that deflation
 // leaves below the request's tolerance of its norm is dropped. The kept pairs into r. Phi_i and
-// the derivatives: this rank's rows; `shapes`: the whole Craig-Bampton shapes.
+// the derivatives: this rank's rows; `shapes`: this rank's rows of the Craig-Bampton shapes, those
+// of the model's DOFs from `first_row` on (all of them on one process).
 Eigen::MatrixXd ModalDerivatives(const InterfacePartition& p, const SparseMatrix& M_ii, const Eigen::MatrixXd& Phi_i,
-                                 const Eigen::MatrixXd& shapes, const DerivativeRequest& derivatives,
+                                 const Eigen::MatrixXd& shapes, long first_row, const DerivativeRequest& derivatives,
                                  const ConstrainedSolver& solver, CraigBamptonResult& r) {
   const int m = int(Phi_i.cols());
   const auto M_ii_times = [&](const Eigen::VectorXd& v) {
@@ -425,7 +427,8 @@ Eigen::MatrixXd ModalDerivatives(const InterfacePartition& p, const SparseMatrix
   for (size_t at = 0; at < pairs.size(); at += kDerivativePairsPerStep) {
     const size_t end = std::min(pairs.size(), at + kDerivativePairsPerStep);
     const std::vector<std::pair<int, int>> step(pairs.begin() + long(at), pairs.begin() + long(end));
-    z.middleCols(long(at), long(step.size())) = -HeldInteriorRows(p, derivatives.stiffness_derivative(shapes, step));
+    z.middleCols(long(at), long(step.size())) =
+        -HeldInteriorRows(p, derivatives.stiffness_derivative(shapes, step), first_row);
   }
   const Eigen::MatrixXd raw = solver.Solve(z);
   Eigen::MatrixXd Theta(p.held_rows(), raw.cols());
@@ -627,14 +630,12 @@ CraigBamptonResult Reduce(const FeModel& model, FeModel* release, int internal_m
   }
 
   clock.Restart();
-  const ColumnShare& rows = p.interior_share;
   Eigen::MatrixXd Theta(p.held_rows(), 0), inertia_u;
   if (derivatives && !derivatives->pairs.empty()) {
-    // (the element loops of dK/dq take the whole shapes: gathered for them)
     const Eigen::MatrixXd shapes =
-        ShapesOnRows(p, 0, model.n_dofs(), 0, GatherRows(Psi_b, rows), GatherRows(Psi_c, rows), GatherRows(Phi_i, rows),
-                     Eigen::MatrixXd(), 6 * int(model.interface_names.size()) + internal_modes);
-    Theta = ModalDerivatives(p, M.ii, Phi_i, shapes, *derivatives, solver, r);
+        ShapesOnRows(p, FirstModelRow(model), ModelRows(model), p.held_first(), Psi_b, Psi_c, Phi_i, Eigen::MatrixXd(),
+                     6 * int(model.interface_names.size()) + internal_modes);
+    Theta = ModalDerivatives(p, M.ii, Phi_i, shapes, FirstModelRow(model), *derivatives, solver, r);
     if (progress) {
       progress(
           "modal derivatives", clock.Seconds(),

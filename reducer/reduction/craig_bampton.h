@@ -31,7 +31,8 @@ struct DerivativeRequest {
   std::vector<std::pair<int, int>> pairs;  ///< indices into the Craig-Bampton coordinates
   double tolerance = 1e-4;
   /// (dK/dq_j) phi_i on the full model DOFs, one column per pair, given the Craig-Bampton
-  /// shapes (n_full x (6N + m)).
+  /// shapes (n_full x (6N + m)); on MPI ranks sharing the model by columns this rank's rows of
+  /// both (those of model.columns).
   std::function<Eigen::MatrixXd(const Eigen::MatrixXd& shapes, const std::vector<std::pair<int, int>>& pairs)>
       stiffness_derivative;
 };
