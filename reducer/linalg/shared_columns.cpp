@@ -232,10 +232,13 @@ Eigen::MatrixXd FetchRows(const Eigen::MatrixXd& mine, const ColumnShare& share,
   }
   const std::vector<ColumnShare> shares = RanksShares(share);
   const std::vector<std::pair<long, long>> asked = RanksEntries(wanted, shares);
-  // The rows asked of each rank, then its answer: the rows' values, column-major.
+  // Its own rows copied; the rows asked of each other rank, then its answer: the rows' values,
+  // column-major.
+  const size_t me = size_t(DistributedRank());
+  for (long i = asked[me].first; i < asked[me].second; ++i) out.row(i) = mine.row(wanted[size_t(i)] - share.first);
   std::vector<std::string> questions(shares.size());
   for (size_t r = 0; r < shares.size(); ++r)
-    AppendBytes(questions[r], wanted.data() + asked[r].first, size_t(asked[r].second - asked[r].first));
+    if (r != me) AppendBytes(questions[r], wanted.data() + asked[r].first, size_t(asked[r].second - asked[r].first));
   const std::vector<std::string> theirs = TheCollectives().exchange(questions);
   std::vector<std::string> answers(shares.size());
   for (size_t r = 0; r < shares.size(); ++r) {
@@ -248,7 +251,7 @@ Eigen::MatrixXd FetchRows(const Eigen::MatrixXd& mine, const ColumnShare& share,
   const std::vector<std::string> received = TheCollectives().exchange(answers);
   for (size_t r = 0; r < shares.size(); ++r) {
     const long rows = asked[r].second - asked[r].first;
-    if (rows == 0) continue;  // (Eigen's slice assignment of no rows can read before them)
+    if (rows == 0 || r == me) continue;  // (Eigen's slice assignment of no rows can read before them)
     Eigen::MatrixXd values(rows, k);
     TakeBytes(received[r].data(), values.data(), size_t(values.size()));
     out.middleRows(asked[r].first, rows) = values;
