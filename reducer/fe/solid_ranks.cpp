@@ -166,7 +166,17 @@ RankMesh RankMeshOf(const FeModel& model) {
   // The rows of mesh_map for the nodes' mesh DOFs (the columns of its transpose), on the model
   // DOFs they touch.
   const SparseMatrix Tt = model.mesh_map.transpose();
+  // The rank that holds a model DOF: the last with a share starting at or before it (the shares
+  // follow each other in rank order; an empty one holds nothing).
+  std::vector<long> firsts;
+  std::vector<int> ranks;
   const std::vector<ColumnShare> shares = RanksShares(model.columns);
+  for (size_t r = 0; r < shares.size(); ++r)
+    if (shares[r].count > 0) firsts.push_back(shares[r].first), ranks.push_back(int(r));
+  const auto rank_of = [&](long row) {
+    const long at = std::upper_bound(firsts.begin(), firsts.end(), row) - firsts.begin();
+    return at > 0 ? ranks[size_t(at - 1)] : 0;
+  };
   std::vector<Eigen::Triplet<double>> entries;
   mesh.owner.assign(mesh.node.size(), 0);
   for (size_t i = 0; i < mesh.node.size(); ++i) {
@@ -175,18 +185,11 @@ RankMesh RankMeshOf(const FeModel& model) {
         entries.emplace_back(int(3 * i) + c, int(it.row()), it.value());
         mesh.model_rows.push_back(int(it.row()));
       }
-    SparseMatrix::InnerIterator first(Tt, 3 * mesh.node[i]);
-    if (!first) continue;
-    for (size_t r = 0; r < shares.size(); ++r)
-      if (shares[r].Holds(first.row()) && shares[r].count > 0) mesh.owner[i] = int(r);
+    if (SparseMatrix::InnerIterator first(Tt, 3 * mesh.node[i]); first) mesh.owner[i] = rank_of(first.row());
   }
   std::sort(mesh.model_rows.begin(), mesh.model_rows.end());
   mesh.model_rows.erase(std::unique(mesh.model_rows.begin(), mesh.model_rows.end()), mesh.model_rows.end());
-  for (const int row : mesh.model_rows) {
-    size_t r = 0;
-    while (r + 1 < shares.size() && !(shares[r].Holds(row) && shares[r].count > 0)) ++r;
-    mesh.row_owner.push_back(int(r));
-  }
+  for (const int row : mesh.model_rows) mesh.row_owner.push_back(rank_of(row));
   for (Eigen::Triplet<double>& t : entries) {
     const long at = std::lower_bound(mesh.model_rows.begin(), mesh.model_rows.end(), t.col()) - mesh.model_rows.begin();
     t = Eigen::Triplet<double>(t.row(), int(at), t.value());
