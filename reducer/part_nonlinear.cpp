@@ -84,7 +84,9 @@ Eigen::MatrixXd SolidDerivativeLoads(const FeModel& model, NonlinearModelOf& non
   const RankMesh& mesh = nonlinear.Mesh();
   const SvkSolidMesh& f = nonlinear.OnRankMesh();
   const Eigen::MatrixXd mesh_shapes = RankMeshFields(model, mesh, shapes);
-  Eigen::VectorXd largest = mesh_shapes.cwiseAbs().colwise().maxCoeff().transpose();
+  // (a rank without cells has no entries: zeros, which the others' exceed)
+  Eigen::VectorXd largest = Eigen::VectorXd::Zero(mesh_shapes.cols());
+  if (mesh_shapes.rows() > 0) largest = mesh_shapes.cwiseAbs().colwise().maxCoeff().transpose();
   MaxOverRanks(largest);
   Eigen::MatrixXd forces(mesh_shapes.rows(), long(pairs.size()));
   const auto force = [&f](const Eigen::VectorXd& u) { return f.OwnForce(u); };
