@@ -196,27 +196,14 @@ Eigen::MatrixXd TimesRowsExchanged(const SparseMatrix& A, const Eigen::MatrixXd&
         }
       }
     }
+  // (the ghost rows to the ranks that hold them, added there)
   const std::vector<ColumnShare> shares = RanksShares(share);
   const std::vector<std::pair<long, long>> held = RanksEntries(ghosts, shares);
-  std::vector<std::string> to(shares.size());
-  for (size_t r = 0; r < shares.size(); ++r) {
-    const long rows = held[r].second - held[r].first, g0 = held[r].first;
-    if (rows == 0) continue;
-    AppendBytes(to[r], &rows, 1);
-    AppendBytes(to[r], ghosts.data() + g0, size_t(rows));
-    const Eigen::MatrixXd values = G.middleRows(g0, rows);
-    AppendBytes(to[r], values.data(), size_t(values.size()));
-  }
-  for (const std::string& bytes : TheCollectives().exchange(to)) {
-    if (bytes.empty()) continue;
-    long rows = 0;
-    const char* at = TakeBytes(bytes.data(), &rows, 1);
-    std::vector<int> which(static_cast<size_t>(rows));
-    at = TakeBytes(at, which.data(), which.size());
-    Eigen::MatrixXd values(rows, k);
-    TakeBytes(at, values.data(), size_t(values.size()));
-    for (long i = 0; i < rows; ++i) out.row(which[size_t(i)] - first) += values.row(i);
-  }
+  std::vector<int> owner(ghosts.size());
+  for (size_t r = 0; r < held.size(); ++r)
+    std::fill(owner.begin() + held[r].first, owner.begin() + held[r].second, int(r));
+  AddOnOwners(ghosts, G, 1, owner);
+  for (size_t i = 0; i < ghosts.size(); ++i) out.row(ghosts[i] - first) += G.row(long(i));
   return out;
 }
 
@@ -389,26 +376,16 @@ Eigen::MatrixXf GatherBlocksOnFirst(const std::vector<int>& keys, const Eigen::M
   const bool first = DistributedRank() == 0;
   const long k = rows.cols(), step = ColumnsPerStep(per_key * n);
   Eigen::MatrixXf whole = first ? Eigen::MatrixXf::Zero(per_key * n, k) : Eigen::MatrixXf(0, k);
-  std::vector<std::string> to(static_cast<size_t>(DistributedRanks()));
+  const std::vector<int> to_first(keys.size(), 0);
   for (long c0 = 0; c0 < k; c0 += step) {
-    const long w = std::min(step, k - c0), count = long(keys.size());
-    to[0].clear();
-    AppendBytes(to[0], &count, 1);
-    AppendBytes(to[0], keys.data(), keys.size());
-    const Eigen::MatrixXd columns = rows.middleCols(c0, w);
-    AppendBytes(to[0], columns.data(), size_t(columns.size()));
-    for (const std::string& bytes : TheCollectives().exchange(to)) {
-      long their_count = 0;
-      const char* at = bytes.empty() ? nullptr : TakeBytes(bytes.data(), &their_count, 1);
-      if (their_count == 0) continue;
-      std::vector<int> their_keys(static_cast<size_t>(their_count));
-      at = TakeBytes(at, their_keys.data(), their_keys.size());
-      Eigen::MatrixXd values(per_key * their_count, w);
-      TakeBytes(at, values.data(), size_t(values.size()));
-      for (size_t j = 0; j < their_keys.size(); ++j)
-        whole.block(per_key * long(their_keys[j]), c0, per_key, w) =
-            values.middleRows(per_key * long(j), per_key).cast<float>();
-    }
+    // (every block owned by rank 0: each key is on one rank, so its sum is its block)
+    const long w = std::min(step, k - c0);
+    std::vector<int> gathered = keys;
+    Eigen::MatrixXd blocks = rows.middleCols(c0, w);
+    AddOnOwners(gathered, blocks, per_key, to_first);
+    for (size_t j = 0; j < gathered.size(); ++j)
+      whole.block(per_key * long(gathered[j]), c0, per_key, w) =
+          blocks.middleRows(per_key * long(j), per_key).cast<float>();
   }
   return whole;
 }
